@@ -1,0 +1,328 @@
+//! The discrete collocation system of the 3-stage Lobatto IIIa scheme (bvp4c / `solve_bvp`).
+//!
+//! On interval `i` with `h_i = x_{i+1} - x_i` the residual is
+//!
+//! ```text
+//! r_i = y_{i+1} - y_i - h_i/6 (f_i + 4 f_{i+1/2} + f_{i+1}),
+//! y_{i+1/2} = (y_i + y_{i+1})/2 - h_i/8 (f_{i+1} - f_i),   f_{i+1/2} = f(x_i + h_i/2, y_{i+1/2}, p).
+//! ```
+//!
+//! The unknowns are `Y = (y_0, …, y_{m-1}, p_unknown)`; the equations are the `(m-1) n`
+//! collocation residuals followed by the `n + k` boundary residuals. Jacobian blocks come from
+//! exact dual-number Jacobians of `f` at the nodes and midpoints and of `g`, combined by the chain
+//! rule (Ascher, Mattheij & Russell; Kierzenka & Shampine 2001).
+
+use crate::dual_jacobian::{BcFn, DualJacobian, RhsFn};
+use crate::error::BvpError;
+use crate::problem::Bvp;
+
+/// Values, residuals and Jacobians of the collocation system on one mesh.
+pub(crate) struct Collocation {
+    /// Number of states.
+    pub n: usize,
+    /// Number of unknown parameters.
+    pub k: usize,
+    /// Number of fixed model parameters.
+    pub q: usize,
+    /// Mesh.
+    pub x: Vec<f64>,
+    /// Interval lengths.
+    pub h: Vec<f64>,
+    /// `f` at the nodes, `m × n` row-major.
+    pub f: Vec<f64>,
+    /// Midpoint states, `(m-1) × n`.
+    pub y_mid: Vec<f64>,
+    /// `f` at the midpoints, `(m-1) × n`.
+    pub f_mid: Vec<f64>,
+    /// Residual vector: `(m-1) n` collocation residuals, then `n + k` boundary residuals.
+    pub res: Vec<f64>,
+    /// Width of the stored Jacobians' parameter part (`k` for Newton, `k + q` for sensitivities).
+    pub seeded_params: usize,
+    /// Node Jacobians `∂f/∂(y, p[..seeded])`, `m × n × (n + seeded)`.
+    pub jn: Vec<f64>,
+    /// Midpoint Jacobians, `(m-1) × n × (n + seeded)`.
+    pub jm: Vec<f64>,
+    /// Boundary Jacobian `∂g/∂(ya, yb, p[..seeded])`, `(n+k) × (2n + seeded)`.
+    pub jbc: Vec<f64>,
+    /// Right-hand-side evaluations in `f64` (one per point).
+    pub rhs_evals: usize,
+    /// Right-hand-side evaluations with dual numbers (one per point and pass).
+    pub jac_evals: usize,
+    input: Vec<f64>,
+    fbuf: Vec<f64>,
+    engine: DualJacobian,
+}
+
+impl Collocation {
+    pub(crate) fn new(n: usize, k: usize, q: usize) -> Self {
+        Collocation {
+            n,
+            k,
+            q,
+            x: Vec::new(),
+            h: Vec::new(),
+            f: Vec::new(),
+            y_mid: Vec::new(),
+            f_mid: Vec::new(),
+            res: Vec::new(),
+            seeded_params: 0,
+            jn: Vec::new(),
+            jm: Vec::new(),
+            jbc: Vec::new(),
+            rhs_evals: 0,
+            jac_evals: 0,
+            input: Vec::new(),
+            fbuf: Vec::new(),
+            engine: DualJacobian::default(),
+        }
+    }
+
+    /// Number of mesh nodes.
+    pub(crate) fn m(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Installs a new mesh and sizes the buffers (allocation happens here, once per mesh).
+    pub(crate) fn set_mesh(&mut self, x: &[f64]) {
+        let (n, m) = (self.n, x.len());
+        self.x.clear();
+        self.x.extend_from_slice(x);
+        self.h.clear();
+        self.h.extend(x.windows(2).map(|w| w[1] - w[0]));
+        self.f.resize(m * n, 0.0);
+        self.y_mid.resize((m - 1) * n, 0.0);
+        self.f_mid.resize((m - 1) * n, 0.0);
+        self.res.resize((m - 1) * n + n + self.k, 0.0);
+    }
+
+    /// Evaluates `f` at the nodes and midpoints and the full residual vector.
+    pub(crate) fn residual<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+    ) -> Result<(), BvpError> {
+        let (n, m) = (self.n, self.m());
+        for i in 0..m {
+            problem.rhs(
+                self.x[i],
+                &y[i * n..(i + 1) * n],
+                p,
+                &mut self.f[i * n..(i + 1) * n],
+            );
+        }
+        self.rhs_evals += m;
+        check_finite(&self.f, n, 1, |i| self.x[i], "right-hand side")?;
+        for i in 0..m - 1 {
+            let h = self.h[i];
+            for c in 0..n {
+                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
+                let (fi, fj) = (self.f[i * n + c], self.f[(i + 1) * n + c]);
+                self.y_mid[i * n + c] = 0.5 * (yi + yj) - 0.125 * h * (fj - fi);
+            }
+            problem.rhs(
+                self.x[i] + 0.5 * h,
+                &self.y_mid[i * n..(i + 1) * n],
+                p,
+                &mut self.f_mid[i * n..(i + 1) * n],
+            );
+        }
+        self.rhs_evals += m - 1;
+        check_finite(
+            &self.f_mid,
+            n,
+            1,
+            |i| self.x[i] + 0.5 * self.h[i],
+            "right-hand side",
+        )?;
+        for i in 0..m - 1 {
+            let h = self.h[i];
+            for c in 0..n {
+                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
+                let (fi, fj) = (self.f[i * n + c], self.f[(i + 1) * n + c]);
+                self.res[i * n + c] = yj - yi - h / 6.0 * (fi + 4.0 * self.f_mid[i * n + c] + fj);
+            }
+        }
+        let off = (m - 1) * n;
+        let (res_col, res_bc) = self.res.split_at_mut(off);
+        let _ = res_col;
+        problem.bc(&y[..n], &y[(m - 1) * n..], p, res_bc);
+        for (c, v) in res_bc.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(BvpError::NonFinite {
+                    what: "boundary residual",
+                    component: c,
+                    x: self.x[0],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Evaluates the node, midpoint and boundary Jacobians with respect to `y` and the first
+    /// `seeded` parameters. Requires a preceding [`residual`](Self::residual) at the same `y`
+    /// (the midpoint states are reused).
+    pub(crate) fn jacobians<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        seeded: usize,
+    ) -> Result<(), BvpError> {
+        let (n, m) = (self.n, self.m());
+        let w = n + seeded;
+        self.seeded_params = seeded;
+        self.jn.resize(m * n * w, 0.0);
+        self.jm.resize((m - 1) * n * w, 0.0);
+        let nb = n + self.k;
+        self.jbc.resize(nb * (2 * n + seeded), 0.0);
+        let mut fbuf = std::mem::take(&mut self.fbuf);
+        fbuf.resize(n.max(nb), 0.0);
+        for i in 0..m {
+            self.input.clear();
+            self.input.extend_from_slice(&y[i * n..(i + 1) * n]);
+            self.input.extend_from_slice(p);
+            let rf = RhsFn {
+                problem,
+                x: self.x[i],
+                n,
+            };
+            self.engine.jacobian(
+                &rf,
+                &self.input,
+                w,
+                &mut fbuf[..n],
+                &mut self.jn[i * n * w..(i + 1) * n * w],
+            );
+        }
+        for i in 0..m - 1 {
+            self.input.clear();
+            self.input
+                .extend_from_slice(&self.y_mid[i * n..(i + 1) * n]);
+            self.input.extend_from_slice(p);
+            let rf = RhsFn {
+                problem,
+                x: self.x[i] + 0.5 * self.h[i],
+                n,
+            };
+            self.engine.jacobian(
+                &rf,
+                &self.input,
+                w,
+                &mut fbuf[..n],
+                &mut self.jm[i * n * w..(i + 1) * n * w],
+            );
+        }
+        self.jac_evals += (2 * m - 1) * w.div_ceil(8).max(1);
+        check_finite(&self.jn, n * w, w, |i| self.x[i], "Jacobian")?;
+        check_finite(
+            &self.jm,
+            n * w,
+            w,
+            |i| self.x[i] + 0.5 * self.h[i],
+            "Jacobian",
+        )?;
+        self.input.clear();
+        self.input.extend_from_slice(&y[..n]);
+        self.input.extend_from_slice(&y[(m - 1) * n..]);
+        self.input.extend_from_slice(p);
+        let bf = BcFn { problem, n };
+        self.engine.jacobian(
+            &bf,
+            &self.input,
+            2 * n + seeded,
+            &mut fbuf[..nb],
+            &mut self.jbc,
+        );
+        self.fbuf = fbuf;
+        for (c, v) in self.jbc.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(BvpError::NonFinite {
+                    what: "boundary-condition Jacobian",
+                    component: c / (2 * n + seeded),
+                    x: self.x[0],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The `n × n` blocks `A_i = ∂r_i/∂y_i` and `B_i = ∂r_i/∂y_{i+1}` (row-major).
+    pub(crate) fn interval_blocks(&self, i: usize, a: &mut [f64], b: &mut [f64]) {
+        let n = self.n;
+        let w = n + self.seeded_params;
+        let h = self.h[i];
+        let ji = &self.jn[i * n * w..(i + 1) * n * w];
+        let jj = &self.jn[(i + 1) * n * w..(i + 2) * n * w];
+        let jm = &self.jm[i * n * w..(i + 1) * n * w];
+        // A = -I - h/6 (J_i + 4 Jm (I/2 + h/8 J_i)),  B = I - h/6 (J_j + 4 Jm (I/2 - h/8 J_j))
+        for r in 0..n {
+            for c in 0..n {
+                let mut sa = 0.0;
+                let mut sb = 0.0;
+                for l in 0..n {
+                    let jml = jm[r * w + l];
+                    sa += jml * ji[l * w + c];
+                    sb += jml * jj[l * w + c];
+                }
+                let d = if r == c { 1.0 } else { 0.0 };
+                let m_a = 2.0 * jm[r * w + c] + 0.5 * h * sa;
+                let m_b = 2.0 * jm[r * w + c] - 0.5 * h * sb;
+                a[r * n + c] = -d - h / 6.0 * (ji[r * w + c] + m_a);
+                b[r * n + c] = d - h / 6.0 * (jj[r * w + c] + m_b);
+            }
+        }
+    }
+
+    /// Column `col` (index into `p`, `< seeded_params`) of `∂r/∂p`: writes the collocation part
+    /// (`(m-1) n` rows) and the boundary part (`n + k` rows) into `out` (length `m n + k`).
+    pub(crate) fn param_column(&self, col: usize, out: &mut [f64]) {
+        let (n, m) = (self.n, self.m());
+        let w = n + self.seeded_params;
+        let pc = n + col;
+        for i in 0..m - 1 {
+            let h = self.h[i];
+            let ji = &self.jn[i * n * w..(i + 1) * n * w];
+            let jj = &self.jn[(i + 1) * n * w..(i + 2) * n * w];
+            let jm = &self.jm[i * n * w..(i + 1) * n * w];
+            for r in 0..n {
+                // d y_mid / dp = -h/8 (fp_j - fp_i)
+                let mut s = 0.0;
+                for l in 0..n {
+                    s += jm[r * w + l] * (-0.125 * h) * (jj[l * w + pc] - ji[l * w + pc]);
+                }
+                out[i * n + r] =
+                    -h / 6.0 * (ji[r * w + pc] + 4.0 * (jm[r * w + pc] + s) + jj[r * w + pc]);
+            }
+        }
+        let wb = 2 * n + self.seeded_params;
+        let off = (m - 1) * n;
+        for r in 0..n + self.k {
+            out[off + r] = self.jbc[r * wb + 2 * n + col];
+        }
+    }
+
+    /// Boundary Jacobian entry `∂g_r/∂ya_c` (`end = 0`) or `∂g_r/∂yb_c` (`end = 1`).
+    #[inline]
+    pub(crate) fn bc_state(&self, r: usize, end: usize, c: usize) -> f64 {
+        let wb = 2 * self.n + self.seeded_params;
+        self.jbc[r * wb + end * self.n + c]
+    }
+}
+
+fn check_finite(
+    v: &[f64],
+    stride: usize,
+    row_width: usize,
+    pos: impl Fn(usize) -> f64,
+    what: &'static str,
+) -> Result<(), BvpError> {
+    if let Some(idx) = v.iter().position(|x| !x.is_finite()) {
+        return Err(BvpError::NonFinite {
+            what,
+            component: (idx % stride) / row_width,
+            x: pos(idx / stride),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,96 @@
+//! Why a solve failed, with the numbers that show it.
+
+use thiserror::Error;
+
+/// A failed solve. Every variant names the reason and the figures reached; nothing panics.
+#[derive(Debug, Clone, Error)]
+pub enum BvpError {
+    /// The input (mesh, guess, parameters or options) is invalid.
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+
+    /// Refinement would need more nodes than allowed.
+    #[error(
+        "maximum number of mesh nodes exceeded: {nodes} nodes needed more than max_nodes = {max_nodes}; \
+         the largest scaled RMS residual reached was {max_residual:.3e} (tol {tol:.1e})"
+    )]
+    MaxNodesExceeded {
+        /// Nodes the next mesh would have had.
+        nodes: usize,
+        /// The limit.
+        max_nodes: usize,
+        /// Largest RMS collocation residual on the last mesh.
+        max_residual: f64,
+        /// Requested tolerance.
+        tol: f64,
+    },
+
+    /// The Newton matrix is singular.
+    #[error("singular Jacobian: {detail}")]
+    SingularJacobian {
+        /// Where the singularity shows (components, positions, parameters).
+        detail: String,
+    },
+
+    /// Newton's method did not converge on a mesh.
+    #[error(
+        "Newton's method did not converge after {iterations} iterations on a mesh of {nodes} nodes: \
+         {reason} (largest scaled collocation residual {max_residual:.3e}, largest boundary residual {max_bc_residual:.3e})"
+    )]
+    NewtonFailed {
+        /// Newton iterations done.
+        iterations: usize,
+        /// Mesh size.
+        nodes: usize,
+        /// What went wrong.
+        reason: String,
+        /// Largest scaled collocation residual at the last iterate.
+        max_residual: f64,
+        /// Largest boundary-condition residual at the last iterate.
+        max_bc_residual: f64,
+    },
+
+    /// The mesh loop ended without meeting the tolerances.
+    #[error(
+        "tolerance not met after {iterations} mesh iterations: largest RMS residual {max_residual:.3e} (tol {tol:.1e}), \
+         largest boundary residual {max_bc_residual:.3e} (bc_tol {bc_tol:.1e})"
+    )]
+    ToleranceNotMet {
+        /// Mesh iterations done.
+        iterations: usize,
+        /// Largest RMS collocation residual.
+        max_residual: f64,
+        /// Requested tolerance.
+        tol: f64,
+        /// Largest boundary residual.
+        max_bc_residual: f64,
+        /// Requested boundary tolerance.
+        bc_tol: f64,
+    },
+
+    /// The right-hand side or the boundary residual returned a non-finite value.
+    #[error("non-finite value in {what}: component {component} at x = {x:e}")]
+    NonFinite {
+        /// `"right-hand side"`, `"boundary residual"`, `"Jacobian"`, `"initial guess"`, ...
+        what: &'static str,
+        /// Offending component index.
+        component: usize,
+        /// Position (for boundary residuals: the left end point `a`).
+        x: f64,
+    },
+
+    /// A path-following method (continuation) could not proceed.
+    #[error("continuation stopped at c = {reached} (target {target}): step {step:.3e} below the minimum {min_step:.1e}; last failure: {last_error}")]
+    ContinuationStalled {
+        /// Continuation parameter value reached.
+        reached: f64,
+        /// Target value.
+        target: f64,
+        /// Step size when it gave up.
+        step: f64,
+        /// Minimum step size.
+        min_step: f64,
+        /// The last solver failure.
+        last_error: Box<BvpError>,
+    },
+}

@@ -1,0 +1,228 @@
+//! The global Newton matrix: its sparsity pattern (built once per mesh from index arithmetic),
+//! assembly from the collocation blocks, and faer's sparse LU with the symbolic analysis done
+//! once per pattern and reused for every numeric factorisation.
+//!
+//! Rows: `(m-1) n` collocation rows (interval by interval), then `n + k` boundary rows.
+//! Columns: `m n` state columns (node by node), then `k` dense unknown-parameter columns.
+//! Collocation rows of interval `i` touch the state blocks of nodes `i` and `i+1`; boundary rows
+//! touch nodes `0` and `m-1`.
+
+use crate::collocation::Collocation;
+use crate::error::BvpError;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, MatMut, Par};
+use std::sync::Arc;
+
+/// Sparsity pattern and symbolic LU of the collocation Jacobian for one `(n, k, m)`.
+pub(crate) struct Pattern {
+    pub n: usize,
+    pub k: usize,
+    pub m: usize,
+    pub symbolic: SymbolicSparseColMat<usize>,
+    pub lu_symbolic: SymbolicLu<usize>,
+}
+
+impl Pattern {
+    pub(crate) fn new(n: usize, k: usize, m: usize) -> Result<Self, BvpError> {
+        let size = m * n + k;
+        let nb = n + k;
+        let mut col_ptr = Vec::with_capacity(size + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0usize);
+        for i in 0..m {
+            for _c in 0..n {
+                if i >= 1 {
+                    row_idx.extend((i - 1) * n..i * n);
+                }
+                if i + 1 < m {
+                    row_idx.extend(i * n..(i + 1) * n);
+                }
+                if i == 0 || i == m - 1 {
+                    row_idx.extend((m - 1) * n..(m - 1) * n + nb);
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        for _l in 0..k {
+            row_idx.extend(0..size);
+            col_ptr.push(row_idx.len());
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(size, size, col_ptr, None, row_idx);
+        let lu_symbolic = factorize_symbolic_lu(symbolic.as_ref(), Default::default())
+            .map_err(|e| BvpError::InvalidInput(format!("sparse symbolic LU failed: {e:?}")))?;
+        Ok(Pattern {
+            n,
+            k,
+            m,
+            symbolic,
+            lu_symbolic,
+        })
+    }
+
+    /// Number of stored entries.
+    pub(crate) fn nnz(&self) -> usize {
+        self.symbolic.row_idx().len()
+    }
+
+    /// Writes the Jacobian of the collocation system into `values` (in the pattern's order).
+    pub(crate) fn assemble(&self, col: &Collocation, values: &mut Vec<f64>, work: &mut Vec<f64>) {
+        let (n, k, m) = (self.n, self.k, self.m);
+        let size = m * n + k;
+        values.resize(self.nnz(), 0.0);
+        let cp = self.symbolic.col_ptr();
+        work.resize(2 * n * n + size, 0.0);
+        let (a, rest) = work.split_at_mut(n * n);
+        let (b, pcol) = rest.split_at_mut(n * n);
+        for i in 0..m - 1 {
+            col.interval_blocks(i, a, b);
+            let a_off = if i >= 1 { n } else { 0 };
+            for c in 0..n {
+                let base_a = cp[i * n + c] + a_off;
+                let base_b = cp[(i + 1) * n + c];
+                for r in 0..n {
+                    values[base_a + r] = a[r * n + c];
+                    values[base_b + r] = b[r * n + c];
+                }
+            }
+        }
+        for c in 0..n {
+            let base0 = cp[c] + n;
+            let base1 = cp[(m - 1) * n + c] + n;
+            for r in 0..n + k {
+                values[base0 + r] = col.bc_state(r, 0, c);
+                values[base1 + r] = col.bc_state(r, 1, c);
+            }
+        }
+        for l in 0..k {
+            col.param_column(l, &mut pcol[..size]);
+            let base = cp[m * n + l];
+            values[base..base + size].copy_from_slice(&pcol[..size]);
+        }
+    }
+}
+
+/// A numeric LU factorisation of the collocation Jacobian, with everything needed to solve with
+/// it or its transpose again later (sensitivities, adjoints).
+#[derive(Clone)]
+pub struct Factorization {
+    pattern: Arc<Pattern>,
+    numeric: NumericLu<usize, f64>,
+}
+
+impl std::fmt::Debug for Factorization {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Factorization {{ size: {}, nnz: {} }}",
+            self.size(),
+            self.pattern.nnz()
+        )
+    }
+}
+
+impl Factorization {
+    /// Dimension of the factored system.
+    pub fn size(&self) -> usize {
+        self.pattern.m * self.pattern.n + self.pattern.k
+    }
+
+    /// Solves `J x = b` in place for the columns of `b` (column-major, `size × ncols`).
+    pub fn solve_in_place(&self, b: &mut [f64], ncols: usize) {
+        self.solve_impl(b, ncols, false)
+    }
+
+    /// Solves `Jᵀ x = b` in place (adjoints).
+    pub fn solve_transpose_in_place(&self, b: &mut [f64], ncols: usize) {
+        self.solve_impl(b, ncols, true)
+    }
+
+    fn solve_impl(&self, b: &mut [f64], ncols: usize, transpose: bool) {
+        let size = self.size();
+        assert_eq!(b.len(), size * ncols, "right-hand side has the wrong size");
+        let sym = &self.pattern.lu_symbolic;
+        let mut buf = MemBuffer::new(sym.solve_in_place_scratch::<f64>(ncols, Par::Seq));
+        let stack = MemStack::new(&mut buf);
+        let lu = LuRef::new_unchecked(sym, &self.numeric);
+        let rhs = MatMut::from_column_major_slice_mut(b, size, ncols);
+        if transpose {
+            lu.solve_transpose_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        } else {
+            lu.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        }
+    }
+}
+
+/// Newton-matrix workspace for one mesh: values, numeric LU and scratch, reused across
+/// iterations.
+pub(crate) struct LinearSystem {
+    pub pattern: Arc<Pattern>,
+    values: Vec<f64>,
+    work: Vec<f64>,
+    numeric: NumericLu<usize, f64>,
+    factor_buf: MemBuffer,
+    solve_buf: MemBuffer,
+    /// Number of numeric factorisations done.
+    pub factorizations: usize,
+}
+
+impl LinearSystem {
+    pub(crate) fn new(pattern: Arc<Pattern>) -> Self {
+        let factor_buf = MemBuffer::new(
+            pattern
+                .lu_symbolic
+                .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+        );
+        let solve_buf = MemBuffer::new(
+            pattern
+                .lu_symbolic
+                .solve_in_place_scratch::<f64>(1, Par::Seq),
+        );
+        LinearSystem {
+            pattern,
+            values: Vec::new(),
+            work: Vec::new(),
+            numeric: NumericLu::new(),
+            factor_buf,
+            solve_buf,
+            factorizations: 0,
+        }
+    }
+
+    /// Assembles and factors the Jacobian held in `col`.
+    pub(crate) fn factor(&mut self, col: &Collocation) -> Result<(), BvpError> {
+        self.pattern.assemble(col, &mut self.values, &mut self.work);
+        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.values);
+        let stack = MemStack::new(&mut self.factor_buf);
+        self.factorizations += 1;
+        self.pattern
+            .lu_symbolic
+            .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Default::default())
+            .map(|_| ())
+            .map_err(|e| BvpError::SingularJacobian {
+                detail: format!("sparse LU found no pivot ({e:?})"),
+            })
+    }
+
+    /// Solves `J x = b` in place with the current factorisation.
+    pub(crate) fn solve(&mut self, b: &mut [f64]) {
+        let size = b.len();
+        let stack = MemStack::new(&mut self.solve_buf);
+        let lu = LuRef::new_unchecked(&self.pattern.lu_symbolic, &self.numeric);
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(b, size, 1),
+            Par::Seq,
+            stack,
+        );
+    }
+
+    /// A copy of the current factorisation for later solves.
+    pub(crate) fn snapshot(&self) -> Factorization {
+        Factorization {
+            pattern: self.pattern.clone(),
+            numeric: self.numeric.clone(),
+        }
+    }
+}

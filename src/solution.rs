@@ -1,0 +1,215 @@
+//! The solution object: mesh, values, derivatives, unknown parameters, the C1 piecewise-cubic
+//! interpolant, per-interval residuals and statistics.
+
+use crate::linear::Factorization;
+
+/// Counters of one solve.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SolveStats {
+    /// Newton iterations (all meshes).
+    pub newton_iterations: usize,
+    /// Numeric factorisations of the Newton matrix.
+    pub jacobian_factorizations: usize,
+    /// Right-hand-side evaluations with `f64` (one per point).
+    pub rhs_evaluations: usize,
+    /// Right-hand-side evaluations with dual numbers (one per point and dual pass).
+    pub rhs_dual_evaluations: usize,
+    /// Mesh modifications (refinements and coarsenings).
+    pub mesh_refinements: usize,
+    /// Of those, coarsenings.
+    pub mesh_coarsenings: usize,
+    /// Largest scaled RMS collocation residual on the final mesh.
+    pub max_residual: f64,
+    /// Largest absolute boundary-condition residual.
+    pub max_bc_residual: f64,
+}
+
+impl SolveStats {
+    /// All right-hand-side evaluations, values and dual passes counted alike (the cost measure of
+    /// the continuation step control).
+    pub fn total_rhs_evaluations(&self) -> usize {
+        self.rhs_evaluations + self.rhs_dual_evaluations
+    }
+}
+
+/// A converged solution of a [`Bvp`](crate::Bvp).
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// Number of states.
+    pub n: usize,
+    /// Mesh nodes.
+    pub x: Vec<f64>,
+    /// States at the nodes, `m × n` row-major: `y[i * n + c]`.
+    pub y: Vec<f64>,
+    /// Derivatives `f(x_i, y_i, p)` at the nodes, same layout.
+    pub yp: Vec<f64>,
+    /// The unknown parameters found (length `k`).
+    pub unknowns: Vec<f64>,
+    /// The fixed model parameters the solution was computed with.
+    pub params: Vec<f64>,
+    /// Scaled RMS collocation residual per interval (length `m - 1`).
+    pub rms_residuals: Vec<f64>,
+    /// Residual scale per component used by error control (`s_c` in `r_c / (s_c + |f_c|)`).
+    pub residual_scale: Vec<f64>,
+    /// Statistics.
+    pub stats: SolveStats,
+    pub(crate) factorization: Option<Factorization>,
+}
+
+impl Solution {
+    /// Number of mesh nodes.
+    pub fn nodes(&self) -> usize {
+        self.x.len()
+    }
+
+    /// All parameters `p = (unknowns, model parameters)` as the problem sees them.
+    pub fn full_params(&self) -> Vec<f64> {
+        let mut p = self.unknowns.clone();
+        p.extend_from_slice(&self.params);
+        p
+    }
+
+    /// State `c` at node `i`.
+    pub fn at_node(&self, i: usize, c: usize) -> f64 {
+        self.y[i * self.n + c]
+    }
+
+    /// Values of component `c` at all nodes.
+    pub fn component(&self, c: usize) -> Vec<f64> {
+        (0..self.nodes()).map(|i| self.y[i * self.n + c]).collect()
+    }
+
+    /// Index of the interval containing `x` (clamped to the mesh).
+    pub fn interval(&self, x: f64) -> usize {
+        interval_of(&self.x, x)
+    }
+
+    /// The C1 interpolant and its derivative at `x`, written into `y` and `yp` (length `n`).
+    /// Outside `[a, b]` the end cubic is extrapolated.
+    pub fn eval_into(&self, x: f64, y: &mut [f64], yp: &mut [f64]) {
+        let i = self.interval(x);
+        hermite(&self.x, &self.y, &self.yp, self.n, i, x, y, yp);
+    }
+
+    /// The interpolated state at `x`.
+    pub fn eval(&self, x: f64) -> Vec<f64> {
+        let mut y = vec![0.0; self.n];
+        let mut yp = vec![0.0; self.n];
+        self.eval_into(x, &mut y, &mut yp);
+        y
+    }
+
+    /// The derivative of the interpolant at `x`.
+    pub fn eval_derivative(&self, x: f64) -> Vec<f64> {
+        let mut y = vec![0.0; self.n];
+        let mut yp = vec![0.0; self.n];
+        self.eval_into(x, &mut y, &mut yp);
+        yp
+    }
+
+    /// The factorisation of the collocation Jacobian at this solution, if it was kept
+    /// ([`SolveOptions::factor_at_solution`](crate::SolveOptions::factor_at_solution)).
+    pub fn factorization(&self) -> Option<&Factorization> {
+        self.factorization.as_ref()
+    }
+}
+
+pub(crate) fn interval_of(x: &[f64], v: f64) -> usize {
+    let m = x.len();
+    if v <= x[0] {
+        return 0;
+    }
+    if v >= x[m - 1] {
+        return m - 2;
+    }
+    // first index with x[idx] > v, minus one
+    let idx = x.partition_point(|&xi| xi <= v);
+    (idx - 1).min(m - 2)
+}
+
+/// Hermite basis weights at `t ∈ [0, 1]` on an interval of length `h`:
+/// `(w_yi, w_fi, w_yj, w_fj)` for the value and `(d_yi, d_fi, d_yj, d_fj)` for the derivative.
+#[inline]
+pub(crate) fn hermite_weights(t: f64, h: f64) -> ([f64; 4], [f64; 4]) {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    let v = [
+        2.0 * t3 - 3.0 * t2 + 1.0,
+        h * (t3 - 2.0 * t2 + t),
+        -2.0 * t3 + 3.0 * t2,
+        h * (t3 - t2),
+    ];
+    let d = [
+        (6.0 * t2 - 6.0 * t) / h,
+        3.0 * t2 - 4.0 * t + 1.0,
+        (-6.0 * t2 + 6.0 * t) / h,
+        3.0 * t2 - 2.0 * t,
+    ];
+    (v, d)
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn hermite(
+    xs: &[f64],
+    ys: &[f64],
+    fs: &[f64],
+    n: usize,
+    i: usize,
+    x: f64,
+    y: &mut [f64],
+    yp: &mut [f64],
+) {
+    let h = xs[i + 1] - xs[i];
+    let t = (x - xs[i]) / h;
+    let (v, d) = hermite_weights(t, h);
+    for c in 0..n {
+        let (yi, yj) = (ys[i * n + c], ys[(i + 1) * n + c]);
+        let (fi, fj) = (fs[i * n + c], fs[(i + 1) * n + c]);
+        y[c] = v[0] * yi + v[1] * fi + v[2] * yj + v[3] * fj;
+        yp[c] = d[0] * yi + d[1] * fi + d[2] * yj + d[3] * fj;
+    }
+}
+
+/// Interpolates node values `ys` (with slopes `fs`) on mesh `xs` onto `new_x`.
+pub(crate) fn resample(xs: &[f64], ys: &[f64], fs: &[f64], n: usize, new_x: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; new_x.len() * n];
+    let mut yp = vec![0.0; n];
+    for (j, &x) in new_x.iter().enumerate() {
+        let i = interval_of(xs, x);
+        hermite(xs, ys, fs, n, i, x, &mut out[j * n..(j + 1) * n], &mut yp);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hermite_reproduces_cubics_and_derivatives() {
+        let xs = [0.0, 0.3, 1.0];
+        let p = |x: f64| 1.0 + 2.0 * x - x * x + 0.5 * x * x * x;
+        let dp = |x: f64| 2.0 - 2.0 * x + 1.5 * x * x;
+        let ys: Vec<f64> = xs.iter().map(|&x| p(x)).collect();
+        let fs: Vec<f64> = xs.iter().map(|&x| dp(x)).collect();
+        let mut y = [0.0];
+        let mut yp = [0.0];
+        for &x in &[0.0, 0.1, 0.3, 0.77, 1.0] {
+            hermite(&xs, &ys, &fs, 1, interval_of(&xs, x), x, &mut y, &mut yp);
+            assert!((y[0] - p(x)).abs() < 1e-14);
+            assert!((yp[0] - dp(x)).abs() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn interval_lookup_is_clamped() {
+        let xs = [0.0, 1.0, 2.0, 3.0];
+        assert_eq!(interval_of(&xs, -1.0), 0);
+        assert_eq!(interval_of(&xs, 0.0), 0);
+        assert_eq!(interval_of(&xs, 1.0), 1);
+        assert_eq!(interval_of(&xs, 2.5), 2);
+        assert_eq!(interval_of(&xs, 3.0), 2);
+        assert_eq!(interval_of(&xs, 9.0), 2);
+    }
+}

@@ -1,0 +1,472 @@
+//! The adaptive solve loop: Newton on the current mesh, residual estimate, refine (or coarsen),
+//! repeat until the scaled RMS residual is below `tol` on every interval and the boundary
+//! residuals below `bc_tol`.
+
+use crate::collocation::Collocation;
+use crate::error::BvpError;
+use crate::error_control::rms_residuals;
+use crate::linear::{LinearSystem, Pattern};
+use crate::mesh;
+use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork};
+use crate::problem::Bvp;
+use crate::solution::{resample, Solution, SolveStats};
+use std::sync::Arc;
+
+/// How collocation residuals are scaled per component before comparison with `tol`:
+/// residual component `c` is divided by `s_c + |f_c|`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum ResidualScale {
+    /// `s_c = 1` for all components: scipy's `solve_bvp` measure `r / (1 + |f|)`.
+    #[default]
+    Relative,
+    /// `s_c = max(1, max_i |y_{i,c}|)`, recomputed on every mesh: a state of magnitude 1e4 is
+    /// measured relative to 1e4, not to 1.
+    Auto,
+    /// User-supplied typical magnitudes `s_c > 0` (one per state).
+    PerComponent(Vec<f64>),
+}
+
+/// Options of [`Solver`].
+#[derive(Debug, Clone)]
+pub struct SolveOptions {
+    /// Tolerance on the scaled RMS residual of every interval (default 1e-3, as scipy).
+    pub tol: f64,
+    /// Tolerance on the absolute boundary residuals (default: `tol`).
+    pub bc_tol: Option<f64>,
+    /// Maximum number of mesh nodes (default 10 000).
+    pub max_nodes: usize,
+    /// Maximum number of mesh iterations (Newton + error estimate) (default 40).
+    pub max_mesh_iterations: usize,
+    /// Residual scaling per component.
+    pub scale: ResidualScale,
+    /// Adapt the mesh (default `true`). With `false` the mesh of the guess is kept and the
+    /// solve succeeds when Newton converges on it.
+    pub adapt: bool,
+    /// Remove nodes where the residual is far below tolerance (default `true`).
+    pub coarsen: bool,
+    /// Factorisations allowed per Newton run on one mesh (default 4, as scipy; 25 on a fixed mesh).
+    pub max_jacobians_per_mesh: usize,
+    /// Newton iterations allowed per mesh (default 8; 50 on a fixed mesh).
+    pub max_newton_iterations_per_mesh: usize,
+    /// Additionally require the last Newton correction to be below
+    /// `newton_step_tol (1 + ‖Y‖∞)` (default: off).
+    pub newton_step_tol: Option<f64>,
+    /// Factor the Jacobian at the accepted solution and keep it in the [`Solution`] for
+    /// sensitivities and adjoints (default `true`; costs one factorisation).
+    pub factor_at_solution: bool,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        SolveOptions {
+            tol: 1e-3,
+            bc_tol: None,
+            max_nodes: 10_000,
+            max_mesh_iterations: 40,
+            scale: ResidualScale::Relative,
+            adapt: true,
+            coarsen: true,
+            max_jacobians_per_mesh: 4,
+            max_newton_iterations_per_mesh: 8,
+            newton_step_tol: None,
+            factor_at_solution: true,
+        }
+    }
+}
+
+impl SolveOptions {
+    /// Options with tolerance `tol`.
+    pub fn with_tol(tol: f64) -> Self {
+        SolveOptions {
+            tol,
+            ..Default::default()
+        }
+    }
+
+    /// Options for a fixed mesh: no adaptation, Newton iterated until the correction is below
+    /// `1e-12` relative.
+    pub fn fixed_mesh() -> Self {
+        SolveOptions {
+            adapt: false,
+            coarsen: false,
+            max_jacobians_per_mesh: 25,
+            max_newton_iterations_per_mesh: 50,
+            newton_step_tol: Some(1e-12),
+            ..Default::default()
+        }
+    }
+
+    fn validate(&self, n: usize) -> Result<(), BvpError> {
+        if !(self.tol > 0.0 && self.tol.is_finite()) {
+            return Err(BvpError::InvalidInput(format!(
+                "tol must be positive and finite, got {}",
+                self.tol
+            )));
+        }
+        if let Some(b) = self.bc_tol {
+            if !(b > 0.0 && b.is_finite()) {
+                return Err(BvpError::InvalidInput(format!(
+                    "bc_tol must be positive and finite, got {b}"
+                )));
+            }
+        }
+        if self.max_nodes < 2 {
+            return Err(BvpError::InvalidInput(
+                "max_nodes must be at least 2".into(),
+            ));
+        }
+        if let ResidualScale::PerComponent(s) = &self.scale {
+            if s.len() != n || s.iter().any(|v| !(*v > 0.0 && v.is_finite())) {
+                return Err(BvpError::InvalidInput(format!(
+                    "ResidualScale::PerComponent needs {n} positive finite values, got {s:?}"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// An initial guess: mesh, states at the nodes and unknown parameters.
+#[derive(Debug, Clone)]
+pub struct Guess {
+    /// Mesh nodes (strictly increasing; `x[0] = a`, `x[m-1] = b`).
+    pub x: Vec<f64>,
+    /// States at the nodes, `m × n` row-major.
+    pub y: Vec<f64>,
+    /// Unknown parameters (length `k`).
+    pub unknowns: Vec<f64>,
+}
+
+impl Guess {
+    /// The same state `y0` at every node of `x`.
+    pub fn constant(x: Vec<f64>, y0: &[f64]) -> Self {
+        let y = x.iter().flat_map(|_| y0.iter().copied()).collect();
+        Guess {
+            x,
+            y,
+            unknowns: Vec::new(),
+        }
+    }
+
+    /// States from a function `g(x, y)` filling `y` (length `n`).
+    pub fn from_fn(x: Vec<f64>, n: usize, mut g: impl FnMut(f64, &mut [f64])) -> Self {
+        let mut y = vec![0.0; x.len() * n];
+        for (i, &xi) in x.iter().enumerate() {
+            g(xi, &mut y[i * n..(i + 1) * n]);
+        }
+        Guess {
+            x,
+            y,
+            unknowns: Vec::new(),
+        }
+    }
+
+    /// Sets the unknown-parameter guess.
+    pub fn with_unknowns(mut self, unknowns: &[f64]) -> Self {
+        self.unknowns = unknowns.to_vec();
+        self
+    }
+}
+
+impl From<&Solution> for Guess {
+    /// A warm start from a previous solution: its mesh, values and unknowns.
+    fn from(s: &Solution) -> Self {
+        Guess {
+            x: s.x.clone(),
+            y: s.y.clone(),
+            unknowns: s.unknowns.clone(),
+        }
+    }
+}
+
+/// A reusable solver for one problem. It keeps its workspace (buffers, sparsity patterns and
+/// symbolic factorisations of recently used mesh sizes) between solves, so repeated solves —
+/// continuation, parameter sweeps, fits — do not redo that work.
+pub struct Solver<'a, P: Bvp> {
+    problem: &'a P,
+    /// The options used by [`solve`](Self::solve).
+    pub options: SolveOptions,
+    col: Collocation,
+    patterns: Vec<Arc<Pattern>>,
+    newton_work: NewtonWork,
+    rms: Vec<f64>,
+    buf: Vec<f64>,
+    marks: Vec<u8>,
+}
+
+/// Solves `problem` once: a convenience around [`Solver`].
+pub fn solve<P: Bvp>(
+    problem: &P,
+    params: &[f64],
+    guess: &Guess,
+    options: &SolveOptions,
+) -> Result<Solution, BvpError> {
+    Solver::new(problem, options.clone()).solve(params, guess)
+}
+
+impl<'a, P: Bvp> Solver<'a, P> {
+    /// A solver for `problem` with `options`.
+    pub fn new(problem: &'a P, options: SolveOptions) -> Self {
+        let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
+        Solver {
+            problem,
+            options,
+            col: Collocation::new(n, k, q),
+            patterns: Vec::new(),
+            newton_work: NewtonWork::default(),
+            rms: Vec::new(),
+            buf: Vec::new(),
+            marks: Vec::new(),
+        }
+    }
+
+    /// The problem.
+    pub fn problem(&self) -> &'a P {
+        self.problem
+    }
+
+    fn pattern(&mut self, m: usize) -> Result<Arc<Pattern>, BvpError> {
+        if let Some(pos) = self.patterns.iter().position(|p| p.m == m) {
+            let p = self.patterns.remove(pos);
+            self.patterns.push(p.clone());
+            return Ok(p);
+        }
+        let p = Arc::new(Pattern::new(self.col.n, self.col.k, m)?);
+        if self.patterns.len() >= 4 {
+            self.patterns.remove(0);
+        }
+        self.patterns.push(p.clone());
+        Ok(p)
+    }
+
+    fn validate(&self, params: &[f64], guess: &Guess) -> Result<(), BvpError> {
+        let (n, k, q) = (self.col.n, self.col.k, self.col.q);
+        if n == 0 {
+            return Err(BvpError::InvalidInput(
+                "the problem has no states (dim() = 0)".into(),
+            ));
+        }
+        self.options.validate(n)?;
+        mesh::validate(&guess.x)?;
+        if guess.y.len() != guess.x.len() * n {
+            return Err(BvpError::InvalidInput(format!(
+                "the guess has {} values, expected {} nodes x {} states = {}",
+                guess.y.len(),
+                guess.x.len(),
+                n,
+                guess.x.len() * n
+            )));
+        }
+        if let Some(i) = guess.y.iter().position(|v| !v.is_finite()) {
+            return Err(BvpError::NonFinite {
+                what: "initial guess",
+                component: i % n,
+                x: guess.x[i / n],
+            });
+        }
+        if guess.unknowns.len() != k {
+            return Err(BvpError::InvalidInput(format!(
+                "the problem has {k} unknown parameters but the guess gives {}",
+                guess.unknowns.len()
+            )));
+        }
+        if params.len() != q {
+            return Err(BvpError::InvalidInput(format!(
+                "the problem has {q} model parameters but {} values were given",
+                params.len()
+            )));
+        }
+        if let Some(i) = guess
+            .unknowns
+            .iter()
+            .chain(params)
+            .position(|v| !v.is_finite())
+        {
+            return Err(BvpError::InvalidInput(format!(
+                "parameter {i} of p = (unknowns, model parameters) is not finite"
+            )));
+        }
+        if guess.x.len() > self.options.max_nodes {
+            return Err(BvpError::InvalidInput(format!(
+                "the initial mesh has {} nodes, more than max_nodes = {}",
+                guess.x.len(),
+                self.options.max_nodes
+            )));
+        }
+        Ok(())
+    }
+
+    fn scale_for(&self, y: &[f64]) -> Vec<f64> {
+        let n = self.col.n;
+        match &self.options.scale {
+            ResidualScale::Relative => vec![1.0; n],
+            ResidualScale::PerComponent(s) => s.clone(),
+            ResidualScale::Auto => {
+                let mut s = vec![1.0f64; n];
+                for (i, v) in y.iter().enumerate() {
+                    s[i % n] = s[i % n].max(v.abs());
+                }
+                s
+            }
+        }
+    }
+
+    /// Solves the problem with model parameters `params` (length `num_params()`) from `guess`.
+    pub fn solve(&mut self, params: &[f64], guess: &Guess) -> Result<Solution, BvpError> {
+        self.validate(params, guess)?;
+        let problem = self.problem;
+        let opts = self.options.clone();
+        let (n, k) = (self.col.n, self.col.k);
+        let bc_tol = opts.bc_tol.unwrap_or(opts.tol);
+        let settings = NewtonSettings {
+            tol: opts.tol,
+            bc_tol,
+            max_jacobians: if opts.adapt {
+                opts.max_jacobians_per_mesh
+            } else {
+                opts.max_jacobians_per_mesh.max(25)
+            },
+            max_iterations: if opts.adapt {
+                opts.max_newton_iterations_per_mesh
+            } else {
+                opts.max_newton_iterations_per_mesh.max(50)
+            },
+            step_tol: opts.newton_step_tol,
+        };
+        let mut x = guess.x.clone();
+        let mut y = guess.y.clone();
+        let mut p: Vec<f64> = guess.unknowns.iter().chain(params).copied().collect();
+        let mut stats = SolveStats::default();
+        self.col.rhs_evals = 0;
+        self.col.jac_evals = 0;
+        let mut coarsenings_left = if opts.coarsen && opts.adapt { 3 } else { 0 };
+        let mut iteration = 0;
+        loop {
+            iteration += 1;
+            let m = x.len();
+            self.col.set_mesh(&x);
+            let pattern = self.pattern(m)?;
+            let mut lin = LinearSystem::new(pattern);
+            let scale = self.scale_for(&y);
+            let report = newton(
+                problem,
+                &mut self.col,
+                &mut lin,
+                &mut y,
+                &mut p,
+                &scale,
+                &settings,
+                &mut self.newton_work,
+            )?;
+            stats.newton_iterations += report.iterations;
+            stats.jacobian_factorizations += lin.factorizations;
+            let max_bc_res = max_bc(&self.col);
+            rms_residuals(
+                problem,
+                &mut self.col,
+                &y,
+                &p,
+                &scale,
+                &mut self.rms,
+                &mut self.buf,
+            );
+            let max_res = self.rms.iter().fold(0.0f64, |a, &v| a.max(v));
+            stats.max_residual = max_res;
+            stats.max_bc_residual = max_bc_res;
+
+            if !opts.adapt {
+                if report.converged {
+                    return self.finish(problem, lin, x, y, p, scale, stats);
+                }
+                return Err(BvpError::NewtonFailed {
+                    iterations: report.iterations,
+                    nodes: m,
+                    reason: "no convergence on the fixed mesh".into(),
+                    max_residual: max_res,
+                    max_bc_residual: max_bc_res,
+                });
+            }
+
+            let added = mesh::mark_refinement(&self.rms, opts.tol, &mut self.marks);
+            if std::env::var("DIFFBVP_DEBUG").is_ok() {
+                eprintln!("iter {iteration} m {m} newton {} conv {} max_res {max_res:e} bc {max_bc_res:e} added {added}", report.iterations, report.converged);
+            }
+            if added > 0 {
+                if m + added > opts.max_nodes {
+                    return Err(BvpError::MaxNodesExceeded {
+                        nodes: m + added,
+                        max_nodes: opts.max_nodes,
+                        max_residual: max_res,
+                        tol: opts.tol,
+                    });
+                }
+                let new_x = mesh::refine(&x, &self.marks);
+                y = resample(&x, &y, &self.col.f, n, &new_x);
+                x = new_x;
+                stats.mesh_refinements += 1;
+            } else if max_bc_res <= bc_tol {
+                if coarsenings_left > 0 && m > 8 {
+                    let new_x = mesh::coarsen(&x, &self.rms, opts.tol / 20.0);
+                    if (m - new_x.len()) * 10 >= m {
+                        coarsenings_left -= 1;
+                        y = resample(&x, &y, &self.col.f, n, &new_x);
+                        x = new_x;
+                        stats.mesh_refinements += 1;
+                        stats.mesh_coarsenings += 1;
+                        if iteration < opts.max_mesh_iterations {
+                            continue;
+                        }
+                    }
+                }
+                return self.finish(problem, lin, x, y, p, scale, stats);
+            }
+            if iteration >= opts.max_mesh_iterations {
+                return Err(BvpError::ToleranceNotMet {
+                    iterations: iteration,
+                    max_residual: max_res,
+                    tol: opts.tol,
+                    max_bc_residual: max_bc_res,
+                    bc_tol,
+                });
+            }
+            let _ = k;
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn finish(
+        &mut self,
+        problem: &P,
+        mut lin: LinearSystem,
+        x: Vec<f64>,
+        y: Vec<f64>,
+        p: Vec<f64>,
+        scale: Vec<f64>,
+        mut stats: SolveStats,
+    ) -> Result<Solution, BvpError> {
+        let k = self.col.k;
+        // `col` holds values at the final iterate (the error estimate used them)
+        let factorization = if self.options.factor_at_solution {
+            self.col.jacobians(problem, &y, &p, k)?;
+            lin.factor(&self.col)?;
+            stats.jacobian_factorizations += 1;
+            Some(lin.snapshot())
+        } else {
+            None
+        };
+        stats.rhs_evaluations = self.col.rhs_evals;
+        stats.rhs_dual_evaluations = self.col.jac_evals;
+        Ok(Solution {
+            n: self.col.n,
+            x,
+            yp: self.col.f.clone(),
+            y,
+            unknowns: p[..k].to_vec(),
+            params: p[k..].to_vec(),
+            rms_residuals: self.rms.clone(),
+            residual_scale: scale,
+            stats,
+            factorization,
+        })
+    }
+}

@@ -1,0 +1,102 @@
+//! Test problems with exact solutions shared by several integration tests.
+#![allow(dead_code)]
+
+use diffbvp::{Bvp, DualNum};
+
+/// y'' = y on [0, 1], y(0) = 1, y(1) = 0.
+pub struct Exp;
+impl Bvp for Exp {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = y[0];
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[0] - 1.0;
+        r[1] = yb[0];
+    }
+}
+pub fn exp_exact(x: f64) -> f64 {
+    ((-x).exp() - (x - 2.0).exp()) / (1.0 - (-2.0f64).exp())
+}
+
+/// Bratu y'' + k e^y = 0, y(0) = y(1) = 0.
+pub struct Bratu {
+    pub k: f64,
+}
+impl Bvp for Bratu {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = -y[0].exp() * self.k;
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[0];
+        r[1] = yb[0];
+    }
+}
+/// Exact Bratu solution for the branch parameter θ (θ = √(2k) cosh(θ/4)).
+pub fn bratu_exact(theta: f64, x: f64) -> f64 {
+    -2.0 * (((x - 0.5) * theta / 2.0).cosh() / (theta / 4.0).cosh()).ln()
+}
+
+/// Shock layer ε y'' + x y' = -ε π² cos(πx) - πx sin(πx), y(-1) = -2, y(1) = 0.
+pub struct Shock {
+    pub eps: f64,
+}
+impl Bvp for Shock {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], _p: &[D], f: &mut [D]) {
+        let pi = std::f64::consts::PI;
+        f[0] = y[1];
+        f[1] = (y[1] * (-x) - self.eps * pi * pi * (pi * x).cos() - pi * x * (pi * x).sin())
+            / self.eps;
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[0] + 2.0;
+        r[1] = yb[0];
+    }
+}
+pub fn shock_exact(eps: f64, x: f64) -> f64 {
+    (std::f64::consts::PI * x).cos() + erf(x / (2.0 * eps).sqrt()) / erf(1.0 / (2.0 * eps).sqrt())
+}
+
+/// erf with ~1e-16 accuracy (series for small |x|, continued fraction for large).
+pub fn erf(x: f64) -> f64 {
+    if x == 0.0 {
+        return 0.0;
+    }
+    if x < 0.0 {
+        return -erf(-x);
+    }
+    if x < 3.0 {
+        // Taylor series
+        let mut sum = x;
+        let mut term = x;
+        let x2 = x * x;
+        let mut k = 0.0;
+        loop {
+            k += 1.0;
+            term *= -x2 / k;
+            let add = term / (2.0 * k + 1.0);
+            sum += add;
+            if add.abs() <= 1e-17 * sum.abs() || add == 0.0 {
+                break;
+            }
+        }
+        2.0 / std::f64::consts::PI.sqrt() * sum
+    } else {
+        // erfc continued fraction (Lentz)
+        let mut f = 0.0;
+        for k in (1..60).rev() {
+            f = (k as f64 / 2.0) / (x + f);
+        }
+        1.0 - (-x * x).exp() / std::f64::consts::PI.sqrt() / (x + f)
+    }
+}
