@@ -2,6 +2,7 @@
 mod collocation;
 mod dual_jacobian;
 pub mod error;
+pub mod fiber;
 mod error_control;
 pub mod linear;
 pub mod mesh;
