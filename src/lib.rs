@@ -1,13 +1,18 @@
 //! diffbvp (work in progress)
+// Numerical kernels index several arrays with the same loop variable, as the formulas do.
+#![allow(clippy::needless_range_loop)]
 mod collocation;
+pub mod continuation;
 mod dual_jacobian;
 pub mod error;
-pub mod fiber;
 mod error_control;
+pub mod fiber;
+pub mod inspect;
 pub mod linear;
 pub mod mesh;
 mod newton;
 pub mod problem;
+pub mod sensitivity;
 pub mod solution;
 pub mod solve;
 pub use error::BvpError;

@@ -3,8 +3,8 @@
 //! Affine-invariant damping as in scipy's `solve_newton` (after Deuflhard and BVP_SOLVER): the
 //! merit of a trial point is `‖J⁻¹ F(Y_trial)‖²` with the *current* factorisation, accepted when
 //! it falls below `(1 - 2 α σ)` of the full-step value (σ = 0.2), otherwise `α` is halved (at
-//! most four times). After a full step the factorisation is reused (simplified Newton); after a
-//! damped step the Jacobian is recomputed. Iteration stops when the collocation residuals are
+//! most four times). After a full step with good contraction (`‖Δ̄_{k+1}‖ ≤ ‖Δ_k‖/4`) the
+//! factorisation is reused (simplified Newton); otherwise the Jacobian is recomputed. Iteration stops when the collocation residuals are
 //! 1.5 orders of magnitude below the tolerance at the interval midpoints and the boundary
 //! residuals below `bc_tol`, or when the Jacobian budget is spent.
 
@@ -22,6 +22,8 @@ pub(crate) struct NewtonSettings {
     /// If set, also require the last Newton correction to satisfy
     /// `‖ΔY‖∞ <= step_tol (1 + ‖Y‖∞)`.
     pub step_tol: Option<f64>,
+    /// 0: silent, 1: one line per mesh, 2: also every Newton iteration (stderr).
+    pub verbose: u8,
 }
 
 /// What a Newton run achieved.
@@ -33,6 +35,8 @@ pub(crate) struct NewtonReport {
 const SIGMA: f64 = 0.2;
 const TAU: f64 = 0.5;
 const N_TRIAL: usize = 4;
+/// Squared contraction factor below which the factorisation is reused.
+const CONTRACTION_SQ: f64 = 1.0 / 16.0;
 
 /// Runs damped Newton from `y`, `p` (unknowns in `p[..k]` are updated). On return `col` holds the
 /// residuals, node and midpoint values of the final iterate.
@@ -71,6 +75,7 @@ pub(crate) fn newton<P: Bvp>(
             cost = dot(&work.step, &work.step);
         }
         iterations += 1;
+        let cost_prev = cost;
         let mut alpha = 1.0;
         let mut accepted_finite = false;
         for trial in 0..=N_TRIAL {
@@ -115,6 +120,11 @@ pub(crate) fn newton<P: Bvp>(
             });
         }
         let step_inf = alpha * inf_norm(&work.step);
+        if settings.verbose >= 2 {
+            eprintln!(
+                "    newton {iterations:>3}: damping {alpha:<6} |step|_inf {step_inf:.3e} |J^-1 F|^2 {cost:.3e}"
+            );
+        }
         y.copy_from_slice(&work.y_new);
         p[..k].copy_from_slice(&work.p_new[..k]);
 
@@ -130,7 +140,10 @@ pub(crate) fn newton<P: Bvp>(
         if njev >= settings.max_jacobians {
             break;
         }
-        if alpha == 1.0 {
+        // Keep the factorisation (simplified Newton) only after a full step with good
+        // contraction, ‖Δ̄_{k+1}‖ <= ‖Δ_k‖ / 4; a stale Jacobian otherwise costs more
+        // iterations than a new factorisation.
+        if alpha == 1.0 && cost <= CONTRACTION_SQ * cost_prev {
             std::mem::swap(&mut work.step, &mut work.step_new);
             recompute = false;
         } else {

@@ -54,6 +54,8 @@ pub struct SolveOptions {
     /// Factor the Jacobian at the accepted solution and keep it in the [`Solution`] for
     /// sensitivities and adjoints (default `true`; costs one factorisation).
     pub factor_at_solution: bool,
+    /// Progress on stderr: 0 silent (default), 1 one line per mesh, 2 also Newton iterations.
+    pub verbose: u8,
 }
 
 impl Default for SolveOptions {
@@ -70,6 +72,7 @@ impl Default for SolveOptions {
             max_newton_iterations_per_mesh: 8,
             newton_step_tol: None,
             factor_at_solution: true,
+            verbose: 0,
         }
     }
 }
@@ -332,6 +335,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 opts.max_newton_iterations_per_mesh.max(50)
             },
             step_tol: opts.newton_step_tol,
+            verbose: opts.verbose,
         };
         let mut x = guess.x.clone();
         let mut y = guess.y.clone();
@@ -388,8 +392,12 @@ impl<'a, P: Bvp> Solver<'a, P> {
             }
 
             let added = mesh::mark_refinement(&self.rms, opts.tol, &mut self.marks);
-            if std::env::var("DIFFBVP_DEBUG").is_ok() {
-                eprintln!("iter {iteration} m {m} newton {} conv {} max_res {max_res:e} bc {max_bc_res:e} added {added}", report.iterations, report.converged);
+            if opts.verbose >= 1 {
+                eprintln!(
+                    "mesh {iteration:>3}: {m:>6} nodes, Newton {:>2} it ({}), max rms residual {max_res:.2e}, max bc residual {max_bc_res:.2e}, nodes to add {added}",
+                    report.iterations,
+                    if report.converged { "converged" } else { "not converged" }
+                );
             }
             if added > 0 {
                 if m + added > opts.max_nodes {

@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)]
 //! scipy's own `solve_bvp` test problems (test_bvp.py), written out in
 //! shared/docs/bvp-test-problems.md, plus Bratu's two branches.
 

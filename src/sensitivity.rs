@@ -1,0 +1,358 @@
+//! Parameter sensitivities of a converged discrete solution (implicit function theorem).
+//!
+//! At a solution `S(Y, p) = 0` of the collocation system (`Y` = states at the nodes and the
+//! unknown parameters, `p` = the fixed model parameters):
+//!
+//! * forward: `D_p Y = -(∂_Y S)⁻¹ ∂_p S` — one solve with `q` right-hand sides;
+//! * adjoint: for `G(Y, p)`, `dG/dp = ∂_p G - λᵀ ∂_p S` with `(∂_Y S)ᵀ λ = (∂_Y G)ᵀ` — one
+//!   transposed solve.
+//!
+//! `∂_p S` and `∂G` come from dual numbers; `∂_Y S` is the factorisation kept in the
+//! [`Solution`] (no refactorisation). Values between nodes go through the C1 interpolant, whose
+//! node slopes `f(x_i, y_i, p)` depend on `p` too; the derivatives here are those of the
+//! interpolated discrete solution, consistent with it to round-off.
+
+use crate::collocation::Collocation;
+use crate::dual_jacobian::{DualFn, DualJacobian};
+use crate::error::BvpError;
+use crate::linear::{Factorization, LinearSystem, Pattern};
+use crate::problem::Bvp;
+use crate::solution::{hermite_weights, interval_of, Solution};
+use num_dual::DualNum;
+use std::sync::Arc;
+
+/// A scalar function `g(x, y, p)` of a point, the state there and all parameters
+/// `p = (unknowns, model parameters)`, written generically over dual numbers. `index` numbers
+/// the points of a functional or residual vector.
+pub trait PointFunction {
+    /// Value of the function at point number `index`, located at `x`.
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, index: usize, x: f64, y: &[D], p: &[D])
+        -> D;
+}
+
+struct PointFn<'a, G> {
+    g: &'a G,
+    index: usize,
+    x: f64,
+    n: usize,
+}
+
+impl<G: PointFunction> DualFn for PointFn<'_, G> {
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, input: &[D], out: &mut [D]) {
+        let (y, p) = input.split_at(self.n);
+        out[0] = self.g.eval(self.index, self.x, y, p);
+    }
+}
+
+/// Collocation data at a solution with Jacobians seeded in all parameters.
+struct Linearization {
+    col: Collocation,
+    p: Vec<f64>,
+}
+
+impl Linearization {
+    fn new<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
+        let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
+        if sol.n != n || sol.unknowns.len() != k || sol.params.len() != q {
+            return Err(BvpError::InvalidInput(
+                "the solution does not belong to this problem (dimensions differ)".into(),
+            ));
+        }
+        let mut col = Collocation::new(n, k, q);
+        col.set_mesh(&sol.x);
+        let p = sol.full_params();
+        col.residual(problem, &sol.y, &p)?;
+        col.jacobians(problem, &sol.y, &p, k + q)?;
+        Ok(Linearization { col, p })
+    }
+
+    /// Node Jacobian entry `∂f_c/∂(y, p)_l` at node `i`.
+    #[inline]
+    fn jn(&self, i: usize, c: usize, l: usize) -> f64 {
+        let n = self.col.n;
+        let w = n + self.col.seeded_params;
+        self.col.jn[i * n * w + c * w + l]
+    }
+
+    /// The factorisation of `∂_Y S`: the one kept in the solution, or a fresh one.
+    fn factorization<'s>(
+        &self,
+        sol: &'s Solution,
+        owned: &'s mut Option<Factorization>,
+    ) -> Result<&'s Factorization, BvpError> {
+        if let Some(f) = sol.factorization.as_ref() {
+            return Ok(f);
+        }
+        let pattern = Arc::new(Pattern::new(self.col.n, self.col.k, self.col.m())?);
+        let mut lin = LinearSystem::new(pattern);
+        lin.factor(&self.col)?;
+        Ok(owned.insert(lin.snapshot()))
+    }
+}
+
+/// Forward sensitivities `dy/dp` of a solution with respect to the fixed model parameters.
+#[derive(Debug, Clone)]
+pub struct Sensitivities {
+    n: usize,
+    q: usize,
+    x: Vec<f64>,
+    /// `∂y_{i,c}/∂p_j` at the nodes, index `(i n + c) q + j`.
+    pub dy: Vec<f64>,
+    /// Derivative of the node slopes `f(x_i, y_i, p)` (total), same layout.
+    pub dyp: Vec<f64>,
+    /// `∂(unknown l)/∂p_j`, index `l q + j`.
+    pub d_unknowns: Vec<f64>,
+}
+
+impl Sensitivities {
+    /// Computes `D_p Y` at `sol` with one solve of `q` right-hand sides, reusing the
+    /// factorisation stored in `sol` (computed once if `sol` has none).
+    pub fn compute<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
+        let lz = Linearization::new(problem, sol)?;
+        let (n, k, q, m) = (lz.col.n, lz.col.k, lz.col.q, lz.col.m());
+        let size = m * n + k;
+        let mut rhs = vec![0.0; size * q];
+        for j in 0..q {
+            lz.col
+                .param_column(k + j, &mut rhs[j * size..(j + 1) * size]);
+        }
+        for v in rhs.iter_mut() {
+            *v = -*v;
+        }
+        let mut owned = None;
+        let fact = lz.factorization(sol, &mut owned)?;
+        fact.solve_in_place(&mut rhs, q);
+        if let Some(pos) = rhs.iter().position(|v| !v.is_finite()) {
+            return Err(BvpError::SingularJacobian {
+                detail: format!("sensitivity solve gave a non-finite value (entry {pos})"),
+            });
+        }
+        let mut dy = vec![0.0; m * n * q];
+        let mut d_unknowns = vec![0.0; k * q];
+        for j in 0..q {
+            for r in 0..m * n {
+                dy[r * q + j] = rhs[j * size + r];
+            }
+            for l in 0..k {
+                d_unknowns[l * q + j] = rhs[j * size + m * n + l];
+            }
+        }
+        let mut dyp = vec![0.0; m * n * q];
+        for i in 0..m {
+            for c in 0..n {
+                for j in 0..q {
+                    let mut v = lz.jn(i, c, n + k + j);
+                    for l in 0..n {
+                        v += lz.jn(i, c, l) * dy[(i * n + l) * q + j];
+                    }
+                    for l in 0..k {
+                        v += lz.jn(i, c, n + l) * d_unknowns[l * q + j];
+                    }
+                    dyp[(i * n + c) * q + j] = v;
+                }
+            }
+        }
+        Ok(Sensitivities {
+            n,
+            q,
+            x: sol.x.clone(),
+            dy,
+            dyp,
+            d_unknowns,
+        })
+    }
+
+    /// Number of model parameters.
+    pub fn num_params(&self) -> usize {
+        self.q
+    }
+
+    /// `∂y_c(x)/∂p_j` of the interpolated solution at `x`, written into `dy` (`n × q`, row-major),
+    /// and of its derivative into `dyp`.
+    pub fn at_into(&self, x: f64, dy: &mut [f64], dyp: &mut [f64]) {
+        let (n, q) = (self.n, self.q);
+        let i = interval_of(&self.x, x);
+        let h = self.x[i + 1] - self.x[i];
+        let (v, d) = hermite_weights((x - self.x[i]) / h, h);
+        for c in 0..n {
+            for j in 0..q {
+                let a = (i * n + c) * q + j;
+                let b = ((i + 1) * n + c) * q + j;
+                dy[c * q + j] =
+                    v[0] * self.dy[a] + v[1] * self.dyp[a] + v[2] * self.dy[b] + v[3] * self.dyp[b];
+                dyp[c * q + j] =
+                    d[0] * self.dy[a] + d[1] * self.dyp[a] + d[2] * self.dy[b] + d[3] * self.dyp[b];
+            }
+        }
+    }
+
+    /// `∂y(x)/∂p` at `x`, `n × q` row-major.
+    pub fn at(&self, x: f64) -> Vec<f64> {
+        let mut dy = vec![0.0; self.n * self.q];
+        let mut dyp = vec![0.0; self.n * self.q];
+        self.at_into(x, &mut dy, &mut dyp);
+        dy
+    }
+}
+
+/// Values and exact Jacobian `dr/dp` (`len × q`, row-major) of a residual vector
+/// `r_j = g(j, x_j, y(x_j), p)` at the points `xs`, from forward sensitivities (one solve with
+/// `q` right-hand sides). This is what a Gauss–Newton fit calls.
+pub fn residual_jacobian<P: Bvp, G: PointFunction>(
+    problem: &P,
+    sol: &Solution,
+    sens: &Sensitivities,
+    xs: &[f64],
+    g: &G,
+) -> Result<(Vec<f64>, Vec<f64>), BvpError> {
+    let (n, k, q) = (sol.n, sol.unknowns.len(), sol.params.len());
+    if problem.dim() != n || problem.num_unknowns() != k || problem.num_params() != q {
+        return Err(BvpError::InvalidInput(
+            "the solution does not belong to this problem (dimensions differ)".into(),
+        ));
+    }
+    if sens.q != q || sens.x.len() != sol.x.len() {
+        return Err(BvpError::InvalidInput(
+            "the sensitivities were computed for a different solution".into(),
+        ));
+    }
+    let p = sol.full_params();
+    let mut engine = DualJacobian::default();
+    let mut input = vec![0.0; n + k + q];
+    let mut grad = vec![0.0; n + k + q];
+    let mut y = vec![0.0; n];
+    let mut yp = vec![0.0; n];
+    let mut dy = vec![0.0; n * q];
+    let mut dyp = vec![0.0; n * q];
+    let mut values = Vec::with_capacity(xs.len());
+    let mut jac = vec![0.0; xs.len() * q];
+    for (idx, &x) in xs.iter().enumerate() {
+        sol.eval_into(x, &mut y, &mut yp);
+        sens.at_into(x, &mut dy, &mut dyp);
+        input[..n].copy_from_slice(&y);
+        input[n..].copy_from_slice(&p);
+        let f = PointFn {
+            g,
+            index: idx,
+            x,
+            n,
+        };
+        let mut out = [0.0];
+        engine.jacobian(&f, &input, n + k + q, &mut out, &mut grad);
+        if !out[0].is_finite() || grad.iter().any(|v| !v.is_finite()) {
+            return Err(BvpError::NonFinite {
+                what: "point function",
+                component: idx,
+                x,
+            });
+        }
+        values.push(out[0]);
+        for j in 0..q {
+            let mut v = grad[n + k + j];
+            for c in 0..n {
+                v += grad[c] * dy[c * q + j];
+            }
+            for l in 0..k {
+                v += grad[n + l] * sens.d_unknowns[l * q + j];
+            }
+            jac[idx * q + j] = v;
+        }
+    }
+    Ok((values, jac))
+}
+
+/// Value and gradient `dG/dp` of `G = Σ_j w_j g(j, x_j, y(x_j), p)` by the adjoint method: one
+/// transposed solve with the solution's factorisation, independent of the number of parameters.
+pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
+    problem: &P,
+    sol: &Solution,
+    xs: &[f64],
+    weights: &[f64],
+    g: &G,
+) -> Result<(f64, Vec<f64>), BvpError> {
+    if xs.len() != weights.len() {
+        return Err(BvpError::InvalidInput(format!(
+            "{} points but {} weights",
+            xs.len(),
+            weights.len()
+        )));
+    }
+    let lz = Linearization::new(problem, sol)?;
+    let (n, k, q, m) = (lz.col.n, lz.col.k, lz.col.q, lz.col.m());
+    let size = m * n + k;
+    let np = k + q;
+    let mut engine = DualJacobian::default();
+    let mut input = vec![0.0; n + np];
+    let mut grad = vec![0.0; n + np];
+    let mut y = vec![0.0; n];
+    let mut yp = vec![0.0; n];
+    let mut b = vec![0.0; size];
+    let mut dg_dp = vec![0.0; q];
+    let mut value = 0.0;
+    for (idx, (&x, &w)) in xs.iter().zip(weights).enumerate() {
+        let i = interval_of(&sol.x, x);
+        let h = sol.x[i + 1] - sol.x[i];
+        let (v, _) = hermite_weights((x - sol.x[i]) / h, h);
+        sol.eval_into(x, &mut y, &mut yp);
+        input[..n].copy_from_slice(&y);
+        input[n..].copy_from_slice(&lz.p);
+        let f = PointFn {
+            g,
+            index: idx,
+            x,
+            n,
+        };
+        let mut out = [0.0];
+        engine.jacobian(&f, &input, n + np, &mut out, &mut grad);
+        if !out[0].is_finite() || grad.iter().any(|v| !v.is_finite()) {
+            return Err(BvpError::NonFinite {
+                what: "point function",
+                component: idx,
+                x,
+            });
+        }
+        value += w * out[0];
+        // y(x) = v0 y_i + v1 f_i + v2 y_{i+1} + v3 f_{i+1}
+        for (node, (vy, vf)) in [(i, (v[0], v[1])), (i + 1, (v[2], v[3]))] {
+            for l in 0..n {
+                let mut s = vy * grad[l];
+                for c in 0..n {
+                    s += vf * grad[c] * lz.jn(node, c, l);
+                }
+                b[node * n + l] += w * s;
+            }
+            for l in 0..np {
+                let mut s = 0.0;
+                for c in 0..n {
+                    s += vf * grad[c] * lz.jn(node, c, n + l);
+                }
+                if l < k {
+                    b[m * n + l] += w * s;
+                } else {
+                    dg_dp[l - k] += w * s;
+                }
+            }
+        }
+        for l in 0..k {
+            b[m * n + l] += w * grad[n + l];
+        }
+        for j in 0..q {
+            dg_dp[j] += w * grad[n + k + j];
+        }
+    }
+    let mut owned = None;
+    let fact = lz.factorization(sol, &mut owned)?;
+    fact.solve_transpose_in_place(&mut b, 1);
+    let mut col = vec![0.0; size];
+    for (j, d) in dg_dp.iter_mut().enumerate() {
+        lz.col.param_column(k + j, &mut col);
+        let dot: f64 = b.iter().zip(&col).map(|(a, c)| a * c).sum();
+        *d -= dot;
+    }
+    if let Some(pos) = dg_dp.iter().position(|v| !v.is_finite()) {
+        return Err(BvpError::SingularJacobian {
+            detail: format!("adjoint solve gave a non-finite gradient (parameter {pos})"),
+        });
+    }
+    Ok((value, dg_dp))
+}

@@ -1,0 +1,236 @@
+#![allow(clippy::needless_range_loop)]
+//! Forward sensitivities and adjoint gradients against finite differences of re-solved
+//! problems and against a closed form.
+
+use diffbvp::mesh::linspace;
+use diffbvp::sensitivity::{adjoint_gradient, residual_jacobian, PointFunction, Sensitivities};
+use diffbvp::{solve, Bvp, DualNum, Guess, Solution, SolveOptions};
+
+/// y'' = p² y, y(0) = 1, y(1) = 0: y = sinh(p(1-x))/sinh(p).
+struct Hyper;
+impl Bvp for Hyper {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        1
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = p[0] * p[0] * y[0];
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[0] - 1.0;
+        r[1] = yb[0];
+    }
+}
+
+/// Bratu-type with parameters in f and g: y'' = -a e^y, y(0) = b, y(1) = a b / 2.
+struct BratuAB;
+impl Bvp for BratuAB {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = -p[0] * y[0].exp();
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
+        r[0] = ya[0] - p[1];
+        r[1] = yb[0] - p[0] * p[1] * 0.5;
+    }
+}
+
+/// Nonlinear oscillator with an unknown frequency λ and parameters in f and g:
+/// y'' = -λ² y - a y³, y(0) = 0, y(1) = 0, y'(0) = b (λ depends on the amplitude).
+struct Oscillator;
+impl Bvp for Oscillator {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_unknowns(&self) -> usize {
+        1
+    }
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = -p[0] * p[0] * y[0] - p[1] * y[0].powi(3);
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
+        r[0] = ya[0];
+        r[1] = yb[0];
+        r[2] = ya[1] - p[2];
+    }
+}
+
+/// g = y_0(x)^2 * p_last + y_1(x) (a functional touching states and a parameter)
+struct Observe;
+impl PointFunction for Observe {
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, _i: usize, x: f64, y: &[D], p: &[D]) -> D {
+        y[0] * y[0] * p[p.len() - 1] + y[1] * x
+    }
+}
+
+fn fd_check<P: Bvp>(problem: &P, params: &[f64], guess: &Guess, xs: &[f64], rel: f64) {
+    let opts = SolveOptions::fixed_mesh();
+    let base = solve(problem, params, guess, &opts).unwrap();
+    let sens = Sensitivities::compute(problem, &base).unwrap();
+    let q = params.len();
+    let n = problem.dim();
+    let warm = Guess::from(&base);
+    for j in 0..q {
+        let h = 1e-5 * (1.0 + params[j].abs());
+        let mut pp = params.to_vec();
+        let mut pm = params.to_vec();
+        pp[j] += h;
+        pm[j] -= h;
+        let sp = solve(problem, &pp, &warm, &opts).unwrap();
+        let sm = solve(problem, &pm, &warm, &opts).unwrap();
+        assert_eq!(sp.nodes(), base.nodes());
+        let mut scale: f64 = 0.0;
+        let mut max_dev: f64 = 0.0;
+        for &x in xs {
+            let fd: Vec<f64> = sp
+                .eval(x)
+                .iter()
+                .zip(sm.eval(x))
+                .map(|(a, b)| (a - b) / (2.0 * h))
+                .collect();
+            let an = sens.at(x);
+            for c in 0..n {
+                scale = scale.max(fd[c].abs());
+                max_dev = max_dev.max((fd[c] - an[c * q + j]).abs());
+            }
+        }
+        for (l, (a, b)) in sp.unknowns.iter().zip(&sm.unknowns).enumerate() {
+            let fd = (a - b) / (2.0 * h);
+            assert!(
+                (fd - sens.d_unknowns[l * q + j]).abs() <= rel * fd.abs().max(1e-3),
+                "unknown {l}"
+            );
+        }
+        assert!(
+            max_dev <= rel * scale,
+            "param {j}: deviation {max_dev:e} vs scale {scale:e}"
+        );
+    }
+}
+
+fn points() -> Vec<f64> {
+    (0..=40).map(|i| i as f64 / 40.0 * 0.999 + 0.0003).collect()
+}
+
+#[test]
+fn forward_sensitivities_match_finite_differences_on_fixed_mesh() {
+    let g = Guess::constant(linspace(0.0, 1.0, 30), &[0.0, 0.0]);
+    fd_check(&BratuAB, &[1.2, 0.3], &g, &points(), 1e-7);
+    let g = Guess::from_fn(linspace(0.0, 1.0, 40), 2, |x, y| {
+        let pi = std::f64::consts::PI;
+        y[0] = 0.5 * (pi * x).sin() / pi;
+        y[1] = 0.5 * (pi * x).cos();
+    })
+    .with_unknowns(&[3.0]);
+    fd_check(&Oscillator, &[2.0, 0.8], &g, &points(), 1e-7);
+    fd_check(
+        &Hyper,
+        &[2.5],
+        &Guess::constant(linspace(0.0, 1.0, 25), &[0.5, -1.0]),
+        &points(),
+        1e-7,
+    );
+}
+
+#[test]
+fn forward_sensitivity_matches_closed_form() {
+    let p: f64 = 2.5;
+    let s = solve(
+        &Hyper,
+        &[p],
+        &Guess::constant(linspace(0.0, 1.0, 5), &[0.5, -1.0]),
+        &SolveOptions::with_tol(1e-8),
+    )
+    .unwrap();
+    let sens = Sensitivities::compute(&Hyper, &s).unwrap();
+    let exact = |x: f64| {
+        let (a, b) = ((p * (1.0 - x)).sinh(), p.sinh());
+        ((1.0 - x) * (p * (1.0 - x)).cosh() * b - a * p.cosh()) / (b * b)
+    };
+    let mut max_dev: f64 = 0.0;
+    for &x in &points() {
+        max_dev = max_dev.max((sens.at(x)[0] - exact(x)).abs());
+    }
+    // discretisation error of a tol = 1e-8 solution
+    assert!(max_dev < 1e-7, "max deviation {max_dev:e}");
+}
+
+fn adjoint_vs_forward(problem: &impl Bvp, sol: &Solution) {
+    let xs = points();
+    let w: Vec<f64> = xs.iter().map(|x| 1.0 + x).collect();
+    let (value, grad) = adjoint_gradient(problem, sol, &xs, &w, &Observe).unwrap();
+    let sens = Sensitivities::compute(problem, sol).unwrap();
+    let (vals, jac) = residual_jacobian(problem, sol, &sens, &xs, &Observe).unwrap();
+    let q = sol.params.len();
+    let v2: f64 = vals.iter().zip(&w).map(|(a, b)| a * b).sum();
+    assert!((value - v2).abs() <= 1e-14 * value.abs().max(1.0));
+    for j in 0..q {
+        let g2: f64 = (0..xs.len()).map(|i| w[i] * jac[i * q + j]).sum();
+        assert!(
+            (grad[j] - g2).abs() <= 1e-10 * g2.abs().max(1e-12),
+            "param {j}: adjoint {} forward {}",
+            grad[j],
+            g2
+        );
+    }
+}
+
+#[test]
+fn adjoint_gradient_equals_forward_gradient() {
+    let s = solve(
+        &BratuAB,
+        &[1.2, 0.3],
+        &Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]),
+        &SolveOptions::with_tol(1e-6),
+    )
+    .unwrap();
+    adjoint_vs_forward(&BratuAB, &s);
+    let g = Guess::from_fn(linspace(0.0, 1.0, 9), 2, |x, y| {
+        let pi = std::f64::consts::PI;
+        y[0] = 0.5 * (pi * x).sin() / pi;
+        y[1] = 0.5 * (pi * x).cos();
+    })
+    .with_unknowns(&[3.0]);
+    let s = solve(&Oscillator, &[2.0, 0.8], &g, &SolveOptions::with_tol(1e-6)).unwrap();
+    adjoint_vs_forward(&Oscillator, &s);
+}
+
+#[test]
+fn sensitivities_with_adaptation_agree_to_discretisation_error() {
+    // adaptive solves at p ± h have different meshes: agreement to the discretisation error
+    let opts = SolveOptions::with_tol(1e-7);
+    let g = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
+    let params = [1.2, 0.3];
+    let base = solve(&BratuAB, &params, &g, &opts).unwrap();
+    let sens = Sensitivities::compute(&BratuAB, &base).unwrap();
+    let h = 1e-4;
+    for j in 0..2 {
+        let mut pp = params;
+        let mut pm = params;
+        pp[j] += h;
+        pm[j] -= h;
+        let sp = solve(&BratuAB, &pp, &g, &opts).unwrap();
+        let sm = solve(&BratuAB, &pm, &g, &opts).unwrap();
+        for &x in &points() {
+            let fd = (sp.eval(x)[0] - sm.eval(x)[0]) / (2.0 * h);
+            assert!(
+                (fd - sens.at(x)[j]).abs() < 1e-4,
+                "x {x} param {j}: fd {fd} vs {}",
+                sens.at(x)[j]
+            );
+        }
+    }
+}
