@@ -32,7 +32,12 @@ fn main() -> Result<(), diffbvp::BvpError> {
     let problem = Bratu { k: 1.0 };
     let options = SolveOptions::with_tol(1e-6);
     let mesh = linspace(0.0, 1.0, 5);
-    let lower = solve(&problem, &[], &Guess::constant(mesh.clone(), &[0.0, 0.0]), &options)?;
+    let lower = solve(
+        &problem,
+        &[],
+        &Guess::constant(mesh.clone(), &[0.0, 0.0]),
+        &options,
+    )?;
     let upper = solve(&problem, &[], &Guess::constant(mesh, &[3.0, 0.0]), &options)?;
     // ANCHOR_END: solve
     for (name, s) in [("lower", &lower), ("upper", &upper)] {

@@ -52,6 +52,7 @@ pub mod error;
 mod error_control;
 pub mod fiber;
 pub mod inspect;
+pub mod least_squares;
 pub mod linear;
 pub mod mesh;
 mod newton;

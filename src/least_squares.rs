@@ -1,0 +1,440 @@
+//! A bounded trust-region Gauss–Newton driver for nonlinear least squares,
+//! `min ½‖r(p)‖²` subject to `lower ≤ p ≤ upper`, for parameter fits whose residuals come from
+//! BVP solves.
+//!
+//! Each iteration solves the trust-region subproblem `min ‖J s + r‖²`, `‖D s‖ ≤ Δ`, exactly
+//! (Levenberg–Marquardt parameter by the secular equation on the eigen-decomposition of `JᵀJ`;
+//! the parameter count is small) with the Coleman–Li affine scaling `D = diag(|v|^{-1/2})`,
+//! where `v_i` is the distance to the bound the negative gradient points at (unbounded
+//! directions get `v_i = 1`). The step is then kept strictly inside the box (truncated at
+//! 0.995 of the way to the nearest bound, then clipped to the box).
+//! The trial point is accepted when the actual reduction is at least 1e-4 of the predicted one.
+//! **A failed model evaluation at a trial point (a BVP that did not converge) is a rejected
+//! step**: the radius shrinks and the iteration goes on. The radius is capped (`max_radius`, in
+//! parameter units) so that warm starts of the BVPs from the last accepted point stay valid.
+//!
+//! The problem keeps its own state (warm starts): [`LeastSquaresProblem::evaluate`] is called at
+//! trial points, [`LeastSquaresProblem::accept`] when a trial point is accepted.
+
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use std::fmt;
+use std::time::Instant;
+
+/// A least-squares problem with exact Jacobians.
+pub trait LeastSquaresProblem {
+    /// Error of a failed evaluation (e.g. a BVP that did not converge).
+    type Error: fmt::Display;
+    /// Number of parameters.
+    fn num_params(&self) -> usize;
+    /// Residuals `r(p)` and Jacobian `∂r/∂p` (row-major, `len × num_params`).
+    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Self::Error>;
+    /// Called when `p` (the last point passed to `evaluate`) becomes the new iterate.
+    fn accept(&mut self, _p: &[f64]) {}
+}
+
+/// Options of [`fit`].
+#[derive(Debug, Clone)]
+pub struct FitOptions {
+    /// Lower bounds (one per parameter; `-inf` for none).
+    pub lower: Vec<f64>,
+    /// Upper bounds (`+inf` for none).
+    pub upper: Vec<f64>,
+    /// Initial trust radius in scaled parameter units (default 0.5).
+    pub initial_radius: f64,
+    /// Cap on the trust radius (default 1.0); keeps warm starts valid.
+    pub max_radius: f64,
+    /// Stop when the scaled gradient's infinity norm is below this (default 1e-8).
+    pub gtol: f64,
+    /// Stop when `‖Δp‖ ≤ xtol (xtol + ‖p‖)` (default 1e-8).
+    pub xtol: f64,
+    /// Stop when the relative cost change of an accepted step is below this (default 1e-10).
+    pub ftol: f64,
+    /// Maximum iterations (accepted or rejected trial steps) (default 100).
+    pub max_iterations: usize,
+}
+
+impl FitOptions {
+    /// Options with bounds and defaults for the rest.
+    pub fn with_bounds(lower: Vec<f64>, upper: Vec<f64>) -> Self {
+        FitOptions {
+            lower,
+            upper,
+            initial_radius: 0.5,
+            max_radius: 1.0,
+            gtol: 1e-8,
+            xtol: 1e-8,
+            ftol: 1e-10,
+            max_iterations: 100,
+        }
+    }
+}
+
+/// Why the fit stopped.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Termination {
+    /// Scaled gradient below `gtol`.
+    Gradient,
+    /// Step below `xtol`.
+    Step,
+    /// Relative cost change below `ftol`.
+    CostChange,
+    /// The iteration budget was spent.
+    MaxIterations,
+    /// The trust radius collapsed (repeated failures or no decrease possible).
+    RadiusCollapsed,
+}
+
+impl fmt::Display for Termination {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            Termination::Gradient => "gradient below gtol",
+            Termination::Step => "step below xtol",
+            Termination::CostChange => "cost change below ftol",
+            Termination::MaxIterations => "maximum number of iterations reached",
+            Termination::RadiusCollapsed => "trust radius collapsed",
+        };
+        f.write_str(s)
+    }
+}
+
+/// One iteration of the fit (for progress reports).
+#[derive(Debug, Clone)]
+pub struct FitIteration {
+    /// Trial point.
+    pub p: Vec<f64>,
+    /// Cost `½‖r‖²` at the trial point (`None` if its evaluation failed).
+    pub cost: Option<f64>,
+    /// Whether the trial point was accepted.
+    pub accepted: bool,
+    /// Trust radius after the iteration.
+    pub radius: f64,
+    /// The evaluation error, if any.
+    pub failure: Option<String>,
+}
+
+/// Result of a least-squares fit.
+#[derive(Debug, Clone)]
+pub struct FitResult {
+    /// Parameters found.
+    pub p: Vec<f64>,
+    /// Cost `½‖r‖²` at `p`.
+    pub cost: f64,
+    /// Residuals at `p`.
+    pub residuals: Vec<f64>,
+    /// Jacobian at `p` (row-major).
+    pub jacobian: Vec<f64>,
+    /// Trial steps done (accepted + rejected).
+    pub iterations: usize,
+    /// Accepted steps.
+    pub accepted_steps: usize,
+    /// Model evaluations that failed (treated as rejected steps).
+    pub failed_evaluations: usize,
+    /// Why it stopped.
+    pub termination: Termination,
+    /// Wall time [s].
+    pub wall_time_s: f64,
+    /// Every iteration.
+    pub history: Vec<FitIteration>,
+}
+
+/// Errors of [`fit`] itself (the model failing at the start point, bad bounds).
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum FitError {
+    /// Inconsistent input.
+    #[error("invalid fit input: {0}")]
+    InvalidInput(String),
+    /// The model could not be evaluated at the start point.
+    #[error("the model could not be evaluated at the start point {p:?}: {cause}")]
+    StartFailed {
+        /// Start point.
+        p: Vec<f64>,
+        /// Cause.
+        cause: String,
+    },
+}
+
+impl FitResult {
+    /// Number of residuals.
+    pub fn num_residuals(&self) -> usize {
+        self.residuals.len()
+    }
+
+    /// Residual variance `‖r‖²/(N − p)` (the Gauss–Newton estimate of σ² for unit weights).
+    pub fn residual_variance(&self) -> f64 {
+        let np = self.p.len();
+        let dof = self.residuals.len().saturating_sub(np).max(1);
+        2.0 * self.cost / dof as f64
+    }
+
+    /// Covariance `σ² (JᵀJ)⁻¹` of the parameters (row-major), `None` if `JᵀJ` is singular.
+    pub fn covariance(&self) -> Option<Vec<f64>> {
+        let np = self.p.len();
+        let j = DMatrix::from_row_slice(self.residuals.len(), np, &self.jacobian);
+        let jtj = j.transpose() * &j;
+        let inv = jtj.try_inverse()?;
+        let s2 = self.residual_variance();
+        Some((0..np * np).map(|i| inv[(i / np, i % np)] * s2).collect())
+    }
+
+    /// Standard errors of the parameters.
+    pub fn standard_errors(&self) -> Option<Vec<f64>> {
+        let np = self.p.len();
+        let c = self.covariance()?;
+        Some((0..np).map(|i| c[i * np + i].max(0.0).sqrt()).collect())
+    }
+
+    /// Correlation matrix (row-major).
+    pub fn correlation(&self) -> Option<Vec<f64>> {
+        let np = self.p.len();
+        let c = self.covariance()?;
+        Some(
+            (0..np * np)
+                .map(|i| {
+                    let (a, b) = (i / np, i % np);
+                    c[i] / (c[a * np + a] * c[b * np + b]).sqrt()
+                })
+                .collect(),
+        )
+    }
+}
+
+fn cost_of(r: &[f64]) -> f64 {
+    0.5 * r.iter().map(|v| v * v).sum::<f64>()
+}
+
+/// Coleman–Li scaling vector: distance to the bound the negative gradient points at.
+fn cl_scaling(p: &[f64], g: &[f64], lo: &[f64], hi: &[f64]) -> Vec<f64> {
+    p.iter()
+        .zip(g)
+        .zip(lo.iter().zip(hi))
+        .map(|((&x, &gi), (&l, &u))| {
+            let v = if gi < 0.0 && u.is_finite() {
+                u - x
+            } else if gi > 0.0 && l.is_finite() {
+                x - l
+            } else {
+                1.0
+            };
+            v.abs().clamp(1e-12, 1.0)
+        })
+        .collect()
+}
+
+/// Solves `min ‖J s + r‖²` s.t. `‖D s‖ ≤ Δ` and returns the step `s`.
+fn trust_region_step(j: &DMatrix<f64>, r: &DVector<f64>, d: &[f64], radius: f64) -> DVector<f64> {
+    let np = j.ncols();
+    // scaled variables u = D s: J s = (J D⁻¹) u
+    let mut js = j.clone();
+    for c in 0..np {
+        let inv = 1.0 / d[c];
+        for rr in 0..js.nrows() {
+            js[(rr, c)] *= inv;
+        }
+    }
+    let a = js.transpose() * &js;
+    let g = js.transpose() * r;
+    let eig = SymmetricEigen::new(a);
+    let q = &eig.eigenvectors;
+    let lam = &eig.eigenvalues;
+    let gq = q.transpose() * &g;
+    let lmax = lam.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let floor = 1e-14 * lmax.max(1e-300);
+    let step_for = |mu: f64| -> DVector<f64> {
+        let mut z = DVector::zeros(np);
+        for i in 0..np {
+            let den = lam[i].max(0.0) + mu;
+            z[i] = if den > floor { -gq[i] / den } else { 0.0 };
+        }
+        q * z
+    };
+    let mut u = step_for(0.0);
+    if u.norm() > radius {
+        // ‖u(μ)‖ decreases in μ; at μ = ‖g‖/Δ + λ_max it is ≤ Δ. Geometric bisection.
+        let mut hi = g.norm() / radius + lmax;
+        let mut lo = hi * 1e-16;
+        for _ in 0..200 {
+            let mid = (lo * hi).sqrt();
+            if step_for(mid).norm() > radius {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            if hi <= lo * (1.0 + 1e-10) {
+                break;
+            }
+        }
+        u = step_for(hi);
+    }
+    DVector::from_iterator(np, (0..np).map(|i| u[i] / d[i]))
+}
+
+/// Runs the bounded trust-region Gauss–Newton iteration from `p0`.
+pub fn fit<L: LeastSquaresProblem>(
+    problem: &mut L,
+    p0: &[f64],
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let t0 = Instant::now();
+    let np = problem.num_params();
+    if p0.len() != np || options.lower.len() != np || options.upper.len() != np {
+        return Err(FitError::InvalidInput(format!(
+            "{np} parameters, but start has {}, lower {}, upper {}",
+            p0.len(),
+            options.lower.len(),
+            options.upper.len()
+        )));
+    }
+    for i in 0..np {
+        let (l, u, x) = (options.lower[i], options.upper[i], p0[i]);
+        let valid = l < u && x >= l && x <= u && x.is_finite();
+        if !valid {
+            return Err(FitError::InvalidInput(format!(
+                "parameter {i}: start {x} must lie in [{l}, {u}] with lower < upper"
+            )));
+        }
+    }
+    let (lo, hi) = (&options.lower, &options.upper);
+    let mut p = p0.to_vec();
+    let (mut r, mut jac) = problem.evaluate(&p).map_err(|e| FitError::StartFailed {
+        p: p.clone(),
+        cause: e.to_string(),
+    })?;
+    problem.accept(&p);
+    let nr = r.len();
+    if nr < np {
+        return Err(FitError::InvalidInput(format!(
+            "{nr} residuals for {np} parameters: the fit is underdetermined"
+        )));
+    }
+    let mut cost = cost_of(&r);
+    let mut radius = options.initial_radius.min(options.max_radius);
+    let mut history = Vec::new();
+    let (mut iterations, mut accepted_steps, mut failed) = (0, 0, 0);
+    let termination;
+    loop {
+        let jm = DMatrix::from_row_slice(nr, np, &jac);
+        let rv = DVector::from_column_slice(&r);
+        let g = jm.transpose() * &rv;
+        let v = cl_scaling(&p, g.as_slice(), lo, hi);
+        let scaled_g = (0..np).map(|i| (g[i] * v[i]).abs()).fold(0.0, f64::max);
+        if scaled_g <= options.gtol {
+            termination = Termination::Gradient;
+            break;
+        }
+        if iterations >= options.max_iterations {
+            termination = Termination::MaxIterations;
+            break;
+        }
+        if radius < 1e-12 {
+            termination = Termination::RadiusCollapsed;
+            break;
+        }
+        let d: Vec<f64> = v.iter().map(|x| 1.0 / x.sqrt()).collect();
+        let s = trust_region_step(&jm, &rv, &d, radius);
+        // keep strictly inside the box
+        let mut t_max = 1.0f64;
+        for i in 0..np {
+            if s[i] > 0.0 && hi[i].is_finite() {
+                t_max = t_max.min((hi[i] - p[i]) / s[i]);
+            } else if s[i] < 0.0 && lo[i].is_finite() {
+                t_max = t_max.min((lo[i] - p[i]) / s[i]);
+            }
+        }
+        let theta = 0.995;
+        let mut trial: Vec<f64> = if t_max < 1.0 {
+            (0..np).map(|i| p[i] + theta * t_max * s[i]).collect()
+        } else {
+            (0..np).map(|i| p[i] + s[i]).collect()
+        };
+        for i in 0..np {
+            trial[i] = trial[i].clamp(lo[i], hi[i]);
+        }
+        let step: Vec<f64> = (0..np).map(|i| trial[i] - p[i]).collect();
+        let step_vec = DVector::from_column_slice(&step);
+        let jr = &jm * &step_vec;
+        let pred_trial = -(jr.dot(&rv) + 0.5 * jr.norm_squared());
+        iterations += 1;
+        let pnorm = p.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let snorm = step_vec.norm();
+        match problem.evaluate(&trial) {
+            Ok((r_new, j_new)) if r_new.len() == nr && r_new.iter().all(|x| x.is_finite()) => {
+                let cost_new = cost_of(&r_new);
+                let actual = cost - cost_new;
+                let rho = if pred_trial > 0.0 {
+                    actual / pred_trial
+                } else {
+                    -1.0
+                };
+                let accepted = rho > 1e-4;
+                if rho < 0.25 {
+                    radius *= 0.25;
+                } else if rho > 0.75
+                    && snorm * d.iter().fold(0.0f64, |m, x| m.max(*x)) >= 0.9 * radius
+                {
+                    radius = (2.0 * radius).min(options.max_radius);
+                }
+                history.push(FitIteration {
+                    p: trial.clone(),
+                    cost: Some(cost_new),
+                    accepted,
+                    radius,
+                    failure: None,
+                });
+                if accepted {
+                    problem.accept(&trial);
+                    accepted_steps += 1;
+                    let rel_change = actual.abs() / cost.max(1e-300);
+                    p = trial;
+                    r = r_new;
+                    jac = j_new;
+                    cost = cost_new;
+                    if rel_change < options.ftol {
+                        termination = Termination::CostChange;
+                        break;
+                    }
+                    if snorm <= options.xtol * (options.xtol + pnorm) {
+                        termination = Termination::Step;
+                        break;
+                    }
+                } else if snorm <= options.xtol * (options.xtol + pnorm) {
+                    termination = Termination::Step;
+                    break;
+                }
+            }
+            Ok(_) => {
+                failed += 1;
+                radius *= 0.25;
+                history.push(FitIteration {
+                    p: trial,
+                    cost: None,
+                    accepted: false,
+                    radius,
+                    failure: Some("non-finite or mis-sized residuals".into()),
+                });
+            }
+            Err(e) => {
+                failed += 1;
+                radius *= 0.25;
+                history.push(FitIteration {
+                    p: trial,
+                    cost: None,
+                    accepted: false,
+                    radius,
+                    failure: Some(e.to_string()),
+                });
+            }
+        }
+    }
+    Ok(FitResult {
+        p,
+        cost,
+        residuals: r,
+        jacobian: jac,
+        iterations,
+        accepted_steps,
+        failed_evaluations: failed,
+        termination,
+        wall_time_s: t0.elapsed().as_secs_f64(),
+        history,
+    })
+}

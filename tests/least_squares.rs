@@ -1,0 +1,135 @@
+#![allow(clippy::needless_range_loop)]
+//! The bounded trust-region Gauss–Newton driver on BVP parameter fits.
+
+use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem, Termination};
+use diffbvp::mesh::linspace;
+use diffbvp::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
+use diffbvp::{Bvp, BvpError, DualNum, Guess, Solution, SolveOptions, Solver};
+
+/// y'' = -a e^y, y(0) = b, y(1) = 0 with model parameters (a, b).
+struct BratuAB;
+impl Bvp for BratuAB {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = -p[0] * y[0].exp();
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
+        r[0] = ya[0] - p[1];
+        r[1] = yb[0];
+    }
+}
+
+/// r_j = y(x_j) - data_j
+struct Misfit<'a> {
+    data: &'a [f64],
+}
+impl PointFunction for Misfit<'_> {
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], _p: &[D]) -> D {
+        y[0] - self.data[j]
+    }
+}
+
+struct BvpFit<'a> {
+    solver: Solver<'a, BratuAB>,
+    xs: Vec<f64>,
+    data: Vec<f64>,
+    accepted: Solution,
+    pending: Option<Solution>,
+}
+
+impl LeastSquaresProblem for BvpFit<'_> {
+    type Error = BvpError;
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), BvpError> {
+        // warm start from the last accepted solution
+        let sol = self.solver.solve(p, &Guess::from(&self.accepted))?;
+        let sens = Sensitivities::compute(&BratuAB, &sol)?;
+        let out = residual_jacobian(
+            &BratuAB,
+            &sol,
+            &sens,
+            &self.xs,
+            &Misfit { data: &self.data },
+        )?;
+        self.pending = Some(sol);
+        Ok(out)
+    }
+    fn accept(&mut self, _p: &[f64]) {
+        if let Some(s) = self.pending.take() {
+            self.accepted = s;
+        }
+    }
+}
+
+fn make_fit(truth: [f64; 2], start: [f64; 2]) -> BvpFit<'static> {
+    let opts = SolveOptions::with_tol(1e-8);
+    let mut solver = Solver::new(&BratuAB, opts);
+    let g = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
+    let xs: Vec<f64> = (1..20).map(|i| i as f64 / 20.0).collect();
+    let truth_sol = solver.solve(&truth, &g).unwrap();
+    let data: Vec<f64> = xs.iter().map(|&x| truth_sol.eval(x)[0]).collect();
+    let accepted = solver.solve(&start, &g).unwrap();
+    BvpFit {
+        solver,
+        xs,
+        data,
+        accepted,
+        pending: None,
+    }
+}
+
+#[test]
+fn recovers_known_optimum() {
+    let mut prob = make_fit([1.7, 0.4], [0.5, 0.0]);
+    let opts = FitOptions::with_bounds(vec![0.0, -1.0], vec![3.0, 1.0]);
+    let res = fit(&mut prob, &[0.5, 0.0], &opts).unwrap();
+    assert!((res.p[0] - 1.7).abs() < 1e-6, "{:?}", res.p);
+    assert!((res.p[1] - 0.4).abs() < 1e-6, "{:?}", res.p);
+    assert!(res.cost < 1e-14);
+    assert!(res.iterations < 30);
+    assert_ne!(res.termination, Termination::MaxIterations);
+    assert!(res.standard_errors().is_some());
+}
+
+#[test]
+fn stops_at_an_active_bound() {
+    // optimum a = 1.7 lies above the upper bound 1.2
+    let mut prob = make_fit([1.7, 0.4], [0.5, 0.0]);
+    let opts = FitOptions::with_bounds(vec![0.0, -1.0], vec![1.2, 1.0]);
+    let res = fit(&mut prob, &[0.5, 0.0], &opts).unwrap();
+    assert!(res.p[0] <= 1.2 && res.p[0] > 1.19, "{:?}", res.p);
+    assert!(res.p.iter().zip([0.0, -1.0]).all(|(p, l)| *p >= l));
+}
+
+#[test]
+fn failed_bvp_at_trial_point_is_a_rejected_step() {
+    // Bratu has no solution for a beyond its turning point (≈ 3.51 at b = 0): a long first
+    // Gauss–Newton step from a = 1 towards data made at a = 3.3 lands there and must be rejected.
+    let mut prob = make_fit([3.3, 0.0], [1.0, 0.0]);
+    let mut opts = FitOptions::with_bounds(vec![0.0, -1.0], vec![10.0, 1.0]);
+    opts.initial_radius = 6.0;
+    opts.max_radius = 6.0;
+    let res = fit(&mut prob, &[1.0, 0.0], &opts).unwrap();
+    assert!(res.failed_evaluations >= 1, "history {:?}", res.history);
+    assert!(res
+        .history
+        .iter()
+        .any(|h| h.failure.is_some() && !h.accepted));
+    assert!((res.p[0] - 3.3).abs() < 1e-5, "{:?}", res.p);
+}
+
+#[test]
+fn bad_start_is_an_error() {
+    let mut prob = make_fit([1.7, 0.4], [0.5, 0.0]);
+    let opts = FitOptions::with_bounds(vec![0.0, -1.0], vec![3.0, 1.0]);
+    assert!(fit(&mut prob, &[5.0, 0.0], &opts).is_err());
+    assert!(fit(&mut prob, &[0.5], &opts).is_err());
+}
