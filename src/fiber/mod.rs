@@ -3,3 +3,4 @@
 //! A *user* of the generic toolkit: nothing in the solver core refers to this module.
 
 pub mod setup;
+pub mod smoothing;
