@@ -2,8 +2,8 @@
 mod collocation;
 mod dual_jacobian;
 pub mod error;
-pub mod fiber;
 mod error_control;
+pub mod fiber;
 pub mod linear;
 pub mod mesh;
 mod newton;
