@@ -2,5 +2,6 @@
 //!
 //! A *user* of the generic toolkit: nothing in the solver core refers to this module.
 
+pub mod input;
 pub mod setup;
 pub mod smoothing;

@@ -14,9 +14,9 @@ pub struct Material {
     pub heat_capacity_intercept: f64,
     /// VFT prefactor `μ_c` of the zero-shear viscosity `μ_s0(T) = μ_c exp(B/(T - T_VF))` [Pa s].
     pub vft_mu_c: f64,
-    /// VFT activation temperature `B` [K].
+    /// VFT activation temperature `B` (K).
     pub vft_b: f64,
-    /// Vogel temperature `T_VF` [K].
+    /// Vogel temperature `T_VF` (K).
     pub vft_t_vf: f64,
     /// Trouton ratio `μ_e0/μ_s0` [-] (3 for generalized Newtonian fluids).
     pub trouton: f64,
@@ -105,9 +105,9 @@ pub struct Experiment {
     pub mass_flow: f64,
     /// Inlet condition.
     pub inlet: Inlet,
-    /// Fiber temperature at the inlet `T_in` [K].
+    /// Fiber temperature at the inlet `T_in` (K).
     pub inlet_temperature: f64,
-    /// Ambient air temperature `T_air` [K].
+    /// Ambient air temperature `T_air` (K).
     pub air_temperature: f64,
     /// Spin-line length `L` [m].
     pub spinline_length: f64,
