@@ -132,12 +132,16 @@ pub fn smooth(s: &[f64], d: &[f64]) -> Result<SmoothFit, SmoothingError> {
         initial_radius: 1.0,
         max_radius: 10.0,
         max_iterations: 200,
-        ..FitOptions::with_bounds(vec![0.05, 1e-6 * length, 1.0 + 1e-9], vec![20.0, 100.0 * length, 1e6])
+        ..FitOptions::with_bounds(
+            vec![0.05, 1e-6 * length, 1.0 + 1e-9],
+            vec![20.0, 100.0 * length, 1e6],
+        )
     };
     // residual u_f d² - 1 = (u_f/u0) (d/d0)² - 1
     let ratio2: Vec<f64> = d2.iter().map(|x| x * u0).collect();
     let mut prob = AnsatzProblem { s, d2: ratio2 };
-    let res = fit(&mut prob, &[b0, c0, w0], &opts).map_err(|e| SmoothingError::FitFailed(e.to_string()))?;
+    let res = fit(&mut prob, &[b0, c0, w0], &opts)
+        .map_err(|e| SmoothingError::FitFailed(e.to_string()))?;
     let rms = (2.0 * res.cost / s.len() as f64).sqrt();
     Ok(SmoothFit {
         b: res.p[0],
@@ -154,7 +158,11 @@ pub fn smooth(s: &[f64], d: &[f64]) -> Result<SmoothFit, SmoothingError> {
 fn initial_guess(s: &[f64], d2: &[f64]) -> (f64, f64, f64) {
     let d0 = d2[0];
     let tail = d2.len().saturating_sub(3).max(1);
-    let dmin = d2[tail..].iter().cloned().fold(f64::INFINITY, f64::min).min(d0 * 0.999);
+    let dmin = d2[tail..]
+        .iter()
+        .cloned()
+        .fold(f64::INFINITY, f64::min)
+        .min(d0 * 0.999);
     // plateau slightly below the smallest measured d² (noise)
     let dv = 0.9 * dmin;
     let w = (d0 / dv).max(1.0 + 1e-6);
