@@ -1,6 +1,7 @@
 //! diffbvp (work in progress)
 mod collocation;
 mod dual_jacobian;
+pub mod dyn_dual;
 pub mod error;
 pub mod fiber;
 mod error_control;
