@@ -48,6 +48,7 @@
 mod collocation;
 pub mod continuation;
 mod dual_jacobian;
+pub mod dyn_dual;
 pub mod error;
 mod error_control;
 pub mod fiber;

@@ -1,7 +1,33 @@
 //! The stationary melt-spinning fiber model and the rheometer built on it.
 //!
 //! A *user* of the generic toolkit: nothing in the solver core refers to this module.
+//!
+//! * [`setup`]: SI inputs (material, air, experiment);
+//! * [`input`]: loading experiments from the project's TOML + CSV format;
+//! * [`scaling`]: non-dimensionalisation (paper Table 2);
+//! * [`material_law`]: elongational viscosity laws (Newtonian, Carreau-type, Carreau–Yasuda);
+//! * [`contributions`]: named force and heat terms, air environment, Nusselt law;
+//! * [`model`]: the strain-rate formulation as a [`Bvp`](crate::Bvp);
+//! * [`cold_start`]: continuation from the stress-free fiber;
+//! * [`simulate`]: the user-facing API with SI profiles;
+//! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5).
 
+pub mod cold_start;
+pub mod contributions;
+pub mod error;
 pub mod input;
+pub mod material_law;
+pub mod model;
+pub mod scaling;
 pub mod setup;
+pub mod simulate;
 pub mod smoothing;
+
+pub use contributions::{
+    Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength,
+};
+pub use error::FiberError;
+pub use material_law::{CarreauLike, CarreauYasuda, Newtonian, ViscosityLaw};
+pub use model::FiberModel;
+pub use scaling::{ReferenceValues, Scaling};
+pub use simulate::{simulate, FiberSolution, Profiles, SimulateOptions};

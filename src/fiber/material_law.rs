@@ -1,0 +1,333 @@
+//! Elongational viscosity laws `μ_e(T, ε̇; p)` in dimensionless form.
+//!
+//! A law sees the dimensionless temperature `T̃ = T/T_o`, the dimensionless zero-rate
+//! elongational viscosity `μ̃_e0(T̃) = Tr μ_s0(T)/μ_o` (VFT, computed by the model from the
+//! [`Material`](super::setup::Material)), the dimensionless strain rate `ε̇̃ = ε̇ L_o/u_o`, the
+//! Deborah number `De = μ_o u_o/(K_o L_o)` and its parameters `p` (as dual numbers, so
+//! derivatives with respect to them are exact). It returns `μ̃_e = μ_e/μ_o`.
+//!
+//! The strain-rate formulation needs `∂_T μ_e` and `∂_ε̇ μ_e`; [`viscosity_with_partials`] gets
+//! them by nested dual numbers (`num_dual::Dual<D>` over the caller's `D`), so a law is written
+//! once, without hand-coded derivatives. Laws must be strictly monotone in the strain rate
+//! (`∂_ε̇ (μ_e ε̇) > 0`) and smooth at `ε̇ = 0` (the stress-free start has `ε̇ ≡ 0`): write powers of
+//! `1 + x²` as `exp(a ln(1 + x²))`, never `powf`/`sqrt` of a quantity that can be 0.
+
+use num_dual::{Dual, DualNum};
+
+/// Largest number of law parameters supported by [`viscosity_with_partials`].
+pub const MAX_LAW_PARAMS: usize = 8;
+
+/// Inputs of a viscosity law at one point, dimensionless.
+#[derive(Debug, Clone, Copy)]
+pub struct LawInputs<D> {
+    /// Temperature `T̃ = T/T_o` [-].
+    pub t: D,
+    /// Zero-rate elongational viscosity `μ̃_e0(T̃)` [-].
+    pub mu0: D,
+    /// Strain rate `ε̇̃` [-].
+    pub rate: D,
+    /// Deborah number `De` [-].
+    pub de: f64,
+}
+
+/// An elongational viscosity law, strictly monotone in the strain rate.
+pub trait ViscosityLaw: Send + Sync {
+    /// Names of the parameters, in order (e.g. `["n", "kappa"]`).
+    fn param_names(&self) -> &'static [&'static str];
+
+    /// Number of parameters.
+    fn num_params(&self) -> usize {
+        self.param_names().len()
+    }
+
+    /// Whether `p` is admissible (e.g. `n ≥ 0`); used to validate user input.
+    fn check_params(&self, p: &[f64]) -> Result<(), String> {
+        if p.len() != self.num_params() {
+            return Err(format!(
+                "the law expects {} parameters {:?}, got {}",
+                self.num_params(),
+                self.param_names(),
+                p.len()
+            ));
+        }
+        if let Some(v) = p.iter().find(|v| !v.is_finite()) {
+            return Err(format!("law parameter {v} is not finite"));
+        }
+        Ok(())
+    }
+
+    /// Dimensionless elongational viscosity `μ̃_e`.
+    fn mu_e<D: DualNum<Primitive = f64> + Copy>(&self, x: &LawInputs<D>, p: &[D]) -> D;
+}
+
+/// Dimensionless VFT zero-rate elongational viscosity
+/// `μ̃_e0(T̃) = a exp(b/(T̃ − t_VF))` with `a = Tr μ_c/μ_o`, `b = B/T_o`, `t_VF = T_VF/T_o`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ZeroRateViscosity {
+    /// `Tr μ_c/μ_o` [-].
+    pub a: f64,
+    /// `B/T_o` [-].
+    pub b: f64,
+    /// `T_VF/T_o` [-].
+    pub t_vf: f64,
+}
+
+impl ZeroRateViscosity {
+    /// Evaluates `μ̃_e0(T̃)`.
+    #[inline]
+    pub fn eval<D: DualNum<Primitive = f64> + Copy>(&self, t: D) -> D {
+        ((t - self.t_vf).recip() * self.b).exp() * self.a
+    }
+}
+
+/// Newtonian law `μ_e = μ_e0(T)` (no parameters).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Newtonian;
+
+impl ViscosityLaw for Newtonian {
+    fn param_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+    #[inline]
+    fn mu_e<D: DualNum<Primitive = f64> + Copy>(&self, x: &LawInputs<D>, _p: &[D]) -> D {
+        x.mu0
+    }
+}
+
+/// The paper's Carreau-type law (eq. CarreauLikeLaw), parameters `p = (n, κ)`, `K = exp(κ)` [Pa]:
+/// `μ_e = μ_e0 (1 + De² (μ_e0 ε̇/K̃)²)^((n−1)/2)` with `K̃ = K/K_o` (dimensionless form).
+/// Newtonian for `n → 1` or `κ → ∞`. Monotone for `n ≥ 0`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CarreauLike {
+    /// Stress scale `K_o` [Pa] of the non-dimensionalisation (`K̃ = exp(κ)/K_o`); 1 Pa in the
+    /// paper.
+    pub stress_scale: f64,
+}
+
+impl CarreauLike {
+    /// The law with `K_o = 1 Pa` (paper Table 2).
+    pub fn new() -> Self {
+        CarreauLike { stress_scale: 1.0 }
+    }
+}
+
+impl ViscosityLaw for CarreauLike {
+    fn param_names(&self) -> &'static [&'static str] {
+        &["n", "kappa"]
+    }
+    fn check_params(&self, p: &[f64]) -> Result<(), String> {
+        if p.len() != 2 || !p.iter().all(|v| v.is_finite()) {
+            return Err(format!(
+                "Carreau-type law needs finite (n, kappa), got {p:?}"
+            ));
+        }
+        if p[0] < 0.0 {
+            return Err(format!("power index n = {} must be >= 0", p[0]));
+        }
+        Ok(())
+    }
+    #[inline]
+    fn mu_e<D: DualNum<Primitive = f64> + Copy>(&self, x: &LawInputs<D>, p: &[D]) -> D {
+        let (n, kappa) = (p[0], p[1]);
+        // λ ε̇ De = De μ0 ε̇ / K̃, K̃ = exp(κ)/K_o
+        let w = x.mu0 * x.rate * (-kappa).exp() * (x.de * self.stress_scale_or_one());
+        let ln1p = (w * w).ln_1p();
+        x.mu0 * ((n - 1.0) * 0.5 * ln1p).exp()
+    }
+}
+
+impl CarreauLike {
+    #[inline]
+    fn stress_scale_or_one(&self) -> f64 {
+        if self.stress_scale > 0.0 {
+            self.stress_scale
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Carreau–Yasuda-type law with the same `K`: `μ_e = μ_e0 (1 + |w|^a)^((n−1)/a)`,
+/// `w = De μ_e0 ε̇/K̃`, parameters `p = (n, κ)`, fixed Yasuda exponent `a > 1` [-]
+/// (`a = 2` is [`CarreauLike`]). Monotone for `n ≥ 0`. `|w|^a` is evaluated as
+/// `exp(a/2 · ln w²)` away from `w = 0` and as exactly 0 (derivative 0, correct for `a > 1`) at it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CarreauYasuda {
+    /// Yasuda exponent `a > 1` [-].
+    pub a: f64,
+    /// Stress scale `K_o` [Pa] (1 Pa in the paper).
+    pub stress_scale: f64,
+}
+
+impl CarreauYasuda {
+    /// The law with exponent `a` and `K_o = 1 Pa`.
+    pub fn new(a: f64) -> Self {
+        CarreauYasuda {
+            a,
+            stress_scale: 1.0,
+        }
+    }
+}
+
+impl ViscosityLaw for CarreauYasuda {
+    fn param_names(&self) -> &'static [&'static str] {
+        &["n", "kappa"]
+    }
+    fn check_params(&self, p: &[f64]) -> Result<(), String> {
+        if !(self.a > 1.0 && self.a.is_finite()) {
+            return Err(format!("Yasuda exponent a = {} must be > 1", self.a));
+        }
+        CarreauLike::new().check_params(p)
+    }
+    #[inline]
+    fn mu_e<D: DualNum<Primitive = f64> + Copy>(&self, x: &LawInputs<D>, p: &[D]) -> D {
+        let (n, kappa) = (p[0], p[1]);
+        let w = x.mu0 * x.rate * (-kappa).exp() * (x.de * self.stress_scale);
+        let w2 = w * w;
+        let wa = if w2.re() > 0.0 {
+            (w2.ln() * (0.5 * self.a)).exp()
+        } else {
+            D::zero()
+        };
+        x.mu0 * ((n - 1.0) / self.a * wa.ln_1p()).exp()
+    }
+}
+
+/// `(μ_e, ∂_T μ_e, ∂_ε̇ μ_e)` (all dimensionless) at temperature `t`, strain rate `rate` and law
+/// parameters `p`, by nested dual numbers: `μ_e0` is recomputed from `zero` on the lifted
+/// temperature so that `∂_T` includes the VFT dependence. Exact for every `D`.
+#[inline]
+pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
+    law: &L,
+    zero: &ZeroRateViscosity,
+    de: f64,
+    t: D,
+    rate: D,
+    p: &[D],
+) -> (D, D, D) {
+    let k = p.len().min(MAX_LAW_PARAMS);
+    let mut pl = [Dual::from_re(D::zero()); MAX_LAW_PARAMS];
+    for (l, &v) in pl.iter_mut().zip(&p[..k]) {
+        *l = Dual::from_re(v);
+    }
+    let pl = &pl[..k];
+    // ∂_T
+    let tt = Dual::new(t, D::one());
+    let xt = LawInputs {
+        t: tt,
+        mu0: zero.eval(tt),
+        rate: Dual::from_re(rate),
+        de,
+    };
+    let mt = law.mu_e(&xt, pl);
+    // ∂_ε̇
+    let t0 = Dual::from_re(t);
+    let xr = LawInputs {
+        t: t0,
+        mu0: Dual::from_re(xt.mu0.re),
+        rate: Dual::new(rate, D::one()),
+        de,
+    };
+    let mr = law.mu_e(&xr, pl);
+    (mt.re, mt.eps, mr.eps)
+}
+
+/// `μ̃_e` alone (no derivatives).
+#[inline]
+pub fn viscosity<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
+    law: &L,
+    zero: &ZeroRateViscosity,
+    de: f64,
+    t: D,
+    rate: D,
+    p: &[D],
+) -> D {
+    law.mu_e(
+        &LawInputs {
+            t,
+            mu0: zero.eval(t),
+            rate,
+            de,
+        },
+        p,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn zero() -> ZeroRateViscosity {
+        // PMMA7N with Table 2 scaling
+        ZeroRateViscosity {
+            a: 3.0 * 3.7074e-4 / 1.4865e3,
+            b: 3649.0 / 513.15,
+            t_vf: 273.15 / 513.15,
+        }
+    }
+
+    #[test]
+    fn zero_rate_viscosity_is_three_at_inlet() {
+        assert!((zero().eval(1.0f64) - 3.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn partials_match_finite_differences() {
+        let z = zero();
+        let laws: [&dyn Fn(f64, f64) -> (f64, f64, f64); 2] = [
+            &|t, r| viscosity_with_partials(&CarreauLike::new(), &z, 82.486, t, r, &[0.8, 11.71]),
+            &|t, r| {
+                viscosity_with_partials(&CarreauYasuda::new(1.5), &z, 82.486, t, r, &[0.7, 11.0])
+            },
+        ];
+        for law in laws {
+            for &(t, r) in &[(1.0, 0.0), (0.8, 3.0), (0.7, 40.0)] {
+                let (m, mt, mr) = law(t, r);
+                let h = 1e-6;
+                let fdt = (law(t + h, r).0 - law(t - h, r).0) / (2.0 * h);
+                let fdr =
+                    (law(t, r + h).0 - law(t, (r - h).max(0.0)).0) / (r + h - (r - h).max(0.0));
+                assert!(m.is_finite() && mt.is_finite() && mr.is_finite());
+                assert!((mt - fdt).abs() <= 1e-6 * (1.0 + fdt.abs()), "{mt} {fdt}");
+                if r > 0.0 {
+                    assert!((mr - fdr).abs() <= 1e-6 * (1.0 + fdr.abs()), "{mr} {fdr}");
+                } else {
+                    assert_eq!(mr, 0.0);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn carreau_is_strictly_monotone_and_tends_to_newtonian() {
+        let z = zero();
+        let c = CarreauLike::new();
+        let mut last = 0.0;
+        for i in 0..200 {
+            let r = i as f64 * 0.5;
+            let s = viscosity(&c, &z, 82.486, 0.8f64, r, &[0.3, 11.0]) * r;
+            assert!(s > last || i == 0);
+            last = s;
+        }
+        let newt = viscosity(&Newtonian, &z, 82.486, 0.8f64, 5.0, &[]);
+        let near = viscosity(&c, &z, 82.486, 0.8f64, 5.0, &[1.0 - 1e-9, 11.71]);
+        assert!((near / newt - 1.0).abs() < 1e-8);
+        let stiff = viscosity(&c, &z, 82.486, 0.8f64, 5.0, &[0.8, 60.0]);
+        assert!((stiff / newt - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn yasuda_with_a_two_is_carreau() {
+        let z = zero();
+        let a = viscosity(
+            &CarreauYasuda::new(2.0),
+            &z,
+            82.486,
+            0.9f64,
+            7.0,
+            &[0.8, 11.71],
+        );
+        let b = viscosity(&CarreauLike::new(), &z, 82.486, 0.9f64, 7.0, &[0.8, 11.71]);
+        assert!((a / b - 1.0).abs() < 1e-13);
+    }
+}

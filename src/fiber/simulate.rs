@@ -1,0 +1,276 @@
+//! The user-facing simulation API: from SI inputs to SI profiles.
+//!
+//! ```no_run
+//! use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
+//! use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+//! let exp = Experiment {
+//!     name: "v0p53_p2".into(),
+//!     mass_flow: 3.08e-5,
+//!     inlet: Inlet::Diameter(1.134e-3),
+//!     inlet_temperature: 513.15,
+//!     air_temperature: 293.15,
+//!     spinline_length: 0.51,
+//!     take_up: Some(TakeUp::Diameter(9e-5)),
+//! };
+//! let model = FiberModel::new(&Material::pmma7n(), &Air::paper(), &exp, CarreauLike::new(), Physics::paper())?;
+//! let sol = simulate(&model, &[0.8, 11.71], &SimulateOptions::default())?;
+//! let prof = sol.profiles(&model, &[0.0, 0.25, 0.51]);
+//! println!("d(L) = {} m, T(L) = {} K", prof.diameter[2], prof.temperature[2]);
+//! # Ok::<(), diffbvp::fiber::FiberError>(())
+//! ```
+
+use super::cold_start::{continuation_in_c, ContinuationOptions};
+use super::contributions::{Balance, NusseltLaw};
+use super::error::FiberError;
+use super::material_law::ViscosityLaw;
+use super::model::FiberModel;
+use crate::mesh::linspace;
+use crate::solution::Solution;
+use crate::solve::{Guess, ResidualScale, SolveOptions, Solver};
+
+/// Options of [`simulate`].
+#[derive(Debug, Clone)]
+pub struct SimulateOptions {
+    /// Tolerance on the scaled collocation residual (default 1e-6).
+    pub tol: f64,
+    /// Tolerance on the boundary residuals (default: `tol`).
+    pub bc_tol: Option<f64>,
+    /// Maximum number of mesh nodes (default 20 000).
+    pub max_nodes: usize,
+    /// Typical magnitudes of `(ũ, Ñ, T̃, ε̇̃)` for the residual scale (default `[1e2, 1e4, 1, 1e3]`).
+    pub scale: [f64; 4],
+    /// Nodes of the initial uniform mesh of a cold start (default 21).
+    pub initial_nodes: usize,
+    /// Continuation settings of a cold start.
+    pub continuation: ContinuationOptions,
+    /// Keep the factorised Jacobian at the solution (for sensitivities; default `false`).
+    pub factor_at_solution: bool,
+    /// Nodes (positions in m) that must be in the final mesh, e.g. output positions (default none).
+    pub required_positions: Vec<f64>,
+}
+
+impl Default for SimulateOptions {
+    fn default() -> Self {
+        SimulateOptions {
+            tol: 1e-6,
+            bc_tol: None,
+            max_nodes: 20_000,
+            scale: [1e2, 1e4, 1.0, 1e3],
+            initial_nodes: 21,
+            continuation: ContinuationOptions::default(),
+            factor_at_solution: false,
+            required_positions: Vec::new(),
+        }
+    }
+}
+
+impl SimulateOptions {
+    /// Default options with tolerance `tol`.
+    pub fn with_tol(tol: f64) -> Self {
+        SimulateOptions {
+            tol,
+            ..Default::default()
+        }
+    }
+
+    /// The toolkit options these settings translate to.
+    pub fn solve_options(&self) -> SolveOptions {
+        SolveOptions {
+            tol: self.tol,
+            bc_tol: self.bc_tol,
+            max_nodes: self.max_nodes,
+            scale: ResidualScale::PerComponent(self.scale.to_vec()),
+            factor_at_solution: self.factor_at_solution,
+            ..Default::default()
+        }
+    }
+}
+
+/// A converged fiber solution (dimensionless states inside) with SI accessors.
+#[derive(Debug, Clone)]
+pub struct FiberSolution {
+    /// The toolkit solution: `x = s̃`, `y = (ũ, Ñ, T̃, ε̇̃)`, `params = p`.
+    pub solution: Solution,
+}
+
+/// Profiles in SI units at chosen positions.
+#[derive(Debug, Clone, Default)]
+pub struct Profiles {
+    /// Positions `s` [m].
+    pub position: Vec<f64>,
+    /// Fiber speed `u` [m/s].
+    pub velocity: Vec<f64>,
+    /// Axial force `N` [N].
+    pub force: Vec<f64>,
+    /// Temperature `T` [K].
+    pub temperature: Vec<f64>,
+    /// Strain rate `ε̇ = u'` [1/s].
+    pub strain_rate: Vec<f64>,
+    /// Diameter `d` [m].
+    pub diameter: Vec<f64>,
+    /// Elongational viscosity `μ_e(T, ε̇)` [Pa s].
+    pub viscosity: Vec<f64>,
+    /// Every named term: name, balance, values in N/m (momentum) or W/m (energy).
+    pub terms: Vec<(&'static str, Balance, Vec<f64>)>,
+}
+
+impl FiberSolution {
+    /// Number of mesh nodes.
+    pub fn nodes(&self) -> usize {
+        self.solution.nodes()
+    }
+
+    /// Profiles at `positions` [m] through the solution's C¹ interpolant.
+    pub fn profiles<L: ViscosityLaw, H: NusseltLaw>(
+        &self,
+        model: &FiberModel<L, H>,
+        positions: &[f64],
+    ) -> Profiles {
+        let co = *model.coefficients();
+        let [u_o, n_o, t_o, rate_o, d_o, _, _, l_o] = co.si;
+        let mu_o = model.scaling.reference.viscosity;
+        let p = &self.solution.params;
+        let n_law = model.law.num_params();
+        let lp = &p[1..(1 + n_law).min(p.len())];
+        let mut out = Profiles::default();
+        let mut y = [0.0; 4];
+        let mut yp = [0.0; 4];
+        for &s in positions {
+            let x = s / l_o;
+            self.solution.eval_into(x, &mut y, &mut yp);
+            let rho = model.density(y[2]);
+            out.position.push(s);
+            out.velocity.push(y[0] * u_o);
+            out.force.push(y[1] * n_o);
+            out.temperature.push(y[2] * t_o);
+            out.strain_rate.push(y[3] * rate_o);
+            out.diameter.push(model.diameter(y[0], rho) * d_o);
+            out.viscosity.push(model.viscosity(y[2], y[3], lp) * mu_o);
+            for (k, (name, balance, v)) in model.terms_at(x, &y, p).into_iter().enumerate() {
+                let scale = match balance {
+                    Balance::Momentum => co.force_per_length,
+                    Balance::Energy => co.heat_per_length,
+                };
+                if out.terms.len() <= k {
+                    out.terms
+                        .push((name, balance, Vec::with_capacity(positions.len())));
+                }
+                out.terms[k].2.push(v * scale);
+            }
+        }
+        out
+    }
+
+    /// Profiles at `m` uniform positions from 0 to `L`.
+    pub fn uniform_profiles<L: ViscosityLaw, H: NusseltLaw>(
+        &self,
+        model: &FiberModel<L, H>,
+        m: usize,
+    ) -> Profiles {
+        let positions = linspace(0.0, model.experiment.spinline_length, m.max(2));
+        self.profiles(model, &positions)
+    }
+}
+
+fn insert_required(x: &[f64], required: &[f64]) -> Vec<f64> {
+    let mut v: Vec<f64> = x.iter().chain(required).copied().collect();
+    v.sort_by(|a, b| a.total_cmp(b));
+    let (a, b) = (x[0], x[x.len() - 1]);
+    let span = b - a;
+    let mut out: Vec<f64> = Vec::with_capacity(v.len());
+    for xi in v {
+        if xi < a || xi > b {
+            continue;
+        }
+        if let Some(&last) = out.last() {
+            if xi - last <= 1e-9 * span {
+                continue;
+            }
+        }
+        out.push(xi);
+    }
+    if let Some(l) = out.last_mut() {
+        *l = b;
+    }
+    out
+}
+
+/// Cold start: solves the model with law parameters `law_params` (and default strengths) by
+/// continuation from the stress-free fiber.
+pub fn simulate<L: ViscosityLaw, H: NusseltLaw>(
+    model: &FiberModel<L, H>,
+    law_params: &[f64],
+    options: &SimulateOptions,
+) -> Result<FiberSolution, FiberError> {
+    let p = model.parameters(1.0, law_params)?;
+    simulate_params(model, &p, None, options)
+}
+
+/// Warm start from a previous solution (e.g. at nearby law parameters); falls back to a cold
+/// start if the direct solve fails.
+pub fn simulate_from<L: ViscosityLaw, H: NusseltLaw>(
+    model: &FiberModel<L, H>,
+    law_params: &[f64],
+    start: &FiberSolution,
+    options: &SimulateOptions,
+) -> Result<FiberSolution, FiberError> {
+    let p = model.parameters(1.0, law_params)?;
+    simulate_params(model, &p, Some(&start.solution), options)
+}
+
+/// The general form: full parameter vector `p` (see [`FiberModel`] for the layout; `p[0]`, the
+/// continuation parameter, is normally 1), optional warm start.
+pub fn simulate_params<L: ViscosityLaw, H: NusseltLaw>(
+    model: &FiberModel<L, H>,
+    p: &[f64],
+    start: Option<&Solution>,
+    options: &SimulateOptions,
+) -> Result<FiberSolution, FiberError> {
+    model.check_parameters(p)?;
+    if options.initial_nodes < 2 {
+        return Err(FiberError::InvalidInput(
+            "initial_nodes must be at least 2".into(),
+        ));
+    }
+    let l_si = model.experiment.spinline_length;
+    let required: Vec<f64> = options
+        .required_positions
+        .iter()
+        .map(|s| s / l_si * model.length())
+        .collect();
+    if options.required_positions.iter().any(|s| !s.is_finite()) {
+        return Err(FiberError::InvalidInput(
+            "required position is not finite".into(),
+        ));
+    }
+    let solve_opts = options.solve_options();
+    if let Some(prev) = start {
+        if prev.n == 4 && prev.nodes() >= 2 {
+            let mut guess = Guess::from(prev);
+            if !required.is_empty() {
+                let x = insert_required(&prev.x, &required);
+                guess = Guess::from_fn(x, 4, |x, y| prev.eval_into(x, y, &mut [0.0; 4]));
+            }
+            let mut solver = Solver::new(model, solve_opts.clone());
+            if let Ok(sol) = solver.solve(p, &guess) {
+                return Ok(FiberSolution { solution: sol });
+            }
+        }
+    }
+    let x = linspace(0.0, model.length(), options.initial_nodes);
+    let y0 = [model.inlet_velocity(), 0.0, model.inlet_temperature(), 0.0];
+    let guess = Guess::constant(x, &y0);
+    if required.is_empty() {
+        let sol = continuation_in_c(model, p, 0, &guess, &solve_opts, &options.continuation)?;
+        return Ok(FiberSolution { solution: sol });
+    }
+    // continuation without the required nodes, then a final solve on a mesh containing them
+    let mut loose = solve_opts.clone();
+    loose.tol = solve_opts.tol.max(options.continuation.intermediate_tol);
+    loose.bc_tol = None;
+    let sol = continuation_in_c(model, p, 0, &guess, &loose, &options.continuation)?;
+    let x = insert_required(&sol.x, &required);
+    let guess = Guess::from_fn(x, 4, |x, y| sol.eval_into(x, y, &mut [0.0; 4]));
+    let sol = Solver::new(model, solve_opts).solve(p, &guess)?;
+    Ok(FiberSolution { solution: sol })
+}
