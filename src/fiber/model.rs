@@ -16,7 +16,10 @@
 //! contributions of [`Physics`].
 //!
 //! **Parameter layout** (`p`, all fixed model parameters, none unknown):
-//! `p = [c, law parameters (e.g. n, κ), strength parameters ([`Physics::strength_parameters`])]`.
+//! `p = [c, law parameters (e.g. n, κ), strength parameters ([`Physics::strength_parameters`]),
+//! take_up_factor]`. The last one, `φ` (neutral value 1), multiplies the prescribed take-up
+//! diameter or speed: `d(L) = c φ d_out + (1 − c) d_in`. It makes the take-up condition a
+//! differentiable parameter, so a fit can treat the take-up diameter as a nuisance parameter.
 //! At `c = 0` the stress-free isothermal fiber `u ≡ u_in, N ≡ 0, T ≡ T_in, ε̇ ≡ 0` solves the
 //! problem for every law parameter.
 
@@ -245,12 +248,24 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         self
     }
 
-    /// Names of the model parameters in `p` order: `"c"`, the law's, the strengths'.
+    /// Names of the model parameters in `p` order: `"c"`, the law's, the strengths',
+    /// `"take_up_factor"`.
     pub fn param_names(&self) -> Vec<&'static str> {
         let mut v = vec!["c"];
         v.extend_from_slice(self.law.param_names());
         v.extend(self.physics.strength_parameters().iter().map(|(n, _)| *n));
+        v.push("take_up_factor");
         v
+    }
+
+    /// Index of the take-up factor `φ` in `p` (the last parameter).
+    pub fn take_up_factor_index(&self) -> usize {
+        1 + self.n_law + self.n_strength
+    }
+
+    /// Index of the first law parameter in `p`.
+    pub fn law_param_offset(&self) -> usize {
+        1
     }
 
     /// Index of the parameter `name` in `p`.
@@ -264,19 +279,20 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             .check_params(law_params)
             .map_err(FiberError::InvalidInput)?;
         finite("continuation parameter c", c)?;
-        let mut p = Vec::with_capacity(1 + self.n_law + self.n_strength);
+        let mut p = Vec::with_capacity(2 + self.n_law + self.n_strength);
         p.push(c);
         p.extend_from_slice(law_params);
         p.extend(self.physics.strength_parameters().iter().map(|(_, d)| *d));
+        p.push(1.0);
         Ok(p)
     }
 
     /// Checks a full parameter vector (length, finiteness, law admissibility).
     pub fn check_parameters(&self, p: &[f64]) -> Result<(), FiberError> {
-        if p.len() != 1 + self.n_law + self.n_strength {
+        if p.len() != 2 + self.n_law + self.n_strength {
             return Err(FiberError::InvalidInput(format!(
                 "expected {} model parameters {:?}, got {}",
-                1 + self.n_law + self.n_strength,
+                2 + self.n_law + self.n_strength,
                 self.param_names(),
                 p.len()
             )));
@@ -383,7 +399,8 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
     /// Values of all named terms at `s̃ = x` for `y` and full parameters `p`:
     /// `(name, balance, dimensionless value)` (strength applied, continuation factor `c` not).
     pub fn terms_at(&self, x: f64, y: &[f64], p: &[f64]) -> Vec<(&'static str, Balance, f64)> {
-        let sp = &p[(1 + self.n_law).min(p.len())..];
+        let lo = (1 + self.n_law).min(p.len());
+        let sp = &p[lo..(lo + self.n_strength).min(p.len())];
         let st = self.local_state(x, y, sp);
         self.physics.report(&st, sp, &self.co)
     }
@@ -395,14 +412,14 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
     }
 
     fn num_params(&self) -> usize {
-        1 + self.n_law + self.n_strength
+        2 + self.n_law + self.n_strength
     }
 
     #[inline]
     fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
         let c = p[0];
         let lp = &p[1..1 + self.n_law];
-        let sp = &p[1 + self.n_law..];
+        let sp = &p[1 + self.n_law..1 + self.n_law + self.n_strength];
         let st = self.local_state(x, y, sp);
         let (force, heat) = self.physics.sums(&st, sp, &self.co);
         let q = self.co.q;
@@ -426,11 +443,13 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
         r[0] = ya[0] - self.u_in;
         r[1] = match self.take_up {
             DimensionlessTakeUp::Diameter { d_out, d_in } => {
-                let target = c * d_out + (-c + 1.0) * d_in;
+                let phi = p[1 + self.n_law + self.n_strength];
+                let target = c * phi * d_out + (-c + 1.0) * d_in;
                 self.diameter(yb[0], self.density(yb[2])) / target - 1.0
             }
             DimensionlessTakeUp::Velocity { u_out } => {
-                let target = c * u_out + (-c + 1.0) * self.u_in;
+                let phi = p[1 + self.n_law + self.n_strength];
+                let target = c * phi * u_out + (-c + 1.0) * self.u_in;
                 yb[0] / target - 1.0
             }
         };
