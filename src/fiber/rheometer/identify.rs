@@ -256,7 +256,11 @@ impl Rheometer {
             j2 = obj.cost_at(n_init, kappa)?;
             trace.push((kappa, j2));
         }
-        Ok(([n_init, kappa], trace))
+        Ok(StartPoint {
+            start: [n_init, kappa],
+            newtonian_cost: j1,
+            trace,
+        })
     }
 
     /// RMS of `(d_model − d_meas)/d_meas` over all measurements for the given solutions.
@@ -288,6 +292,17 @@ impl Rheometer {
             })
             .collect()
     }
+}
+
+/// Result of the start heuristic.
+#[derive(Debug, Clone)]
+pub struct StartPoint {
+    /// The start point `(n_init, κ)`.
+    pub start: [f64; 2],
+    /// The Newtonian reference cost `J(1, κ_upper)`.
+    pub newtonian_cost: f64,
+    /// `(κ, J(n_init, κ))` for every κ tried.
+    pub trace: Vec<(f64, f64)>,
 }
 
 /// Result of an identification.

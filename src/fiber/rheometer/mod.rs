@@ -15,5 +15,5 @@ pub mod identify;
 pub mod report;
 
 pub use estimator::Estimator;
-pub use identify::{Identification, IdentifyOptions, Rheometer};
+pub use identify::{Identification, IdentifyOptions, Rheometer, RheometerError, StartPoint};
 pub use report::FitReport;
