@@ -238,12 +238,8 @@ impl Rheometer {
     }
 
     /// Paper Algorithm 2: with `n = n_init` (0.5), walk κ down from the upper bound in steps of
-    /// 1 until the cost differs from the Newtonian cost by more than 10%. Returns the start point
-    /// and the `(κ, J)` trace.
-    pub fn start_heuristic(
-        &self,
-        options: &IdentifyOptions,
-    ) -> Result<([f64; 2], Vec<(f64, f64)>), RheometerError> {
+    /// 1 until the cost differs from the Newtonian cost by more than 10%.
+    pub fn start_heuristic(&self, options: &IdentifyOptions) -> Result<StartPoint, RheometerError> {
         let n_init = 0.5;
         let (k_lo, k_hi) = (options.lower[1], options.upper[1]);
         let mut obj = self.objective([1.0, k_hi], options)?;
