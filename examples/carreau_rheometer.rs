@@ -26,12 +26,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     let principled = IdentifyOptions::with_estimator(Estimator::Principled);
-    let (start, trace) = rheometer.start_heuristic(&principled)?;
+    let heuristic = rheometer.start_heuristic(&principled)?;
+    let start = heuristic.start;
     println!(
         "\nStart heuristic (paper Algorithm 2): (n, κ) = ({}, {}) after {} cost evaluations",
         start[0],
         start[1],
-        trace.len() + 1
+        heuristic.trace.len() + 1
     );
     let id = rheometer.identify(start, &principled)?;
     let report = FitReport::new(&id);

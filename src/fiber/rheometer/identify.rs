@@ -290,6 +290,9 @@ impl Rheometer {
     }
 }
 
+/// Residuals and row-major Jacobian of one experiment.
+type ResidualsAndJacobian = (Vec<f64>, Vec<f64>);
+
 /// Result of the start heuristic.
 #[derive(Debug, Clone)]
 pub struct StartPoint {
@@ -474,7 +477,7 @@ impl<'a> Objective<'a> {
         let (n, kappa) = (p[0], p[1]);
         let estimator = self.estimator;
         let sigma = self.sigma;
-        let parts: Result<Vec<(Vec<f64>, Vec<f64>)>, RheometerError> = self
+        let parts: Result<Vec<ResidualsAndJacobian>, RheometerError> = self
             .runs
             .par_iter_mut()
             .enumerate()
