@@ -18,6 +18,7 @@ pub mod error;
 pub mod input;
 pub mod material_law;
 pub mod model;
+pub mod output;
 pub mod rheometer;
 pub mod scaling;
 pub mod setup;

@@ -622,6 +622,30 @@ impl<'a> Objective<'a> {
         Ok(r.iter().map(|v| v * v).sum())
     }
 
+    /// Cost at `(n, κ)` from the current warm starts only (no cold-start fallback); on success
+    /// the solutions become the new warm starts.
+    pub fn try_cost_at(&mut self, n: f64, kappa: f64) -> Result<f64, RheometerError> {
+        let mut p = vec![n, kappa];
+        if self.estimator == Estimator::Principled {
+            p.extend(std::iter::repeat_n(1.0, self.runs.len()));
+        }
+        let (r, _) = self.eval(&p, false)?;
+        self.accept_pending();
+        Ok(r.iter().map(|v| v * v).sum())
+    }
+
+    /// The current warm-start solutions, one per experiment.
+    pub fn solutions(&self) -> Vec<Solution> {
+        self.runs.iter().map(|r| r.accepted.clone()).collect()
+    }
+
+    /// Replaces the warm-start solutions (same order as [`solutions`](Self::solutions)).
+    pub fn set_solutions(&mut self, sols: &[Solution]) {
+        for (r, s) in self.runs.iter_mut().zip(sols) {
+            r.accepted = s.clone();
+        }
+    }
+
     fn accept_pending(&mut self) {
         for run in &mut self.runs {
             if let Some(s) = run.pending.take() {

@@ -12,8 +12,10 @@
 
 pub mod estimator;
 pub mod identify;
+pub mod landscape;
 pub mod report;
 
 pub use estimator::Estimator;
 pub use identify::{Identification, IdentifyOptions, Rheometer, RheometerError, StartPoint};
+pub use landscape::Landscape;
 pub use report::FitReport;

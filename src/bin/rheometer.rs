@@ -1,0 +1,390 @@
+//! `rheometer`: simulate fiber spinning and identify the Carreau-type elongational viscosity
+//! from your own TOML + CSV measurements.
+
+use clap::{Parser, Subcommand, ValueEnum};
+use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
+use diffbvp::fiber::output::{create_dir, profiles_csv, write_text};
+use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
+use diffbvp::fiber::setup::TakeUp;
+use diffbvp::fiber::smoothing::smooth;
+use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::error::Error;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "rheometer",
+    version,
+    about = "Simulation-based elongational rheometer for Carreau-type polymer melts",
+    long_about = "Simulates stationary melt spinning and identifies the Carreau-type elongational \
+viscosity (n, kappa = ln K) from fiber diameters measured along the spin line.\n\n\
+Example:\n  rheometer fit data/pmma7n_synthetic/experiments.toml --json target/fit.json"
+)]
+struct Cli {
+    /// Print nothing but results and errors.
+    #[arg(long, global = true)]
+    quiet: bool,
+    /// Print more detail (solver statistics, iterations).
+    #[arg(long, short, global = true)]
+    verbose: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum EstimatorArg {
+    /// Relative least squares against the raw data, take-up diameters fitted (default).
+    Principled,
+    /// The paper's strain-rate-weighted cost against the smoothed data.
+    Paper,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate every experiment and write profiles (CSV) into DIR.
+    ///
+    /// Example: rheometer simulate data/pmma7n_synthetic/experiments.toml --n 0.8 --kappa 11.71
+    /// --take-up-from-data --out target/sim
+    Simulate {
+        /// The experiments file (TOML; see the book for the format).
+        experiments: PathBuf,
+        /// Power index n of the Carreau-type law.
+        #[arg(long, default_value_t = 0.8)]
+        n: f64,
+        /// kappa = ln(K / 1 Pa) of the Carreau-type law.
+        #[arg(long, default_value_t = 11.71)]
+        kappa: f64,
+        /// Use the Newtonian law (n = 1).
+        #[arg(long)]
+        newtonian: bool,
+        /// Take-up diameter [m] for experiments without one in the TOML.
+        #[arg(long)]
+        take_up_diameter: Option<f64>,
+        /// Take the take-up diameter d_fit(L) from the smoothed measurements where the TOML has none.
+        #[arg(long)]
+        take_up_from_data: bool,
+        /// Number of uniform output positions.
+        #[arg(long, default_value_t = 101)]
+        points: usize,
+        /// Output directory (created; input files are never overwritten).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Identify (n, kappa) from the measurements and print an uncertainty report.
+    ///
+    /// Example: rheometer fit data/pmma7n_synthetic/experiments.toml --json target/fit.json
+    Fit {
+        /// The experiments file (TOML).
+        experiments: PathBuf,
+        /// Start point "N,KAPPA" (default: the paper's start heuristic).
+        #[arg(long, value_parser = parse_pair)]
+        start: Option<(f64, f64)>,
+        /// The estimator.
+        #[arg(long, value_enum, default_value_t = EstimatorArg::Principled)]
+        estimator: EstimatorArg,
+        /// Evaluate the Newtonian model (n = 1) instead of fitting.
+        #[arg(long)]
+        newtonian: bool,
+        /// Write the result as JSON to FILE.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Write the report and the fitted profiles into DIR.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Compute the cost landscape J(n, kappa) on a grid and write it as CSV.
+    ///
+    /// Example: rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 41x41 --out target/landscape
+    Landscape {
+        /// The experiments file (TOML).
+        experiments: PathBuf,
+        /// Grid size "NxM" (n values x kappa values).
+        #[arg(long, default_value = "41x41", value_parser = parse_grid)]
+        grid: (usize, usize),
+        /// Range of n "MIN,MAX".
+        #[arg(long, default_value = "0,1", value_parser = parse_pair)]
+        n_range: (f64, f64),
+        /// Range of kappa "MIN,MAX".
+        #[arg(long, default_value = "9,16", value_parser = parse_pair)]
+        kappa_range: (f64, f64),
+        /// The estimator whose cost is mapped.
+        #[arg(long, value_enum, default_value_t = EstimatorArg::Paper)]
+        estimator: EstimatorArg,
+        /// BVP tolerance of the landscape solves (a picture; fits use 1e-6).
+        #[arg(long, default_value_t = 1e-4)]
+        tol: f64,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+fn parse_pair(s: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 2 {
+        return Err(format!("expected two numbers \"A,B\", got \"{s}\""));
+    }
+    let a: f64 = parts[0]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a number", parts[0]))?;
+    let b: f64 = parts[1]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a number", parts[1]))?;
+    if !a.is_finite() || !b.is_finite() {
+        return Err(format!("\"{s}\" contains a non-finite number"));
+    }
+    Ok((a, b))
+}
+
+fn parse_grid(s: &str) -> Result<(usize, usize), String> {
+    let parts: Vec<&str> = s.split(['x', 'X']).collect();
+    if parts.len() != 2 {
+        return Err(format!("expected \"NxM\", got \"{s}\""));
+    }
+    let a: usize = parts[0]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a count", parts[0]))?;
+    let b: usize = parts[1]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a count", parts[1]))?;
+    if a < 2 || b < 2 {
+        return Err("the grid needs at least 2 points per direction".into());
+    }
+    Ok((a, b))
+}
+
+fn inputs_of(path: &Path, loaded: &LoadedExperiments) -> Vec<PathBuf> {
+    let mut v = vec![path.to_path_buf()];
+    v.extend(loaded.details.iter().filter_map(|d| d.data.clone()));
+    v
+}
+
+fn estimator(e: EstimatorArg) -> Estimator {
+    match e {
+        EstimatorArg::Principled => Estimator::Principled,
+        EstimatorArg::Paper => Estimator::Paper,
+    }
+}
+
+fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
+    diffbvp::mesh::linspace(a, b, m)
+}
+
+fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
+    let say = |s: String| {
+        if !cli.quiet {
+            eprintln!("{s}");
+        }
+    };
+    match cli.command {
+        Command::Simulate {
+            experiments,
+            n,
+            kappa,
+            newtonian,
+            take_up_diameter,
+            take_up_from_data,
+            points,
+            out,
+        } => {
+            let loaded = load_experiments_with(&experiments, 4)?;
+            let inputs = inputs_of(&experiments, &loaded);
+            let set = &loaded.set;
+            create_dir(&out)?;
+            let law = if newtonian { [1.0, kappa] } else { [n, kappa] };
+            for (k, e) in set.experiments.iter().enumerate() {
+                let mut e = e.clone();
+                if e.take_up.is_none() {
+                    if let Some(d) = take_up_diameter {
+                        e.take_up = Some(TakeUp::Diameter(d));
+                    } else if take_up_from_data {
+                        let m = set.measurements[k].as_ref().ok_or_else(|| {
+                            format!(
+                                "experiment {}: --take-up-from-data needs measurements",
+                                e.name
+                            )
+                        })?;
+                        let f = smooth(&m.positions, &m.diameters)?;
+                        e.take_up = Some(TakeUp::Diameter(f.diameter(e.spinline_length)));
+                    } else {
+                        return Err(format!(
+                            "experiment {} has no take-up condition: give take_up_diameter_m or take_up_velocity_m_s \
+                             in {}, or use --take-up-diameter M or --take-up-from-data",
+                            e.name,
+                            experiments.display()
+                        )
+                        .into());
+                    }
+                }
+                let model = FiberModel::new(
+                    &set.material,
+                    &set.air,
+                    &e,
+                    CarreauLike::new(),
+                    Physics::paper(),
+                )?;
+                let sol = simulate(&model, &law, &SimulateOptions::default())?;
+                let prof = sol.uniform_profiles(&model, points.max(2));
+                let path = out.join(format!("{}_profile.csv", e.name));
+                write_text(&path, &profiles_csv(&prof), &inputs)?;
+                if cli.verbose {
+                    say(format!(
+                        "{}: {} nodes, T(L) = {:.2} K, d(L) = {:.3} µm -> {}",
+                        e.name,
+                        sol.nodes(),
+                        prof.temperature[prof.temperature.len() - 1],
+                        1e6 * prof.diameter[prof.diameter.len() - 1],
+                        path.display()
+                    ));
+                }
+            }
+            say(format!(
+                "wrote {} profiles to {}",
+                set.experiments.len(),
+                out.display()
+            ));
+        }
+        Command::Fit {
+            experiments,
+            start,
+            estimator: est,
+            newtonian,
+            json,
+            out,
+        } => {
+            let loaded = load_experiments_with(&experiments, 4)?;
+            let inputs = inputs_of(&experiments, &loaded);
+            let rh = Rheometer::new(&loaded.set)?;
+            let opts = IdentifyOptions::with_estimator(estimator(est));
+            if newtonian {
+                let mut obj = rh.objective([1.0, 20.0], &opts)?;
+                let j = obj.cost_at(1.0, 20.0)?;
+                println!(
+                    "Newtonian model (n = 1): cost J = {j:.6e} ({} estimator)",
+                    opts.estimator.name()
+                );
+                return Ok(());
+            }
+            let start = match start {
+                Some((n, k)) => [n, k],
+                None => {
+                    let sp = rh.start_heuristic(&opts)?;
+                    say(format!(
+                        "start heuristic: (n, kappa) = ({}, {})",
+                        sp.start[0], sp.start[1]
+                    ));
+                    sp.start
+                }
+            };
+            let id = rh.identify(start, &opts)?;
+            let rep = FitReport::new(&id);
+            println!("{}", rep.to_text());
+            let text = serde_json::to_string_pretty(&rep)?;
+            if let Some(path) = json {
+                if let Some(parent) = path.parent() {
+                    if !parent.as_os_str().is_empty() {
+                        create_dir(parent)?;
+                    }
+                }
+                write_text(&path, &text, &inputs)?;
+                say(format!("wrote {}", path.display()));
+            }
+            if let Some(dir) = out {
+                create_dir(&dir)?;
+                write_text(&dir.join("fit_report.txt"), &rep.to_text(), &inputs)?;
+                write_text(&dir.join("fit.json"), &text, &inputs)?;
+                for (k, sol) in id.solutions.iter().enumerate() {
+                    let model = &rh.models[k];
+                    let fs = diffbvp::fiber::FiberSolution {
+                        solution: sol.clone(),
+                    };
+                    let prof = fs.uniform_profiles(model, 101);
+                    write_text(
+                        &dir.join(format!("{}_fitted_profile.csv", rh.experiments[k].name)),
+                        &profiles_csv(&prof),
+                        &inputs,
+                    )?;
+                }
+                say(format!(
+                    "wrote the report and fitted profiles to {}",
+                    dir.display()
+                ));
+            }
+        }
+        Command::Landscape {
+            experiments,
+            grid,
+            n_range,
+            kappa_range,
+            estimator: est,
+            tol,
+            out,
+        } => {
+            let loaded = load_experiments_with(&experiments, 4)?;
+            let inputs = inputs_of(&experiments, &loaded);
+            let rh = Rheometer::new(&loaded.set)?;
+            let mut opts = IdentifyOptions::with_estimator(estimator(est));
+            if !(tol > 0.0 && tol < 1.0) {
+                return Err(format!("--tol must lie in (0, 1), got {tol}").into());
+            }
+            opts.simulate.tol = tol;
+            let ns = linspace(n_range.0, n_range.1, grid.0);
+            let ks = linspace(kappa_range.0, kappa_range.1, grid.1);
+            let bar = if cli.quiet {
+                ProgressBar::hidden()
+            } else {
+                let b = ProgressBar::new((grid.0 * grid.1) as u64);
+                b.set_style(
+                    ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta} left)")
+                        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+                );
+                b.set_message("landscape");
+                b
+            };
+            let t0 = std::time::Instant::now();
+            let l = rh.landscape(&ns, &ks, &opts, |d| bar.set_position(d as u64))?;
+            bar.finish_and_clear();
+            create_dir(&out)?;
+            let mut csv = String::from("n,kappa,cost\n");
+            for (j, k) in ks.iter().enumerate() {
+                for (i, n) in ns.iter().enumerate() {
+                    csv.push_str(&format!("{n},{k},{:e}\n", l.cost[j * ns.len() + i]));
+                }
+            }
+            let path = out.join("landscape.csv");
+            write_text(&path, &csv, &inputs)?;
+            if let Some((n, k, c)) = l.minimum() {
+                println!("grid minimum: n = {n:.4}, kappa = {k:.4}, J = {c:.6e}");
+            }
+            say(format!(
+                "{} points in {:.1} s; wrote {}",
+                grid.0 * grid.1,
+                t0.elapsed().as_secs_f64(),
+                path.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            let mut src = e.source();
+            while let Some(s) = src {
+                eprintln!("  caused by: {s}");
+                src = s.source();
+            }
+            ExitCode::FAILURE
+        }
+    }
+}
