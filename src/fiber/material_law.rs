@@ -266,7 +266,7 @@ mod tests {
 
     #[test]
     fn zero_rate_viscosity_is_three_at_inlet() {
-        assert!((zero().eval(1.0) - 3.0).abs() < 1e-3);
+        assert!((zero().eval(1.0f64) - 3.0).abs() < 1e-3);
     }
 
     #[test]
@@ -306,18 +306,18 @@ mod tests {
             assert!(s > last || i == 0);
             last = s;
         }
-        let newt = viscosity(&Newtonian, &z, 82.486, 0.8, 5.0, &[]);
-        let near = viscosity(&c, &z, 82.486, 0.8, 5.0, &[1.0 - 1e-9, 11.71]);
+        let newt = viscosity::<_, f64>(&Newtonian, &z, 82.486, 0.8, 5.0, &[]);
+        let near = viscosity::<_, f64>(&c, &z, 82.486, 0.8, 5.0, &[1.0 - 1e-9, 11.71]);
         assert!((near / newt - 1.0).abs() < 1e-8);
-        let stiff = viscosity(&c, &z, 82.486, 0.8, 5.0, &[0.8, 60.0]);
+        let stiff = viscosity::<_, f64>(&c, &z, 82.486, 0.8, 5.0, &[0.8, 60.0]);
         assert!((stiff / newt - 1.0).abs() < 1e-12);
     }
 
     #[test]
     fn yasuda_with_a_two_is_carreau() {
         let z = zero();
-        let a = viscosity(&CarreauYasuda::new(2.0), &z, 82.486, 0.9, 7.0, &[0.8, 11.71]);
-        let b = viscosity(&CarreauLike::new(), &z, 82.486, 0.9, 7.0, &[0.8, 11.71]);
+        let a = viscosity::<_, f64>(&CarreauYasuda::new(2.0), &z, 82.486, 0.9, 7.0, &[0.8, 11.71]);
+        let b = viscosity::<_, f64>(&CarreauLike::new(), &z, 82.486, 0.9, 7.0, &[0.8, 11.71]);
         assert!((a / b - 1.0).abs() < 1e-13);
     }
 }

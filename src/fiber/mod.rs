@@ -24,4 +24,4 @@ pub use error::FiberError;
 pub use material_law::{CarreauLike, CarreauYasuda, Newtonian, ViscosityLaw};
 pub use model::FiberModel;
 pub use scaling::{ReferenceValues, Scaling};
-pub use simulate::{simulate, FiberSolution, Profiles, SimulateOptions};
+pub use simulate::{simulate, simulate_from, FiberSolution, Profiles, SimulateOptions, Simulator};
