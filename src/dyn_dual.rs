@@ -135,7 +135,11 @@ mod tests {
         let g = Prod.eval(2.0, &[a, b]);
         assert_eq!(r.re, 24.0);
         assert_eq!(r.eps, g.eps);
-        let r = eval_dyn(f, 2.0, &[Dual64::from_re(3.0).derivative(), Dual64::from_re(4.0)]);
+        let r = eval_dyn(
+            f,
+            2.0,
+            &[Dual64::from_re(3.0).derivative(), Dual64::from_re(4.0)],
+        );
         assert_eq!((r.re, r.eps), (24.0, 8.0));
     }
 

@@ -83,7 +83,10 @@ fn newtonian_strain_rate_form_equals_explicit_three_state_form() {
             worst[c] = worst[c].max(((a[c] - b[c]) / b[c]).abs());
         }
     }
-    eprintln!("4-state vs 3-state: max rel dev u {:.2e} N {:.2e} T {:.2e}", worst[0], worst[1], worst[2]);
+    eprintln!(
+        "4-state vs 3-state: max rel dev u {:.2e} N {:.2e} T {:.2e}",
+        worst[0], worst[1], worst[2]
+    );
     assert!(worst.iter().all(|w| *w < 1e-7), "{worst:?}");
 }
 
@@ -97,7 +100,8 @@ fn isothermal_newtonian_fiber_matches_riccati_closed_form() {
         .strength("air_drag", Strength::Off)
         .strength("convection", Strength::Off)
         .strength("viscous_heating", Strength::Off);
-    let u_in_si = 4.0 * 3.08e-5 / (std::f64::consts::PI * Material::pmma7n().density(513.15) * 1.134e-3f64.powi(2));
+    let u_in_si = 4.0 * 3.08e-5
+        / (std::f64::consts::PI * Material::pmma7n().density(513.15) * 1.134e-3f64.powi(2));
     let m = FiberModel::new(
         &Material::pmma7n(),
         &Air::paper(),
@@ -168,7 +172,8 @@ fn momentum_and_energy_balances_close() {
     }
     let last = s.nodes() - 1;
     // N(L) − N(0) = Q (u(L) − u(0)) − ∫ ΣF
-    let mom = (s.at_node(last, 1) - s.at_node(0, 1)) - q * (s.at_node(last, 0) - s.at_node(0, 0)) + int_f;
+    let mom =
+        (s.at_node(last, 1) - s.at_node(0, 1)) - q * (s.at_node(last, 0) - s.at_node(0, 0)) + int_f;
     // T(L) − T(0) = ∫ ΣH/(c_p Q)
     let dt = s.at_node(last, 2) - s.at_node(0, 2);
     let en = dt - int_h;
@@ -186,7 +191,11 @@ fn diameters<L: ViscosityLaw>(m: &FiberModel<L>, p: &[f64]) -> Vec<f64> {
 fn carreau_tends_to_newtonian() {
     let newt = diameters(&model(Newtonian, Physics::paper()), &[]);
     let carreau = model(CarreauLike::new(), Physics::paper());
-    let dev = |d: &[f64]| d.iter().zip(&newt).fold(0.0f64, |a, (x, y)| a.max((x / y - 1.0).abs()));
+    let dev = |d: &[f64]| {
+        d.iter()
+            .zip(&newt)
+            .fold(0.0f64, |a, (x, y)| a.max((x / y - 1.0).abs()))
+    };
     let truth = dev(&diameters(&carreau, &[0.8, 11.71]));
     let n_near_1 = dev(&diameters(&carreau, &[1.0 - 1e-9, 11.71]));
     let kappa_big = dev(&diameters(&carreau, &[0.8, 40.0]));

@@ -3,7 +3,9 @@
 
 use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
 use diffbvp::fiber::simulate::simulate_from;
-use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Newtonian, Physics, SimulateOptions, ViscosityLaw};
+use diffbvp::fiber::{
+    simulate, CarreauLike, FiberModel, Newtonian, Physics, SimulateOptions, ViscosityLaw,
+};
 use std::time::Instant;
 
 const EXPERIMENTS: [(&str, f64, f64); 9] = [
@@ -32,7 +34,10 @@ fn experiment(name: &str, vs: f64, d_out: f64) -> Experiment {
 
 /// Columns: position, velocity, force, temperature, strain rate, diameter.
 fn read_reference(file: &str) -> Vec<[f64; 6]> {
-    let path = format!("{}/tests/data/reference_profiles/{file}", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/tests/data/reference_profiles/{file}",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     text.lines()
         .skip(1)
@@ -44,7 +49,11 @@ fn read_reference(file: &str) -> Vec<[f64; 6]> {
 }
 
 /// Max relative deviations (velocity, force, temperature, strain rate / max, diameter).
-fn compare<L: ViscosityLaw>(model: &FiberModel<L>, params: &[f64], file: &str) -> ([f64; 5], usize, f64) {
+fn compare<L: ViscosityLaw>(
+    model: &FiberModel<L>,
+    params: &[f64],
+    file: &str,
+) -> ([f64; 5], usize, f64) {
     let reference = read_reference(file);
     let positions: Vec<f64> = reference.iter().map(|r| r[0]).collect();
     let opts = SimulateOptions::with_tol(1e-8);
@@ -97,7 +106,10 @@ fn check_all<L: ViscosityLaw + Clone>(law: L, params: &[f64], suffix: &str) {
             worst[k] = worst[k].max(dev[k]);
         }
     }
-    eprintln!("{suffix}: worst u {:.2e} N {:.2e} T {:.2e} epsdot {:.2e} d {:.2e}", worst[0], worst[1], worst[2], worst[3], worst[4]);
+    eprintln!(
+        "{suffix}: worst u {:.2e} N {:.2e} T {:.2e} epsdot {:.2e} d {:.2e}",
+        worst[0], worst[1], worst[2], worst[3], worst[4]
+    );
     for (k, w) in worst.iter().enumerate() {
         assert!(*w < 1e-4, "component {k}: max relative deviation {w:e}");
     }

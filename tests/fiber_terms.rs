@@ -21,19 +21,67 @@ fn experiment() -> Experiment {
 }
 
 fn build(e: &Experiment, physics: Physics) -> Result<FiberModel<CarreauLike>, FiberError> {
-    FiberModel::new(&Material::pmma7n(), &Air::paper(), e, CarreauLike::new(), physics)
+    FiberModel::new(
+        &Material::pmma7n(),
+        &Air::paper(),
+        e,
+        CarreauLike::new(),
+        physics,
+    )
 }
 
 #[test]
 fn bad_inputs_are_errors_not_panics() {
     let cases: Vec<(&str, Experiment)> = vec![
-        ("negative mass flow", Experiment { mass_flow: -1.0, ..experiment() }),
-        ("NaN mass flow", Experiment { mass_flow: f64::NAN, ..experiment() }),
-        ("zero inlet diameter", Experiment { inlet: Inlet::Diameter(0.0), ..experiment() }),
-        ("NaN temperature", Experiment { inlet_temperature: f64::NAN, ..experiment() }),
-        ("take-up too thick", Experiment { take_up: Some(TakeUp::Diameter(2e-3)), ..experiment() }),
-        ("take-up too slow", Experiment { take_up: Some(TakeUp::Velocity(1e-3)), ..experiment() }),
-        ("negative length", Experiment { spinline_length: -0.5, ..experiment() }),
+        (
+            "negative mass flow",
+            Experiment {
+                mass_flow: -1.0,
+                ..experiment()
+            },
+        ),
+        (
+            "NaN mass flow",
+            Experiment {
+                mass_flow: f64::NAN,
+                ..experiment()
+            },
+        ),
+        (
+            "zero inlet diameter",
+            Experiment {
+                inlet: Inlet::Diameter(0.0),
+                ..experiment()
+            },
+        ),
+        (
+            "NaN temperature",
+            Experiment {
+                inlet_temperature: f64::NAN,
+                ..experiment()
+            },
+        ),
+        (
+            "take-up too thick",
+            Experiment {
+                take_up: Some(TakeUp::Diameter(2e-3)),
+                ..experiment()
+            },
+        ),
+        (
+            "take-up too slow",
+            Experiment {
+                take_up: Some(TakeUp::Velocity(1e-3)),
+                ..experiment()
+            },
+        ),
+        (
+            "negative length",
+            Experiment {
+                spinline_length: -0.5,
+                ..experiment()
+            },
+        ),
     ];
     for (what, e) in cases {
         match build(&e, Physics::paper()) {
@@ -41,13 +89,28 @@ fn bad_inputs_are_errors_not_panics() {
             other => panic!("{what}: expected InvalidInput, got {other:?}"),
         }
     }
-    let missing = Experiment { take_up: None, ..experiment() };
-    assert!(matches!(build(&missing, Physics::paper()), Err(FiberError::MissingTakeUp(_))));
+    let missing = Experiment {
+        take_up: None,
+        ..experiment()
+    };
+    assert!(matches!(
+        build(&missing, Physics::paper()),
+        Err(FiberError::MissingTakeUp(_))
+    ));
     let m = build(&experiment(), Physics::paper()).unwrap();
     let opts = SimulateOptions::default();
-    assert!(matches!(simulate(&m, &[0.8], &opts), Err(FiberError::InvalidInput(_))));
-    assert!(matches!(simulate(&m, &[-0.1, 11.0], &opts), Err(FiberError::InvalidInput(_))));
-    assert!(matches!(simulate(&m, &[0.8, f64::NAN], &opts), Err(FiberError::InvalidInput(_))));
+    assert!(matches!(
+        simulate(&m, &[0.8], &opts),
+        Err(FiberError::InvalidInput(_))
+    ));
+    assert!(matches!(
+        simulate(&m, &[-0.1, 11.0], &opts),
+        Err(FiberError::InvalidInput(_))
+    ));
+    assert!(matches!(
+        simulate(&m, &[0.8, f64::NAN], &opts),
+        Err(FiberError::InvalidInput(_))
+    ));
 }
 
 /// Gravity written by a user in SI: ρ A g = Q g/u [N/m].
@@ -79,7 +142,10 @@ fn user_term_reproduces_builtin_gravity() {
         let g_builtin = pa.terms.iter().find(|t| t.0 == "gravity").unwrap().2[i];
         let g_user = pb.terms.iter().find(|t| t.0 == "user_gravity").unwrap().2[i];
         let expected = 3.08e-5 * 9.81 / pa.velocity[i];
-        assert!((g_builtin / expected - 1.0).abs() < 1e-12, "{g_builtin} {expected}");
+        assert!(
+            (g_builtin / expected - 1.0).abs() < 1e-12,
+            "{g_builtin} {expected}"
+        );
         assert!((g_user / g_builtin - 1.0).abs() < 1e-8);
         let off = pb.terms.iter().find(|t| t.0 == "gravity").unwrap().2[i];
         assert_eq!(off, 0.0);
@@ -99,10 +165,17 @@ fn term_report_units_and_signs() {
     let re = p.diameter[0] * p.velocity[0] / 2e-5;
     let pr: f64 = 1000.0 * 1.0 * 2e-5 / 0.031;
     let nu_cb = 0.3
-        + 0.62 * re.sqrt() * pr.cbrt() * (1.0 + (0.4 / pr).powf(2.0 / 3.0)).powf(-0.25)
+        + 0.62
+            * re.sqrt()
+            * pr.cbrt()
+            * (1.0 + (0.4 / pr).powf(2.0 / 3.0)).powf(-0.25)
             * (1.0 + (re / 282000.0).powf(0.625)).powf(0.8);
     let conv = -std::f64::consts::PI * 0.031 * 0.5 * nu_cb * (p.temperature[0] - 293.15);
-    assert!((get("convection") / conv - 1.0).abs() < 1e-5, "{} {conv}", get("convection"));
+    assert!(
+        (get("convection") / conv - 1.0).abs() < 1e-5,
+        "{} {conv}",
+        get("convection")
+    );
     // viscous heating N u' [W/m]
     let vh = p.force[0] * p.strain_rate[0];
     assert!((get("viscous_heating") / vh - 1.0).abs() < 1e-12);
@@ -141,18 +214,26 @@ fn strength_parameters_extend_p_and_are_neutral_at_default() {
 fn optional_effects_solve_and_change_the_fiber() {
     let opts = SimulateOptions::with_tol(1e-6);
     let base = build(&experiment(), Physics::paper()).unwrap();
-    let tb = simulate(&base, &[0.8, 11.71], &opts).unwrap().uniform_profiles(&base, 11);
+    let tb = simulate(&base, &[0.8, 11.71], &opts)
+        .unwrap()
+        .uniform_profiles(&base, 11);
     // radiation cools
     let rad = build(&experiment(), Physics::paper().with_radiation(0.9)).unwrap();
     let sol = simulate(&rad, &[0.8, 11.71], &opts).unwrap();
     let tr = sol.uniform_profiles(&rad, 11);
     assert!(tr.temperature[10] < tb.temperature[10] - 1.0);
     let q_rad = tr.terms.iter().find(|t| t.0 == "radiation").unwrap().2[0];
-    let expected = -std::f64::consts::PI * tr.diameter[0] * 0.9 * 5.670374419e-8 * (513.15f64.powi(4) - 293.15f64.powi(4));
+    let expected = -std::f64::consts::PI
+        * tr.diameter[0]
+        * 0.9
+        * 5.670374419e-8
+        * (513.15f64.powi(4) - 293.15f64.powi(4));
     assert!((q_rad / expected - 1.0).abs() < 1e-10, "{q_rad} {expected}");
     // warm air near the nozzle heats
     let warm = build(&experiment(), Physics::paper().with_warm_air(100.0, 0.05)).unwrap();
-    let tw = simulate(&warm, &[0.8, 11.71], &opts).unwrap().uniform_profiles(&warm, 11);
+    let tw = simulate(&warm, &[0.8, 11.71], &opts)
+        .unwrap()
+        .uniform_profiles(&warm, 11);
     assert!(tw.temperature[10] > tb.temperature[10] + 0.1);
     // an aspirator co-flow (smoothed inclination factor) pulls on the fiber near the take-up
     let physics = Physics::with_nusselt(InclinedChurchillBernstein {
@@ -160,21 +241,49 @@ fn optional_effects_solve_and_change_the_fiber() {
         inclination_regularisation: 0.05,
     })
     .with_coflow(8.0, 0.05); // take-up speed ≈ 4 m/s
-    let co = FiberModel::new(&Material::pmma7n(), &Air::paper(), &experiment(), CarreauLike::new(), physics).unwrap();
+    let co = FiberModel::new(
+        &Material::pmma7n(),
+        &Air::paper(),
+        &experiment(),
+        CarreauLike::new(),
+        physics,
+    )
+    .unwrap();
     let sol = simulate(&co, &[0.8, 11.71], &opts).unwrap();
     let pc = sol.uniform_profiles(&co, 11);
     let drag_end = pc.terms.iter().find(|t| t.0 == "air_drag").unwrap().2[10];
-    assert!(drag_end > 0.0, "co-flow drag at the take-up should pull: {drag_end}");
-    eprintln!("co-flow drag at L {drag_end:e} N/m; N(0) {:e} vs {:e}; T(L) {} vs {}", pc.force[0], tb.force[0], pc.temperature[10], tb.temperature[10]);
+    assert!(
+        drag_end > 0.0,
+        "co-flow drag at the take-up should pull: {drag_end}"
+    );
+    eprintln!(
+        "co-flow drag at L {drag_end:e} N/m; N(0) {:e} vs {:e}; T(L) {} vs {}",
+        pc.force[0], tb.force[0], pc.temperature[10], tb.temperature[10]
+    );
     // less relative speed near the take-up: less convective cooling there
     assert!(pc.temperature[10] > tb.temperature[10] + 1.0);
-    eprintln!("co-flow: {} nodes, N(0) {:.4e} N vs {:.4e} N still air", sol.nodes(), pc.force[0], tb.force[0]);
+    eprintln!(
+        "co-flow: {} nodes, N(0) {:.4e} N vs {:.4e} N still air",
+        sol.nodes(),
+        pc.force[0],
+        tb.force[0]
+    );
 }
 
 #[test]
 fn velocity_take_up_and_newtonian_law_work() {
-    let e = Experiment { take_up: Some(TakeUp::Velocity(3.0)), ..experiment() };
-    let m = FiberModel::new(&Material::pmma7n(), &Air::paper(), &e, Newtonian, Physics::paper()).unwrap();
+    let e = Experiment {
+        take_up: Some(TakeUp::Velocity(3.0)),
+        ..experiment()
+    };
+    let m = FiberModel::new(
+        &Material::pmma7n(),
+        &Air::paper(),
+        &e,
+        Newtonian,
+        Physics::paper(),
+    )
+    .unwrap();
     let sol = simulate(&m, &[], &SimulateOptions::with_tol(1e-8)).unwrap();
     let p = sol.profiles(&m, &[0.51]);
     assert!((p.velocity[0] / 3.0 - 1.0).abs() < 1e-9);

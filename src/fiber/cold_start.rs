@@ -73,7 +73,12 @@ fn continuation_steps<P: Bvp>(
             params.len()
         )));
     }
-    if !(cont.initial_step > 0.0 && cont.min_step > 0.0 && cont.grow >= 1.0 && cont.shrink < 1.0 && cont.shrink > 0.0) {
+    if !(cont.initial_step > 0.0
+        && cont.min_step > 0.0
+        && cont.grow >= 1.0
+        && cont.shrink < 1.0
+        && cont.shrink > 0.0)
+    {
         return Err(BvpError::InvalidInput(format!(
             "invalid continuation options {cont:?}"
         )));
@@ -82,7 +87,12 @@ fn continuation_steps<P: Bvp>(
     p[index] = 0.0;
     let mut loose = options.clone();
     loose.tol = options.tol.max(cont.intermediate_tol);
-    loose.bc_tol = Some(options.bc_tol.unwrap_or(options.tol).max(cont.intermediate_tol));
+    loose.bc_tol = Some(
+        options
+            .bc_tol
+            .unwrap_or(options.tol)
+            .max(cont.intermediate_tol),
+    );
     loose.factor_at_solution = false;
     solver.options = loose;
     let mut sol = solver.solve(&p, guess)?;

@@ -109,7 +109,7 @@ impl NusseltLaw for InclinedChurchillBernstein {
         let inc2 = re_sq + self.inclination_regularisation * self.inclination_regularisation;
         let inclination = -(re_tau * re_tau / inc2) * 0.5 + 1.0;
         let sqrt_re = re_eps2.sqrt().sqrt(); // Re_ε^½, Re_ε² > 0
-        // [1 + (Re_ε/282000)^(5/8)]^(4/5)
+                                             // [1 + (Re_ε/282000)^(5/8)]^(4/5)
         let big = ((re_eps2 * (1.0 / (282000.0 * 282000.0))).ln() * 0.3125)
             .exp()
             .ln_1p()
@@ -462,7 +462,11 @@ impl Coefficients {
             pr: scaling.pr_star * cp_a * rho_a * nu_a / lam_a,
             pr_arg: scaling.pr_star * cp_a * rho_a * nu_a / lam_a,
             ec: scaling.ec,
-            radiation: PI * STEFAN_BOLTZMANN * r.temperature.powi(3) * scaling.diameter() * r.length
+            radiation: PI
+                * STEFAN_BOLTZMANN
+                * r.temperature.powi(3)
+                * scaling.diameter()
+                * r.length
                 / (r.heat_capacity * r.mass_flow),
             t_air: t_air_si / r.temperature,
             length: length_si / r.length,
@@ -538,7 +542,11 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         co: &Coefficients,
     ) -> (D, D) {
-        let mut k = self.terms.iter().filter(|t| t.strength.is_parameter()).count();
+        let mut k = self
+            .terms
+            .iter()
+            .filter(|t| t.strength.is_parameter())
+            .count();
         let l_o = co.si[7];
         let v = match &self.air_speed {
             AirSpeed::Still => D::zero(),
@@ -666,7 +674,10 @@ mod tests {
         let pr: f64 = 0.64516;
         let re: f64 = 1.7;
         let cb = 0.3
-            + 0.62 * re.sqrt() * pr.cbrt() * (1.0 + (0.4 / pr).powf(2.0 / 3.0)).powf(-0.25)
+            + 0.62
+                * re.sqrt()
+                * pr.cbrt()
+                * (1.0 + (0.4 / pr).powf(2.0 / 3.0)).powf(-0.25)
                 * (1.0 + (re / 282000.0).powf(0.625)).powf(0.8);
         let v = law.nusselt(-re, re * re, law.prandtl_argument(pr));
         assert!((v - 0.5 * cb).abs() < 1e-6 * cb, "{v} {cb}");

@@ -117,7 +117,9 @@ impl ViscosityLaw for CarreauLike {
     }
     fn check_params(&self, p: &[f64]) -> Result<(), String> {
         if p.len() != 2 || !p.iter().all(|v| v.is_finite()) {
-            return Err(format!("Carreau-type law needs finite (n, kappa), got {p:?}"));
+            return Err(format!(
+                "Carreau-type law needs finite (n, kappa), got {p:?}"
+            ));
         }
         if p[0] < 0.0 {
             return Err(format!("power index n = {} must be >= 0", p[0]));
@@ -283,7 +285,8 @@ mod tests {
                 let (m, mt, mr) = law(t, r);
                 let h = 1e-6;
                 let fdt = (law(t + h, r).0 - law(t - h, r).0) / (2.0 * h);
-                let fdr = (law(t, r + h).0 - law(t, (r - h).max(0.0)).0) / (r + h - (r - h).max(0.0));
+                let fdr =
+                    (law(t, r + h).0 - law(t, (r - h).max(0.0)).0) / (r + h - (r - h).max(0.0));
                 assert!(m.is_finite() && mt.is_finite() && mr.is_finite());
                 assert!((mt - fdt).abs() <= 1e-6 * (1.0 + fdt.abs()), "{mt} {fdt}");
                 if r > 0.0 {
@@ -316,7 +319,14 @@ mod tests {
     #[test]
     fn yasuda_with_a_two_is_carreau() {
         let z = zero();
-        let a = viscosity::<_, f64>(&CarreauYasuda::new(2.0), &z, 82.486, 0.9, 7.0, &[0.8, 11.71]);
+        let a = viscosity::<_, f64>(
+            &CarreauYasuda::new(2.0),
+            &z,
+            82.486,
+            0.9,
+            7.0,
+            &[0.8, 11.71],
+        );
         let b = viscosity::<_, f64>(&CarreauLike::new(), &z, 82.486, 0.9, 7.0, &[0.8, 11.71]);
         assert!((a / b - 1.0).abs() < 1e-13);
     }

@@ -19,7 +19,9 @@ pub mod scaling;
 pub mod setup;
 pub mod simulate;
 
-pub use contributions::{Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength};
+pub use contributions::{
+    Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength,
+};
 pub use error::FiberError;
 pub use material_law::{CarreauLike, CarreauYasuda, Newtonian, ViscosityLaw};
 pub use model::FiberModel;

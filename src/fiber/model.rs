@@ -20,7 +20,9 @@
 //! At `c = 0` the stress-free isothermal fiber `u ≡ u_in, N ≡ 0, T ≡ T_in, ε̇ ≡ 0` solves the
 //! problem for every law parameter.
 
-use super::contributions::{Balance, Coefficients, InclinedChurchillBernstein, LocalState, NusseltLaw, Physics};
+use super::contributions::{
+    Balance, Coefficients, InclinedChurchillBernstein, LocalState, NusseltLaw, Physics,
+};
 use super::error::FiberError;
 use super::material_law::{viscosity, viscosity_with_partials, ViscosityLaw, ZeroRateViscosity};
 use super::scaling::Scaling;
@@ -90,7 +92,9 @@ fn finite(name: &str, v: f64) -> Result<f64, FiberError> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(FiberError::InvalidInput(format!("{name} is not finite ({v})")))
+        Err(FiberError::InvalidInput(format!(
+            "{name} is not finite ({v})"
+        )))
     }
 }
 
@@ -139,7 +143,10 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             )));
         }
         for (what, t) in [("inlet", t_in), ("air", t_air)] {
-            positive(&format!("density at the {what} temperature"), material.density(t))?;
+            positive(
+                &format!("density at the {what} temperature"),
+                material.density(t),
+            )?;
             positive(
                 &format!("heat capacity at the {what} temperature"),
                 material.heat_capacity(t),
@@ -158,7 +165,10 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             ("reference heat transfer", r.heat_transfer),
             ("reference air density", r.air_density),
             ("reference air heat capacity", r.air_heat_capacity),
-            ("reference air kinematic viscosity", r.air_kinematic_viscosity),
+            (
+                "reference air kinematic viscosity",
+                r.air_kinematic_viscosity,
+            ),
             ("reference air heat conductivity", r.air_heat_conductivity),
             ("reference stress", r.stress),
             ("gravity", r.gravity),
@@ -273,7 +283,9 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             )));
         }
         if let Some(v) = p.iter().find(|v| !v.is_finite()) {
-            return Err(FiberError::InvalidInput(format!("parameter {v} is not finite")));
+            return Err(FiberError::InvalidInput(format!(
+                "parameter {v} is not finite"
+            )));
         }
         self.law
             .check_params(&p[1..1 + self.n_law])

@@ -122,8 +122,8 @@ impl Scaling {
         let a_star = r.air_density * d_o * r.velocity * r.velocity / f_o;
         let re_star = d_o * r.velocity / r.air_kinematic_viscosity;
         let nu_star = r.heat_transfer * d_o / r.air_heat_conductivity;
-        let pr_star =
-            r.air_heat_capacity * r.air_density * r.air_kinematic_viscosity / r.air_heat_conductivity;
+        let pr_star = r.air_heat_capacity * r.air_density * r.air_kinematic_viscosity
+            / r.air_heat_conductivity;
         Scaling {
             reference,
             re,

@@ -153,7 +153,8 @@ impl FiberSolution {
                     Balance::Energy => co.heat_per_length,
                 };
                 if out.terms.len() <= k {
-                    out.terms.push((name, balance, Vec::with_capacity(positions.len())));
+                    out.terms
+                        .push((name, balance, Vec::with_capacity(positions.len())));
                 }
                 out.terms[k].2.push(v * scale);
             }
