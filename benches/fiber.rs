@@ -59,5 +59,33 @@ fn bench(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench);
+fn bench_rhs(c: &mut Criterion) {
+    use diffbvp::Bvp;
+    use num_dual::DualSVec64;
+    let m = model();
+    let p = m.parameters(1.0, &[0.8, 11.71]).expect("params");
+    let y = [2.0, 5000.0, 0.9, 3.0];
+    let mut f = [0.0; 4];
+    c.bench_function("fiber_rhs_f64", |b| {
+        b.iter(|| {
+            m.rhs(black_box(0.3), black_box(&y), &p, &mut f);
+            f[3]
+        })
+    });
+    let yd: Vec<DualSVec64<4>> = y
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| DualSVec64::from_re(v).derivative(i))
+        .collect();
+    let pd: Vec<DualSVec64<4>> = p.iter().map(|&v| DualSVec64::from_re(v)).collect();
+    let mut fd = [DualSVec64::<4>::from_re(0.0); 4];
+    c.bench_function("fiber_rhs_dual4", |b| {
+        b.iter(|| {
+            m.rhs(black_box(0.3), black_box(&yd), &pd, &mut fd);
+            fd[3].re
+        })
+    });
+}
+
+criterion_group!(benches, bench, bench_rhs);
 criterion_main!(benches);

@@ -203,3 +203,50 @@ fn carreau_tends_to_newtonian() {
     assert!(truth > 1e-3);
     assert!(n_near_1 < 1e-8 && kappa_big < 1e-8);
 }
+
+/// The physical solution must not depend on the reference values (in particular not on `α_o`).
+#[test]
+fn profiles_do_not_depend_on_reference_values() {
+    use diffbvp::fiber::{ReferenceValues, Scaling};
+    let opts = SimulateOptions::with_tol(1e-8);
+    let e = experiment(TakeUp::Diameter(9e-5));
+    let base = model(CarreauLike::new(), Physics::paper());
+    let a = simulate(&base, &[0.8, 11.71], &opts)
+        .unwrap()
+        .uniform_profiles(&base, 21);
+    for reference in [
+        ReferenceValues {
+            heat_transfer: 50.0,
+            ..Default::default()
+        },
+        ReferenceValues {
+            length: 1.0,
+            velocity: 0.05,
+            temperature: 400.0,
+            viscosity: 1e3,
+            mass_flow: 1e-5,
+            ..Default::default()
+        },
+    ] {
+        let m = FiberModel::with_scaling(
+            &Material::pmma7n(),
+            &Air::paper(),
+            &e,
+            CarreauLike { stress_scale: 1.0 },
+            Physics::paper(),
+            Scaling::new(reference),
+        )
+        .unwrap();
+        let b = simulate(&m, &[0.8, 11.71], &opts)
+            .unwrap()
+            .uniform_profiles(&m, 21);
+        let mut worst = 0.0f64;
+        for i in 0..21 {
+            worst = worst.max((a.diameter[i] / b.diameter[i] - 1.0).abs());
+            worst = worst.max((a.temperature[i] / b.temperature[i] - 1.0).abs());
+            worst = worst.max((a.force[i] / b.force[i] - 1.0).abs());
+        }
+        eprintln!("other reference values: max rel dev {worst:.2e}");
+        assert!(worst < 1e-6, "{worst:e}");
+    }
+}
