@@ -109,11 +109,10 @@ impl NusseltLaw for InclinedChurchillBernstein {
         let inc2 = re_sq + self.inclination_regularisation * self.inclination_regularisation;
         let inclination = -(re_tau * re_tau / inc2) * 0.5 + 1.0;
         let sqrt_re = re_eps2.sqrt().sqrt(); // Re_ε^½, Re_ε² > 0
-                                             // [1 + (Re_ε/282000)^(5/8)]^(4/5)
-        let big = ((re_eps2 * (1.0 / (282000.0 * 282000.0))).ln() * 0.3125)
-            .exp()
-            .ln_1p()
-            * 0.8;
+                                             // (Re_ε/282000)^(5/8) = Re_ε^½ Re_ε^⅛ / 282000^(5/8), by square roots only
+        let re_58 = sqrt_re * sqrt_re.sqrt().sqrt() * 282000f64.powf(-0.625);
+        // [1 + (Re_ε/282000)^(5/8)]^(4/5)
+        let big = re_58.ln_1p() * 0.8;
         inclination * (sqrt_re * pr_arg * big.exp() + 0.3)
     }
 }

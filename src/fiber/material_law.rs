@@ -7,12 +7,15 @@
 //! derivatives with respect to them are exact). It returns `μ̃_e = μ_e/μ_o`.
 //!
 //! The strain-rate formulation needs `∂_T μ_e` and `∂_ε̇ μ_e`; [`viscosity_with_partials`] gets
-//! them by nested dual numbers (`num_dual::Dual<D>` over the caller's `D`), so a law is written
-//! once, without hand-coded derivatives. Laws must be strictly monotone in the strain rate
+//! them by nested dual numbers (one pass with `num_dual::DualSVec<D, 2>` over the caller's `D`,
+//! seeded in `T` and `ε̇`), so a law is written once, without hand-coded derivatives, and the
+//! derivatives of the right-hand side with respect to the states and the law parameters stay
+//! exact. Laws must be strictly monotone in the strain rate
 //! (`∂_ε̇ (μ_e ε̇) > 0`) and smooth at `ε̇ = 0` (the stress-free start has `ε̇ ≡ 0`): write powers of
 //! `1 + x²` as `exp(a ln(1 + x²))`, never `powf`/`sqrt` of a quantity that can be 0.
 
-use num_dual::{Dual, DualNum};
+use nalgebra::{Const, U1};
+use num_dual::{DualNum, DualSVec};
 
 /// Largest number of law parameters supported by [`viscosity_with_partials`].
 pub const MAX_LAW_PARAMS: usize = 8;
@@ -194,8 +197,9 @@ impl ViscosityLaw for CarreauYasuda {
 }
 
 /// `(μ_e, ∂_T μ_e, ∂_ε̇ μ_e)` (all dimensionless) at temperature `t`, strain rate `rate` and law
-/// parameters `p`, by nested dual numbers: `μ_e0` is recomputed from `zero` on the lifted
-/// temperature so that `∂_T` includes the VFT dependence. Exact for every `D`.
+/// parameters `p`, by nested dual numbers (one pass, two seeds over `D`): `μ_e0` is computed
+/// from `zero` on the lifted temperature so that `∂_T` includes the VFT dependence. Exact for
+/// every `D`.
 #[inline]
 pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
     law: &L,
@@ -206,30 +210,21 @@ pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Co
     p: &[D],
 ) -> (D, D, D) {
     let k = p.len().min(MAX_LAW_PARAMS);
-    let mut pl = [Dual::from_re(D::zero()); MAX_LAW_PARAMS];
+    let mut pl = [DualSVec::<D, 2>::from_re(D::zero()); MAX_LAW_PARAMS];
     for (l, &v) in pl.iter_mut().zip(&p[..k]) {
-        *l = Dual::from_re(v);
+        *l = DualSVec::from_re(v);
     }
     let pl = &pl[..k];
-    // ∂_T
-    let tt = Dual::new(t, D::one());
-    let xt = LawInputs {
+    let tt = DualSVec::<D, 2>::from_re(t).derivative(0);
+    let x = LawInputs {
         t: tt,
         mu0: zero.eval(tt),
-        rate: Dual::from_re(rate),
+        rate: DualSVec::from_re(rate).derivative(1),
         de,
     };
-    let mt = law.mu_e(&xt, pl);
-    // ∂_ε̇
-    let t0 = Dual::from_re(t);
-    let xr = LawInputs {
-        t: t0,
-        mu0: Dual::from_re(xt.mu0.re),
-        rate: Dual::new(rate, D::one()),
-        de,
-    };
-    let mr = law.mu_e(&xr, pl);
-    (mt.re, mt.eps, mr.eps)
+    let m = law.mu_e(&x, pl);
+    let e = m.eps.unwrap_generic(Const::<2>, U1);
+    (m.re, e[0], e[1])
 }
 
 /// `μ̃_e` alone (no derivatives).
