@@ -100,7 +100,7 @@ impl ViscosityLaw for Newtonian {
 /// The paper's Carreau-type law (eq. CarreauLikeLaw), parameters `p = (n, κ)`, `K = exp(κ)` [Pa]:
 /// `μ_e = μ_e0 (1 + De² (μ_e0 ε̇/K̃)²)^((n−1)/2)` with `K̃ = K/K_o` (dimensionless form).
 /// Newtonian for `n → 1` or `κ → ∞`. Monotone for `n ≥ 0`.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CarreauLike {
     /// Stress scale `K_o` [Pa] of the non-dimensionalisation (`K̃ = exp(κ)/K_o`); 1 Pa in the
     /// paper.
@@ -111,6 +111,13 @@ impl CarreauLike {
     /// The law with `K_o = 1 Pa` (paper Table 2).
     pub fn new() -> Self {
         CarreauLike { stress_scale: 1.0 }
+    }
+}
+
+impl Default for CarreauLike {
+    /// `K_o = 1 Pa`.
+    fn default() -> Self {
+        CarreauLike::new()
     }
 }
 
@@ -133,20 +140,9 @@ impl ViscosityLaw for CarreauLike {
     fn mu_e<D: DualNum<Primitive = f64> + Copy>(&self, x: &LawInputs<D>, p: &[D]) -> D {
         let (n, kappa) = (p[0], p[1]);
         // λ ε̇ De = De μ0 ε̇ / K̃, K̃ = exp(κ)/K_o
-        let w = x.mu0 * x.rate * (-kappa).exp() * (x.de * self.stress_scale_or_one());
+        let w = x.mu0 * x.rate * (-kappa).exp() * (x.de * self.stress_scale);
         let ln1p = (w * w).ln_1p();
         x.mu0 * ((n - 1.0) * 0.5 * ln1p).exp()
-    }
-}
-
-impl CarreauLike {
-    #[inline]
-    fn stress_scale_or_one(&self) -> f64 {
-        if self.stress_scale > 0.0 {
-            self.stress_scale
-        } else {
-            1.0
-        }
     }
 }
 
