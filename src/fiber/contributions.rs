@@ -120,23 +120,23 @@ impl NusseltLaw for InclinedChurchillBernstein {
 /// Local state in SI units, as seen by user terms ([`FiberTerm`]).
 #[derive(Debug, Clone, Copy)]
 pub struct SiState<D> {
-    /// Position `s` [m].
+    /// Position `s` \[m\].
     pub s: f64,
     /// Fiber speed `u` [m/s].
     pub velocity: D,
-    /// Axial force `N` [N].
+    /// Axial force `N` \[N\].
     pub force: D,
-    /// Fiber temperature `T` [K].
+    /// Fiber temperature `T` \[K\].
     pub temperature: D,
     /// Strain rate `ε̇` [1/s].
     pub strain_rate: D,
-    /// Fiber diameter `d` [m].
+    /// Fiber diameter `d` \[m\].
     pub diameter: D,
     /// Polymer density `ρ(T)` [kg/m³].
     pub density: D,
     /// Polymer specific heat `c_p(T)` [J/(kg K)].
     pub heat_capacity: D,
-    /// Air temperature at `s` [K].
+    /// Air temperature at `s` \[K\].
     pub air_temperature: D,
     /// Air speed along the fiber at `s` [m/s].
     pub air_velocity: D,
@@ -225,7 +225,7 @@ pub enum AirSpeed {
     CoFlow {
         /// `V` [m/s].
         speed: f64,
-        /// Decay length `ℓ` [m].
+        /// Decay length `ℓ` \[m\].
         length: f64,
         /// Factor on `V` (`Parameter` makes it a model parameter named `"coflow"`).
         strength: Strength,
@@ -239,9 +239,9 @@ pub enum AirTemperature {
     Uniform,
     /// Warm air near the nozzle: `T_air(s) = T_air + strength · ΔT exp(−s/ℓ)`.
     WarmNozzle {
-        /// `ΔT` [K].
+        /// `ΔT` \[K\].
         excess: f64,
-        /// Decay length `ℓ` [m].
+        /// Decay length `ℓ` \[m\].
         length: f64,
         /// Factor on `ΔT` (`Parameter` makes it a model parameter named `"warm_air"`).
         strength: Strength,
@@ -311,8 +311,8 @@ impl<H: NusseltLaw> Physics<H> {
         self
     }
 
-    /// Warm air near the nozzle: `T_air(s) = T_air + ΔT exp(−s/ℓ)`, `excess` = ΔT [K],
-    /// `length` = ℓ [m].
+    /// Warm air near the nozzle: `T_air(s) = T_air + ΔT exp(−s/ℓ)`, `excess` = ΔT \[K\],
+    /// `length` = ℓ \[m\].
     pub fn with_warm_air(mut self, excess: f64, length: f64) -> Self {
         self.air_temperature = AirTemperature::WarmNozzle {
             excess,
@@ -322,7 +322,7 @@ impl<H: NusseltLaw> Physics<H> {
         self
     }
 
-    /// Aspirator co-flow `v_air(s) = V exp(−(L − s)/ℓ)`, `speed` = V [m/s], `length` = ℓ [m].
+    /// Aspirator co-flow `v_air(s) = V exp(−(L − s)/ℓ)`, `speed` = V [m/s], `length` = ℓ \[m\].
     pub fn with_coflow(mut self, speed: f64, length: f64) -> Self {
         self.air_speed = AirSpeed::CoFlow {
             speed,
@@ -437,8 +437,8 @@ pub struct Coefficients {
 }
 
 impl Coefficients {
-    /// Coefficients for `air`, mass flow `q_si` [kg/s], air temperature `t_air_si` [K] and
-    /// spin-line length `length_si` [m].
+    /// Coefficients for `air`, mass flow `q_si` [kg/s], air temperature `t_air_si` \[K\] and
+    /// spin-line length `length_si` \[m\].
     pub fn new(
         scaling: &super::scaling::Scaling,
         air: &Air,

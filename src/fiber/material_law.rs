@@ -97,12 +97,12 @@ impl ViscosityLaw for Newtonian {
     }
 }
 
-/// The paper's Carreau-type law (eq. CarreauLikeLaw), parameters `p = (n, κ)`, `K = exp(κ)` [Pa]:
+/// The paper's Carreau-type law (eq. CarreauLikeLaw), parameters `p = (n, κ)`, `K = exp(κ)` \[Pa\]:
 /// `μ_e = μ_e0 (1 + De² (μ_e0 ε̇/K̃)²)^((n−1)/2)` with `K̃ = K/K_o` (dimensionless form).
 /// Newtonian for `n → 1` or `κ → ∞`. Monotone for `n ≥ 0`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CarreauLike {
-    /// Stress scale `K_o` [Pa] of the non-dimensionalisation (`K̃ = exp(κ)/K_o`); 1 Pa in the
+    /// Stress scale `K_o` \[Pa\] of the non-dimensionalisation (`K̃ = exp(κ)/K_o`); 1 Pa in the
     /// paper.
     pub stress_scale: f64,
 }
@@ -154,7 +154,7 @@ impl ViscosityLaw for CarreauLike {
 pub struct CarreauYasuda {
     /// Yasuda exponent `a > 1` [-].
     pub a: f64,
-    /// Stress scale `K_o` [Pa] (1 Pa in the paper).
+    /// Stress scale `K_o` \[Pa\] (1 Pa in the paper).
     pub stress_scale: f64,
 }
 

@@ -8,7 +8,7 @@
 //! * [`contributions`]: named force and heat terms, air environment, Nusselt law;
 //! * [`model`]: the strain-rate formulation as a [`Bvp`](crate::Bvp);
 //! * [`cold_start`]: continuation from the stress-free fiber;
-//! * [`simulate`]: the user-facing API with SI profiles.
+//! * [`mod@simulate`]: the user-facing API with SI profiles.
 
 pub mod cold_start;
 pub mod contributions;

@@ -45,7 +45,7 @@ pub struct SimulateOptions {
     pub continuation: ContinuationOptions,
     /// Keep the factorised Jacobian at the solution (for sensitivities; default `false`).
     pub factor_at_solution: bool,
-    /// Positions [m] added as nodes to the mesh of the final solve, e.g. output positions
+    /// Positions \[m\] added as nodes to the mesh of the final solve, e.g. output positions
     /// (default none; mesh coarsening may remove some again — the interpolant is used anyway).
     pub required_positions: Vec<f64>,
 }
@@ -97,17 +97,17 @@ pub struct FiberSolution {
 /// Profiles in SI units at chosen positions.
 #[derive(Debug, Clone, Default)]
 pub struct Profiles {
-    /// Positions `s` [m].
+    /// Positions `s` \[m\].
     pub position: Vec<f64>,
     /// Fiber speed `u` [m/s].
     pub velocity: Vec<f64>,
-    /// Axial force `N` [N].
+    /// Axial force `N` \[N\].
     pub force: Vec<f64>,
-    /// Temperature `T` [K].
+    /// Temperature `T` \[K\].
     pub temperature: Vec<f64>,
     /// Strain rate `ε̇ = u'` [1/s].
     pub strain_rate: Vec<f64>,
-    /// Diameter `d` [m].
+    /// Diameter `d` \[m\].
     pub diameter: Vec<f64>,
     /// Elongational viscosity `μ_e(T, ε̇)` [Pa s].
     pub viscosity: Vec<f64>,
@@ -121,7 +121,7 @@ impl FiberSolution {
         self.solution.nodes()
     }
 
-    /// Profiles at `positions` [m] through the solution's C¹ interpolant.
+    /// Profiles at `positions` \[m\] through the solution's C¹ interpolant.
     pub fn profiles<L: ViscosityLaw, H: NusseltLaw>(
         &self,
         model: &FiberModel<L, H>,
