@@ -43,9 +43,24 @@ impl Default for ContinuationOptions {
 
 /// Continuation in `p[index]` from 0 to 1 starting from `guess`, which must (nearly) solve the
 /// problem at `p[index] = 0`. `params` holds the other model parameters (its entry `index` is
-/// overwritten). Returns the solution at `p[index] = 1`, solved with `options`.
+/// overwritten). Returns the solution at `p[index] = 1`, solved with the solver's options
+/// (intermediate steps at the looser `cont.intermediate_tol`). The solver (and its cached
+/// symbolic factorisations) is reused for every step; its options are restored on return.
 pub fn continuation_in_c<P: Bvp>(
-    problem: &P,
+    solver: &mut Solver<'_, P>,
+    params: &[f64],
+    index: usize,
+    guess: &Guess,
+    cont: &ContinuationOptions,
+) -> Result<Solution, BvpError> {
+    let options = solver.options.clone();
+    let result = continuation_steps(solver, params, index, guess, &options, cont);
+    solver.options = options;
+    result
+}
+
+fn continuation_steps<P: Bvp>(
+    solver: &mut Solver<'_, P>,
     params: &[f64],
     index: usize,
     guess: &Guess,
@@ -79,7 +94,7 @@ pub fn continuation_in_c<P: Bvp>(
             .max(cont.intermediate_tol),
     );
     loose.factor_at_solution = false;
-    let mut solver = Solver::new(problem, loose);
+    solver.options = loose;
     let mut sol = solver.solve(&p, guess)?;
     let mut c = 0.0;
     let mut step = cont.initial_step;

@@ -57,9 +57,18 @@ impl Strength {
 /// Nusselt function `𝒩(Re_τ, Re², Pr)` of the heat-transfer coefficient `α = λ_*/d 𝒩`
 /// (dimensionless inputs: tangential Reynolds number `Re_τ = d v_rel,τ/ν_*` (signed), the square
 /// of the Reynolds number of the relative speed and the Prandtl number).
+///
+/// The Prandtl number is constant along the fiber, so a law may preprocess it once:
+/// [`prandtl_argument`](NusseltLaw::prandtl_argument) maps `Pr` to the value handed to
+/// [`nusselt`](NusseltLaw::nusselt) on every evaluation (default: `Pr` itself).
 pub trait NusseltLaw: Send + Sync {
-    /// Evaluates `𝒩` [-].
-    fn nusselt<D: DualNum<Primitive = f64> + Copy>(&self, re_tau: D, re_sq: D, pr: f64) -> D;
+    /// Evaluates `𝒩` [-]; `pr_arg` is [`prandtl_argument`](NusseltLaw::prandtl_argument)`(Pr)`.
+    fn nusselt<D: DualNum<Primitive = f64> + Copy>(&self, re_tau: D, re_sq: D, pr_arg: f64) -> D;
+
+    /// Preprocessing of the (constant) Prandtl number, done once per model.
+    fn prandtl_argument(&self, pr: f64) -> f64 {
+        pr
+    }
 }
 
 /// Default Nusselt law of `docs/model-closure.md` (an assumption; the paper's law is not public):
@@ -89,39 +98,45 @@ impl Default for InclinedChurchillBernstein {
 }
 
 impl NusseltLaw for InclinedChurchillBernstein {
+    /// `0.62 Pr^⅓ [1 + (0.4/Pr)^⅔]^(−¼)`.
+    fn prandtl_argument(&self, pr: f64) -> f64 {
+        0.62 * pr.cbrt() * (1.0 + (0.4 / pr).powf(2.0 / 3.0)).powf(-0.25)
+    }
+
     #[inline]
-    fn nusselt<D: DualNum<Primitive = f64> + Copy>(&self, re_tau: D, re_sq: D, pr: f64) -> D {
+    fn nusselt<D: DualNum<Primitive = f64> + Copy>(&self, re_tau: D, re_sq: D, pr_arg: f64) -> D {
         let re_eps2 = re_sq + self.re_regularisation * self.re_regularisation;
         let inc2 = re_sq + self.inclination_regularisation * self.inclination_regularisation;
         let inclination = -(re_tau * re_tau / inc2) * 0.5 + 1.0;
-        let pr_fac = 0.62 * pr.cbrt() * (1.0 + (0.4 / pr).powf(2.0 / 3.0)).powf(-0.25);
-        let ln_re = re_eps2.ln() * 0.5; // ln Re_ε
-        let sqrt_re = (ln_re * 0.5).exp();
-        let big = ((ln_re - 282000f64.ln()) * 0.625).exp().ln_1p() * 0.8;
-        inclination * (sqrt_re * pr_fac * big.exp() + 0.3)
+        let sqrt_re = re_eps2.sqrt().sqrt(); // Re_ε^½, Re_ε² > 0
+                                             // (Re_ε/282000)^(5/8) = Re_ε^½ Re_ε^⅛ / 282000^(5/8), by square roots only
+        let re_58 = sqrt_re * sqrt_re.sqrt().sqrt() * 282000f64.powf(-0.625);
+        // [1 + (Re_ε/282000)^(5/8)]^(4/5)
+        let big = re_58.ln_1p() * 0.8;
+        inclination * (sqrt_re * pr_arg * big.exp() + 0.3)
     }
 }
 
 /// Local state in SI units, as seen by user terms ([`FiberTerm`]).
 #[derive(Debug, Clone, Copy)]
 pub struct SiState<D> {
-    /// Position `s` [m].
+    /// Position `s` \[m\].
     pub s: f64,
     /// Fiber speed `u` [m/s].
     pub velocity: D,
-    /// Axial force `N` [N].
+    /// Axial force `N` \[N\].
     pub force: D,
-    /// Fiber temperature `T` [K].
+    /// Fiber temperature `T` \[K\].
     pub temperature: D,
     /// Strain rate `ε̇` [1/s].
     pub strain_rate: D,
-    /// Fiber diameter `d` [m].
+    /// Fiber diameter `d` \[m\].
     pub diameter: D,
     /// Polymer density `ρ(T)` [kg/m³].
     pub density: D,
     /// Polymer specific heat `c_p(T)` [J/(kg K)].
     pub heat_capacity: D,
-    /// Air temperature at `s` [K].
+    /// Air temperature at `s` \[K\].
     pub air_temperature: D,
     /// Air speed along the fiber at `s` [m/s].
     pub air_velocity: D,
@@ -210,7 +225,7 @@ pub enum AirSpeed {
     CoFlow {
         /// `V` [m/s].
         speed: f64,
-        /// Decay length `ℓ` [m].
+        /// Decay length `ℓ` \[m\].
         length: f64,
         /// Factor on `V` (`Parameter` makes it a model parameter named `"coflow"`).
         strength: Strength,
@@ -224,9 +239,9 @@ pub enum AirTemperature {
     Uniform,
     /// Warm air near the nozzle: `T_air(s) = T_air + strength · ΔT exp(−s/ℓ)`.
     WarmNozzle {
-        /// `ΔT` [K].
+        /// `ΔT` \[K\].
         excess: f64,
-        /// Decay length `ℓ` [m].
+        /// Decay length `ℓ` \[m\].
         length: f64,
         /// Factor on `ΔT` (`Parameter` makes it a model parameter named `"warm_air"`).
         strength: Strength,
@@ -296,8 +311,8 @@ impl<H: NusseltLaw> Physics<H> {
         self
     }
 
-    /// Warm air near the nozzle: `T_air(s) = T_air + ΔT exp(−s/ℓ)`, `excess` = ΔT [K],
-    /// `length` = ℓ [m].
+    /// Warm air near the nozzle: `T_air(s) = T_air + ΔT exp(−s/ℓ)`, `excess` = ΔT \[K\],
+    /// `length` = ℓ \[m\].
     pub fn with_warm_air(mut self, excess: f64, length: f64) -> Self {
         self.air_temperature = AirTemperature::WarmNozzle {
             excess,
@@ -307,7 +322,7 @@ impl<H: NusseltLaw> Physics<H> {
         self
     }
 
-    /// Aspirator co-flow `v_air(s) = V exp(−(L − s)/ℓ)`, `speed` = V [m/s], `length` = ℓ [m].
+    /// Aspirator co-flow `v_air(s) = V exp(−(L − s)/ℓ)`, `speed` = V [m/s], `length` = ℓ \[m\].
     pub fn with_coflow(mut self, speed: f64, length: f64) -> Self {
         self.air_speed = AirSpeed::CoFlow {
             speed,
@@ -403,6 +418,8 @@ pub struct Coefficients {
     pub re_air: f64,
     /// Prandtl number of the actual air [-].
     pub pr: f64,
+    /// The Nusselt law's preprocessed Prandtl argument ([`NusseltLaw::prandtl_argument`]).
+    pub pr_arg: f64,
     /// Eckert number [-].
     pub ec: f64,
     /// Radiation factor `π σ T_o³ d_o L_o/(c_p,o Q_o)` [-] (times ε).
@@ -420,8 +437,8 @@ pub struct Coefficients {
 }
 
 impl Coefficients {
-    /// Coefficients for `air`, mass flow `q_si` [kg/s], air temperature `t_air_si` [K] and
-    /// spin-line length `length_si` [m].
+    /// Coefficients for `air`, mass flow `q_si` [kg/s], air temperature `t_air_si` \[K\] and
+    /// spin-line length `length_si` \[m\].
     pub fn new(
         scaling: &super::scaling::Scaling,
         air: &Air,
@@ -442,6 +459,7 @@ impl Coefficients {
             convection: PI * scaling.st_over_nu() * lam_a,
             re_air: scaling.re_star / nu_a,
             pr: scaling.pr_star * cp_a * rho_a * nu_a / lam_a,
+            pr_arg: scaling.pr_star * cp_a * rho_a * nu_a / lam_a,
             ec: scaling.ec,
             radiation: PI
                 * STEFAN_BOLTZMANN
@@ -568,7 +586,7 @@ impl<H: NusseltLaw> Physics<H> {
             TermKind::AirDrag => (st.v_air - st.u) * co.drag,
             TermKind::Convection => {
                 let re_tau = st.d * (st.v_air - st.u) * co.re_air;
-                let nu = self.nusselt.nusselt(re_tau, re_tau * re_tau, co.pr);
+                let nu = self.nusselt.nusselt(re_tau, re_tau * re_tau, co.pr_arg);
                 -nu * (st.t - st.t_air) * co.convection
             }
             TermKind::ViscousHeating => st.n * st.rate * co.ec,
@@ -660,9 +678,9 @@ mod tests {
                 * pr.cbrt()
                 * (1.0 + (0.4 / pr).powf(2.0 / 3.0)).powf(-0.25)
                 * (1.0 + (re / 282000.0).powf(0.625)).powf(0.8);
-        let v = law.nusselt(-re, re * re, pr);
+        let v = law.nusselt(-re, re * re, law.prandtl_argument(pr));
         assert!((v - 0.5 * cb).abs() < 1e-6 * cb, "{v} {cb}");
-        let cross = law.nusselt(0.0, re * re, pr);
+        let cross = law.nusselt(0.0, re * re, law.prandtl_argument(pr));
         assert!((cross - cb).abs() < 1e-6 * cb);
     }
 }

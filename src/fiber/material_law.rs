@@ -7,12 +7,15 @@
 //! derivatives with respect to them are exact). It returns `μ̃_e = μ_e/μ_o`.
 //!
 //! The strain-rate formulation needs `∂_T μ_e` and `∂_ε̇ μ_e`; [`viscosity_with_partials`] gets
-//! them by nested dual numbers (`num_dual::Dual<D>` over the caller's `D`), so a law is written
-//! once, without hand-coded derivatives. Laws must be strictly monotone in the strain rate
+//! them by nested dual numbers (one pass with `num_dual::DualSVec<D, 2>` over the caller's `D`,
+//! seeded in `T` and `ε̇`), so a law is written once, without hand-coded derivatives, and the
+//! derivatives of the right-hand side with respect to the states and the law parameters stay
+//! exact. Laws must be strictly monotone in the strain rate
 //! (`∂_ε̇ (μ_e ε̇) > 0`) and smooth at `ε̇ = 0` (the stress-free start has `ε̇ ≡ 0`): write powers of
 //! `1 + x²` as `exp(a ln(1 + x²))`, never `powf`/`sqrt` of a quantity that can be 0.
 
-use num_dual::{Dual, DualNum};
+use nalgebra::{Const, U1};
+use num_dual::{DualNum, DualSVec};
 
 /// Largest number of law parameters supported by [`viscosity_with_partials`].
 pub const MAX_LAW_PARAMS: usize = 8;
@@ -94,12 +97,12 @@ impl ViscosityLaw for Newtonian {
     }
 }
 
-/// The paper's Carreau-type law (eq. CarreauLikeLaw), parameters `p = (n, κ)`, `K = exp(κ)` [Pa]:
+/// The paper's Carreau-type law (eq. CarreauLikeLaw), parameters `p = (n, κ)`, `K = exp(κ)` \[Pa\]:
 /// `μ_e = μ_e0 (1 + De² (μ_e0 ε̇/K̃)²)^((n−1)/2)` with `K̃ = K/K_o` (dimensionless form).
 /// Newtonian for `n → 1` or `κ → ∞`. Monotone for `n ≥ 0`.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CarreauLike {
-    /// Stress scale `K_o` [Pa] of the non-dimensionalisation (`K̃ = exp(κ)/K_o`); 1 Pa in the
+    /// Stress scale `K_o` \[Pa\] of the non-dimensionalisation (`K̃ = exp(κ)/K_o`); 1 Pa in the
     /// paper.
     pub stress_scale: f64,
 }
@@ -108,6 +111,13 @@ impl CarreauLike {
     /// The law with `K_o = 1 Pa` (paper Table 2).
     pub fn new() -> Self {
         CarreauLike { stress_scale: 1.0 }
+    }
+}
+
+impl Default for CarreauLike {
+    /// `K_o = 1 Pa`.
+    fn default() -> Self {
+        CarreauLike::new()
     }
 }
 
@@ -130,20 +140,9 @@ impl ViscosityLaw for CarreauLike {
     fn mu_e<D: DualNum<Primitive = f64> + Copy>(&self, x: &LawInputs<D>, p: &[D]) -> D {
         let (n, kappa) = (p[0], p[1]);
         // λ ε̇ De = De μ0 ε̇ / K̃, K̃ = exp(κ)/K_o
-        let w = x.mu0 * x.rate * (-kappa).exp() * (x.de * self.stress_scale_or_one());
+        let w = x.mu0 * x.rate * (-kappa).exp() * (x.de * self.stress_scale);
         let ln1p = (w * w).ln_1p();
         x.mu0 * ((n - 1.0) * 0.5 * ln1p).exp()
-    }
-}
-
-impl CarreauLike {
-    #[inline]
-    fn stress_scale_or_one(&self) -> f64 {
-        if self.stress_scale > 0.0 {
-            self.stress_scale
-        } else {
-            1.0
-        }
     }
 }
 
@@ -155,7 +154,7 @@ impl CarreauLike {
 pub struct CarreauYasuda {
     /// Yasuda exponent `a > 1` [-].
     pub a: f64,
-    /// Stress scale `K_o` [Pa] (1 Pa in the paper).
+    /// Stress scale `K_o` \[Pa\] (1 Pa in the paper).
     pub stress_scale: f64,
 }
 
@@ -194,8 +193,9 @@ impl ViscosityLaw for CarreauYasuda {
 }
 
 /// `(μ_e, ∂_T μ_e, ∂_ε̇ μ_e)` (all dimensionless) at temperature `t`, strain rate `rate` and law
-/// parameters `p`, by nested dual numbers: `μ_e0` is recomputed from `zero` on the lifted
-/// temperature so that `∂_T` includes the VFT dependence. Exact for every `D`.
+/// parameters `p`, by nested dual numbers (one pass, two seeds over `D`): `μ_e0` is computed
+/// from `zero` on the lifted temperature so that `∂_T` includes the VFT dependence. Exact for
+/// every `D`.
 #[inline]
 pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
     law: &L,
@@ -206,30 +206,21 @@ pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Co
     p: &[D],
 ) -> (D, D, D) {
     let k = p.len().min(MAX_LAW_PARAMS);
-    let mut pl = [Dual::from_re(D::zero()); MAX_LAW_PARAMS];
+    let mut pl = [DualSVec::<D, 2>::from_re(D::zero()); MAX_LAW_PARAMS];
     for (l, &v) in pl.iter_mut().zip(&p[..k]) {
-        *l = Dual::from_re(v);
+        *l = DualSVec::from_re(v);
     }
     let pl = &pl[..k];
-    // ∂_T
-    let tt = Dual::new(t, D::one());
-    let xt = LawInputs {
+    let tt = DualSVec::<D, 2>::from_re(t).derivative(0);
+    let x = LawInputs {
         t: tt,
         mu0: zero.eval(tt),
-        rate: Dual::from_re(rate),
+        rate: DualSVec::from_re(rate).derivative(1),
         de,
     };
-    let mt = law.mu_e(&xt, pl);
-    // ∂_ε̇
-    let t0 = Dual::from_re(t);
-    let xr = LawInputs {
-        t: t0,
-        mu0: Dual::from_re(xt.mu0.re),
-        rate: Dual::new(rate, D::one()),
-        de,
-    };
-    let mr = law.mu_e(&xr, pl);
-    (mt.re, mt.eps, mr.eps)
+    let m = law.mu_e(&x, pl);
+    let e = m.eps.unwrap_generic(Const::<2>, U1);
+    (m.re, e[0], e[1])
 }
 
 /// `μ̃_e` alone (no derivatives).
@@ -305,29 +296,29 @@ mod tests {
         let mut last = 0.0;
         for i in 0..200 {
             let r = i as f64 * 0.5;
-            let s = viscosity(&c, &z, 82.486, 0.8f64, r, &[0.3, 11.0]) * r;
+            let s = viscosity(&c, &z, 82.486, 0.8, r, &[0.3, 11.0]) * r;
             assert!(s > last || i == 0);
             last = s;
         }
-        let newt = viscosity(&Newtonian, &z, 82.486, 0.8f64, 5.0, &[]);
-        let near = viscosity(&c, &z, 82.486, 0.8f64, 5.0, &[1.0 - 1e-9, 11.71]);
+        let newt = viscosity::<_, f64>(&Newtonian, &z, 82.486, 0.8, 5.0, &[]);
+        let near = viscosity::<_, f64>(&c, &z, 82.486, 0.8, 5.0, &[1.0 - 1e-9, 11.71]);
         assert!((near / newt - 1.0).abs() < 1e-8);
-        let stiff = viscosity(&c, &z, 82.486, 0.8f64, 5.0, &[0.8, 60.0]);
+        let stiff = viscosity::<_, f64>(&c, &z, 82.486, 0.8, 5.0, &[0.8, 60.0]);
         assert!((stiff / newt - 1.0).abs() < 1e-12);
     }
 
     #[test]
     fn yasuda_with_a_two_is_carreau() {
         let z = zero();
-        let a = viscosity(
+        let a = viscosity::<_, f64>(
             &CarreauYasuda::new(2.0),
             &z,
             82.486,
-            0.9f64,
+            0.9,
             7.0,
             &[0.8, 11.71],
         );
-        let b = viscosity(&CarreauLike::new(), &z, 82.486, 0.9f64, 7.0, &[0.8, 11.71]);
+        let b = viscosity::<_, f64>(&CarreauLike::new(), &z, 82.486, 0.9, 7.0, &[0.8, 11.71]);
         assert!((a / b - 1.0).abs() < 1e-13);
     }
 }

@@ -9,7 +9,7 @@
 //! * [`contributions`]: named force and heat terms, air environment, Nusselt law;
 //! * [`model`]: the strain-rate formulation as a [`Bvp`](crate::Bvp);
 //! * [`cold_start`]: continuation from the stress-free fiber;
-//! * [`simulate`]: the user-facing API with SI profiles;
+//! * [`mod@simulate`]: the user-facing API with SI profiles;
 //! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5).
 
 pub mod cold_start;
@@ -32,4 +32,4 @@ pub use error::FiberError;
 pub use material_law::{CarreauLike, CarreauYasuda, Newtonian, ViscosityLaw};
 pub use model::FiberModel;
 pub use scaling::{ReferenceValues, Scaling};
-pub use simulate::{simulate, FiberSolution, Profiles, SimulateOptions};
+pub use simulate::{simulate, simulate_from, FiberSolution, Profiles, SimulateOptions, Simulator};

@@ -213,7 +213,8 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
                 }
             }
         };
-        let co = Coefficients::new(&scaling, air, physics.slenderness, q, t_air, length);
+        let mut co = Coefficients::new(&scaling, air, physics.slenderness, q, t_air, length);
+        co.pr_arg = physics.nusselt.prandtl_argument(co.pr);
         let zero = ZeroRateViscosity {
             a: material.trouton * material.vft_mu_c / r.viscosity,
             b: material.vft_b / r.temperature,

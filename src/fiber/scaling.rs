@@ -17,11 +17,11 @@ use std::f64::consts::PI;
 pub struct ReferenceValues {
     /// Mass flow `Q_o` [kg/s].
     pub mass_flow: f64,
-    /// Length `L_o = s_o` [m].
+    /// Length `L_o = s_o` \[m\].
     pub length: f64,
     /// Velocity `u_o` [m/s].
     pub velocity: f64,
-    /// Temperature `T_o` [K].
+    /// Temperature `T_o` \[K\].
     pub temperature: f64,
     /// Polymer density `ρ_o` [kg/m³].
     pub density: f64,
@@ -39,7 +39,7 @@ pub struct ReferenceValues {
     pub air_kinematic_viscosity: f64,
     /// Air heat conductivity `λ_*,o` [W/(m K)].
     pub air_heat_conductivity: f64,
-    /// Stress scale `K_o` of the Carreau parameter `K` [Pa].
+    /// Stress scale `K_o` of the Carreau parameter `K` \[Pa\].
     pub stress: f64,
     /// Gravitational acceleration `g` [m/s²] (a model constant, merged into `Fr`).
     pub gravity: f64,
@@ -138,18 +138,18 @@ impl Scaling {
         }
     }
 
-    /// Reference area `A_o = Q_o/(ρ_o u_o)` [m²].
+    /// Reference area `A_o = Q_o/(ρ_o u_o)` \[m²\].
     pub fn area(&self) -> f64 {
         let r = &self.reference;
         r.mass_flow / (r.density * r.velocity)
     }
 
-    /// Reference diameter `d_o = √A_o` [m].
+    /// Reference diameter `d_o = √A_o` \[m\].
     pub fn diameter(&self) -> f64 {
         self.area().sqrt()
     }
 
-    /// Reference force `N_o = Q_o u_o` [N].
+    /// Reference force `N_o = Q_o u_o` \[N\].
     pub fn force(&self) -> f64 {
         self.reference.mass_flow * self.reference.velocity
     }

@@ -45,7 +45,8 @@ pub struct SimulateOptions {
     pub continuation: ContinuationOptions,
     /// Keep the factorised Jacobian at the solution (for sensitivities; default `false`).
     pub factor_at_solution: bool,
-    /// Nodes (positions in m) that must be in the final mesh, e.g. output positions (default none).
+    /// Positions \[m\] added as nodes to the mesh of the final solve, e.g. output positions
+    /// (default none; mesh coarsening may remove some again — the interpolant is used anyway).
     pub required_positions: Vec<f64>,
 }
 
@@ -96,17 +97,17 @@ pub struct FiberSolution {
 /// Profiles in SI units at chosen positions.
 #[derive(Debug, Clone, Default)]
 pub struct Profiles {
-    /// Positions `s` [m].
+    /// Positions `s` \[m\].
     pub position: Vec<f64>,
     /// Fiber speed `u` [m/s].
     pub velocity: Vec<f64>,
-    /// Axial force `N` [N].
+    /// Axial force `N` \[N\].
     pub force: Vec<f64>,
-    /// Temperature `T` [K].
+    /// Temperature `T` \[K\].
     pub temperature: Vec<f64>,
     /// Strain rate `ε̇ = u'` [1/s].
     pub strain_rate: Vec<f64>,
-    /// Diameter `d` [m].
+    /// Diameter `d` \[m\].
     pub diameter: Vec<f64>,
     /// Elongational viscosity `μ_e(T, ε̇)` [Pa s].
     pub viscosity: Vec<f64>,
@@ -120,7 +121,7 @@ impl FiberSolution {
         self.solution.nodes()
     }
 
-    /// Profiles at `positions` [m] through the solution's C¹ interpolant.
+    /// Profiles at `positions` \[m\] through the solution's C¹ interpolant.
     pub fn profiles<L: ViscosityLaw, H: NusseltLaw>(
         &self,
         model: &FiberModel<L, H>,
@@ -203,7 +204,7 @@ pub fn simulate<L: ViscosityLaw, H: NusseltLaw>(
     options: &SimulateOptions,
 ) -> Result<FiberSolution, FiberError> {
     let p = model.parameters(1.0, law_params)?;
-    simulate_params(model, &p, None, options)
+    Simulator::new(model, options.clone()).solve(&p, None)
 }
 
 /// Warm start from a previous solution (e.g. at nearby law parameters); falls back to a cold
@@ -215,7 +216,7 @@ pub fn simulate_from<L: ViscosityLaw, H: NusseltLaw>(
     options: &SimulateOptions,
 ) -> Result<FiberSolution, FiberError> {
     let p = model.parameters(1.0, law_params)?;
-    simulate_params(model, &p, Some(&start.solution), options)
+    Simulator::new(model, options.clone()).solve(&p, Some(&start.solution))
 }
 
 /// The general form: full parameter vector `p` (see [`FiberModel`] for the layout; `p[0]`, the
@@ -226,51 +227,106 @@ pub fn simulate_params<L: ViscosityLaw, H: NusseltLaw>(
     start: Option<&Solution>,
     options: &SimulateOptions,
 ) -> Result<FiberSolution, FiberError> {
-    model.check_parameters(p)?;
-    if options.initial_nodes < 2 {
-        return Err(FiberError::InvalidInput(
-            "initial_nodes must be at least 2".into(),
-        ));
-    }
-    let l_si = model.experiment.spinline_length;
-    let required: Vec<f64> = options
-        .required_positions
-        .iter()
-        .map(|s| s / l_si * model.length())
-        .collect();
-    if options.required_positions.iter().any(|s| !s.is_finite()) {
-        return Err(FiberError::InvalidInput(
-            "required position is not finite".into(),
-        ));
-    }
-    let solve_opts = options.solve_options();
-    if let Some(prev) = start {
-        if prev.n == 4 && prev.nodes() >= 2 {
-            let mut guess = Guess::from(prev);
-            if !required.is_empty() {
-                let x = insert_required(&prev.x, &required);
-                guess = Guess::from_fn(x, 4, |x, y| prev.eval_into(x, y, &mut [0.0; 4]));
-            }
-            let mut solver = Solver::new(model, solve_opts.clone());
-            if let Ok(sol) = solver.solve(p, &guess) {
-                return Ok(FiberSolution { solution: sol });
-            }
+    Simulator::new(model, options.clone()).solve(p, start)
+}
+
+/// A reusable simulator for one model: keeps the toolkit [`Solver`] (workspace and symbolic
+/// factorisations of recent mesh sizes) between solves, for parameter sweeps and fits.
+pub struct Simulator<'a, L: ViscosityLaw, H: NusseltLaw> {
+    model: &'a FiberModel<L, H>,
+    solver: Solver<'a, FiberModel<L, H>>,
+    options: SimulateOptions,
+}
+
+impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
+    /// A simulator for `model` with `options`.
+    pub fn new(model: &'a FiberModel<L, H>, options: SimulateOptions) -> Self {
+        Simulator {
+            model,
+            solver: Solver::new(model, options.solve_options()),
+            options,
         }
     }
-    let x = linspace(0.0, model.length(), options.initial_nodes);
-    let y0 = [model.inlet_velocity(), 0.0, model.inlet_temperature(), 0.0];
-    let guess = Guess::constant(x, &y0);
-    if required.is_empty() {
-        let sol = continuation_in_c(model, p, 0, &guess, &solve_opts, &options.continuation)?;
-        return Ok(FiberSolution { solution: sol });
+
+    /// The model.
+    pub fn model(&self) -> &'a FiberModel<L, H> {
+        self.model
     }
-    // continuation without the required nodes, then a final solve on a mesh containing them
-    let mut loose = solve_opts.clone();
-    loose.tol = solve_opts.tol.max(options.continuation.intermediate_tol);
-    loose.bc_tol = None;
-    let sol = continuation_in_c(model, p, 0, &guess, &loose, &options.continuation)?;
-    let x = insert_required(&sol.x, &required);
-    let guess = Guess::from_fn(x, 4, |x, y| sol.eval_into(x, y, &mut [0.0; 4]));
-    let sol = Solver::new(model, solve_opts).solve(p, &guess)?;
-    Ok(FiberSolution { solution: sol })
+
+    /// Cold start with law parameters `law_params` and default strengths.
+    pub fn cold(&mut self, law_params: &[f64]) -> Result<FiberSolution, FiberError> {
+        let p = self.model.parameters(1.0, law_params)?;
+        self.solve(&p, None)
+    }
+
+    /// Warm start from `start` with law parameters `law_params` (cold start if that fails).
+    pub fn warm(
+        &mut self,
+        law_params: &[f64],
+        start: &FiberSolution,
+    ) -> Result<FiberSolution, FiberError> {
+        let p = self.model.parameters(1.0, law_params)?;
+        self.solve(&p, Some(&start.solution))
+    }
+
+    /// Solves with full parameters `p` from `start` (warm) or by continuation in `c` (cold).
+    pub fn solve(
+        &mut self,
+        p: &[f64],
+        start: Option<&Solution>,
+    ) -> Result<FiberSolution, FiberError> {
+        let model = self.model;
+        let options = &self.options;
+        model.check_parameters(p)?;
+        if options.initial_nodes < 2 {
+            return Err(FiberError::InvalidInput(
+                "initial_nodes must be at least 2".into(),
+            ));
+        }
+        if options.required_positions.iter().any(|s| !s.is_finite()) {
+            return Err(FiberError::InvalidInput(
+                "required position is not finite".into(),
+            ));
+        }
+        let l_si = model.experiment.spinline_length;
+        let required: Vec<f64> = options
+            .required_positions
+            .iter()
+            .map(|s| s / l_si * model.length())
+            .collect();
+        let solve_opts = options.solve_options();
+        self.solver.options = solve_opts.clone();
+        if let Some(prev) = start {
+            if prev.n == 4 && prev.nodes() >= 2 {
+                let guess = if required.is_empty() {
+                    Guess::from(prev)
+                } else {
+                    let x = insert_required(&prev.x, &required);
+                    Guess::from_fn(x, 4, |x, y| prev.eval_into(x, y, &mut [0.0; 4]))
+                };
+                if let Ok(sol) = self.solver.solve(p, &guess) {
+                    return Ok(FiberSolution { solution: sol });
+                }
+            }
+        }
+        let x = linspace(0.0, model.length(), options.initial_nodes);
+        let y0 = [model.inlet_velocity(), 0.0, model.inlet_temperature(), 0.0];
+        let guess = Guess::constant(x, &y0);
+        if required.is_empty() {
+            let sol = continuation_in_c(&mut self.solver, p, 0, &guess, &options.continuation)?;
+            return Ok(FiberSolution { solution: sol });
+        }
+        // continuation without the required nodes, then a final solve on a mesh with them
+        let mut loose = solve_opts.clone();
+        loose.tol = solve_opts.tol.max(options.continuation.intermediate_tol);
+        loose.bc_tol = None;
+        self.solver.options = loose;
+        let sol = continuation_in_c(&mut self.solver, p, 0, &guess, &options.continuation);
+        self.solver.options = solve_opts;
+        let sol = sol?;
+        let x = insert_required(&sol.x, &required);
+        let guess = Guess::from_fn(x, 4, |x, y| sol.eval_into(x, y, &mut [0.0; 4]));
+        let sol = self.solver.solve(p, &guess)?;
+        Ok(FiberSolution { solution: sol })
+    }
 }

@@ -1,0 +1,91 @@
+//! Fiber model benchmarks: cold solve (continuation from c = 0) and warm re-solve from a nearby
+//! (n, κ), experiment v0p53_p2, tol 1e-6.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use diffbvp::fiber::simulate::simulate_from;
+use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions, Simulator};
+use std::hint::black_box;
+
+fn model() -> FiberModel<CarreauLike> {
+    let exp = Experiment {
+        name: "v0p53_p2".into(),
+        mass_flow: 3.08e-5,
+        inlet: Inlet::Diameter(1.134e-3),
+        inlet_temperature: 513.15,
+        air_temperature: 293.15,
+        spinline_length: 0.51,
+        take_up: Some(TakeUp::Diameter(9e-5)),
+    };
+    FiberModel::new(
+        &Material::pmma7n(),
+        &Air::paper(),
+        &exp,
+        CarreauLike::new(),
+        Physics::paper(),
+    )
+    .expect("valid experiment")
+}
+
+fn bench(c: &mut Criterion) {
+    let m = model();
+    let opts = SimulateOptions::with_tol(1e-6);
+    let cold = simulate(&m, &[0.8, 11.71], &opts).expect("cold solve");
+    let near = simulate(&m, &[0.79, 11.70], &opts).expect("nearby solve");
+    let warm = simulate_from(&m, &[0.8, 11.71], &near, &opts).expect("warm solve");
+    eprintln!(
+        "nodes: cold {} (newton its {}, rhs evals {}), warm {} (newton its {}, rhs evals {})",
+        cold.nodes(),
+        cold.solution.stats.newton_iterations,
+        cold.solution.stats.total_rhs_evaluations(),
+        warm.nodes(),
+        warm.solution.stats.newton_iterations,
+        warm.solution.stats.total_rhs_evaluations()
+    );
+    c.bench_function("fiber_cold_v0p53_p2_tol1e-6", |b| {
+        b.iter(|| simulate(black_box(&m), black_box(&[0.8, 11.71]), &opts).expect("cold"))
+    });
+    let mut sim = Simulator::new(&m, opts.clone());
+    c.bench_function("fiber_warm_reused_simulator_v0p53_p2_tol1e-6", |b| {
+        b.iter(|| sim.warm(black_box(&[0.8, 11.71]), &near).expect("warm"))
+    });
+    c.bench_function("fiber_cold_reused_simulator_v0p53_p2_tol1e-6", |b| {
+        b.iter(|| sim.cold(black_box(&[0.8, 11.71])).expect("cold"))
+    });
+    c.bench_function("fiber_warm_v0p53_p2_tol1e-6", |b| {
+        b.iter(|| {
+            simulate_from(black_box(&m), black_box(&[0.8, 11.71]), &near, &opts).expect("warm")
+        })
+    });
+}
+
+fn bench_rhs(c: &mut Criterion) {
+    use diffbvp::Bvp;
+    use num_dual::DualSVec64;
+    let m = model();
+    let p = m.parameters(1.0, &[0.8, 11.71]).expect("params");
+    let y = [2.0, 5000.0, 0.9, 3.0];
+    let mut f = [0.0; 4];
+    c.bench_function("fiber_rhs_f64", |b| {
+        b.iter(|| {
+            m.rhs(black_box(0.3), black_box(&y), &p, &mut f);
+            f[3]
+        })
+    });
+    let yd: Vec<DualSVec64<4>> = y
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| DualSVec64::from_re(v).derivative(i))
+        .collect();
+    let pd: Vec<DualSVec64<4>> = p.iter().map(|&v| DualSVec64::from_re(v)).collect();
+    let mut fd = [DualSVec64::<4>::from_re(0.0); 4];
+    c.bench_function("fiber_rhs_dual4", |b| {
+        b.iter(|| {
+            m.rhs(black_box(0.3), black_box(&yd), &pd, &mut fd);
+            fd[3].re
+        })
+    });
+}
+
+criterion_group!(benches, bench, bench_rhs);
+criterion_main!(benches);
