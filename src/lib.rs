@@ -2,11 +2,12 @@
 mod collocation;
 mod dual_jacobian;
 pub mod error;
-pub mod fiber;
 mod error_control;
+pub mod fiber;
 pub mod linear;
 pub mod mesh;
 mod newton;
+pub mod plot;
 pub mod problem;
 pub mod solution;
 pub mod solve;
