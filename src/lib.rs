@@ -57,6 +57,7 @@ pub mod least_squares;
 pub mod linear;
 pub mod mesh;
 mod newton;
+pub mod plot;
 pub mod problem;
 pub mod sensitivity;
 pub mod solution;
