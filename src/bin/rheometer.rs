@@ -2,12 +2,13 @@
 //! from your own TOML + CSV measurements.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
 use diffbvp::fiber::output::{create_dir, profiles_csv, write_text};
 use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
 use diffbvp::fiber::setup::TakeUp;
 use diffbvp::fiber::smoothing::smooth;
-use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+use diffbvp::fiber::{simulate, CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -29,6 +30,9 @@ struct Cli {
     /// Print more detail (solver statistics, iterations).
     #[arg(long, short, global = true)]
     verbose: bool,
+    /// Figure format.
+    #[arg(long, value_enum, global = true, default_value_t = FormatArg::Png)]
+    format: FormatArg,
     #[command(subcommand)]
     command: Command,
 }
@@ -41,9 +45,26 @@ enum EstimatorArg {
     Paper,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum FormatArg {
+    /// Bitmap figures.
+    Png,
+    /// Vector figures.
+    Svg,
+}
+
+impl FormatArg {
+    fn ext(self) -> &'static str {
+        match self {
+            FormatArg::Png => "png",
+            FormatArg::Svg => "svg",
+        }
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
-    /// Simulate every experiment and write profiles (CSV) into DIR.
+    /// Simulate every experiment and write profiles (CSV) and figures into DIR.
     ///
     /// Example: rheometer simulate data/pmma7n_synthetic/experiments.toml --n 0.8 --kappa 11.71
     /// --take-up-from-data --out target/sim
@@ -198,6 +219,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             let set = &loaded.set;
             create_dir(&out)?;
             let law = if newtonian { [1.0, kappa] } else { [n, kappa] };
+            let mut all_profiles = Vec::with_capacity(set.experiments.len());
             for (k, e) in set.experiments.iter().enumerate() {
                 let mut e = e.clone();
                 if e.take_up.is_none() {
@@ -243,9 +265,44 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                         path.display()
                     ));
                 }
+                all_profiles.push(prof);
+            }
+            let names: Vec<&str> = set.experiments.iter().map(|e| e.name.as_str()).collect();
+            let fig = out.join(format!("profiles.{}", cli.format.ext()));
+            figures::profile_overview(&fig, &names, &all_profiles, &inputs)?;
+            let with_data: Vec<usize> = (0..set.experiments.len())
+                .filter(|&k| set.measurements[k].is_some())
+                .collect();
+            if !with_data.is_empty() {
+                let views: Vec<ExperimentView> = with_data
+                    .iter()
+                    .filter_map(|&k| {
+                        let m = set.measurements[k].as_ref()?;
+                        Some(ExperimentView {
+                            name: &set.experiments[k].name,
+                            length: set.experiments[k].spinline_length,
+                            positions: &m.positions,
+                            diameters: &m.diameters,
+                            smooth: None,
+                        })
+                    })
+                    .collect();
+                let profs: Vec<_> = with_data.iter().map(|&k| all_profiles[k].clone()).collect();
+                let label = if newtonian {
+                    "Newtonian (n = 1)".to_string()
+                } else {
+                    format!("n = {n}, κ = {kappa}")
+                };
+                let curves = [ModelCurves {
+                    label: &label,
+                    profiles: &profs,
+                    dashed: false,
+                }];
+                let fig = out.join(format!("diameters_vs_data.{}", cli.format.ext()));
+                figures::experiment_panels(&fig, &views, &curves, View::Diameter, &inputs)?;
             }
             say(format!(
-                "wrote {} profiles to {}",
+                "wrote {} profiles and figures to {}",
                 set.experiments.len(),
                 out.display()
             ));
@@ -301,7 +358,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 write_text(&dir.join("fit.json"), &text, &inputs)?;
                 for (k, sol) in id.solutions.iter().enumerate() {
                     let model = &rh.models[k];
-                    let fs = diffbvp::fiber::FiberSolution {
+                    let fs = FiberSolution {
                         solution: sol.clone(),
                     };
                     let prof = fs.uniform_profiles(model, 101);
@@ -310,6 +367,17 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                         &profiles_csv(&prof),
                         &inputs,
                     )?;
+                }
+                let written = figures::identification_figures(
+                    &rh,
+                    &id,
+                    &opts,
+                    &dir,
+                    cli.format.ext(),
+                    &inputs,
+                )?;
+                for w in written {
+                    say(format!("wrote {}", w.display()));
                 }
                 say(format!(
                     "wrote the report and fitted profiles to {}",
@@ -359,9 +427,14 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             }
             let path = out.join("landscape.csv");
             write_text(&path, &csv, &inputs)?;
+            let mut markers = Vec::new();
             if let Some((n, k, c)) = l.minimum() {
                 println!("grid minimum: n = {n:.4}, kappa = {k:.4}, J = {c:.6e}");
+                markers.push((n, k, "grid minimum".to_string()));
             }
+            let fig = out.join(format!("landscape.{}", cli.format.ext()));
+            let title = format!("J(n, κ), {} estimator", opts.estimator.name());
+            figures::landscape_map(&fig, &l, &title, &markers, &inputs)?;
             say(format!(
                 "{} points in {:.1} s; wrote {}",
                 grid.0 * grid.1,

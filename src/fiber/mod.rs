@@ -10,11 +10,14 @@
 //! * [`model`]: the strain-rate formulation as a [`Bvp`](crate::Bvp);
 //! * [`cold_start`]: continuation from the stress-free fiber;
 //! * [`mod@simulate`]: the user-facing API with SI profiles;
-//! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5).
+//! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
+//! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
+//! * [`figures`]: profile, fit and landscape figures (PNG/SVG).
 
 pub mod cold_start;
 pub mod contributions;
 pub mod error;
+pub mod figures;
 pub mod input;
 pub mod material_law;
 pub mod model;

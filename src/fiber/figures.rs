@@ -1,0 +1,344 @@
+//! Figures of spinning experiments: simulated profiles, measured diameters with the smooth fit
+//! and model curves (paper Fig. 2, 3, 5), and the cost landscape (paper Fig. 4).
+//!
+//! A thin fiber-specific layer over the model-agnostic [`crate::plot`]: it converts units for
+//! display (positions in m, diameters in µm, `1/d²` in 1/mm², temperatures in °C) and lays out
+//! one panel per experiment. Every function refuses to write over one of the `inputs` (see
+//! [`ensure_not_input`]); the format follows the extension (`.png` or `.svg`).
+
+use super::output::{ensure_not_input, OutputError};
+use super::rheometer::{Identification, IdentifyOptions, Landscape, Rheometer, RheometerError};
+use super::simulate::FiberSolution;
+use super::simulate::Profiles;
+use super::smoothing::SmoothFit;
+use crate::plot::{save_heatmap, save_panels, Heatmap, Panel, PlotError, Series};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Writing a figure failed.
+#[derive(Debug, Error)]
+pub enum FigureError {
+    /// The output path is an input, or a directory could not be created.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// Drawing or writing the figure failed.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    /// The model curves could not be computed.
+    #[error(transparent)]
+    Model(#[from] RheometerError),
+}
+
+/// Number of points at which smooth curves (the ansatz fit) are drawn.
+const CURVE_POINTS: usize = 200;
+
+/// One experiment as shown in a figure panel.
+#[derive(Debug, Clone, Copy)]
+pub struct ExperimentView<'a> {
+    /// Experiment name (panel title).
+    pub name: &'a str,
+    /// Spin-line length `L` \[m\].
+    pub length: f64,
+    /// Measurement positions `s` \[m\].
+    pub positions: &'a [f64],
+    /// Measured diameters \[m\].
+    pub diameters: &'a [f64],
+    /// The ansatz fit of the measurements, if it is to be drawn.
+    pub smooth: Option<&'a SmoothFit>,
+}
+
+/// A labelled model curve per experiment (same order as the experiments), drawn as a line
+/// (`dashed = false`) or dashed line.
+#[derive(Debug, Clone, Copy)]
+pub struct ModelCurves<'a> {
+    /// Legend label, e.g. `"identified n = 0.80"`.
+    pub label: &'a str,
+    /// One profile per experiment.
+    pub profiles: &'a [Profiles],
+    /// Draw dashed.
+    pub dashed: bool,
+}
+
+/// Which quantity the experiment panels show.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum View {
+    /// Diameter `d` in µm (paper Fig. 2 and 3).
+    Diameter,
+    /// The velocity-like `1/d²` in 1/mm² (paper Fig. 5).
+    InverseSquare,
+}
+
+impl View {
+    fn value(self, d_m: f64) -> f64 {
+        match self {
+            View::Diameter => d_m * 1e6,
+            View::InverseSquare => 1.0 / (d_m * 1e3).powi(2),
+        }
+    }
+
+    fn label(self) -> &'static str {
+        match self {
+            View::Diameter => "d / µm",
+            View::InverseSquare => "1/d² / mm⁻²",
+        }
+    }
+}
+
+fn check(path: &Path, inputs: &[PathBuf]) -> Result<(), FigureError> {
+    ensure_not_input(path, inputs)?;
+    Ok(())
+}
+
+/// Columns of a panel grid for `k` panels (3 for the paper's 9 experiments).
+fn columns(k: usize) -> usize {
+    match k {
+        0..=3 => k.max(1),
+        4 => 2,
+        _ => 3,
+    }
+}
+
+/// Figure size for a grid of `k` panels.
+fn grid_size(k: usize) -> (u32, u32) {
+    let c = columns(k) as u32;
+    let r = k.div_ceil(columns(k)).max(1) as u32;
+    (420 * c, 320 * r)
+}
+
+/// One panel per experiment: measured points, the smooth fit (if given) and `curves`, in the
+/// chosen `view`. Writes `path`.
+pub fn experiment_panels(
+    path: &Path,
+    experiments: &[ExperimentView<'_>],
+    curves: &[ModelCurves<'_>],
+    view: View,
+    inputs: &[PathBuf],
+) -> Result<(), FigureError> {
+    check(path, inputs)?;
+    let mut panels = Vec::with_capacity(experiments.len());
+    for (k, e) in experiments.iter().enumerate() {
+        let mut panel =
+            Panel::new(e.name, "s / m", view.label()).with_log_y(view == View::Diameter);
+        let data: Vec<(f64, f64)> = e
+            .positions
+            .iter()
+            .zip(e.diameters)
+            .map(|(&s, &d)| (s, view.value(d)))
+            .collect();
+        panel = panel.with_series(Series::markers("measured", data).with_color(7));
+        if let Some(f) = e.smooth {
+            let pts: Vec<(f64, f64)> = crate::mesh::linspace(0.0, e.length, CURVE_POINTS)
+                .into_iter()
+                .map(|s| (s, view.value(f.diameter(s))))
+                .collect();
+            panel = panel.with_series(Series::line("smooth fit (eq. 5)", pts).with_color(2));
+        }
+        for (c, curve) in curves.iter().enumerate() {
+            if let Some(p) = curve.profiles.get(k) {
+                let pts: Vec<(f64, f64)> = p
+                    .position
+                    .iter()
+                    .zip(&p.diameter)
+                    .map(|(&s, &d)| (s, view.value(d)))
+                    .collect();
+                let series = if curve.dashed {
+                    Series::dashed(curve.label, pts)
+                } else {
+                    Series::line(curve.label, pts)
+                };
+                panel = panel.with_series(series.with_color(if c == 0 { 0 } else { c + 2 }));
+            }
+        }
+        panels.push(panel);
+    }
+    save_panels(
+        path,
+        &panels,
+        columns(experiments.len()),
+        grid_size(experiments.len()),
+    )?;
+    Ok(())
+}
+
+/// Simulated diameter (log scale) and temperature profiles of all experiments in two panels
+/// side by side, one line per experiment. Writes `path`.
+pub fn profile_overview(
+    path: &Path,
+    names: &[&str],
+    profiles: &[Profiles],
+    inputs: &[PathBuf],
+) -> Result<(), FigureError> {
+    check(path, inputs)?;
+    let mut d = Panel::new("diameter", "s / m", "d / µm").with_log_y(true);
+    let mut t = Panel::new("temperature", "s / m", "T / °C");
+    for (k, (name, p)) in names.iter().zip(profiles).enumerate() {
+        let dd: Vec<(f64, f64)> = p
+            .position
+            .iter()
+            .zip(&p.diameter)
+            .map(|(&s, &v)| (s, v * 1e6))
+            .collect();
+        let tt: Vec<(f64, f64)> = p
+            .position
+            .iter()
+            .zip(&p.temperature)
+            .map(|(&s, &v)| (s, v - 273.15))
+            .collect();
+        d = d.with_series(Series::line(*name, dd).with_color(k));
+        t = t.with_series(Series::line(*name, tt).with_color(k));
+    }
+    save_panels(path, &[d, t], 2, (1200, 480))?;
+    Ok(())
+}
+
+/// The cost landscape as a heat map over `(n, κ)` with a logarithmic colour scale (paper
+/// Fig. 4), with `markers` `(n, κ, label)` (e.g. start points and the identified optimum).
+/// Missing values (failed simulations) are grey. Writes `path`.
+pub fn landscape_map(
+    path: &Path,
+    landscape: &Landscape,
+    title: &str,
+    markers: &[(f64, f64, String)],
+    inputs: &[PathBuf],
+) -> Result<(), FigureError> {
+    check(path, inputs)?;
+    let map = Heatmap {
+        title,
+        x_label: "n",
+        y_label: "κ = ln(K / 1 Pa)",
+        value_label: "J",
+        log_color: true,
+        markers,
+        ..Heatmap::new(&landscape.n, &landscape.kappa, &landscape.cost)
+    };
+    save_heatmap(path, &map)?;
+    Ok(())
+}
+
+/// Paper Fig. 2, 3 and 5 for an identification, written into `dir` with extension `ext`
+/// (`"png"` or `"svg"`): `fig2_smoothing` (measured diameters with the smooth fit),
+/// `fig3_newtonian_vs_identified` (the Newtonian model `n = 1` at the identified κ with the
+/// take-up diameters `d_fit(L)`, and the identified law), and `fig5_inverse_square` (the
+/// velocity-like `1/d²` view). Returns the paths written.
+pub fn identification_figures(
+    rh: &Rheometer,
+    id: &Identification,
+    opts: &IdentifyOptions,
+    dir: &Path,
+    ext: &str,
+    inputs: &[PathBuf],
+) -> Result<Vec<PathBuf>, FigureError> {
+    let views: Vec<ExperimentView> = rh
+        .experiments
+        .iter()
+        .zip(&rh.measurements)
+        .zip(&rh.smoothing)
+        .map(|((e, m), f)| ExperimentView {
+            name: &e.name,
+            length: e.spinline_length,
+            positions: &m.positions,
+            diameters: &m.diameters,
+            smooth: Some(f),
+        })
+        .collect();
+    let profiles = |sols: &[crate::Solution]| -> Vec<crate::fiber::Profiles> {
+        sols.iter()
+            .zip(&rh.models)
+            .map(|(s, m)| {
+                FiberSolution {
+                    solution: s.clone(),
+                }
+                .uniform_profiles(m, 201)
+            })
+            .collect()
+    };
+    let identified = profiles(&id.solutions);
+    let mut newt = rh.objective([1.0, id.kappa], opts)?;
+    newt.cost_at(1.0, id.kappa)?;
+    let newtonian = profiles(&newt.solutions());
+    let label = format!("identified n = {:.3}, κ = {:.2}", id.n, id.kappa);
+    let fitted = ModelCurves {
+        label: &label,
+        profiles: &identified,
+        dashed: false,
+    };
+    let newt_curves = ModelCurves {
+        label: "Newtonian n = 1",
+        profiles: &newtonian,
+        dashed: true,
+    };
+    let no_smooth: Vec<ExperimentView> = views
+        .iter()
+        .map(|v| ExperimentView { smooth: None, ..*v })
+        .collect();
+    let f2 = dir.join(format!("fig2_smoothing.{ext}"));
+    experiment_panels(&f2, &views, &[], View::Diameter, inputs)?;
+    let f3 = dir.join(format!("fig3_newtonian_vs_identified.{ext}"));
+    experiment_panels(
+        &f3,
+        &no_smooth,
+        &[fitted, newt_curves],
+        View::Diameter,
+        inputs,
+    )?;
+    let f5 = dir.join(format!("fig5_inverse_square.{ext}"));
+    experiment_panels(
+        &f5,
+        &views,
+        &[fitted, newt_curves],
+        View::InverseSquare,
+        inputs,
+    )?;
+    Ok(vec![f2, f3, f5])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refuses_to_overwrite_an_input() {
+        let dir = std::env::temp_dir().join("diffbvp-figures-unit");
+        std::fs::create_dir_all(&dir).unwrap();
+        let input = dir.join("input.png");
+        std::fs::write(&input, b"keep me").unwrap();
+        let p = Profiles {
+            position: vec![0.0, 1.0],
+            diameter: vec![1e-3, 1e-4],
+            temperature: vec![500.0, 400.0],
+            ..Profiles::default()
+        };
+        let err = profile_overview(&input, &["a"], &[p], std::slice::from_ref(&input));
+        assert!(matches!(err, Err(FigureError::Output(_))));
+        assert_eq!(std::fs::read(&input).unwrap(), b"keep me");
+    }
+
+    #[test]
+    fn writes_panels_for_each_view() {
+        let dir = std::env::temp_dir().join("diffbvp-figures-unit");
+        let s = [0.0, 0.5, 1.0];
+        let d = [1e-3, 3e-4, 1e-4];
+        let e = ExperimentView {
+            name: "exp",
+            length: 1.0,
+            positions: &s,
+            diameters: &d,
+            smooth: None,
+        };
+        let p = Profiles {
+            position: s.to_vec(),
+            diameter: d.to_vec(),
+            ..Profiles::default()
+        };
+        let curves = [ModelCurves {
+            label: "model",
+            profiles: std::slice::from_ref(&p),
+            dashed: false,
+        }];
+        for (view, name) in [(View::Diameter, "d.svg"), (View::InverseSquare, "u.png")] {
+            let path = dir.join(name);
+            experiment_panels(&path, &[e], &curves, view, &[]).unwrap();
+            assert!(std::fs::metadata(&path).unwrap().len() > 100);
+        }
+    }
+}
