@@ -2,14 +2,28 @@
 //! (n, κ) = (0.8, 11.71)): smoothing, start heuristic, identification with the principled and
 //! the paper's estimator, uncertainty report, and the paper's Table 3 sweep.
 //!
+//! Figures like the paper's Fig. 2, 3, 4 and 5 are written into `OUT_DIR` (default
+//! `target/carreau_rheometer/`).
+//!
 //! Run with `cargo run --release --example carreau_rheometer [-- OUT_DIR]`.
 
+use diffbvp::fiber::figures::{identification_figures, landscape_map};
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
-use std::path::Path;
+use diffbvp::mesh::linspace;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/pmma7n_synthetic/experiments.toml");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let data = root.join("data/pmma7n_synthetic/experiments.toml");
+    let out: PathBuf = match std::env::args_os().nth(1) {
+        Some(dir) => dir.into(),
+        None => root.join("target/carreau_rheometer"),
+    };
+    let inputs: Vec<PathBuf> = std::fs::read_dir(data.parent().unwrap_or(root))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
     // ANCHOR: identify
     let set = load_experiments(&data)?;
     let rheometer = Rheometer::new(&set)?;
@@ -77,5 +91,48 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         println!("{:>5} {:>6} | {} | {}", n0, k0, cell(&a), cell(&b));
     }
+
+    // Figures: paper Fig. 2, 3, 5 for the principled fit, and Fig. 4, the cost landscape.
+    std::fs::create_dir_all(&out)?;
+    for path in identification_figures(&rheometer, &id, &principled, &out, "png", &inputs)? {
+        println!("wrote {}", path.display());
+    }
+    let (ns, kappas) = (linspace(0.0, 1.0, 41), linspace(9.0, 16.0, 41));
+    let mut landscape_opts = paper.clone();
+    landscape_opts.simulate.tol = 1e-4; // a picture, not a fit
+    let bar = ProgressBar::new((ns.len() * kappas.len()) as u64);
+    bar.set_style(
+        ProgressStyle::with_template("landscape [{bar:40}] {pos}/{len} ({eta} left)")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let t0 = std::time::Instant::now();
+    let landscape = rheometer.landscape(&ns, &kappas, &landscape_opts, |done| {
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
+    let mut markers: Vec<(f64, f64, String)> = starts
+        .iter()
+        .map(|&(n, k)| (n, k, "Table 3 start".to_string()))
+        .collect();
+    markers.push((
+        id_paper.n,
+        id_paper.kappa,
+        "identified (paper J)".to_string(),
+    ));
+    let path = out.join("fig4_landscape.png");
+    landscape_map(
+        &path,
+        &landscape,
+        "J(n, κ), paper's cost",
+        &markers,
+        &inputs,
+    )?;
+    println!(
+        "wrote {} ({}×{} grid in {:.1} s)",
+        path.display(),
+        ns.len(),
+        kappas.len(),
+        t0.elapsed().as_secs_f64()
+    );
     Ok(())
 }

@@ -267,7 +267,8 @@ pub struct Heatmap<'a> {
     pub ys: &'a [f64],
     /// Row-major values, `ys.len() × xs.len()`.
     pub values: &'a [f64],
-    /// Points to mark (e.g. start and optimum), each `(x, y, legend label)`; markers outside
+    /// Points to mark (e.g. start and optimum), each `(x, y, legend label)`; markers with the
+    /// same label share a colour and one legend entry; markers outside
     /// the grid's cells (or non-finite) are not drawn.
     pub markers: &'a [(f64, f64, String)],
     /// Logarithmic colour scale.
@@ -1053,19 +1054,28 @@ where
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], MISSING.filled()));
     }
     let (x_range, y_range) = (chart.x_range(), chart.y_range());
-    for (k, (mx, my, label)) in hm.markers.iter().enumerate() {
+    // Markers sharing a label share a colour and one legend entry.
+    let mut labels: Vec<&str> = Vec::new();
+    for (mx, my, label) in hm.markers.iter() {
         // Markers off the grid are not drawn (nor listed in the legend).
         if !(x_range.contains(mx) || *mx == x_range.end)
             || !(y_range.contains(my) || *my == y_range.end)
         {
             continue;
         }
+        let (k, first) = match labels.iter().position(|l| *l == label.as_str()) {
+            Some(k) if !label.is_empty() => (k, false),
+            _ => {
+                labels.push(label.as_str());
+                (labels.len() - 1, true)
+            }
+        };
         let color = MARKER_COLORS[k % MARKER_COLORS.len()];
         let marker = EmptyElement::at((*mx, *my))
             + Circle::new((0, 0), radius, color.filled())
             + Circle::new((0, 0), radius, BLACK.stroke_width(2));
         let series = chart.draw_series(std::iter::once(marker))?;
-        if !label.is_empty() {
+        if first && !label.is_empty() {
             any_legend = true;
             series.label(label.as_str()).legend(move |(x, y)| {
                 EmptyElement::at((x + 7, y))
