@@ -40,6 +40,7 @@ fn main() -> Result<(), diffbvp::BvpError> {
     )?;
     let upper = solve(&problem, &[], &Guess::constant(mesh, &[3.0, 0.0]), &options)?;
     // ANCHOR_END: solve
+    // ANCHOR: report
     for (name, s) in [("lower", &lower), ("upper", &upper)] {
         println!(
             "{name} branch: y(1/2) = {:.10}, y'(0) = {:.10}",
@@ -57,6 +58,7 @@ fn main() -> Result<(), diffbvp::BvpError> {
             s.stats.max_residual
         );
     }
+    // ANCHOR_END: report
     println!("exact: y(1/2) = 0.1405392144 (lower), 4.0914672462 (upper)");
     Ok(())
 }

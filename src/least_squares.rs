@@ -131,7 +131,7 @@ pub struct FitResult {
     pub failed_evaluations: usize,
     /// Why it stopped.
     pub termination: Termination,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_time_s: f64,
     /// Every iteration.
     pub history: Vec<FitIteration>,

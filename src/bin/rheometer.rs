@@ -20,8 +20,12 @@ use std::process::ExitCode;
     version,
     about = "Simulation-based elongational rheometer for Carreau-type polymer melts",
     long_about = "Simulates stationary melt spinning and identifies the Carreau-type elongational \
-viscosity (n, kappa = ln K) from fiber diameters measured along the spin line.\n\n\
-Example:\n  rheometer fit data/pmma7n_synthetic/experiments.toml --json target/fit.json"
+viscosity (n, kappa = ln K) from fiber diameters measured along the spin line.",
+    after_help = "Examples:\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --json target/fit.json\n  \
+rheometer simulate data/pmma7n_synthetic/experiments.toml --take-up-from-data --out target/sim\n  \
+rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 21x21 --out target/landscape\n\n\
+Input format, outputs and error messages: see the book (mdbook build book)."
 )]
 struct Cli {
     /// Print nothing but results and errors.
@@ -65,9 +69,14 @@ impl FormatArg {
 #[derive(Subcommand)]
 enum Command {
     /// Simulate every experiment and write profiles (CSV) and figures into DIR.
-    ///
-    /// Example: rheometer simulate data/pmma7n_synthetic/experiments.toml --n 0.8 --kappa 11.71
-    /// --take-up-from-data --out target/sim
+    #[command(after_help = "Examples:\n  \
+rheometer simulate data/pmma7n_synthetic/experiments.toml --n 0.8 --kappa 11.71 \
+--take-up-from-data --out target/sim\n  \
+rheometer simulate data/pmma7n_synthetic/experiments.toml --newtonian --take-up-diameter 1e-4 \
+--out target/sim_newtonian\n\n\
+Writes DIR/<experiment>_profile.csv with the columns listed in the book's CLI reference, \
+DIR/profiles.png (diameter and temperature of all experiments) and, where measurements exist, \
+DIR/diameters_vs_data.png.")]
     Simulate {
         /// The experiments file (TOML; see the book for the format).
         experiments: PathBuf,
@@ -80,7 +89,7 @@ enum Command {
         /// Use the Newtonian law (n = 1).
         #[arg(long)]
         newtonian: bool,
-        /// Take-up diameter [m] for experiments without one in the TOML.
+        /// Take-up diameter (m) for experiments without one in the TOML.
         #[arg(long)]
         take_up_diameter: Option<f64>,
         /// Take the take-up diameter d_fit(L) from the smoothed measurements where the TOML has none.
@@ -94,8 +103,11 @@ enum Command {
         out: PathBuf,
     },
     /// Identify (n, kappa) from the measurements and print an uncertainty report.
-    ///
-    /// Example: rheometer fit data/pmma7n_synthetic/experiments.toml --json target/fit.json
+    #[command(after_help = "Examples:\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --json target/fit.json\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --estimator paper --start 0.5,11.51\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --out target/fit\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --newtonian")]
     Fit {
         /// The experiments file (TOML).
         experiments: PathBuf,
@@ -116,8 +128,11 @@ enum Command {
         out: Option<PathBuf>,
     },
     /// Compute the cost landscape J(n, kappa) on a grid and write it as CSV.
-    ///
-    /// Example: rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 41x41 --out target/landscape
+    #[command(after_help = "Examples:\n  \
+rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 41x41 --out target/landscape\n  \
+rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 11x11 --n-range 0.6,1 \
+--kappa-range 10,14 --estimator principled --out target/landscape_zoom\n\n\
+Writes DIR/landscape.csv with the columns n,kappa,cost.")]
     Landscape {
         /// The experiments file (TOML).
         experiments: PathBuf,

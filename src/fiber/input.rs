@@ -222,7 +222,7 @@ pub enum InputError {
 pub struct ExperimentDetails {
     /// Stencil velocity of the extruder [mm/s] (`stencil_velocity_mm_s`), if given.
     pub stencil_velocity_mm_s: Option<f64>,
-    /// Take-up (aspirator) pressure [bar] (`take_up_pressure_bar`), if given.
+    /// Take-up (aspirator) pressure \[bar\] (`take_up_pressure_bar`), if given.
     pub take_up_pressure_bar: Option<f64>,
     /// The measurement CSV file (resolved against the TOML file's directory), if given.
     pub data: Option<PathBuf>,
@@ -333,7 +333,7 @@ pub fn parse_experiments(text: &str, path: &Path) -> Result<LoadedExperiments, I
 }
 
 /// Loads one measurement CSV file (`position_m,diameter_m`), requiring positions within
-/// `[0, spinline_length]` [m] (pass `f64::INFINITY` to skip that check) and at least
+/// `[0, spinline_length]` \[m\] (pass `f64::INFINITY` to skip that check) and at least
 /// `min_points` rows.
 pub fn load_measurements(
     path: &Path,

@@ -37,17 +37,17 @@ impl Material {
         }
     }
 
-    /// Density `ρ(T)` [kg/m³] at temperature `t` [K].
+    /// Density `ρ(T)` [kg/m³] at temperature `t` \[K\].
     pub fn density(&self, t: f64) -> f64 {
         self.density_slope * t + self.density_intercept
     }
 
-    /// Specific heat capacity `c_p(T)` [J/(kg K)] at temperature `t` [K].
+    /// Specific heat capacity `c_p(T)` [J/(kg K)] at temperature `t` \[K\].
     pub fn heat_capacity(&self, t: f64) -> f64 {
         self.heat_capacity_slope * t + self.heat_capacity_intercept
     }
 
-    /// Zero-shear viscosity `μ_s0(T)` [Pa s] at temperature `t` [K].
+    /// Zero-shear viscosity `μ_s0(T)` [Pa s] at temperature `t` \[K\].
     pub fn zero_shear_viscosity(&self, t: f64) -> f64 {
         self.vft_mu_c * (self.vft_b / (t - self.vft_t_vf)).exp()
     }
@@ -81,7 +81,7 @@ impl Air {
 /// How the fiber enters the spin line (after die swell).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Inlet {
-    /// Inlet diameter `d_in` [m]; the inlet speed follows as `u_in = 4 Q/(π ρ(T_in) d_in²)`.
+    /// Inlet diameter `d_in` \[m\]; the inlet speed follows as `u_in = 4 Q/(π ρ(T_in) d_in²)`.
     Diameter(f64),
     /// Inlet speed `u_in` [m/s].
     Velocity(f64),
@@ -90,7 +90,7 @@ pub enum Inlet {
 /// The take-up boundary condition at `s = L`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TakeUp {
-    /// Take-up diameter `d_out` [m]: `d(L) = d_out`.
+    /// Take-up diameter `d_out` \[m\]: `d(L) = d_out`.
     Diameter(f64),
     /// Take-up speed `u_out` [m/s]: `u(L) = u_out`.
     Velocity(f64),
@@ -109,7 +109,7 @@ pub struct Experiment {
     pub inlet_temperature: f64,
     /// Ambient air temperature `T_air` (K).
     pub air_temperature: f64,
-    /// Spin-line length `L` [m].
+    /// Spin-line length `L` \[m\].
     pub spinline_length: f64,
     /// Take-up condition, if known (the shipped measurement set has none: the rheometer takes
     /// it from the data).
@@ -119,9 +119,9 @@ pub struct Experiment {
 /// Measured diameters of one experiment.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurements {
-    /// Positions `s` along the spin line [m], strictly increasing.
+    /// Positions `s` along the spin line \[m\], strictly increasing.
     pub positions: Vec<f64>,
-    /// Measured fiber diameters [m].
+    /// Measured fiber diameters \[m\].
     pub diameters: Vec<f64>,
 }
 

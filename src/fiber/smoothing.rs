@@ -22,7 +22,7 @@ use thiserror::Error;
 pub struct SmoothFit {
     /// Shape exponent `b` [-].
     pub b: f64,
-    /// Length scale `c` [m].
+    /// Length scale `c` \[m\].
     pub c: f64,
     /// Plateau `v` of `1/d²` [1/m²].
     pub v: f64,
@@ -63,7 +63,7 @@ impl SmoothFit {
         self.u0 * ansatz_ratio(s, self.b, self.c, self.v / self.u0)
     }
 
-    /// Smoothed diameter `d_fit(s) = u_f(s)^{-1/2}` [m] at position `s` [m].
+    /// Smoothed diameter `d_fit(s) = u_f(s)^{-1/2}` \[m\] at position `s` \[m\].
     pub fn diameter(&self, s: f64) -> f64 {
         self.velocity_like(s).sqrt().recip()
     }
@@ -103,7 +103,7 @@ impl LeastSquaresProblem for AnsatzProblem<'_> {
     }
 }
 
-/// Fits the ansatz to positions `s` [m] and diameters `d` [m] (first point at or near the
+/// Fits the ansatz to positions `s` \[m\] and diameters `d` \[m\] (first point at or near the
 /// nozzle: `u0 = d[0]^{-2}`).
 pub fn smooth(s: &[f64], d: &[f64]) -> Result<SmoothFit, SmoothingError> {
     if s.len() != d.len() {

@@ -323,7 +323,7 @@ pub struct Identification {
     pub solutions: Vec<Solution>,
     /// The least-squares result (cost, Jacobian, iterations, termination).
     pub fit: FitResult,
-    /// Wall time [s], including the cold starts.
+    /// Wall time \[s\], including the cold starts.
     pub wall_time_s: f64,
 }
 

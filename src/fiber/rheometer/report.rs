@@ -21,7 +21,7 @@ pub struct FitReport {
     pub n: f64,
     /// `κ = ln(K / 1 Pa)` [-].
     pub kappa: f64,
-    /// `K = e^κ` [Pa].
+    /// `K = e^κ` \[Pa\].
     #[serde(rename = "K_Pa")]
     pub k_pa: f64,
     /// Standard error of `n`.
@@ -32,7 +32,7 @@ pub struct FitReport {
     pub ci95_n: [f64; 2],
     /// 95% confidence interval of `κ`.
     pub ci95_kappa: [f64; 2],
-    /// 95% confidence interval of `K` [Pa].
+    /// 95% confidence interval of `K` \[Pa\].
     #[serde(rename = "ci95_K_Pa")]
     pub ci95_k_pa: [f64; 2],
     /// Correlation of `n` and `κ`.
@@ -49,7 +49,7 @@ pub struct FitReport {
     pub iterations: usize,
     /// Trial points where a BVP failed (rejected steps).
     pub failed_evaluations: usize,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_time_s: f64,
     /// Why the fit stopped.
     pub termination: String,
