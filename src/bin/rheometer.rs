@@ -4,7 +4,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
-use diffbvp::fiber::output::{create_dir, profiles_csv, write_text};
+use diffbvp::fiber::output::{create_dir, ensure_not_input, profiles_csv, write_text};
 use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
 use diffbvp::fiber::setup::TakeUp;
 use diffbvp::fiber::smoothing::smooth;
@@ -123,16 +123,16 @@ rheometer fit data/pmma7n_synthetic/experiments.toml --newtonian")]
         /// Write the result as JSON to FILE.
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Write the report and the fitted profiles into DIR.
+        /// Write the report, the fitted profiles and figures (paper Fig. 2, 3, 5) into DIR.
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Compute the cost landscape J(n, kappa) on a grid and write it as CSV.
+    /// Compute the cost landscape J(n, kappa) on a grid; write it as CSV and heat map.
     #[command(after_help = "Examples:\n  \
 rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 41x41 --out target/landscape\n  \
 rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 11x11 --n-range 0.6,1 \
 --kappa-range 10,14 --estimator principled --out target/landscape_zoom\n\n\
-Writes DIR/landscape.csv with the columns n,kappa,cost.")]
+Writes DIR/landscape.csv with the columns n,kappa,cost and the heat map DIR/landscape.png.")]
     Landscape {
         /// The experiments file (TOML).
         experiments: PathBuf,
@@ -332,6 +332,15 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
         } => {
             let loaded = load_experiments_with(&experiments, 4)?;
             let inputs = inputs_of(&experiments, &loaded);
+            // refuse an output that is an input before spending time on the fit
+            if let Some(path) = &json {
+                ensure_not_input(path, &inputs)?;
+            }
+            if let Some(dir) = &out {
+                for name in ["fit.json", "fit_report.txt"] {
+                    ensure_not_input(&dir.join(name), &inputs)?;
+                }
+            }
             let rh = Rheometer::new(&loaded.set)?;
             let opts = IdentifyOptions::with_estimator(estimator(est));
             if newtonian {
@@ -466,10 +475,16 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            let mut printed = e.to_string();
+            eprintln!("error: {printed}");
             let mut src = e.source();
             while let Some(s) = src {
-                eprintln!("  caused by: {s}");
+                // messages that already quote their cause are not repeated
+                let text = s.to_string();
+                if !printed.contains(&text) {
+                    eprintln!("  caused by: {text}");
+                }
+                printed = text;
                 src = s.source();
             }
             ExitCode::FAILURE
