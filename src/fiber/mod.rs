@@ -10,10 +10,12 @@
 //! * [`model`]: the strain-rate formulation as a [`Bvp`](crate::Bvp);
 //! * [`cold_start`]: continuation from the stress-free fiber;
 //! * [`mod@simulate`]: the user-facing API with SI profiles;
-//! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5).
+//! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
+//! * [`diagnostics`]: model vs measurement comparison (where and how the model misses the data).
 
 pub mod cold_start;
 pub mod contributions;
+pub mod diagnostics;
 pub mod error;
 pub mod input;
 pub mod material_law;
