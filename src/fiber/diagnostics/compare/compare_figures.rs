@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 fn grid_size(panels: usize, columns: usize) -> (u32, u32) {
     let rows = panels.div_ceil(columns).max(1) as u32;
-    (420 * columns as u32, 320 * rows)
+    ((420 * columns as u32).max(900), 320 * rows)
 }
 
 /// Writes into `dir` (which must exist):
