@@ -97,22 +97,20 @@ impl Comparison {
             "chi2/dof = {:.1}/{} = {:.2} ({} fitted parameters): {verdict}",
             self.chi2, self.dof, self.chi2_per_dof, self.fitted_parameters
         );
-        let white_runs = self.runs.z.is_nan() || self.runs.z >= -2.0;
-        let white_lag = self.lag1_z.is_nan() || self.lag1_z <= 2.0;
+        // evidence against whiteness: the larger of −z(runs) and z(lag-1)
+        let evidence = (-self.runs.z).max(self.lag1_z);
+        let verdict = if evidence.is_nan() || evidence < 2.0 {
+            "residuals look white"
+        } else if evidence < 3.0 {
+            "marginal evidence of structure along s (2-3 sigma)"
+        } else {
+            "residuals are NOT white (structure along s that noise does not explain)"
+        };
         let _ = writeln!(
             s,
             "whiteness: runs test z = {:.1} ({} runs of residual signs, {:.1} expected for \
-             random signs), lag-1 autocorrelation {:.2} (z = {:.1}): {}",
-            self.runs.z,
-            self.runs.runs,
-            self.runs.expected,
-            self.lag1,
-            self.lag1_z,
-            if white_runs && white_lag {
-                "residuals look white"
-            } else {
-                "residuals are NOT white (structure along s that noise does not explain)"
-            }
+             random signs), lag-1 autocorrelation {:.2} (z = {:.1}): {verdict}",
+            self.runs.z, self.runs.runs, self.runs.expected, self.lag1, self.lag1_z,
         );
         let names: Vec<String> = self.experiments.iter().map(|e| e.name.clone()).collect();
         if self.segments.is_empty() {
