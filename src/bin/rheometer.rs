@@ -2,6 +2,10 @@
 //! from your own TOML + CSV measurements.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use diffbvp::fiber::diagnostics::compare::{
+    compare, simulate_experiments, CompareOptions, FigureFormat, FitParameters, MissingTakeUp,
+    ModelSetup,
+};
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
 use diffbvp::fiber::output::{create_dir, ensure_not_input, profiles_csv, write_text};
@@ -155,6 +159,38 @@ Writes DIR/landscape.csv with the columns n,kappa,cost and the heat map DIR/land
         #[arg(long)]
         out: PathBuf,
     },
+    /// Compare the model with the measurements: residuals along the spin line, noise level,
+    /// chi2/dof, whiteness and where the misfit is systematic; text, JSON, CSV and figures.
+    ///
+    /// Example: rheometer compare data/pmma7n_synthetic/experiments.toml --fit target/fit.json
+    /// --out target/compare
+    Compare {
+        /// The experiments file (TOML).
+        experiments: PathBuf,
+        /// Parameters (n, kappa and take-up factors) from the JSON written by `rheometer fit --json`.
+        #[arg(long, conflicts_with_all = ["n", "kappa", "newtonian"])]
+        fit: Option<PathBuf>,
+        /// Power index n of the Carreau-type law (without --fit).
+        #[arg(long)]
+        n: Option<f64>,
+        /// kappa = ln(K / 1 Pa) of the Carreau-type law (without --fit).
+        #[arg(long)]
+        kappa: Option<f64>,
+        /// Use the Newtonian law (n = 1).
+        #[arg(long)]
+        newtonian: bool,
+        /// Take the take-up diameter d_fit(L) from the smoothed measurements where the TOML has
+        /// none (implied by --fit, which was fitted that way).
+        #[arg(long)]
+        take_up_from_data: bool,
+        /// Relative measurement uncertainty (overrides the TOML's relative_uncertainty; default:
+        /// the TOML's, else estimated from the data).
+        #[arg(long)]
+        relative_uncertainty: Option<f64>,
+        /// Output directory (created; input files are never overwritten).
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 fn parse_pair(s: &str) -> Result<(f64, f64), String> {
@@ -210,6 +246,15 @@ fn estimator(e: EstimatorArg) -> Estimator {
 
 fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
     diffbvp::mesh::linspace(a, b, m)
+}
+
+fn read_fit(path: &Path) -> Result<FitParameters, Box<dyn Error>> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read the fit file {}: {e}", path.display()))?;
+    Ok(FitParameters::from_json(
+        &text,
+        &path.display().to_string(),
+    )?)
 }
 
 fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
@@ -464,6 +509,74 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 grid.0 * grid.1,
                 t0.elapsed().as_secs_f64(),
                 path.display()
+            ));
+        }
+        Command::Compare {
+            experiments,
+            fit,
+            n,
+            kappa,
+            newtonian,
+            take_up_from_data,
+            relative_uncertainty,
+            out,
+        } => {
+            let loaded = load_experiments_with(&experiments, 4)?;
+            let inputs = inputs_of(&experiments, &loaded);
+            let set = &loaded.set;
+            let physics = || Physics::paper();
+            let mut setup = ModelSetup::carreau([0.8, 11.71], &physics);
+            let mut fitted = 0;
+            if let Some(path) = &fit {
+                let rep = read_fit(path)?;
+                rep.apply(
+                    &mut setup,
+                    set.experiments.len(),
+                    &path.display().to_string(),
+                )?;
+                fitted = rep.fitted_parameters();
+                say(format!(
+                    "model from {}: n = {}, kappa = {} ({} estimator)",
+                    path.display(),
+                    rep.n,
+                    rep.kappa,
+                    rep.estimator.name()
+                ));
+            } else {
+                let kappa = kappa.ok_or(
+                    "give the parameters: --fit FIT.json (from `rheometer fit --json`) or --kappa K \
+                     with --n N or --newtonian",
+                )?;
+                let n = if newtonian {
+                    1.0
+                } else {
+                    n.ok_or("give --n N (or --newtonian) together with --kappa")?
+                };
+                setup.law_params = [n, kappa];
+                if take_up_from_data {
+                    setup.missing_take_up = MissingTakeUp::FromData;
+                }
+            }
+            let options = CompareOptions {
+                relative_uncertainty,
+                fitted_parameters: fitted,
+                ..Default::default()
+            };
+            let t0 = std::time::Instant::now();
+            let runs = simulate_experiments(set, &setup)?;
+            let cmp = compare(&runs, set.relative_uncertainty, &options)?;
+            let fmt = match cli.format {
+                FormatArg::Png => FigureFormat::Png,
+                FormatArg::Svg => FigureFormat::Svg,
+            };
+            let written = cmp.write(&out, fmt, &inputs)?;
+            println!("{}", cmp.to_text());
+            say(format!(
+                "compared {} experiments in {:.1} s; wrote {} files to {}",
+                set.experiments.len(),
+                t0.elapsed().as_secs_f64(),
+                written.len(),
+                out.display()
             ));
         }
     }

@@ -12,10 +12,12 @@
 //! * [`mod@simulate`]: the user-facing API with SI profiles;
 //! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
 //! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
-//! * [`figures`]: profile, fit and landscape figures (PNG/SVG).
+//! * [`figures`]: profile, fit and landscape figures (PNG/SVG);
+//! * [`diagnostics`]: model vs measurement comparison (where and how the model misses the data).
 
 pub mod cold_start;
 pub mod contributions;
+pub mod diagnostics;
 pub mod error;
 pub mod figures;
 pub mod input;

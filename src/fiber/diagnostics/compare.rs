@@ -1,0 +1,447 @@
+//! Model vs measurement: per experiment and measurement point the measured and simulated
+//! diameters, `1/d²`, the relative residual `r = (d_model − d_meas)/d_meas` and the local
+//! strain rate, temperature and speed of the model; summary statistics that say whether the
+//! misfit is noise or systematic, and where.
+//!
+//! ```no_run
+//! use diffbvp::fiber::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
+//! use diffbvp::fiber::input::load_experiments;
+//! use diffbvp::fiber::Physics;
+//! use std::path::Path;
+//! let set = load_experiments(Path::new("data/hidden_radiation/experiments.toml"))?;
+//! let physics = || Physics::paper();
+//! let setup = ModelSetup::carreau([0.8, 11.71], &physics).take_up_from_data();
+//! let cmp = compare_set(&set, &setup, &CompareOptions::default())?;
+//! println!("{}", cmp.to_text());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! **Statistics** (all on the relative residuals):
+//! * *noise level* `σ`: the data set's `relative_uncertainty` if given (or
+//!   [`CompareOptions::relative_uncertainty`]), else estimated from the data by
+//!   [`residual_stats::estimate_noise`] — the robust (MAD) standard deviation of normalised
+//!   second differences of consecutive residuals along `s`, which cancel any residual that is
+//!   locally linear in `s`, so a smooth systematic misfit does not inflate the noise estimate;
+//! * `χ² = Σ r²/σ²` over all points with `dof = N − p` (`p` fitted parameters);
+//! * whiteness: the Wald–Wolfowitz runs test on the residual signs
+//!   ([`residual_stats::RunsTest`]) and the lag-1 autocorrelation, per experiment and pooled;
+//! * where: systematic segments of the pooled residual profile ([`segments`]), pooled over all
+//!   experiments and per experiment;
+//! * trends: Spearman rank correlations of the residual with strain rate, temperature, speed.
+
+pub mod compare_figures;
+pub mod model_runs;
+pub mod residual_stats;
+pub mod segments;
+pub mod summary_text;
+
+pub use model_runs::{compare_set, simulate_experiments, FitParameters, MissingTakeUp, ModelSetup};
+pub use residual_stats::RunsTest;
+pub use segments::{Segment, SegmentOptions, Station};
+
+use crate::fiber::error::FiberError;
+use crate::fiber::output::{create_dir, write_text, OutputError};
+use crate::fiber::simulate::Profiles;
+use crate::fiber::smoothing::SmoothingError;
+use crate::plot::PlotError;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// What can go wrong in a comparison.
+#[derive(Debug, Error)]
+pub enum CompareError {
+    /// Unusable input (named).
+    #[error("{0}")]
+    Data(String),
+    /// Smoothing an experiment's data (for its take-up diameter) failed.
+    #[error("experiment {experiment}: smoothing the measurements failed: {source}")]
+    Smoothing {
+        /// Experiment name.
+        experiment: String,
+        /// Cause.
+        source: SmoothingError,
+    },
+    /// Setting up or solving an experiment's model failed.
+    #[error("experiment {experiment}: {source}")]
+    Simulation {
+        /// Experiment name.
+        experiment: String,
+        /// Cause.
+        source: FiberError,
+    },
+    /// Writing an output failed.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// Drawing a figure failed.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    /// Serialising the JSON summary failed.
+    #[error("cannot serialise the comparison: {0}")]
+    Json(#[from] serde_json::Error),
+}
+
+/// One experiment's measurements and its simulation.
+#[derive(Debug, Clone)]
+pub struct SimulatedExperiment {
+    /// Experiment name.
+    pub name: String,
+    /// Measurement positions `s` (m).
+    pub positions: Vec<f64>,
+    /// Measured diameters (m).
+    pub measured: Vec<f64>,
+    /// Model profiles at the measurement positions.
+    pub at_measurements: Profiles,
+    /// Model profiles on a fine grid, for figures (may be empty).
+    pub curve: Profiles,
+}
+
+/// Settings of [`compare`].
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct CompareOptions {
+    /// Relative measurement uncertainty `σ` [-]; overrides the data set's value. `None`: the
+    /// data set's, else estimated from the data.
+    pub relative_uncertainty: Option<f64>,
+    /// Number of parameters fitted to these data (for `dof = N − p`; default 0).
+    pub fitted_parameters: usize,
+    /// Thresholds of the segment search.
+    pub segments: SegmentOptions,
+}
+
+/// One measurement point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ComparedPoint {
+    /// Position `s` (m).
+    pub position_m: f64,
+    /// Measured diameter (m).
+    pub d_meas_m: f64,
+    /// Simulated diameter (m).
+    pub d_model_m: f64,
+    /// Relative residual `(d_model − d_meas)/d_meas` [-].
+    pub residual: f64,
+    /// `1/d_meas²` (1/m²).
+    pub inv_d2_meas: f64,
+    /// `1/d_model²` (1/m²).
+    pub inv_d2_model: f64,
+    /// Model strain rate `u'` (1/s).
+    pub strain_rate_1_s: f64,
+    /// Model temperature (K).
+    pub temperature_k: f64,
+    /// Model fiber speed (m/s).
+    pub speed_m_s: f64,
+}
+
+/// The comparison of one experiment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ComparedExperiment {
+    /// Experiment name.
+    pub name: String,
+    /// The measurement points, in order along `s`.
+    pub points: Vec<ComparedPoint>,
+    /// Model curve positions (m) for figures.
+    #[serde(skip)]
+    pub curve_position_m: Vec<f64>,
+    /// Model curve diameters (m) for figures.
+    #[serde(skip)]
+    pub curve_diameter_m: Vec<f64>,
+    /// RMS of the relative residuals [-].
+    pub rms: f64,
+    /// Mean relative residual [-].
+    pub mean: f64,
+    /// `Σ r²/σ²` of this experiment.
+    pub chi2: f64,
+    /// Runs test on the residual signs.
+    pub runs: RunsTest,
+    /// Lag-1 autocorrelation of the residuals (about their mean).
+    pub lag1: f64,
+    /// Systematic segments of this experiment alone.
+    pub segments: Vec<Segment>,
+}
+
+/// Where the noise level came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseSource {
+    /// Given (TOML `relative_uncertainty` or the options).
+    Given,
+    /// Estimated from the residuals.
+    Estimated,
+}
+
+/// Rank correlation of the residual with a local model quantity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Trend {
+    /// `"strain_rate"`, `"temperature"` or `"speed"`.
+    pub quantity: String,
+    /// Spearman rank correlation over all points [-].
+    pub spearman: f64,
+}
+
+/// The result of a comparison.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Comparison {
+    /// Per experiment.
+    pub experiments: Vec<ComparedExperiment>,
+    /// The noise level `σ` used [-].
+    pub sigma: f64,
+    /// Where `σ` came from.
+    pub sigma_source: NoiseSource,
+    /// The data-based estimate of `σ` (always computed, for reference) [-].
+    pub sigma_estimated: f64,
+    /// Number of measurement points `N`.
+    pub points: usize,
+    /// Number of fitted parameters `p`.
+    pub fitted_parameters: usize,
+    /// `χ² = Σ r²/σ²`.
+    pub chi2: f64,
+    /// `dof = N − p`.
+    pub dof: usize,
+    /// `χ²/dof`.
+    pub chi2_per_dof: f64,
+    /// RMS of all relative residuals [-].
+    pub rms: f64,
+    /// Pooled runs test.
+    pub runs: RunsTest,
+    /// Pooled lag-1 autocorrelation.
+    pub lag1: f64,
+    /// `z` of the lag-1 autocorrelation against white noise (`ρ₁ √pairs`).
+    pub lag1_z: f64,
+    /// The pooled residual profile.
+    pub stations: Vec<Station>,
+    /// Systematic segments of the pooled residual.
+    pub segments: Vec<Segment>,
+    /// Rank correlations of the residual with local model quantities.
+    pub trends: Vec<Trend>,
+    /// The segment thresholds used.
+    pub segment_options: SegmentOptions,
+}
+
+/// Compares the simulations with the measurements. `set_uncertainty` is the data set's
+/// relative measurement uncertainty (used unless the options give one).
+pub fn compare(
+    runs: &[SimulatedExperiment],
+    set_uncertainty: Option<f64>,
+    options: &CompareOptions,
+) -> Result<Comparison, CompareError> {
+    if runs.is_empty() {
+        return Err(CompareError::Data("no experiments to compare".into()));
+    }
+    let mut experiments = Vec::with_capacity(runs.len());
+    for run in runs {
+        experiments.push(compared_experiment(run)?);
+    }
+    let series: Vec<(Vec<f64>, Vec<f64>)> = experiments
+        .iter()
+        .map(|e| {
+            (
+                e.points.iter().map(|p| p.position_m).collect(),
+                e.points.iter().map(|p| p.residual).collect(),
+            )
+        })
+        .collect();
+    let sigma_estimated = residual_stats::estimate_noise(&series);
+    let given = options.relative_uncertainty.or(set_uncertainty);
+    if let Some(s) = given {
+        if !(s > 0.0 && s.is_finite()) {
+            return Err(CompareError::Data(format!(
+                "relative uncertainty must be positive and finite, got {s}"
+            )));
+        }
+    }
+    let (sigma, sigma_source) = match given {
+        Some(s) => (s, NoiseSource::Given),
+        None => (sigma_estimated, NoiseSource::Estimated),
+    };
+    if !(sigma > 0.0 && sigma.is_finite()) {
+        return Err(CompareError::Data(format!(
+            "cannot estimate the noise level from the data (estimate {sigma_estimated}); \
+             give relative_uncertainty in the experiments TOML"
+        )));
+    }
+    let n_points: usize = experiments.iter().map(|e| e.points.len()).sum();
+    let mut sum2 = 0.0;
+    for (e, (s, r)) in experiments.iter_mut().zip(&series) {
+        e.chi2 = r.iter().map(|v| v * v).sum::<f64>() / (sigma * sigma);
+        sum2 += r.iter().map(|v| v * v).sum::<f64>();
+        e.segments = segments::find_segments(&[(s.clone(), r.clone())], sigma, &options.segments);
+    }
+    let chi2 = sum2 / (sigma * sigma);
+    let dof = n_points.saturating_sub(options.fitted_parameters);
+    let runs_each: Vec<RunsTest> = experiments.iter().map(|e| e.runs).collect();
+    let seqs: Vec<&[f64]> = series.iter().map(|(_, r)| r.as_slice()).collect();
+    let (lag1, pairs) = residual_stats::lag1_autocorrelation(&seqs);
+    let all = |f: fn(&ComparedPoint) -> f64| -> Vec<f64> {
+        experiments
+            .iter()
+            .flat_map(|e| e.points.iter().map(f))
+            .collect()
+    };
+    let residuals = all(|p| p.residual);
+    let trends = [
+        ("strain_rate", all(|p| p.strain_rate_1_s)),
+        ("temperature", all(|p| p.temperature_k)),
+        ("speed", all(|p| p.speed_m_s)),
+    ]
+    .into_iter()
+    .map(|(q, x)| Trend {
+        quantity: q.into(),
+        spearman: residual_stats::spearman(&x, &residuals),
+    })
+    .collect();
+    Ok(Comparison {
+        sigma,
+        sigma_source,
+        sigma_estimated,
+        points: n_points,
+        fitted_parameters: options.fitted_parameters,
+        chi2,
+        dof,
+        chi2_per_dof: if dof > 0 { chi2 / dof as f64 } else { f64::NAN },
+        rms: (sum2 / n_points.max(1) as f64).sqrt(),
+        runs: RunsTest::pooled(&runs_each),
+        lag1,
+        lag1_z: lag1 * (pairs as f64).sqrt(),
+        stations: segments::station_profile(&series, sigma),
+        segments: segments::find_segments(&series, sigma, &options.segments),
+        trends,
+        segment_options: options.segments,
+        experiments,
+    })
+}
+
+fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, CompareError> {
+    let n = run.positions.len();
+    let p = &run.at_measurements;
+    if run.measured.len() != n
+        || p.diameter.len() != n
+        || p.strain_rate.len() != n
+        || p.temperature.len() != n
+        || p.velocity.len() != n
+    {
+        return Err(CompareError::Data(format!(
+            "experiment {}: {} positions, {} measured diameters and {} model values do not match",
+            run.name,
+            n,
+            run.measured.len(),
+            p.diameter.len()
+        )));
+    }
+    if n == 0 {
+        return Err(CompareError::Data(format!(
+            "experiment {} has no measurements",
+            run.name
+        )));
+    }
+    let mut points = Vec::with_capacity(n);
+    for i in 0..n {
+        let (dm, dd) = (run.measured[i], p.diameter[i]);
+        if !(dm > 0.0 && dd > 0.0 && dm.is_finite() && dd.is_finite()) {
+            return Err(CompareError::Data(format!(
+                "experiment {} at s = {} m: diameters must be positive (measured {dm} m, model {dd} m)",
+                run.name, run.positions[i]
+            )));
+        }
+        points.push(ComparedPoint {
+            position_m: run.positions[i],
+            d_meas_m: dm,
+            d_model_m: dd,
+            residual: dd / dm - 1.0,
+            inv_d2_meas: 1.0 / (dm * dm),
+            inv_d2_model: 1.0 / (dd * dd),
+            strain_rate_1_s: p.strain_rate[i],
+            temperature_k: p.temperature[i],
+            speed_m_s: p.velocity[i],
+        });
+    }
+    let r: Vec<f64> = points.iter().map(|p| p.residual).collect();
+    let m = n as f64;
+    let (lag1, _) = residual_stats::lag1_autocorrelation(&[&r]);
+    Ok(ComparedExperiment {
+        name: run.name.clone(),
+        curve_position_m: run.curve.position.clone(),
+        curve_diameter_m: run.curve.diameter.clone(),
+        rms: (r.iter().map(|v| v * v).sum::<f64>() / m).sqrt(),
+        mean: r.iter().sum::<f64>() / m,
+        chi2: f64::NAN,
+        runs: RunsTest::of(&r),
+        lag1,
+        segments: Vec::new(),
+        points,
+    })
+}
+
+/// Output image format of the figures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FigureFormat {
+    /// Bitmap.
+    Png,
+    /// Vector graphics.
+    Svg,
+}
+
+impl FigureFormat {
+    /// The file extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            FigureFormat::Png => "png",
+            FigureFormat::Svg => "svg",
+        }
+    }
+}
+
+impl Comparison {
+    /// The JSON summary (all numbers, per point).
+    pub fn to_json(&self) -> Result<String, CompareError> {
+        Ok(serde_json::to_string_pretty(self)?)
+    }
+
+    /// The per-point table as CSV.
+    pub fn to_csv(&self) -> String {
+        let mut s = String::from(
+            "experiment,position_m,d_meas_m,d_model_m,relative_residual,inv_d2_meas_1_m2,\
+             inv_d2_model_1_m2,strain_rate_1_s,temperature_K,speed_m_s\n",
+        );
+        for e in &self.experiments {
+            for p in &e.points {
+                s.push_str(&format!(
+                    "{},{},{:.8e},{:.8e},{:.6e},{:.8e},{:.8e},{:.6e},{:.6e},{:.6e}\n",
+                    e.name,
+                    p.position_m,
+                    p.d_meas_m,
+                    p.d_model_m,
+                    p.residual,
+                    p.inv_d2_meas,
+                    p.inv_d2_model,
+                    p.strain_rate_1_s,
+                    p.temperature_k,
+                    p.speed_m_s
+                ));
+            }
+        }
+        s
+    }
+
+    /// Writes `compare_summary.txt`, `compare.json`, `compare_points.csv` and the figures
+    /// (see [`compare_figures::write_figures`]) into `dir` (created), never over a file in
+    /// `inputs`. Returns the written paths.
+    pub fn write(
+        &self,
+        dir: &Path,
+        format: FigureFormat,
+        inputs: &[PathBuf],
+    ) -> Result<Vec<PathBuf>, CompareError> {
+        create_dir(dir)?;
+        let mut written = Vec::new();
+        for (name, text) in [
+            ("compare_summary.txt", self.to_text()),
+            ("compare.json", self.to_json()?),
+            ("compare_points.csv", self.to_csv()),
+        ] {
+            let path = dir.join(name);
+            write_text(&path, &text, inputs)?;
+            written.push(path);
+        }
+        written.extend(compare_figures::write_figures(self, dir, format, inputs)?);
+        Ok(written)
+    }
+}

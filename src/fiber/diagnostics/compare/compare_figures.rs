@@ -1,0 +1,171 @@
+//! Figures of a comparison: diameters, `1/d²`, residual along `s` with the noise band, and
+//! residuals against the local strain rate, temperature and speed.
+
+use super::{CompareError, Comparison, FigureFormat};
+use crate::fiber::output::ensure_not_input;
+use crate::plot::{save_panels, Panel, Series};
+use std::path::{Path, PathBuf};
+
+fn grid_size(panels: usize, columns: usize) -> (u32, u32) {
+    let rows = panels.div_ceil(columns).max(1) as u32;
+    ((420 * columns as u32).max(900), 320 * rows)
+}
+
+/// Writes into `dir` (which must exist):
+/// * `compare_diameters.EXT`: measured and simulated diameters per experiment (µm);
+/// * `compare_inverse_d2.EXT`: `1/d²` measured and simulated per experiment (1/mm²);
+/// * `compare_residuals.EXT`: relative residual vs `s`, per experiment and the pooled station
+///   mean, with the `±2σ` band of single points and the `±2 se` band of the pooled mean;
+/// * `compare_residual_trends.EXT`: residuals against strain rate, temperature and speed, one
+///   colour per experiment.
+///
+/// Never writes over a file in `inputs`. Returns the paths.
+pub fn write_figures(
+    cmp: &Comparison,
+    dir: &Path,
+    format: FigureFormat,
+    inputs: &[PathBuf],
+) -> Result<Vec<PathBuf>, CompareError> {
+    let ext = format.extension();
+    let mut out = Vec::new();
+    let mut save = |name: &str, panels: &[Panel], columns: usize| -> Result<(), CompareError> {
+        let path = dir.join(format!("{name}.{ext}"));
+        ensure_not_input(&path, inputs)?;
+        save_panels(&path, panels, columns, grid_size(panels.len(), columns))?;
+        out.push(path);
+        Ok(())
+    };
+    let columns = 3.min(cmp.experiments.len().max(1));
+    let diam: Vec<Panel> = cmp
+        .experiments
+        .iter()
+        .map(|e| {
+            Panel::new(e.name.as_str(), "s (m)", "d (µm)")
+                .with_series(Series::markers(
+                    "measured",
+                    e.points
+                        .iter()
+                        .map(|p| (p.position_m, 1e6 * p.d_meas_m))
+                        .collect(),
+                ))
+                .with_series(Series::line(
+                    "model",
+                    e.curve_position_m
+                        .iter()
+                        .zip(&e.curve_diameter_m)
+                        .map(|(s, d)| (*s, 1e6 * d))
+                        .collect(),
+                ))
+                .with_log_y(true)
+        })
+        .collect();
+    save("compare_diameters", &diam, columns)?;
+    let inv: Vec<Panel> = cmp
+        .experiments
+        .iter()
+        .map(|e| {
+            Panel::new(e.name.as_str(), "s (m)", "1/d² (1/mm²)")
+                .with_series(Series::markers(
+                    "measured",
+                    e.points
+                        .iter()
+                        .map(|p| (p.position_m, 1e-6 * p.inv_d2_meas))
+                        .collect(),
+                ))
+                .with_series(Series::line(
+                    "model",
+                    e.curve_position_m
+                        .iter()
+                        .zip(&e.curve_diameter_m)
+                        .map(|(s, d)| (*s, 1e-6 / (d * d)))
+                        .collect(),
+                ))
+        })
+        .collect();
+    save("compare_inverse_d2", &inv, columns)?;
+
+    let two_sigma = 200.0 * cmp.sigma;
+    let (s_lo, s_hi) = cmp
+        .stations
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), st| {
+            (a.min(st.position_m), b.max(st.position_m))
+        });
+    let mut each = Panel::new("relative residual per experiment", "s (m)", "residual (%)");
+    for (k, e) in cmp.experiments.iter().enumerate() {
+        each = each.with_series(
+            Series::markers(
+                e.name.as_str(),
+                e.points
+                    .iter()
+                    .map(|p| (p.position_m, 100.0 * p.residual))
+                    .collect(),
+            )
+            .with_color(k),
+        );
+    }
+    each = each
+        .with_series(
+            Series::dashed("±2σ", vec![(s_lo, two_sigma), (s_hi, two_sigma)]).with_color(9),
+        )
+        .with_series(
+            Series::dashed("", vec![(s_lo, -two_sigma), (s_hi, -two_sigma)]).with_color(9),
+        );
+    let st = &cmp.stations;
+    let pooled = Panel::new("pooled residual (station mean)", "s (m)", "residual (%)")
+        .with_series(
+            Series::line(
+                "mean",
+                st.iter().map(|s| (s.position_m, 100.0 * s.mean)).collect(),
+            )
+            .with_color(0),
+        )
+        .with_series(
+            Series::dashed(
+                "±2 se",
+                st.iter()
+                    .map(|s| (s.position_m, 200.0 * s.std_error))
+                    .collect(),
+            )
+            .with_color(9),
+        )
+        .with_series(
+            Series::dashed(
+                "",
+                st.iter()
+                    .map(|s| (s.position_m, -200.0 * s.std_error))
+                    .collect(),
+            )
+            .with_color(9),
+        )
+        .with_series(Series::line("", vec![(s_lo, 0.0), (s_hi, 0.0)]).with_color(7));
+    save("compare_residuals", &[each, pooled], 1)?;
+
+    type Getter = fn(&super::ComparedPoint) -> f64;
+    let quantities: [(&str, &str, Getter); 3] = [
+        ("vs strain rate", "strain rate (1/s)", |p| p.strain_rate_1_s),
+        ("vs temperature", "T (K)", |p| p.temperature_k),
+        ("vs speed", "u (m/s)", |p| p.speed_m_s),
+    ];
+    let trends: Vec<Panel> = quantities
+        .iter()
+        .map(|(title, xl, get)| {
+            let mut panel = Panel::new(*title, *xl, "residual (%)");
+            for (k, e) in cmp.experiments.iter().enumerate() {
+                panel = panel.with_series(
+                    Series::markers(
+                        e.name.as_str(),
+                        e.points
+                            .iter()
+                            .map(|p| (get(p), 100.0 * p.residual))
+                            .collect(),
+                    )
+                    .with_color(k),
+                );
+            }
+            panel
+        })
+        .collect();
+    save("compare_residual_trends", &trends, 3)?;
+    Ok(out)
+}

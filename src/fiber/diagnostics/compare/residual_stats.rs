@@ -1,0 +1,237 @@
+//! Statistics of relative residuals: a robust noise estimate, the Wald–Wolfowitz runs test,
+//! lag-1 autocorrelation and Spearman rank correlation.
+
+use serde::{Deserialize, Serialize};
+
+/// `1/Φ⁻¹(3/4)`: turns a median absolute deviation into a normal standard deviation.
+const MAD_TO_SD: f64 = 1.482_602_218_505_602;
+
+/// Median of `v` (`NaN` if empty); `v` is reordered.
+pub fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    let m = v.len() / 2;
+    if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    }
+}
+
+/// Robust standard deviation `1.4826 · median |v − median v|` (`NaN` if empty).
+pub fn robust_sd(v: &[f64]) -> f64 {
+    let mut w = v.to_vec();
+    let med = median(&mut w);
+    let mut dev: Vec<f64> = v.iter().map(|x| (x - med).abs()).collect();
+    MAD_TO_SD * median(&mut dev)
+}
+
+/// Normalised second differences of one experiment's residuals `r` at positions `s`.
+///
+/// For consecutive points `i−1, i, i+1` with spacings `h₁ = s_i − s_{i−1}`, `h₂ = s_{i+1} − s_i`
+/// the combination `e = (h₂ r_{i−1} − (h₁ + h₂) r_i + h₁ r_{i+1}) / ‖(h₂, h₁ + h₂, h₁)‖` vanishes
+/// for any residual linear in `s` and has the variance `σ²` of independent noise of standard
+/// deviation `σ`. A smooth systematic residual therefore drops out (to second order).
+pub fn second_differences(s: &[f64], r: &[f64]) -> Vec<f64> {
+    let mut out = Vec::new();
+    for i in 1..r.len().saturating_sub(1) {
+        let h1 = s[i] - s[i - 1];
+        let h2 = s[i + 1] - s[i];
+        let w = [h2, -(h1 + h2), h1];
+        let norm = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+        if norm > 0.0 {
+            out.push((w[0] * r[i - 1] + w[1] * r[i] + w[2] * r[i + 1]) / norm);
+        }
+    }
+    out
+}
+
+/// The noise estimator: robust standard deviation of the normalised second differences
+/// ([`second_differences`]) pooled over all experiments (`NaN` with fewer than 3 of them).
+///
+/// The median absolute deviation ignores the few large differences that a kink of the
+/// systematic residual or an outlier produces; for heteroscedastic noise it estimates the level
+/// of the majority of the points.
+pub fn estimate_noise(experiments: &[(Vec<f64>, Vec<f64>)]) -> f64 {
+    let e: Vec<f64> = experiments
+        .iter()
+        .flat_map(|(s, r)| second_differences(s, r))
+        .collect();
+    if e.len() < 3 {
+        return f64::NAN;
+    }
+    robust_sd(&e)
+}
+
+/// The Wald–Wolfowitz runs test on the signs of residuals.
+///
+/// With `n₊` positive and `n₋` negative residuals (exact zeros are left out) and `R` runs of
+/// equal sign, `μ = 2 n₊ n₋ / n + 1`, `var = (μ − 1)(μ − 2)/(n − 1)` and `z = (R − μ)/√var`.
+/// White noise gives `z ≈ N(0, 1)`; a smooth systematic residual gives too few runs, `z ≪ 0`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub struct RunsTest {
+    /// Number of runs `R`.
+    pub runs: usize,
+    /// Positive residuals `n₊`.
+    pub positive: usize,
+    /// Negative residuals `n₋`.
+    pub negative: usize,
+    /// Expected number of runs `μ` for random signs.
+    pub expected: f64,
+    /// Variance of the number of runs for random signs.
+    pub variance: f64,
+    /// `z = (R − μ)/√var` (`NaN` if the variance is 0, e.g. all residuals of one sign).
+    pub z: f64,
+}
+
+impl RunsTest {
+    /// The test on one sequence of residuals (in order along the spin line).
+    pub fn of(r: &[f64]) -> Self {
+        let signs: Vec<bool> = r.iter().filter(|v| **v != 0.0).map(|v| *v > 0.0).collect();
+        let positive = signs.iter().filter(|b| **b).count();
+        let negative = signs.len() - positive;
+        let runs = if signs.is_empty() {
+            0
+        } else {
+            1 + signs.windows(2).filter(|w| w[0] != w[1]).count()
+        };
+        let n = signs.len() as f64;
+        let (expected, variance) = if signs.len() >= 2 {
+            let mu = 2.0 * positive as f64 * negative as f64 / n + 1.0;
+            (mu, (mu - 1.0) * (mu - 2.0) / (n - 1.0))
+        } else {
+            (f64::NAN, 0.0)
+        };
+        RunsTest {
+            runs,
+            positive,
+            negative,
+            expected,
+            variance,
+            z: z_of(runs as f64, expected, variance),
+        }
+    }
+
+    /// Pools independent sequences: runs, expectations and variances add.
+    pub fn pooled(tests: &[RunsTest]) -> Self {
+        let mut t = RunsTest::default();
+        for x in tests.iter().filter(|x| x.expected.is_finite()) {
+            t.runs += x.runs;
+            t.positive += x.positive;
+            t.negative += x.negative;
+            t.expected += x.expected;
+            t.variance += x.variance;
+        }
+        t.z = z_of(t.runs as f64, t.expected, t.variance);
+        t
+    }
+}
+
+fn z_of(value: f64, expected: f64, variance: f64) -> f64 {
+    if variance > 0.0 {
+        (value - expected) / variance.sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
+/// Lag-1 autocorrelation of each sequence about its own mean, pooled:
+/// `ρ₁ = Σ (r_i − r̄)(r_{i+1} − r̄) / Σ (r_i − r̄)²` with both sums over all sequences.
+/// Returns `(ρ₁, number of lag pairs)`; for white noise `ρ₁ ≈ N(0, 1/pairs)` (to `O(1/n)`).
+pub fn lag1_autocorrelation(sequences: &[&[f64]]) -> (f64, usize) {
+    let (mut num, mut den, mut pairs) = (0.0, 0.0, 0usize);
+    for r in sequences {
+        if r.len() < 2 {
+            continue;
+        }
+        let mean = r.iter().sum::<f64>() / r.len() as f64;
+        den += r.iter().map(|v| (v - mean).powi(2)).sum::<f64>();
+        num += r
+            .windows(2)
+            .map(|w| (w[0] - mean) * (w[1] - mean))
+            .sum::<f64>();
+        pairs += r.len() - 1;
+    }
+    if den > 0.0 {
+        (num / den, pairs)
+    } else {
+        (f64::NAN, pairs)
+    }
+}
+
+fn ranks(v: &[f64]) -> Vec<f64> {
+    let mut idx: Vec<usize> = (0..v.len()).collect();
+    idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
+    let mut r = vec![0.0; v.len()];
+    let mut i = 0;
+    while i < idx.len() {
+        let mut j = i;
+        while j + 1 < idx.len() && v[idx[j + 1]] == v[idx[i]] {
+            j += 1;
+        }
+        let avg = 0.5 * (i + j) as f64 + 1.0;
+        for &k in &idx[i..=j] {
+            r[k] = avg;
+        }
+        i = j + 1;
+    }
+    r
+}
+
+/// Spearman rank correlation of `x` and `y` (`NaN` with fewer than 3 finite pairs or no
+/// spread).
+pub fn spearman(x: &[f64], y: &[f64]) -> f64 {
+    let (xs, ys): (Vec<f64>, Vec<f64>) = x
+        .iter()
+        .zip(y)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (*a, *b))
+        .unzip();
+    if xs.len() < 3 {
+        return f64::NAN;
+    }
+    let (rx, ry) = (ranks(&xs), ranks(&ys));
+    let n = rx.len() as f64;
+    let (mx, my) = (rx.iter().sum::<f64>() / n, ry.iter().sum::<f64>() / n);
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for (a, b) in rx.iter().zip(&ry) {
+        sxy += (a - mx) * (b - my);
+        sxx += (a - mx) * (a - mx);
+        syy += (b - my) * (b - my);
+    }
+    if sxx > 0.0 && syy > 0.0 {
+        sxy / (sxx * syy).sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_of_known_sequence() {
+        let t = RunsTest::of(&[1.0, 2.0, -1.0, -1.0, 3.0, 0.0, -2.0]);
+        assert_eq!((t.runs, t.positive, t.negative), (4, 3, 3));
+        assert!((t.expected - 4.0).abs() < 1e-12);
+        assert!((t.variance - 6.0 / 5.0).abs() < 1e-12);
+        assert!(t.z.abs() < 1e-12);
+    }
+
+    #[test]
+    fn second_differences_remove_lines_and_keep_variance() {
+        let s = [0.0, 0.1, 0.3, 0.4, 0.7];
+        let r: Vec<f64> = s.iter().map(|x| 0.03 - 0.2 * x).collect();
+        assert!(second_differences(&s, &r).iter().all(|e| e.abs() < 1e-15));
+    }
+
+    #[test]
+    fn spearman_of_monotone_and_reversed() {
+        let x = [1.0, 2.0, 3.0, 4.0];
+        assert!((spearman(&x, &[1.0, 4.0, 9.0, 16.0]) - 1.0).abs() < 1e-12);
+        assert!((spearman(&x, &[4.0, 3.0, 2.0, 1.0]) + 1.0).abs() < 1e-12);
+    }
+}

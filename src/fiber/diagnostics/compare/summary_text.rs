@@ -1,0 +1,158 @@
+//! The comparison in words: noise level, χ²/dof, whiteness, where the misfit is systematic.
+
+use super::{Comparison, NoiseSource, Segment};
+use std::fmt::Write;
+
+fn pct(v: f64) -> f64 {
+    100.0 * v
+}
+
+/// "model too thin by 5.0 ± 1.1 % on s = 0.02–0.12 m in 9 of 9 experiments".
+fn segment_line(seg: &Segment, total: usize, names: &[String], pooled: bool) -> String {
+    let range = if seg.stations == 1 {
+        format!("at s = {:.3} m", seg.start_m)
+    } else {
+        format!("on s = {:.3}–{:.3} m", seg.start_m, seg.end_m)
+    };
+    let mut s = format!(
+        "model too {} by {:.1}",
+        seg.direction(),
+        pct(seg.mean.abs())
+    );
+    if pooled {
+        let _ = write!(
+            s,
+            " ± {:.1} % {range} in {} of {total} experiments \
+             ({} significant alone; ± is the spread across experiments; {} points, z = {:.1})",
+            pct(seg.spread),
+            seg.same_sign,
+            seg.significant,
+            seg.points,
+            seg.z
+        );
+        let other: Vec<&str> = seg
+            .per_experiment
+            .iter()
+            .filter(|(_, v)| (*v > 0.0) != (seg.mean > 0.0))
+            .filter_map(|(k, _)| names.get(*k).map(String::as_str))
+            .collect();
+        if !other.is_empty() && other.len() <= 4 {
+            let _ = write!(s, "; opposite sign in {}", other.join(", "));
+        }
+    } else {
+        let pts = if seg.points == 1 { "point" } else { "points" };
+        let _ = write!(s, " % {range} ({} {pts}, z = {:.1})", seg.points, seg.z);
+    }
+    s
+}
+
+impl Comparison {
+    /// The summary in words.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        let m = self.experiments.len();
+        let _ = writeln!(
+            s,
+            "[[Model vs measurement: {m} experiments, {} points]]",
+            self.points
+        );
+        let _ = writeln!(
+            s,
+            "RMS relative residual (d_model - d_meas)/d_meas = {:.2} %",
+            pct(self.rms)
+        );
+        match self.sigma_source {
+            NoiseSource::Given => {
+                let _ = writeln!(
+                    s,
+                    "noise level sigma = {:.2} % (given); estimated from the data: {:.2} %",
+                    pct(self.sigma),
+                    pct(self.sigma_estimated)
+                );
+            }
+            NoiseSource::Estimated => {
+                let _ = writeln!(
+                    s,
+                    "noise level sigma = {:.2} % (estimated from the data: robust scatter of \
+                     second differences of the residuals along s; none given in the TOML)",
+                    pct(self.sigma)
+                );
+            }
+        }
+        let dof = self.dof as f64;
+        let excess = (self.chi2 - dof) / (2.0 * dof).sqrt();
+        let verdict = if self.dof == 0 {
+            "no degrees of freedom left".to_string()
+        } else if excess < 3.0 {
+            "consistent with the noise".to_string()
+        } else {
+            format!(
+                "the misfit is {:.1} times the noise variance (RMS {:.1} sigma)",
+                self.chi2_per_dof,
+                self.chi2_per_dof.sqrt()
+            )
+        };
+        let _ = writeln!(
+            s,
+            "chi2/dof = {:.1}/{} = {:.2} ({} fitted parameters): {verdict}",
+            self.chi2, self.dof, self.chi2_per_dof, self.fitted_parameters
+        );
+        // evidence against whiteness: the larger of −z(runs) and z(lag-1)
+        let evidence = (-self.runs.z).max(self.lag1_z);
+        let verdict = if evidence.is_nan() || evidence < 2.0 {
+            "residuals look white"
+        } else if evidence < 3.0 {
+            "marginal evidence of structure along s (2-3 sigma)"
+        } else {
+            "residuals are NOT white (structure along s that noise does not explain)"
+        };
+        let _ = writeln!(
+            s,
+            "whiteness: runs test z = {:.1} ({} runs of residual signs, {:.1} expected for \
+             random signs), lag-1 autocorrelation {:.2} (z = {:.1}): {verdict}",
+            self.runs.z, self.runs.runs, self.runs.expected, self.lag1, self.lag1_z,
+        );
+        let names: Vec<String> = self.experiments.iter().map(|e| e.name.clone()).collect();
+        if self.segments.is_empty() {
+            let _ = writeln!(
+                s,
+                "no systematic segment: the pooled residual stays within the noise along the \
+                 spin line (|z| < {} or below {:.1} %)",
+                self.segment_options.z_segment,
+                pct(self.segment_options.min_effect)
+            );
+        } else {
+            let _ = writeln!(s, "systematic misfit (pooled over experiments):");
+            for seg in &self.segments {
+                let _ = writeln!(s, "  - {}", segment_line(seg, m, &names, true));
+            }
+        }
+        let trends: Vec<String> = self
+            .trends
+            .iter()
+            .map(|t| format!("{} {:+.2}", t.quantity.replace('_', " "), t.spearman))
+            .collect();
+        let _ = writeln!(
+            s,
+            "rank correlation of the residual with: {}",
+            trends.join(", ")
+        );
+        let _ = writeln!(s, "per experiment:");
+        for e in &self.experiments {
+            let _ = writeln!(
+                s,
+                "  {}: RMS {:.2} %, mean {:+.2} %, chi2/n {:.2}, runs z {:.1}, lag-1 {:.2}",
+                e.name,
+                pct(e.rms),
+                pct(e.mean),
+                e.chi2 / e.points.len().max(1) as f64,
+                e.runs.z,
+                e.lag1
+            );
+            for seg in &e.segments {
+                let _ = writeln!(s, "      {}", segment_line(seg, 1, &names, false));
+            }
+        }
+        s
+    }
+}
