@@ -14,6 +14,7 @@
 
 pub mod cold_start;
 pub mod contributions;
+pub mod diagnostics;
 pub mod error;
 pub mod input;
 pub mod material_law;
