@@ -8,3 +8,5 @@
 
 pub mod candidates;
 pub mod diagnose;
+pub mod report;
+pub mod scores;
