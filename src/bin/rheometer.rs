@@ -2,10 +2,15 @@
 //! from your own TOML + CSV measurements.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use diffbvp::fiber::diagnostics::candidates::{
+    EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+};
 use diffbvp::fiber::diagnostics::compare::{
     compare, simulate_experiments, CompareOptions, FigureFormat, FitParameters, MissingTakeUp,
     ModelSetup,
 };
+use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, ResidualProfiles};
+use diffbvp::fiber::diagnostics::report::save_residual_figure;
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
 use diffbvp::fiber::output::{create_dir, ensure_not_input, profiles_csv, write_text};
@@ -124,12 +129,45 @@ rheometer fit data/pmma7n_synthetic/experiments.toml --newtonian")]
         /// Evaluate the Newtonian model (n = 1) instead of fitting.
         #[arg(long)]
         newtonian: bool,
+        /// The viscosity law of the model: carreau (n, kappa fitted) or newtonian.
+        #[arg(long, default_value = "carreau")]
+        model: LawChoice,
+        /// Add an effect, its strength fitted ("radiation") or fixed ("radiation=0.9");
+        /// repeatable. Effects: strain_thinning, radiation, air_coflow,
+        /// air_temperature_profile, inlet_velocity, nusselt_scale.
+        #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
+        with: Vec<EffectSetting>,
         /// Write the result as JSON to FILE.
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Write the report, the fitted profiles and figures (paper Fig. 2, 3, 5) into DIR.
+        /// Write the report, the fitted profiles and figures (paper Fig. 2, 3, 5; with --with also
+        /// a before/after residual figure) into DIR.
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Which physical effect is missing from the model? Ranks the candidate effects by how
+    /// much of the misfit each explains (linearised scores, refits, delta BIC).
+    ///
+    /// Example: rheometer diagnose data/pmma7n_synthetic/experiments.toml --json
+    /// target/diagnose.json --out target/diagnose
+    Diagnose {
+        /// The experiments file (TOML).
+        experiments: PathBuf,
+        /// The viscosity law of your model: carreau or newtonian.
+        #[arg(long, default_value = "carreau")]
+        model: LawChoice,
+        /// Effects already in your model (fitted or "=VALUE" fixed); repeatable.
+        #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
+        with: Vec<EffectSetting>,
+        /// How many of the best linearised candidates are refitted.
+        #[arg(long, default_value_t = 3)]
+        refit_top: usize,
+        /// Write the diagnosis as JSON to FILE.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Output directory (report and before/after residual figure).
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Compute the cost landscape J(n, kappa) on a grid; write it as CSV and heat map.
     #[command(after_help = "Examples:\n  \
@@ -242,6 +280,33 @@ fn estimator(e: EstimatorArg) -> Estimator {
         EstimatorArg::Principled => Estimator::Principled,
         EstimatorArg::Paper => Estimator::Paper,
     }
+}
+
+fn write_json(path: &Path, text: &str, inputs: &[PathBuf]) -> Result<(), Box<dyn Error>> {
+    if let Some(parent) = path.parent() {
+        if !parent.as_os_str().is_empty() {
+            create_dir(parent)?;
+        }
+    }
+    write_text(path, text, inputs)?;
+    Ok(())
+}
+
+fn profiles_of(rh: &Rheometer, sols: &[diffbvp::Solution]) -> ResidualProfiles {
+    sols.iter()
+        .enumerate()
+        .map(|(k, s)| {
+            (
+                rh.experiments[k].name.clone(),
+                rh.measurements[k]
+                    .positions
+                    .iter()
+                    .copied()
+                    .zip(rh.relative_residuals(k, s))
+                    .collect(),
+            )
+        })
+        .collect()
 }
 
 fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
@@ -372,6 +437,8 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             start,
             estimator: est,
             newtonian,
+            model,
+            with,
             json,
             out,
         } => {
@@ -386,8 +453,17 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                     ensure_not_input(&dir.join(name), &inputs)?;
                 }
             }
-            let rh = Rheometer::new(&loaded.set)?;
+            let spec = ModelSpec {
+                law: model,
+                effects: with.clone(),
+                candidates: Vec::new(),
+            };
+            let rh = Rheometer::with_spec(&loaded.set, spec)?;
             let opts = IdentifyOptions::with_estimator(estimator(est));
+            let law_fitted = model == LawChoice::Carreau
+                || with
+                    .iter()
+                    .any(|w| w.effect.name() == "strain_thinning" && w.value.is_none());
             if newtonian {
                 let mut obj = rh.objective([1.0, 20.0], &opts)?;
                 let j = obj.cost_at(1.0, 20.0)?;
@@ -399,6 +475,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             }
             let start = match start {
                 Some((n, k)) => [n, k],
+                None if !law_fitted => [1.0, STRAIN_THINNING_REFERENCE_KAPPA],
                 None => {
                     let sp = rh.start_heuristic(&opts)?;
                     say(format!(
@@ -413,16 +490,34 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             println!("{}", rep.to_text());
             let text = serde_json::to_string_pretty(&rep)?;
             if let Some(path) = json {
-                if let Some(parent) = path.parent() {
-                    if !parent.as_os_str().is_empty() {
-                        create_dir(parent)?;
-                    }
-                }
-                write_text(&path, &text, &inputs)?;
+                write_json(&path, &text, &inputs)?;
                 say(format!("wrote {}", path.display()));
             }
             if let Some(dir) = out {
                 create_dir(&dir)?;
+                if !with.is_empty() {
+                    // the same fit without the effects, for the before/after comparison
+                    let rh0 = Rheometer::with_spec(&loaded.set, ModelSpec::new(model))?;
+                    let s0 = if model == LawChoice::Carreau {
+                        [id.n, id.kappa]
+                    } else {
+                        [1.0, STRAIN_THINNING_REFERENCE_KAPPA]
+                    };
+                    let id0 = rh0.identify(s0, &opts)?;
+                    let names: Vec<String> =
+                        with.iter().map(|w| w.effect.name().to_string()).collect();
+                    let label = names.join(" + ");
+                    let before = profiles_of(&rh0, &id0.solutions);
+                    let after = profiles_of(&rh, &id.solutions);
+                    let fig = dir.join("residuals_before_after.png");
+                    save_residual_figure(&fig, &before, Some((&label, &after)))?;
+                    println!(
+                        "RMS relative residual: {:.4} % without {label}, {:.4} % with it ({})",
+                        100.0 * id0.rms_relative_residual,
+                        100.0 * id.rms_relative_residual,
+                        fig.display()
+                    );
+                }
                 write_text(&dir.join("fit_report.txt"), &rep.to_text(), &inputs)?;
                 write_text(&dir.join("fit.json"), &text, &inputs)?;
                 for (k, sol) in id.solutions.iter().enumerate() {
@@ -453,6 +548,46 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                     dir.display()
                 ));
             }
+        }
+        Command::Diagnose {
+            experiments,
+            model,
+            with,
+            refit_top,
+            json,
+            out,
+        } => {
+            let loaded = load_experiments_with(&experiments, 4)?;
+            let inputs = inputs_of(&experiments, &loaded);
+            let spec = ModelSpec {
+                law: model,
+                effects: with,
+                candidates: Vec::new(),
+            };
+            spec.validate()?;
+            let opts = DiagnoseOptions {
+                refit_top,
+                ..DiagnoseOptions::default()
+            };
+            say("fitting your model and scoring the candidate effects...".into());
+            let run = diagnose(&loaded.set, &spec, &opts)?;
+            let text = run.diagnosis.to_text();
+            println!("{text}");
+            create_dir(&out)?;
+            write_text(&out.join("diagnosis.txt"), &text, &inputs)?;
+            let js = serde_json::to_string_pretty(&run.diagnosis)?;
+            write_text(&out.join("diagnosis.json"), &js, &inputs)?;
+            if let Some(path) = json {
+                write_json(&path, &js, &inputs)?;
+                say(format!("wrote {}", path.display()));
+            }
+            let fig = out.join("residuals_before_after.png");
+            run.save_figure(&fig)?;
+            say(format!(
+                "wrote the report and {} to {}",
+                fig.display(),
+                out.display()
+            ));
         }
         Command::Landscape {
             experiments,

@@ -69,7 +69,35 @@ pub trait NusseltLaw: Send + Sync {
     fn prandtl_argument(&self, pr: f64) -> f64 {
         pr
     }
+
+    /// `𝒩` with an extra regularisation `extra_sq` (≥ 0, dimensionless) of the inclination
+    /// dependence, used with an air co-flow (see [`COFLOW_INCLINATION_REGULARISATION`]); it is
+    /// exactly 0 in still air. Default: ignores `extra_sq`.
+    fn nusselt_regularised<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        re_tau: D,
+        re_sq: D,
+        pr_arg: f64,
+        extra_sq: D,
+    ) -> D {
+        let _ = extra_sq;
+        self.nusselt(re_tau, re_sq, pr_arg)
+    }
 }
+
+/// Extra inclination regularisation `ε_c` [-] with an air co-flow: the default Nusselt law's
+/// inclination factor becomes `1 − ½ Re_τ²/(Re² + ε_i² + ε_c² w²/(1 + w²))`,
+/// `w = v_air/`[`COFLOW_REGULARISATION_SPEED`]. Where the air overtakes the fiber the relative
+/// speed changes sign and the unregularised factor jumps from ½ to 1 and back within
+/// `|Re| ≲ 1e-3` (a layer of ~1e-5 m the collocation cannot resolve cheaply); `ε_c` widens it.
+/// In still air (`v_air = 0`, also a co-flow of strength 0) the term vanishes identically, with
+/// zero derivative, so the base model is reproduced exactly. Elsewhere it changes `𝒩` by
+/// `≲ ε_c²/(2 Re²)` (0.1% at `Re = 1`).
+pub const COFLOW_INCLINATION_REGULARISATION: f64 = 0.05;
+
+/// Air speed scale [m/s] of the co-flow regularisation weight `w` (see
+/// [`COFLOW_INCLINATION_REGULARISATION`]).
+pub const COFLOW_REGULARISATION_SPEED: f64 = 0.01;
 
 /// Default Nusselt law of `docs/model-closure.md` (an assumption; the paper's law is not public):
 /// `𝒩 = (1 − ½ Re_τ²/(Re² + ε_i²)) Nu_CB(Re_ε, Pr)`, `Re_ε = √(Re² + ε_r²)`, with the
@@ -105,8 +133,20 @@ impl NusseltLaw for InclinedChurchillBernstein {
 
     #[inline]
     fn nusselt<D: DualNum<Primitive = f64> + Copy>(&self, re_tau: D, re_sq: D, pr_arg: f64) -> D {
+        self.nusselt_regularised(re_tau, re_sq, pr_arg, D::zero())
+    }
+
+    #[inline]
+    fn nusselt_regularised<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        re_tau: D,
+        re_sq: D,
+        pr_arg: f64,
+        extra_sq: D,
+    ) -> D {
         let re_eps2 = re_sq + self.re_regularisation * self.re_regularisation;
-        let inc2 = re_sq + self.inclination_regularisation * self.inclination_regularisation;
+        let inc2 =
+            re_sq + self.inclination_regularisation * self.inclination_regularisation + extra_sq;
         let inclination = -(re_tau * re_tau / inc2) * 0.5 + 1.0;
         let sqrt_re = re_eps2.sqrt().sqrt(); // Re_ε^½, Re_ε² > 0
                                              // (Re_ε/282000)^(5/8) = Re_ε^½ Re_ε^⅛ / 282000^(5/8), by square roots only
@@ -261,6 +301,10 @@ pub struct Physics<H: NusseltLaw = InclinedChurchillBernstein> {
     pub air_temperature: AirTemperature,
     /// Slenderness `δ` of the drag coefficient [-] (paper: 1e-3).
     pub slenderness: f64,
+    /// Relative error `δ` [-] of the inlet velocity (die swell): the inlet condition becomes
+    /// `u(0) = (1 + δ) u_in` (`Off` by default; `Parameter` makes `δ` a model parameter named
+    /// `"inlet_velocity"`, neutral value 0).
+    pub inlet_velocity: Strength,
 }
 
 impl Default for Physics {
@@ -297,7 +341,15 @@ impl<H: NusseltLaw> Physics<H> {
             air_speed: AirSpeed::Still,
             air_temperature: AirTemperature::Uniform,
             slenderness: super::scaling::PAPER_SLENDERNESS,
+            inlet_velocity: Strength::Off,
         }
+    }
+
+    /// Makes the relative inlet-velocity error `δ` (`u(0) = (1 + δ) u_in`) a model parameter
+    /// named `"inlet_velocity"` with default value `error` [-].
+    pub fn with_inlet_velocity_error(mut self, error: f64) -> Self {
+        self.inlet_velocity = Strength::Parameter(error);
+        self
     }
 
     /// Adds grey-body radiation with emissivity `emissivity` [-] (term `"radiation"`).
@@ -364,6 +416,10 @@ impl<H: NusseltLaw> Physics<H> {
                 *s = strength;
                 true
             }
+            ("inlet_velocity", _, _) => {
+                self.inlet_velocity = strength;
+                true
+            }
             _ => false,
         }
     }
@@ -375,7 +431,8 @@ impl<H: NusseltLaw> Physics<H> {
     }
 
     /// Names and default values of the strengths that are model parameters, in `p` order:
-    /// terms first (in term order), then `"coflow"`, then `"warm_air"`.
+    /// terms first (in term order), then `"coflow"`, then `"warm_air"`, then
+    /// `"inlet_velocity"`.
     pub fn strength_parameters(&self) -> Vec<(&'static str, f64)> {
         let mut v: Vec<(&'static str, f64)> = self
             .terms
@@ -398,6 +455,9 @@ impl<H: NusseltLaw> Physics<H> {
         } = self.air_temperature
         {
             v.push(("warm_air", d));
+        }
+        if let Strength::Parameter(d) = self.inlet_velocity {
+            v.push(("inlet_velocity", d));
         }
         v
     }
@@ -533,6 +593,29 @@ impl<H: NusseltLaw> Physics<H> {
         self.strength_parameters().len()
     }
 
+    /// The inlet-velocity factor `1 + δ` with strength parameters `sp` (1 when the error is off).
+    #[inline]
+    pub fn inlet_velocity_factor<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> D {
+        match self.inlet_velocity {
+            Strength::Off => D::one(),
+            Strength::Fixed(v) => D::from(1.0 + v),
+            Strength::Parameter(_) => {
+                let mut k = self
+                    .terms
+                    .iter()
+                    .filter(|t| t.strength.is_parameter())
+                    .count();
+                if let AirSpeed::CoFlow { strength, .. } = &self.air_speed {
+                    k += usize::from(strength.is_parameter());
+                }
+                if let AirTemperature::WarmNozzle { strength, .. } = &self.air_temperature {
+                    k += usize::from(strength.is_parameter());
+                }
+                sp.get(k).copied().unwrap_or_else(|| D::from(f64::NAN)) + 1.0
+            }
+        }
+    }
+
     /// `(T̃_air(s̃), ṽ_air(s̃))` with strength parameters `sp`.
     #[inline]
     pub fn environment<D: DualNum<Primitive = f64> + Copy>(
@@ -586,7 +669,18 @@ impl<H: NusseltLaw> Physics<H> {
             TermKind::AirDrag => (st.v_air - st.u) * co.drag,
             TermKind::Convection => {
                 let re_tau = st.d * (st.v_air - st.u) * co.re_air;
-                let nu = self.nusselt.nusselt(re_tau, re_tau * re_tau, co.pr_arg);
+                let nu = match self.air_speed {
+                    AirSpeed::Still => self.nusselt.nusselt(re_tau, re_tau * re_tau, co.pr_arg),
+                    AirSpeed::CoFlow { .. } => {
+                        let w = st.v_air * (co.si[0] / COFLOW_REGULARISATION_SPEED);
+                        let w2 = w * w;
+                        let extra = w2 / (w2 + 1.0)
+                            * (COFLOW_INCLINATION_REGULARISATION
+                                * COFLOW_INCLINATION_REGULARISATION);
+                        self.nusselt
+                            .nusselt_regularised(re_tau, re_tau * re_tau, co.pr_arg, extra)
+                    }
+                };
                 -nu * (st.t - st.t_air) * co.convection
             }
             TermKind::ViscousHeating => st.n * st.rate * co.ec,

@@ -440,24 +440,29 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
     fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
         let c = p[0];
         let lp = &p[1..1 + self.n_law];
+        let sp = &p[1 + self.n_law..1 + self.n_law + self.n_strength];
         let q = self.co.q;
-        r[0] = ya[0] - self.u_in;
+        // inlet-velocity error (die swell): u(0) = (1 + δ) u_in; the stress-free fiber of c = 0
+        // then has d = d_in/√(1 + δ)
+        let f_in = self.physics.inlet_velocity_factor(sp);
+        let u_in = f_in * self.u_in;
+        r[0] = ya[0] - u_in;
         r[1] = match self.take_up {
             DimensionlessTakeUp::Diameter { d_out, d_in } => {
                 let phi = p[1 + self.n_law + self.n_strength];
-                let target = c * phi * d_out + (-c + 1.0) * d_in;
+                let target = c * phi * d_out + (-c + 1.0) * f_in.sqrt().recip() * d_in;
                 self.diameter(yb[0], self.density(yb[2])) / target - 1.0
             }
             DimensionlessTakeUp::Velocity { u_out } => {
                 let phi = p[1 + self.n_law + self.n_strength];
-                let target = c * phi * u_out + (-c + 1.0) * self.u_in;
+                let target = c * phi * u_out + (-c + 1.0) * u_in;
                 yb[0] / target - 1.0
             }
         };
         r[2] = ya[2] - self.t_in;
         let t_in = D::from(self.t_in);
         let rho_in = self.density(self.t_in);
-        r[3] = self.re_c(c) / q * (ya[1] * (rho_in * self.u_in))
-            - ya[3] * self.viscosity(t_in, ya[3], lp);
+        r[3] =
+            self.re_c(c) / q * (ya[1] * (u_in * rho_in)) - ya[3] * self.viscosity(t_in, ya[3], lp);
     }
 }

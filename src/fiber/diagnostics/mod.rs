@@ -1,8 +1,16 @@
-//! Diagnostics of a fitted fiber model against measurements: where and how the model misses
-//! the data.
+//! Model diagnostics: where and how a fitted fiber model misses the measurements, which
+//! physical effect is missing, adding it, and watching the error fall.
 //!
 //! * [`compare`]: measured vs simulated diameters per experiment, residual statistics
 //!   (noise level, χ²/dof, runs test, lag-1 autocorrelation), systematic segments along the
-//!   spin line, text/JSON summaries and figures.
+//!   spin line, text/JSON summaries and figures;
+//! * [`candidates`]: the candidate effects (canonical names, strength parameters, neutral
+//!   values), the model specification (law + effects) a rheometer fit uses;
+//! * [`diagnose`]: ranking the candidates by the excess misfit they explain (linearised scores,
+//!   refits, information criteria) and the report in words.
 
+pub mod candidates;
 pub mod compare;
+pub mod diagnose;
+pub mod report;
+pub mod scores;

@@ -8,13 +8,14 @@
 //! driver treats as a rejected step.
 
 use super::estimator::{Estimator, PaperResidual, RelativeResidual};
+use super::layout::{EffectSlot, FitStart, Layout};
+use crate::fiber::diagnostics::candidates::ModelSpec;
 use crate::fiber::error::FiberError;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements, TakeUp};
 use crate::fiber::simulate::{simulate_params, SimulateOptions};
 use crate::fiber::smoothing::{smooth, SmoothFit, SmoothingError};
-use crate::fiber::Physics;
 use crate::least_squares::{fit, FitError, FitOptions, FitResult, LeastSquaresProblem};
 use crate::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
 use crate::solution::Solution;
@@ -23,7 +24,8 @@ use rayon::prelude::*;
 use std::time::Instant;
 use thiserror::Error;
 
-/// The fiber model the rheometer identifies: Carreau-type law, the paper's physics.
+/// The fiber model the rheometer identifies: Carreau-type law (a Newtonian model is `n = 1`),
+/// the paper's physics plus the effects of its [`ModelSpec`].
 pub type CarreauFiber = FiberModel<CarreauLike>;
 
 /// What can go wrong in the rheometer.
@@ -125,12 +127,22 @@ pub struct Rheometer {
     pub models: Vec<CarreauFiber>,
     /// Relative measurement uncertainty from the data set, if given.
     pub relative_uncertainty: Option<f64>,
+    /// The model: law, effects, neutral candidates.
+    pub spec: ModelSpec,
 }
 
 impl Rheometer {
-    /// Smooths every experiment's data and builds its model. Experiments without measurements
-    /// are an error (the rheometer needs data for each).
+    /// Smooths every experiment's data and builds its model (the paper's: Carreau-type law,
+    /// no extra effects). Experiments without measurements are an error (the rheometer needs
+    /// data for each).
     pub fn new(set: &ExperimentSet) -> Result<Self, RheometerError> {
+        Self::with_spec(set, ModelSpec::default())
+    }
+
+    /// As [`new`](Self::new) with the model `spec` (law, effects fitted or fixed, neutral
+    /// candidates).
+    pub fn with_spec(set: &ExperimentSet, spec: ModelSpec) -> Result<Self, RheometerError> {
+        spec.validate().map_err(RheometerError::Data)?;
         if set.experiments.is_empty() {
             return Err(RheometerError::Data(
                 "the data set has no experiments".into(),
@@ -158,7 +170,7 @@ impl Rheometer {
                 &set.air,
                 &e,
                 CarreauLike::new(),
-                Physics::paper(),
+                spec.physics(),
             )
             .map_err(|source| RheometerError::Simulation {
                 experiment: e.name.clone(),
@@ -179,6 +191,7 @@ impl Rheometer {
             smoothing,
             models,
             relative_uncertainty: set.relative_uncertainty,
+            spec,
         })
     }
 
@@ -198,6 +211,15 @@ impl Rheometer {
         start: [f64; 2],
         options: &IdentifyOptions,
     ) -> Result<Objective<'_>, RheometerError> {
+        Objective::new(self, &FitStart::at(start), options)
+    }
+
+    /// An objective for a general start (free candidates, start strengths, warm starts).
+    pub fn objective_from(
+        &self,
+        start: &FitStart,
+        options: &IdentifyOptions,
+    ) -> Result<Objective<'_>, RheometerError> {
         Objective::new(self, start, options)
     }
 
@@ -207,9 +229,18 @@ impl Rheometer {
         start: [f64; 2],
         options: &IdentifyOptions,
     ) -> Result<Identification, RheometerError> {
+        self.identify_from(&FitStart::at(start), options)
+    }
+
+    /// Runs the identification from a general start.
+    pub fn identify_from(
+        &self,
+        start: &FitStart,
+        options: &IdentifyOptions,
+    ) -> Result<Identification, RheometerError> {
         let t0 = Instant::now();
-        let mut obj = self.objective(start, options)?;
-        let p0 = obj.initial_parameters(start);
+        let mut obj = self.objective_from(start, options)?;
+        let p0 = obj.initial_parameters();
         let (lower, upper) = obj.bounds();
         let fo = FitOptions {
             initial_radius: 0.3,
@@ -220,16 +251,25 @@ impl Rheometer {
         let fit_result = fit(&mut obj, &p0, &fo)?;
         let solutions: Vec<Solution> = obj.runs.iter().map(|r| r.accepted.clone()).collect();
         let rms = self.rms_relative_residual(&solutions);
+        let ns = obj.layout.num_shared();
+        let local = obj.layout.local(
+            &fit_result.p[..ns],
+            1.0,
+            self.models[0].take_up_factor_index(),
+        );
         Ok(Identification {
             estimator: options.estimator,
-            start,
-            n: fit_result.p[0],
-            kappa: fit_result.p[1],
+            start: start.law,
+            n: local[1],
+            kappa: local[2],
             take_up_factors: if options.estimator == Estimator::Principled {
-                fit_result.p[2..].to_vec()
+                fit_result.p[ns..].to_vec()
             } else {
                 vec![1.0; self.len()]
             },
+            names: obj.layout.names.clone(),
+            effects: obj.layout.effects.clone(),
+            local_params: local,
             rms_relative_residual: rms,
             solutions,
             fit: fit_result,
@@ -317,6 +357,13 @@ pub struct Identification {
     pub kappa: f64,
     /// Take-up factors `φ_k = d_out,k / d_fit,k(L)` (all 1 for the paper's estimator).
     pub take_up_factors: Vec<f64>,
+    /// Names of the shared fitted parameters (the first entries of `fit.p`; the take-up factors
+    /// follow).
+    pub names: Vec<String>,
+    /// The model's effects (fixed or fitted) and where their strengths sit.
+    pub effects: Vec<EffectSlot>,
+    /// The fitted local model parameters `[c, n, κ, strengths..., φ = 1]`.
+    pub local_params: Vec<f64>,
     /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements [-].
     pub rms_relative_residual: f64,
     /// Final fiber solutions, one per experiment.
@@ -346,26 +393,27 @@ pub struct Objective<'a> {
     runs: Vec<Run<'a>>,
     options: IdentifyOptions,
     sigma: f64,
-}
-
-fn local_params(
-    model: &CarreauFiber,
-    n: f64,
-    kappa: f64,
-    phi: f64,
-) -> Result<Vec<f64>, FiberError> {
-    let mut p = model.parameters(1.0, &[n, kappa])?;
-    let i = model.take_up_factor_index();
-    p[i] = phi;
-    Ok(p)
+    layout: Layout,
 }
 
 impl<'a> Objective<'a> {
     fn new(
         rheo: &'a Rheometer,
-        start: [f64; 2],
+        fit_start: &FitStart,
         options: &IdentifyOptions,
     ) -> Result<Self, RheometerError> {
+        let start = fit_start.law;
+        let layout = Layout::new(&rheo.models[0], &rheo.spec, fit_start, options)?;
+        if let Some(w) = &fit_start.warm {
+            if w.len() != rheo.len() {
+                return Err(RheometerError::Data(format!(
+                    "{} warm-start solutions for {} experiments",
+                    w.len(),
+                    rheo.len()
+                )));
+            }
+        }
+        let shared0 = layout.shared_start();
         if options.n_opt_points < 1 {
             return Err(RheometerError::Data(
                 "n_opt_points must be at least 1".into(),
@@ -380,16 +428,10 @@ impl<'a> Objective<'a> {
             .par_iter()
             .enumerate()
             .map(|(k, model)| {
-                let p = local_params(model, start[0], start[1], 1.0).map_err(|source| {
-                    RheometerError::Simulation {
-                        experiment: rheo.experiments[k].name.clone(),
-                        n: start[0],
-                        kappa: start[1],
-                        source,
-                    }
-                })?;
+                let p = layout.local(&shared0, 1.0, model.take_up_factor_index());
+                let warm = fit_start.warm.as_ref().map(|w| &w[k]);
                 let sol =
-                    simulate_params(model, &p, None, &options.simulate).map_err(|source| {
+                    simulate_params(model, &p, warm, &options.simulate).map_err(|source| {
                         RheometerError::Simulation {
                             experiment: rheo.experiments[k].name.clone(),
                             n: start[0],
@@ -439,20 +481,34 @@ impl<'a> Objective<'a> {
             runs: runs?,
             options: options.clone(),
             sigma,
+            layout,
         })
     }
 
-    fn initial_parameters(&self, start: [f64; 2]) -> Vec<f64> {
-        let mut p = start.to_vec();
+    /// The parameter layout of this objective.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    fn initial_parameters(&self) -> Vec<f64> {
+        let mut p = self.layout.shared_start();
         if self.estimator == Estimator::Principled {
             p.extend(std::iter::repeat_n(1.0, self.runs.len()));
         }
         p
     }
 
+    /// Global parameters at `(n, κ)` (overriding the template's law values), strengths at their
+    /// start values, take-up factors 1.
+    fn global_at(&mut self, n: f64, kappa: f64) -> Vec<f64> {
+        self.layout.template[1] = n;
+        self.layout.template[2] = kappa;
+        self.initial_parameters()
+    }
+
     fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
-        let mut lo = self.options.lower.to_vec();
-        let mut hi = self.options.upper.to_vec();
+        let mut lo = self.layout.lower.clone();
+        let mut hi = self.layout.upper.clone();
         if self.estimator == Estimator::Principled {
             lo.extend(std::iter::repeat_n(
                 self.options.take_up_bounds[0],
@@ -474,7 +530,10 @@ impl<'a> Objective<'a> {
         with_jacobian: bool,
     ) -> Result<(Vec<f64>, Vec<f64>), RheometerError> {
         let np = p.len();
-        let (n, kappa) = (p[0], p[1]);
+        let ns = self.layout.num_shared();
+        let layout = &self.layout;
+        let probe = layout.local(&p[..ns], 1.0, layout.template.len() - 1);
+        let (n, kappa) = (probe[1], probe[2]);
         let estimator = self.estimator;
         let sigma = self.sigma;
         let parts: Result<Vec<ResidualsAndJacobian>, RheometerError> = self
@@ -483,7 +542,7 @@ impl<'a> Objective<'a> {
             .enumerate()
             .map(|(k, run)| {
                 let phi = if estimator == Estimator::Principled {
-                    p[2 + k]
+                    p[ns + k]
                 } else {
                     1.0
                 };
@@ -493,7 +552,7 @@ impl<'a> Objective<'a> {
                     kappa,
                     source,
                 };
-                let lp = local_params(run.model, n, kappa, phi).map_err(err)?;
+                let lp = layout.local(&p[..ns], phi, run.model.take_up_factor_index());
                 let sol = run
                     .solver
                     .solve(&lp, &Guess::from(&run.accepted))
@@ -556,10 +615,11 @@ impl<'a> Objective<'a> {
                 if with_jacobian {
                     jg = vec![0.0; r.len() * np];
                     for i in 0..r.len() {
-                        jg[i * np] = jl[i * q + 1];
-                        jg[i * np + 1] = jl[i * q + 2];
+                        for (c, &li) in layout.free.iter().enumerate() {
+                            jg[i * np + c] = jl[i * q + li];
+                        }
                         if estimator == Estimator::Principled {
-                            jg[i * np + 2 + k] = jl[i * q + phi_idx];
+                            jg[i * np + ns + k] = jl[i * q + phi_idx];
                         }
                     }
                 }
@@ -580,27 +640,19 @@ impl<'a> Objective<'a> {
     /// The cost `J = Σ r²` at `(n, κ)` with take-up factors 1, accepting the solutions as new
     /// warm starts (falls back to a cold start for experiments whose warm solve fails).
     pub fn cost_at(&mut self, n: f64, kappa: f64) -> Result<f64, RheometerError> {
-        let mut p = vec![n, kappa];
-        if self.estimator == Estimator::Principled {
-            p.extend(std::iter::repeat_n(1.0, self.runs.len()));
-        }
+        let p = self.global_at(n, kappa);
         let r = match self.eval(&p, false) {
             Ok((r, _)) => r,
             Err(_) => {
                 // cold starts
                 let opts = self.options.simulate.clone();
+                let layout = &self.layout;
+                let ns = layout.num_shared();
                 let res: Result<Vec<()>, RheometerError> = self
                     .runs
                     .par_iter_mut()
                     .map(|run| {
-                        let lp = local_params(run.model, n, kappa, 1.0).map_err(|source| {
-                            RheometerError::Simulation {
-                                experiment: run.name.clone(),
-                                n,
-                                kappa,
-                                source,
-                            }
-                        })?;
+                        let lp = layout.local(&p[..ns], 1.0, run.model.take_up_factor_index());
                         let sol =
                             simulate_params(run.model, &lp, None, &opts).map_err(|source| {
                                 RheometerError::Simulation {
@@ -625,10 +677,7 @@ impl<'a> Objective<'a> {
     /// Cost at `(n, κ)` from the current warm starts only (no cold-start fallback); on success
     /// the solutions become the new warm starts.
     pub fn try_cost_at(&mut self, n: f64, kappa: f64) -> Result<f64, RheometerError> {
-        let mut p = vec![n, kappa];
-        if self.estimator == Estimator::Principled {
-            p.extend(std::iter::repeat_n(1.0, self.runs.len()));
-        }
+        let p = self.global_at(n, kappa);
         let (r, _) = self.eval(&p, false)?;
         self.accept_pending();
         Ok(r.iter().map(|v| v * v).sum())
@@ -672,8 +721,8 @@ impl LeastSquaresProblem for Objective<'_> {
     type Error = RheometerError;
     fn num_params(&self) -> usize {
         match self.estimator {
-            Estimator::Paper => 2,
-            Estimator::Principled => 2 + self.runs.len(),
+            Estimator::Paper => self.layout.num_shared(),
+            Estimator::Principled => self.layout.num_shared() + self.runs.len(),
         }
     }
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), RheometerError> {

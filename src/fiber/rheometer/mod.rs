@@ -13,9 +13,11 @@
 pub mod estimator;
 pub mod identify;
 pub mod landscape;
+pub mod layout;
 pub mod report;
 
 pub use estimator::Estimator;
 pub use identify::{Identification, IdentifyOptions, Rheometer, RheometerError, StartPoint};
 pub use landscape::Landscape;
-pub use report::FitReport;
+pub use layout::{EffectSlot, FitStart, Layout};
+pub use report::{EffectReport, FitReport};

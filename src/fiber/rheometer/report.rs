@@ -53,6 +53,26 @@ pub struct FitReport {
     pub wall_time_s: f64,
     /// Why the fit stopped.
     pub termination: String,
+    /// The model's extra effects with their strengths (empty for the paper's model).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub effects: Vec<EffectReport>,
+}
+
+/// An effect's strength in a fit report.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EffectReport {
+    /// Canonical name (e.g. `"radiation"`).
+    pub effect: String,
+    /// Strength (in the effect's unit, see `unit`).
+    pub strength: f64,
+    /// Its standard error (`0` if fixed).
+    pub stderr_strength: f64,
+    /// 95% confidence interval.
+    pub ci95_strength: [f64; 2],
+    /// Unit of the strength.
+    pub unit: String,
+    /// Whether it was fitted (else fixed).
+    pub fitted: bool,
 }
 
 impl FitReport {
@@ -62,9 +82,33 @@ impl FitReport {
             .fit
             .standard_errors()
             .unwrap_or_else(|| vec![f64::NAN; id.fit.p.len()]);
-        let corr = id.fit.correlation().map(|c| c[1]).unwrap_or(f64::NAN);
-        let (sn, sk) = (se[0], se[1]);
+        let np = id.fit.p.len();
+        let col = |name: &str| id.names.iter().position(|n| n == name);
+        let (ni, ki) = (col("n"), col("kappa"));
+        let corr = match (ni, ki, id.fit.correlation()) {
+            (Some(a), Some(b), Some(c)) => c[a * np + b],
+            _ => f64::NAN,
+        };
+        let sn = ni.map_or(f64::NAN, |i| se[i]);
+        let sk = ki.map_or(f64::NAN, |i| se[i]);
         let z = 1.96;
+        let effects = id
+            .effects
+            .iter()
+            .map(|slot| {
+                let e = &slot.effect;
+                let strength = e.strength_of(id.local_params[slot.local]);
+                let sd = slot.column.map_or(0.0, |c| se[c]);
+                EffectReport {
+                    effect: e.name().to_string(),
+                    strength,
+                    stderr_strength: sd,
+                    ci95_strength: [strength - z * sd, strength + z * sd],
+                    unit: e.unit().to_string(),
+                    fitted: slot.column.is_some(),
+                }
+            })
+            .collect();
         FitReport {
             estimator: id.estimator,
             start: id.start,
@@ -85,6 +129,7 @@ impl FitReport {
             failed_evaluations: id.fit.failed_evaluations,
             wall_time_s: id.wall_time_s,
             termination: id.fit.termination.to_string(),
+            effects,
         }
     }
 
@@ -150,6 +195,24 @@ impl FitReport {
                 "    take-up factors d_out/d_fit(L): [{}]\n",
                 f.join(", ")
             ));
+        }
+        for e in &self.effects {
+            if e.fitted {
+                s.push_str(&format!(
+                    "    {}: {:.5} +/- {:.5} {}  95% CI [{:.5}, {:.5}]\n",
+                    e.effect,
+                    e.strength,
+                    e.stderr_strength,
+                    e.unit,
+                    e.ci95_strength[0],
+                    e.ci95_strength[1]
+                ));
+            } else {
+                s.push_str(&format!(
+                    "    {}: {:.5} {} (fixed)\n",
+                    e.effect, e.strength, e.unit
+                ));
+            }
         }
         s.push_str("[[Correlations]]\n");
         s.push_str(&format!(

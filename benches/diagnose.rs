@@ -1,0 +1,25 @@
+//! A full `diagnose` (user's Carreau fit from the start heuristic, linearised scores of all six
+//! built-in candidates, refits of the top 3) on the 9 shipped experiments. Target: < 5 s median.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use diffbvp::fiber::diagnostics::candidates::ModelSpec;
+use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
+use diffbvp::fiber::input::load_experiments;
+use std::hint::black_box;
+use std::path::Path;
+
+fn full_diagnose(c: &mut Criterion) {
+    let set = load_experiments(Path::new("data/pmma7n_synthetic/experiments.toml")).unwrap();
+    let opts = DiagnoseOptions::default();
+    let spec = ModelSpec::default();
+    c.bench_function("diagnose_9_experiments", |b| {
+        b.iter(|| diagnose(black_box(&set), &spec, &opts).unwrap())
+    });
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10).measurement_time(std::time::Duration::from_secs(15));
+    targets = full_diagnose
+}
+criterion_main!(benches);

@@ -1,0 +1,218 @@
+//! Which model parameters a fit frees: the law's `(n, κ)`, effect strengths (see
+//! [`candidates`](crate::fiber::diagnostics::candidates)) and, for the principled estimator,
+//! one take-up factor per experiment.
+//!
+//! Every experiment's model has the same parameter layout
+//! `p = [c, n, κ, strengths..., φ]`; a fit's parameter vector is
+//! `[shared free parameters..., φ_1, ..., φ_M]`, the shared ones being `n, κ` (where the law is
+//! fitted) followed by the fitted strengths (in model-parameter units, e.g. `1 + s` for
+//! `nusselt_scale`).
+
+use super::identify::{CarreauFiber, IdentifyOptions, RheometerError};
+use crate::fiber::diagnostics::candidates::{
+    Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+};
+use crate::solution::Solution;
+
+/// Start of a fit.
+#[derive(Debug, Clone)]
+pub struct FitStart {
+    /// `(n, κ)` start (where fitted; a Newtonian model uses `n = 1`).
+    pub law: [f64; 2],
+    /// Candidates of the model whose strengths this fit frees (by effect name).
+    pub free_candidates: Vec<String>,
+    /// Start strengths by effect name (default: neutral).
+    pub strengths: Vec<(String, f64)>,
+    /// Warm-start solutions, one per experiment (default: cold starts).
+    pub warm: Option<Vec<Solution>>,
+}
+
+impl FitStart {
+    /// Start at `(n, κ)`, candidates not freed, cold starts.
+    pub fn at(law: [f64; 2]) -> Self {
+        FitStart {
+            law,
+            free_candidates: Vec::new(),
+            strengths: Vec::new(),
+            warm: None,
+        }
+    }
+
+    fn strength(&self, name: &str) -> Option<f64> {
+        self.strengths
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v)
+    }
+}
+
+/// Where an effect's strength sits.
+#[derive(Debug, Clone)]
+pub struct EffectSlot {
+    /// The effect.
+    pub effect: Effect,
+    /// Index of its model parameter in the local `p`.
+    pub local: usize,
+    /// Its column in the fit's parameter vector (`None` if fixed).
+    pub column: Option<usize>,
+}
+
+/// The parameter layout of one fit.
+#[derive(Debug, Clone)]
+pub struct Layout {
+    /// Local model parameters with the start (or fixed) values; `φ = 1`.
+    pub template: Vec<f64>,
+    /// Local indices of the shared free parameters, in fit order.
+    pub free: Vec<usize>,
+    /// Names of the shared free parameters (`"n"`, `"kappa"`, effect names).
+    pub names: Vec<String>,
+    /// Lower bounds of the shared free parameters (model-parameter units).
+    pub lower: Vec<f64>,
+    /// Upper bounds.
+    pub upper: Vec<f64>,
+    /// The effects of the model (fixed or fitted; neutral candidates not freed are left out).
+    pub effects: Vec<EffectSlot>,
+}
+
+impl Layout {
+    /// The layout for `spec` (the model `model` was built from) and `start`.
+    pub fn new(
+        model: &CarreauFiber,
+        spec: &ModelSpec,
+        start: &FitStart,
+        options: &IdentifyOptions,
+    ) -> Result<Self, RheometerError> {
+        spec.validate().map_err(RheometerError::Data)?;
+        let idx = |name: &str| {
+            model
+                .param_index(name)
+                .ok_or_else(|| RheometerError::Data(format!("the model has no parameter {name}")))
+        };
+        let mut template = model.parameters(1.0, &start.law).map_err(|e| {
+            RheometerError::Data(format!("start (n, kappa) = {:?}: {e}", start.law))
+        })?;
+        let (ni, ki) = (1, 2);
+        let (mut n_free, mut k_free) = (spec.law == LawChoice::Carreau, false);
+        if spec.law == LawChoice::Newtonian {
+            template[ni] = 1.0;
+            template[ki] = STRAIN_THINNING_REFERENCE_KAPPA;
+        }
+        let mut free = Vec::new();
+        let mut names = Vec::new();
+        let (mut lower, mut upper) = (Vec::new(), Vec::new());
+        let mut effects = Vec::new();
+        let mut st_free = false;
+        let settings = spec.effects.iter().map(|s| (&s.effect, s.value)).chain(
+            spec.candidates
+                .iter()
+                .filter(|c| start.free_candidates.iter().any(|n| n == c.name()))
+                .map(|c| (c, None)),
+        );
+        for (e, value) in settings {
+            if let Effect::StrainThinning = e {
+                match value {
+                    Some(v) => template[ni] = e.param_value(v),
+                    None => {
+                        n_free = true;
+                        st_free = true;
+                        let s = start.strength(e.name()).unwrap_or(1.0 - start.law[0]);
+                        template[ni] = e.param_value(s).clamp(options.lower[0], options.upper[0]);
+                        template[ki] = start.law[1];
+                    }
+                }
+                k_free = true;
+                effects.push(EffectSlot {
+                    effect: e.clone(),
+                    local: ni,
+                    column: None,
+                });
+                continue;
+            }
+            let li = idx(e.model_param())?;
+            match value {
+                Some(v) => {
+                    template[li] = e.param_value(v);
+                    effects.push(EffectSlot {
+                        effect: e.clone(),
+                        local: li,
+                        column: None,
+                    });
+                }
+                None => {
+                    let s = start.strength(e.name()).unwrap_or(e.neutral());
+                    template[li] = e.param_value(s);
+                    let (lo, hi) = e.bounds();
+                    let (a, b) = (e.param_value(lo), e.param_value(hi));
+                    effects.push(EffectSlot {
+                        effect: e.clone(),
+                        local: li,
+                        column: Some(free.len()),
+                    });
+                    free.push(li);
+                    names.push(e.name().to_string());
+                    lower.push(a.min(b));
+                    upper.push(a.max(b));
+                }
+            }
+        }
+        if spec.law == LawChoice::Carreau {
+            k_free = true;
+        }
+        // the law's parameters go first
+        let mut head = Vec::new();
+        if n_free {
+            head.push((ni, "n", options.lower[0], options.upper[0]));
+        }
+        if k_free {
+            head.push((ki, "kappa", options.lower[1], options.upper[1]));
+        }
+        let shift = head.len();
+        for slot in &mut effects {
+            if let Some(c) = slot.column.as_mut() {
+                *c += shift;
+            }
+            if st_free && matches!(slot.effect, Effect::StrainThinning) {
+                slot.column = Some(0);
+            }
+        }
+        let mut f2: Vec<usize> = head.iter().map(|h| h.0).collect();
+        let mut n2: Vec<String> = head.iter().map(|h| h.1.to_string()).collect();
+        let mut l2: Vec<f64> = head.iter().map(|h| h.2).collect();
+        let mut u2: Vec<f64> = head.iter().map(|h| h.3).collect();
+        f2.extend(free);
+        n2.extend(names);
+        l2.extend(lower);
+        u2.extend(upper);
+        for (i, &li) in f2.iter().enumerate() {
+            template[li] = template[li].clamp(l2[i], u2[i]);
+        }
+        Ok(Layout {
+            template,
+            free: f2,
+            names: n2,
+            lower: l2,
+            upper: u2,
+            effects,
+        })
+    }
+
+    /// Number of shared free parameters.
+    pub fn num_shared(&self) -> usize {
+        self.free.len()
+    }
+
+    /// The shared free values of the template.
+    pub fn shared_start(&self) -> Vec<f64> {
+        self.free.iter().map(|&i| self.template[i]).collect()
+    }
+
+    /// The local parameters for shared values `shared` and take-up factor `phi`.
+    pub fn local(&self, shared: &[f64], phi: f64, phi_index: usize) -> Vec<f64> {
+        let mut p = self.template.clone();
+        for (&i, &v) in self.free.iter().zip(shared) {
+            p[i] = v;
+        }
+        p[phi_index] = phi;
+        p
+    }
+}

@@ -1,0 +1,163 @@
+//! Candidate effects: neutral strengths reproduce the base model exactly, dual-number
+//! derivatives with respect to a strength agree with finite differences, CLI parsing.
+
+use diffbvp::fiber::diagnostics::candidates::{
+    Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+};
+use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use diffbvp::fiber::simulate::simulate_params;
+use diffbvp::fiber::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
+use diffbvp::sensitivity::Sensitivities;
+use diffbvp::DualNum;
+
+fn experiment() -> Experiment {
+    Experiment {
+        name: "v0p53_p2".into(),
+        mass_flow: 3.08e-5,
+        inlet: Inlet::Diameter(1.134e-3),
+        inlet_temperature: 513.15,
+        air_temperature: 293.15,
+        spinline_length: 0.51,
+        take_up: Some(TakeUp::Diameter(9e-5)),
+    }
+}
+
+/// A user-written effect: natural convection near the nozzle, a heat loss
+/// `−h π d (T − T_air) exp(−s/0.03 m)` with `h` = 10 W/(m² K) at unit strength.
+#[derive(Clone)]
+struct NozzleConvection;
+
+impl FiberTerm for NozzleConvection {
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, st: &SiState<D>) -> D {
+        -(st.temperature - st.air_temperature)
+            * st.diameter
+            * (10.0 * std::f64::consts::PI * (-st.s / 0.03).exp())
+    }
+}
+
+fn all_effects() -> Vec<Effect> {
+    let mut v = Effect::builtin();
+    v.push(Effect::custom(
+        "nozzle_convection",
+        Balance::Energy,
+        NozzleConvection,
+    ));
+    v
+}
+
+fn model(spec: &ModelSpec) -> FiberModel<CarreauLike> {
+    FiberModel::new(
+        &Material::pmma7n(),
+        &Air::paper(),
+        &experiment(),
+        CarreauLike::new(),
+        spec.physics(),
+    )
+    .unwrap()
+}
+
+fn opts() -> SimulateOptions {
+    SimulateOptions {
+        tol: 1e-8,
+        factor_at_solution: true,
+        ..SimulateOptions::default()
+    }
+}
+
+fn diameters(m: &FiberModel<CarreauLike>, sol: &diffbvp::Solution, xs: &[f64]) -> Vec<f64> {
+    xs.iter()
+        .map(|&x| {
+            let y = sol.eval(x);
+            m.diameter(y[0], m.density(y[2]))
+        })
+        .collect()
+}
+
+#[test]
+fn neutral_strengths_reproduce_the_base_model_exactly() {
+    let base = model(&ModelSpec::default());
+    let p0 = base.parameters(1.0, &[0.8, 11.71]).unwrap();
+    let s0 = simulate_params(&base, &p0, None, &opts()).unwrap().solution;
+    let xs: Vec<f64> = (0..=50).map(|i| base.length() * i as f64 / 50.0).collect();
+    let d0 = diameters(&base, &s0, &xs);
+    let spec = ModelSpec::default().with_candidates(&all_effects());
+    let m = model(&spec);
+    assert_eq!(m.physics.num_strength_params(), 6, "{:?}", m.param_names());
+    let p = m.parameters(1.0, &[0.8, 11.71]).unwrap();
+    let s = simulate_params(&m, &p, None, &opts()).unwrap().solution;
+    assert_eq!(s.x.len(), s0.x.len());
+    let d = diameters(&m, &s, &xs);
+    for (a, b) in d.iter().zip(&d0) {
+        assert!((a / b - 1.0).abs() <= 1e-14, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn strength_derivatives_match_finite_differences() {
+    // Newtonian base so that strain_thinning is a candidate (derivative wrt n at n = 1)
+    let spec = ModelSpec::new(LawChoice::Newtonian).with_candidates(&all_effects());
+    let m = model(&spec);
+    let p = m
+        .parameters(1.0, &[1.0, STRAIN_THINNING_REFERENCE_KAPPA])
+        .unwrap();
+    let s = simulate_params(&m, &p, None, &opts()).unwrap().solution;
+    let sens = Sensitivities::compute(&m, &s).unwrap();
+    let xs: Vec<f64> = (1..=10).map(|i| m.length() * i as f64 / 10.0).collect();
+    // relative steps in strength units
+    let steps = [
+        ("strain_thinning", 1e-3),
+        ("radiation", 1e-3),
+        ("air_coflow", 1e-3),
+        ("air_temperature_profile", 1e-2),
+        ("inlet_velocity", 1e-4),
+        ("nusselt_scale", 1e-4),
+        ("nozzle_convection", 1e-3),
+    ];
+    for e in all_effects() {
+        let h = steps.iter().find(|s| s.0 == e.name()).unwrap().1;
+        let j = m.param_index(e.model_param()).unwrap();
+        let per = e.param_per_strength();
+        let solve_at = |sv: f64| {
+            let mut q = p.clone();
+            q[j] = e.param_value(sv);
+            let sol = simulate_params(&m, &q, Some(&s), &opts()).unwrap().solution;
+            xs.iter().map(|&x| sol.eval(x)[0]).collect::<Vec<f64>>()
+        };
+        let (up, dn) = (solve_at(h), solve_at(-h));
+        let scale = xs
+            .iter()
+            .map(|&x| (sens.at(x)[j] * per).abs())
+            .fold(0.0, f64::max);
+        assert!(scale > 0.0, "{}: zero sensitivity", e.name());
+        for (i, &x) in xs.iter().enumerate() {
+            // ∂u/∂strength (row 0 of the n × q block)
+            let exact = sens.at(x)[j] * per;
+            let fd = (up[i] - dn[i]) / (2.0 * h);
+            assert!(
+                (exact - fd).abs() <= 2e-3 * scale,
+                "{} at x = {x}: dual {exact} vs FD {fd} (scale {scale})",
+                e.name()
+            );
+        }
+    }
+}
+
+#[test]
+fn settings_parse_names_and_values() {
+    for name in diffbvp::fiber::diagnostics::candidates::BUILTIN_NAMES {
+        let s: EffectSetting = name.parse().unwrap();
+        assert_eq!(s.effect.name(), name);
+        assert!(s.value.is_none());
+    }
+    let s: EffectSetting = "radiation=0.9".parse().unwrap();
+    assert_eq!(s.value, Some(0.9));
+    assert!("radiation=abc".parse::<EffectSetting>().is_err());
+    assert!("radiation=7".parse::<EffectSetting>().is_err());
+    let e = "magnetism".parse::<EffectSetting>().unwrap_err();
+    assert!(e.contains("air_coflow"), "{e}");
+    assert!("carreau".parse::<LawChoice>().is_ok());
+    let bad = ModelSpec::new(LawChoice::Carreau)
+        .with(EffectSetting::fitted(Effect::StrainThinning))
+        .validate();
+    assert!(bad.is_err());
+}
