@@ -3,7 +3,7 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use diffbvp::fiber::diagnostics::candidates::{
-    EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+    Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
 };
 use diffbvp::fiber::diagnostics::compare::{
     compare, simulate_experiments, CompareOptions, FigureFormat, FitParameters, MissingTakeUp,
@@ -17,11 +17,21 @@ use diffbvp::fiber::output::{create_dir, ensure_not_input, profiles_csv, write_t
 use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
 use diffbvp::fiber::setup::TakeUp;
 use diffbvp::fiber::smoothing::smooth;
-use diffbvp::fiber::{simulate, CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions};
+use diffbvp::fiber::{
+    simulate, CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions, Strength,
+};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// `println!` that ignores a closed stdout (e.g. `rheometer ... | head`) instead of panicking.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
 
 #[derive(Parser)]
 #[command(
@@ -221,6 +231,11 @@ Writes DIR/landscape.csv with the columns n,kappa,cost and the heat map DIR/land
         /// none (implied by --fit, which was fitted that way).
         #[arg(long)]
         take_up_from_data: bool,
+        /// An effect in the model with its strength, "EFFECT=VALUE" (repeatable; "EFFECT" alone
+        /// takes the strength from --fit): radiation, air_coflow, air_temperature_profile,
+        /// inlet_velocity, nusselt_scale. Effects in the fit file are included automatically.
+        #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
+        with: Vec<EffectSetting>,
         /// Relative measurement uncertainty (overrides the TOML's relative_uncertainty; default:
         /// the TOML's, else estimated from the data).
         #[arg(long)]
@@ -311,6 +326,36 @@ fn profiles_of(rh: &Rheometer, sols: &[diffbvp::Solution]) -> ResidualProfiles {
 
 fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
     diffbvp::mesh::linspace(a, b, m)
+}
+
+/// The effects of a compared model: those of the fit file, overridden or extended by `--with`.
+fn compare_effects(
+    fit: Option<&FitParameters>,
+    with: &[EffectSetting],
+) -> Result<Vec<(Effect, f64)>, Box<dyn Error>> {
+    let mut out: Vec<(Effect, f64)> = Vec::new();
+    if let Some(f) = fit {
+        for e in &f.effects {
+            let effect: Effect = e.effect.parse()?;
+            out.push((effect, e.strength));
+        }
+    }
+    for w in with {
+        let name = w.effect.name();
+        let value = match (w.value, out.iter().find(|(e, _)| e.name() == name)) {
+            (Some(v), _) => v,
+            (None, Some((_, v))) => *v,
+            (None, None) => {
+                return Err(format!(
+                "--with {name}: give its strength as --with {name}=VALUE (the fit file has none)"
+            )
+                .into())
+            }
+        };
+        out.retain(|(e, _)| e.name() != name);
+        out.push((w.effect.clone(), value));
+    }
+    Ok(out)
 }
 
 fn read_fit(path: &Path) -> Result<FitParameters, Box<dyn Error>> {
@@ -467,7 +512,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             if newtonian {
                 let mut obj = rh.objective([1.0, 20.0], &opts)?;
                 let j = obj.cost_at(1.0, 20.0)?;
-                println!(
+                outln!(
                     "Newtonian model (n = 1): cost J = {j:.6e} ({} estimator)",
                     opts.estimator.name()
                 );
@@ -487,7 +532,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             };
             let id = rh.identify(start, &opts)?;
             let rep = FitReport::new(&id);
-            println!("{}", rep.to_text());
+            outln!("{}", rep.to_text());
             let text = serde_json::to_string_pretty(&rep)?;
             if let Some(path) = json {
                 write_json(&path, &text, &inputs)?;
@@ -511,7 +556,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                     let after = profiles_of(&rh, &id.solutions);
                     let fig = dir.join("residuals_before_after.png");
                     save_residual_figure(&fig, &before, Some((&label, &after)))?;
-                    println!(
+                    outln!(
                         "RMS relative residual: {:.4} % without {label}, {:.4} % with it ({})",
                         100.0 * id0.rms_relative_residual,
                         100.0 * id.rms_relative_residual,
@@ -572,7 +617,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             say("fitting your model and scoring the candidate effects...".into());
             let run = diagnose(&loaded.set, &spec, &opts)?;
             let text = run.diagnosis.to_text();
-            println!("{text}");
+            outln!("{text}");
             create_dir(&out)?;
             write_text(&out.join("diagnosis.txt"), &text, &inputs)?;
             let js = serde_json::to_string_pretty(&run.diagnosis)?;
@@ -633,7 +678,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             write_text(&path, &csv, &inputs)?;
             let mut markers = Vec::new();
             if let Some((n, k, c)) = l.minimum() {
-                println!("grid minimum: n = {n:.4}, kappa = {k:.4}, J = {c:.6e}");
+                outln!("grid minimum: n = {n:.4}, kappa = {k:.4}, J = {c:.6e}");
                 markers.push((n, k, "grid minimum".to_string()));
             }
             let fig = out.join(format!("landscape.{}", cli.format.ext()));
@@ -654,16 +699,30 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             newtonian,
             take_up_from_data,
             relative_uncertainty,
+            with,
             out,
         } => {
             let loaded = load_experiments_with(&experiments, 4)?;
             let inputs = inputs_of(&experiments, &loaded);
             let set = &loaded.set;
-            let physics = || Physics::paper();
+            let fit_params = fit.as_ref().map(|p| read_fit(p)).transpose()?;
+            let effects = compare_effects(fit_params.as_ref(), &with)?;
+            // validated once here; the closure below rebuilds the same physics per experiment
+            for (e, v) in &effects {
+                e.apply_at(Physics::paper(), *v)?;
+            }
+            let physics = || {
+                effects.iter().fold(Physics::paper(), |p, (e, v)| {
+                    e.apply(p)
+                        .strength(e.model_param(), Strength::Parameter(e.param_value(*v)))
+                })
+            };
+            for (e, v) in &effects {
+                say(format!("model includes {} = {v} {}", e.name(), e.unit()));
+            }
             let mut setup = ModelSetup::carreau([0.8, 11.71], &physics);
             let mut fitted = 0;
-            if let Some(path) = &fit {
-                let rep = read_fit(path)?;
+            if let (Some(path), Some(rep)) = (&fit, fit_params) {
                 rep.apply(
                     &mut setup,
                     set.experiments.len(),
@@ -705,7 +764,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 FormatArg::Svg => FigureFormat::Svg,
             };
             let written = cmp.write(&out, fmt, &inputs)?;
-            println!("{}", cmp.to_text());
+            outln!("{}", cmp.to_text());
             say(format!(
                 "compared {} experiments in {:.1} s; wrote {} files to {}",
                 set.experiments.len(),

@@ -261,6 +261,29 @@ impl Effect {
     }
 }
 
+impl Effect {
+    /// Adds the effect to `physics` at `strength` (in the effect's unit, see
+    /// [`unit`](Self::unit)) — e.g. a fitted strength from a fit report. Errors for
+    /// `strain_thinning`, which is not a term of the physics but the law's `n = 1 − strength`.
+    pub fn apply_at(&self, physics: Physics, strength: f64) -> Result<Physics, String> {
+        if matches!(self, Effect::StrainThinning) {
+            return Err(
+                "strain_thinning is the viscosity law's n = 1 - strength; set n instead".into(),
+            );
+        }
+        let (lo, hi) = self.bounds();
+        if !(strength.is_finite() && strength >= lo && strength <= hi) {
+            return Err(format!(
+                "{} = {strength} is outside its admissible range [{lo}, {hi}] {}",
+                self.name(),
+                self.unit()
+            ));
+        }
+        let par = Strength::Parameter(self.param_value(strength));
+        Ok(self.apply(physics).strength(self.model_param(), par))
+    }
+}
+
 impl FromStr for Effect {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {

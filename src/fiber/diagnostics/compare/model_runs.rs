@@ -176,6 +176,22 @@ pub struct FitParameters {
     /// Take-up factors `φ_k`, in the experiment order of the data set.
     #[serde(default)]
     pub take_up_factors: Vec<f64>,
+    /// The extra effects of the fitted model with their strengths (empty for the paper's
+    /// model).
+    #[serde(default)]
+    pub effects: Vec<FittedEffect>,
+}
+
+/// An effect of a fitted model as read from a fit report.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+pub struct FittedEffect {
+    /// Canonical name (e.g. `"radiation"`).
+    pub effect: String,
+    /// Strength in the effect's unit.
+    pub strength: f64,
+    /// Whether the strength was fitted (else fixed).
+    #[serde(default)]
+    pub fitted: bool,
 }
 
 impl FitParameters {
@@ -202,6 +218,7 @@ impl FitParameters {
             crate::fiber::rheometer::Estimator::Principled => 2 + self.take_up_factors.len(),
             crate::fiber::rheometer::Estimator::Paper => 2,
         }
+        .saturating_add(self.effects.iter().filter(|e| e.fitted).count())
     }
 
     /// Applies the fit to `setup`: law parameters, take-up factors (principled estimator;
