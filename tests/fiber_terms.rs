@@ -192,9 +192,13 @@ fn term_report_units_and_signs() {
 fn strength_parameters_extend_p_and_are_neutral_at_default() {
     let physics = Physics::paper().strength("convection", Strength::Parameter(1.0));
     let m = build(&experiment(), physics).unwrap();
-    assert_eq!(m.param_names(), vec!["c", "n", "kappa", "convection"]);
+    assert_eq!(
+        m.param_names(),
+        vec!["c", "n", "kappa", "convection", "take_up_factor"]
+    );
     let p = m.parameters(1.0, &[0.8, 11.71]).unwrap();
-    assert_eq!(p, vec![1.0, 0.8, 11.71, 1.0]);
+    assert_eq!(p, vec![1.0, 0.8, 11.71, 1.0, 1.0]);
+    assert_eq!(m.param_index("convection"), Some(3));
     let opts = SimulateOptions::with_tol(1e-8);
     let a = simulate_params(&m, &p, None, &opts).unwrap();
     let r = build(&experiment(), Physics::paper()).unwrap();

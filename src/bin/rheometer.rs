@@ -3,7 +3,7 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use diffbvp::fiber::diagnostics::candidates::{
-    Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+    physics_with, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
 };
 use diffbvp::fiber::diagnostics::compare::{
     compare, simulate_experiments, CompareOptions, FigureFormat, FitParameters, MissingTakeUp,
@@ -17,9 +17,7 @@ use diffbvp::fiber::output::{create_dir, ensure_not_input, profiles_csv, write_t
 use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
 use diffbvp::fiber::setup::TakeUp;
 use diffbvp::fiber::smoothing::smooth;
-use diffbvp::fiber::{
-    simulate, CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions, Strength,
-};
+use diffbvp::fiber::{simulate, CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -707,16 +705,9 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
             let set = &loaded.set;
             let fit_params = fit.as_ref().map(|p| read_fit(p)).transpose()?;
             let effects = compare_effects(fit_params.as_ref(), &with)?;
-            // validated once here; the closure below rebuilds the same physics per experiment
-            for (e, v) in &effects {
-                e.apply_at(Physics::paper(), *v)?;
-            }
-            let physics = || {
-                effects.iter().fold(Physics::paper(), |p, (e, v)| {
-                    e.apply(p)
-                        .strength(e.model_param(), Strength::Parameter(e.param_value(*v)))
-                })
-            };
+            // validated once here; the closure rebuilds the same physics per experiment
+            physics_with(&effects)?;
+            let physics = || physics_with(&effects).unwrap_or_else(|_| Physics::paper());
             for (e, v) in &effects {
                 say(format!("model includes {} = {v} {}", e.name(), e.unit()));
             }

@@ -284,6 +284,14 @@ impl Effect {
     }
 }
 
+/// The paper's physics plus `effects` at the given strengths (e.g. the effects of a fit
+/// report); errors name an effect whose strength is inadmissible.
+pub fn physics_with(effects: &[(Effect, f64)]) -> Result<Physics, String> {
+    effects
+        .iter()
+        .try_fold(Physics::paper(), |p, (e, v)| e.apply_at(p, *v))
+}
+
 impl FromStr for Effect {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
