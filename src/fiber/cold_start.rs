@@ -14,13 +14,13 @@ use crate::solve::{Guess, SolveOptions, Solver};
 /// Settings of the continuation in `c`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContinuationOptions {
-    /// First step `Δc` [-] (paper: 0.1).
+    /// First step `Δc` \[-\] (paper: 0.1).
     pub initial_step: f64,
-    /// Factor applied to `Δc` after a successful step [-].
+    /// Factor applied to `Δc` after a successful step \[-\].
     pub grow: f64,
-    /// Factor applied to `Δc` after a failed step [-].
+    /// Factor applied to `Δc` after a failed step \[-\].
     pub shrink: f64,
-    /// Smallest admissible step [-]; below it the continuation fails.
+    /// Smallest admissible step \[-\]; below it the continuation fails.
     pub min_step: f64,
     /// Tolerance of the intermediate solves (the larger of this and the final tolerance).
     pub intermediate_tol: f64,

@@ -31,9 +31,9 @@ pub const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
 /// Which balance a term enters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Balance {
-    /// A force per length [N/m] in the momentum balance.
+    /// A force per length \[N/m\] in the momentum balance.
     Momentum,
-    /// A heat gain per length [W/m] in the energy balance.
+    /// A heat gain per length \[W/m\] in the energy balance.
     Energy,
 }
 
@@ -62,7 +62,7 @@ impl Strength {
 /// [`prandtl_argument`](NusseltLaw::prandtl_argument) maps `Pr` to the value handed to
 /// [`nusselt`](NusseltLaw::nusselt) on every evaluation (default: `Pr` itself).
 pub trait NusseltLaw: Send + Sync {
-    /// Evaluates `𝒩` [-]; `pr_arg` is [`prandtl_argument`](NusseltLaw::prandtl_argument)`(Pr)`.
+    /// Evaluates `𝒩` \[-\]; `pr_arg` is [`prandtl_argument`](NusseltLaw::prandtl_argument)`(Pr)`.
     fn nusselt<D: DualNum<Primitive = f64> + Copy>(&self, re_tau: D, re_sq: D, pr_arg: f64) -> D;
 
     /// Preprocessing of the (constant) Prandtl number, done once per model.
@@ -85,7 +85,7 @@ pub trait NusseltLaw: Send + Sync {
     }
 }
 
-/// Extra inclination regularisation `ε_c` [-] with an air co-flow: the default Nusselt law's
+/// Extra inclination regularisation `ε_c` \[-\] with an air co-flow: the default Nusselt law's
 /// inclination factor becomes `1 − ½ Re_τ²/(Re² + ε_i² + ε_c² w²/(1 + w²))`,
 /// `w = v_air/`[`COFLOW_REGULARISATION_SPEED`]. Where the air overtakes the fiber the relative
 /// speed changes sign and the unregularised factor jumps from ½ to 1 and back within
@@ -95,7 +95,7 @@ pub trait NusseltLaw: Send + Sync {
 /// `≲ ε_c²/(2 Re²)` (0.1% at `Re = 1`).
 pub const COFLOW_INCLINATION_REGULARISATION: f64 = 0.05;
 
-/// Air speed scale [m/s] of the co-flow regularisation weight `w` (see
+/// Air speed scale \[m/s\] of the co-flow regularisation weight `w` (see
 /// [`COFLOW_INCLINATION_REGULARISATION`]).
 pub const COFLOW_REGULARISATION_SPEED: f64 = 0.01;
 
@@ -110,9 +110,9 @@ pub const COFLOW_REGULARISATION_SPEED: f64 = 0.01;
 /// `inclination_regularisation` (e.g. 0.05) smooths that layer (a documented modelling choice).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InclinedChurchillBernstein {
-    /// `ε_r` in `Re_ε = √(Re² + ε_r²)` [-].
+    /// `ε_r` in `Re_ε = √(Re² + ε_r²)` \[-\].
     pub re_regularisation: f64,
-    /// `ε_i` in the inclination factor [-].
+    /// `ε_i` in the inclination factor \[-\].
     pub inclination_regularisation: f64,
 }
 
@@ -162,27 +162,27 @@ impl NusseltLaw for InclinedChurchillBernstein {
 pub struct SiState<D> {
     /// Position `s` \[m\].
     pub s: f64,
-    /// Fiber speed `u` [m/s].
+    /// Fiber speed `u` \[m/s\].
     pub velocity: D,
     /// Axial force `N` \[N\].
     pub force: D,
     /// Fiber temperature `T` \[K\].
     pub temperature: D,
-    /// Strain rate `ε̇` [1/s].
+    /// Strain rate `ε̇` \[1/s\].
     pub strain_rate: D,
     /// Fiber diameter `d` \[m\].
     pub diameter: D,
-    /// Polymer density `ρ(T)` [kg/m³].
+    /// Polymer density `ρ(T)` \[kg/m³\].
     pub density: D,
     /// Polymer specific heat `c_p(T)` [J/(kg K)].
     pub heat_capacity: D,
     /// Air temperature at `s` \[K\].
     pub air_temperature: D,
-    /// Air speed along the fiber at `s` [m/s].
+    /// Air speed along the fiber at `s` \[m/s\].
     pub air_velocity: D,
 }
 
-/// A user contribution in SI: a force per length [N/m] (momentum) or heat gain per length [W/m]
+/// A user contribution in SI: a force per length \[N/m\] (momentum) or heat gain per length \[W/m\]
 /// (energy), written once generically. Register it with [`Physics::with_custom`].
 pub trait FiberTerm: Send + Sync {
     /// The term's value at the local state.
@@ -223,7 +223,7 @@ pub enum TermKind {
     ViscousHeating,
     /// Grey-body radiation `−π d ε σ (T⁴ − T_air⁴)`.
     Radiation {
-        /// Emissivity ε [-].
+        /// Emissivity ε \[-\].
         emissivity: f64,
     },
     /// A user term (SI), see [`FiberTerm`].
@@ -263,7 +263,7 @@ pub enum AirSpeed {
     Still,
     /// Aspirator co-flow `v_air(s) = strength · V exp(−(L − s)/ℓ)`.
     CoFlow {
-        /// `V` [m/s].
+        /// `V` \[m/s\].
         speed: f64,
         /// Decay length `ℓ` \[m\].
         length: f64,
@@ -299,9 +299,9 @@ pub struct Physics<H: NusseltLaw = InclinedChurchillBernstein> {
     pub air_speed: AirSpeed,
     /// Air temperature profile.
     pub air_temperature: AirTemperature,
-    /// Slenderness `δ` of the drag coefficient [-] (paper: 1e-3).
+    /// Slenderness `δ` of the drag coefficient \[-\] (paper: 1e-3).
     pub slenderness: f64,
-    /// Relative error `δ` [-] of the inlet velocity (die swell): the inlet condition becomes
+    /// Relative error `δ` \[-\] of the inlet velocity (die swell): the inlet condition becomes
     /// `u(0) = (1 + δ) u_in` (`Off` by default; `Parameter` makes `δ` a model parameter named
     /// `"inlet_velocity"`, neutral value 0).
     pub inlet_velocity: Strength,
@@ -346,13 +346,13 @@ impl<H: NusseltLaw> Physics<H> {
     }
 
     /// Makes the relative inlet-velocity error `δ` (`u(0) = (1 + δ) u_in`) a model parameter
-    /// named `"inlet_velocity"` with default value `error` [-].
+    /// named `"inlet_velocity"` with default value `error` \[-\].
     pub fn with_inlet_velocity_error(mut self, error: f64) -> Self {
         self.inlet_velocity = Strength::Parameter(error);
         self
     }
 
-    /// Adds grey-body radiation with emissivity `emissivity` [-] (term `"radiation"`).
+    /// Adds grey-body radiation with emissivity `emissivity` \[-\] (term `"radiation"`).
     pub fn with_radiation(mut self, emissivity: f64) -> Self {
         self.terms.push(Term {
             name: "radiation",
@@ -374,7 +374,7 @@ impl<H: NusseltLaw> Physics<H> {
         self
     }
 
-    /// Aspirator co-flow `v_air(s) = V exp(−(L − s)/ℓ)`, `speed` = V [m/s], `length` = ℓ \[m\].
+    /// Aspirator co-flow `v_air(s) = V exp(−(L − s)/ℓ)`, `speed` = V \[m/s\], `length` = ℓ \[m\].
     pub fn with_coflow(mut self, speed: f64, length: f64) -> Self {
         self.air_speed = AirSpeed::CoFlow {
             speed,
@@ -466,38 +466,38 @@ impl<H: NusseltLaw> Physics<H> {
 /// Dimensionless coefficients of the built-in terms, computed once from the scaling.
 #[derive(Debug, Clone, Copy)]
 pub struct Coefficients {
-    /// Dimensionless mass flow `Q̃` [-].
+    /// Dimensionless mass flow `Q̃` \[-\].
     pub q: f64,
-    /// `1/Fr²` [-].
+    /// `1/Fr²` \[-\].
     pub inv_fr2: f64,
-    /// Drag factor `(A_*/Re_*) r_τ,S ρ̃_* ν̃_*` [-].
+    /// Drag factor `(A_*/Re_*) r_τ,S ρ̃_* ν̃_*` \[-\].
     pub drag: f64,
-    /// Convection factor `π (St/Nu_*) λ̃_*` [-].
+    /// Convection factor `π (St/Nu_*) λ̃_*` \[-\].
     pub convection: f64,
     /// `Re_*/ν̃_*` [-]: the air Reynolds number is this times `d̃ ṽ_rel`.
     pub re_air: f64,
-    /// Prandtl number of the actual air [-].
+    /// Prandtl number of the actual air \[-\].
     pub pr: f64,
     /// The Nusselt law's preprocessed Prandtl argument ([`NusseltLaw::prandtl_argument`]).
     pub pr_arg: f64,
-    /// Eckert number [-].
+    /// Eckert number \[-\].
     pub ec: f64,
-    /// Radiation factor `π σ T_o³ d_o L_o/(c_p,o Q_o)` [-] (times ε).
+    /// Radiation factor `π σ T_o³ d_o L_o/(c_p,o Q_o)` \[-\] (times ε).
     pub radiation: f64,
-    /// Uniform air temperature `T̃_air` [-].
+    /// Uniform air temperature `T̃_air` \[-\].
     pub t_air: f64,
-    /// Dimensionless spin-line length `L̃` [-].
+    /// Dimensionless spin-line length `L̃` \[-\].
     pub length: f64,
     /// SI factors: `[u_o, N_o, T_o, u_o/L_o, d_o, ρ_o, c_p,o, L_o]`.
     pub si: [f64; 8],
-    /// `f_o` [N/m].
+    /// `f_o` \[N/m\].
     pub force_per_length: f64,
-    /// `h_o` [W/m].
+    /// `h_o` \[W/m\].
     pub heat_per_length: f64,
 }
 
 impl Coefficients {
-    /// Coefficients for `air`, mass flow `q_si` [kg/s], air temperature `t_air_si` \[K\] and
+    /// Coefficients for `air`, mass flow `q_si` \[kg/s\], air temperature `t_air_si` \[K\] and
     /// spin-line length `length_si` \[m\].
     pub fn new(
         scaling: &super::scaling::Scaling,
@@ -548,25 +548,25 @@ impl Coefficients {
 /// Local dimensionless state handed to the built-in terms.
 #[derive(Debug, Clone, Copy)]
 pub struct LocalState<D> {
-    /// Position `s̃` [-].
+    /// Position `s̃` \[-\].
     pub s: f64,
-    /// `ũ` [-].
+    /// `ũ` \[-\].
     pub u: D,
-    /// `Ñ` [-].
+    /// `Ñ` \[-\].
     pub n: D,
-    /// `T̃` [-].
+    /// `T̃` \[-\].
     pub t: D,
-    /// `ε̇̃` [-].
+    /// `ε̇̃` \[-\].
     pub rate: D,
-    /// `ρ̃(T̃)` [-].
+    /// `ρ̃(T̃)` \[-\].
     pub rho: D,
-    /// `c̃_p(T̃)` [-].
+    /// `c̃_p(T̃)` \[-\].
     pub cp: D,
-    /// `d̃ = 2√(Q̃/(π ρ̃ ũ))` [-].
+    /// `d̃ = 2√(Q̃/(π ρ̃ ũ))` \[-\].
     pub d: D,
-    /// `T̃_air(s̃)` [-].
+    /// `T̃_air(s̃)` \[-\].
     pub t_air: D,
-    /// `ṽ_air(s̃)` [-].
+    /// `ṽ_air(s̃)` \[-\].
     pub v_air: D,
 }
 

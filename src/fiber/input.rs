@@ -220,7 +220,7 @@ pub enum InputError {
 /// Descriptive information on an experiment that is not part of the model input.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ExperimentDetails {
-    /// Stencil velocity of the extruder [mm/s] (`stencil_velocity_mm_s`), if given.
+    /// Stencil velocity of the extruder \[mm/s\] (`stencil_velocity_mm_s`), if given.
     pub stencil_velocity_mm_s: Option<f64>,
     /// Take-up (aspirator) pressure \[bar\] (`take_up_pressure_bar`), if given.
     pub take_up_pressure_bar: Option<f64>,

@@ -23,13 +23,13 @@ pub const MAX_LAW_PARAMS: usize = 8;
 /// Inputs of a viscosity law at one point, dimensionless.
 #[derive(Debug, Clone, Copy)]
 pub struct LawInputs<D> {
-    /// Temperature `T̃ = T/T_o` [-].
+    /// Temperature `T̃ = T/T_o` \[-\].
     pub t: D,
-    /// Zero-rate elongational viscosity `μ̃_e0(T̃)` [-].
+    /// Zero-rate elongational viscosity `μ̃_e0(T̃)` \[-\].
     pub mu0: D,
-    /// Strain rate `ε̇̃` [-].
+    /// Strain rate `ε̇̃` \[-\].
     pub rate: D,
-    /// Deborah number `De` [-].
+    /// Deborah number `De` \[-\].
     pub de: f64,
 }
 
@@ -67,11 +67,11 @@ pub trait ViscosityLaw: Send + Sync {
 /// `μ̃_e0(T̃) = a exp(b/(T̃ − t_VF))` with `a = Tr μ_c/μ_o`, `b = B/T_o`, `t_VF = T_VF/T_o`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ZeroRateViscosity {
-    /// `Tr μ_c/μ_o` [-].
+    /// `Tr μ_c/μ_o` \[-\].
     pub a: f64,
-    /// `B/T_o` [-].
+    /// `B/T_o` \[-\].
     pub b: f64,
-    /// `T_VF/T_o` [-].
+    /// `T_VF/T_o` \[-\].
     pub t_vf: f64,
 }
 
@@ -147,12 +147,12 @@ impl ViscosityLaw for CarreauLike {
 }
 
 /// Carreau–Yasuda-type law with the same `K`: `μ_e = μ_e0 (1 + |w|^a)^((n−1)/a)`,
-/// `w = De μ_e0 ε̇/K̃`, parameters `p = (n, κ)`, fixed Yasuda exponent `a > 1` [-]
+/// `w = De μ_e0 ε̇/K̃`, parameters `p = (n, κ)`, fixed Yasuda exponent `a > 1` \[-\]
 /// (`a = 2` is [`CarreauLike`]). Monotone for `n ≥ 0`. `|w|^a` is evaluated as
 /// `exp(a/2 · ln w²)` away from `w = 0` and as exactly 0 (derivative 0, correct for `a > 1`) at it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CarreauYasuda {
-    /// Yasuda exponent `a > 1` [-].
+    /// Yasuda exponent `a > 1` \[-\].
     pub a: f64,
     /// Stress scale `K_o` \[Pa\] (1 Pa in the paper).
     pub stress_scale: f64,

@@ -39,14 +39,14 @@ use std::f64::consts::PI;
 pub enum DimensionlessTakeUp {
     /// `d̃(L) = c d̃_out + (1 − c) d̃_in`.
     Diameter {
-        /// `d̃_out` [-].
+        /// `d̃_out` \[-\].
         d_out: f64,
-        /// `d̃(ũ_in, ρ̃(T̃_in))` [-].
+        /// `d̃(ũ_in, ρ̃(T̃_in))` \[-\].
         d_in: f64,
     },
     /// `ũ(L) = c ũ_out + (1 − c) ũ_in`.
     Velocity {
-        /// `ũ_out` [-].
+        /// `ũ_out` \[-\].
         u_out: f64,
     },
 }
@@ -308,22 +308,22 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             .map_err(FiberError::InvalidInput)
     }
 
-    /// Dimensionless inlet speed `ũ_in` [-].
+    /// Dimensionless inlet speed `ũ_in` \[-\].
     pub fn inlet_velocity(&self) -> f64 {
         self.u_in
     }
 
-    /// Dimensionless inlet temperature `T̃_in` [-].
+    /// Dimensionless inlet temperature `T̃_in` \[-\].
     pub fn inlet_temperature(&self) -> f64 {
         self.t_in
     }
 
-    /// Dimensionless spin-line length `L̃` [-].
+    /// Dimensionless spin-line length `L̃` \[-\].
     pub fn length(&self) -> f64 {
         self.co.length
     }
 
-    /// Dimensionless mass flow `Q̃` [-].
+    /// Dimensionless mass flow `Q̃` \[-\].
     pub fn mass_flow(&self) -> f64 {
         self.co.q
     }
@@ -343,19 +343,19 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         &self.zero
     }
 
-    /// `ρ̃(T̃)` [-].
+    /// `ρ̃(T̃)` \[-\].
     #[inline]
     pub fn density<D: DualNum<Primitive = f64> + Copy>(&self, t: D) -> D {
         t * self.rho_a + self.rho_b
     }
 
-    /// `c̃_p(T̃)` [-].
+    /// `c̃_p(T̃)` \[-\].
     #[inline]
     pub fn heat_capacity<D: DualNum<Primitive = f64> + Copy>(&self, t: D) -> D {
         t * self.cp_a + self.cp_b
     }
 
-    /// `d̃(ũ, ρ̃) = 2√(Q̃/(π ρ̃ ũ))` [-].
+    /// `d̃(ũ, ρ̃) = 2√(Q̃/(π ρ̃ ũ))` \[-\].
     #[inline]
     pub fn diameter<D: DualNum<Primitive = f64> + Copy>(&self, u: D, rho: D) -> D {
         ((rho * u).recip() * (4.0 * self.co.q / PI)).sqrt()

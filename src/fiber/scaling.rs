@@ -15,33 +15,33 @@ use std::f64::consts::PI;
 /// Reference values `x_o` of the non-dimensionalisation, SI units. Defaults: paper Table 2.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReferenceValues {
-    /// Mass flow `Q_o` [kg/s].
+    /// Mass flow `Q_o` \[kg/s\].
     pub mass_flow: f64,
     /// Length `L_o = s_o` \[m\].
     pub length: f64,
-    /// Velocity `u_o` [m/s].
+    /// Velocity `u_o` \[m/s\].
     pub velocity: f64,
     /// Temperature `T_o` \[K\].
     pub temperature: f64,
-    /// Polymer density `ρ_o` [kg/m³].
+    /// Polymer density `ρ_o` \[kg/m³\].
     pub density: f64,
     /// Polymer specific heat capacity `c_p,o` [J/(kg K)].
     pub heat_capacity: f64,
-    /// Dynamic (elongational) viscosity `μ_o` [Pa s].
+    /// Dynamic (elongational) viscosity `μ_o` \[Pa s\].
     pub viscosity: f64,
     /// Heat-transfer coefficient `α_o` [W/(m² K)] (results do not depend on it).
     pub heat_transfer: f64,
-    /// Air density `ρ_*,o` [kg/m³].
+    /// Air density `ρ_*,o` \[kg/m³\].
     pub air_density: f64,
     /// Air specific heat capacity `c_p,*,o` [J/(kg K)].
     pub air_heat_capacity: f64,
-    /// Air kinematic viscosity `ν_*,o` [m²/s].
+    /// Air kinematic viscosity `ν_*,o` \[m²/s\].
     pub air_kinematic_viscosity: f64,
     /// Air heat conductivity `λ_*,o` [W/(m K)].
     pub air_heat_conductivity: f64,
     /// Stress scale `K_o` of the Carreau parameter `K` \[Pa\].
     pub stress: f64,
-    /// Gravitational acceleration `g` [m/s²] (a model constant, merged into `Fr`).
+    /// Gravitational acceleration `g` \[m/s²\] (a model constant, merged into `Fr`).
     pub gravity: f64,
 }
 
@@ -68,13 +68,13 @@ impl Default for ReferenceValues {
 }
 
 /// Regularised tangential Stokes resistance coefficient of a slender fiber
-/// `r_τ,S^δ = 2π/ln(4/δ) + (π/2)/ln²(4/δ)` [-] at slenderness `δ` [-] (Marheineke & Wegener 2011).
+/// `r_τ,S^δ = 2π/ln(4/δ) + (π/2)/ln²(4/δ)` \[-\] at slenderness `δ` \[-\] (Marheineke & Wegener 2011).
 pub fn stokes_tangential_resistance(delta: f64) -> f64 {
     let l = (4.0 / delta).ln();
     2.0 * PI / l + 0.5 * PI / (l * l)
 }
 
-/// Slenderness `δ = 1e-3` used by the paper for the drag coefficient [-].
+/// Slenderness `δ = 1e-3` used by the paper for the drag coefficient \[-\].
 pub const PAPER_SLENDERNESS: f64 = 1e-3;
 
 /// Reference values and the derived dimensionless numbers.
@@ -82,23 +82,23 @@ pub const PAPER_SLENDERNESS: f64 = 1e-3;
 pub struct Scaling {
     /// The reference values.
     pub reference: ReferenceValues,
-    /// Reynolds number `Re = ρ_o u_o L_o/μ_o` [-].
+    /// Reynolds number `Re = ρ_o u_o L_o/μ_o` \[-\].
     pub re: f64,
-    /// Froude number `Fr = u_o/√(g L_o)` [-].
+    /// Froude number `Fr = u_o/√(g L_o)` \[-\].
     pub fr: f64,
-    /// Eckert number `Ec = u_o²/(c_p,o T_o)` [-].
+    /// Eckert number `Ec = u_o²/(c_p,o T_o)` \[-\].
     pub ec: f64,
-    /// Stanton number `St = α_o d_o L_o/(c_p,o Q_o)` [-].
+    /// Stanton number `St = α_o d_o L_o/(c_p,o Q_o)` \[-\].
     pub st: f64,
-    /// Deborah number `De = λ_o u_o/L_o`, `λ_o = μ_o/K_o` [-].
+    /// Deborah number `De = λ_o u_o/L_o`, `λ_o = μ_o/K_o` \[-\].
     pub de: f64,
-    /// Air drag number `A_* = ρ_*,o d_o u_o²/f_o` [-].
+    /// Air drag number `A_* = ρ_*,o d_o u_o²/f_o` \[-\].
     pub a_star: f64,
-    /// Air Reynolds number `Re_* = d_o u_o/ν_*,o` [-].
+    /// Air Reynolds number `Re_* = d_o u_o/ν_*,o` \[-\].
     pub re_star: f64,
-    /// Nusselt number `Nu_* = α_o d_o/λ_*,o` [-].
+    /// Nusselt number `Nu_* = α_o d_o/λ_*,o` \[-\].
     pub nu_star: f64,
-    /// Prandtl number `Pr_* = c_p,*,o ρ_*,o ν_*,o/λ_*,o` [-].
+    /// Prandtl number `Pr_* = c_p,*,o ρ_*,o ν_*,o/λ_*,o` \[-\].
     pub pr_star: f64,
 }
 
@@ -154,33 +154,33 @@ impl Scaling {
         self.reference.mass_flow * self.reference.velocity
     }
 
-    /// Reference force per length `f_o = Q_o u_o/L_o` [N/m].
+    /// Reference force per length `f_o = Q_o u_o/L_o` \[N/m\].
     pub fn force_per_length(&self) -> f64 {
         self.force() / self.reference.length
     }
 
-    /// Reference heat flow per length `h_o = c_p,o Q_o T_o/L_o` [W/m].
+    /// Reference heat flow per length `h_o = c_p,o Q_o T_o/L_o` \[W/m\].
     pub fn heat_per_length(&self) -> f64 {
         let r = &self.reference;
         r.heat_capacity * r.mass_flow * r.temperature / r.length
     }
 
-    /// Reference strain rate `u_o/L_o` [1/s].
+    /// Reference strain rate `u_o/L_o` \[1/s\].
     pub fn strain_rate(&self) -> f64 {
         self.reference.velocity / self.reference.length
     }
 
-    /// `1/Fr²` [-], the gravity coefficient.
+    /// `1/Fr²` \[-\], the gravity coefficient.
     pub fn inv_fr2(&self) -> f64 {
         1.0 / (self.fr * self.fr)
     }
 
-    /// `St/Nu_*` [-], the coefficient of the convective heat loss (independent of `α_o`).
+    /// `St/Nu_*` \[-\], the coefficient of the convective heat loss (independent of `α_o`).
     pub fn st_over_nu(&self) -> f64 {
         self.st / self.nu_star
     }
 
-    /// Dimensionless air-drag factor `(A_*/Re_*) r_τ,S^δ` [-] for the reference air
+    /// Dimensionless air-drag factor `(A_*/Re_*) r_τ,S^δ` \[-\] for the reference air
     /// (`f̃_air = factor · ρ̃_* ν̃_* (ṽ_air − ũ)`).
     pub fn drag_factor(&self, delta: f64) -> f64 {
         self.a_star / self.re_star * stokes_tangential_resistance(delta)

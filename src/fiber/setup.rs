@@ -6,19 +6,19 @@
 pub struct Material {
     /// Slope `a_ρ` of the density line `ρ(T) = a_ρ T + b_ρ` [kg/(m³ K)].
     pub density_slope: f64,
-    /// Intercept `b_ρ` of the density line [kg/m³].
+    /// Intercept `b_ρ` of the density line \[kg/m³\].
     pub density_intercept: f64,
     /// Slope `a_cp` of the heat-capacity line `c_p(T) = a_cp T + b_cp` [J/(kg K²)].
     pub heat_capacity_slope: f64,
     /// Intercept `b_cp` of the heat-capacity line [J/(kg K)].
     pub heat_capacity_intercept: f64,
-    /// VFT prefactor `μ_c` of the zero-shear viscosity `μ_s0(T) = μ_c exp(B/(T - T_VF))` [Pa s].
+    /// VFT prefactor `μ_c` of the zero-shear viscosity `μ_s0(T) = μ_c exp(B/(T - T_VF))` \[Pa s\].
     pub vft_mu_c: f64,
     /// VFT activation temperature `B` (K).
     pub vft_b: f64,
     /// Vogel temperature `T_VF` (K).
     pub vft_t_vf: f64,
-    /// Trouton ratio `μ_e0/μ_s0` [-] (3 for generalized Newtonian fluids).
+    /// Trouton ratio `μ_e0/μ_s0` \[-\] (3 for generalized Newtonian fluids).
     pub trouton: f64,
 }
 
@@ -37,7 +37,7 @@ impl Material {
         }
     }
 
-    /// Density `ρ(T)` [kg/m³] at temperature `t` \[K\].
+    /// Density `ρ(T)` \[kg/m³\] at temperature `t` \[K\].
     pub fn density(&self, t: f64) -> f64 {
         self.density_slope * t + self.density_intercept
     }
@@ -47,7 +47,7 @@ impl Material {
         self.heat_capacity_slope * t + self.heat_capacity_intercept
     }
 
-    /// Zero-shear viscosity `μ_s0(T)` [Pa s] at temperature `t` \[K\].
+    /// Zero-shear viscosity `μ_s0(T)` \[Pa s\] at temperature `t` \[K\].
     pub fn zero_shear_viscosity(&self, t: f64) -> f64 {
         self.vft_mu_c * (self.vft_b / (t - self.vft_t_vf)).exp()
     }
@@ -56,11 +56,11 @@ impl Material {
 /// Ambient air properties (constant along the spin line; paper Table 1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Air {
-    /// Density `ρ_*` [kg/m³].
+    /// Density `ρ_*` \[kg/m³\].
     pub density: f64,
     /// Specific heat capacity `c_p,*` [J/(kg K)].
     pub heat_capacity: f64,
-    /// Kinematic viscosity `ν_*` [m²/s].
+    /// Kinematic viscosity `ν_*` \[m²/s\].
     pub kinematic_viscosity: f64,
     /// Heat conductivity `λ_*` [W/(m K)].
     pub heat_conductivity: f64,
@@ -83,7 +83,7 @@ impl Air {
 pub enum Inlet {
     /// Inlet diameter `d_in` \[m\]; the inlet speed follows as `u_in = 4 Q/(π ρ(T_in) d_in²)`.
     Diameter(f64),
-    /// Inlet speed `u_in` [m/s].
+    /// Inlet speed `u_in` \[m/s\].
     Velocity(f64),
 }
 
@@ -101,7 +101,7 @@ pub enum TakeUp {
 pub struct Experiment {
     /// Name used in reports and output file names.
     pub name: String,
-    /// Mass flow `Q` [kg/s].
+    /// Mass flow `Q` \[kg/s\].
     pub mass_flow: f64,
     /// Inlet condition.
     pub inlet: Inlet,
@@ -136,6 +136,6 @@ pub struct ExperimentSet {
     pub experiments: Vec<Experiment>,
     /// Measurements per experiment (same order; `None` where an experiment has no data file).
     pub measurements: Vec<Option<Measurements>>,
-    /// Relative measurement uncertainty of the diameters [-], if given.
+    /// Relative measurement uncertainty of the diameters \[-\], if given.
     pub relative_uncertainty: Option<f64>,
 }

@@ -99,17 +99,17 @@ pub struct FiberSolution {
 pub struct Profiles {
     /// Positions `s` \[m\].
     pub position: Vec<f64>,
-    /// Fiber speed `u` [m/s].
+    /// Fiber speed `u` \[m/s\].
     pub velocity: Vec<f64>,
     /// Axial force `N` \[N\].
     pub force: Vec<f64>,
     /// Temperature `T` \[K\].
     pub temperature: Vec<f64>,
-    /// Strain rate `ε̇ = u'` [1/s].
+    /// Strain rate `ε̇ = u'` \[1/s\].
     pub strain_rate: Vec<f64>,
     /// Diameter `d` \[m\].
     pub diameter: Vec<f64>,
-    /// Elongational viscosity `μ_e(T, ε̇)` [Pa s].
+    /// Elongational viscosity `μ_e(T, ε̇)` \[Pa s\].
     pub viscosity: Vec<f64>,
     /// Every named term: name, balance, values in N/m (momentum) or W/m (energy).
     pub terms: Vec<(&'static str, Balance, Vec<f64>)>,

@@ -20,15 +20,15 @@ use thiserror::Error;
 /// Parameters of a fitted ansatz.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SmoothFit {
-    /// Shape exponent `b` [-].
+    /// Shape exponent `b` \[-\].
     pub b: f64,
     /// Length scale `c` \[m\].
     pub c: f64,
-    /// Plateau `v` of `1/d²` [1/m²].
+    /// Plateau `v` of `1/d²` \[1/m²\].
     pub v: f64,
-    /// Start value `u0 = d_meas(0)^{-2}` [1/m²].
+    /// Start value `u0 = d_meas(0)^{-2}` \[1/m²\].
     pub u0: f64,
-    /// RMS of the relative deviations `u_f(s_i) d_i² - 1` [-].
+    /// RMS of the relative deviations `u_f(s_i) d_i² - 1` \[-\].
     pub rms: f64,
     /// Gauss–Newton iterations.
     pub iterations: usize,
@@ -58,7 +58,7 @@ fn ansatz_ratio<D: DualNum<Primitive = f64> + Copy>(s: f64, b: D, c: D, w: D) ->
 }
 
 impl SmoothFit {
-    /// `u_f(s)` [1/m²].
+    /// `u_f(s)` \[1/m²\].
     pub fn velocity_like(&self, s: f64) -> f64 {
         self.u0 * ansatz_ratio(s, self.b, self.c, self.v / self.u0)
     }

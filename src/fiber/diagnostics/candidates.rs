@@ -85,11 +85,11 @@ impl fmt::Debug for UserEffect {
 /// A candidate effect.
 #[derive(Debug, Clone)]
 pub enum Effect {
-    /// `strain_thinning`: Carreau-type law instead of Newtonian, strength `1 − n` [-].
+    /// `strain_thinning`: Carreau-type law instead of Newtonian, strength `1 − n` \[-\].
     StrainThinning,
-    /// `radiation`: grey-body radiation, strength = emissivity ε [-].
+    /// `radiation`: grey-body radiation, strength = emissivity ε \[-\].
     Radiation,
-    /// `air_coflow`: aspirator co-flow, strength = amplitude `V` [m/s].
+    /// `air_coflow`: aspirator co-flow, strength = amplitude `V` \[m/s\].
     AirCoflow {
         /// Decay length `ℓ` \[m\] (default [`DEFAULT_COFLOW_DECAY_LENGTH`]).
         decay_length: f64,
@@ -99,9 +99,9 @@ pub enum Effect {
         /// Decay length `ℓ` \[m\] (default [`DEFAULT_WARM_AIR_DECAY_LENGTH`]).
         decay_length: f64,
     },
-    /// `inlet_velocity`: relative inlet-velocity error δ [-], `u(0) = (1 + δ) u_in`.
+    /// `inlet_velocity`: relative inlet-velocity error δ \[-\], `u(0) = (1 + δ) u_in`.
     InletVelocity,
-    /// `nusselt_scale`: `𝒩 → (1 + s) 𝒩`, strength `s` [-].
+    /// `nusselt_scale`: `𝒩 → (1 + s) 𝒩`, strength `s` \[-\].
     NusseltScale,
     /// A user-written term with its own strength.
     Custom(UserEffect),

@@ -99,7 +99,7 @@ pub struct SimulatedExperiment {
 /// Settings of [`compare`].
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct CompareOptions {
-    /// Relative measurement uncertainty `σ` [-]; overrides the data set's value. `None`: the
+    /// Relative measurement uncertainty `σ` \[-\]; overrides the data set's value. `None`: the
     /// data set's, else estimated from the data.
     pub relative_uncertainty: Option<f64>,
     /// Number of parameters fitted to these data (for `dof = N − p`; default 0).
@@ -117,7 +117,7 @@ pub struct ComparedPoint {
     pub d_meas_m: f64,
     /// Simulated diameter (m).
     pub d_model_m: f64,
-    /// Relative residual `(d_model − d_meas)/d_meas` [-].
+    /// Relative residual `(d_model − d_meas)/d_meas` \[-\].
     pub residual: f64,
     /// `1/d_meas²` (1/m²).
     pub inv_d2_meas: f64,
@@ -144,9 +144,9 @@ pub struct ComparedExperiment {
     /// Model curve diameters (m) for figures.
     #[serde(skip)]
     pub curve_diameter_m: Vec<f64>,
-    /// RMS of the relative residuals [-].
+    /// RMS of the relative residuals \[-\].
     pub rms: f64,
-    /// Mean relative residual [-].
+    /// Mean relative residual \[-\].
     pub mean: f64,
     /// `Σ r²/σ²` of this experiment.
     pub chi2: f64,
@@ -173,7 +173,7 @@ pub enum NoiseSource {
 pub struct Trend {
     /// `"strain_rate"`, `"temperature"` or `"speed"`.
     pub quantity: String,
-    /// Spearman rank correlation over all points [-].
+    /// Spearman rank correlation over all points \[-\].
     pub spearman: f64,
 }
 
@@ -182,11 +182,11 @@ pub struct Trend {
 pub struct Comparison {
     /// Per experiment.
     pub experiments: Vec<ComparedExperiment>,
-    /// The noise level `σ` used [-].
+    /// The noise level `σ` used \[-\].
     pub sigma: f64,
     /// Where `σ` came from.
     pub sigma_source: NoiseSource,
-    /// The data-based estimate of `σ` (always computed, for reference) [-].
+    /// The data-based estimate of `σ` (always computed, for reference) \[-\].
     pub sigma_estimated: f64,
     /// Number of measurement points `N`.
     pub points: usize,
@@ -198,7 +198,7 @@ pub struct Comparison {
     pub dof: usize,
     /// `χ²/dof`.
     pub chi2_per_dof: f64,
-    /// RMS of all relative residuals [-].
+    /// RMS of all relative residuals \[-\].
     pub rms: f64,
     /// Pooled runs test.
     pub runs: RunsTest,

@@ -145,7 +145,7 @@ pub struct Diagnosis {
     pub indistinguishable: Vec<Indistinguishable>,
     /// The most likely missing effect, if one earns its place.
     pub most_likely_missing: Option<String>,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_time_s: f64,
 }
 

@@ -351,9 +351,9 @@ pub struct Identification {
     pub estimator: Estimator,
     /// Start point `(n, κ)`.
     pub start: [f64; 2],
-    /// Identified power index `n` [-].
+    /// Identified power index `n` \[-\].
     pub n: f64,
-    /// Identified `κ = ln(K / 1 Pa)` [-].
+    /// Identified `κ = ln(K / 1 Pa)` \[-\].
     pub kappa: f64,
     /// Take-up factors `φ_k = d_out,k / d_fit,k(L)` (all 1 for the paper's estimator).
     pub take_up_factors: Vec<f64>,
@@ -364,7 +364,7 @@ pub struct Identification {
     pub effects: Vec<EffectSlot>,
     /// The fitted local model parameters `[c, n, κ, strengths..., φ = 1]`.
     pub local_params: Vec<f64>,
-    /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements [-].
+    /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements \[-\].
     pub rms_relative_residual: f64,
     /// Final fiber solutions, one per experiment.
     pub solutions: Vec<Solution>,

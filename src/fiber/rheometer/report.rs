@@ -17,9 +17,9 @@ pub struct FitReport {
     pub estimator: Estimator,
     /// Start point `(n, κ)`.
     pub start: [f64; 2],
-    /// Power index `n` [-].
+    /// Power index `n` \[-\].
     pub n: f64,
-    /// `κ = ln(K / 1 Pa)` [-].
+    /// `κ = ln(K / 1 Pa)` \[-\].
     pub kappa: f64,
     /// `K = e^κ` \[Pa\].
     #[serde(rename = "K_Pa")]
@@ -39,7 +39,7 @@ pub struct FitReport {
     pub correlation_n_kappa: f64,
     /// Cost `J = ‖r‖²` of the estimator at the optimum.
     pub cost: f64,
-    /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements [-].
+    /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements \[-\].
     pub rms_relative_residual: f64,
     /// Take-up factors `φ_k = d_out,k/d_fit,k(L)` (1 for the paper's estimator).
     pub take_up_factors: Vec<f64>,

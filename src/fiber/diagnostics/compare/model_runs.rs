@@ -169,9 +169,9 @@ pub fn compare_set(
 pub struct FitParameters {
     /// The estimator of the fit.
     pub estimator: crate::fiber::rheometer::Estimator,
-    /// Power index `n` [-].
+    /// Power index `n` \[-\].
     pub n: f64,
-    /// `κ = ln(K / 1 Pa)` [-].
+    /// `κ = ln(K / 1 Pa)` \[-\].
     pub kappa: f64,
     /// Take-up factors `φ_k`, in the experiment order of the data set.
     #[serde(default)]

@@ -52,9 +52,9 @@ pub struct Station {
     pub position_m: f64,
     /// Number of residuals `m_j`.
     pub count: usize,
-    /// Mean relative residual `b_j` [-].
+    /// Mean relative residual `b_j` \[-\].
     pub mean: f64,
-    /// Standard error `se_j` of the mean [-].
+    /// Standard error `se_j` of the mean \[-\].
     pub std_error: f64,
 }
 
@@ -69,13 +69,13 @@ pub struct Segment {
     pub stations: usize,
     /// Number of residuals in the segment.
     pub points: usize,
-    /// Mean relative residual `X = mean (d_model − d_meas)/d_meas` [-]; `> 0`: model too thick.
+    /// Mean relative residual `X = mean (d_model − d_meas)/d_meas` \[-\]; `> 0`: model too thick.
     pub mean: f64,
-    /// Standard error of `X` from the noise level [-].
+    /// Standard error of `X` from the noise level \[-\].
     pub std_error: f64,
     /// `X / std_error`.
     pub z: f64,
-    /// Standard deviation of the per-experiment means across experiments [-] (0 for one).
+    /// Standard deviation of the per-experiment means across experiments \[-\] (0 for one).
     pub spread: f64,
     /// Per experiment with points in the segment: (experiment index, mean residual there).
     pub per_experiment: Vec<(usize, f64)>,
