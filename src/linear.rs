@@ -187,8 +187,6 @@ pub(crate) struct LinearSystem {
     row_perm_inv: Vec<usize>,
     factor_buf: MemBuffer,
     solve_buf: MemBuffer,
-    /// System size the scratch buffers were allocated for.
-    scratch_size: usize,
     /// Number of numeric factorisations done.
     pub factorizations: usize,
 }
@@ -209,29 +207,8 @@ impl LinearSystem {
             row_perm_inv: vec![0; size],
             factor_buf,
             solve_buf,
-            scratch_size: size,
             factorizations: 0,
         }
-    }
-
-    /// Reuses this workspace for `pattern`, whose system must be at least as large: faer's LU
-    /// storage keeps its capacity (no reallocation once warmed up), but its column pointers
-    /// have the length of the system and cannot shrink. Resets the factorisation counter.
-    fn reuse_for(&mut self, pattern: Arc<Pattern>) {
-        let size = pattern.size();
-        debug_assert!(size >= self.pattern.size());
-        if size > self.scratch_size {
-            self.factor_buf = MemBuffer::new(
-                factorize_simplicial_numeric_lu_scratch::<usize, f64>(size, size),
-            );
-            self.solve_buf =
-                MemBuffer::new(solve_in_place_scratch::<usize, f64>(size, 1, Par::Seq));
-            self.scratch_size = size;
-        }
-        self.row_perm.resize(size, 0);
-        self.row_perm_inv.resize(size, 0);
-        self.pattern = pattern;
-        self.factorizations = 0;
     }
 
     /// Assembles and factors the Jacobian held in `col`.
@@ -276,47 +253,5 @@ impl LinearSystem {
             row_perm: self.row_perm.clone(),
             row_perm_inv: self.row_perm_inv.clone(),
         }
-    }
-}
-
-/// Recently used Newton-matrix workspaces. Building the LU storage of a fresh workspace costs
-/// reallocations and page faults (profiled at ~10% of a warm fiber solve), so a solver keeps up
-/// to four: one of the same size is reused as is, else the largest smaller one grows.
-#[derive(Default)]
-pub(crate) struct LinearPool {
-    systems: Vec<LinearSystem>,
-}
-
-impl LinearPool {
-    const CAPACITY: usize = 4;
-
-    /// A workspace for `pattern` (taken out of the pool; give it back with [`put`](Self::put)).
-    pub(crate) fn take(&mut self, pattern: Arc<Pattern>) -> LinearSystem {
-        let size = pattern.size();
-        let exact = self.systems.iter().position(|l| l.pattern.size() == size);
-        let smaller = || {
-            self.systems
-                .iter()
-                .enumerate()
-                .filter(|(_, l)| l.pattern.size() < size)
-                .max_by_key(|(_, l)| l.pattern.size())
-                .map(|(i, _)| i)
-        };
-        match exact.or_else(smaller) {
-            Some(i) => {
-                let mut lin = self.systems.remove(i);
-                lin.reuse_for(pattern);
-                lin
-            }
-            None => LinearSystem::new(pattern),
-        }
-    }
-
-    /// Returns a workspace to the pool (the least recently used one is dropped when full).
-    pub(crate) fn put(&mut self, lin: LinearSystem) {
-        if self.systems.len() >= Self::CAPACITY {
-            self.systems.remove(0);
-        }
-        self.systems.push(lin);
     }
 }

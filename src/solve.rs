@@ -5,7 +5,7 @@
 use crate::collocation::Collocation;
 use crate::error::BvpError;
 use crate::error_control::rms_residuals;
-use crate::linear::{LinearPool, Pattern};
+use crate::linear::{LinearSystem, Pattern};
 use crate::mesh;
 use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork};
 use crate::problem::Bvp;
@@ -191,8 +191,6 @@ pub struct Solver<'a, P: Bvp> {
     pub options: SolveOptions,
     col: Collocation,
     patterns: Vec<Arc<Pattern>>,
-    /// Newton-matrix workspaces (LU storage, scratch), kept across meshes and solves.
-    linear: LinearPool,
     newton_work: NewtonWork,
     rms: Vec<f64>,
     buf: Vec<f64>,
@@ -218,7 +216,6 @@ impl<'a, P: Bvp> Solver<'a, P> {
             options,
             col: Collocation::new(n, k, q),
             patterns: Vec::new(),
-            linear: LinearPool::default(),
             newton_work: NewtonWork::default(),
             rms: Vec::new(),
             buf: Vec::new(),
@@ -353,7 +350,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
             let m = x.len();
             self.col.set_mesh(&x);
             let pattern = self.pattern(m)?;
-            let mut lin = self.linear.take(pattern);
+            let mut lin = LinearSystem::new(pattern);
             let scale = self.scale_for(&y);
             let report = newton(
                 problem,
@@ -364,16 +361,9 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 &scale,
                 &settings,
                 &mut self.newton_work,
-            );
-            stats.jacobian_factorizations += lin.factorizations;
-            let report = match report {
-                Ok(r) => r,
-                Err(e) => {
-                    self.linear.put(lin);
-                    return Err(e);
-                }
-            };
+            )?;
             stats.newton_iterations += report.iterations;
+            stats.jacobian_factorizations += lin.factorizations;
             let max_bc_res = max_bc(&self.col);
             rms_residuals(
                 problem,
@@ -392,7 +382,6 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 if report.converged {
                     return self.finish(problem, lin, x, y, p, scale, stats);
                 }
-                self.linear.put(lin);
                 return Err(BvpError::NewtonFailed {
                     iterations: report.iterations,
                     nodes: m,
@@ -410,28 +399,6 @@ impl<'a, P: Bvp> Solver<'a, P> {
                     if report.converged { "converged" } else { "not converged" }
                 );
             }
-            if added == 0 && max_bc_res <= bc_tol {
-                let coarse = if coarsenings_left > 0 && m > 8 {
-                    let new_x = mesh::coarsen(&x, &self.rms, opts.tol / 20.0);
-                    ((m - new_x.len()) * 10 >= m && iteration < opts.max_mesh_iterations)
-                        .then_some(new_x)
-                } else {
-                    None
-                };
-                match coarse {
-                    Some(new_x) => {
-                        coarsenings_left -= 1;
-                        y = resample(&x, &y, &self.col.f, n, &new_x);
-                        x = new_x;
-                        stats.mesh_refinements += 1;
-                        stats.mesh_coarsenings += 1;
-                        self.linear.put(lin);
-                        continue;
-                    }
-                    None => return self.finish(problem, lin, x, y, p, scale, stats),
-                }
-            }
-            self.linear.put(lin);
             if added > 0 {
                 if m + added > opts.max_nodes {
                     return Err(BvpError::MaxNodesExceeded {
@@ -445,6 +412,21 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 y = resample(&x, &y, &self.col.f, n, &new_x);
                 x = new_x;
                 stats.mesh_refinements += 1;
+            } else if max_bc_res <= bc_tol {
+                if coarsenings_left > 0 && m > 8 {
+                    let new_x = mesh::coarsen(&x, &self.rms, opts.tol / 20.0);
+                    if (m - new_x.len()) * 10 >= m {
+                        coarsenings_left -= 1;
+                        y = resample(&x, &y, &self.col.f, n, &new_x);
+                        x = new_x;
+                        stats.mesh_refinements += 1;
+                        stats.mesh_coarsenings += 1;
+                        if iteration < opts.max_mesh_iterations {
+                            continue;
+                        }
+                    }
+                }
+                return self.finish(problem, lin, x, y, p, scale, stats);
             }
             if iteration >= opts.max_mesh_iterations {
                 return Err(BvpError::ToleranceNotMet {
@@ -463,7 +445,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
     fn finish(
         &mut self,
         problem: &P,
-        mut lin: crate::linear::LinearSystem,
+        mut lin: LinearSystem,
         x: Vec<f64>,
         y: Vec<f64>,
         p: Vec<f64>,
@@ -473,16 +455,11 @@ impl<'a, P: Bvp> Solver<'a, P> {
         let k = self.col.k;
         // `col` holds values at the final iterate (the error estimate used them)
         let factorization = if self.options.factor_at_solution {
-            let factored = self
-                .col
-                .jacobians(problem, &y, &p, k)
-                .and_then(|()| lin.factor(&self.col));
-            let snapshot = factored.map(|()| lin.snapshot());
-            self.linear.put(lin);
+            self.col.jacobians(problem, &y, &p, k)?;
+            lin.factor(&self.col)?;
             stats.jacobian_factorizations += 1;
-            Some(snapshot?)
+            Some(lin.snapshot())
         } else {
-            self.linear.put(lin);
             None
         };
         stats.rhs_evaluations = self.col.rhs_evals;
