@@ -5,7 +5,7 @@
 //!
 //! * [`StepControl::Simple`] (default): enlarge the step on success, shrink it on failure, give
 //!   up below a minimum step. One solve per step.
-//! * [`StepControl::Adapter`]: the library's [`continuation`](crate::continuation::continuation)
+//! * [`StepControl::Adapter`]: the library's [`continuation()`](crate::continuation::continuation)
 //!   with the paper's Algorithm 1 (Adapter): every step is solved as one full and two half steps
 //!   and the step adapted from their costs. About three solves per step, so it is slower on
 //!   the fiber model (see `benches/README.md`), but it is the paper's method.
