@@ -1,7 +1,10 @@
 //! Fiber model benchmarks: cold solve (continuation from c = 0) and warm re-solve from a nearby
-//! (n, κ), experiment v0p53_p2, tol 1e-6.
+//! (n, κ), experiment v0p53_p2, tol 1e-6; the cold start with the simple step control (default)
+//! and with the paper's Adapter.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use diffbvp::continuation::ContinuationOptions as AdapterOptions;
+use diffbvp::fiber::cold_start::StepControl;
 use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
 use diffbvp::fiber::simulate::simulate_from;
 use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions, Simulator};
@@ -51,6 +54,17 @@ fn bench(c: &mut Criterion) {
     });
     c.bench_function("fiber_cold_reused_simulator_v0p53_p2_tol1e-6", |b| {
         b.iter(|| sim.cold(black_box(&[0.8, 11.71])).expect("cold"))
+    });
+    let mut adapter = opts.clone();
+    adapter.continuation.step_control = StepControl::Adapter(AdapterOptions::default());
+    let cold_adapter = simulate(&m, &[0.8, 11.71], &adapter).expect("cold adapter solve");
+    eprintln!(
+        "adapter cold start: nodes {}, final solve newton its {}",
+        cold_adapter.nodes(),
+        cold_adapter.solution.stats.newton_iterations
+    );
+    c.bench_function("fiber_cold_adapter_v0p53_p2_tol1e-6", |b| {
+        b.iter(|| simulate(black_box(&m), black_box(&[0.8, 11.71]), &adapter).expect("cold"))
     });
     c.bench_function("fiber_warm_v0p53_p2_tol1e-6", |b| {
         b.iter(|| {

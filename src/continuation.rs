@@ -20,7 +20,7 @@ use crate::solution::{Solution, SolveStats};
 use crate::solve::{Guess, Solver};
 
 /// Options of [`continuation`].
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ContinuationOptions {
     /// Initial step `Δc₀` (paper: 0.1, relative to `|c₁ - c₀| = 1`; scaled by `|c₁ - c₀|`).
     pub initial_step: f64,

@@ -1,19 +1,39 @@
 //! Cold start: natural-parameter continuation in `c` from the stress-free fiber (`c = 0`) to the
 //! full model (`c = 1`), paper Sec. 2.2 / App. B.
 //!
-//! A simple step-size loop (enlarge on success, shrink on failure, give up below a minimum step),
-//! kept in one function so that it can later be replaced by the library's continuation adapter.
+//! Two step controls ([`StepControl`]):
+//!
+//! * [`StepControl::Simple`] (default): enlarge the step on success, shrink it on failure, give
+//!   up below a minimum step. One solve per step.
+//! * [`StepControl::Adapter`]: the library's [`continuation()`](crate::continuation::continuation)
+//!   with the paper's Algorithm 1 (Adapter): every step is solved as one full and two half steps
+//!   and the step adapted from their costs. About three solves per step, so it is slower on
+//!   the fiber model (see `benches/README.md`), but it is the paper's method.
+//!
 //! Intermediate steps are solved at a loose tolerance; the final `c = 1` solve uses the caller's
 //! options.
 
+use crate::continuation::{continuation, ContinuationOptions as AdapterOptions};
 use crate::error::BvpError;
 use crate::problem::Bvp;
 use crate::solution::Solution;
 use crate::solve::{Guess, SolveOptions, Solver};
 
+/// How the continuation chooses its steps in `c`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepControl {
+    /// Grow the step by `grow` after a success, shrink it by `shrink` after a failure.
+    Simple,
+    /// The paper's Algorithm 1 (Adapter) with these options (`initial_step`, `min_step` and
+    /// `max_steps` of [`ContinuationOptions`] are not used by it).
+    Adapter(AdapterOptions),
+}
+
 /// Settings of the continuation in `c`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContinuationOptions {
+    /// Step control (default [`StepControl::Simple`]).
+    pub step_control: StepControl,
     /// First step `Δc` \[-\] (paper: 0.1).
     pub initial_step: f64,
     /// Factor applied to `Δc` after a successful step \[-\].
@@ -31,6 +51,7 @@ pub struct ContinuationOptions {
 impl Default for ContinuationOptions {
     fn default() -> Self {
         ContinuationOptions {
+            step_control: StepControl::Simple,
             initial_step: 0.25,
             grow: 2.0,
             shrink: 0.5,
@@ -96,6 +117,12 @@ fn continuation_steps<P: Bvp>(
     loose.factor_at_solution = false;
     solver.options = loose;
     let mut sol = solver.solve(&p, guess)?;
+    if let StepControl::Adapter(adapter) = &cont.step_control {
+        let path = continuation(solver, &sol, index, 1.0, adapter)?;
+        p[index] = 1.0;
+        solver.options = options.clone();
+        return solver.solve(&p, &Guess::from(&path.solution));
+    }
     let mut c = 0.0;
     let mut step = cont.initial_step;
     let mut steps = 0;
