@@ -413,7 +413,9 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 x = new_x;
                 stats.mesh_refinements += 1;
             } else if max_bc_res <= bc_tol {
-                if coarsenings_left > 0 && m > 8 {
+                // coarsen only if the coarser mesh can still be solved and checked: the solution
+                // returned must belong to the mesh it was computed on
+                if coarsenings_left > 0 && m > 8 && iteration < opts.max_mesh_iterations {
                     let new_x = mesh::coarsen(&x, &self.rms, opts.tol / 20.0);
                     if (m - new_x.len()) * 10 >= m {
                         coarsenings_left -= 1;
@@ -421,9 +423,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                         x = new_x;
                         stats.mesh_refinements += 1;
                         stats.mesh_coarsenings += 1;
-                        if iteration < opts.max_mesh_iterations {
-                            continue;
-                        }
+                        continue;
                     }
                 }
                 return self.finish(problem, lin, x, y, p, scale, stats);
