@@ -79,7 +79,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (0.7, 13.82),
         (0.9, 13.82),
     ];
+    // progress on stderr (nothing is drawn when stderr is not a terminal)
+    let sweep = ProgressBar::new(starts.len() as u64);
+    sweep.set_style(
+        ProgressStyle::with_template("Table 3 [{bar:40}] {pos}/{len}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
     for (n0, k0) in starts {
+        sweep.inc(1);
         let a = rheometer.identify([n0, k0], &principled);
         let b = rheometer.identify([n0, k0], &paper);
         let cell = |r: &Result<diffbvp::fiber::rheometer::Identification, _>| match r {
@@ -89,8 +96,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ),
             Err(e) => format!("failed: {e}"),
         };
-        println!("{:>5} {:>6} | {} | {}", n0, k0, cell(&a), cell(&b));
+        sweep.suspend(|| println!("{:>5} {:>6} | {} | {}", n0, k0, cell(&a), cell(&b)));
     }
+    sweep.finish_and_clear();
 
     // Figures: paper Fig. 2, 3, 5 for the principled fit, and Fig. 4, the cost landscape.
     std::fs::create_dir_all(&out)?;

@@ -612,8 +612,18 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 refit_top,
                 ..DiagnoseOptions::default()
             };
-            say("fitting your model and scoring the candidate effects...".into());
-            let run = diagnose(&loaded.set, &spec, &opts)?;
+            // a spinner on a terminal (indicatif draws nothing when stderr is not a terminal)
+            let spinner = if cli.quiet {
+                ProgressBar::hidden()
+            } else {
+                let b = ProgressBar::new_spinner();
+                b.set_message("fitting your model and scoring the candidate effects");
+                b.enable_steady_tick(std::time::Duration::from_millis(120));
+                b
+            };
+            let run = diagnose(&loaded.set, &spec, &opts);
+            spinner.finish_and_clear();
+            let run = run?;
             let text = run.diagnosis.to_text();
             outln!("{text}");
             create_dir(&out)?;
@@ -624,7 +634,8 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
                 write_json(&path, &js, &inputs)?;
                 say(format!("wrote {}", path.display()));
             }
-            let fig = out.join("residuals_before_after.png");
+            let fig = out.join(format!("residuals_before_after.{}", cli.format.ext()));
+            ensure_not_input(&fig, &inputs)?;
             run.save_figure(&fig)?;
             say(format!(
                 "wrote the report and {} to {}",
