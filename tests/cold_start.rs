@@ -3,20 +3,12 @@
 
 use diffbvp::continuation::ContinuationOptions as AdapterOptions;
 use diffbvp::fiber::cold_start::StepControl;
-use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use diffbvp::fiber::setup::{Air, Experiment, Material};
 use diffbvp::fiber::{simulate, CarreauLike, FiberError, FiberModel, Physics, SimulateOptions};
 use diffbvp::BvpError;
 
 fn model() -> FiberModel<CarreauLike> {
-    let exp = Experiment {
-        name: "v0p53_p2".into(),
-        mass_flow: 3.08e-5,
-        inlet: Inlet::Diameter(1.134e-3),
-        inlet_temperature: 513.15,
-        air_temperature: 293.15,
-        spinline_length: 0.51,
-        take_up: Some(TakeUp::Diameter(9e-5)),
-    };
+    let exp = Experiment::pmma7n_v0p53_p2();
     FiberModel::new(
         &Material::pmma7n(),
         &Air::paper(),

@@ -4,22 +4,14 @@
 use diffbvp::fiber::diagnostics::candidates::{
     Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
 };
-use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use diffbvp::fiber::setup::{Air, Experiment, Material};
 use diffbvp::fiber::simulate::simulate_params;
 use diffbvp::fiber::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
 use diffbvp::sensitivity::Sensitivities;
 use diffbvp::DualNum;
 
 fn experiment() -> Experiment {
-    Experiment {
-        name: "v0p53_p2".into(),
-        mass_flow: 3.08e-5,
-        inlet: Inlet::Diameter(1.134e-3),
-        inlet_temperature: 513.15,
-        air_temperature: 293.15,
-        spinline_length: 0.51,
-        take_up: Some(TakeUp::Diameter(9e-5)),
-    }
+    Experiment::pmma7n_v0p53_p2()
 }
 
 /// A user-written effect: natural convection near the nozzle, a heat loss

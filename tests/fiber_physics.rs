@@ -1,6 +1,6 @@
 //! Physics checks of the fiber model: alternative formulations, closed forms, balances, limits.
 
-use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use diffbvp::fiber::setup::{Air, Experiment, Material, TakeUp};
 use diffbvp::fiber::{
     simulate, CarreauLike, FiberModel, FiberSolution, Newtonian, Physics, SimulateOptions,
     Strength, ViscosityLaw,
@@ -9,13 +9,8 @@ use diffbvp::{Bvp, DualNum, Guess, ResidualScale, SolveOptions};
 
 fn experiment(take_up: TakeUp) -> Experiment {
     Experiment {
-        name: "v0p53_p2".into(),
-        mass_flow: 3.08e-5,
-        inlet: Inlet::Diameter(1.134e-3),
-        inlet_temperature: 513.15,
-        air_temperature: 293.15,
-        spinline_length: 0.51,
         take_up: Some(take_up),
+        ..Experiment::pmma7n_v0p53_p2()
     }
 }
 

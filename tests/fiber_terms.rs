@@ -9,15 +9,7 @@ use diffbvp::fiber::{
 use diffbvp::DualNum;
 
 fn experiment() -> Experiment {
-    Experiment {
-        name: "v0p53_p2".into(),
-        mass_flow: 3.08e-5,
-        inlet: Inlet::Diameter(1.134e-3),
-        inlet_temperature: 513.15,
-        air_temperature: 293.15,
-        spinline_length: 0.51,
-        take_up: Some(TakeUp::Diameter(9e-5)),
-    }
+    Experiment::pmma7n_v0p53_p2()
 }
 
 fn build(e: &Experiment, physics: Physics) -> Result<FiberModel<CarreauLike>, FiberError> {

@@ -116,6 +116,24 @@ pub struct Experiment {
     pub take_up: Option<TakeUp>,
 }
 
+impl Experiment {
+    /// Experiment `v0p53_p2` of the shipped PMMA7N-like data set (`data/pmma7n_synthetic`):
+    /// mass flow 3.08e-5 kg/s, inlet diameter 1.134 mm at 513.15 K, air at 293.15 K, spin line
+    /// 0.51 m, and its true take-up diameter 90 µm. A fixed reference case for examples,
+    /// tests and benchmarks.
+    pub fn pmma7n_v0p53_p2() -> Self {
+        Experiment {
+            name: "v0p53_p2".into(),
+            mass_flow: 3.08e-5,
+            inlet: Inlet::Diameter(1.134e-3),
+            inlet_temperature: 513.15,
+            air_temperature: 293.15,
+            spinline_length: 0.51,
+            take_up: Some(TakeUp::Diameter(9e-5)),
+        }
+    }
+}
+
 /// Measured diameters of one experiment.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurements {
