@@ -165,26 +165,31 @@ impl FitReport {
             100.0 * self.rms_relative_residual
         ));
         s.push_str("[[Variables]]\n");
-        s.push_str(&format!(
-            "    n:     {:.5} +/- {:.5} ({:.2}%)  95% CI [{:.5}, {:.5}]\n",
-            self.n,
-            self.stderr_n,
-            100.0 * self.stderr_n / self.n.abs(),
-            self.ci95_n[0],
-            self.ci95_n[1]
-        ));
-        s.push_str(&format!(
-            "    kappa: {:.5} +/- {:.5} ({:.2}%)  95% CI [{:.5}, {:.5}]\n",
-            self.kappa,
-            self.stderr_kappa,
-            100.0 * self.stderr_kappa / self.kappa.abs(),
-            self.ci95_kappa[0],
-            self.ci95_kappa[1]
-        ));
-        s.push_str(&format!(
-            "    K:     {:.5e} Pa  95% CI [{:.5e}, {:.5e}] Pa\n",
-            self.k_pa, self.ci95_k_pa[0], self.ci95_k_pa[1]
-        ));
+        if self.stderr_n.is_nan() && self.stderr_kappa.is_nan() && self.n == 1.0 {
+            // a Newtonian model: the law has no fitted parameter and κ does not enter
+            s.push_str("    law:   Newtonian (n = 1 fixed; kappa and K do not enter)\n");
+        } else {
+            s.push_str(&format!(
+                "    n:     {:.5} +/- {:.5} ({:.2}%)  95% CI [{:.5}, {:.5}]\n",
+                self.n,
+                self.stderr_n,
+                100.0 * self.stderr_n / self.n.abs(),
+                self.ci95_n[0],
+                self.ci95_n[1]
+            ));
+            s.push_str(&format!(
+                "    kappa: {:.5} +/- {:.5} ({:.2}%)  95% CI [{:.5}, {:.5}]\n",
+                self.kappa,
+                self.stderr_kappa,
+                100.0 * self.stderr_kappa / self.kappa.abs(),
+                self.ci95_kappa[0],
+                self.ci95_kappa[1]
+            ));
+            s.push_str(&format!(
+                "    K:     {:.5e} Pa  95% CI [{:.5e}, {:.5e}] Pa\n",
+                self.k_pa, self.ci95_k_pa[0], self.ci95_k_pa[1]
+            ));
+        }
         if self.estimator == Estimator::Principled {
             let f: Vec<String> = self
                 .take_up_factors
@@ -214,11 +219,13 @@ impl FitReport {
                 ));
             }
         }
-        s.push_str("[[Correlations]]\n");
-        s.push_str(&format!(
-            "    C(n, kappa) = {:+.4}\n",
-            self.correlation_n_kappa
-        ));
+        if self.correlation_n_kappa.is_finite() {
+            s.push_str("[[Correlations]]\n");
+            s.push_str(&format!(
+                "    C(n, kappa) = {:+.4}\n",
+                self.correlation_n_kappa
+            ));
+        }
         s
     }
 }
