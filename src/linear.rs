@@ -149,18 +149,27 @@ impl Factorization {
     }
 
     /// Solves `J x = b` in place for the columns of `b` (column-major, `size × ncols`).
-    pub fn solve_in_place(&self, b: &mut [f64], ncols: usize) {
+    /// Errors if `b` does not hold `size × ncols` values.
+    pub fn solve_in_place(&self, b: &mut [f64], ncols: usize) -> Result<(), BvpError> {
         self.solve_impl(b, ncols, false)
     }
 
-    /// Solves `Jᵀ x = b` in place (adjoints).
-    pub fn solve_transpose_in_place(&self, b: &mut [f64], ncols: usize) {
+    /// Solves `Jᵀ x = b` in place (adjoints). Errors if `b` does not hold `size × ncols`
+    /// values.
+    pub fn solve_transpose_in_place(&self, b: &mut [f64], ncols: usize) -> Result<(), BvpError> {
         self.solve_impl(b, ncols, true)
     }
 
-    fn solve_impl(&self, b: &mut [f64], ncols: usize, transpose: bool) {
+    fn solve_impl(&self, b: &mut [f64], ncols: usize, transpose: bool) -> Result<(), BvpError> {
         let size = self.size();
-        assert_eq!(b.len(), size * ncols, "right-hand side has the wrong size");
+        if b.len() != size * ncols {
+            return Err(BvpError::InvalidInput(format!(
+                "right-hand side of {} values for a {size} × {size} system with {ncols} column(s) \
+                 (expected {})",
+                b.len(),
+                size * ncols
+            )));
+        }
         let mut buf = MemBuffer::new(solve_in_place_scratch::<usize, f64>(size, ncols, Par::Seq));
         let stack = MemStack::new(&mut buf);
         let rp = PermRef::new_checked(&self.row_perm, &self.row_perm_inv, size);
@@ -173,6 +182,7 @@ impl Factorization {
             self.lu
                 .solve_in_place_with_conj(rp, cp, Conj::No, rhs, Par::Seq, stack);
         }
+        Ok(())
     }
 }
 

@@ -121,7 +121,7 @@ impl Sensitivities {
         }
         let mut owned = None;
         let fact = lz.factorization(sol, &mut owned)?;
-        fact.solve_in_place(&mut rhs, q);
+        fact.solve_in_place(&mut rhs, q)?;
         if let Some(pos) = rhs.iter().position(|v| !v.is_finite()) {
             return Err(BvpError::SingularJacobian {
                 detail: format!("sensitivity solve gave a non-finite value (entry {pos})"),
@@ -342,7 +342,7 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
     }
     let mut owned = None;
     let fact = lz.factorization(sol, &mut owned)?;
-    fact.solve_transpose_in_place(&mut b, 1);
+    fact.solve_transpose_in_place(&mut b, 1)?;
     let mut col = vec![0.0; size];
     for (j, d) in dg_dp.iter_mut().enumerate() {
         lz.col.param_column(k + j, &mut col);

@@ -234,3 +234,36 @@ fn sensitivities_with_adaptation_agree_to_discretisation_error() {
         }
     }
 }
+
+#[test]
+fn factorization_solve_checks_the_right_hand_side_size() {
+    let opts = SolveOptions {
+        factor_at_solution: true,
+        ..SolveOptions::with_tol(1e-8)
+    };
+    let s = solve(
+        &Hyper,
+        &[2.5],
+        &Guess::constant(linspace(0.0, 1.0, 5), &[0.5, -1.0]),
+        &opts,
+    )
+    .unwrap();
+    let fact = s
+        .factorization()
+        .expect("factorisation kept at the solution");
+    let size = fact.size();
+    let mut short = vec![1.0; size - 1];
+    assert!(matches!(
+        fact.solve_in_place(&mut short, 1),
+        Err(diffbvp::BvpError::InvalidInput(_))
+    ));
+    assert!(fact.solve_transpose_in_place(&mut short, 1).is_err());
+    assert_eq!(
+        short,
+        vec![1.0; size - 1],
+        "a rejected right-hand side is left untouched"
+    );
+    let mut ok = vec![1.0; 2 * size];
+    fact.solve_in_place(&mut ok, 2).unwrap();
+    assert!(ok.iter().all(|v| v.is_finite()));
+}
