@@ -12,10 +12,11 @@
 //! (`Physics::paper().with_radiation(0.9)`), the true take-up diameters of
 //! `data/pmma7n_synthetic/TRUTH.md`, the same positions. Noise as in that data set:
 //! `d_meas = d_true (1 + 0.015 ξ₁ + sd_extra(s) ξ₂)`, `sd_extra(s) = 0.04 ((s − 0.35)/0.16)²`
-//! for `s > 0.35 m`, with a seeded SplitMix64 + Box–Muller generator written below.
+//! for `s > 0.35 m`, with the seeded generator of `diffbvp::fiber::synthetic`.
 
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::setup::TakeUp;
+use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
 use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use std::error::Error;
 use std::fmt::Write as _;
@@ -32,40 +33,6 @@ const TRUTH: [f64; 2] = [0.8, 11.71];
 const TAKE_UP_M: [f64; 9] = [
     110e-6, 70e-6, 55e-6, 140e-6, 90e-6, 70e-6, 180e-6, 120e-6, 95e-6,
 ];
-/// Relative white noise of every measurement.
-const NOISE: f64 = 0.015;
-
-/// SplitMix64 (Steele, Lea, Flood 2014): a tiny, well-mixed 64-bit generator.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in (0, 1).
-    fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    /// Standard normal (Box–Muller, one value per call).
-    fn normal(&mut self) -> f64 {
-        let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
-}
-
-/// Extra (aspirator) noise near the take-up.
-fn sd_extra(s: f64) -> f64 {
-    if s > 0.35 {
-        0.04 * ((s - 0.35) / 0.16).powi(2)
-    } else {
-        0.0
-    }
-}
-
 /// `v` in scientific notation with `digits` decimals and a two-digit exponent (`1.2345e-04`).
 fn sci(v: f64, digits: usize) -> String {
     let t = format!("{v:.digits$e}");
@@ -151,19 +118,16 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
 
     // noise: per experiment first all ξ₁, then all ξ₂
-    let mut rng = SplitMix64(SEED);
+    let noise = NoiseModel::pmma7n_synthetic();
+    let mut rng = SplitMix64::new(SEED);
     let mut files: Vec<(PathBuf, String)> = Vec::new();
     for r in &runs {
-        let xi1: Vec<f64> = r.positions.iter().map(|_| rng.normal()).collect();
-        let xi2: Vec<f64> = r.positions.iter().map(|_| rng.normal()).collect();
+        let measured = noise
+            .apply(&r.positions, &r.with, &mut rng)
+            .map_err(|e| format!("{}: {e}", r.name))?;
         let mut csv = String::from("position_m,diameter_m\n");
-        for i in 0..r.positions.len() {
-            let s = r.positions[i];
-            let d = r.with[i] * (1.0 + NOISE * xi1[i] + sd_extra(s) * xi2[i]);
-            if d.is_nan() || d <= 0.0 {
-                return Err(format!("{} at s = {s}: non-positive noisy diameter", r.name).into());
-            }
-            let _ = writeln!(csv, "{},{}", fmt_position(s), sci(d, 7));
+        for (s, d) in r.positions.iter().zip(&measured) {
+            let _ = writeln!(csv, "{},{}", fmt_position(*s), sci(*d, 7));
         }
         files.push((out.join(format!("{}.csv", r.name)), csv));
     }

@@ -11,38 +11,18 @@ use diffbvp::fiber::setup::{
     Air, Experiment, ExperimentSet, Inlet, Material, Measurements, TakeUp,
 };
 use diffbvp::fiber::simulate::simulate_params;
+use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
 use diffbvp::fiber::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
 use diffbvp::DualNum;
 
-/// SplitMix64 with Box–Muller normals.
-struct Rng(u64);
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^ (z >> 31)
-    }
-    fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
-}
-
-const NOISE: f64 = 0.015;
-
-/// Extra relative noise near the take-up (aspirator disturbance): 3% at s = 0.50 m.
-fn extra_sd(s: f64) -> f64 {
-    if s > 0.35 {
-        0.03 * ((s - 0.35) / 0.15).powi(2)
-    } else {
-        0.0
-    }
-}
+/// 1.5% white noise plus up to 3% extra near the take-up (aspirator disturbance): 3% at
+/// s = 0.50 m.
+const NOISE: NoiseModel = NoiseModel {
+    relative_sd: 0.015,
+    disturbance_start: 0.35,
+    disturbance_width: 0.15,
+    disturbance_amplitude: 0.03,
+};
 
 fn positions() -> Vec<f64> {
     (0..26).map(|i| 0.02 * i as f64).collect()
@@ -50,12 +30,7 @@ fn positions() -> Vec<f64> {
 
 /// RMS of the noise model over the measurement positions (the level the data were made with).
 fn noise_level() -> f64 {
-    let p = positions();
-    (p.iter()
-        .map(|&s| NOISE * NOISE + extra_sd(s).powi(2))
-        .sum::<f64>()
-        / p.len() as f64)
-        .sqrt()
+    NOISE.rms_level(&positions())
 }
 
 /// (name, stencil velocity mm/s, take-up diameter m)
@@ -107,7 +82,7 @@ fn make_data(
     hidden: Option<(Effect, f64)>,
     seed: u64,
 ) -> ExperimentSet {
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut spec = ModelSpec::default();
     if let Some((e, _)) = &hidden {
         if !matches!(e, Effect::StrainThinning) {
@@ -137,17 +112,14 @@ fn make_data(
             .solution;
         let pos = positions();
         let lo = m.scaling.reference.length;
-        let xi1: Vec<f64> = pos.iter().map(|_| rng.normal()).collect();
-        let xi2: Vec<f64> = pos.iter().map(|_| rng.normal()).collect();
-        let d: Vec<f64> = pos
+        let clean: Vec<f64> = pos
             .iter()
-            .enumerate()
-            .map(|(j, &s)| {
+            .map(|&s| {
                 let y = sol.eval(s / lo);
-                let d = m.diameter(y[0], m.density(y[2])) * m.scaling.diameter();
-                d * (1.0 + NOISE * xi1[j] + extra_sd(s) * xi2[j])
+                m.diameter(y[0], m.density(y[2])) * m.scaling.diameter()
             })
             .collect();
+        let d = NOISE.apply(&pos, &clean, &mut rng).unwrap();
         experiments.push(e);
         measurements.push(Some(Measurements {
             positions: pos,

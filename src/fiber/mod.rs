@@ -13,6 +13,7 @@
 //! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
 //! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
 //! * [`figures`]: profile, fit and landscape figures (PNG/SVG);
+//! * [`synthetic`]: reproducible measurement noise for synthetic data sets;
 //! * [`diagnostics`]: model vs measurement comparison (where and how the model misses the data).
 
 pub mod cold_start;
@@ -29,6 +30,7 @@ pub mod scaling;
 pub mod setup;
 pub mod simulate;
 pub mod smoothing;
+pub mod synthetic;
 
 pub use contributions::{
     Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength,
