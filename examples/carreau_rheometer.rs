@@ -9,7 +9,9 @@
 
 use diffbvp::fiber::figures::{identification_figures, landscape_map};
 use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
+use diffbvp::fiber::rheometer::{
+    Estimator, FitReport, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS,
+};
 use diffbvp::mesh::linspace;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -66,26 +68,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "n0", "κ0", "n", "κ", "it", "time[s]", "n", "κ", "it", "time[s]"
     );
     println!("{:>13} | {:^32} | {:^32}", "", "principled", "paper");
-    let starts = [
-        (0.5, 9.21),
-        (0.7, 9.21),
-        (0.9, 9.21),
-        (0.3, 11.51),
-        (0.5, 11.51),
-        (0.7, 11.51),
-        (0.9, 11.51),
-        (0.3, 13.82),
-        (0.5, 13.82),
-        (0.7, 13.82),
-        (0.9, 13.82),
-    ];
+    let starts = PAPER_TABLE3_STARTS;
     // progress on stderr (nothing is drawn when stderr is not a terminal)
     let sweep = ProgressBar::new(starts.len() as u64);
     sweep.set_style(
         ProgressStyle::with_template("Table 3 [{bar:40}] {pos}/{len}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    for (n0, k0) in starts {
+    for [n0, k0] in starts {
         sweep.inc(1);
         let a = rheometer.identify([n0, k0], &principled);
         let b = rheometer.identify([n0, k0], &paper);
@@ -120,7 +110,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     bar.finish_and_clear();
     let mut markers: Vec<(f64, f64, String)> = starts
         .iter()
-        .map(|&(n, k)| (n, k, "Table 3 start".to_string()))
+        .map(|&[n, k]| (n, k, "Table 3 start".to_string()))
         .collect();
     markers.push((
         id_paper.n,

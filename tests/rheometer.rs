@@ -1,42 +1,21 @@
 //! Acceptance of the rheometer on the shipped synthetic data (truth (n, κ) = (0.8, 11.71)).
 
 use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
+use diffbvp::fiber::rheometer::{
+    Estimator, FitReport, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS,
+};
+use diffbvp::fiber::synthetic::NoiseModel;
 use std::path::Path;
-
-const TABLE3: [(f64, f64); 11] = [
-    (0.5, 9.21),
-    (0.7, 9.21),
-    (0.9, 9.21),
-    (0.3, 11.51),
-    (0.5, 11.51),
-    (0.7, 11.51),
-    (0.9, 11.51),
-    (0.3, 13.82),
-    (0.5, 13.82),
-    (0.7, 13.82),
-    (0.9, 13.82),
-];
 
 fn rheometer() -> Rheometer {
     let set = load_experiments(Path::new("data/pmma7n_synthetic/experiments.toml")).unwrap();
     Rheometer::new(&set).unwrap()
 }
 
-/// RMS of the noise model of TRUTH.md over the 26 shared positions:
-/// sd(s)² = 0.015² + (0.04 ((s − 0.35)/0.16)²)² for s > 0.35 m.
+/// RMS of the noise model of TRUTH.md over the 26 shared positions.
 fn truth_noise_level() -> f64 {
-    let mut sum = 0.0;
-    for i in 0..26 {
-        let s = i as f64 * 0.02;
-        let extra = if s > 0.35 {
-            0.04 * ((s - 0.35) / 0.16).powi(2)
-        } else {
-            0.0
-        };
-        sum += 0.015f64.powi(2) + extra * extra;
-    }
-    (sum / 26.0).sqrt()
+    let positions: Vec<f64> = (0..26).map(|i| 0.02 * f64::from(i)).collect();
+    NoiseModel::pmma7n_synthetic().rms_level(&positions)
 }
 
 #[test]
@@ -44,9 +23,9 @@ fn every_table3_start_gives_the_same_answer_for_both_estimators() {
     let rh = rheometer();
     for est in [Estimator::Principled, Estimator::Paper] {
         let opts = IdentifyOptions::with_estimator(est);
-        let ids: Vec<_> = TABLE3
+        let ids: Vec<_> = PAPER_TABLE3_STARTS
             .iter()
-            .map(|&(n, k)| rh.identify([n, k], &opts).unwrap())
+            .map(|&start| rh.identify(start, &opts).unwrap())
             .collect();
         let (n0, k0) = (ids[0].n, ids[0].kappa);
         for id in &ids {

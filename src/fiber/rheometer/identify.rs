@@ -110,6 +110,21 @@ impl IdentifyOptions {
     }
 }
 
+/// The eleven start points `(n, κ)` of the paper's Table 3 (κ = ln 10⁴, ln 10⁵, ln 10⁶).
+pub const PAPER_TABLE3_STARTS: [[f64; 2]; 11] = [
+    [0.5, 9.21],
+    [0.7, 9.21],
+    [0.9, 9.21],
+    [0.3, 11.51],
+    [0.5, 11.51],
+    [0.7, 11.51],
+    [0.9, 11.51],
+    [0.3, 13.82],
+    [0.5, 13.82],
+    [0.7, 13.82],
+    [0.9, 13.82],
+];
+
 /// Prepared data: smoothed measurements and one fiber model per experiment.
 #[derive(Debug)]
 pub struct Rheometer {

@@ -17,7 +17,9 @@ pub mod layout;
 pub mod report;
 
 pub use estimator::Estimator;
-pub use identify::{Identification, IdentifyOptions, Rheometer, RheometerError, StartPoint};
+pub use identify::{
+    Identification, IdentifyOptions, Rheometer, RheometerError, StartPoint, PAPER_TABLE3_STARTS,
+};
 pub use landscape::Landscape;
 pub use layout::{EffectSlot, FitStart, Layout};
 pub use report::{EffectReport, FitReport};
