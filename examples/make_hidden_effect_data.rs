@@ -15,7 +15,7 @@
 //! for `s > 0.35 m`, with the seeded generator of `diffbvp::fiber::synthetic`.
 
 use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::setup::TakeUp;
+use diffbvp::fiber::setup::Experiment;
 use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
 use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use std::error::Error;
@@ -29,10 +29,6 @@ const SEED: u64 = 20_250_611;
 const EMISSIVITY: f64 = 0.9;
 /// Truth of the law.
 const TRUTH: [f64; 2] = [0.8, 11.71];
-/// True take-up diameters (m) of `data/pmma7n_synthetic/TRUTH.md`, in experiment order.
-const TAKE_UP_M: [f64; 9] = [
-    110e-6, 70e-6, 55e-6, 140e-6, 90e-6, 70e-6, 180e-6, 120e-6, 95e-6,
-];
 /// `v` in scientific notation with `digits` decimals and a two-digit exponent (`1.2345e-04`).
 fn sci(v: f64, digits: usize) -> String {
     let t = format!("{v:.digits$e}");
@@ -78,9 +74,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
     let source = Path::new("data/pmma7n_synthetic/experiments.toml");
     let set = load_experiments(source)?;
-    if set.experiments.len() != TAKE_UP_M.len() {
-        return Err(format!("expected 9 experiments in {}", source.display()).into());
-    }
+    // the true take-up diameters of data/pmma7n_synthetic/TRUTH.md
+    let truth = Experiment::pmma7n_synthetic_truth();
     let options = SimulateOptions::with_tol(1e-8);
     let mut runs = Vec::new();
     for (k, e) in set.experiments.iter().enumerate() {
@@ -88,7 +83,11 @@ fn main() -> Result<(), Box<dyn Error>> {
             .as_ref()
             .ok_or_else(|| format!("{} has no measurements", e.name))?;
         let mut e = e.clone();
-        e.take_up = Some(TakeUp::Diameter(TAKE_UP_M[k]));
+        e.take_up = truth
+            .iter()
+            .find(|t| t.name == e.name)
+            .ok_or_else(|| format!("{}: no such experiment in the data set's truth", e.name))?
+            .take_up;
         let hidden = Physics::paper().with_radiation(EMISSIVITY);
         let model = FiberModel::new(&set.material, &set.air, &e, CarreauLike::new(), hidden)?;
         let sol = simulate(&model, &TRUTH, &options)?;

@@ -7,9 +7,7 @@
 
 use diffbvp::fiber::diagnostics::candidates::{Effect, LawChoice, ModelSpec};
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
-use diffbvp::fiber::setup::{
-    Air, Experiment, ExperimentSet, Inlet, Material, Measurements, TakeUp,
-};
+use diffbvp::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
 use diffbvp::fiber::simulate::simulate_params;
 use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
 use diffbvp::fiber::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
@@ -33,30 +31,8 @@ fn noise_level() -> f64 {
     NOISE.rms_level(&positions())
 }
 
-/// (name, stencil velocity mm/s, take-up diameter m)
-const EXPERIMENTS: [(&str, f64, f64); 9] = [
-    ("v0p27_p1", 0.27, 110e-6),
-    ("v0p27_p2", 0.27, 70e-6),
-    ("v0p27_p3", 0.27, 55e-6),
-    ("v0p53_p1", 0.53, 140e-6),
-    ("v0p53_p2", 0.53, 90e-6),
-    ("v0p53_p3", 0.53, 70e-6),
-    ("v1p06_p1", 1.06, 180e-6),
-    ("v1p06_p2", 1.06, 120e-6),
-    ("v1p06_p3", 1.06, 95e-6),
-];
-
 fn experiment(i: usize) -> Experiment {
-    let (name, v, d) = EXPERIMENTS[i];
-    Experiment {
-        name: name.into(),
-        mass_flow: 3.08e-5 * v / 0.53,
-        inlet: Inlet::Diameter(1.134e-3),
-        inlet_temperature: 513.15,
-        air_temperature: 293.15,
-        spinline_length: 0.51,
-        take_up: Some(TakeUp::Diameter(d)),
-    }
+    Experiment::pmma7n_synthetic_truth().swap_remove(i)
 }
 
 /// A user-written effect: natural convection near the nozzle,

@@ -1,36 +1,12 @@
 //! Agreement with the noise-free reference profiles of an independent scipy implementation
 //! (`tests/data/reference_profiles/`, solve_bvp tol 1e-8 with every output point a node).
 
-use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use diffbvp::fiber::setup::{Air, Experiment, Material};
 use diffbvp::fiber::simulate::simulate_from;
 use diffbvp::fiber::{
     simulate, CarreauLike, FiberModel, Newtonian, Physics, SimulateOptions, ViscosityLaw,
 };
 use std::time::Instant;
-
-const EXPERIMENTS: [(&str, f64, f64); 9] = [
-    ("v0p27_p1", 0.27, 110e-6),
-    ("v0p27_p2", 0.27, 70e-6),
-    ("v0p27_p3", 0.27, 55e-6),
-    ("v0p53_p1", 0.53, 140e-6),
-    ("v0p53_p2", 0.53, 90e-6),
-    ("v0p53_p3", 0.53, 70e-6),
-    ("v1p06_p1", 1.06, 180e-6),
-    ("v1p06_p2", 1.06, 120e-6),
-    ("v1p06_p3", 1.06, 95e-6),
-];
-
-fn experiment(name: &str, vs: f64, d_out: f64) -> Experiment {
-    Experiment {
-        name: name.into(),
-        mass_flow: 3.08e-5 * vs / 0.53,
-        inlet: Inlet::Diameter(1.134e-3),
-        inlet_temperature: 513.15,
-        air_temperature: 293.15,
-        spinline_length: 0.51,
-        take_up: Some(TakeUp::Diameter(d_out)),
-    }
-}
 
 /// Columns: position, velocity, force, temperature, strain rate, diameter.
 fn read_reference(file: &str) -> Vec<[f64; 6]> {
@@ -78,21 +54,13 @@ fn compare<L: ViscosityLaw>(
 
 fn check_all<L: ViscosityLaw + Clone>(law: L, params: &[f64], suffix: &str) {
     let mut worst = [0.0f64; 5];
-    for (name, vs, d_out) in EXPERIMENTS {
-        let file = format!("{name}_{suffix}.csv");
-        if !std::path::Path::new(&format!(
-            "{}/tests/data/reference_profiles/{file}",
-            env!("CARGO_MANIFEST_DIR")
-        ))
-        .exists()
-        {
-            eprintln!("{file}: no reference file");
-            continue;
-        }
+    for experiment in Experiment::pmma7n_synthetic_truth() {
+        let file = format!("{}_{suffix}.csv", experiment.name);
+        // every experiment has its reference profile: a missing file fails in read_reference
         let model = FiberModel::new(
             &Material::pmma7n(),
             &Air::paper(),
-            &experiment(name, vs, d_out),
+            &experiment,
             law.clone(),
             Physics::paper(),
         )
@@ -127,11 +95,10 @@ fn newtonian_matches_reference_profiles() {
 
 #[test]
 fn warm_start_from_nearby_parameters_gives_the_same_solution() {
-    let (name, vs, d_out) = EXPERIMENTS[4];
     let model = FiberModel::new(
         &Material::pmma7n(),
         &Air::paper(),
-        &experiment(name, vs, d_out),
+        &Experiment::pmma7n_v0p53_p2(),
         CarreauLike::new(),
         Physics::paper(),
     )

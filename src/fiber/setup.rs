@@ -116,21 +116,45 @@ pub struct Experiment {
     pub take_up: Option<TakeUp>,
 }
 
+/// Names, stencil velocities (mm/s) and true take-up diameters (m) of the nine experiments of
+/// the shipped data set `data/pmma7n_synthetic` (its TRUTH.md).
+const PMMA7N_SYNTHETIC: [(&str, f64, f64); 9] = [
+    ("v0p27_p1", 0.27, 110e-6),
+    ("v0p27_p2", 0.27, 70e-6),
+    ("v0p27_p3", 0.27, 55e-6),
+    ("v0p53_p1", 0.53, 140e-6),
+    ("v0p53_p2", 0.53, 90e-6),
+    ("v0p53_p3", 0.53, 70e-6),
+    ("v1p06_p1", 1.06, 180e-6),
+    ("v1p06_p2", 1.06, 120e-6),
+    ("v1p06_p3", 1.06, 95e-6),
+];
+
 impl Experiment {
-    /// Experiment `v0p53_p2` of the shipped PMMA7N-like data set (`data/pmma7n_synthetic`):
-    /// mass flow 3.08e-5 kg/s, inlet diameter 1.134 mm at 513.15 K, air at 293.15 K, spin line
-    /// 0.51 m, and its true take-up diameter 90 µm. A fixed reference case for examples,
-    /// tests and benchmarks.
+    /// The nine experiments of the shipped PMMA7N-like data set (`data/pmma7n_synthetic`) with
+    /// the true take-up diameters of its TRUTH.md (the TOML has none): mass flow
+    /// 3.08e-5 kg/s × v/(0.53 mm/s) for stencil velocity v = 0.27, 0.53, 1.06 mm/s, inlet
+    /// diameter 1.134 mm at 513.15 K, air at 293.15 K, spin line 0.51 m. Reference cases for
+    /// examples, tests, benchmarks and synthetic data.
+    pub fn pmma7n_synthetic_truth() -> Vec<Experiment> {
+        PMMA7N_SYNTHETIC
+            .iter()
+            .map(|&(name, v, d_out)| Experiment {
+                name: name.into(),
+                mass_flow: 3.08e-5 * v / 0.53,
+                inlet: Inlet::Diameter(1.134e-3),
+                inlet_temperature: 513.15,
+                air_temperature: 293.15,
+                spinline_length: 0.51,
+                take_up: Some(TakeUp::Diameter(d_out)),
+            })
+            .collect()
+    }
+
+    /// Experiment `v0p53_p2` of [`pmma7n_synthetic_truth`](Self::pmma7n_synthetic_truth)
+    /// (mass flow 3.08e-5 kg/s, take-up diameter 90 µm): a single reference case.
     pub fn pmma7n_v0p53_p2() -> Self {
-        Experiment {
-            name: "v0p53_p2".into(),
-            mass_flow: 3.08e-5,
-            inlet: Inlet::Diameter(1.134e-3),
-            inlet_temperature: 513.15,
-            air_temperature: 293.15,
-            spinline_length: 0.51,
-            take_up: Some(TakeUp::Diameter(9e-5)),
-        }
+        Self::pmma7n_synthetic_truth().swap_remove(4)
     }
 }
 
