@@ -43,24 +43,6 @@ fn observed_convergence_order_is_four() {
 /// 5 nodes on [0, 1], y = (sin πx, π cos πx)).
 #[test]
 fn jacobian_blocks_match_scipy_analytic_formulas() {
-    struct Sl;
-    impl Bvp for Sl {
-        fn dim(&self) -> usize {
-            2
-        }
-        fn num_unknowns(&self) -> usize {
-            1
-        }
-        fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-            f[0] = y[1];
-            f[1] = -p[0] * p[0] * y[0];
-        }
-        fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
-            r[0] = ya[0];
-            r[1] = yb[0];
-            r[2] = ya[1] - p[0];
-        }
-    }
     let pi = std::f64::consts::PI;
     let x = linspace(0.0, 1.0, 5);
     let g = Guess::from_fn(x.clone(), 2, |x, y| {
@@ -68,7 +50,7 @@ fn jacobian_blocks_match_scipy_analytic_formulas() {
         y[1] = pi * (pi * x).cos();
     })
     .with_unknowns(&[3.0]);
-    let sys = discrete_system(&Sl, &[], &g).unwrap();
+    let sys = discrete_system(&SturmLiouville, &[], &g).unwrap();
     let size = sys.size;
     assert_eq!(size, 11);
     let p: f64 = 3.0;

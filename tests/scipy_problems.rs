@@ -27,26 +27,6 @@ fn a1_no_params_keeps_five_nodes_and_matches_exact() {
     }
 }
 
-/// y'' = -p² y on [0, π], y(0) = y(π) = 0, y'(0) = p; p unknown.
-struct SturmLiouville;
-impl Bvp for SturmLiouville {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_unknowns(&self) -> usize {
-        1
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -p[0] * p[0] * y[0];
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0];
-        r[2] = ya[1] - p[0];
-    }
-}
-
 #[test]
 fn a2_with_unknown_parameter() {
     let pi = std::f64::consts::PI;
@@ -258,30 +238,12 @@ fn bratu_both_branches_from_two_guesses() {
 fn sturm_liouville_docstring_finds_two_pi() {
     let pi = std::f64::consts::PI;
     // y'' + k^2 y = 0 on [0, 1], y(0) = y(1) = 0, y'(0) = k
-    struct Sl;
-    impl Bvp for Sl {
-        fn dim(&self) -> usize {
-            2
-        }
-        fn num_unknowns(&self) -> usize {
-            1
-        }
-        fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-            f[0] = y[1];
-            f[1] = -p[0] * p[0] * y[0];
-        }
-        fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
-            r[0] = ya[0];
-            r[1] = yb[0];
-            r[2] = ya[1] - p[0];
-        }
-    }
     let g = Guess::from_fn(linspace(0.0, 1.0, 5), 2, |x, y| {
         y[0] = (2.0 * pi * x).sin();
         y[1] = 2.0 * pi * (2.0 * pi * x).cos();
     })
     .with_unknowns(&[6.0]);
-    let s = solve(&Sl, &[], &g, &SolveOptions::with_tol(1e-6)).unwrap();
+    let s = solve(&SturmLiouville, &[], &g, &SolveOptions::with_tol(1e-6)).unwrap();
     assert!(
         (s.unknowns[0] - 2.0 * pi).abs() < 1e-5,
         "k = {}",

@@ -100,3 +100,23 @@ pub fn erf(x: f64) -> f64 {
         1.0 - (-x * x).exp() / std::f64::consts::PI.sqrt() / (x + f)
     }
 }
+
+/// y'' = -p² y, y(a) = y(b) = 0, y'(a) = p; p unknown (an eigenvalue problem).
+pub struct SturmLiouville;
+impl Bvp for SturmLiouville {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_unknowns(&self) -> usize {
+        1
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = -p[0] * p[0] * y[0];
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
+        r[0] = ya[0];
+        r[1] = yb[0];
+        r[2] = ya[1] - p[0];
+    }
+}
