@@ -76,6 +76,9 @@ pub enum CompareError {
     /// Drawing a figure failed.
     #[error(transparent)]
     Plot(#[from] PlotError),
+    /// Writing a figure failed.
+    #[error(transparent)]
+    Figure(#[from] crate::fiber::figures::FigureError),
     /// Serialising the JSON summary failed.
     #[error("cannot serialise the comparison: {0}")]
     Json(#[from] serde_json::Error),

@@ -2,7 +2,9 @@
 //! residuals against the local strain rate, temperature and speed.
 
 use super::{CompareError, Comparison, FigureFormat};
+use crate::fiber::figures::{experiment_panels, ExperimentView, ModelCurves, View};
 use crate::fiber::output::ensure_not_input;
+use crate::fiber::simulate::Profiles;
 use crate::plot::{save_panels, Panel, Series};
 use std::path::{Path, PathBuf};
 
@@ -28,6 +30,47 @@ pub fn write_figures(
 ) -> Result<Vec<PathBuf>, CompareError> {
     let ext = format.extension();
     let mut out = Vec::new();
+    // measured vs model per experiment, as d and as 1/d² (the rheometer's figure panels)
+    let measured: Vec<(Vec<f64>, Vec<f64>)> = cmp
+        .experiments
+        .iter()
+        .map(|e| e.points.iter().map(|p| (p.position_m, p.d_meas_m)).unzip())
+        .collect();
+    let views: Vec<ExperimentView> = cmp
+        .experiments
+        .iter()
+        .zip(&measured)
+        .map(|(e, (s, d))| ExperimentView {
+            name: &e.name,
+            length: e.curve_position_m.last().copied().unwrap_or(0.0),
+            positions: s,
+            diameters: d,
+            smooth: None,
+        })
+        .collect();
+    let curves: Vec<Profiles> = cmp
+        .experiments
+        .iter()
+        .map(|e| Profiles {
+            position: e.curve_position_m.clone(),
+            diameter: e.curve_diameter_m.clone(),
+            ..Profiles::default()
+        })
+        .collect();
+    let model = [ModelCurves {
+        label: "model",
+        profiles: &curves,
+        dashed: false,
+    }];
+    for (name, view) in [
+        ("compare_diameters", View::Diameter),
+        ("compare_inverse_d2", View::InverseSquare),
+    ] {
+        let path = dir.join(format!("{name}.{ext}"));
+        experiment_panels(&path, &views, &model, view, inputs)?;
+        out.push(path);
+    }
+
     let mut save = |name: &str, panels: &[Panel], columns: usize| -> Result<(), CompareError> {
         let path = dir.join(format!("{name}.{ext}"));
         ensure_not_input(&path, inputs)?;
@@ -35,55 +78,6 @@ pub fn write_figures(
         out.push(path);
         Ok(())
     };
-    let columns = 3.min(cmp.experiments.len().max(1));
-    let diam: Vec<Panel> = cmp
-        .experiments
-        .iter()
-        .map(|e| {
-            Panel::new(e.name.as_str(), "s (m)", "d (µm)")
-                .with_series(Series::markers(
-                    "measured",
-                    e.points
-                        .iter()
-                        .map(|p| (p.position_m, 1e6 * p.d_meas_m))
-                        .collect(),
-                ))
-                .with_series(Series::line(
-                    "model",
-                    e.curve_position_m
-                        .iter()
-                        .zip(&e.curve_diameter_m)
-                        .map(|(s, d)| (*s, 1e6 * d))
-                        .collect(),
-                ))
-                .with_log_y(true)
-        })
-        .collect();
-    save("compare_diameters", &diam, columns)?;
-    let inv: Vec<Panel> = cmp
-        .experiments
-        .iter()
-        .map(|e| {
-            Panel::new(e.name.as_str(), "s (m)", "1/d² (1/mm²)")
-                .with_series(Series::markers(
-                    "measured",
-                    e.points
-                        .iter()
-                        .map(|p| (p.position_m, 1e-6 * p.inv_d2_meas))
-                        .collect(),
-                ))
-                .with_series(Series::line(
-                    "model",
-                    e.curve_position_m
-                        .iter()
-                        .zip(&e.curve_diameter_m)
-                        .map(|(s, d)| (*s, 1e-6 / (d * d)))
-                        .collect(),
-                ))
-        })
-        .collect();
-    save("compare_inverse_d2", &inv, columns)?;
-
     let two_sigma = 200.0 * cmp.sigma;
     let (s_lo, s_hi) = cmp
         .stations
