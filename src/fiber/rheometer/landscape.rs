@@ -15,7 +15,8 @@
 //! landscape caps the mesh at [`LANDSCAPE_MAX_NODES`] nodes: a failure costs a few
 //! milliseconds instead of tens, and points that would need more nodes are marked missing.
 
-use super::identify::{IdentifyOptions, Objective, Rheometer, RheometerError};
+use super::identify::{IdentifyOptions, Rheometer, RheometerError};
+use super::objective::Objective;
 use crate::solution::Solution;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};

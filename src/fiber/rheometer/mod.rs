@@ -4,9 +4,12 @@
 //! * [`estimator`]: the two cost functions — the paper's strain-rate-weighted distance to the
 //!   smoothed data, and the statistically principled relative least squares against the raw
 //!   measurements with the take-up diameters as nuisance parameters;
-//! * [`identify`]: the objective over all experiments (solved in parallel, warm-started, exact
-//!   Jacobians from forward sensitivities), the start-point heuristic (paper Algorithm 2) and
-//!   the bounded trust-region Gauss–Newton fit;
+//! * [`identify`]: the prepared data ([`Rheometer`]), the start-point heuristic (paper
+//!   Algorithm 2) and the bounded trust-region Gauss–Newton fit;
+//! * [`objective`]: the least-squares objective over all experiments (solved in parallel,
+//!   warm-started, exact Jacobians from forward sensitivities);
+//! * [`layout`]: which parameters are fitted (law, effect strengths, take-up factors);
+//! * [`landscape`]: the cost on a grid (paper Fig. 4);
 //! * [`report`]: uncertainty (standard errors, 95% confidence intervals, correlation) and the
 //!   text and JSON reports.
 
@@ -14,6 +17,7 @@ pub mod estimator;
 pub mod identify;
 pub mod landscape;
 pub mod layout;
+pub mod objective;
 pub mod report;
 
 pub use estimator::Estimator;
