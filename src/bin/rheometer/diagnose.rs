@@ -1,0 +1,80 @@
+//! `rheometer diagnose`.
+
+use crate::*;
+
+/// Arguments of `rheometer diagnose`.
+#[derive(clap::Args)]
+pub struct DiagnoseArgs {
+    /// The experiments file (TOML).
+    pub experiments: PathBuf,
+    /// The viscosity law of your model: carreau or newtonian.
+    #[arg(long, default_value = "carreau")]
+    pub model: LawChoice,
+    /// Effects already in your model (fitted or "=VALUE" fixed); repeatable.
+    #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
+    pub with: Vec<EffectSetting>,
+    /// How many of the best linearised candidates are refitted.
+    #[arg(long, default_value_t = 3)]
+    pub refit_top: usize,
+    /// Write the diagnosis as JSON to FILE.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Output directory (report and before/after residual figure).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Runs `rheometer diagnose`.
+pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
+    let DiagnoseArgs {
+        experiments,
+        model,
+        with,
+        refit_top,
+        json,
+        out,
+    } = args;
+    let loaded = load_experiments_with(&experiments, 4)?;
+    let inputs = inputs_of(&experiments, &loaded);
+    let spec = ModelSpec {
+        law: model,
+        effects: with,
+        candidates: Vec::new(),
+    };
+    spec.validate()?;
+    let opts = DiagnoseOptions {
+        refit_top,
+        ..DiagnoseOptions::default()
+    };
+    // a spinner on a terminal (indicatif draws nothing when stderr is not a terminal)
+    let spinner = if g.quiet {
+        ProgressBar::hidden()
+    } else {
+        let b = ProgressBar::new_spinner();
+        b.set_message("fitting your model and scoring the candidate effects");
+        b.enable_steady_tick(std::time::Duration::from_millis(120));
+        b
+    };
+    let run = diagnose(&loaded.set, &spec, &opts);
+    spinner.finish_and_clear();
+    let run = run?;
+    let text = run.diagnosis.to_text();
+    outln!("{text}");
+    create_dir(&out)?;
+    write_text(&out.join("diagnosis.txt"), &text, &inputs)?;
+    let js = serde_json::to_string_pretty(&run.diagnosis)?;
+    write_text(&out.join("diagnosis.json"), &js, &inputs)?;
+    if let Some(path) = json {
+        write_json(&path, &js, &inputs)?;
+        g.say(format!("wrote {}", path.display()));
+    }
+    let fig = out.join(format!("residuals_before_after.{}", g.format.ext()));
+    ensure_not_input(&fig, &inputs)?;
+    run.save_figure(&fig)?;
+    g.say(format!(
+        "wrote the report and {} to {}",
+        fig.display(),
+        out.display()
+    ));
+    Ok(())
+}

@@ -1,0 +1,89 @@
+//! `rheometer landscape`.
+
+use crate::*;
+
+/// Arguments of `rheometer landscape`.
+#[derive(clap::Args)]
+pub struct LandscapeArgs {
+    /// The experiments file (TOML).
+    pub experiments: PathBuf,
+    /// Grid size "NxM" (n values x kappa values).
+    #[arg(long, default_value = "41x41", value_parser = parse_grid)]
+    pub grid: (usize, usize),
+    /// Range of n "MIN,MAX".
+    #[arg(long, default_value = "0,1", value_parser = parse_pair)]
+    pub n_range: (f64, f64),
+    /// Range of kappa "MIN,MAX".
+    #[arg(long, default_value = "9,16", value_parser = parse_pair)]
+    pub kappa_range: (f64, f64),
+    /// The estimator whose cost is mapped.
+    #[arg(long, value_enum, default_value_t = EstimatorArg::Paper)]
+    pub estimator: EstimatorArg,
+    /// BVP tolerance of the landscape solves (a picture; fits use 1e-6).
+    #[arg(long, default_value_t = 1e-4)]
+    pub tol: f64,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Runs `rheometer landscape`.
+pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
+    let LandscapeArgs {
+        experiments,
+        grid,
+        n_range,
+        kappa_range,
+        estimator: est,
+        tol,
+        out,
+    } = args;
+    let loaded = load_experiments_with(&experiments, 4)?;
+    let inputs = inputs_of(&experiments, &loaded);
+    let rh = Rheometer::new(&loaded.set)?;
+    let mut opts = IdentifyOptions::with_estimator(estimator(est));
+    if !(tol > 0.0 && tol < 1.0) {
+        return Err(format!("--tol must lie in (0, 1), got {tol}").into());
+    }
+    opts.simulate.tol = tol;
+    let ns = linspace(n_range.0, n_range.1, grid.0);
+    let ks = linspace(kappa_range.0, kappa_range.1, grid.1);
+    let bar = if g.quiet {
+        ProgressBar::hidden()
+    } else {
+        let b = ProgressBar::new((grid.0 * grid.1) as u64);
+        b.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta} left)")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b.set_message("landscape");
+        b
+    };
+    let t0 = std::time::Instant::now();
+    let l = rh.landscape(&ns, &ks, &opts, |d| bar.set_position(d as u64))?;
+    bar.finish_and_clear();
+    create_dir(&out)?;
+    let mut csv = String::from("n,kappa,cost\n");
+    for (j, k) in ks.iter().enumerate() {
+        for (i, n) in ns.iter().enumerate() {
+            csv.push_str(&format!("{n},{k},{:e}\n", l.cost[j * ns.len() + i]));
+        }
+    }
+    let path = out.join("landscape.csv");
+    write_text(&path, &csv, &inputs)?;
+    let mut markers = Vec::new();
+    if let Some((n, k, c)) = l.minimum() {
+        outln!("grid minimum: n = {n:.4}, kappa = {k:.4}, J = {c:.6e}");
+        markers.push((n, k, "grid minimum".to_string()));
+    }
+    let fig = out.join(format!("landscape.{}", g.format.ext()));
+    let title = format!("J(n, κ), {} estimator", opts.estimator.name());
+    figures::landscape_map(&fig, &l, &title, &markers, &inputs)?;
+    g.say(format!(
+        "{} points in {:.1} s; wrote {}",
+        grid.0 * grid.1,
+        t0.elapsed().as_secs_f64(),
+        path.display()
+    ));
+    Ok(())
+}

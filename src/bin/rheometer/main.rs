@@ -1,0 +1,308 @@
+//! `rheometer`: simulate fiber spinning and identify the Carreau-type elongational viscosity
+//! from your own TOML + CSV measurements.
+
+use clap::{Parser, Subcommand, ValueEnum};
+use diffbvp::fiber::diagnostics::candidates::{
+    physics_with, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+};
+use diffbvp::fiber::diagnostics::compare::{
+    compare, simulate_experiments, CompareOptions, FigureFormat, FitParameters, MissingTakeUp,
+    ModelSetup,
+};
+use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, ResidualProfiles};
+use diffbvp::fiber::diagnostics::report::save_residual_figure;
+use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
+use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
+use diffbvp::fiber::output::{create_dir, ensure_not_input, profiles_csv, write_text};
+use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
+use diffbvp::fiber::setup::TakeUp;
+use diffbvp::fiber::smoothing::smooth;
+use diffbvp::fiber::{CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::error::Error;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// `println!` that ignores a closed stdout (e.g. `rheometer ... | head`) instead of panicking.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+// after the macro, which they use
+mod compare;
+mod diagnose;
+mod fit;
+mod landscape;
+mod simulate;
+
+#[derive(Parser)]
+#[command(
+    name = "rheometer",
+    version,
+    about = "Simulation-based elongational rheometer for Carreau-type polymer melts",
+    long_about = "Simulates stationary melt spinning and identifies the Carreau-type elongational \
+viscosity (n, kappa = ln K) from fiber diameters measured along the spin line.",
+    after_help = "Examples:\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --json target/fit.json\n  \
+rheometer simulate data/pmma7n_synthetic/experiments.toml --take-up-from-data --out target/sim\n  \
+rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 21x21 --out target/landscape\n\n\
+Input format, outputs and error messages: see the book (mdbook build book)."
+)]
+struct Cli {
+    /// Print nothing but results and errors.
+    #[arg(long, global = true)]
+    quiet: bool,
+    /// Print more detail (solver statistics, iterations).
+    #[arg(long, short, global = true)]
+    verbose: bool,
+    /// Figure format.
+    #[arg(long, value_enum, global = true, default_value_t = FormatArg::Png)]
+    format: FormatArg,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum EstimatorArg {
+    /// Relative least squares against the raw data, take-up diameters fitted (default).
+    Principled,
+    /// The paper's strain-rate-weighted cost against the smoothed data.
+    Paper,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum FormatArg {
+    /// Bitmap figures.
+    Png,
+    /// Vector figures.
+    Svg,
+}
+
+impl FormatArg {
+    fn ext(self) -> &'static str {
+        match self {
+            FormatArg::Png => "png",
+            FormatArg::Svg => "svg",
+        }
+    }
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate every experiment and write profiles (CSV) and figures into DIR.
+    #[command(after_help = "Examples:\n  \
+rheometer simulate data/pmma7n_synthetic/experiments.toml --n 0.8 --kappa 11.71 \
+--take-up-from-data --out target/sim\n  \
+rheometer simulate data/pmma7n_synthetic/experiments.toml --newtonian --take-up-diameter 1e-4 \
+--out target/sim_newtonian\n\n\
+Writes DIR/<experiment>_profile.csv with the columns listed in the book's CLI reference, \
+DIR/profiles.png (diameter and temperature of all experiments) and, where measurements exist, \
+DIR/diameters_vs_data.png.")]
+    Simulate(simulate::SimulateArgs),
+    /// Identify (n, kappa) from the measurements and print an uncertainty report.
+    #[command(after_help = "Examples:\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --json target/fit.json\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --estimator paper --start 0.5,11.51\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --out target/fit\n  \
+rheometer fit data/pmma7n_synthetic/experiments.toml --newtonian")]
+    Fit(fit::FitArgs),
+    /// Which physical effect is missing from the model? Ranks the candidate effects by how
+    /// much of the misfit each explains (linearised scores, refits, delta BIC).
+    ///
+    /// Example: rheometer diagnose data/pmma7n_synthetic/experiments.toml --json
+    /// target/diagnose.json --out target/diagnose
+    Diagnose(diagnose::DiagnoseArgs),
+    /// Compute the cost landscape J(n, kappa) on a grid; write it as CSV and heat map.
+    #[command(after_help = "Examples:\n  \
+rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 41x41 --out target/landscape\n  \
+rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 11x11 --n-range 0.6,1 \
+--kappa-range 10,14 --estimator principled --out target/landscape_zoom\n\n\
+Writes DIR/landscape.csv with the columns n,kappa,cost and the heat map DIR/landscape.png.")]
+    Landscape(landscape::LandscapeArgs),
+    /// Compare the model with the measurements: residuals along the spin line, noise level,
+    /// chi2/dof, whiteness and where the misfit is systematic; text, JSON, CSV and figures.
+    ///
+    /// Example: rheometer compare data/pmma7n_synthetic/experiments.toml --fit target/fit.json
+    /// --out target/compare
+    Compare(compare::CompareArgs),
+}
+
+/// Options shared by every subcommand.
+pub struct Global {
+    /// Print nothing but results and errors.
+    pub quiet: bool,
+    /// Print more detail.
+    pub verbose: bool,
+    /// Figure format.
+    pub format: FormatArg,
+}
+
+impl Global {
+    /// A progress message on stderr (nothing with `--quiet`).
+    pub fn say(&self, s: String) {
+        if !self.quiet {
+            eprintln!("{s}");
+        }
+    }
+}
+
+fn parse_pair(s: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 2 {
+        return Err(format!("expected two numbers \"A,B\", got \"{s}\""));
+    }
+    let a: f64 = parts[0]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a number", parts[0]))?;
+    let b: f64 = parts[1]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a number", parts[1]))?;
+    if !a.is_finite() || !b.is_finite() {
+        return Err(format!("\"{s}\" contains a non-finite number"));
+    }
+    Ok((a, b))
+}
+
+fn parse_grid(s: &str) -> Result<(usize, usize), String> {
+    let parts: Vec<&str> = s.split(['x', 'X']).collect();
+    if parts.len() != 2 {
+        return Err(format!("expected \"NxM\", got \"{s}\""));
+    }
+    let a: usize = parts[0]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a count", parts[0]))?;
+    let b: usize = parts[1]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a count", parts[1]))?;
+    if a < 2 || b < 2 {
+        return Err("the grid needs at least 2 points per direction".into());
+    }
+    Ok((a, b))
+}
+
+fn inputs_of(path: &Path, loaded: &LoadedExperiments) -> Vec<PathBuf> {
+    let mut v = vec![path.to_path_buf()];
+    v.extend(loaded.details.iter().filter_map(|d| d.data.clone()));
+    v
+}
+
+fn estimator(e: EstimatorArg) -> Estimator {
+    match e {
+        EstimatorArg::Principled => Estimator::Principled,
+        EstimatorArg::Paper => Estimator::Paper,
+    }
+}
+
+fn write_json(path: &Path, text: &str, inputs: &[PathBuf]) -> Result<(), Box<dyn Error>> {
+    if let Some(parent) = path.parent() {
+        if !parent.as_os_str().is_empty() {
+            create_dir(parent)?;
+        }
+    }
+    write_text(path, text, inputs)?;
+    Ok(())
+}
+
+fn profiles_of(rh: &Rheometer, sols: &[diffbvp::Solution]) -> ResidualProfiles {
+    sols.iter()
+        .enumerate()
+        .map(|(k, s)| {
+            (
+                rh.experiments[k].name.clone(),
+                rh.measurements[k]
+                    .positions
+                    .iter()
+                    .copied()
+                    .zip(rh.relative_residuals(k, s))
+                    .collect(),
+            )
+        })
+        .collect()
+}
+
+fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
+    diffbvp::mesh::linspace(a, b, m)
+}
+
+/// The effects of a compared model: those of the fit file, overridden or extended by `--with`.
+fn compare_effects(
+    fit: Option<&FitParameters>,
+    with: &[EffectSetting],
+) -> Result<Vec<(Effect, f64)>, Box<dyn Error>> {
+    let mut out: Vec<(Effect, f64)> = Vec::new();
+    if let Some(f) = fit {
+        for e in &f.effects {
+            let effect: Effect = e.effect.parse()?;
+            out.push((effect, e.strength));
+        }
+    }
+    for w in with {
+        let name = w.effect.name();
+        let value = match (w.value, out.iter().find(|(e, _)| e.name() == name)) {
+            (Some(v), _) => v,
+            (None, Some((_, v))) => *v,
+            (None, None) => {
+                return Err(format!(
+                "--with {name}: give its strength as --with {name}=VALUE (the fit file has none)"
+            )
+                .into())
+            }
+        };
+        out.retain(|(e, _)| e.name() != name);
+        out.push((w.effect.clone(), value));
+    }
+    Ok(out)
+}
+
+fn read_fit(path: &Path) -> Result<FitParameters, Box<dyn Error>> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read the fit file {}: {e}", path.display()))?;
+    Ok(FitParameters::from_json(
+        &text,
+        &path.display().to_string(),
+    )?)
+}
+
+fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
+    let g = Global {
+        quiet: cli.quiet,
+        verbose: cli.verbose,
+        format: cli.format,
+    };
+    match cli.command {
+        Command::Simulate(a) => simulate::run(a, &g),
+        Command::Fit(a) => fit::run(a, &g),
+        Command::Diagnose(a) => diagnose::run(a, &g),
+        Command::Landscape(a) => landscape::run(a, &g),
+        Command::Compare(a) => compare::run(a, &g),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let mut printed = e.to_string();
+            eprintln!("error: {printed}");
+            let mut src = e.source();
+            while let Some(s) = src {
+                // messages that already quote their cause are not repeated
+                let text = s.to_string();
+                if !printed.contains(&text) {
+                    eprintln!("  caused by: {text}");
+                }
+                printed = text;
+                src = s.source();
+            }
+            ExitCode::FAILURE
+        }
+    }
+}

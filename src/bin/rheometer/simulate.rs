@@ -1,0 +1,139 @@
+//! `rheometer simulate`.
+
+use crate::*;
+use diffbvp::fiber::simulate;
+
+/// Arguments of `rheometer simulate`.
+#[derive(clap::Args)]
+pub struct SimulateArgs {
+    /// The experiments file (TOML; see the book for the format).
+    pub experiments: PathBuf,
+    /// Power index n of the Carreau-type law.
+    #[arg(long, default_value_t = 0.8)]
+    pub n: f64,
+    /// kappa = ln(K / 1 Pa) of the Carreau-type law.
+    #[arg(long, default_value_t = 11.71)]
+    pub kappa: f64,
+    /// Use the Newtonian law (n = 1).
+    #[arg(long)]
+    pub newtonian: bool,
+    /// Take-up diameter (m) for experiments without one in the TOML.
+    #[arg(long)]
+    pub take_up_diameter: Option<f64>,
+    /// Take the take-up diameter d_fit(L) from the smoothed measurements where the TOML has none.
+    #[arg(long)]
+    pub take_up_from_data: bool,
+    /// Number of uniform output positions.
+    #[arg(long, default_value_t = 101)]
+    pub points: usize,
+    /// Output directory (created; input files are never overwritten).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Runs `rheometer simulate`.
+pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
+    let SimulateArgs {
+        experiments,
+        n,
+        kappa,
+        newtonian,
+        take_up_diameter,
+        take_up_from_data,
+        points,
+        out,
+    } = args;
+    let loaded = load_experiments_with(&experiments, 4)?;
+    let inputs = inputs_of(&experiments, &loaded);
+    let set = &loaded.set;
+    create_dir(&out)?;
+    let law = if newtonian { [1.0, kappa] } else { [n, kappa] };
+    let mut all_profiles = Vec::with_capacity(set.experiments.len());
+    for (k, e) in set.experiments.iter().enumerate() {
+        let mut e = e.clone();
+        if e.take_up.is_none() {
+            if let Some(d) = take_up_diameter {
+                e.take_up = Some(TakeUp::Diameter(d));
+            } else if take_up_from_data {
+                let m = set.measurements[k].as_ref().ok_or_else(|| {
+                    format!(
+                        "experiment {}: --take-up-from-data needs measurements",
+                        e.name
+                    )
+                })?;
+                let f = smooth(&m.positions, &m.diameters)?;
+                e.take_up = Some(TakeUp::Diameter(f.diameter(e.spinline_length)));
+            } else {
+                return Err(format!(
+                    "experiment {} has no take-up condition: give take_up_diameter_m or take_up_velocity_m_s \
+                     in {}, or use --take-up-diameter M or --take-up-from-data",
+                    e.name,
+                    experiments.display()
+                )
+                .into());
+            }
+        }
+        let model = FiberModel::new(
+            &set.material,
+            &set.air,
+            &e,
+            CarreauLike::new(),
+            Physics::paper(),
+        )?;
+        let sol = simulate(&model, &law, &SimulateOptions::default())?;
+        let prof = sol.uniform_profiles(&model, points.max(2));
+        let path = out.join(format!("{}_profile.csv", e.name));
+        write_text(&path, &profiles_csv(&prof), &inputs)?;
+        if g.verbose {
+            g.say(format!(
+                "{}: {} nodes, T(L) = {:.2} K, d(L) = {:.3} µm -> {}",
+                e.name,
+                sol.nodes(),
+                prof.temperature[prof.temperature.len() - 1],
+                1e6 * prof.diameter[prof.diameter.len() - 1],
+                path.display()
+            ));
+        }
+        all_profiles.push(prof);
+    }
+    let names: Vec<&str> = set.experiments.iter().map(|e| e.name.as_str()).collect();
+    let fig = out.join(format!("profiles.{}", g.format.ext()));
+    figures::profile_overview(&fig, &names, &all_profiles, &inputs)?;
+    let with_data: Vec<usize> = (0..set.experiments.len())
+        .filter(|&k| set.measurements[k].is_some())
+        .collect();
+    if !with_data.is_empty() {
+        let views: Vec<ExperimentView> = with_data
+            .iter()
+            .filter_map(|&k| {
+                let m = set.measurements[k].as_ref()?;
+                Some(ExperimentView {
+                    name: &set.experiments[k].name,
+                    length: set.experiments[k].spinline_length,
+                    positions: &m.positions,
+                    diameters: &m.diameters,
+                    smooth: None,
+                })
+            })
+            .collect();
+        let profs: Vec<_> = with_data.iter().map(|&k| all_profiles[k].clone()).collect();
+        let label = if newtonian {
+            "Newtonian (n = 1)".to_string()
+        } else {
+            format!("n = {n}, κ = {kappa}")
+        };
+        let curves = [ModelCurves {
+            label: &label,
+            profiles: &profs,
+            dashed: false,
+        }];
+        let fig = out.join(format!("diameters_vs_data.{}", g.format.ext()));
+        figures::experiment_panels(&fig, &views, &curves, View::Diameter, &inputs)?;
+    }
+    g.say(format!(
+        "wrote {} profiles and figures to {}",
+        set.experiments.len(),
+        out.display()
+    ));
+    Ok(())
+}
