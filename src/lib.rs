@@ -42,6 +42,16 @@
 //!
 //! Modules read like the method: [`mesh`], collocation, Newton, [`solve`](mod@solve) (adaptive
 //! loop), [`solution`] (interpolant), [`continuation`], [`sensitivity`], [`inspect`].
+//!
+//! ## Cargo features
+//!
+//! | feature | default | what it adds |
+//! |---|---|---|
+//! | `plots` | yes | [`plot`]: PNG/SVG figures through plotters (shipped font, no system fonts) |
+//! | `rheometer` | yes | `fiber`: the fiber-spinning model, the rheometer, TOML/CSV input, the `rheometer` program (implies `plots`) |
+//!
+//! The toolkit alone (`default-features = false`) depends on num-dual, faer, nalgebra,
+//! num-traits and thiserror only.
 #![warn(missing_docs)]
 // Numerical kernels index several arrays with the same loop variable, as the formulas do.
 #![allow(clippy::needless_range_loop)]
@@ -51,12 +61,14 @@ mod dual_jacobian;
 pub mod dyn_dual;
 pub mod error;
 mod error_control;
+#[cfg(feature = "rheometer")]
 pub mod fiber;
 pub mod inspect;
 pub mod least_squares;
 pub mod linear;
 pub mod mesh;
 mod newton;
+#[cfg(feature = "plots")]
 pub mod plot;
 pub mod problem;
 pub mod sensitivity;
