@@ -160,6 +160,55 @@ pub fn experiment_panels(
     Ok(())
 }
 
+/// Most experiment panels in one figure file (8 rows of 3: 1260 × 2560 pixels); more are split
+/// over several files by [`experiment_panel_pages`].
+pub const MAX_PANELS_PER_FIGURE: usize = 24;
+
+/// Like [`experiment_panels`], split into figures of at most [`MAX_PANELS_PER_FIGURE`] panels
+/// so that any number of experiments can be drawn: up to that many, `path` itself; beyond,
+/// `STEM_1.EXT`, `STEM_2.EXT`, … next to it. Returns the paths written.
+pub fn experiment_panel_pages(
+    path: &Path,
+    experiments: &[ExperimentView<'_>],
+    curves: &[ModelCurves<'_>],
+    view: View,
+    inputs: &[PathBuf],
+) -> Result<Vec<PathBuf>, FigureError> {
+    if experiments.len() <= MAX_PANELS_PER_FIGURE {
+        experiment_panels(path, experiments, curves, view, inputs)?;
+        return Ok(vec![path.to_path_buf()]);
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    let mut written = Vec::new();
+    for (page, start) in (0..experiments.len())
+        .step_by(MAX_PANELS_PER_FIGURE)
+        .enumerate()
+    {
+        let end = (start + MAX_PANELS_PER_FIGURE).min(experiments.len());
+        let page_curves: Vec<ModelCurves<'_>> = curves
+            .iter()
+            .map(|c| ModelCurves {
+                profiles: c
+                    .profiles
+                    .get(start..end.min(c.profiles.len()))
+                    .unwrap_or(&[]),
+                ..*c
+            })
+            .collect();
+        let p = path.with_file_name(format!("{stem}_{}{ext}", page + 1));
+        experiment_panels(&p, &experiments[start..end], &page_curves, view, inputs)?;
+        written.push(p);
+    }
+    Ok(written)
+}
+
 /// Simulated diameter (log scale) and temperature profiles of all experiments in two panels
 /// side by side, one line per experiment. Writes `path`.
 pub fn profile_overview(
