@@ -42,21 +42,25 @@ fn retry_bisections(step: f64) -> u32 {
 }
 
 /// Cost at `(to, κ)` reached from the current warm starts (at `from`): directly, or by
-/// recursively halving the step up to `depth` times.
+/// recursively halving the step up to `depth` times (giving up early once `cancel` is set).
 fn walk(
     obj: &mut Objective<'_>,
     from: f64,
     to: f64,
     kappa: f64,
     depth: u32,
+    cancel: &AtomicBool,
 ) -> Result<f64, RheometerError> {
+    if cancel.load(Ordering::Relaxed) {
+        return Err(RheometerError::Data("the landscape was cancelled".into()));
+    }
     match obj.try_cost_at(to, kappa) {
         Ok(c) => Ok(c),
         Err(e) if depth == 0 => Err(e),
         Err(_) => {
             let mid = 0.5 * (from + to);
-            walk(obj, from, mid, kappa, depth - 1)?;
-            walk(obj, mid, to, kappa, depth - 1)
+            walk(obj, from, mid, kappa, depth - 1, cancel)?;
+            walk(obj, mid, to, kappa, depth - 1, cancel)
         }
     }
 }
@@ -228,7 +232,7 @@ impl Rheometer {
                             let r = obj.try_cost_at(n, k).or_else(|_| {
                                 // retry from the neighbour itself, bisecting the step
                                 obj.set_solutions(&last.1);
-                                walk(obj, last.0, n, k, retry_bisections(n - last.0))
+                                walk(obj, last.0, n, k, retry_bisections(n - last.0), cancel)
                             });
                             match r {
                                 Ok(c) => {
@@ -237,7 +241,16 @@ impl Rheometer {
                                     let sols = obj.solutions();
                                     before = Some(std::mem::replace(&mut last, (n, sols)));
                                 }
-                                Err(_) => break,
+                                Err(_) => {
+                                    // a retry given up because of the cancellation: the point
+                                    // and the rest of the row were not reached, not failed
+                                    if cancel.load(Ordering::Relaxed) {
+                                        for &rest in &order[pos..] {
+                                            status[rest] = PointStatus::NotReached;
+                                        }
+                                    }
+                                    break;
+                                }
                             }
                         }
                     }
