@@ -521,8 +521,36 @@ fn interrupt(args: &[&str], watch: &[&Path], ready: impl Fn() -> bool) -> (Probe
         .status()
         .unwrap();
     assert!(kill.success());
-    let out = child.wait_with_output().unwrap();
+    // drain the pipes on threads; kill the child if it does not stop within 10 s
+    let mut so = child.stdout.take().unwrap();
+    let mut se = child.stderr.take().unwrap();
+    let t_out = std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let _ = std::io::Read::read_to_end(&mut so, &mut v);
+        v
+    });
+    let t_err = std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let _ = std::io::Read::read_to_end(&mut se, &mut v);
+        v
+    });
+    let status = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        if sent.elapsed() > Duration::from_secs(10) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{args:?} still running 10 s after SIGINT: killed");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
     let stop = sent.elapsed();
+    let out = std::process::Output {
+        status,
+        stdout: t_out.join().unwrap(),
+        stderr: t_err.join().unwrap(),
+    };
     let changed_inputs = watch
         .iter()
         .zip(&before)
@@ -598,8 +626,8 @@ fn sigint_during_landscape_keeps_the_finished_points() {
     let (dir, toml, data) = data("sigint_landscape");
     let out = dir.join("land");
     let t0 = Instant::now();
-    // the default 41x41 grid runs for tens of seconds
-    let ready = || t0.elapsed() > Duration::from_millis(2500);
+    // the default 41x41 grid runs for tens of seconds (about 70 points per second here)
+    let ready = || t0.elapsed() > Duration::from_millis(1500);
     let (p, stop) = interrupt(&["landscape", s(&toml), "--out", s(&out)], &[&data], ready);
     assert!(!p.panicked(), "{}", p.stderr);
     assert_eq!(p.code, Some(130), "{}", p.stderr);
@@ -795,4 +823,48 @@ fn library_landscape_cancelled_up_front_reaches_no_point() {
         .landscape(&[0.7, 0.9], &[11.0, 12.0], &opts, |_| {})
         .unwrap();
     assert_eq!(plain.cost, full.landscape.cost);
+}
+
+#[test]
+fn sigint_during_fit_and_compare_still_stops_at_once() {
+    // commands without a clean stop keep the default: SIGINT ends them immediately, and their
+    // outputs (written atomically, at the end) are never half-written
+    let (dir, _toml, data) = data("sigint_fit_compare");
+    let toml = many_experiments(&data, "many.toml", 40); // 360 experiments
+    let t0 = Instant::now();
+    let json = dir.join("fit.json");
+    let (p, stop) = interrupt(&["fit", s(&toml), "--json", s(&json)], &[&data], || {
+        t0.elapsed() > Duration::from_millis(800)
+    });
+    assert!(!p.panicked(), "{}", p.stderr);
+    assert_ne!(p.code, Some(0), "{p:?}");
+    assert!(stop < Duration::from_secs(2), "fit took {stop:?} to stop");
+    assert!(!json.exists());
+    p.assert_inputs_unchanged();
+
+    let out = dir.join("cmp");
+    let t1 = Instant::now();
+    let (p, stop) = interrupt(
+        &[
+            "compare",
+            s(&toml),
+            "--n",
+            "0.8",
+            "--kappa",
+            "11.71",
+            "--take-up-from-data",
+            "--out",
+            s(&out),
+        ],
+        &[&data],
+        || t1.elapsed() > Duration::from_millis(800),
+    );
+    assert!(!p.panicked(), "{}", p.stderr);
+    assert_ne!(p.code, Some(0), "{p:?}");
+    assert!(
+        stop < Duration::from_secs(2),
+        "compare took {stop:?} to stop"
+    );
+    assert!(temporaries(&out).is_empty(), "{:?}", temporaries(&out));
+    p.assert_inputs_unchanged();
 }
