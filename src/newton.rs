@@ -121,7 +121,10 @@ pub(crate) fn newton<P: Bvp>(
         }
         let step_inf = alpha * inf_norm(&work.step);
         if settings.verbose >= 2 {
-            eprintln!(
+            // a failed write to stderr must not panic
+            use std::io::Write as _;
+            let _ = writeln!(
+                std::io::stderr(),
                 "    newton {iterations:>3}: damping {alpha:<6} |step|_inf {step_inf:.3e} |J^-1 F|^2 {cost:.3e}"
             );
         }

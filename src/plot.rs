@@ -48,6 +48,7 @@
 use std::error::Error as StdError;
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
 
 use plotters::coord::ranged1d::{Ranged, ValueFormatter};
@@ -429,7 +430,8 @@ fn ensure_font() -> bool {
     })
 }
 
-/// Validates, renders in memory, and only then creates directories and writes `path`.
+/// Validates, renders in memory, and only then creates directories and writes `path` (through a
+/// temporary sibling renamed into place).
 fn write_figure<F: Figure>(path: &Path, size: (u32, u32), figure: &F) -> Result<(), PlotError> {
     let format = format_of(path)?;
     let (w, h) = size;
@@ -476,16 +478,39 @@ fn write_figure<F: Figure>(path: &Path, size: (u32, u32), figure: &F) -> Result<
             fs::create_dir_all(parent).map_err(io_err)?;
         }
     }
-    match format {
+    // written to a temporary sibling and renamed into place: never a half-written figure, and
+    // an existing file (or hard link) at `path` is replaced, not truncated
+    let tmp = temporary_sibling(path);
+    let written = match format {
         Format::Png => {
-            let mut backend = BitMapBackend::new(path, size);
-            let written = backend
+            let mut backend = BitMapBackend::new(&tmp, size);
+            backend
                 .blit_bitmap((0, 0), size, &rgb)
-                .and_then(|()| backend.present());
-            written.map_err(|e| draw_err(Box::new(e)))
+                .and_then(|()| backend.present())
+                .map_err(|e| draw_err(Box::new(e)))
         }
-        Format::Svg => fs::write(path, svg).map_err(io_err),
+        Format::Svg => fs::write(&tmp, svg).map_err(io_err),
     }
+    .and_then(|()| fs::rename(&tmp, path).map_err(io_err));
+    if written.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    written
+}
+
+/// A fresh temporary path next to `path` with the same extension (`.NAME.tmp-PID-N.EXT`).
+fn temporary_sibling(path: &Path) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "figure".into());
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.tmp-{}-{n}{ext}", std::process::id()))
 }
 
 fn render<DB, F>(root: &DrawingArea<DB, Shift>, figure: &F) -> DrawResult

@@ -393,7 +393,10 @@ impl<'a, P: Bvp> Solver<'a, P> {
 
             let added = mesh::mark_refinement(&self.rms, opts.tol, &mut self.marks);
             if opts.verbose >= 1 {
-                eprintln!(
+                // a failed write to stderr must not panic
+                use std::io::Write as _;
+                let _ = writeln!(
+                    std::io::stderr(),
                     "mesh {iteration:>3}: {m:>6} nodes, Newton {:>2} it ({}), max rms residual {max_res:.2e}, max bc residual {max_bc_res:.2e}, nodes to add {added}",
                     report.iterations,
                     if report.converged { "converged" } else { "not converged" }

@@ -160,6 +160,55 @@ pub fn experiment_panels(
     Ok(())
 }
 
+/// Most experiment panels in one figure file (8 rows of 3: 1260 × 2560 pixels); more are split
+/// over several files by [`experiment_panel_pages`].
+pub const MAX_PANELS_PER_FIGURE: usize = 24;
+
+/// Like [`experiment_panels`], split into figures of at most [`MAX_PANELS_PER_FIGURE`] panels
+/// so that any number of experiments can be drawn: up to that many, `path` itself; beyond,
+/// `STEM_1.EXT`, `STEM_2.EXT`, … next to it. Returns the paths written.
+pub fn experiment_panel_pages(
+    path: &Path,
+    experiments: &[ExperimentView<'_>],
+    curves: &[ModelCurves<'_>],
+    view: View,
+    inputs: &[PathBuf],
+) -> Result<Vec<PathBuf>, FigureError> {
+    if experiments.len() <= MAX_PANELS_PER_FIGURE {
+        experiment_panels(path, experiments, curves, view, inputs)?;
+        return Ok(vec![path.to_path_buf()]);
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    let mut written = Vec::new();
+    for (page, start) in (0..experiments.len())
+        .step_by(MAX_PANELS_PER_FIGURE)
+        .enumerate()
+    {
+        let end = (start + MAX_PANELS_PER_FIGURE).min(experiments.len());
+        let page_curves: Vec<ModelCurves<'_>> = curves
+            .iter()
+            .map(|c| ModelCurves {
+                profiles: c
+                    .profiles
+                    .get(start..end.min(c.profiles.len()))
+                    .unwrap_or(&[]),
+                ..*c
+            })
+            .collect();
+        let p = path.with_file_name(format!("{stem}_{}{ext}", page + 1));
+        experiment_panels(&p, &experiments[start..end], &page_curves, view, inputs)?;
+        written.push(p);
+    }
+    Ok(written)
+}
+
 /// Simulated diameter (log scale) and temperature profiles of all experiments in two panels
 /// side by side, one line per experiment. Writes `path`.
 pub fn profile_overview(
@@ -219,7 +268,8 @@ pub fn landscape_map(
 /// (`"png"` or `"svg"`): `fig2_smoothing` (measured diameters with the smooth fit),
 /// `fig3_newtonian_vs_identified` (the Newtonian model `n = 1` at the identified κ with the
 /// take-up diameters `d_fit(L)`, and the identified law), and `fig5_inverse_square` (the
-/// velocity-like `1/d²` view). Returns the paths written.
+/// velocity-like `1/d²` view), each split into `NAME_1`, `NAME_2`, … beyond
+/// [`MAX_PANELS_PER_FIGURE`] experiments. Returns the paths written.
 pub fn identification_figures(
     rh: &Rheometer,
     id: &Identification,
@@ -271,25 +321,32 @@ pub fn identification_figures(
         .iter()
         .map(|v| ExperimentView { smooth: None, ..*v })
         .collect();
+    let mut written = Vec::new();
     let f2 = dir.join(format!("fig2_smoothing.{ext}"));
-    experiment_panels(&f2, &views, &[], View::Diameter, inputs)?;
+    written.extend(experiment_panel_pages(
+        &f2,
+        &views,
+        &[],
+        View::Diameter,
+        inputs,
+    )?);
     let f3 = dir.join(format!("fig3_newtonian_vs_identified.{ext}"));
-    experiment_panels(
+    written.extend(experiment_panel_pages(
         &f3,
         &no_smooth,
         &[fitted, newt_curves],
         View::Diameter,
         inputs,
-    )?;
+    )?);
     let f5 = dir.join(format!("fig5_inverse_square.{ext}"));
-    experiment_panels(
+    written.extend(experiment_panel_pages(
         &f5,
         &views,
         &[fitted, newt_curves],
         View::InverseSquare,
         inputs,
-    )?;
-    Ok(vec![f2, f3, f5])
+    )?);
+    Ok(written)
 }
 
 #[cfg(test)]
@@ -340,5 +397,79 @@ mod tests {
             experiment_panels(&path, &[e], &curves, view, &[]).unwrap();
             assert!(std::fs::metadata(&path).unwrap().len() > 100);
         }
+    }
+
+    #[test]
+    fn many_panels_are_split_into_pages_of_their_own_experiments() {
+        let dir =
+            std::env::temp_dir().join(format!("diffbvp-figures-pages-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let s = [0.0, 0.5, 1.0];
+        let d = [1e-3, 3e-4, 1e-4];
+        let k = 2 * MAX_PANELS_PER_FIGURE + 1;
+        let names: Vec<String> = (0..k).map(|i| format!("e{i}")).collect();
+        let views: Vec<ExperimentView> = names
+            .iter()
+            .map(|n| ExperimentView {
+                name: n,
+                length: 1.0,
+                positions: &s,
+                diameters: &d,
+                smooth: None,
+            })
+            .collect();
+        let profiles: Vec<Profiles> = (0..k)
+            .map(|_| Profiles {
+                position: s.to_vec(),
+                diameter: d.to_vec(),
+                ..Profiles::default()
+            })
+            .collect();
+        let curves = [ModelCurves {
+            label: "model",
+            profiles: &profiles,
+            dashed: false,
+        }];
+        let path = dir.join("panels.svg");
+        let pages = experiment_panel_pages(&path, &views, &curves, View::Diameter, &[]).unwrap();
+        assert_eq!(pages.len(), 3);
+        assert!(!path.exists());
+        // 24 panels are 3 × 8 (1260 × 2560 pixels), the last page holds one panel
+        let sizes = [
+            "width=\"1260\" height=\"2560\"",
+            "width=\"1260\" height=\"2560\"",
+            "width=\"420\" height=\"320\"",
+        ];
+        for (i, (p, size)) in pages.iter().zip(sizes).enumerate() {
+            assert_eq!(p, &dir.join(format!("panels_{}.svg", i + 1)));
+            let svg = std::fs::read_to_string(p).unwrap();
+            assert!(
+                svg[..svg.len().min(300)].contains(size),
+                "{}: {}",
+                p.display(),
+                &svg[..200]
+            );
+            // page i shows the experiments 24 i … 24 i + 23 (titles as SVG text lines)
+            let first = MAX_PANELS_PER_FIGURE * i;
+            let last = (first + MAX_PANELS_PER_FIGURE).min(k) - 1;
+            for e in [first, last] {
+                assert!(
+                    svg.contains(&format!("e{e}\n")),
+                    "{} lacks e{e}",
+                    p.display()
+                );
+            }
+            if i > 0 {
+                assert!(
+                    !svg.contains(&format!("e{}\n", first - 1)),
+                    "{}",
+                    p.display()
+                );
+            }
+        }
+        // few experiments: the path itself
+        let one = experiment_panel_pages(&path, &views[..3], &curves, View::Diameter, &[]).unwrap();
+        assert_eq!(one, vec![path.clone()]);
+        assert!(path.is_file());
     }
 }

@@ -40,6 +40,11 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     } = args;
     let loaded = load_experiments_with(&experiments, 4)?;
     let inputs = inputs_of(&experiments, &loaded);
+    let outputs = [
+        "landscape.csv".to_string(),
+        format!("landscape.{}", g.format.ext()),
+    ];
+    check_output_dir(&out, &outputs, &inputs)?;
     let rh = Rheometer::new(&loaded.set)?;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
     if !(tol > 0.0 && tol < 1.0) {
@@ -60,17 +65,45 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         b
     };
     let t0 = std::time::Instant::now();
-    let l = rh.landscape(&ns, &ks, &opts, |d| bar.set_position(d as u64))?;
+    let run = rh.landscape_with(
+        &ns,
+        &ks,
+        &opts,
+        |d| bar.set_position(d as u64),
+        &INTERRUPTED,
+    )?;
     bar.finish_and_clear();
     create_dir(&out)?;
-    let mut csv = String::from("n,kappa,cost\n");
-    for (j, k) in ks.iter().enumerate() {
-        for (i, n) in ns.iter().enumerate() {
-            csv.push_str(&format!("{n},{k},{:e}\n", l.cost[j * ns.len() + i]));
-        }
-    }
     let path = out.join("landscape.csv");
-    write_text(&path, &csv, &inputs)?;
+    write_atomically(&path, &inputs, |w| write_landscape_csv(w, &run))?;
+    let total = run.status.len();
+    let failed = run.failed();
+    if run.cancelled {
+        return Err(Interrupted(format!(
+            "finished {} of {total} grid points ({} computed, {failed} failed); {} keeps \
+             them, the {} points not computed have status not_computed; no figure written",
+            total - run.not_reached(),
+            run.count(PointStatus::Computed),
+            path.display(),
+            run.not_reached()
+        ))
+        .into());
+    }
+    let l = run.landscape;
+    if failed > 0 {
+        outln!(
+            "{failed} of {total} grid points failed (no solution there; cost NaN, grey in the \
+             figure, status failed in the CSV)"
+        );
+    }
+    if 2 * failed > total {
+        g.warn(format!(
+            "most grid points failed ({failed} of {total}): the ranges --n-range {},{} \
+             --kappa-range {},{} reach far beyond where the model has a solution for these \
+             experiments; narrow them",
+            n_range.0, n_range.1, kappa_range.0, kappa_range.1
+        ));
+    }
     let mut markers = Vec::new();
     if let Some((n, k, c)) = l.minimum() {
         outln!("grid minimum: n = {n:.4}, kappa = {k:.4}, J = {c:.6e}");
@@ -85,5 +118,24 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         t0.elapsed().as_secs_f64(),
         path.display()
     ));
+    Ok(())
+}
+
+/// Writes the landscape as CSV `n,kappa,cost,status`, one row per grid point (`n` varying
+/// fastest); status is `ok`, `failed` (cost NaN: no solution) or `not_computed` (interrupted).
+fn write_landscape_csv(w: &mut dyn std::io::Write, run: &LandscapeRun) -> std::io::Result<()> {
+    let l = &run.landscape;
+    writeln!(w, "n,kappa,cost,status")?;
+    for (j, k) in l.kappa.iter().enumerate() {
+        for (i, n) in l.n.iter().enumerate() {
+            let idx = j * l.n.len() + i;
+            let status = match run.status[idx] {
+                PointStatus::Computed => "ok",
+                PointStatus::Failed => "failed",
+                PointStatus::NotReached => "not_computed",
+            };
+            writeln!(w, "{n},{k},{:e},{status}", l.cost[idx])?;
+        }
+    }
     Ok(())
 }

@@ -13,8 +13,13 @@ use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, ResidualP
 use diffbvp::fiber::diagnostics::report::save_residual_figure;
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
-use diffbvp::fiber::output::{create_dir, ensure_not_input, profiles_csv, write_text};
-use diffbvp::fiber::rheometer::{Estimator, FitReport, IdentifyOptions, Rheometer};
+use diffbvp::fiber::output::{
+    check_output_dir, create_dir, ensure_not_input, profiles_csv, write_atomically, write_profiles,
+    write_text,
+};
+use diffbvp::fiber::rheometer::{
+    Estimator, FitReport, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
+};
 use diffbvp::fiber::setup::TakeUp;
 use diffbvp::fiber::smoothing::smooth;
 use diffbvp::fiber::{CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions};
@@ -23,12 +28,93 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// `println!` that ignores a closed stdout (e.g. `rheometer ... | head`) instead of panicking.
+/// `println!` that never panics: a closed stdout (e.g. `rheometer ... | head`) is ignored,
+/// any other write error (e.g. `> /dev/full`) is remembered and makes the program exit 1 at the
+/// end (see [`out_line`]).
 macro_rules! outln {
     ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
+        $crate::out_line(format_args!($($arg)*));
     }};
+}
+
+/// The first error writing to stdout other than a closed pipe.
+static STDOUT_ERROR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
+/// Set by the first SIGINT while `simulate` or `landscape` runs: they stop between experiments
+/// or grid points, keep and mark what they finished, and exit with code 130. A second SIGINT
+/// ends the program at once.
+pub static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Whether SIGINT was received (see [`INTERRUPTED`]).
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst)
+}
+
+/// A command stopped by SIGINT after keeping what it finished: reported as
+/// `interrupted: MESSAGE`, exit code 130.
+#[derive(Debug)]
+pub struct Interrupted(pub String);
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl Error for Interrupted {}
+
+/// Exit code after SIGINT (128 + 2, the shell's convention).
+const EXIT_INTERRUPTED: u8 = 130;
+
+/// Writes one line to stdout; remembers the first failure other than a closed pipe.
+pub fn out_line(args: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let mut o = std::io::stdout().lock();
+    if let Err(e) = o.write_fmt(args).and_then(|()| o.write_all(b"\n")) {
+        note_stdout_error(&e);
+    }
+}
+
+fn note_stdout_error(e: &std::io::Error) {
+    if e.kind() != std::io::ErrorKind::BrokenPipe {
+        let _ = STDOUT_ERROR.set(e.to_string());
+    }
+}
+
+/// Writes one line to stderr, ignoring failures (`2>/dev/full` must not panic).
+pub fn err_line(s: &str) {
+    use std::io::Write as _;
+    let mut e = std::io::stderr().lock();
+    let _ = e.write_all(s.as_bytes()).and_then(|()| e.write_all(b"\n"));
+}
+
+/// SIGINT handling for the commands that stop cleanly.
+#[cfg(unix)]
+mod sigint {
+    use std::sync::atomic::Ordering;
+
+    extern "C" fn on_sigint(_: libc::c_int) {
+        // async-signal-safe only: an atomic swap, and _exit on the second signal
+        if super::INTERRUPTED.swap(true, Ordering::SeqCst) {
+            // SAFETY: _exit is async-signal-safe and takes no pointers
+            unsafe { libc::_exit(i32::from(super::EXIT_INTERRUPTED)) };
+        }
+    }
+
+    /// Installs the handler setting [`super::INTERRUPTED`].
+    pub fn install() {
+        let handler: extern "C" fn(libc::c_int) = on_sigint;
+        // SAFETY: the handler only touches an atomic and calls _exit, both async-signal-safe
+        unsafe {
+            libc::signal(libc::SIGINT, handler as libc::sighandler_t);
+        }
+    }
+}
+
+#[cfg(not(unix))]
+mod sigint {
+    /// Elsewhere SIGINT keeps its default (the program ends at once).
+    pub fn install() {}
 }
 
 // after the macro, which they use
@@ -100,7 +186,9 @@ rheometer simulate data/pmma7n_synthetic/experiments.toml --newtonian --take-up-
 --out target/sim_newtonian\n\n\
 Writes DIR/<experiment>_profile.csv with the columns listed in the book's CLI reference, \
 DIR/profiles.png (diameter and temperature of all experiments) and, where measurements exist, \
-DIR/diameters_vs_data.png.")]
+DIR/diameters_vs_data.png (split into diameters_vs_data_1.png, ... beyond 24 experiments). \
+DIR/PARTIAL.txt lists finished and missing profiles while the run is incomplete (running, \
+failed, or stopped by Ctrl-C: exit code 130); it is removed when every profile is written.")]
     Simulate(simulate::SimulateArgs),
     /// Identify (n, kappa) from the measurements and print an uncertainty report.
     #[command(after_help = "Examples:\n  \
@@ -120,7 +208,8 @@ rheometer fit data/pmma7n_synthetic/experiments.toml --newtonian")]
 rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 41x41 --out target/landscape\n  \
 rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 11x11 --n-range 0.6,1 \
 --kappa-range 10,14 --estimator principled --out target/landscape_zoom\n\n\
-Writes DIR/landscape.csv with the columns n,kappa,cost and the heat map DIR/landscape.png.")]
+Writes DIR/landscape.csv with the columns n,kappa,cost,status (ok, failed or not_computed) \
+and the heat map DIR/landscape.png. Ctrl-C stops it, keeping the finished points (exit code 130).")]
     Landscape(landscape::LandscapeArgs),
     /// Compare the model with the measurements: residuals along the spin line, noise level,
     /// chi2/dof, whiteness and where the misfit is systematic; text, JSON, CSV and figures.
@@ -144,8 +233,13 @@ impl Global {
     /// A progress message on stderr (nothing with `--quiet`).
     pub fn say(&self, s: String) {
         if !self.quiet {
-            eprintln!("{s}");
+            err_line(&s);
         }
+    }
+
+    /// A warning on stderr (`warning: ...`), printed even with `--quiet`.
+    pub fn warn(&self, s: String) {
+        err_line(&format!("warning: {s}"));
     }
 }
 
@@ -286,23 +380,80 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
         Err(e) => {
+            // usage errors on stderr (exit 2), --help and --version on stdout (exit 0)
+            if let Err(w) = e.print() {
+                if !e.use_stderr() {
+                    note_stdout_error(&w);
+                }
+            }
+            return match finish_stdout() {
+                Err(()) => ExitCode::FAILURE,
+                Ok(()) => ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(1)),
+            };
+        }
+    };
+    if matches!(cli.command, Command::Simulate(_) | Command::Landscape(_)) {
+        sigint::install();
+        interrupt_watchdog();
+    }
+    let result = run(cli);
+    let stdout_ok = finish_stdout();
+    match result {
+        Ok(()) if stdout_ok.is_ok() => ExitCode::SUCCESS,
+        Ok(()) => ExitCode::FAILURE,
+        Err(e) => {
+            if let Some(i) = e.downcast_ref::<Interrupted>() {
+                err_line(&format!("interrupted: {i}"));
+                return ExitCode::from(EXIT_INTERRUPTED);
+            }
             let mut printed = e.to_string();
-            eprintln!("error: {printed}");
+            err_line(&format!("error: {printed}"));
             let mut src = e.source();
             while let Some(s) = src {
                 // messages that already quote their cause are not repeated
                 let text = s.to_string();
                 if !printed.contains(&text) {
-                    eprintln!("  caused by: {text}");
+                    err_line(&format!("  caused by: {text}"));
                 }
                 printed = text;
                 src = s.source();
             }
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Grace period after SIGINT before the program is ended regardless (a single solve that
+/// does not check the flag); outputs are written atomically and `simulate` keeps its
+/// `PARTIAL.txt` manifest up to date, so ending here loses no finished file.
+const INTERRUPT_GRACE: std::time::Duration = std::time::Duration::from_millis(1500);
+
+/// Starts a thread that ends the program [`INTERRUPT_GRACE`] after SIGINT.
+fn interrupt_watchdog() {
+    std::thread::spawn(|| {
+        while !interrupted() {
+            std::thread::sleep(std::time::Duration::from_millis(25));
+        }
+        std::thread::sleep(INTERRUPT_GRACE);
+        err_line("interrupted: stopped before the current step finished; finished files are kept");
+        std::process::exit(i32::from(EXIT_INTERRUPTED));
+    });
+}
+
+/// Flushes stdout; reports (on stderr) the first stdout write error other than a closed pipe.
+fn finish_stdout() -> Result<(), ()> {
+    use std::io::Write as _;
+    if let Err(e) = std::io::stdout().flush() {
+        note_stdout_error(&e);
+    }
+    match STDOUT_ERROR.get() {
+        Some(e) => {
+            err_line(&format!("error: cannot write to standard output: {e}"));
+            Err(())
+        }
+        None => Ok(()),
     }
 }

@@ -46,10 +46,33 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let loaded = load_experiments_with(&experiments, 4)?;
     let inputs = inputs_of(&experiments, &loaded);
     let set = &loaded.set;
+    // every output name is checked against the inputs before any work starts
+    let names: Vec<&str> = set.experiments.iter().map(|e| e.name.as_str()).collect();
+    let ext = g.format.ext();
+    let mut outputs: Vec<String> = names.iter().map(|n| format!("{n}_profile.csv")).collect();
+    outputs.extend([
+        PARTIAL.to_string(),
+        format!("profiles.{ext}"),
+        format!("diameters_vs_data.{ext}"),
+    ]);
+    check_output_dir(&out, &outputs, &inputs)?;
     create_dir(&out)?;
+    // the manifest stays until every profile is written: an interrupted or failed run (or
+    // one still running) is always marked, with the finished experiments listed
+    let mut complete: Vec<&str> = Vec::with_capacity(names.len());
+    write_partial(&out, &names, &complete, &inputs)?;
     let law = if newtonian { [1.0, kappa] } else { [n, kappa] };
     let mut all_profiles = Vec::with_capacity(set.experiments.len());
     for (k, e) in set.experiments.iter().enumerate() {
+        if interrupted() {
+            return Err(Interrupted(format!(
+                "simulated {} of {} experiments; {} lists the profiles written and the missing ones",
+                complete.len(),
+                names.len(),
+                out.join(PARTIAL).display()
+            ))
+            .into());
+        }
         let mut e = e.clone();
         if e.take_up.is_none() {
             if let Some(d) = take_up_diameter {
@@ -83,7 +106,9 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         let sol = simulate(&model, &law, &SimulateOptions::default())?;
         let prof = sol.uniform_profiles(&model, points.max(2));
         let path = out.join(format!("{}_profile.csv", e.name));
-        write_text(&path, &profiles_csv(&prof), &inputs)?;
+        write_profiles(&path, &prof, &inputs)?;
+        complete.push(names[k]);
+        write_partial(&out, &names, &complete, &inputs)?;
         if g.verbose {
             g.say(format!(
                 "{}: {} nodes, T(L) = {:.2} K, d(L) = {:.3} µm -> {}",
@@ -96,9 +121,16 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         }
         all_profiles.push(prof);
     }
-    let names: Vec<&str> = set.experiments.iter().map(|e| e.name.as_str()).collect();
-    let fig = out.join(format!("profiles.{}", g.format.ext()));
-    figures::profile_overview(&fig, &names, &all_profiles, &inputs)?;
+    // every profile is written: the figures cannot lose data any more
+    remove_partial(&out, &inputs)?;
+    let fig = out.join(format!("profiles.{ext}"));
+    figures::profile_overview(&fig, &names, &all_profiles, &inputs).map_err(|e| {
+        format!(
+            "the {} profiles were written to {}, but the figure failed: {e}",
+            names.len(),
+            out.display()
+        )
+    })?;
     let with_data: Vec<usize> = (0..set.experiments.len())
         .filter(|&k| set.measurements[k].is_some())
         .collect();
@@ -127,8 +159,25 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             profiles: &profs,
             dashed: false,
         }];
-        let fig = out.join(format!("diameters_vs_data.{}", g.format.ext()));
-        figures::experiment_panels(&fig, &views, &curves, View::Diameter, &inputs)?;
+        let fig = out.join(format!("diameters_vs_data.{ext}"));
+        let pages = figures::experiment_panel_pages(&fig, &views, &curves, View::Diameter, &inputs)
+            .map_err(|e| {
+                format!(
+                    "the {} profiles were written to {}, but the figure failed: {e}",
+                    names.len(),
+                    out.display()
+                )
+            })?;
+        if pages.len() > 1 {
+            g.say(format!(
+                "{} experiments with measurements: the diameter figure is split into {} files \
+                 ({}_1.{ext} …) of at most {} panels",
+                views.len(),
+                pages.len(),
+                out.join("diameters_vs_data").display(),
+                figures::MAX_PANELS_PER_FIGURE
+            ));
+        }
     }
     g.say(format!(
         "wrote {} profiles and figures to {}",
@@ -136,4 +185,46 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         out.display()
     ));
     Ok(())
+}
+
+/// Name of the manifest that marks an incomplete `simulate` output directory.
+pub const PARTIAL: &str = "PARTIAL.txt";
+
+/// Writes `DIR/PARTIAL.txt`: which experiments have their profile written and which are missing.
+fn write_partial(
+    out: &Path,
+    names: &[&str],
+    complete: &[&str],
+    inputs: &[PathBuf],
+) -> Result<(), Box<dyn Error>> {
+    let mut text = String::from(
+        "# rheometer simulate: INCOMPLETE output (still running, interrupted or failed).\n\
+         # This file is removed once every profile is written.\n",
+    );
+    text.push_str(&format!(
+        "# {} of {} profiles written\n",
+        complete.len(),
+        names.len()
+    ));
+    for n in names {
+        let state = if complete.contains(n) {
+            "complete"
+        } else {
+            "missing"
+        };
+        text.push_str(&format!("{state} {n} {n}_profile.csv\n"));
+    }
+    write_text(&out.join(PARTIAL), &text, inputs)?;
+    Ok(())
+}
+
+/// Removes `DIR/PARTIAL.txt` (after [`write_partial`]; never an input).
+fn remove_partial(out: &Path, inputs: &[PathBuf]) -> Result<(), Box<dyn Error>> {
+    let path = out.join(PARTIAL);
+    ensure_not_input(&path, inputs)?;
+    match std::fs::remove_file(&path) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(format!("cannot remove {}: {e}", path.display()).into()),
+    }
 }

@@ -40,7 +40,7 @@ pub use residual_stats::RunsTest;
 pub use segments::{Segment, SegmentOptions, Station};
 
 use crate::fiber::error::FiberError;
-use crate::fiber::output::{create_dir, write_text, OutputError};
+use crate::fiber::output::{create_output_dir, write_text, OutputError};
 use crate::fiber::simulate::Profiles;
 use crate::fiber::smoothing::SmoothingError;
 use crate::plot::PlotError;
@@ -425,15 +425,16 @@ impl Comparison {
     }
 
     /// Writes `compare_summary.txt`, `compare.json`, `compare_points.csv` and the figures
-    /// (see [`compare_figures::write_figures`]) into `dir` (created), never over a file in
-    /// `inputs`. Returns the written paths.
+    /// (see [`compare_figures::write_figures`]) into `dir` (created; refused if it is an input
+    /// or a file), never over a file in `inputs`, each file atomically (see
+    /// [`write_atomically`](crate::fiber::output::write_atomically)). Returns the written paths.
     pub fn write(
         &self,
         dir: &Path,
         format: FigureFormat,
         inputs: &[PathBuf],
     ) -> Result<Vec<PathBuf>, CompareError> {
-        create_dir(dir)?;
+        create_output_dir(dir, inputs)?;
         let mut written = Vec::new();
         for (name, text) in [
             ("compare_summary.txt", self.to_text()),

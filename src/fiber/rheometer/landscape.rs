@@ -14,12 +14,16 @@
 //! meshes grow quickly and a failing solve refines until it exceeds its node budget, so the
 //! landscape caps the mesh at [`LANDSCAPE_MAX_NODES`] nodes: a failure costs a few
 //! milliseconds instead of tens, and points that would need more nodes are marked missing.
+//!
+//! [`Rheometer::landscape_with`] can be stopped early (a cancellation flag, checked before
+//! every grid point) and says for every point whether it was computed, failed, or not reached
+//! ([`PointStatus`]).
 
 use super::identify::{IdentifyOptions, Rheometer, RheometerError};
 use super::objective::Objective;
 use crate::solution::Solution;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// Largest mesh of a landscape solve (at the CLI's tolerance 1e-4 the solutions need 60–300
@@ -38,21 +42,25 @@ fn retry_bisections(step: f64) -> u32 {
 }
 
 /// Cost at `(to, κ)` reached from the current warm starts (at `from`): directly, or by
-/// recursively halving the step up to `depth` times.
+/// recursively halving the step up to `depth` times (giving up early once `cancel` is set).
 fn walk(
     obj: &mut Objective<'_>,
     from: f64,
     to: f64,
     kappa: f64,
     depth: u32,
+    cancel: &AtomicBool,
 ) -> Result<f64, RheometerError> {
+    if cancel.load(Ordering::Relaxed) {
+        return Err(RheometerError::Data("the landscape was cancelled".into()));
+    }
     match obj.try_cost_at(to, kappa) {
         Ok(c) => Ok(c),
         Err(e) if depth == 0 => Err(e),
         Err(_) => {
             let mid = 0.5 * (from + to);
-            walk(obj, from, mid, kappa, depth - 1)?;
-            walk(obj, mid, to, kappa, depth - 1)
+            walk(obj, from, mid, kappa, depth - 1, cancel)?;
+            walk(obj, mid, to, kappa, depth - 1, cancel)
         }
     }
 }
@@ -101,6 +109,46 @@ impl Landscape {
     }
 }
 
+/// What happened at one grid point of a landscape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointStatus {
+    /// The cost was computed.
+    Computed,
+    /// The simulation failed, or an earlier point of the row (larger `n`) failed so the point
+    /// lies beyond the edge of the solvable region: cost `NaN`.
+    Failed,
+    /// Not computed because the landscape was cancelled: cost `NaN`.
+    NotReached,
+}
+
+/// A landscape that may be incomplete: the costs and, per point, what happened.
+#[derive(Debug, Clone)]
+pub struct LandscapeRun {
+    /// The grid and the costs (`NaN` where failed or not reached).
+    pub landscape: Landscape,
+    /// Status of `cost[j * n.len() + i]`, same indexing.
+    pub status: Vec<PointStatus>,
+    /// Whether the run was cancelled before every point was reached.
+    pub cancelled: bool,
+}
+
+impl LandscapeRun {
+    /// Number of grid points with the given status.
+    pub fn count(&self, status: PointStatus) -> usize {
+        self.status.iter().filter(|&&s| s == status).count()
+    }
+
+    /// Number of failed grid points ([`PointStatus::Failed`]).
+    pub fn failed(&self) -> usize {
+        self.count(PointStatus::Failed)
+    }
+
+    /// Number of grid points not reached before cancellation ([`PointStatus::NotReached`]).
+    pub fn not_reached(&self) -> usize {
+        self.count(PointStatus::NotReached)
+    }
+}
+
 impl Rheometer {
     /// Computes `J(n, κ)` of `options.estimator` (take-up factors 1) on the grid `ns × kappas`,
     /// solving the BVPs at `options.simulate.tol` (the CLI uses 1e-4 for landscapes: a picture,
@@ -111,8 +159,26 @@ impl Rheometer {
         ns: &[f64],
         kappas: &[f64],
         options: &IdentifyOptions,
-        mut progress: impl FnMut(usize) + Send,
+        progress: impl FnMut(usize) + Send,
     ) -> Result<Landscape, RheometerError> {
+        let never = AtomicBool::new(false);
+        Ok(self
+            .landscape_with(ns, kappas, options, progress, &never)?
+            .landscape)
+    }
+
+    /// [`Rheometer::landscape`] that stops early once `cancel` is set (checked before every
+    /// grid point, so within one point's solve, typically milliseconds) and returns what it
+    /// has, with the status of every point. `progress` is called after every finished row with
+    /// the number of points done.
+    pub fn landscape_with(
+        &self,
+        ns: &[f64],
+        kappas: &[f64],
+        options: &IdentifyOptions,
+        mut progress: impl FnMut(usize) + Send,
+        cancel: &AtomicBool,
+    ) -> Result<LandscapeRun, RheometerError> {
         if ns.is_empty() || kappas.is_empty() {
             return Err(RheometerError::Data("the landscape grid is empty".into()));
         }
@@ -127,18 +193,29 @@ impl Rheometer {
         let progress = Mutex::new(&mut progress);
         // rows are independent: each starts from the Newtonian solution; one objective (solver
         // workspace) per worker
-        let rows: Vec<Vec<f64>> = kappas
+        let rows: Vec<(Vec<f64>, Vec<PointStatus>)> = kappas
             .par_iter()
             .map_init(
                 || self.objective([1.0, kappas[0]], &opts).ok(),
                 |obj, &k| {
                     let mut row = vec![f64::NAN; ns.len()];
+                    let mut status = vec![PointStatus::Failed; ns.len()];
+                    if cancel.load(Ordering::Relaxed) {
+                        status.fill(PointStatus::NotReached);
+                        return (row, status);
+                    }
                     if let Some(obj) = obj.as_mut() {
                         obj.set_solutions(&newtonian);
                         // the last two accepted points of the row: (n, solutions)
                         let mut last: (f64, Vec<Solution>) = (1.0, newtonian.clone());
                         let mut before: Option<(f64, Vec<Solution>)> = None;
-                        for &i in &order {
+                        for (pos, &i) in order.iter().enumerate() {
+                            if cancel.load(Ordering::Relaxed) {
+                                for &rest in &order[pos..] {
+                                    status[rest] = PointStatus::NotReached;
+                                }
+                                break;
+                            }
                             let n = ns[i];
                             if let Some((nb, sb)) = &before {
                                 let t = (n - last.0) / (last.0 - nb);
@@ -155,15 +232,25 @@ impl Rheometer {
                             let r = obj.try_cost_at(n, k).or_else(|_| {
                                 // retry from the neighbour itself, bisecting the step
                                 obj.set_solutions(&last.1);
-                                walk(obj, last.0, n, k, retry_bisections(n - last.0))
+                                walk(obj, last.0, n, k, retry_bisections(n - last.0), cancel)
                             });
                             match r {
                                 Ok(c) => {
                                     row[i] = c;
+                                    status[i] = PointStatus::Computed;
                                     let sols = obj.solutions();
                                     before = Some(std::mem::replace(&mut last, (n, sols)));
                                 }
-                                Err(_) => break,
+                                Err(_) => {
+                                    // a retry given up because of the cancellation: the point
+                                    // and the rest of the row were not reached, not failed
+                                    if cancel.load(Ordering::Relaxed) {
+                                        for &rest in &order[pos..] {
+                                            status[rest] = PointStatus::NotReached;
+                                        }
+                                    }
+                                    break;
+                                }
                             }
                         }
                     }
@@ -171,15 +258,25 @@ impl Rheometer {
                     if let Ok(mut p) = progress.lock() {
                         (*p)(d);
                     }
-                    row
+                    (row, status)
                 },
             )
             .collect();
-        let cost: Vec<f64> = rows.into_iter().flatten().collect();
-        Ok(Landscape {
-            n: ns.to_vec(),
-            kappa: kappas.to_vec(),
-            cost,
+        let mut cost = Vec::with_capacity(ns.len() * kappas.len());
+        let mut status = Vec::with_capacity(ns.len() * kappas.len());
+        for (r, st) in rows {
+            cost.extend(r);
+            status.extend(st);
+        }
+        let cancelled = status.contains(&PointStatus::NotReached);
+        Ok(LandscapeRun {
+            landscape: Landscape {
+                n: ns.to_vec(),
+                kappa: kappas.to_vec(),
+                cost,
+            },
+            status,
+            cancelled,
         })
     }
 }

@@ -24,6 +24,6 @@ pub use estimator::Estimator;
 pub use identify::{
     Identification, IdentifyOptions, Rheometer, RheometerError, StartPoint, PAPER_TABLE3_STARTS,
 };
-pub use landscape::Landscape;
+pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout};
 pub use report::{EffectReport, FitReport};

@@ -2,7 +2,7 @@
 //! residuals against the local strain rate, temperature and speed.
 
 use super::{CompareError, Comparison, FigureFormat};
-use crate::fiber::figures::{experiment_panels, ExperimentView, ModelCurves, View};
+use crate::fiber::figures::{experiment_panel_pages, ExperimentView, ModelCurves, View};
 use crate::fiber::output::ensure_not_input;
 use crate::fiber::simulate::Profiles;
 use crate::plot::{save_panels, Panel, Series};
@@ -16,6 +16,8 @@ fn grid_size(panels: usize, columns: usize) -> (u32, u32) {
 /// Writes into `dir` (which must exist):
 /// * `compare_diameters.EXT`: measured and simulated diameters per experiment (µm);
 /// * `compare_inverse_d2.EXT`: `1/d²` measured and simulated per experiment (1/mm²);
+///   (both split into `NAME_1.EXT`, `NAME_2.EXT`, … beyond
+///   [`MAX_PANELS_PER_FIGURE`](crate::fiber::figures::MAX_PANELS_PER_FIGURE) experiments);
 /// * `compare_residuals.EXT`: relative residual vs `s`, per experiment and the pooled station
 ///   mean, with the `±2σ` band of single points and the `±2 se` band of the pooled mean;
 /// * `compare_residual_trends.EXT`: residuals against strain rate, temperature and speed, one
@@ -67,8 +69,7 @@ pub fn write_figures(
         ("compare_inverse_d2", View::InverseSquare),
     ] {
         let path = dir.join(format!("{name}.{ext}"));
-        experiment_panels(&path, &views, &model, view, inputs)?;
-        out.push(path);
+        out.extend(experiment_panel_pages(&path, &views, &model, view, inputs)?);
     }
 
     let mut save = |name: &str, panels: &[Panel], columns: usize| -> Result<(), CompareError> {
