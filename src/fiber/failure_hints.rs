@@ -77,7 +77,9 @@ pub fn solver_error<'a>(error: &'a (dyn Error + 'static)) -> Option<&'a BvpError
 fn inlet_diameter(e: &Experiment, material: &Material) -> f64 {
     match e.inlet {
         Inlet::Diameter(d) => d,
-        Inlet::Velocity(u) => 2.0 * (e.mass_flow / (PI * material.density(e.inlet_temperature) * u)).sqrt(),
+        Inlet::Velocity(u) => {
+            2.0 * (e.mass_flow / (PI * material.density(e.inlet_temperature) * u)).sqrt()
+        }
     }
 }
 
@@ -237,7 +239,11 @@ impl ExperimentFailure {
 
 impl fmt::Display for ExperimentFailure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "experiment {} ({}): simulation", self.experiment, self.at)?;
+        write!(
+            f,
+            "experiment {} ({}): simulation",
+            self.experiment, self.at
+        )?;
         if let Some([n, kappa]) = self.law_params {
             write!(f, " at (n, kappa) = ({n}, {kappa})")?;
         }
@@ -325,10 +331,17 @@ mod tests {
             line: Some(27),
         };
         let f = ExperimentFailure::new(&e, &m, at, Some([0.8, 11.71]), Box::new(cause));
-        assert!(f.to_string().starts_with("experiment e1 (x.toml:27)"), "{f}");
+        assert!(
+            f.to_string().starts_with("experiment e1 (x.toml:27)"),
+            "{f}"
+        );
         let src = f.source().map(|s| s.to_string()).unwrap_or_default();
         assert!(src.contains("continuation stopped"), "{src}");
-        assert!(f.hints.iter().any(|s| s.contains("hotter")), "{:?}", f.hints);
+        assert!(
+            f.hints.iter().any(|s| s.contains("hotter")),
+            "{:?}",
+            f.hints
+        );
         assert_eq!(failed_experiment(&f).map(|x| x.0), Some("e1".to_string()));
     }
 }

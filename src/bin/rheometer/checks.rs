@@ -3,9 +3,9 @@
 //! experiment's simulation named with the experiment and its TOML line.
 
 use diffbvp::fiber::diagnostics::candidates::Effect;
+use diffbvp::fiber::diagnostics::compare::FitParameters;
 use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::input::{parse_experiments, Location, MAX_PLAUSIBLE_DIAMETER_M};
-use diffbvp::fiber::diagnostics::compare::FitParameters;
 use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;
 use diffbvp::fiber::rheometer::{IdentifyOptions, Rheometer};
 use std::error::Error;
@@ -130,7 +130,7 @@ pub fn parse_kappa(s: &str) -> Result<f64, String> {
 
 /// Checks that `v` is a usable κ (finite, |κ| <= [`MAX_ABS_KAPPA`]).
 pub fn check_kappa(v: f64) -> Result<f64, String> {
-    if !(v.abs() <= MAX_ABS_KAPPA) {
+    if v.is_nan() || v.abs() > MAX_ABS_KAPPA {
         return Err(format!(
             "kappa = ln(K / 1 Pa) must lie in [-{MAX_ABS_KAPPA}, {MAX_ABS_KAPPA}] (K = e^kappa \
              overflows beyond; the fit searches [7, 20]), got {v}"
@@ -153,7 +153,12 @@ pub fn parse_take_up_diameter(s: &str) -> Result<f64, String> {
 
 /// Checks that `(lo, hi)` given with `flag` is increasing and within `[min, max]`, the fit's
 /// bounds of the parameter `name`.
-pub fn check_range(flag: &str, name: &str, (lo, hi): (f64, f64), [min, max]: [f64; 2]) -> Result<(), String> {
+pub fn check_range(
+    flag: &str,
+    name: &str,
+    (lo, hi): (f64, f64),
+    [min, max]: [f64; 2],
+) -> Result<(), String> {
     if lo >= hi {
         return Err(format!(
             "{flag} {lo},{hi}: give MIN,MAX with MIN < MAX (did you mean {hi},{lo}?)"
@@ -216,8 +221,7 @@ pub fn name_experiment(e: Box<dyn Error>, toml: &Path, law: Option<[f64; 2]>) ->
     if e.downcast_ref::<ExperimentFailure>().is_some() {
         return e;
     }
-    let Some((name, stated)) = diffbvp::fiber::failure_hints::failed_experiment(e.as_ref())
-    else {
+    let Some((name, stated)) = diffbvp::fiber::failure_hints::failed_experiment(e.as_ref()) else {
         return e;
     };
     let law = stated.or(law);

@@ -14,7 +14,7 @@ pub struct DiagnoseArgs {
     #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
     pub with: Vec<EffectSetting>,
     /// How many of the best linearised candidates are refitted.
-    #[arg(long, default_value_t = 3, value_parser = checks::parse_refit_top)]
+    #[arg(long, default_value_t = 3, allow_hyphen_values = true, value_parser = checks::parse_refit_top)]
     pub refit_top: usize,
     /// Write the diagnosis as JSON to FILE.
     #[arg(long)]

@@ -20,7 +20,7 @@ pub struct LandscapeArgs {
     #[arg(long, value_enum, default_value_t = EstimatorArg::Paper)]
     pub estimator: EstimatorArg,
     /// BVP tolerance of the landscape solves (1e-12 to 0.1; a picture: fits use 1e-6).
-    #[arg(long, default_value_t = 1e-4, value_parser = checks::parse_tol)]
+    #[arg(long, default_value_t = 1e-4, allow_hyphen_values = true, value_parser = checks::parse_tol)]
     pub tol: f64,
     /// Output directory.
     #[arg(long)]
@@ -41,7 +41,12 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
     // sizes and ranges before any work
     checks::check_range("--n-range", "n", n_range, [opts.lower[0], opts.upper[0]])?;
-    checks::check_range("--kappa-range", "kappa", kappa_range, [opts.lower[1], opts.upper[1]])?;
+    checks::check_range(
+        "--kappa-range",
+        "kappa",
+        kappa_range,
+        [opts.lower[1], opts.upper[1]],
+    )?;
     opts.simulate.tol = tol;
     opts.simulate.max_nodes = checks::landscape_max_nodes(g.max_nodes)?;
     let loaded = load_experiments_with(&experiments, 4)?;
