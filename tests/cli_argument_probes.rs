@@ -84,7 +84,7 @@ fn simulate_points_zero_one_and_huge_are_refused() {
                 s(&out),
             ],
             &dd,
-            &["--points", &format!("'{v}'"), "1000000"],
+            &["--points", &format!("'{v}'"), "2 to 100000"],
         );
     }
     assert!(!out.join("v0p27_p1_profile.csv").exists());

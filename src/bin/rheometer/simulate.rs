@@ -24,7 +24,7 @@ pub struct SimulateArgs {
     /// Take the take-up diameter d_fit(L) from the smoothed measurements where the TOML has none.
     #[arg(long)]
     pub take_up_from_data: bool,
-    /// Number of uniform output positions (2 to 1000000).
+    /// Number of uniform output positions (2 to 100000).
     #[arg(long, default_value_t = 101, value_parser = checks::parse_points)]
     pub points: usize,
     /// Output directory (created; input files are never overwritten).
