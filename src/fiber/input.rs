@@ -226,6 +226,9 @@ pub struct ExperimentDetails {
     pub take_up_pressure_bar: Option<f64>,
     /// The measurement CSV file (resolved against the TOML file's directory), if given.
     pub data: Option<PathBuf>,
+    /// 1-based line of the experiment's `name` key in the TOML file, if known (for messages
+    /// that name the experiment).
+    pub line: Option<usize>,
 }
 
 /// An experiment set together with per-experiment details (same order as the experiments).
@@ -304,7 +307,8 @@ pub fn parse_experiments(text: &str, path: &Path) -> Result<LoadedExperiments, I
     let mut seen: Vec<(String, Option<usize>)> = Vec::new();
     for tab in tables {
         let label = tab.name.clone();
-        let (experiment, detail, name_at) = experiment(tab, defaults.as_ref(), &material)?;
+        let (experiment, mut detail, name_at) = experiment(tab, defaults.as_ref(), &material)?;
+        detail.line = name_at.line;
         if let Some((_, first)) = seen.iter().find(|(n, _)| *n == experiment.name) {
             let first = first
                 .map(|l| format!(" (first defined at line {l})"))
@@ -1072,6 +1076,7 @@ fn experiment(
         stencil_velocity_mm_s: metadata("stencil_velocity_mm_s")?,
         take_up_pressure_bar: metadata("take_up_pressure_bar")?,
         data,
+        line: None,
     };
     let experiment = Experiment {
         name,

@@ -9,6 +9,7 @@
 //! * [`contributions`]: named force and heat terms, air environment, Nusselt law;
 //! * [`model`]: the strain-rate formulation as a [`Bvp`](crate::Bvp);
 //! * [`cold_start`]: continuation from the stress-free fiber;
+//! * [`failure_hints`]: simulation failures naming their experiment, with likely causes;
 //! * [`mod@simulate`]: the user-facing API with SI profiles;
 //! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
 //! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
@@ -20,6 +21,7 @@ pub mod cold_start;
 pub mod contributions;
 pub mod diagnostics;
 pub mod error;
+pub mod failure_hints;
 pub mod figures;
 pub mod input;
 pub mod material_law;

@@ -186,7 +186,16 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             }
             Inlet::Velocity(u) => positive("inlet velocity", u)?,
         };
+        // derived values that overflow (e.g. an implausible mass flow) are refused here
+        positive(
+            &format!("inlet velocity 4 Q/(π ρ d²) from the mass flow Q = {q:e} kg/s"),
+            u_in_si,
+        )?;
         let d_in_si = 2.0 * (q / (PI * rho_in * u_in_si)).sqrt();
+        positive(
+            &format!("inlet diameter from the mass flow {q:e} kg/s and the inlet velocity {u_in_si:e} m/s"),
+            d_in_si,
+        )?;
         let take_up = match e.take_up {
             None => return Err(FiberError::MissingTakeUp(e.name.clone())),
             Some(TakeUp::Diameter(d)) => {

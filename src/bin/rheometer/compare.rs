@@ -10,11 +10,11 @@ pub struct CompareArgs {
     /// Parameters (n, kappa and take-up factors) from the JSON written by `rheometer fit --json`.
     #[arg(long, conflicts_with_all = ["n", "kappa", "newtonian"])]
     pub fit: Option<PathBuf>,
-    /// Power index n of the Carreau-type law (without --fit).
-    #[arg(long)]
+    /// Power index n of the Carreau-type law (without --fit; n >= 0, 1 is Newtonian).
+    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_n)]
     pub n: Option<f64>,
-    /// kappa = ln(K / 1 Pa) of the Carreau-type law (without --fit).
-    #[arg(long)]
+    /// kappa = ln(K / 1 Pa) of the Carreau-type law (without --fit; |kappa| <= 700).
+    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_kappa)]
     pub kappa: Option<f64>,
     /// Use the Newtonian law (n = 1).
     #[arg(long)]
@@ -29,8 +29,8 @@ pub struct CompareArgs {
     #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
     pub with: Vec<EffectSetting>,
     /// Relative measurement uncertainty (overrides the TOML's relative_uncertainty; default:
-    /// the TOML's, else estimated from the data).
-    #[arg(long)]
+    /// the TOML's, else estimated from the data; in (0, 1)).
+    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_fraction)]
     pub relative_uncertainty: Option<f64>,
     /// Output directory (created; input files are never overwritten).
     #[arg(long)]
@@ -54,6 +54,9 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let inputs = inputs_of(&experiments, &loaded);
     let set = &loaded.set;
     let fit_params = fit.as_ref().map(|p| read_fit(p)).transpose()?;
+    if let (Some(path), Some(p)) = (&fit, &fit_params) {
+        checks::check_fit_values(path, p, set.experiments.len())?;
+    }
     let effects = compare_effects(fit_params.as_ref(), &with)?;
     // validated once here; the closure rebuilds the same physics per experiment
     physics_with(&effects)?;
@@ -62,6 +65,7 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         g.say(format!("model includes {} = {v} {}", e.name(), e.unit()));
     }
     let mut setup = ModelSetup::carreau([0.8, 11.71], &physics);
+    setup.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     let mut fitted = 0;
     if let (Some(path), Some(rep)) = (&fit, fit_params) {
         rep.apply(
@@ -98,7 +102,8 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         ..Default::default()
     };
     let t0 = std::time::Instant::now();
-    let runs = simulate_experiments(set, &setup)?;
+    let runs = simulate_experiments(set, &setup)
+        .map_err(|e| checks::name_experiment(Box::new(e), &experiments, Some(setup.law_params)))?;
     let cmp = compare(&runs, set.relative_uncertainty, &options)?;
     let fmt = match g.format {
         FormatArg::Png => FigureFormat::Png,

@@ -14,7 +14,7 @@ pub struct DiagnoseArgs {
     #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
     pub with: Vec<EffectSetting>,
     /// How many of the best linearised candidates are refitted.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_hyphen_values = true, value_parser = checks::parse_refit_top)]
     pub refit_top: usize,
     /// Write the diagnosis as JSON to FILE.
     #[arg(long)]
@@ -42,10 +42,11 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         candidates: Vec::new(),
     };
     spec.validate()?;
-    let opts = DiagnoseOptions {
+    let mut opts = DiagnoseOptions {
         refit_top,
         ..DiagnoseOptions::default()
     };
+    opts.identify.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     // a spinner on a terminal (indicatif draws nothing when stderr is not a terminal)
     let spinner = if g.quiet {
         ProgressBar::hidden()

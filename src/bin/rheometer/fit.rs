@@ -8,7 +8,7 @@ pub struct FitArgs {
     /// The experiments file (TOML).
     pub experiments: PathBuf,
     /// Start point "N,KAPPA" (default: the paper's start heuristic).
-    #[arg(long, value_parser = parse_pair)]
+    #[arg(long, value_parser = parse_pair, allow_hyphen_values = true)]
     pub start: Option<(f64, f64)>,
     /// The estimator.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Principled)]
@@ -45,6 +45,11 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         json,
         out,
     } = args;
+    let mut opts = IdentifyOptions::with_estimator(estimator(est));
+    opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
+    if let Some(s) = start {
+        checks::check_start(s, &opts)?;
+    }
     let loaded = load_experiments_with(&experiments, 4)?;
     let inputs = inputs_of(&experiments, &loaded);
     // refuse an output that is an input before spending time on the fit
@@ -62,7 +67,6 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         candidates: Vec::new(),
     };
     let rh = Rheometer::with_spec(&loaded.set, spec)?;
-    let opts = IdentifyOptions::with_estimator(estimator(est));
     let law_fitted = model == LawChoice::Carreau
         || with
             .iter()

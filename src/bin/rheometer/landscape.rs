@@ -8,19 +8,19 @@ pub struct LandscapeArgs {
     /// The experiments file (TOML).
     pub experiments: PathBuf,
     /// Grid size "NxM" (n values x kappa values).
-    #[arg(long, default_value = "41x41", value_parser = parse_grid)]
+    #[arg(long, default_value = "41x41", value_parser = checks::parse_grid)]
     pub grid: (usize, usize),
-    /// Range of n "MIN,MAX".
-    #[arg(long, default_value = "0,1", value_parser = parse_pair)]
+    /// Range of n "MIN,MAX" (within the fit's bounds [0, 1]).
+    #[arg(long, default_value = "0,1", value_parser = parse_pair, allow_hyphen_values = true)]
     pub n_range: (f64, f64),
-    /// Range of kappa "MIN,MAX".
-    #[arg(long, default_value = "9,16", value_parser = parse_pair)]
+    /// Range of kappa "MIN,MAX" (within the fit's bounds [7, 20]).
+    #[arg(long, default_value = "9,16", value_parser = parse_pair, allow_hyphen_values = true)]
     pub kappa_range: (f64, f64),
     /// The estimator whose cost is mapped.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Paper)]
     pub estimator: EstimatorArg,
-    /// BVP tolerance of the landscape solves (a picture; fits use 1e-6).
-    #[arg(long, default_value_t = 1e-4)]
+    /// BVP tolerance of the landscape solves (1e-12 to 0.1; a picture: fits use 1e-6).
+    #[arg(long, default_value_t = 1e-4, allow_hyphen_values = true, value_parser = checks::parse_tol)]
     pub tol: f64,
     /// Output directory.
     #[arg(long)]
@@ -38,6 +38,17 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         tol,
         out,
     } = args;
+    let mut opts = IdentifyOptions::with_estimator(estimator(est));
+    // sizes and ranges before any work
+    checks::check_range("--n-range", "n", n_range, [opts.lower[0], opts.upper[0]])?;
+    checks::check_range(
+        "--kappa-range",
+        "kappa",
+        kappa_range,
+        [opts.lower[1], opts.upper[1]],
+    )?;
+    opts.simulate.tol = tol;
+    opts.simulate.max_nodes = checks::landscape_max_nodes(g.max_nodes)?;
     let loaded = load_experiments_with(&experiments, 4)?;
     let inputs = inputs_of(&experiments, &loaded);
     let outputs = [
@@ -46,13 +57,12 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     ];
     check_output_dir(&out, &outputs, &inputs)?;
     let rh = Rheometer::new(&loaded.set)?;
-    let mut opts = IdentifyOptions::with_estimator(estimator(est));
-    if !(tol > 0.0 && tol < 1.0) {
-        return Err(format!("--tol must lie in (0, 1), got {tol}").into());
-    }
-    opts.simulate.tol = tol;
     let ns = linspace(n_range.0, n_range.1, grid.0);
     let ks = linspace(kappa_range.0, kappa_range.1, grid.1);
+    if !g.quiet {
+        let est = checks::landscape_estimate(&rh, &ns, &ks, &opts)?;
+        g.say(est.message());
+    }
     let bar = if g.quiet {
         ProgressBar::hidden()
     } else {

@@ -11,6 +11,7 @@ use diffbvp::fiber::diagnostics::compare::{
 };
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, ResidualProfiles};
 use diffbvp::fiber::diagnostics::report::save_residual_figure;
+use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
 use diffbvp::fiber::output::{
@@ -118,6 +119,7 @@ mod sigint {
 }
 
 // after the macro, which they use
+mod checks;
 mod compare;
 mod diagnose;
 mod fit;
@@ -147,6 +149,10 @@ struct Cli {
     /// Figure format.
     #[arg(long, value_enum, global = true, default_value_t = FormatArg::Png)]
     format: FormatArg,
+    /// Largest mesh (nodes) of a BVP solve (50 to 1000000; default 20000, the landscape
+    /// 1000). A solve that needs more fails and names this flag.
+    #[arg(long, global = true, value_parser = checks::parse_max_nodes)]
+    max_nodes: Option<usize>,
     #[command(subcommand)]
     command: Command,
 }
@@ -227,6 +233,8 @@ pub struct Global {
     pub verbose: bool,
     /// Figure format.
     pub format: FormatArg,
+    /// `--max-nodes`, if given.
+    pub max_nodes: Option<usize>,
 }
 
 impl Global {
@@ -258,25 +266,6 @@ fn parse_pair(s: &str) -> Result<(f64, f64), String> {
         .map_err(|_| format!("\"{}\" is not a number", parts[1]))?;
     if !a.is_finite() || !b.is_finite() {
         return Err(format!("\"{s}\" contains a non-finite number"));
-    }
-    Ok((a, b))
-}
-
-fn parse_grid(s: &str) -> Result<(usize, usize), String> {
-    let parts: Vec<&str> = s.split(['x', 'X']).collect();
-    if parts.len() != 2 {
-        return Err(format!("expected \"NxM\", got \"{s}\""));
-    }
-    let a: usize = parts[0]
-        .trim()
-        .parse()
-        .map_err(|_| format!("\"{}\" is not a count", parts[0]))?;
-    let b: usize = parts[1]
-        .trim()
-        .parse()
-        .map_err(|_| format!("\"{}\" is not a count", parts[1]))?;
-    if a < 2 || b < 2 {
-        return Err("the grid needs at least 2 points per direction".into());
     }
     Ok((a, b))
 }
@@ -369,6 +358,14 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
         quiet: cli.quiet,
         verbose: cli.verbose,
         format: cli.format,
+        max_nodes: cli.max_nodes,
+    };
+    let toml = match &cli.command {
+        Command::Simulate(a) => a.experiments.clone(),
+        Command::Fit(a) => a.experiments.clone(),
+        Command::Diagnose(a) => a.experiments.clone(),
+        Command::Landscape(a) => a.experiments.clone(),
+        Command::Compare(a) => a.experiments.clone(),
     };
     match cli.command {
         Command::Simulate(a) => simulate::run(a, &g),
@@ -377,6 +374,8 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
         Command::Landscape(a) => landscape::run(a, &g),
         Command::Compare(a) => compare::run(a, &g),
     }
+    // a failed simulation names its experiment and TOML line, with likely causes
+    .map_err(|e| checks::name_experiment(e, &toml, None))
 }
 
 fn main() -> ExitCode {
@@ -420,6 +419,11 @@ fn main() -> ExitCode {
                 }
                 printed = text;
                 src = s.source();
+            }
+            if let Some(f) = e.downcast_ref::<ExperimentFailure>() {
+                for h in &f.hints {
+                    eprintln!("  hint: {h}");
+                }
             }
             ExitCode::FAILURE
         }

@@ -1,6 +1,7 @@
 //! `rheometer simulate`.
 
 use crate::*;
+use diffbvp::fiber::input::Location;
 use diffbvp::fiber::simulate;
 
 /// Arguments of `rheometer simulate`.
@@ -8,23 +9,23 @@ use diffbvp::fiber::simulate;
 pub struct SimulateArgs {
     /// The experiments file (TOML; see the book for the format).
     pub experiments: PathBuf,
-    /// Power index n of the Carreau-type law.
-    #[arg(long, default_value_t = 0.8)]
+    /// Power index n of the Carreau-type law (n >= 0; 1 is Newtonian).
+    #[arg(long, default_value_t = 0.8, allow_hyphen_values = true, value_parser = checks::parse_n)]
     pub n: f64,
-    /// kappa = ln(K / 1 Pa) of the Carreau-type law.
-    #[arg(long, default_value_t = 11.71)]
+    /// kappa = ln(K / 1 Pa) of the Carreau-type law (|kappa| <= 700).
+    #[arg(long, default_value_t = 11.71, allow_hyphen_values = true, value_parser = checks::parse_kappa)]
     pub kappa: f64,
     /// Use the Newtonian law (n = 1).
     #[arg(long)]
     pub newtonian: bool,
-    /// Take-up diameter (m) for experiments without one in the TOML.
-    #[arg(long)]
+    /// Take-up diameter (m, 1e-7 to 0.02) for experiments without one in the TOML.
+    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_take_up_diameter)]
     pub take_up_diameter: Option<f64>,
     /// Take the take-up diameter d_fit(L) from the smoothed measurements where the TOML has none.
     #[arg(long)]
     pub take_up_from_data: bool,
-    /// Number of uniform output positions.
-    #[arg(long, default_value_t = 101)]
+    /// Number of uniform output positions (2 to 100000).
+    #[arg(long, default_value_t = 101, value_parser = checks::parse_points)]
     pub points: usize,
     /// Output directory (created; input files are never overwritten).
     #[arg(long)]
@@ -62,6 +63,10 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let mut complete: Vec<&str> = Vec::with_capacity(names.len());
     write_partial(&out, &names, &complete, &inputs)?;
     let law = if newtonian { [1.0, kappa] } else { [n, kappa] };
+    let options = SimulateOptions {
+        max_nodes: g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES),
+        ..SimulateOptions::default()
+    };
     let mut all_profiles = Vec::with_capacity(set.experiments.len());
     for (k, e) in set.experiments.iter().enumerate() {
         if interrupted() {
@@ -74,6 +79,7 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             .into());
         }
         let mut e = e.clone();
+        let mut from_data = None;
         if e.take_up.is_none() {
             if let Some(d) = take_up_diameter {
                 e.take_up = Some(TakeUp::Diameter(d));
@@ -84,8 +90,20 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
                         e.name
                     )
                 })?;
-                let f = smooth(&m.positions, &m.diameters)?;
-                e.take_up = Some(TakeUp::Diameter(f.diameter(e.spinline_length)));
+                let f = smooth(&m.positions, &m.diameters).map_err(|err| {
+                    format!(
+                        "experiment {} ({}): --take-up-from-data: smoothing the measurements \
+                         failed: {err}",
+                        e.name,
+                        Location {
+                            path: experiments.clone(),
+                            line: loaded.details[k].line,
+                        }
+                    )
+                })?;
+                let d = f.diameter(e.spinline_length);
+                from_data = Some(d);
+                e.take_up = Some(TakeUp::Diameter(d));
             } else {
                 return Err(format!(
                     "experiment {} has no take-up condition: give take_up_diameter_m or take_up_velocity_m_s \
@@ -96,15 +114,36 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
                 .into());
             }
         }
+        // a failure names the experiment, its TOML line and likely causes
+        let failed = |source: diffbvp::fiber::FiberError| {
+            let mut f = ExperimentFailure::new(
+                &e,
+                &set.material,
+                Location {
+                    path: experiments.clone(),
+                    line: loaded.details[k].line,
+                },
+                Some(law),
+                Box::new(source),
+            );
+            if let Some(d) = from_data {
+                f.hints.push(format!(
+                    "the take-up diameter {d:.4e} m is d_fit(L) of the smoothed measurements \
+                     (--take-up-from-data)"
+                ));
+            }
+            f
+        };
         let model = FiberModel::new(
             &set.material,
             &set.air,
             &e,
             CarreauLike::new(),
             Physics::paper(),
-        )?;
-        let sol = simulate(&model, &law, &SimulateOptions::default())?;
-        let prof = sol.uniform_profiles(&model, points.max(2));
+        )
+        .map_err(failed)?;
+        let sol = simulate(&model, &law, &options).map_err(failed)?;
+        let prof = sol.uniform_profiles(&model, points);
         let path = out.join(format!("{}_profile.csv", e.name));
         write_profiles(&path, &prof, &inputs)?;
         complete.push(names[k]);

@@ -114,7 +114,16 @@ pub fn simulate_experiments(
                                 source,
                             }
                         })?;
-                        TakeUp::Diameter(f.diameter(e.spinline_length))
+                        let d = f.diameter(e.spinline_length);
+                        if !(d.is_finite() && d > 0.0) {
+                            return Err(CompareError::Data(format!(
+                                "experiment {}: the take-up diameter d_fit(L) = {d} m of the \
+                                 smoothed measurements is not a positive number; give \
+                                 take_up_diameter_m in the TOML",
+                                e.name
+                            )));
+                        }
+                        TakeUp::Diameter(d)
                     }
                 });
             }

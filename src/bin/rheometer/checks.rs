@@ -1,0 +1,391 @@
+//! Up-front checks of command-line values (sizes, ranges, domains), so that a bad value is
+//! refused with the flag and value named before any work starts, and failures of one
+//! experiment's simulation named with the experiment and its TOML line.
+
+use diffbvp::fiber::diagnostics::candidates::Effect;
+use diffbvp::fiber::diagnostics::compare::FitParameters;
+use diffbvp::fiber::failure_hints::ExperimentFailure;
+use diffbvp::fiber::input::{parse_experiments, Location, MAX_PLAUSIBLE_DIAMETER_M};
+use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;
+use diffbvp::fiber::rheometer::{IdentifyOptions, Rheometer};
+use std::error::Error;
+use std::path::Path;
+use std::time::Instant;
+
+/// Largest `--points` of `simulate` (rows per profile CSV; 1e6 rows took 1.8 GB of memory and
+/// 86 MB per CSV for the 9 shipped experiments, 1e5 a tenth).
+pub const MAX_POINTS: usize = 100_000;
+/// Largest number of values per direction of `landscape --grid`.
+pub const MAX_GRID_SIDE: usize = 1000;
+/// Largest number of points of `landscape --grid` (N x M).
+pub const MAX_GRID_POINTS: usize = 100_000;
+/// Smallest `--max-nodes` (the cold start begins on a mesh of 21 nodes).
+pub const MIN_MAX_NODES: usize = 50;
+/// Largest `--max-nodes`.
+pub const MAX_MAX_NODES: usize = 1_000_000;
+/// Default `--max-nodes` of the solves of `simulate`, `fit`, `diagnose` and `compare`.
+pub const DEFAULT_MAX_NODES: usize = 20_000;
+/// Smallest take-up diameter accepted from `--take-up-diameter` \[m\].
+pub const MIN_TAKE_UP_DIAMETER_M: f64 = 1e-7;
+/// Largest |κ| (K = e^κ Pa stays a finite positive number).
+pub const MAX_ABS_KAPPA: f64 = 700.0;
+/// Tolerance range of `landscape --tol`.
+pub const TOL_RANGE: (f64, f64) = (1e-12, 0.1);
+
+fn number(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{s}\" is not a number"))?;
+    if !v.is_finite() {
+        return Err(format!("{s} is not a finite number"));
+    }
+    Ok(v)
+}
+
+fn count(s: &str) -> Result<usize, String> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("\"{s}\" is not a whole number >= 0"))
+}
+
+/// `--points`: 2 to [`MAX_POINTS`].
+pub fn parse_points(s: &str) -> Result<usize, String> {
+    let v = count(s)?;
+    if !(2..=MAX_POINTS).contains(&v) {
+        return Err(format!(
+            "give 2 to {MAX_POINTS} output positions per profile (got {v})"
+        ));
+    }
+    Ok(v)
+}
+
+/// `--max-nodes`: [`MIN_MAX_NODES`] to [`MAX_MAX_NODES`].
+pub fn parse_max_nodes(s: &str) -> Result<usize, String> {
+    let v = count(s)?;
+    if !(MIN_MAX_NODES..=MAX_MAX_NODES).contains(&v) {
+        return Err(format!(
+            "the mesh limit must lie in {MIN_MAX_NODES}..={MAX_MAX_NODES} nodes (got {v}; \
+             default {DEFAULT_MAX_NODES})"
+        ));
+    }
+    Ok(v)
+}
+
+/// `--relative-uncertainty`: in (0, 1), like the TOML key `relative_uncertainty`.
+pub fn parse_fraction(s: &str) -> Result<f64, String> {
+    let v = number(s)?;
+    if !(v > 0.0 && v < 1.0) {
+        return Err(format!(
+            "a relative uncertainty must lie in (0, 1) like the TOML key relative_uncertainty \
+             (got {v}; 0.01 is 1 %)"
+        ));
+    }
+    Ok(v)
+}
+
+/// `--tol`: in [`TOL_RANGE`].
+pub fn parse_tol(s: &str) -> Result<f64, String> {
+    let v = number(s)?;
+    if !(TOL_RANGE.0..=TOL_RANGE.1).contains(&v) {
+        return Err(format!(
+            "the tolerance must lie in [{:e}, {}] (got {v})",
+            TOL_RANGE.0, TOL_RANGE.1
+        ));
+    }
+    Ok(v)
+}
+
+/// `--refit-top`: 1 to the number of built-in candidate effects.
+pub fn parse_refit_top(s: &str) -> Result<usize, String> {
+    let v = count(s)?;
+    let most = Effect::builtin().len();
+    if !(1..=most).contains(&v) {
+        return Err(format!(
+            "give 1 to {most} (the number of candidate effects) candidates to refit (got {v})"
+        ));
+    }
+    Ok(v)
+}
+
+/// `--n`: the Carreau-type law's domain, a finite n >= 0.
+pub fn parse_n(s: &str) -> Result<f64, String> {
+    check_n(number(s)?)
+}
+
+/// Checks that `v` lies in the Carreau-type law's domain of n (finite, >= 0).
+pub fn check_n(v: f64) -> Result<f64, String> {
+    if !(v >= 0.0 && v.is_finite()) {
+        return Err(format!(
+            "the power index n must be >= 0 (the Carreau-type law's domain; 1 is Newtonian), \
+             got {v}"
+        ));
+    }
+    Ok(v)
+}
+
+/// `--kappa`: a finite κ with |κ| <= [`MAX_ABS_KAPPA`].
+pub fn parse_kappa(s: &str) -> Result<f64, String> {
+    check_kappa(number(s)?)
+}
+
+/// Checks that `v` is a usable κ (finite, |κ| <= [`MAX_ABS_KAPPA`]).
+pub fn check_kappa(v: f64) -> Result<f64, String> {
+    if v.is_nan() || v.abs() > MAX_ABS_KAPPA {
+        return Err(format!(
+            "kappa = ln(K / 1 Pa) must lie in [-{MAX_ABS_KAPPA}, {MAX_ABS_KAPPA}] (K = e^kappa \
+             overflows beyond; the fit searches [7, 20]), got {v}"
+        ));
+    }
+    Ok(v)
+}
+
+/// `--take-up-diameter`: in [[`MIN_TAKE_UP_DIAMETER_M`], `MAX_PLAUSIBLE_DIAMETER_M`] m.
+pub fn parse_take_up_diameter(s: &str) -> Result<f64, String> {
+    let v = number(s)?;
+    if !(MIN_TAKE_UP_DIAMETER_M..=MAX_PLAUSIBLE_DIAMETER_M).contains(&v) {
+        return Err(format!(
+            "a take-up diameter must lie in [{MIN_TAKE_UP_DIAMETER_M:e}, \
+             {MAX_PLAUSIBLE_DIAMETER_M}] m (got {v} m; the unit is metres)"
+        ));
+    }
+    Ok(v)
+}
+
+/// Checks that `(lo, hi)` given with `flag` is increasing and within `[min, max]`, the fit's
+/// bounds of the parameter `name`.
+pub fn check_range(
+    flag: &str,
+    name: &str,
+    (lo, hi): (f64, f64),
+    [min, max]: [f64; 2],
+) -> Result<(), String> {
+    if lo >= hi {
+        return Err(format!(
+            "{flag} {lo},{hi}: give MIN,MAX with MIN < MAX (did you mean {hi},{lo}?)"
+        ));
+    }
+    if lo < min || hi > max {
+        return Err(format!(
+            "{flag} {lo},{hi}: {name} must lie within the fit's bounds [{min}, {max}]"
+        ));
+    }
+    Ok(())
+}
+
+/// Checks `--start N,KAPPA` against the fit's bounds.
+pub fn check_start((n, kappa): (f64, f64), opts: &IdentifyOptions) -> Result<(), String> {
+    let inside = |v: f64, i: usize| v >= opts.lower[i] && v <= opts.upper[i];
+    if !inside(n, 0) || !inside(kappa, 1) {
+        return Err(format!(
+            "--start {n},{kappa}: the start must lie within the fit's bounds n in [{}, {}] and \
+             kappa in [{}, {}]",
+            opts.lower[0], opts.upper[0], opts.lower[1], opts.upper[1]
+        ));
+    }
+    Ok(())
+}
+
+/// The `--grid` size "NxM": 2 to [`MAX_GRID_SIDE`] values per direction, at most
+/// [`MAX_GRID_POINTS`] points.
+pub fn parse_grid(s: &str) -> Result<(usize, usize), String> {
+    let parts: Vec<&str> = s.split(['x', 'X']).collect();
+    if parts.len() != 2 {
+        return Err(format!("expected \"NxM\", got \"{s}\""));
+    }
+    let a: usize = parts[0]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a count", parts[0]))?;
+    let b: usize = parts[1]
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{}\" is not a count", parts[1]))?;
+    if a < 2 || b < 2 {
+        return Err("the grid needs at least 2 points per direction".into());
+    }
+    if a > MAX_GRID_SIDE || b > MAX_GRID_SIDE || a.saturating_mul(b) > MAX_GRID_POINTS {
+        return Err(format!(
+            "{a}x{b} is too large: at most {MAX_GRID_SIDE} values per direction and \
+             {MAX_GRID_POINTS} points (a 41x41 grid of the shipped data takes seconds; zoom in \
+             with --n-range and --kappa-range instead)"
+        ));
+    }
+    Ok((a, b))
+}
+
+/// The failure `e` prefixed with the experiment's name and its line in the experiments file
+/// `toml` (with hints) where the error chain names an experiment whose simulation failed;
+/// other errors unchanged. `law` are the law parameters `(n, κ)` of the solve where the error
+/// does not state them.
+pub fn name_experiment(e: Box<dyn Error>, toml: &Path, law: Option<[f64; 2]>) -> Box<dyn Error> {
+    if e.downcast_ref::<ExperimentFailure>().is_some() {
+        return e;
+    }
+    let Some((name, stated)) = diffbvp::fiber::failure_hints::failed_experiment(e.as_ref()) else {
+        return e;
+    };
+    let law = stated.or(law);
+    let loaded = std::fs::read_to_string(toml)
+        .ok()
+        .and_then(|text| parse_experiments(&text, toml).ok());
+    let unlocated = Location {
+        path: toml.to_path_buf(),
+        line: None,
+    };
+    let Some(loaded) = loaded else {
+        return Box::new(ExperimentFailure::unlocated(&name, unlocated, e));
+    };
+    match loaded.set.experiments.iter().position(|x| x.name == name) {
+        Some(k) => {
+            let at = Location {
+                path: toml.to_path_buf(),
+                line: loaded.details[k].line,
+            };
+            Box::new(ExperimentFailure::new(
+                &loaded.set.experiments[k],
+                &loaded.set.material,
+                at,
+                law,
+                e,
+            ))
+        }
+        None => Box::new(ExperimentFailure::unlocated(&name, unlocated, e)),
+    }
+}
+
+/// The mesh limit of a landscape: `--max-nodes` (at most [`LANDSCAPE_MAX_NODES`], the cap of
+/// the landscape's solves) or that cap.
+pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, String> {
+    match max_nodes {
+        None => Ok(LANDSCAPE_MAX_NODES),
+        Some(m) if m <= LANDSCAPE_MAX_NODES => Ok(m),
+        Some(m) => Err(format!(
+            "--max-nodes {m}: the landscape caps its meshes at {LANDSCAPE_MAX_NODES} nodes \
+             (points that need more are marked missing); give at most {LANDSCAPE_MAX_NODES}"
+        )),
+    }
+}
+
+/// Checks the values read from a fit file (`compare --fit`): n and κ in the law's domain,
+/// take-up factors within the fit's bounds, one per experiment (`experiments`).
+pub fn check_fit_values(path: &Path, p: &FitParameters, experiments: usize) -> Result<(), String> {
+    let at = path.display();
+    check_n(p.n).map_err(|m| format!("{at}: n: {m}"))?;
+    check_kappa(p.kappa).map_err(|m| format!("{at}: kappa: {m}"))?;
+    let [lo, hi] = IdentifyOptions::default().take_up_bounds;
+    if let Some((k, v)) = p
+        .take_up_factors
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(**v >= lo && **v <= hi))
+    {
+        return Err(format!(
+            "{at}: take-up factor {} of {experiments} is {v}, outside the fit's bounds [{lo}, {hi}]",
+            k + 1
+        ));
+    }
+    Ok(())
+}
+
+/// A measured estimate of a landscape's run time.
+pub struct LandscapeEstimate {
+    /// Grid points.
+    pub points: usize,
+    /// Worker threads the rows are spread over.
+    pub threads: usize,
+    /// Points per row.
+    pub row_points: usize,
+    /// Estimated time of one row, from the sampled rows \[s\].
+    pub row_s: f64,
+    /// Estimated total \[s\].
+    pub total_s: f64,
+}
+
+impl LandscapeEstimate {
+    /// "landscape: 441 points on 2 threads, about 16 s (estimated from sample rows: about 1.5 s
+    /// per row of 21 points)".
+    pub fn message(&self) -> String {
+        let t = self.total_s;
+        let about = if t < 90.0 {
+            format!("{t:.0} s")
+        } else if t < 5400.0 {
+            format!("{:.0} min", t / 60.0)
+        } else {
+            format!("{:.1} h", t / 3600.0)
+        };
+        format!(
+            "landscape: {} points on {} threads, about {about} (estimated from sample rows: \
+             about {:.2} s per row of {} points)",
+            self.points, self.threads, self.row_s, self.row_points
+        )
+    }
+}
+
+/// Estimates the run time of `rh.landscape(ns, ks, opts)` by walking two rows (the smallest
+/// and the middle κ; the smallest has the largest region without solution) as the landscape
+/// does: from the Newtonian solution towards smaller n, warm-started, up to the first failure,
+/// on at most 6 evenly picked values of n. The time per solved point is scaled to the row's
+/// points above the failure, and a failure counts four times (the landscape retries it with
+/// bisected steps).
+pub fn landscape_estimate(
+    rh: &Rheometer,
+    ns: &[f64],
+    ks: &[f64],
+    opts: &IdentifyOptions,
+) -> Result<LandscapeEstimate, Box<dyn Error>> {
+    let mut o = opts.clone();
+    o.simulate.factor_at_solution = false;
+    let mut order = ns.to_vec();
+    order.sort_by(|a, b| b.total_cmp(a));
+    let stride = order.len().div_ceil(6).max(1);
+    let mut sample: Vec<f64> = order.iter().copied().step_by(stride).collect();
+    if let Some(&last) = order.last() {
+        if sample.last() != Some(&last) {
+            sample.push(last);
+        }
+    }
+    let mut rows = vec![ks[0]];
+    if ks.len() > 2 {
+        rows.push(ks[ks.len() / 2]);
+    }
+    let mut cold_s = 0.0;
+    let mut row_s = 0.0;
+    for &kappa in &rows {
+        let t0 = Instant::now();
+        let mut obj = rh.objective([1.0, kappa], &o)?;
+        cold_s += t0.elapsed().as_secs_f64();
+        let (mut solved, mut solved_s, mut failed_at, mut failed_s) = (0usize, 0.0, None, 0.0);
+        for &n in &sample {
+            let t = Instant::now();
+            // a failing point costs time as well; its error does not matter here
+            let ok = obj.try_cost_at(n, kappa).is_ok();
+            let dt = t.elapsed().as_secs_f64();
+            if ok {
+                solved += 1;
+                solved_s += dt;
+            } else {
+                failed_at = Some(n);
+                failed_s = dt;
+                break;
+            }
+        }
+        let reached = match failed_at {
+            Some(nf) => order.iter().filter(|&&n| n > nf).count(),
+            None => order.len(),
+        };
+        row_s += solved_s / solved.max(1) as f64 * reached as f64 + 4.0 * failed_s;
+    }
+    let cold_s = cold_s / rows.len() as f64;
+    let row_s = row_s / rows.len() as f64;
+    let threads = rayon::current_num_threads().clamp(1, ks.len().max(1));
+    // every worker starts with a cold start at n = 1, and the landscape makes one more
+    let total_s = row_s * ks.len().div_ceil(threads) as f64 + 2.0 * cold_s;
+    Ok(LandscapeEstimate {
+        points: ns.len() * ks.len(),
+        threads,
+        row_points: ns.len(),
+        row_s,
+        total_s,
+    })
+}
