@@ -64,6 +64,8 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let mut setup = ModelSetup::carreau([0.8, 11.71], &physics);
     let mut fitted = 0;
     if let (Some(path), Some(rep)) = (&fit, fit_params) {
+        let names: Vec<String> = set.experiments.iter().map(|e| e.name.clone()).collect();
+        rep.check_experiments(&names, &path.display().to_string())?;
         rep.apply(
             &mut setup,
             set.experiments.len(),

@@ -26,4 +26,4 @@ pub use identify::{
 };
 pub use landscape::Landscape;
 pub use layout::{EffectSlot, FitStart, Layout};
-pub use report::{EffectReport, FitReport};
+pub use report::{AtBound, BoundSide, EffectReport, FitReport, FitWarning, WarningCode};
