@@ -350,6 +350,16 @@ fn library_bounds_that_exclude_the_optimum_are_marked() {
         let v: Value = serde_json::to_value(&rep).unwrap();
         assert!(v[if name == "n" { "ci95_n" } else { "ci95_kappa" }][0].is_null());
         assert_eq!(at_bound(&v, name), Some((side.name().to_string(), bound)));
+        // and the written report reads back, nulls as NaN, marks and warnings kept
+        let back: FitReport = serde_json::from_value(v).unwrap();
+        assert!(back
+            .ci95_n
+            .iter()
+            .chain(&back.ci95_kappa)
+            .any(|x| x.is_nan()));
+        assert_eq!(back.at_bound, rep.at_bound);
+        assert_eq!(back.warnings, rep.warnings);
+        assert_eq!(back.to_text().lines().count(), text.lines().count());
     }
 }
 

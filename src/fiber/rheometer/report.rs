@@ -200,17 +200,22 @@ pub struct FitReport {
     #[serde(rename = "K_Pa")]
     pub k_pa: f64,
     /// Standard error of `n`.
+    #[serde(deserialize_with = "nullable::f64")]
     pub stderr_n: f64,
     /// Standard error of `κ`.
+    #[serde(deserialize_with = "nullable::f64")]
     pub stderr_kappa: f64,
     /// 95% confidence interval of `n` (`NaN` when `n` is at a bound or has no standard error).
+    #[serde(deserialize_with = "nullable::pair")]
     pub ci95_n: [f64; 2],
     /// 95% confidence interval of `κ` (`NaN` when `κ` is at a bound or has no standard error).
+    #[serde(deserialize_with = "nullable::pair")]
     pub ci95_kappa: [f64; 2],
     /// 95% confidence interval of `K` \[Pa\] (`NaN` when `κ`'s is).
-    #[serde(rename = "ci95_K_Pa")]
+    #[serde(rename = "ci95_K_Pa", deserialize_with = "nullable::pair")]
     pub ci95_k_pa: [f64; 2],
     /// Correlation of `n` and `κ`.
+    #[serde(deserialize_with = "nullable::f64")]
     pub correlation_n_kappa: f64,
     /// Cost `J = ‖r‖²` of the estimator at the optimum.
     pub cost: f64,
@@ -220,7 +225,7 @@ pub struct FitReport {
     #[serde(default)]
     pub rms_relative_residual_by_experiment: Vec<f64>,
     /// Relative noise level the misfit is judged against \[-\] (`NaN` if unknown).
-    #[serde(default = "nan")]
+    #[serde(default = "nan", deserialize_with = "nullable::f64")]
     pub noise_level: f64,
     /// Where `noise_level` comes from (`"declared relative_uncertainty"` or
     /// `"estimated from second differences of the residuals"`).
@@ -253,6 +258,23 @@ fn nan() -> f64 {
     f64::NAN
 }
 
+/// Reading numbers that JSON writes as `null` when they are `NaN` (no standard error, no valid
+/// interval), so that a written report reads back.
+mod nullable {
+    use serde::{Deserialize, Deserializer};
+
+    /// `null` → `NaN`.
+    pub fn f64<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+    }
+
+    /// `[null, null]` → `[NaN, NaN]`.
+    pub fn pair<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+        let [a, b] = <[Option<f64>; 2]>::deserialize(d)?;
+        Ok([a.unwrap_or(f64::NAN), b.unwrap_or(f64::NAN)])
+    }
+}
+
 /// An effect's strength in a fit report.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct EffectReport {
@@ -261,8 +283,10 @@ pub struct EffectReport {
     /// Strength (in the effect's unit, see `unit`).
     pub strength: f64,
     /// Its standard error (`0` if fixed).
+    #[serde(deserialize_with = "nullable::f64")]
     pub stderr_strength: f64,
     /// 95% confidence interval (`NaN` at a bound or without a standard error).
+    #[serde(deserialize_with = "nullable::pair")]
     pub ci95_strength: [f64; 2],
     /// Unit of the strength.
     pub unit: String,
