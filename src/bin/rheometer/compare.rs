@@ -68,6 +68,8 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     setup.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     let mut fitted = 0;
     if let (Some(path), Some(rep)) = (&fit, fit_params) {
+        let names: Vec<String> = set.experiments.iter().map(|e| e.name.clone()).collect();
+        rep.check_experiments(&names, &path.display().to_string())?;
         rep.apply(
             &mut setup,
             set.experiments.len(),

@@ -95,6 +95,9 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let id = rh.identify(start, &opts)?;
     let rep = FitReport::new(&id);
     outln!("{}", rep.to_text());
+    for w in &rep.warnings {
+        g.say(format!("warning: {w}"));
+    }
     let text = serde_json::to_string_pretty(&rep)?;
     if let Some(path) = json {
         write_json(&path, &text, &inputs)?;

@@ -29,6 +29,9 @@ impl Diagnosis {
             100.0 * self.noise_level,
             self.noise_source
         ));
+        for w in &b.warnings {
+            s.push_str(&format!("WARNING about your model's fit: {w}\n"));
+        }
         s.push_str(&format!(
             "The residuals are {} (RMS/noise = {:.2}, lag-1 autocorrelation {:+.2}).\n",
             if self.systematic {

@@ -10,7 +10,9 @@
 use super::estimator::Estimator;
 use super::layout::{EffectSlot, FitStart};
 use super::objective::Objective;
-use crate::fiber::diagnostics::candidates::ModelSpec;
+use super::report::{FitWarning, WarningCode};
+use crate::fiber::diagnostics::candidates::{LawChoice, ModelSpec};
+use crate::fiber::diagnostics::compare::residual_stats::median;
 use crate::fiber::error::FiberError;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
@@ -259,12 +261,22 @@ impl Rheometer {
             initial_radius: 0.3,
             max_radius: 1.0,
             max_iterations: options.max_iterations,
-            ..FitOptions::with_bounds(lower, upper)
+            ..FitOptions::with_bounds(lower.clone(), upper.clone())
         };
         let fit_result = fit(&mut obj, &p0, &fo)?;
         let solutions: Vec<Solution> = obj.runs.iter().map(|r| r.accepted.clone()).collect();
         let rms = self.rms_relative_residual(&solutions);
         let ns = obj.layout.num_shared();
+        let residual_profiles = solutions
+            .iter()
+            .enumerate()
+            .map(|(k, sol)| {
+                (
+                    self.measurements[k].positions.clone(),
+                    self.relative_residuals(k, sol),
+                )
+            })
+            .collect();
         let local = obj.layout.local(
             &fit_result.p[..ns],
             1.0,
@@ -284,6 +296,13 @@ impl Rheometer {
             effects: obj.layout.effects.clone(),
             local_params: local,
             rms_relative_residual: rms,
+            law: self.spec.law,
+            experiment_names: self.experiments.iter().map(|e| e.name.clone()).collect(),
+            lower,
+            upper,
+            residual_profiles,
+            relative_uncertainty: options.relative_uncertainty.or(self.relative_uncertainty),
+            data_warnings: self.data_warnings(),
             solutions,
             fit: fit_result,
             wall_time_s: t0.elapsed().as_secs_f64(),
@@ -310,6 +329,37 @@ impl Rheometer {
             newtonian_cost: j1,
             trace,
         })
+    }
+
+    /// Checks of the measured data that the model cannot describe, one warning per experiment:
+    /// the spin-line model draws the fiber down, so its diameter decreases along the spin line;
+    /// measured diameters whose last third lies above their first third (median against median)
+    /// cannot be fitted (reversed positions, a swapped column or the wrong file).
+    pub fn data_warnings(&self) -> Vec<FitWarning> {
+        let mut out = Vec::new();
+        for (e, m) in self.experiments.iter().zip(&self.measurements) {
+            let d = &m.diameters;
+            let third = d.len() / 3;
+            if third == 0 {
+                continue;
+            }
+            let first = median(&mut d[..third].to_vec());
+            let last = median(&mut d[d.len() - third..].to_vec());
+            if last >= first {
+                out.push(FitWarning::new(
+                    WarningCode::DataTrend,
+                    format!(
+                        "experiment {}: the measured diameters do not decrease along the spin \
+                         line (median {:.4e} m over the first third of the points, {:.4e} m over \
+                         the last third); a drawn fiber thins towards the take-up, so the model \
+                         cannot describe these data: check the data file (reversed positions, \
+                         swapped columns, wrong file)",
+                        e.name, first, last
+                    ),
+                ));
+            }
+        }
+        out
     }
 
     /// RMS of `(d_model − d_meas)/d_meas` over all measurements for the given solutions.
@@ -382,4 +432,19 @@ pub struct Identification {
     pub fit: FitResult,
     /// Wall time \[s\], including the cold starts.
     pub wall_time_s: f64,
+    /// The viscosity law of the model (what was fitted; never inferred from the values).
+    pub law: LawChoice,
+    /// Experiment names, in the order of `take_up_factors` and `solutions`.
+    pub experiment_names: Vec<String>,
+    /// Lower bounds of `fit.p` (shared parameters in model units, then take-up factors).
+    pub lower: Vec<f64>,
+    /// Upper bounds of `fit.p`.
+    pub upper: Vec<f64>,
+    /// Per experiment: measurement positions \[m\] and relative residuals
+    /// `(d_model − d_meas)/d_meas` \[-\] at the optimum.
+    pub residual_profiles: Vec<(Vec<f64>, Vec<f64>)>,
+    /// Declared relative measurement uncertainty (options, else the data set), if any.
+    pub relative_uncertainty: Option<f64>,
+    /// Warnings about the data found before fitting ([`Rheometer::data_warnings`]).
+    pub data_warnings: Vec<FitWarning>,
 }

@@ -10,7 +10,8 @@
 //!   warm-started, exact Jacobians from forward sensitivities);
 //! * [`layout`]: which parameters are fitted (law, effect strengths, take-up factors);
 //! * [`landscape`]: the cost on a grid (paper Fig. 4);
-//! * [`report`]: uncertainty (standard errors, 95% confidence intervals, correlation) and the
+//! * [`report`]: uncertainty (standard errors, 95% confidence intervals, correlation), the checks
+//!   of a fit (estimates at bounds, misfit, huge errors, data the model cannot describe) and the
 //!   text and JSON reports.
 
 pub mod estimator;
@@ -26,4 +27,4 @@ pub use identify::{
 };
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout};
-pub use report::{EffectReport, FitReport};
+pub use report::{AtBound, BoundSide, EffectReport, FitReport, FitWarning, WarningCode};

@@ -2,6 +2,7 @@
 //! conditions (from the data set, from the smoothed data, or as fitted) and the physics.
 
 use super::{compare, CompareError, CompareOptions, Comparison, SimulatedExperiment};
+use crate::fiber::diagnostics::candidates::Effect;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::setup::{ExperimentSet, TakeUp};
@@ -189,7 +190,19 @@ pub struct FitParameters {
     /// model).
     #[serde(default)]
     pub effects: Vec<FittedEffect>,
+    /// Experiment names of the fit, in the order of `take_up_factors` (empty in reports
+    /// written before this field existed).
+    #[serde(default)]
+    pub experiments: Vec<String>,
 }
+
+/// The range of `n` accepted from a fit file (the rheometer's search range) \[-\].
+pub const FIT_FILE_N_RANGE: [f64; 2] = [0.0, 1.0];
+/// The range of `κ = ln(K / 1 Pa)` accepted from a fit file (`K` from 1 Pa to about
+/// `5·10²¹` Pa) \[-\].
+pub const FIT_FILE_KAPPA_RANGE: [f64; 2] = [0.0, 50.0];
+/// The range of take-up factors accepted from a fit file \[-\].
+pub const FIT_FILE_TAKE_UP_RANGE: [f64; 2] = [0.01, 100.0];
 
 /// An effect of a fitted model as read from a fit report.
 #[derive(Debug, Clone, PartialEq, serde::Deserialize)]
@@ -206,18 +219,196 @@ pub struct FittedEffect {
 impl FitParameters {
     /// Parses the JSON text of a fit report; `source` names it in errors.
     pub fn from_json(text: &str, source: &str) -> Result<Self, CompareError> {
-        let p: FitParameters = serde_json::from_str(text).map_err(|e| {
+        let not_report = |what: String| {
             CompareError::Data(format!(
-                "{source} is not a fit report as written by `rheometer fit --json`: {e}"
+                "{source} is not a fit report as written by `rheometer fit --json`: {what}"
             ))
-        })?;
-        if !(p.n.is_finite() && p.kappa.is_finite()) {
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| not_report(format!("not valid JSON: {e}")))?;
+        let obj = value
+            .as_object()
+            .ok_or_else(|| not_report("expected a JSON object {...}".into()))?;
+        // the fields a comparison needs, checked one by one so that errors name them
+        let kind = |v: &serde_json::Value| match v {
+            serde_json::Value::Null => "null",
+            serde_json::Value::Bool(_) => "a boolean",
+            serde_json::Value::Number(_) => "a number",
+            serde_json::Value::String(_) => "a string",
+            serde_json::Value::Array(_) => "an array",
+            serde_json::Value::Object(_) => "an object",
+        };
+        let field_err = |field: &str, msg: String| {
+            CompareError::Data(format!("{source}: field {field}: {msg}"))
+        };
+        for key in ["estimator", "n", "kappa"] {
+            if !obj.contains_key(key) {
+                return Err(field_err(
+                    &format!("\"{key}\""),
+                    "missing (a fit report from `rheometer fit --json` has it)".into(),
+                ));
+            }
+        }
+        for key in ["n", "kappa"] {
+            if let Some(v) = obj.get(key).filter(|v| !v.is_number()) {
+                return Err(field_err(
+                    &format!("\"{key}\""),
+                    format!("expected a number, found {} ({v})", kind(v)),
+                ));
+            }
+        }
+        if let Some(v) = obj.get("take_up_factors") {
+            let arr = v.as_array().ok_or_else(|| {
+                field_err(
+                    "\"take_up_factors\"",
+                    format!("expected an array of numbers, found {}", kind(v)),
+                )
+            })?;
+            if let Some((i, x)) = arr.iter().enumerate().find(|(_, x)| !x.is_number()) {
+                return Err(field_err(
+                    &format!("\"take_up_factors\"[{i}]"),
+                    format!("expected a number, found {} ({x})", kind(x)),
+                ));
+            }
+        }
+        if let Some(v) = obj.get("effects") {
+            let arr = v.as_array().ok_or_else(|| {
+                field_err(
+                    "\"effects\"",
+                    format!("expected an array of effects, found {}", kind(v)),
+                )
+            })?;
+            for (i, e) in arr.iter().enumerate() {
+                let f = format!("\"effects\"[{i}]");
+                match e.get("effect") {
+                    Some(serde_json::Value::String(_)) => {}
+                    Some(x) => {
+                        return Err(field_err(
+                            &format!("{f}.effect"),
+                            format!("expected an effect name, found {} ({x})", kind(x)),
+                        ))
+                    }
+                    None => return Err(field_err(&format!("{f}.effect"), "missing".into())),
+                }
+                match e.get("strength") {
+                    Some(x) if x.is_number() => {}
+                    Some(x) => {
+                        return Err(field_err(
+                            &format!("{f}.strength"),
+                            format!("expected a number, found {} ({x})", kind(x)),
+                        ))
+                    }
+                    None => return Err(field_err(&format!("{f}.strength"), "missing".into())),
+                }
+            }
+        }
+        let p: FitParameters =
+            serde_json::from_value(value).map_err(|e| not_report(e.to_string()))?;
+        p.validate(source)?;
+        Ok(p)
+    }
+
+    /// Checks the values (as read from a file `source`): `n` in [`FIT_FILE_N_RANGE`], `κ` in
+    /// [`FIT_FILE_KAPPA_RANGE`], take-up factors in [`FIT_FILE_TAKE_UP_RANGE`], effects known,
+    /// once each, with finite strengths inside their search ranges, and as many experiment
+    /// names (if given) as take-up factors. Errors name the file and the field.
+    pub fn validate(&self, source: &str) -> Result<(), CompareError> {
+        let bad = |field: String, msg: String| {
+            Err(CompareError::Data(format!(
+                "{source}: field {field}: {msg}"
+            )))
+        };
+        let in_range = |v: f64, r: [f64; 2]| v.is_finite() && v >= r[0] && v <= r[1];
+        if !in_range(self.n, FIT_FILE_N_RANGE) {
+            return bad(
+                "\"n\"".into(),
+                format!(
+                    "n = {} must be a finite power index in [{}, {}]",
+                    self.n, FIT_FILE_N_RANGE[0], FIT_FILE_N_RANGE[1]
+                ),
+            );
+        }
+        if !in_range(self.kappa, FIT_FILE_KAPPA_RANGE) {
+            return bad(
+                "\"kappa\"".into(),
+                format!(
+                    "kappa = ln(K / 1 Pa) = {} must be finite and in [{}, {}]",
+                    self.kappa, FIT_FILE_KAPPA_RANGE[0], FIT_FILE_KAPPA_RANGE[1]
+                ),
+            );
+        }
+        for (i, &f) in self.take_up_factors.iter().enumerate() {
+            if !in_range(f, FIT_FILE_TAKE_UP_RANGE) {
+                return bad(
+                    format!("\"take_up_factors\"[{i}]"),
+                    format!(
+                        "take-up factor {f} must be finite and in [{}, {}]",
+                        FIT_FILE_TAKE_UP_RANGE[0], FIT_FILE_TAKE_UP_RANGE[1]
+                    ),
+                );
+            }
+        }
+        if !self.experiments.is_empty() && self.experiments.len() != self.take_up_factors.len() {
+            return bad(
+                "\"experiments\"".into(),
+                format!(
+                    "{} experiment names but {} take-up factors",
+                    self.experiments.len(),
+                    self.take_up_factors.len()
+                ),
+            );
+        }
+        for (i, e) in self.effects.iter().enumerate() {
+            let field = format!("\"effects\"[{i}]");
+            let effect: Effect = match e.effect.parse() {
+                Ok(effect) => effect,
+                Err(msg) => return bad(format!("{field}.effect"), msg),
+            };
+            if self.effects[..i].iter().any(|o| o.effect == e.effect) {
+                return bad(
+                    format!("{field}.effect"),
+                    format!("effect \"{}\" appears twice", e.effect),
+                );
+            }
+            let (lo, hi) = effect.bounds();
+            if !(e.strength.is_finite() && e.strength >= lo && e.strength <= hi) {
+                return bad(
+                    format!("{field}.strength"),
+                    format!(
+                        "{} strength {} must be finite and in [{lo}, {hi}] {}",
+                        e.effect,
+                        e.strength,
+                        effect.unit()
+                    ),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the fit's experiment names (where the file has them) against the data set's
+    /// `names`, in order; `source` names the fit file in errors.
+    pub fn check_experiments(&self, names: &[String], source: &str) -> Result<(), CompareError> {
+        if self.experiments.is_empty() {
+            return Ok(());
+        }
+        if self.experiments.len() != names.len() {
             return Err(CompareError::Data(format!(
-                "{source}: n = {} and kappa = {} must be finite",
-                p.n, p.kappa
+                "{source}: field \"experiments\": the fit has {} experiments, the data set {}; \
+                 was the fit made on this data set?",
+                self.experiments.len(),
+                names.len()
             )));
         }
-        Ok(p)
+        for (i, (a, b)) in self.experiments.iter().zip(names).enumerate() {
+            if a != b {
+                return Err(CompareError::Data(format!(
+                    "{source}: field \"experiments\"[{i}]: the fit's experiment \"{a}\" is \
+                     \"{b}\" in the data set; was the fit made on this data set (same order)?"
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Number of parameters the fit adjusted to the data: `(n, κ)` and, for the principled
@@ -245,8 +436,8 @@ impl FitParameters {
         if self.estimator == crate::fiber::rheometer::Estimator::Principled {
             if self.take_up_factors.len() != experiments {
                 return Err(CompareError::Data(format!(
-                    "{source}: {} take-up factors for {experiments} experiments; was the fit made \
-                     on this data set?",
+                    "{source}: field \"take_up_factors\": {} take-up factors for {experiments} \
+                     experiments; was the fit made on this data set?",
                     self.take_up_factors.len()
                 )));
             }
