@@ -560,13 +560,13 @@ fn compare_fit_file_values_are_checked() {
     let (dir, toml, dd) = data("args_fit_values");
     let out = dir.join("out");
     for (n, kappa, factor, needles) in [
-        (-0.5, 11.71, 1.0, vec!["n:", "-0.5", ">= 0"]),
-        (0.8, 1000.0, 1.0, vec!["kappa:", "1000"]),
+        (-0.5, 11.71, 1.0, vec!["field \"n\"", "-0.5", "[0, 1]"]),
+        (0.8, 1000.0, 1.0, vec!["field \"kappa\"", "1000"]),
         (
             0.8,
             11.71,
             7.0,
-            vec!["take-up factor 5 of 9 is 7", "[0.5, 1.5]"],
+            vec!["\"take_up_factors\"[4]", "take-up factor 7", "[0.5, 1.5]"],
         ),
     ] {
         let f = fit_json(&dir, n, kappa, factor);

@@ -3,7 +3,6 @@
 //! experiment's simulation named with the experiment and its TOML line.
 
 use diffbvp::fiber::diagnostics::candidates::Effect;
-use diffbvp::fiber::diagnostics::compare::FitParameters;
 use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::input::{parse_experiments, Location, MAX_PLAUSIBLE_DIAMETER_M};
 use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;
@@ -265,27 +264,6 @@ pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, String> {
              (points that need more are marked missing); give at most {LANDSCAPE_MAX_NODES}"
         )),
     }
-}
-
-/// Checks the values read from a fit file (`compare --fit`): n and κ in the law's domain,
-/// take-up factors within the fit's bounds, one per experiment (`experiments`).
-pub fn check_fit_values(path: &Path, p: &FitParameters, experiments: usize) -> Result<(), String> {
-    let at = path.display();
-    check_n(p.n).map_err(|m| format!("{at}: n: {m}"))?;
-    check_kappa(p.kappa).map_err(|m| format!("{at}: kappa: {m}"))?;
-    let [lo, hi] = IdentifyOptions::default().take_up_bounds;
-    if let Some((k, v)) = p
-        .take_up_factors
-        .iter()
-        .enumerate()
-        .find(|(_, v)| !(**v >= lo && **v <= hi))
-    {
-        return Err(format!(
-            "{at}: take-up factor {} of {experiments} is {v}, outside the fit's bounds [{lo}, {hi}]",
-            k + 1
-        ));
-    }
-    Ok(())
 }
 
 /// A measured estimate of a landscape's run time.

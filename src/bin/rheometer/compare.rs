@@ -54,9 +54,6 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let inputs = inputs_of(&experiments, &loaded);
     let set = &loaded.set;
     let fit_params = fit.as_ref().map(|p| read_fit(p)).transpose()?;
-    if let (Some(path), Some(p)) = (&fit, &fit_params) {
-        checks::check_fit_values(path, p, set.experiments.len())?;
-    }
     let effects = compare_effects(fit_params.as_ref(), &with)?;
     // validated once here; the closure rebuilds the same physics per experiment
     physics_with(&effects)?;

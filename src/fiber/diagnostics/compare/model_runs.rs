@@ -201,8 +201,9 @@ pub const FIT_FILE_N_RANGE: [f64; 2] = [0.0, 1.0];
 /// The range of `κ = ln(K / 1 Pa)` accepted from a fit file (`K` from 1 Pa to about
 /// `5·10²¹` Pa) \[-\].
 pub const FIT_FILE_KAPPA_RANGE: [f64; 2] = [0.0, 50.0];
-/// The range of take-up factors accepted from a fit file \[-\].
-pub const FIT_FILE_TAKE_UP_RANGE: [f64; 2] = [0.01, 100.0];
+/// The range of take-up factors accepted from a fit file: the rheometer's default search range
+/// (`IdentifyOptions::take_up_bounds`), which every fit of the `rheometer` program uses \[-\].
+pub const FIT_FILE_TAKE_UP_RANGE: [f64; 2] = [0.5, 1.5];
 
 /// An effect of a fitted model as read from a fit report.
 #[derive(Debug, Clone, PartialEq, serde::Deserialize)]
