@@ -123,7 +123,8 @@ impl Solution {
     /// The C1 interpolant and its derivative at `x`, written into `y` and `yp` (length `n`).
     ///
     /// Outside `[a, b]` the cubic of the end interval is extrapolated (as scipy's
-    /// `solve_bvp` solution does); far outside, its value may overflow to `±inf`. A
+    /// `solve_bvp` solution does); far outside (the cube of the distance in interval lengths
+    /// beyond `f64::MAX`, about 1e100) its terms overflow and the result is `±inf` or NaN. A
     /// non-finite `x` (NaN or `±inf`) gives NaN in every component of `y` and `yp`.
     ///
     /// # Panics
