@@ -860,7 +860,7 @@ impl Field<'_> {
         if self.table == experiment_table {
             self.table.clone()
         } else {
-            format!("{experiment_table} (`{}` from {})", self.key, self.table)
+            format!("{experiment_table} (value from {})", self.table)
         }
     }
 
@@ -1144,18 +1144,19 @@ fn experiment(
     if !(mu_in.is_finite() && mu_in <= MAX_INLET_VISCOSITY_PA_S) {
         let what = if mu_in.is_finite() {
             format!(
-                "{mu_in:.3e} Pa s, above {MAX_INLET_VISCOSITY_PA_S:e} Pa s (a glass, not a melt)"
+                "a zero-shear viscosity of {mu_in:.3e} Pa s at the inlet, above \
+                 {MAX_INLET_VISCOSITY_PA_S:e} Pa s (a glass, not a melt)"
             )
         } else {
-            "an infinite value (beyond the floating-point range)".to_string()
+            "an infinite zero-shear viscosity at the inlet (beyond the floating-point range)"
+                .to_string()
         };
         return Err(t_in_field.invalid_in(
             table,
             inlet_temperature,
             format!(
                 "the inlet temperature is only {:.4} K above the Vogel temperature \
-                 vft_T_VF_K = {t_vf} K: the VFT law mu_c exp(B/(T - T_VF)) gives a zero-shear \
-                 viscosity of {what} at the inlet",
+                 vft_T_VF_K = {t_vf} K: the VFT law mu_c exp(B/(T - T_VF)) gives {what}",
                 inlet_temperature - t_vf
             ),
         ));
@@ -1197,7 +1198,7 @@ fn experiment(
             table,
             format!(
                 "`mass_flow_kg_s` = {mass_flow} (line {}) and `{}` = {inlet_value} give an {derived} \
-                 = {value:e} {unit} (with ρ(T_in) = {rho_in:.6} kg/m³), outside the plausible range \
+                 = {value:.3e} {unit} (with ρ(T_in) = {rho_in:.1} kg/m³), outside the plausible range \
                  {min:e} to {max:e} {unit}",
                 q_field.at().line.unwrap_or(0),
                 inlet_field.key

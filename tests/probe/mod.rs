@@ -108,7 +108,12 @@ impl Probe {
     /// Asserts: a failure with exit code 1 or 2 (clap's usage errors), no panic, every needle
     /// (case-insensitive) in stderr, no input changed.
     pub fn assert_clean_failure(&self, needles: &[&str]) {
-        assert!(!self.panicked(), "{:?} panicked:\n{}", self.args, self.stderr);
+        assert!(
+            !self.panicked(),
+            "{:?} panicked:\n{}",
+            self.args,
+            self.stderr
+        );
         assert!(
             matches!(self.code, Some(1) | Some(2)),
             "{:?}: expected exit code 1 or 2, got {:?}\nstderr:\n{}",
@@ -130,7 +135,12 @@ impl Probe {
 
     /// Asserts success (exit 0), no panic, inputs unchanged.
     pub fn assert_success(&self) {
-        assert!(!self.panicked(), "{:?} panicked:\n{}", self.args, self.stderr);
+        assert!(
+            !self.panicked(),
+            "{:?} panicked:\n{}",
+            self.args,
+            self.stderr
+        );
         assert_eq!(
             self.code,
             Some(0),
