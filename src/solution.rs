@@ -168,9 +168,9 @@ impl Solution {
 /// Index of the interval of the mesh `x` (at least 2 nodes) containing `v`, clamped; NaN gives 0.
 pub(crate) fn interval_of(x: &[f64], v: f64) -> usize {
     let m = x.len();
-    // `!(v > x[0])` also catches NaN, for which `partition_point` would return 0 and the
+    // NaN must be caught: `partition_point` would return 0 for it and the
     // subtraction below would overflow
-    if !(v > x[0]) {
+    if v.is_nan() || v <= x[0] {
         return 0;
     }
     if v >= x[m - 1] {

@@ -100,12 +100,12 @@ fn eval_outside_the_interval_extrapolates_the_end_cubic() {
     let s = bratu();
     for x in [1.5, 3.0, 100.0] {
         let y = s.eval(x);
-        for c in 0..2 {
+        assert_eq!(y.len(), 2);
+        for (c, &yc) in y.iter().enumerate() {
             let want = end_cubic(&s, x, c);
             assert!(
-                (y[c] - want).abs() <= 1e-12 * want.abs().max(1.0),
-                "x = {x}, component {c}: {} vs {want}",
-                y[c]
+                (yc - want).abs() <= 1e-12 * want.abs().max(1.0),
+                "x = {x}, component {c}: {yc} vs {want}"
             );
         }
     }
@@ -347,7 +347,7 @@ fn solve_options_are_validated_with_names_and_values() {
     for (options, needle) in cases {
         let m = invalid_input(solve(&Bratu, &[1.0], &guess(), &options).unwrap_err());
         assert!(m.contains(needle), "expected {needle:?} in {m}");
-        assert_eq!(options.validate(2).is_err(), true);
+        assert!(options.validate(2).is_err());
     }
     assert!(SolveOptions::default().validate(2).is_ok());
 }
@@ -446,4 +446,41 @@ fn fit_options_are_validated_with_names_and_values() {
     }
     let m = fit(&mut Shift, &[f64::NAN], &base).unwrap_err().to_string();
     assert!(m.contains("start NaN"), "{m}");
+}
+
+#[test]
+fn discrete_system_refuses_a_dense_jacobian_beyond_its_limit() {
+    use diffbvp::inspect::{discrete_system, MAX_DENSE_ENTRIES};
+    let small = discrete_system(&Bratu, &[1.0], &guess()).unwrap();
+    assert_eq!(small.size, 10);
+    assert_eq!(small.jacobian.len(), 100);
+    // 20 000 nodes x 2 states: 1.6e9 dense entries (12.8 GB) — an error, not an abort
+    let big = Guess::constant(linspace(0.0, 1.0, 20_000), &[0.0, 0.0]);
+    let t0 = Instant::now();
+    let m = invalid_input(discrete_system(&Bratu, &[1.0], &big).unwrap_err());
+    assert!(
+        m.contains("20000 nodes x 2 states") && m.contains(&MAX_DENSE_ENTRIES.to_string()),
+        "{m}"
+    );
+    assert!(t0.elapsed() < Duration::from_secs(1));
+}
+
+#[test]
+fn fiber_model_refuses_an_overflowing_inlet_velocity() {
+    use diffbvp::fiber::setup::{Air, Experiment, Material};
+    use diffbvp::fiber::{CarreauLike, FiberModel, Physics};
+    let mut e = Experiment::pmma7n_v0p53_p2();
+    e.mass_flow = 1e308;
+    let m = FiberModel::new(
+        &Material::pmma7n(),
+        &Air::paper(),
+        &e,
+        CarreauLike::new(),
+        Physics::default(),
+    )
+    .err()
+    .expect("an error")
+    .to_string();
+    assert!(m.contains("inlet velocity") && m.contains("inf"), "{m}");
+    assert!(!m.contains("inlet diameter 0 m"), "{m}");
 }

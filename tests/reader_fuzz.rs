@@ -215,10 +215,12 @@ fn mutated(base: &str, ms: &[Mutation]) -> String {
 }
 
 /// Parses `text` as the TOML experiment file `path`; fails the case on a panic or on an error
-/// message that is empty or does not start with the file.
-/// Returns whether the text was accepted.
+/// message that is empty or does not start with the file. Returns whether the text was
+/// accepted.
 fn check_toml(text: &str, path: &Path) -> Result<bool, TestCaseError> {
-    let r = catch_unwind(AssertUnwindSafe(|| parse_experiments(text, path)));
+    let r = catch_unwind(AssertUnwindSafe(|| {
+        parse_experiments(text, path).map_err(Box::new)
+    }));
     match r {
         Err(_) => Err(TestCaseError::fail(format!(
             "parse_experiments panicked on {text:?}"
@@ -236,10 +238,11 @@ fn check_toml(text: &str, path: &Path) -> Result<bool, TestCaseError> {
     }
 }
 
-/// Returns whether the text was accepted.
+/// Like [`check_toml`] for the CSV text of a measurement file; what is accepted must satisfy
+/// the documented checks. Returns whether the text was accepted.
 fn check_csv(text: &str, path: &Path, length: f64) -> Result<bool, TestCaseError> {
     let r = catch_unwind(AssertUnwindSafe(|| {
-        parse_measurements(text, path, length, 4)
+        parse_measurements(text, path, length, 4).map_err(Box::new)
     }));
     match r {
         Err(_) => Err(TestCaseError::fail(format!(
@@ -253,7 +256,7 @@ fn check_csv(text: &str, path: &Path, length: f64) -> Result<bool, TestCaseError
             prop_assert!(m
                 .diameters
                 .iter()
-                .all(|d| d.is_finite() && *d > 0.0 && *d <= 0.02));
+                .all(|d| d.is_finite() && *d >= 1e-6 && *d <= 0.02));
             Ok(true)
         }
         Ok(Err(e)) => {
@@ -392,14 +395,16 @@ fn loader_survives_mutated_toml_and_csv_files() {
             let csv_path = dir.join(&names[which]);
             std::fs::write(&csv_path, mutated(&base_csv, &cm)).unwrap();
             std::fs::write(&toml_path, mutated(&base_toml, &tm)).unwrap();
-            let r = catch_unwind(AssertUnwindSafe(|| load_experiments_with(&toml_path, 4)));
+            let r = catch_unwind(AssertUnwindSafe(|| {
+                load_experiments_with(&toml_path, 4).map_err(Box::new)
+            }));
             match r {
                 Err(_) => Err(TestCaseError::fail("load_experiments_with panicked")),
                 Ok(Ok(_)) => Ok(true),
                 Ok(Err(e)) => {
                     let msg = e.to_string();
                     prop_assert!(msg.starts_with(&toml_path.display().to_string()), "{msg:?}");
-                    if let diffbvp::fiber::input::InputError::Data { cause, .. } = &e {
+                    if let diffbvp::fiber::input::InputError::Data { cause, .. } = &*e {
                         let cause = cause.to_string();
                         prop_assert!(cause.contains(".csv"), "{cause:?}");
                     }

@@ -388,7 +388,7 @@ pub fn parse_measurements(
         },
         message,
     };
-    if !(spinline_length > 0.0) {
+    if spinline_length.is_nan() || spinline_length <= 0.0 {
         return Err(csv_error(
             None,
             format!(

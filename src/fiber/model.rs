@@ -186,7 +186,16 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             }
             Inlet::Velocity(u) => positive("inlet velocity", u)?,
         };
-        let d_in_si = 2.0 * (q / (PI * rho_in * u_in_si)).sqrt();
+        // derived values that overflow or underflow (e.g. a mass flow of 1e308 kg/s) are refused
+        // here, not reported later as a consequence ("inlet diameter 0 m")
+        let u_in_si = positive(
+            "inlet velocity (from mass flow, density and diameter)",
+            u_in_si,
+        )?;
+        let d_in_si = positive(
+            "inlet diameter (from mass flow, density and velocity)",
+            2.0 * (q / (PI * rho_in * u_in_si)).sqrt(),
+        )?;
         let take_up = match e.take_up {
             None => return Err(FiberError::MissingTakeUp(e.name.clone())),
             Some(TakeUp::Diameter(d)) => {
