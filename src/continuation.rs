@@ -52,6 +52,55 @@ impl Default for ContinuationOptions {
     }
 }
 
+impl ContinuationOptions {
+    /// Checks the options: steps finite with `0 < min_step <= max_step`, `initial_step > 0`,
+    /// `enlarge >= 1`, `0 < shrink < 1`, `divergence_divisor > 1`, `max_steps >= 1`. The error
+    /// names the option and its value. [`continuation`] calls this before any solve.
+    pub fn validate(&self) -> Result<(), BvpError> {
+        let bad = |name: &str, value: f64, rule: &str| {
+            Err(BvpError::InvalidInput(format!(
+                "ContinuationOptions::{name} = {value} {rule}"
+            )))
+        };
+        let positive = [
+            ("initial_step", self.initial_step),
+            ("min_step", self.min_step),
+            ("max_step", self.max_step),
+        ];
+        for (name, v) in positive {
+            if !(v > 0.0 && v.is_finite()) {
+                return bad(name, v, "must be positive and finite");
+            }
+        }
+        if self.min_step > self.max_step {
+            return bad(
+                "min_step",
+                self.min_step,
+                &format!("must not exceed max_step = {}", self.max_step),
+            );
+        }
+        if !(self.enlarge >= 1.0 && self.enlarge.is_finite()) {
+            return bad("enlarge", self.enlarge, "must be finite and at least 1");
+        }
+        if !(self.shrink > 0.0 && self.shrink < 1.0) {
+            return bad("shrink", self.shrink, "must lie in (0, 1)");
+        }
+        if !(self.divergence_divisor > 1.0 && self.divergence_divisor.is_finite()) {
+            return bad(
+                "divergence_divisor",
+                self.divergence_divisor,
+                "must be finite and larger than 1",
+            );
+        }
+        if self.max_steps == 0 {
+            return Err(BvpError::InvalidInput(
+                "ContinuationOptions::max_steps = 0 must be at least 1".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// One attempted continuation step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepRecord {
@@ -101,7 +150,8 @@ fn add_stats(total: &mut SolveStats, s: &SolveStats) {
 
 /// Follows the path `params[index] = c` from `start` (a solution at `c = start.params[index]`)
 /// to `c = target`, with Adapter step control. The other model parameters are taken from
-/// `start.params`.
+/// `start.params`. Invalid options (see [`ContinuationOptions::validate`]), an index out of
+/// range or a non-finite target are errors before any solve.
 pub fn continuation<P: Bvp>(
     solver: &mut Solver<'_, P>,
     start: &Solution,
@@ -120,6 +170,7 @@ pub fn continuation<P: Bvp>(
             "continuation target {target} is not finite"
         )));
     }
+    options.validate()?;
     let c0 = start.params[index];
     let span = target - c0;
     let mut path = ContinuationPath {

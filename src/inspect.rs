@@ -22,8 +22,13 @@ pub struct DiscreteSystem {
     pub param_jacobian: Vec<f64>,
 }
 
+/// Largest dense Jacobian [`discrete_system`] builds, in entries (2^27, 1 GiB of `f64`).
+pub const MAX_DENSE_ENTRIES: usize = 1 << 27;
+
 /// Evaluates the discrete system of `problem` at the mesh, states and unknowns of `at`, with
-/// model parameters `params`.
+/// model parameters `params`. The Jacobian is dense (`size²` values), so this is meant for
+/// small meshes: a system with more than [`MAX_DENSE_ENTRIES`] Jacobian entries is an error,
+/// not an allocation failure.
 pub fn discrete_system<P: Bvp>(
     problem: &P,
     params: &[f64],
@@ -37,6 +42,16 @@ pub fn discrete_system<P: Bvp>(
         ));
     }
     let m = at.x.len();
+    let size = m * n + k;
+    if size
+        .checked_mul(size.max(q))
+        .is_none_or(|e| e > MAX_DENSE_ENTRIES)
+    {
+        return Err(BvpError::InvalidInput(format!(
+            "the dense Jacobian of {m} nodes x {n} states (+ {k} unknowns) would have {size}² \
+             entries, more than MAX_DENSE_ENTRIES = {MAX_DENSE_ENTRIES}; inspect a coarser mesh"
+        )));
+    }
     let p: Vec<f64> = at.unknowns.iter().chain(params).copied().collect();
     let mut col = Collocation::new(n, k, q);
     col.set_mesh(&at.x);
@@ -46,7 +61,6 @@ pub fn discrete_system<P: Bvp>(
     let mut values = Vec::new();
     let mut work = Vec::new();
     pattern.assemble(&col, &mut values, &mut work);
-    let size = m * n + k;
     let mut jacobian = vec![0.0; size * size];
     let cp = pattern.symbolic.col_ptr();
     let ri = pattern.symbolic.row_idx();

@@ -293,6 +293,21 @@ pub fn fit<L: LeastSquaresProblem>(
             )));
         }
     }
+    for (name, v, strictly) in [
+        ("initial_radius", options.initial_radius, true),
+        ("max_radius", options.max_radius, true),
+        ("gtol", options.gtol, false),
+        ("xtol", options.xtol, false),
+        ("ftol", options.ftol, false),
+    ] {
+        let valid = v.is_finite() && if strictly { v > 0.0 } else { v >= 0.0 };
+        if !valid {
+            let rule = if strictly { "positive" } else { "non-negative" };
+            return Err(FitError::InvalidInput(format!(
+                "FitOptions::{name} must be {rule} and finite, got {v}"
+            )));
+        }
+    }
     let (lo, hi) = (&options.lower, &options.upper);
     let mut p = p0.to_vec();
     let (mut r, mut jac) = problem.evaluate(&p).map_err(|e| FitError::StartFailed {

@@ -4,10 +4,14 @@
 
 use crate::error::BvpError;
 
-/// `m` equally spaced nodes on `[a, b]`.
+/// `m` equally spaced nodes on `[a, b]`, the last one exactly `b`. `m = 0` gives an empty
+/// vector and `m = 1` gives `[a]` (as numpy's `linspace`); neither is a valid mesh
+/// ([`validate`] needs two nodes).
 pub fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
-    if m == 1 {
-        return vec![a];
+    match m {
+        0 => return Vec::new(),
+        1 => return vec![a],
+        _ => {}
     }
     let h = (b - a) / (m - 1) as f64;
     (0..m)
@@ -45,7 +49,15 @@ pub fn validate(x: &[f64]) -> Result<(), BvpError> {
 
 /// Inserts one node into each interval of `insert_1` and two nodes (equal subdivision) into each
 /// interval of `insert_2`. Interval `i` is `[x[i], x[i+1]]`; both lists are sorted.
+/// A mesh of fewer than two nodes is returned unchanged.
+///
+/// # Panics
+///
+/// Panics if `nodes_per_interval` has fewer than `x.len() - 1` entries.
 pub fn refine(x: &[f64], nodes_per_interval: &[u8]) -> Vec<f64> {
+    if x.len() < 2 {
+        return x.to_vec();
+    }
     let mut out = Vec::with_capacity(
         x.len()
             + nodes_per_interval
@@ -87,8 +99,17 @@ pub fn mark_refinement(rms: &[f64], tol: f64, marks: &mut Vec<u8>) -> usize {
 /// Removes interior nodes shared by two neighbouring intervals whose residuals are both below
 /// `threshold` (pairs taken left to right without overlap). Merging two intervals doubles `h`,
 /// and the residual of the 4th-order Lobatto IIIa solution scales like `h^3`, so a threshold of
-/// `tol / 20` keeps the merged interval below about `0.4 tol`. Returns the coarser mesh.
+/// `tol / 20` keeps the merged interval below about `0.4 tol`. Returns the coarser mesh; a mesh
+/// of fewer than two nodes is returned unchanged, and a NaN residual never counts as below the
+/// threshold.
+///
+/// # Panics
+///
+/// Panics if `rms` has more than `x.len() - 1` entries.
 pub fn coarsen(x: &[f64], rms: &[f64], threshold: f64) -> Vec<f64> {
+    if x.len() < 2 {
+        return x.to_vec();
+    }
     let mut out = Vec::with_capacity(x.len());
     out.push(x[0]);
     let mut i = 0;
@@ -155,5 +176,7 @@ mod tests {
         assert!(e.contains("strictly increasing"), "{e}");
         assert!(validate(&[0.0, f64::NAN]).is_err());
         assert_eq!(linspace(0.0, 1.0, 5), vec![0.0, 0.25, 0.5, 0.75, 1.0]);
+        assert_eq!(linspace(0.0, 1.0, 0), Vec::<f64>::new());
+        assert_eq!(linspace(2.0, 1.0, 1), vec![2.0]);
     }
 }

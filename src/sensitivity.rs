@@ -168,9 +168,15 @@ impl Sensitivities {
     }
 
     /// `∂y_c(x)/∂p_j` of the interpolated solution at `x`, written into `dy` (`n × q`, row-major),
-    /// and of its derivative into `dyp`.
+    /// and of its derivative into `dyp`. Like [`Solution::eval_into`]: outside the mesh the end
+    /// interval's cubic is extrapolated, and a non-finite `x` gives NaN everywhere.
     pub fn at_into(&self, x: f64, dy: &mut [f64], dyp: &mut [f64]) {
         let (n, q) = (self.n, self.q);
+        if !x.is_finite() {
+            dy[..n * q].fill(f64::NAN);
+            dyp[..n * q].fill(f64::NAN);
+            return;
+        }
         let i = interval_of(&self.x, x);
         let h = self.x[i + 1] - self.x[i];
         let (v, d) = hermite_weights((x - self.x[i]) / h, h);
@@ -195,6 +201,17 @@ impl Sensitivities {
     }
 }
 
+/// Errors on the first non-finite evaluation point.
+fn check_points(xs: &[f64]) -> Result<(), BvpError> {
+    match xs.iter().position(|x| !x.is_finite()) {
+        Some(j) => Err(BvpError::InvalidInput(format!(
+            "evaluation point {j} is not finite (x = {})",
+            xs[j]
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Values and exact Jacobian `dr/dp` (`len × q`, row-major) of a residual vector
 /// `r_j = g(j, x_j, y(x_j), p)` at the points `xs`, from forward sensitivities (one solve with
 /// `q` right-hand sides). This is what a Gauss–Newton fit calls.
@@ -216,6 +233,7 @@ pub fn residual_jacobian<P: Bvp, G: PointFunction>(
             "the sensitivities were computed for a different solution".into(),
         ));
     }
+    check_points(xs)?;
     let p = sol.full_params();
     let mut engine = DualJacobian::default();
     let mut input = vec![0.0; n + k + q];
@@ -275,6 +293,13 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
             "{} points but {} weights",
             xs.len(),
             weights.len()
+        )));
+    }
+    check_points(xs)?;
+    if let Some(j) = weights.iter().position(|w| !w.is_finite()) {
+        return Err(BvpError::InvalidInput(format!(
+            "weight {j} is not finite ({})",
+            weights[j]
         )));
     }
     let lz = Linearization::new(problem, sol)?;

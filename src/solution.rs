@@ -70,28 +70,78 @@ impl Solution {
     }
 
     /// State `c` at node `i`.
+    ///
+    /// # Panics
+    ///
+    /// Panics if `i >= self.nodes()` or `c >= self.n` (as slice indexing does); see
+    /// [`get`](Self::get) for a non-panicking version.
     pub fn at_node(&self, i: usize, c: usize) -> f64 {
+        assert!(
+            c < self.n,
+            "Solution::at_node: component {c} out of range ({} states)",
+            self.n
+        );
         self.y[i * self.n + c]
     }
 
+    /// State `c` at node `i`, or `None` if `i >= self.nodes()` or `c >= self.n`.
+    pub fn get(&self, i: usize, c: usize) -> Option<f64> {
+        if c < self.n && i < self.nodes() {
+            self.y.get(i * self.n + c).copied()
+        } else {
+            None
+        }
+    }
+
     /// Values of component `c` at all nodes.
+    ///
+    /// # Panics
+    ///
+    /// Panics if `c >= self.n`; see [`try_component`](Self::try_component) for a
+    /// non-panicking version.
     pub fn component(&self, c: usize) -> Vec<f64> {
+        assert!(
+            c < self.n,
+            "Solution::component: component {c} out of range ({} states)",
+            self.n
+        );
         (0..self.nodes()).map(|i| self.y[i * self.n + c]).collect()
     }
 
-    /// Index of the interval containing `x` (clamped to the mesh).
+    /// Values of component `c` at all nodes, or `None` if `c >= self.n`.
+    pub fn try_component(&self, c: usize) -> Option<Vec<f64>> {
+        (c < self.n).then(|| self.component(c))
+    }
+
+    /// Index of the interval `[x_i, x_{i+1}]` containing `x`, clamped to the mesh: `0` for
+    /// `x <= a` (including `-inf`), `nodes() - 2` for `x >= b` (including `+inf`). A NaN `x`
+    /// gives `0` (any interval would do: every evaluation at NaN gives NaN).
     pub fn interval(&self, x: f64) -> usize {
         interval_of(&self.x, x)
     }
 
     /// The C1 interpolant and its derivative at `x`, written into `y` and `yp` (length `n`).
-    /// Outside `[a, b]` the end cubic is extrapolated.
+    ///
+    /// Outside `[a, b]` the cubic of the end interval is extrapolated (as scipy's
+    /// `solve_bvp` solution does); far outside (the cube of the distance in interval lengths
+    /// beyond `f64::MAX`, about 1e100) its terms overflow and the result is `±inf` or NaN. A
+    /// non-finite `x` (NaN or `±inf`) gives NaN in every component of `y` and `yp`.
+    ///
+    /// # Panics
+    ///
+    /// Panics if `y` or `yp` is shorter than `n`.
     pub fn eval_into(&self, x: f64, y: &mut [f64], yp: &mut [f64]) {
+        if !x.is_finite() {
+            y[..self.n].fill(f64::NAN);
+            yp[..self.n].fill(f64::NAN);
+            return;
+        }
         let i = self.interval(x);
         hermite(&self.x, &self.y, &self.yp, self.n, i, x, y, yp);
     }
 
-    /// The interpolated state at `x`.
+    /// The interpolated state at `x` (see [`eval_into`](Self::eval_into) for `x` outside
+    /// `[a, b]` and non-finite `x`).
     pub fn eval(&self, x: f64) -> Vec<f64> {
         let mut y = vec![0.0; self.n];
         let mut yp = vec![0.0; self.n];
@@ -99,7 +149,8 @@ impl Solution {
         y
     }
 
-    /// The derivative of the interpolant at `x`.
+    /// The derivative of the interpolant at `x` (see [`eval_into`](Self::eval_into) for `x`
+    /// outside `[a, b]` and non-finite `x`).
     pub fn eval_derivative(&self, x: f64) -> Vec<f64> {
         let mut y = vec![0.0; self.n];
         let mut yp = vec![0.0; self.n];
@@ -114,9 +165,12 @@ impl Solution {
     }
 }
 
+/// Index of the interval of the mesh `x` (at least 2 nodes) containing `v`, clamped; NaN gives 0.
 pub(crate) fn interval_of(x: &[f64], v: f64) -> usize {
     let m = x.len();
-    if v <= x[0] {
+    // NaN must be caught: `partition_point` would return 0 for it and the
+    // subtraction below would overflow
+    if v.is_nan() || v <= x[0] {
         return 0;
     }
     if v >= x[m - 1] {
@@ -211,5 +265,8 @@ mod tests {
         assert_eq!(interval_of(&xs, 2.5), 2);
         assert_eq!(interval_of(&xs, 3.0), 2);
         assert_eq!(interval_of(&xs, 9.0), 2);
+        assert_eq!(interval_of(&xs, f64::NAN), 0);
+        assert_eq!(interval_of(&xs, f64::INFINITY), 2);
+        assert_eq!(interval_of(&xs, f64::NEG_INFINITY), 0);
     }
 }

@@ -99,29 +99,51 @@ impl SolveOptions {
         }
     }
 
-    fn validate(&self, n: usize) -> Result<(), BvpError> {
-        if !(self.tol > 0.0 && self.tol.is_finite()) {
-            return Err(BvpError::InvalidInput(format!(
-                "tol must be positive and finite, got {}",
-                self.tol
-            )));
-        }
-        if let Some(b) = self.bc_tol {
-            if !(b > 0.0 && b.is_finite()) {
-                return Err(BvpError::InvalidInput(format!(
-                    "bc_tol must be positive and finite, got {b}"
-                )));
+    /// Checks the options for a problem with `n` states: `tol`, `bc_tol` and `newton_step_tol`
+    /// positive and finite, `max_nodes >= 2`, the iteration and factorisation budgets at least
+    /// 1, and a [`ResidualScale::PerComponent`] of `n` positive finite values. The error names
+    /// the option and its value. [`Solver::solve`] calls this before any work.
+    pub fn validate(&self, n: usize) -> Result<(), BvpError> {
+        let positive = |name: &str, v: f64| {
+            if v > 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                Err(BvpError::InvalidInput(format!(
+                    "SolveOptions::{name} must be positive and finite, got {v}"
+                )))
             }
+        };
+        positive("tol", self.tol)?;
+        if let Some(b) = self.bc_tol {
+            positive("bc_tol", b)?;
+        }
+        if let Some(t) = self.newton_step_tol {
+            positive("newton_step_tol", t)?;
         }
         if self.max_nodes < 2 {
-            return Err(BvpError::InvalidInput(
-                "max_nodes must be at least 2".into(),
-            ));
+            return Err(BvpError::InvalidInput(format!(
+                "SolveOptions::max_nodes must be at least 2, got {}",
+                self.max_nodes
+            )));
+        }
+        for (name, v) in [
+            ("max_mesh_iterations", self.max_mesh_iterations),
+            ("max_jacobians_per_mesh", self.max_jacobians_per_mesh),
+            (
+                "max_newton_iterations_per_mesh",
+                self.max_newton_iterations_per_mesh,
+            ),
+        ] {
+            if v == 0 {
+                return Err(BvpError::InvalidInput(format!(
+                    "SolveOptions::{name} must be at least 1, got 0"
+                )));
+            }
         }
         if let ResidualScale::PerComponent(s) = &self.scale {
             if s.len() != n || s.iter().any(|v| !(*v > 0.0 && v.is_finite())) {
                 return Err(BvpError::InvalidInput(format!(
-                    "ResidualScale::PerComponent needs {n} positive finite values, got {s:?}"
+                    "SolveOptions::scale: ResidualScale::PerComponent needs {n} positive finite values, got {s:?}"
                 )));
             }
         }

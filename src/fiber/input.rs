@@ -47,21 +47,28 @@
 //! either key of a pair, `[defaults]` is not consulted for that pair. Integers are accepted
 //! where numbers are expected; `nan` and `inf` are rejected.
 //!
-//! Checks: mass flow, diameters, velocities, lengths and temperatures must be positive; the
-//! inlet temperature must exceed `vft_T_VF_K`; density and heat capacity must be positive at the
-//! inlet and air temperatures; diameters above 0.02 m are rejected as probably millimetres; a
-//! take-up diameter must be smaller than the inlet diameter (a take-up velocity larger than the
-//! inlet velocity); experiment names must be unique.
+//! Checks: mass flow, diameters, velocities, lengths and temperatures must be positive and
+//! within plausible ranges for melt spinning ([`PLAUSIBLE_RANGES`]; diameters between
+//! [`MIN_PLAUSIBLE_DIAMETER_M`] = 1 µm and [`MAX_PLAUSIBLE_DIAMETER_M`] = 2 cm, larger ones
+//! being probably millimetres); the inlet and air temperatures must exceed `vft_T_VF_K` (the VFT
+//! viscosity is undefined at and below it) and the zero-shear viscosity at the inlet must be
+//! finite and at most [`MAX_INLET_VISCOSITY_PA_S`] (a glass is not a melt); density and heat
+//! capacity must be positive at the inlet and air temperatures; the derived inlet velocity
+//! `4 Q/(π ρ(T_in) d_in²)` (or inlet diameter, when the velocity is given) must be finite and
+//! plausible; a take-up diameter must be smaller than the inlet diameter (a take-up velocity
+//! larger than the inlet velocity), with a draw ratio of at most [`MAX_DRAW_RATIO`]; experiment
+//! names must be unique. Errors about values that come from `[defaults]` name the experiment too.
 //!
 //! The CSV file has the header `position_m,diameter_m` and one row per measurement: the
 //! position `s` along the spin line \[m\] (strictly increasing, within `[0, spinline_length_m]`)
-//! and the measured fiber diameter \[m\] (positive, at most 0.02 m). Blank lines and lines
+//! and the measured fiber diameter \[m\] (between 1 µm and 0.02 m). Blank lines and lines
 //! starting with `#` are ignored; surrounding spaces are trimmed. At least
 //! [`DEFAULT_MIN_POINTS`] rows are required by [`load_experiments`]; the minimum is a parameter
 //! of [`load_measurements`] and [`load_experiments_with`].
 //!
 //! Loading only reads files; it never modifies or writes them.
 
+use std::f64::consts::PI;
 use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -76,6 +83,28 @@ pub const DEFAULT_MIN_POINTS: usize = 4;
 
 /// Largest plausible fiber diameter \[m\]; larger values suggest the file is in millimetres.
 pub const MAX_PLAUSIBLE_DIAMETER_M: f64 = 0.02;
+
+/// Smallest plausible fiber diameter \[m\] (1 µm); smaller values are probably a unit error.
+pub const MIN_PLAUSIBLE_DIAMETER_M: f64 = 1e-6;
+
+/// Plausible ranges `(key, min, max)` of the per-experiment quantities of melt spinning (SI, the
+/// unit is in the key); a value outside is rejected as a probable unit or typing error. The
+/// diameters have their own bounds ([`MIN_PLAUSIBLE_DIAMETER_M`], [`MAX_PLAUSIBLE_DIAMETER_M`]).
+pub const PLAUSIBLE_RANGES: &[(&str, f64, f64)] = &[
+    ("mass_flow_kg_s", 1e-10, 1.0),
+    ("inlet_velocity_m_s", 1e-6, 1e3),
+    ("take_up_velocity_m_s", 1e-6, 1e3),
+    ("spinline_length_m", 1e-3, 100.0),
+    ("inlet_temperature_K", 100.0, 1500.0),
+    ("air_temperature_K", 100.0, 1500.0),
+];
+
+/// Largest plausible zero-shear viscosity of the melt at the inlet \[Pa s\]: 1e12 Pa s is the
+/// conventional viscosity of a glass at its glass transition; above it the polymer is not a melt.
+pub const MAX_INLET_VISCOSITY_PA_S: f64 = 1e12;
+
+/// Largest plausible draw ratio `u_out/u_in = (d_in/d_out)²` \[-\].
+pub const MAX_DRAW_RATIO: f64 = 1e6;
 
 /// The required CSV header (column names carry the unit: metres).
 pub const CSV_HEADER: [&str; 2] = ["position_m", "diameter_m"];
@@ -363,6 +392,15 @@ pub fn parse_measurements(
         },
         message,
     };
+    if spinline_length.is_nan() || spinline_length <= 0.0 {
+        return Err(csv_error(
+            None,
+            format!(
+                "cannot check the positions against a spin-line length of {spinline_length} m \
+                 (it must be positive, or infinite to skip the check)"
+            ),
+        ));
+    }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
@@ -448,6 +486,12 @@ pub fn parse_measurements(
         }
         if d <= 0.0 {
             return Err(err(format!("diameter {d} m is not positive")));
+        }
+        if d < MIN_PLAUSIBLE_DIAMETER_M {
+            return Err(err(format!(
+                "diameter {d} m is implausibly small for a fiber (< {MIN_PLAUSIBLE_DIAMETER_M} m \
+                 = 1 µm); the values must be in metres"
+            )));
         }
         if d > MAX_PLAUSIBLE_DIAMETER_M {
             return Err(err(format!(
@@ -814,6 +858,36 @@ impl Field<'_> {
         }
     }
 
+    /// The table name for an error about experiment `experiment_table`: the experiment, and
+    /// where the value came from if it is another table (`[defaults]`).
+    fn table_in(&self, experiment_table: &str) -> String {
+        if self.table == experiment_table {
+            self.table.clone()
+        } else {
+            format!("{experiment_table} (value from {})", self.table)
+        }
+    }
+
+    /// Like [`invalid`](Self::invalid), for a check of experiment `experiment_table`.
+    fn invalid_in(&self, experiment_table: &str, value: f64, reason: String) -> InputError {
+        InputError::InvalidValue {
+            at: self.at(),
+            table: self.table_in(experiment_table),
+            key: self.key.to_string(),
+            value,
+            reason,
+        }
+    }
+
+    /// Like [`inconsistent`](Self::inconsistent), for a check of experiment `experiment_table`.
+    fn inconsistent_in(&self, experiment_table: &str, message: String) -> InputError {
+        InputError::Inconsistent {
+            at: self.at(),
+            table: self.table_in(experiment_table),
+            message,
+        }
+    }
+
     fn inconsistent(&self, message: String) -> InputError {
         InputError::Inconsistent {
             at: self.at(),
@@ -831,10 +905,11 @@ impl Field<'_> {
 
     /// The value as a number satisfying `rule`.
     fn number(&self, rule: Rule) -> Result<f64, InputError> {
+        // TOML allows `_` between digits (`1_000`); Rust's parsers do not
         let (value, raw) = match self.value.get_ref() {
-            DeValue::Float(f) => (f.as_str().parse::<f64>().ok(), f.as_str()),
+            DeValue::Float(f) => (f.as_str().replace('_', "").parse::<f64>().ok(), f.as_str()),
             DeValue::Integer(i) => (
-                i64::from_str_radix(i.as_str(), i.radix())
+                i64::from_str_radix(&i.as_str().replace('_', ""), i.radix())
                     .ok()
                     .map(|v| v as f64),
                 i.as_str(),
@@ -862,13 +937,46 @@ impl Field<'_> {
                      was it given in millimetres?"
                 ),
             )),
+            Rule::Diameter if value < MIN_PLAUSIBLE_DIAMETER_M => Err(self.invalid(
+                value,
+                format!(
+                    "implausibly small for a fiber diameter in metres (< {MIN_PLAUSIBLE_DIAMETER_M} m \
+                     = 1 µm)"
+                ),
+            )),
             Rule::Fraction if value <= 0.0 || value >= 1.0 => Err(self.invalid(
                 value,
                 "must lie in (0, 1) (a relative uncertainty: 0.015 means 1.5 %)",
             )),
+            _ => self.plausible(value),
+        }
+    }
+
+    /// `value` if it lies in the key's plausible range ([`PLAUSIBLE_RANGES`]), if it has one.
+    fn plausible(&self, value: f64) -> Result<f64, InputError> {
+        match PLAUSIBLE_RANGES.iter().find(|(k, _, _)| *k == self.key) {
+            Some(&(_, min, max)) if value < min || value > max => {
+                let unit = unit_of(self.key);
+                let side = if value < min { "small" } else { "large" };
+                Err(self.invalid(
+                    value,
+                    format!(
+                        "implausibly {side} for melt spinning (expected {min:e} to {max:e} {unit}); \
+                         check the unit"
+                    ),
+                ))
+            }
             _ => Ok(value),
         }
     }
+}
+
+/// The unit of a key, from its suffix (`mass_flow_kg_s` → `kg/s`).
+fn unit_of(key: &str) -> &'static str {
+    [("_kg_s", "kg/s"), ("_m_s", "m/s"), ("_m", "m"), ("_K", "K")]
+        .iter()
+        .find(|(suffix, _)| key.ends_with(suffix))
+        .map_or("", |(_, unit)| *unit)
 }
 
 fn type_name(value: &DeValue<'_>) -> &'static str {
@@ -992,12 +1100,73 @@ fn experiment(
         table: &tab,
         defaults,
     };
-    let (mass_flow, _) = scope.required("mass_flow_kg_s")?;
+    let (mass_flow, q_field) = scope.required("mass_flow_kg_s")?;
     let (spinline_length, _) = scope.required("spinline_length_m")?;
     let (inlet_temperature, t_in_field) = scope.required("inlet_temperature_K")?;
     let (air_temperature, t_air_field) = scope.required("air_temperature_K")?;
+    let table = tab.name.as_str();
 
-    let (inlet_is_diameter, inlet_value, _) = scope
+    let t_vf = material.vft_t_vf;
+    if inlet_temperature <= t_vf {
+        return Err(t_in_field.invalid_in(
+            table,
+            inlet_temperature,
+            format!(
+                "must exceed the Vogel temperature vft_T_VF_K = {t_vf} K of [material]: the VFT \
+                 viscosity is undefined at and below it"
+            ),
+        ));
+    }
+    if air_temperature <= t_vf {
+        return Err(t_air_field.invalid_in(
+            table,
+            air_temperature,
+            format!(
+                "must exceed the Vogel temperature vft_T_VF_K = {t_vf} K of [material]: the fiber \
+                 cools towards the air temperature, and the VFT viscosity is undefined at and \
+                 below T_VF"
+            ),
+        ));
+    }
+    for (t, field) in [
+        (inlet_temperature, &t_in_field),
+        (air_temperature, &t_air_field),
+    ] {
+        let (rho, cp) = (material.density(t), material.heat_capacity(t));
+        if !(rho > 0.0 && cp > 0.0) {
+            return Err(field.invalid_in(
+                table,
+                t,
+                format!(
+                    "[material] gives a non-positive density ({rho} kg/m³) or heat capacity \
+                     ({cp} J/(kg K)) at this temperature"
+                ),
+            ));
+        }
+    }
+    let mu_in = material.zero_shear_viscosity(inlet_temperature);
+    if !(mu_in.is_finite() && mu_in <= MAX_INLET_VISCOSITY_PA_S) {
+        let what = if mu_in.is_finite() {
+            format!(
+                "a zero-shear viscosity of {mu_in:.3e} Pa s at the inlet, above \
+                 {MAX_INLET_VISCOSITY_PA_S:e} Pa s (a glass, not a melt)"
+            )
+        } else {
+            "an infinite zero-shear viscosity at the inlet (beyond the floating-point range)"
+                .to_string()
+        };
+        return Err(t_in_field.invalid_in(
+            table,
+            inlet_temperature,
+            format!(
+                "the inlet temperature is only {:.4} K above the Vogel temperature \
+                 vft_T_VF_K = {t_vf} K: the VFT law mu_c exp(B/(T - T_VF)) gives {what}",
+                inlet_temperature - t_vf
+            ),
+        ));
+    }
+
+    let (inlet_is_diameter, inlet_value, inlet_field) = scope
         .either("inlet_diameter_m", "inlet_velocity_m_s")?
         .ok_or_else(|| InputError::Inconsistent {
             at: tab.doc.at_line(tab.line),
@@ -1011,54 +1180,97 @@ fn experiment(
     } else {
         Inlet::Velocity(inlet_value)
     };
+    // the other inlet quantity, from the mass balance Q = ρ(T_in) u_in π d_in²/4
+    let rho_in = material.density(inlet_temperature);
+    let (d_in, u_in) = match inlet {
+        Inlet::Diameter(d) => (d, 4.0 * mass_flow / (PI * rho_in * d * d)),
+        Inlet::Velocity(u) => (2.0 * (mass_flow / (PI * rho_in * u)).sqrt(), u),
+    };
+    let (derived, value, unit, min, max) = if inlet_is_diameter {
+        ("inlet velocity 4 Q/(π ρ d_in²)", u_in, "m/s", 1e-6, 1e3)
+    } else {
+        (
+            "inlet diameter 2 √(Q/(π ρ u_in))",
+            d_in,
+            "m",
+            MIN_PLAUSIBLE_DIAMETER_M,
+            MAX_PLAUSIBLE_DIAMETER_M,
+        )
+    };
+    if !(value.is_finite() && value >= min && value <= max) {
+        return Err(inlet_field.inconsistent_in(
+            table,
+            format!(
+                "`mass_flow_kg_s` = {mass_flow} (line {}) and `{}` = {inlet_value} give an {derived} \
+                 = {value:.3e} {unit} (with ρ(T_in) = {rho_in:.1} kg/m³), outside the plausible range \
+                 {min:e} to {max:e} {unit}",
+                q_field.at().line.unwrap_or(0),
+                inlet_field.key
+            ),
+        ));
+    }
+    let given = |derived_from: &str| {
+        if derived_from.is_empty() {
+            String::new()
+        } else {
+            format!(" (derived from `mass_flow_kg_s` and `{derived_from}`)")
+        }
+    };
     let take_up = match scope.either("take_up_diameter_m", "take_up_velocity_m_s")? {
         None => None,
         Some((true, d_out, field)) => {
-            if let Inlet::Diameter(d_in) = inlet {
-                if d_out >= d_in {
-                    return Err(field.inconsistent(format!(
-                        "take-up diameter {d_out} m must be smaller than the inlet diameter {d_in} m"
-                    )));
-                }
+            let from = given(if inlet_is_diameter {
+                ""
+            } else {
+                "inlet_velocity_m_s"
+            });
+            if d_out >= d_in {
+                return Err(field.inconsistent_in(
+                    table,
+                    format!(
+                        "take-up diameter {d_out} m must be smaller than the inlet diameter {d_in} m{from}"
+                    ),
+                ));
+            }
+            let ratio = (d_in / d_out).powi(2);
+            if ratio > MAX_DRAW_RATIO {
+                return Err(field.inconsistent_in(
+                    table,
+                    format!(
+                        "take-up diameter {d_out} m and inlet diameter {d_in} m{from} give a draw \
+                         ratio (d_in/d_out)² = {ratio:.3e}, above the plausible {MAX_DRAW_RATIO:e}"
+                    ),
+                ));
             }
             Some(TakeUp::Diameter(d_out))
         }
         Some((false, u_out, field)) => {
-            if let Inlet::Velocity(u_in) = inlet {
-                if u_out <= u_in {
-                    return Err(field.inconsistent(format!(
-                        "take-up velocity {u_out} m/s must be larger than the inlet velocity {u_in} m/s"
-                    )));
-                }
+            let from = given(if inlet_is_diameter {
+                "inlet_diameter_m"
+            } else {
+                ""
+            });
+            if u_out <= u_in {
+                return Err(field.inconsistent_in(
+                    table,
+                    format!(
+                        "take-up velocity {u_out} m/s must be larger than the inlet velocity {u_in} m/s{from}"
+                    ),
+                ));
+            }
+            let ratio = u_out / u_in;
+            if ratio > MAX_DRAW_RATIO {
+                return Err(field.inconsistent_in(
+                    table,
+                    format!(
+                        "take-up velocity {u_out} m/s and inlet velocity {u_in} m/s{from} give a \
+                         draw ratio u_out/u_in = {ratio:.3e}, above the plausible {MAX_DRAW_RATIO:e}"
+                    ),
+                ));
             }
             Some(TakeUp::Velocity(u_out))
         }
     };
-
-    if inlet_temperature <= material.vft_t_vf {
-        return Err(t_in_field.invalid(
-            inlet_temperature,
-            format!(
-                "must exceed the Vogel temperature vft_T_VF_K = {} K of [material]",
-                material.vft_t_vf
-            ),
-        ));
-    }
-    for (t, field) in [
-        (inlet_temperature, &t_in_field),
-        (air_temperature, &t_air_field),
-    ] {
-        let (rho, cp) = (material.density(t), material.heat_capacity(t));
-        if rho <= 0.0 || cp <= 0.0 {
-            return Err(field.invalid(
-                t,
-                format!(
-                    "[material] gives a non-positive density ({rho} kg/m³) or heat capacity \
-                     ({cp} J/(kg K)) at this temperature"
-                ),
-            ));
-        }
-    }
 
     let metadata = |key| scope.optional(key).map(|v| v.map(|(x, _)| x));
     let data = match tab.get("data") {
@@ -1188,7 +1400,15 @@ air_temperature_K = 293
 
     #[test]
     fn integers_are_numbers_and_strings_are_not() {
-        assert!(parse(&ONE.replace("3e-5", "1")).is_ok());
+        let loaded = parse(&format!("{ONE}spinline_length_m = 1\n")).unwrap();
+        assert_eq!(loaded.set.experiments[0].spinline_length, 1.0);
+        // TOML's digit separators, in integers and floats
+        let loaded = parse(&format!(
+            "{ONE}air_temperature_K = 2_93\nspinline_length_m = 0.5_1\n"
+        ))
+        .unwrap();
+        assert_eq!(loaded.set.experiments[0].air_temperature, 293.0);
+        assert_eq!(loaded.set.experiments[0].spinline_length, 0.51);
         let msg = parse_err(&ONE.replace("3e-5", "\"3e-5\""));
         assert!(
             msg.contains("`mass_flow_kg_s` must be a number, found a string"),

@@ -186,15 +186,17 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             }
             Inlet::Velocity(u) => positive("inlet velocity", u)?,
         };
-        // derived values that overflow (e.g. an implausible mass flow) are refused here
-        positive(
+        // derived values that overflow or underflow (e.g. a mass flow of 1e308 kg/s) are refused
+        // here, not reported later as a consequence ("inlet diameter 0 m")
+        let u_in_si = positive(
             &format!("inlet velocity 4 Q/(π ρ d²) from the mass flow Q = {q:e} kg/s"),
             u_in_si,
         )?;
-        let d_in_si = 2.0 * (q / (PI * rho_in * u_in_si)).sqrt();
-        positive(
-            &format!("inlet diameter from the mass flow {q:e} kg/s and the inlet velocity {u_in_si:e} m/s"),
-            d_in_si,
+        let d_in_si = positive(
+            &format!(
+                "inlet diameter from the mass flow {q:e} kg/s and the inlet velocity {u_in_si:e} m/s"
+            ),
+            2.0 * (q / (PI * rho_in * u_in_si)).sqrt(),
         )?;
         let take_up = match e.take_up {
             None => return Err(FiberError::MissingTakeUp(e.name.clone())),
