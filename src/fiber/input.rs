@@ -202,7 +202,7 @@ pub enum InputError {
         value: String,
     },
     /// A value is out of its admissible range.
-    #[error("{at}: {table}: `{key}` = {value}: {reason}")]
+    #[error("{at}: {table}: `{key}` = {}: {reason}", Readable(*.value))]
     InvalidValue {
         /// Where the value is.
         at: Location,
@@ -967,6 +967,21 @@ impl Field<'_> {
                 ))
             }
             _ => Ok(value),
+        }
+    }
+}
+
+/// A number as a reader would write it: plain for ordinary magnitudes, in exponent notation for
+/// very large or small ones (`1e308`, not 309 digits).
+struct Readable(f64);
+
+impl std::fmt::Display for Readable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-4..1e6).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
         }
     }
 }
