@@ -81,7 +81,7 @@ fn inlet_diameter_of_a_nanometre_is_refused() {
         &[
             &line,
             "\"v0p27_p1\"",
-            "`inlet_diameter_m` = 0.000000001",
+            "`inlet_diameter_m` = 1e-9",
             "implausibly small",
             "1 µm",
         ],
@@ -378,7 +378,7 @@ fn csv_diameter_of_a_nanometre_is_refused() {
             &format!("{}:5:", csv.display()),
             &at(&toml, "data = \"v0p53_p2.csv\""),
             "\"v0p53_p2\"",
-            "diameter 0.000000001 m is implausibly small",
+            "diameter 1e-9 m is implausibly small",
         ],
     );
 }

@@ -489,14 +489,16 @@ pub fn parse_measurements(
         }
         if d < MIN_PLAUSIBLE_DIAMETER_M {
             return Err(err(format!(
-                "diameter {d} m is implausibly small for a fiber (< {MIN_PLAUSIBLE_DIAMETER_M} m \
-                 = 1 µm); the values must be in metres"
+                "diameter {} m is implausibly small for a fiber (< {MIN_PLAUSIBLE_DIAMETER_M:e} m \
+                 = 1 µm); the values must be in metres",
+                Readable(d)
             )));
         }
         if d > MAX_PLAUSIBLE_DIAMETER_M {
             return Err(err(format!(
-                "diameter {d} is implausibly large for metres (> {MAX_PLAUSIBLE_DIAMETER_M} m); \
-                 the file looks like millimetres or micrometres: convert to metres"
+                "diameter {} is implausibly large for metres (> {MAX_PLAUSIBLE_DIAMETER_M} m); \
+                 the file looks like millimetres or micrometres: convert to metres",
+                Readable(d)
             )));
         }
         positions.push(s);
@@ -940,7 +942,7 @@ impl Field<'_> {
             Rule::Diameter if value < MIN_PLAUSIBLE_DIAMETER_M => Err(self.invalid(
                 value,
                 format!(
-                    "implausibly small for a fiber diameter in metres (< {MIN_PLAUSIBLE_DIAMETER_M} m \
+                    "implausibly small for a fiber diameter in metres (< {MIN_PLAUSIBLE_DIAMETER_M:e} m \
                      = 1 µm)"
                 ),
             )),
