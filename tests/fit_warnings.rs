@@ -564,3 +564,54 @@ fn fit_files_are_checked_by_the_library_too() {
         .to_string();
     assert!(err.contains("field \"experiments\"[0]"), "{err}");
 }
+
+/// `diagnose` refits candidates: a refit whose strength ends at a bound of its search range is
+/// marked in the text and the JSON and gets no credible-estimate wording. On the shipped
+/// hidden-radiation data the co-flow candidate is pushed to its lower bound; radiation (the
+/// hidden effect) is not.
+#[test]
+fn diagnose_marks_a_candidate_refit_at_its_bound() {
+    let dir = probe::scratch("fit_warn_diagnose_bound");
+    let toml = probe::copy_data_set("hidden_radiation", &dir);
+    let data = dir.join("hidden_radiation");
+    let out = dir.join("out");
+    let json = dir.join("diagnosis.json");
+    let p = probe::rheometer(
+        &[
+            "diagnose",
+            toml.to_str().unwrap(),
+            "--json",
+            json.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[&data],
+        LIMIT,
+    );
+    p.assert_success();
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let cands = v["candidates"].as_array().unwrap();
+    let marked: Vec<&str> = cands
+        .iter()
+        .filter(|c| {
+            c["at_bound"]
+                .as_array()
+                .is_some_and(|a| a.iter().any(|b| b["parameter"] == c["effect"]))
+        })
+        .map(|c| c["effect"].as_str().unwrap())
+        .collect();
+    assert!(marked.contains(&"air_coflow"), "{marked:?}\n{}", p.stdout);
+    assert!(!marked.contains(&"radiation"), "{marked:?}\n{}", p.stdout);
+    let coflow_line = p
+        .stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("air_coflow"))
+        .unwrap();
+    assert!(coflow_line.contains("AT LOWER BOUND"), "{coflow_line}");
+    let radiation_line = p
+        .stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("radiation "))
+        .unwrap();
+    assert!(!radiation_line.contains("BOUND"), "{radiation_line}");
+}

@@ -27,7 +27,7 @@ use super::candidates::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_
 use super::scores::{cosine, linear_scores};
 use crate::fiber::rheometer::estimator::RelativeResidual;
 use crate::fiber::rheometer::{
-    Estimator, FitReport, FitStart, Identification, IdentifyOptions, Layout, Rheometer,
+    AtBound, Estimator, FitReport, FitStart, Identification, IdentifyOptions, Layout, Rheometer,
     RheometerError,
 };
 use crate::fiber::setup::ExperimentSet;
@@ -110,6 +110,11 @@ pub struct CandidateResult {
     pub ci95_n: [f64; 2],
     /// 95% CI of `κ` in the refit.
     pub ci95_kappa: [f64; 2],
+    /// Estimates of the refit that ended at a bound of their search range (the strength among
+    /// them means the data push the effect beyond its range: not a credible estimate; the
+    /// intervals of those estimates are not valid).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub at_bound: Vec<AtBound>,
 }
 
 /// A pair of candidates the data cannot tell apart.
@@ -420,6 +425,7 @@ pub fn diagnose(
                 kappa: f64::NAN,
                 ci95_n: [f64::NAN; 2],
                 ci95_kappa: [f64::NAN; 2],
+                at_bound: Vec::new(),
             }
         })
         .collect();
@@ -471,6 +477,7 @@ pub fn diagnose(
         res.stderr_strength = er.map_or(f64::NAN, |x| x.stderr_strength);
         res.cost_after = after;
         res.rms_relative_residual_after = id.rms_relative_residual;
+        res.at_bound = rep.at_bound.clone();
         res.delta_bic = bic;
         res.delta_aic = aic;
         if rep.stderr_n.is_finite() || spec.law == LawChoice::Carreau {

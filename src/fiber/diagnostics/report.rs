@@ -1,6 +1,6 @@
 //! The diagnosis in words, and the before/after residual figure.
 
-use super::diagnose::{Diagnosis, DiagnosisRun, ResidualProfiles};
+use super::diagnose::{CandidateResult, Diagnosis, DiagnosisRun, ResidualProfiles};
 use crate::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
 
@@ -61,10 +61,21 @@ impl Diagnosis {
                     c.stderr_strength,
                     c.unit
                 ));
+                if let Some(b) = c.at_bound.iter().find(|b| b.parameter == c.effect) {
+                    s.push_str(&format!(
+                        "WARNING: its strength ends AT ITS {} BOUND {} {}: the data push it beyond its \
+                         search range, so this is not a credible estimate of the effect (a different \
+                         effect, or a process or instrument error, may be behind the misfit).\n",
+                        b.side.name().to_uppercase(),
+                        b.bound,
+                        c.unit
+                    ));
+                }
                 if c.n.is_finite() {
                     s.push_str(&format!(
-                        "With it: n = {:.4} (95% CI [{:.4}, {:.4}]), kappa = {:.4} (95% CI [{:.4}, {:.4}]).\n",
-                        c.n, c.ci95_n[0], c.ci95_n[1], c.kappa, c.ci95_kappa[0], c.ci95_kappa[1]
+                        "With it: n = {}, kappa = {}.\n",
+                        estimate_with_ci(c, "n", c.n, c.ci95_n),
+                        estimate_with_ci(c, "kappa", c.kappa, c.ci95_kappa)
                     ));
                 }
             }
@@ -76,8 +87,12 @@ impl Diagnosis {
         s.push_str("[[Candidates, best first]]\n");
         s.push_str("    effect                   refit  strength +/- stderr        J after      RMS after  dBIC     signature\n");
         for c in &self.candidates {
+            let bound = match c.at_bound.iter().find(|b| b.parameter == c.effect) {
+                Some(b) => format!("  AT {} BOUND", b.side.name().to_uppercase()),
+                None => String::new(),
+            };
             s.push_str(&format!(
-                "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {} (peak {:.2} m)\n",
+                "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {} (peak {:.2} m){bound}\n",
                 c.effect,
                 if c.refitted { "yes" } else { "lin" },
                 c.strength,
@@ -106,6 +121,20 @@ impl Diagnosis {
         }
         s.push_str(&format!("wall time {:.2} s\n", self.wall_time_s));
         s
+    }
+}
+
+/// `"0.8040 (95% CI [0.79, 0.82])"`, or the estimate marked at its bound without an interval.
+fn estimate_with_ci(c: &CandidateResult, name: &str, value: f64, ci: [f64; 2]) -> String {
+    match c.at_bound.iter().find(|b| b.parameter == name) {
+        Some(b) => format!(
+            "{value:.4} (AT ITS {} BOUND: no valid 95% CI)",
+            b.side.name().to_uppercase()
+        ),
+        None if ci.iter().all(|v| v.is_finite()) => {
+            format!("{value:.4} (95% CI [{:.4}, {:.4}])", ci[0], ci[1])
+        }
+        None => format!("{value:.4} (no valid 95% CI)"),
     }
 }
 
