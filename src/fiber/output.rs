@@ -19,11 +19,16 @@ use thiserror::Error;
 /// Writing an output failed.
 #[derive(Debug, Error)]
 pub enum OutputError {
-    /// The output path is one of the inputs.
-    #[error("refusing to write {path}: it is an input file; choose another output directory")]
+    /// The output path is one of the inputs (also through a hard or symbolic link).
+    #[error(
+        "refusing to write {path}: it is an input file{}; choose another output directory",
+        alias_note(path, input)
+    )]
     WouldOverwriteInput {
         /// The path.
         path: PathBuf,
+        /// The input it is (the same file, perhaps under another name).
+        input: PathBuf,
     },
     /// The output directory is one of the inputs (e.g. `--out` names a measurement CSV).
     #[error(
@@ -87,9 +92,10 @@ pub fn ensure_not_input(path: &Path, inputs: &[PathBuf]) -> Result<(), OutputErr
     if fs::symlink_metadata(path).is_err() {
         return Ok(());
     }
-    if inputs.iter().any(|i| same_file(path, i)) {
+    if let Some(input) = inputs.iter().find(|i| same_file(path, i)) {
         return Err(OutputError::WouldOverwriteInput {
             path: path.to_path_buf(),
+            input: input.clone(),
         });
     }
     if path.is_dir() {
@@ -98,6 +104,23 @@ pub fn ensure_not_input(path: &Path, inputs: &[PathBuf]) -> Result<(), OutputErr
         });
     }
     Ok(())
+}
+
+/// `" (the same file as the input X, through a link)"` when the output path names the input
+/// under another name; empty when it is the input's own path.
+fn alias_note(path: &Path, input: &Path) -> String {
+    let same_name = match (fs::canonicalize(path), fs::canonicalize(input)) {
+        (Ok(a), Ok(b)) => a == b && fs::symlink_metadata(path).is_ok_and(|m| !m.is_symlink()),
+        _ => false,
+    };
+    if same_name || path == input {
+        String::new()
+    } else {
+        format!(
+            " (the same file as the input {}, through a link)",
+            input.display()
+        )
+    }
 }
 
 /// The first of `dir` and its ancestors that exists and is not a directory.

@@ -3,6 +3,7 @@
 
 use super::{compare, CompareError, CompareOptions, Comparison, SimulatedExperiment};
 use crate::fiber::diagnostics::candidates::Effect;
+use crate::fiber::error::Readable;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::setup::{ExperimentSet, TakeUp};
@@ -325,7 +326,9 @@ impl FitParameters {
                 "\"n\"".into(),
                 format!(
                     "n = {} must be a finite power index in [{}, {}]",
-                    self.n, FIT_FILE_N_RANGE[0], FIT_FILE_N_RANGE[1]
+                    Readable(self.n),
+                    FIT_FILE_N_RANGE[0],
+                    FIT_FILE_N_RANGE[1]
                 ),
             );
         }
@@ -334,7 +337,9 @@ impl FitParameters {
                 "\"kappa\"".into(),
                 format!(
                     "kappa = ln(K / 1 Pa) = {} must be finite and in [{}, {}]",
-                    self.kappa, FIT_FILE_KAPPA_RANGE[0], FIT_FILE_KAPPA_RANGE[1]
+                    Readable(self.kappa),
+                    FIT_FILE_KAPPA_RANGE[0],
+                    FIT_FILE_KAPPA_RANGE[1]
                 ),
             );
         }
@@ -343,8 +348,10 @@ impl FitParameters {
                 return bad(
                     format!("\"take_up_factors\"[{i}]"),
                     format!(
-                        "take-up factor {f} must be finite and in [{}, {}]",
-                        FIT_FILE_TAKE_UP_RANGE[0], FIT_FILE_TAKE_UP_RANGE[1]
+                        "take-up factor {} must be finite and in [{}, {}]",
+                        Readable(f),
+                        FIT_FILE_TAKE_UP_RANGE[0],
+                        FIT_FILE_TAKE_UP_RANGE[1]
                     ),
                 );
             }
