@@ -206,6 +206,32 @@ fn a_take_up_factor_pinned_at_its_bound_and_a_huge_misfit_are_warned_about() {
     assert!(warning_with(&v, "misfit", "v0p53_p2"), "{v}");
     assert!(line(&p.stdout, "take_up_factor[v0p53_p2]:").contains("AT LOWER BOUND 0.5"));
     assert!(p.stdout.contains("WARNING [misfit]"), "{}", p.stdout);
+    // a comparison with this fit repeats its warnings
+    let json = dir.join("fit.json");
+    let c = probe::rheometer(
+        &[
+            "compare",
+            toml.to_str().unwrap(),
+            "--fit",
+            json.to_str().unwrap(),
+            "--out",
+            dir.join("compare").to_str().unwrap(),
+        ],
+        &[&data, &json],
+        LIMIT,
+    );
+    c.assert_success();
+    assert!(
+        c.stderr
+            .contains("carries a warning: [at_bound] take_up_factor[v0p53_p2]"),
+        "{}",
+        c.stderr
+    );
+    assert!(
+        c.stderr.contains("carries a warning: [misfit]"),
+        "{}",
+        c.stderr
+    );
 }
 
 #[test]

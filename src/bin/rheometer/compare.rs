@@ -73,6 +73,14 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             &path.display().to_string(),
         )?;
         fitted = rep.fitted_parameters();
+        for w in &rep.warnings {
+            g.warn(format!(
+                "the fit in {} carries a warning: [{}] {}",
+                path.display(),
+                w.code.name(),
+                w.message
+            ));
+        }
         g.say(format!(
             "model from {}: n = {}, kappa = {} ({} estimator)",
             path.display(),

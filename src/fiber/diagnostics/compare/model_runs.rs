@@ -195,6 +195,10 @@ pub struct FitParameters {
     /// written before this field existed).
     #[serde(default)]
     pub experiments: Vec<String>,
+    /// The warnings of the fit (estimates at bounds, misfit, …): a comparison with a doubtful
+    /// fit repeats them.
+    #[serde(default)]
+    pub warnings: Vec<crate::fiber::rheometer::FitWarning>,
 }
 
 /// The range of `n` accepted from a fit file (the rheometer's search range) \[-\].
