@@ -5,48 +5,20 @@
 
 mod probe;
 
-use probe::Probe;
+use probe::{s, variant, Probe};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-const SET: &str = "pmma7n_synthetic";
 /// Refused-up-front probes must end within this time.
 const QUICK: Duration = Duration::from_secs(2);
 /// Time limit of probes that solve something.
 const LIMIT: Duration = Duration::from_secs(120);
 
-/// A scratch copy of the shipped data set: (scratch dir, TOML path, data dir).
-fn data(name: &str) -> (PathBuf, PathBuf, PathBuf) {
-    let dir = probe::scratch(name);
-    let toml = probe::copy_data_set(SET, &dir);
-    let data_dir = dir.join(SET);
-    (dir, toml, data_dir)
-}
-
-/// A variant of the copied TOML with `from` replaced by `to` (first occurrence), written next
-/// to it as `file`; the line structure is unchanged.
-fn variant(toml: &Path, file: &str, from: &str, to: &str) -> PathBuf {
-    let text = std::fs::read_to_string(toml).unwrap();
-    assert!(text.contains(from), "{from:?} not in {}", toml.display());
-    let out = toml.with_file_name(file);
-    std::fs::write(&out, text.replacen(from, to, 1)).unwrap();
-    out
-}
-
 /// "FILE:LINE" of the experiment `name` (its `name = "..."` line) in `toml`.
 fn place(toml: &Path, name: &str) -> String {
-    let text = std::fs::read_to_string(toml).unwrap();
     let key = format!("name = \"{name}\"");
-    let line = text
-        .lines()
-        .position(|l| l.trim() == key)
-        .map(|i| i + 1)
-        .unwrap_or_else(|| panic!("{key} not in {}", toml.display()));
+    let line = probe::line_where(toml, |l| l.trim() == key);
     format!("{}:{line}", toml.display())
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 /// Runs `rheometer ARGS` watching the data dir.
@@ -70,7 +42,7 @@ fn refused(args: &[&str], data_dir: &Path, needles: &[&str]) -> Probe {
 
 #[test]
 fn simulate_points_zero_one_and_huge_are_refused() {
-    let (dir, toml, dd) = data("args_points");
+    let (dir, toml, dd) = probe::shipped_copy("args_points");
     let out = dir.join("out");
     for v in ["0", "1", "50000000"] {
         refused(
@@ -92,7 +64,7 @@ fn simulate_points_zero_one_and_huge_are_refused() {
 
 #[test]
 fn simulate_negative_n_is_a_value_and_refused_by_domain() {
-    let (dir, toml, dd) = data("args_neg_n");
+    let (dir, toml, dd) = probe::shipped_copy("args_neg_n");
     let out = dir.join("out");
     // both spellings reach the value check (no "use -- -0" tip)
     for args in [
@@ -121,7 +93,7 @@ fn simulate_negative_n_is_a_value_and_refused_by_domain() {
 
 #[test]
 fn simulate_n_zero_names_experiment_line_and_cause() {
-    let (dir, toml, dd) = data("args_n_zero");
+    let (dir, toml, dd) = probe::shipped_copy("args_n_zero");
     let out = dir.join("out");
     let p = run(
         &[
@@ -148,7 +120,7 @@ fn simulate_n_zero_names_experiment_line_and_cause() {
 
 #[test]
 fn simulate_kappa_out_of_range_and_non_numbers_are_refused() {
-    let (dir, toml, dd) = data("args_kappa");
+    let (dir, toml, dd) = probe::shipped_copy("args_kappa");
     let out = dir.join("out");
     refused(
         &[
@@ -193,7 +165,7 @@ fn simulate_kappa_out_of_range_and_non_numbers_are_refused() {
 
 #[test]
 fn simulate_take_up_diameter_out_of_range_is_refused() {
-    let (dir, toml, dd) = data("args_take_up");
+    let (dir, toml, dd) = probe::shipped_copy("args_take_up");
     let out = dir.join("out");
     for v in ["-1e-4", "1e-9", "0.5"] {
         refused(
@@ -213,7 +185,7 @@ fn simulate_take_up_diameter_out_of_range_is_refused() {
 
 #[test]
 fn max_nodes_out_of_range_is_refused_on_every_subcommand() {
-    let (dir, toml, dd) = data("args_max_nodes");
+    let (dir, toml, dd) = probe::shipped_copy("args_max_nodes");
     let out = dir.join("out");
     for (cmd, extra) in [
         ("simulate", vec!["--take-up-from-data", "--out", s(&out)]),
@@ -235,7 +207,7 @@ fn max_nodes_out_of_range_is_refused_on_every_subcommand() {
 
 #[test]
 fn small_max_nodes_fails_naming_experiment_line_and_flag() {
-    let (dir, toml, dd) = data("args_small_max_nodes");
+    let (dir, toml, dd) = probe::shipped_copy("args_small_max_nodes");
     let out = dir.join("out");
     let p = run(
         &[
@@ -276,7 +248,7 @@ fn small_max_nodes_fails_naming_experiment_line_and_flag() {
 #[test]
 fn extreme_thin_take_up_names_the_experiment() {
     // a valid but extreme take-up (1 µm from a 1.1 mm inlet) with a small mesh limit
-    let (dir, toml, dd) = data("args_thin_take_up");
+    let (dir, toml, dd) = probe::shipped_copy("args_thin_take_up");
     let out = dir.join("out");
     let p = run(
         &[
@@ -303,7 +275,7 @@ fn extreme_thin_take_up_names_the_experiment() {
 #[test]
 fn simulate_overflowing_mass_flow_is_refused_with_experiment() {
     // refused by the reader (plausible range of the key), before any derived value overflows
-    let (dir, toml, dd) = data("args_mass_flow");
+    let (dir, toml, dd) = probe::shipped_copy("args_mass_flow");
     let out = dir.join("out");
     let bad = variant(
         &toml,
@@ -340,7 +312,7 @@ fn cold(toml: &Path) -> PathBuf {
 #[test]
 fn cold_melt_names_experiment_and_vft_in_simulate_compare_fit_landscape_diagnose() {
     // refused by the reader in every subcommand, before a solver meets the infinite viscosity
-    let (dir, toml, dd) = data("args_cold");
+    let (dir, toml, dd) = probe::shipped_copy("args_cold");
     let bad = cold(&toml);
     let at = format!("{}:", bad.display());
     let out = dir.join("out");
@@ -377,7 +349,7 @@ fn cold_melt_names_experiment_and_vft_in_simulate_compare_fit_landscape_diagnose
 
 #[test]
 fn landscape_huge_and_degenerate_grids_are_refused() {
-    let (dir, toml, dd) = data("args_grid");
+    let (dir, toml, dd) = probe::shipped_copy("args_grid");
     let out = dir.join("out");
     for (v, needle) in [
         ("100000x100000", "too large"),
@@ -397,7 +369,7 @@ fn landscape_huge_and_degenerate_grids_are_refused() {
 
 #[test]
 fn landscape_reversed_and_out_of_bounds_ranges_are_refused() {
-    let (dir, toml, dd) = data("args_ranges");
+    let (dir, toml, dd) = probe::shipped_copy("args_ranges");
     let out = dir.join("out");
     for (flag, v, needle) in [
         ("--n-range", "1,0", "did you mean 0,1"),
@@ -418,7 +390,7 @@ fn landscape_reversed_and_out_of_bounds_ranges_are_refused() {
 
 #[test]
 fn landscape_tol_and_max_nodes_out_of_range_are_refused() {
-    let (dir, toml, dd) = data("args_tol");
+    let (dir, toml, dd) = probe::shipped_copy("args_tol");
     let out = dir.join("out");
     for v in ["0", "2", "-1e-4", "1e-20"] {
         refused(
@@ -443,7 +415,7 @@ fn landscape_tol_and_max_nodes_out_of_range_are_refused() {
 
 #[test]
 fn landscape_prints_a_measured_time_estimate_up_front() {
-    let (dir, toml, dd) = data("args_estimate");
+    let (dir, toml, dd) = probe::shipped_copy("args_estimate");
     let out = dir.join("out");
     let p = run(
         &["landscape", s(&toml), "--grid", "4x3", "--out", s(&out)],
@@ -488,7 +460,7 @@ fn landscape_prints_a_measured_time_estimate_up_front() {
 
 #[test]
 fn fit_start_outside_the_bounds_is_refused() {
-    let (_dir, toml, dd) = data("args_start");
+    let (_dir, toml, dd) = probe::shipped_copy("args_start");
     for v in ["1.5,11", "-0.1,11", "0.5,25", "0.5,-3"] {
         refused(
             &["fit", s(&toml), "--start", v],
@@ -500,7 +472,7 @@ fn fit_start_outside_the_bounds_is_refused() {
 
 #[test]
 fn compare_relative_uncertainty_outside_zero_one_is_refused() {
-    let (dir, toml, dd) = data("args_sigma");
+    let (dir, toml, dd) = probe::shipped_copy("args_sigma");
     let out = dir.join("out");
     for v in ["2", "0", "1", "-0.01", "inf"] {
         refused(
@@ -525,7 +497,7 @@ fn compare_relative_uncertainty_outside_zero_one_is_refused() {
 
 #[test]
 fn compare_negative_n_is_a_value_and_refused() {
-    let (dir, toml, dd) = data("args_compare_n");
+    let (dir, toml, dd) = probe::shipped_copy("args_compare_n");
     let out = dir.join("out");
     refused(
         &[
@@ -561,7 +533,7 @@ fn fit_json(dir: &Path, n: f64, kappa: f64, factor: f64) -> PathBuf {
 
 #[test]
 fn compare_fit_file_values_are_checked() {
-    let (dir, toml, dd) = data("args_fit_values");
+    let (dir, toml, dd) = probe::shipped_copy("args_fit_values");
     let out = dir.join("out");
     for (n, kappa, factor, needles) in [
         (-0.5, 11.71, 1.0, vec!["field \"n\"", "-0.5", "[0, 1]"]),
@@ -588,7 +560,7 @@ fn compare_fit_file_values_are_checked() {
 
 #[test]
 fn diagnose_refit_top_zero_or_huge_is_refused() {
-    let (dir, toml, dd) = data("args_refit_top");
+    let (dir, toml, dd) = probe::shipped_copy("args_refit_top");
     let out = dir.join("out");
     for v in ["0", "1000", "-1"] {
         refused(
@@ -601,7 +573,7 @@ fn diagnose_refit_top_zero_or_huge_is_refused() {
 
 #[test]
 fn loaded_experiments_know_their_toml_line() {
-    let (_dir, toml, _dd) = data("args_lines");
+    let (_dir, toml, _dd) = probe::shipped_copy("args_lines");
     let loaded = diffbvp::fiber::input::load_experiments_with(&toml, 4).unwrap();
     assert_eq!(loaded.details.len(), loaded.set.experiments.len());
     for (e, d) in loaded.set.experiments.iter().zip(&loaded.details) {

@@ -7,25 +7,13 @@
 
 mod probe;
 
-use probe::{checksums_below, copy_data_set, rheometer, run_with, scratch, Probe};
+use probe::{checksums_below, rheometer, run_with, s, shipped_copy, Probe};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const LIMIT: Duration = Duration::from_secs(120);
-
-/// A scratch copy of the shipped data set: (scratch dir, TOML path, data dir).
-fn data(name: &str) -> (PathBuf, PathBuf, PathBuf) {
-    let dir = scratch(name);
-    let toml = copy_data_set("pmma7n_synthetic", &dir);
-    let data = toml.parent().unwrap().to_path_buf();
-    (dir, toml, data)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// Names of files in `dir` that are leftovers of atomic writes.
 fn temporaries(dir: &Path) -> Vec<String> {
@@ -82,7 +70,7 @@ fn profile_files(dir: &Path) -> Vec<String> {
 
 #[test]
 fn json_hard_link_to_a_measurement_csv_is_refused() {
-    let (dir, toml, data) = data("hard_link_json");
+    let (dir, toml, data) = shipped_copy("hard_link_json");
     let hard = dir.join("hard.json");
     fs::hard_link(data.join("v0p27_p1.csv"), &hard).unwrap();
     let p = rheometer(&["fit", s(&toml), "--json", s(&hard)], &[&data], LIMIT);
@@ -101,7 +89,7 @@ fn json_hard_link_to_a_measurement_csv_is_refused() {
 
 #[test]
 fn json_symlink_to_the_toml_is_refused() {
-    let (dir, toml, data) = data("symlink_json");
+    let (dir, toml, data) = shipped_copy("symlink_json");
     let sym = dir.join("sym.json");
     std::os::unix::fs::symlink(&toml, &sym).unwrap();
     let p = rheometer(&["fit", s(&toml), "--json", s(&sym)], &[&data], LIMIT);
@@ -115,7 +103,7 @@ fn json_symlink_to_the_toml_is_refused() {
 
 #[test]
 fn simulate_out_equal_to_an_input_csv_is_refused() {
-    let (_dir, toml, data) = data("out_is_csv_simulate");
+    let (_dir, toml, data) = shipped_copy("out_is_csv_simulate");
     let csv = data.join("v0p27_p1.csv");
     let p = rheometer(
         &[
@@ -139,7 +127,7 @@ fn simulate_out_equal_to_an_input_csv_is_refused() {
 
 #[test]
 fn landscape_out_equal_to_an_input_csv_is_refused_before_the_work() {
-    let (_dir, toml, data) = data("out_is_csv_landscape");
+    let (_dir, toml, data) = shipped_copy("out_is_csv_landscape");
     let csv = data.join("v0p53_p2.csv");
     let p = rheometer(&["landscape", s(&toml), "--out", s(&csv)], &[&data], LIMIT);
     p.assert_clean_failure(&["refusing to use", "v0p53_p2.csv", "input file"]);
@@ -149,7 +137,7 @@ fn landscape_out_equal_to_an_input_csv_is_refused_before_the_work() {
 
 #[test]
 fn compare_out_equal_to_the_toml_is_refused() {
-    let (_dir, toml, data) = data("out_is_toml_compare");
+    let (_dir, toml, data) = shipped_copy("out_is_toml_compare");
     let p = rheometer(
         &[
             "compare",
@@ -170,7 +158,7 @@ fn compare_out_equal_to_the_toml_is_refused() {
 
 #[test]
 fn out_below_an_input_file_names_the_file() {
-    let (_dir, toml, data) = data("out_below_file");
+    let (_dir, toml, data) = shipped_copy("out_below_file");
     let below = data.join("v0p27_p1.csv").join("sim");
     let p = rheometer(
         &[
@@ -188,7 +176,7 @@ fn out_below_an_input_file_names_the_file() {
 
 #[test]
 fn out_equal_to_an_existing_other_file_is_refused() {
-    let (dir, toml, data) = data("out_is_other_file");
+    let (dir, toml, data) = shipped_copy("out_is_other_file");
     let file = dir.join("notes.txt");
     fs::write(&file, "my notes").unwrap();
     let p = rheometer(
@@ -207,7 +195,7 @@ fn out_equal_to_an_existing_other_file_is_refused() {
 
 #[test]
 fn out_equal_to_the_data_directory_writes_next_to_unchanged_inputs() {
-    let (_dir, toml, data) = data("out_is_data_dir");
+    let (_dir, toml, data) = shipped_copy("out_is_data_dir");
     let before = checksums_below(&data);
     let p = rheometer(
         &[
@@ -236,7 +224,7 @@ fn out_equal_to_the_data_directory_writes_next_to_unchanged_inputs() {
 
 #[test]
 fn output_name_colliding_with_an_input_is_refused_before_any_file_is_written() {
-    let (_dir, toml, data) = data("name_collision");
+    let (_dir, toml, data) = shipped_copy("name_collision");
     // the last experiment's measurements live in a file named like the first profile
     fs::copy(data.join("v1p06_p3.csv"), data.join("v0p27_p1_profile.csv")).unwrap();
     let text = fs::read_to_string(&toml)
@@ -264,7 +252,7 @@ fn output_name_colliding_with_an_input_is_refused_before_any_file_is_written() {
 
 #[test]
 fn existing_profile_hard_linked_to_an_input_is_refused() {
-    let (dir, toml, data) = data("profile_hard_link");
+    let (dir, toml, data) = shipped_copy("profile_hard_link");
     let out = dir.join("sim");
     fs::create_dir_all(&out).unwrap();
     fs::hard_link(data.join("v0p53_p1.csv"), out.join("v0p53_p1_profile.csv")).unwrap();
@@ -289,7 +277,7 @@ fn existing_profile_hard_linked_to_an_input_is_refused() {
 
 #[test]
 fn compare_json_hard_linked_to_an_input_is_refused_and_the_input_kept() {
-    let (dir, toml, data) = data("compare_hard_link");
+    let (dir, toml, data) = shipped_copy("compare_hard_link");
     let out = dir.join("cmp");
     fs::create_dir_all(&out).unwrap();
     fs::hard_link(data.join("v1p06_p2.csv"), out.join("compare.json")).unwrap();
@@ -313,7 +301,7 @@ fn compare_json_hard_linked_to_an_input_is_refused_and_the_input_kept() {
 
 #[test]
 fn fit_out_with_report_symlinked_to_an_input_is_refused() {
-    let (dir, toml, data) = data("fit_out_symlink");
+    let (dir, toml, data) = shipped_copy("fit_out_symlink");
     let out = dir.join("fit");
     fs::create_dir_all(&out).unwrap();
     std::os::unix::fs::symlink(data.join("v0p27_p3.csv"), out.join("fit_report.txt")).unwrap();
@@ -323,7 +311,7 @@ fn fit_out_with_report_symlinked_to_an_input_is_refused() {
 
 #[test]
 fn landscape_figure_symlinked_to_the_toml_is_refused_before_the_work() {
-    let (dir, toml, data) = data("landscape_symlink");
+    let (dir, toml, data) = shipped_copy("landscape_symlink");
     let out = dir.join("land");
     fs::create_dir_all(&out).unwrap();
     std::os::unix::fs::symlink(&toml, out.join("landscape.png")).unwrap();
@@ -335,7 +323,7 @@ fn landscape_figure_symlinked_to_the_toml_is_refused_before_the_work() {
 #[test]
 fn existing_output_hard_linked_to_another_file_is_replaced_not_truncated() {
     // atomic writes replace the directory entry: a hard link elsewhere keeps its content
-    let (dir, toml, data) = data("replace_not_truncate");
+    let (dir, toml, data) = shipped_copy("replace_not_truncate");
     let out = dir.join("sim");
     fs::create_dir_all(&out).unwrap();
     let keep = dir.join("backup.csv");
@@ -363,7 +351,7 @@ fn existing_output_hard_linked_to_another_file_is_replaced_not_truncated() {
 
 #[test]
 fn json_into_a_missing_directory_creates_it() {
-    let (dir, toml, data) = data("json_missing_dir");
+    let (dir, toml, data) = shipped_copy("json_missing_dir");
     let json = dir.join("new").join("deeper").join("fit.json");
     let p = rheometer(&["fit", s(&toml), "--json", s(&json)], &[&data], LIMIT);
     p.assert_success();
@@ -375,7 +363,7 @@ fn json_into_a_missing_directory_creates_it() {
 #[test]
 fn json_into_a_read_only_location_fails_naming_it() {
     // /proc accepts no new files, even for root (chmod 555 would not stop root)
-    let (_dir, toml, data) = data("json_read_only");
+    let (_dir, toml, data) = shipped_copy("json_read_only");
     let p = rheometer(
         &["fit", s(&toml), "--json", "/proc/fit.json"],
         &[&data],
@@ -386,7 +374,7 @@ fn json_into_a_read_only_location_fails_naming_it() {
 
 #[test]
 fn stdout_to_dev_full_exits_non_zero_with_a_message() {
-    let (_dir, toml, data) = data("stdout_full");
+    let (_dir, toml, data) = shipped_copy("stdout_full");
     let p = run_with(&["fit", s(&toml)], &[&data], LIMIT, |c| {
         c.stdout(
             fs::OpenOptions::new()
@@ -400,7 +388,7 @@ fn stdout_to_dev_full_exits_non_zero_with_a_message() {
 
 #[test]
 fn landscape_stdout_to_dev_full_exits_non_zero() {
-    let (dir, toml, data) = data("landscape_stdout_full");
+    let (dir, toml, data) = shipped_copy("landscape_stdout_full");
     let out = dir.join("land");
     let p = run_with(
         &[
@@ -446,7 +434,7 @@ fn help_to_dev_full_exits_non_zero() {
 
 #[test]
 fn stderr_to_dev_full_never_panics() {
-    let (dir, toml, data) = data("stderr_full");
+    let (dir, toml, data) = shipped_copy("stderr_full");
     let full = || {
         fs::OpenOptions::new()
             .write(true)
@@ -478,7 +466,7 @@ fn stderr_to_dev_full_never_panics() {
 
 #[test]
 fn closed_stdout_pipe_exits_zero_silently() {
-    let (_dir, toml, data) = data("closed_pipe");
+    let (_dir, toml, data) = shipped_copy("closed_pipe");
     let before = checksums_below(&data);
     let mut child = Command::new(env!("CARGO_BIN_EXE_rheometer"))
         .args(["fit", s(&toml)])
@@ -585,7 +573,7 @@ fn interrupt(args: &[&str], watch: &[&Path], ready: impl Fn() -> bool) -> (Probe
 
 #[test]
 fn sigint_during_simulate_keeps_and_marks_the_finished_profiles() {
-    let (dir, _toml, data) = data("sigint_simulate");
+    let (dir, _toml, data) = shipped_copy("sigint_simulate");
     let toml = many_experiments(&data, "many.toml", 120); // 1080 experiments
     let out = dir.join("sim");
     let ready = || out.is_dir() && profile_files(&out).len() >= 3;
@@ -633,7 +621,7 @@ fn sigint_during_simulate_keeps_and_marks_the_finished_profiles() {
 
 #[test]
 fn sigint_during_landscape_keeps_the_finished_points() {
-    let (dir, toml, data) = data("sigint_landscape");
+    let (dir, toml, data) = shipped_copy("sigint_landscape");
     let out = dir.join("land");
     let t0 = Instant::now();
     // the default 41x41 grid runs for tens of seconds (about 70 points per second here)
@@ -681,7 +669,7 @@ fn sigint_during_landscape_keeps_the_finished_points() {
 
 #[test]
 fn simulate_with_two_hundred_experiments_writes_everything() {
-    let (dir, _toml, data) = data("many_experiments");
+    let (dir, _toml, data) = shipped_copy("many_experiments");
     let toml = many_experiments(&data, "many.toml", 23); // 207 experiments
     let out = dir.join("sim");
     let p = rheometer(
@@ -715,7 +703,7 @@ fn simulate_with_two_hundred_experiments_writes_everything() {
 
 #[test]
 fn simulate_failing_midway_leaves_a_manifest() {
-    let (dir, toml, data) = data("simulate_fails_midway");
+    let (dir, toml, data) = shipped_copy("simulate_fails_midway");
     // the last experiment loses its measurements: --take-up-from-data fails there
     let text = fs::read_to_string(&toml)
         .unwrap()
@@ -742,7 +730,7 @@ fn simulate_failing_midway_leaves_a_manifest() {
 
 #[test]
 fn a_complete_rerun_removes_the_manifest() {
-    let (dir, toml, data) = data("rerun_removes_manifest");
+    let (dir, toml, data) = shipped_copy("rerun_removes_manifest");
     let out = dir.join("sim");
     fs::create_dir_all(&out).unwrap();
     fs::write(out.join("PARTIAL.txt"), "stale\n").unwrap();
@@ -764,7 +752,7 @@ fn a_complete_rerun_removes_the_manifest() {
 
 #[test]
 fn landscape_counts_failed_points_and_warns_when_most_fail() {
-    let (dir, toml, data) = data("landscape_failures");
+    let (dir, toml, data) = shipped_copy("landscape_failures");
     let out = dir.join("land");
     // strain thinning this strong (n near 0) has no solution for most of these points
     let p = rheometer(
@@ -809,7 +797,7 @@ fn library_landscape_cancelled_up_front_reaches_no_point() {
     use diffbvp::fiber::input::load_experiments_with;
     use diffbvp::fiber::rheometer::{Estimator, IdentifyOptions, PointStatus, Rheometer};
     use std::sync::atomic::AtomicBool;
-    let (_dir, toml, _data) = data("library_cancel");
+    let (_dir, toml, _data) = shipped_copy("library_cancel");
     let loaded = load_experiments_with(&toml, 4).unwrap();
     let rh = Rheometer::new(&loaded.set).unwrap();
     let mut opts = IdentifyOptions::with_estimator(Estimator::Paper);
@@ -839,7 +827,7 @@ fn library_landscape_cancelled_up_front_reaches_no_point() {
 fn sigint_during_fit_and_compare_still_stops_at_once() {
     // commands without a clean stop keep the default: SIGINT ends them immediately, and their
     // outputs (written atomically, at the end) are never half-written
-    let (dir, _toml, data) = data("sigint_fit_compare");
+    let (dir, _toml, data) = shipped_copy("sigint_fit_compare");
     let toml = many_experiments(&data, "many.toml", 40); // 360 experiments
     let t0 = Instant::now();
     let json = dir.join("fit.json");

@@ -19,16 +19,7 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-const SET: &str = "pmma7n_synthetic";
 const LIMIT: Duration = Duration::from_secs(120);
-
-/// A scratch copy of the shipped data: (scratch dir, TOML path, data dir).
-fn copy(name: &str) -> (PathBuf, PathBuf, PathBuf) {
-    let dir = probe::scratch(name);
-    let toml = probe::copy_data_set(SET, &dir);
-    let data = dir.join(SET);
-    (dir, toml, data)
-}
 
 /// Rewrites the diameters of a CSV (`position_m,diameter_m`) with `f(index, diameters)`.
 fn rewrite_diameters(csv: &Path, f: impl Fn(&[f64]) -> Vec<f64>) {
@@ -120,7 +111,7 @@ fn line<'a>(text: &'a str, prefix: &str) -> &'a str {
 
 #[test]
 fn shipped_data_fit_has_no_warning() {
-    let (dir, toml, data) = copy("fw_control");
+    let (dir, toml, data) = probe::shipped_copy("fw_control");
     let (p, v) = fit_cli(&toml, &data, &dir);
     assert!(!p.stdout.contains("[[Warnings"), "{}", p.stdout);
     assert!(!p.stdout.contains("AT LOWER") && !p.stdout.contains("AT UPPER"));
@@ -151,7 +142,7 @@ fn shipped_data_fit_has_no_warning() {
 #[test]
 fn a_kappa_at_its_lower_bound_is_marked_and_gets_no_interval() {
     // case (a): one experiment's diameters scaled by 0.4 drive κ to its lower bound 7
-    let (dir, toml, data) = copy("fw_kappa_bound");
+    let (dir, toml, data) = probe::shipped_copy("fw_kappa_bound");
     rewrite_diameters(&data.join("v0p53_p2.csv"), |d| {
         d.iter().map(|x| 0.4 * x).collect()
     });
@@ -183,7 +174,7 @@ fn a_kappa_at_its_lower_bound_is_marked_and_gets_no_interval() {
 #[test]
 fn a_take_up_factor_pinned_at_its_bound_and_a_huge_misfit_are_warned_about() {
     // case (b): a take-up diameter 10× too large (1e-3 m instead of ~1e-4 m) for one experiment
-    let (dir, toml, data) = copy("fw_take_up_bound");
+    let (dir, toml, data) = probe::shipped_copy("fw_take_up_bound");
     edit(
         &toml,
         "data = \"v0p53_p2.csv\"",
@@ -237,7 +228,7 @@ fn a_take_up_factor_pinned_at_its_bound_and_a_huge_misfit_are_warned_about() {
 #[test]
 fn increasing_diameters_are_named_and_undetermined_parameters_warned_about() {
     // case (c): one CSV's diameters in reverse order (increasing along the spin line)
-    let (dir, toml, data) = copy("fw_increasing");
+    let (dir, toml, data) = probe::shipped_copy("fw_increasing");
     rewrite_diameters(&data.join("v0p53_p2.csv"), |d| {
         d.iter().rev().copied().collect()
     });
@@ -269,7 +260,7 @@ fn increasing_diameters_are_named_and_undetermined_parameters_warned_about() {
 #[test]
 fn air_hotter_than_the_melt_is_not_relabelled_newtonian() {
     // case (d): the air at 600 K, above the melt's 513 K
-    let (dir, toml, data) = copy("fw_hot_air");
+    let (dir, toml, data) = probe::shipped_copy("fw_hot_air");
     edit(
         &toml,
         "air_temperature_K = 293.15",
@@ -296,7 +287,7 @@ fn air_hotter_than_the_melt_is_not_relabelled_newtonian() {
 
 #[test]
 fn a_newtonian_model_is_still_labelled_newtonian() {
-    let (dir, toml, data) = copy("fw_newtonian");
+    let (dir, toml, data) = probe::shipped_copy("fw_newtonian");
     let json = dir.join("fit.json");
     let p = probe::rheometer(
         &[
@@ -427,7 +418,7 @@ fn good_fit() -> Value {
 
 /// Runs `rheometer compare TOML --fit FILE --out DIR` with `text` as the fit file.
 fn compare_with(name: &str, text: &str) -> (probe::Probe, PathBuf) {
-    let (dir, toml, data) = copy(name);
+    let (dir, toml, data) = probe::shipped_copy(name);
     let fit = dir.join("bad_fit.json");
     std::fs::write(&fit, text).unwrap();
     let out = dir.join("cmp");

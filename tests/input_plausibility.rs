@@ -29,12 +29,7 @@ fn first(from: &'static str, to: &'static str) -> impl FnOnce(&str) -> String {
 
 /// `file:line` of the first line of `path` containing `needle` (1-based).
 fn at(path: &Path, needle: &str) -> String {
-    let text = std::fs::read_to_string(path).unwrap();
-    let line = text
-        .lines()
-        .position(|l| l.contains(needle))
-        .unwrap_or_else(|| panic!("{needle:?} not in {}", path.display()))
-        + 1;
+    let line = probe::line_where(path, |l| l.contains(needle));
     format!("{}:{line}:", path.display())
 }
 

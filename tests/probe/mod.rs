@@ -50,6 +50,39 @@ fn copy_tree(from: &Path, to: &Path) {
     }
 }
 
+/// A scratch copy of the shipped `pmma7n_synthetic` data set for test `name`: (scratch dir,
+/// TOML path, data dir).
+pub fn shipped_copy(name: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let dir = scratch(name);
+    let toml = copy_data_set("pmma7n_synthetic", &dir);
+    let data = dir.join("pmma7n_synthetic");
+    (dir, toml, data)
+}
+
+/// A path as `&str` (test paths are UTF-8).
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("UTF-8 path")
+}
+
+/// A variant of `toml` with the first `from` replaced by `to`, written next to it as `file`
+/// (the line structure unchanged); returns its path.
+pub fn variant(toml: &Path, file: &str, from: &str, to: &str) -> PathBuf {
+    let text = std::fs::read_to_string(toml).expect("read TOML");
+    assert!(text.contains(from), "{from:?} not in {}", toml.display());
+    let out = toml.with_file_name(file);
+    std::fs::write(&out, text.replacen(from, to, 1)).expect("write variant");
+    out
+}
+
+/// The 1-based number of the first line of `path` for which `matches` holds.
+pub fn line_where(path: &Path, matches: impl Fn(&str) -> bool) -> usize {
+    let text = std::fs::read_to_string(path).expect("read file");
+    text.lines()
+        .position(matches)
+        .unwrap_or_else(|| panic!("no such line in {}", path.display()))
+        + 1
+}
+
 /// A 64-bit checksum of a file's bytes (None if it cannot be read).
 pub fn checksum(path: &Path) -> Option<u64> {
     let bytes = std::fs::read(path).ok()?;

@@ -185,21 +185,39 @@ pub fn check_start((n, kappa): (f64, f64), opts: &IdentifyOptions) -> Result<(),
     Ok(())
 }
 
+/// Two values separated by one of `separators` ("0.5,11" or "41x41"); `form` and `what` name
+/// the expected form and kind of value in messages.
+fn parse_two<T: std::str::FromStr>(
+    s: &str,
+    separators: &[char],
+    form: &str,
+    what: &str,
+) -> Result<(T, T), String> {
+    let parts: Vec<&str> = s.split(separators).collect();
+    if parts.len() != 2 {
+        return Err(format!("expected {form}, got \"{s}\""));
+    }
+    let value = |p: &str| {
+        p.trim()
+            .parse::<T>()
+            .map_err(|_| format!("\"{p}\" is not {what}"))
+    };
+    Ok((value(parts[0])?, value(parts[1])?))
+}
+
+/// A pair "A,B" of finite numbers (`--start`, `--n-range`, `--kappa-range`).
+pub fn parse_pair(s: &str) -> Result<(f64, f64), String> {
+    let (a, b) = parse_two::<f64>(s, &[','], "two numbers \"A,B\"", "a number")?;
+    if !a.is_finite() || !b.is_finite() {
+        return Err(format!("\"{s}\" contains a non-finite number"));
+    }
+    Ok((a, b))
+}
+
 /// The `--grid` size "NxM": 2 to [`MAX_GRID_SIDE`] values per direction, at most
 /// [`MAX_GRID_POINTS`] points.
 pub fn parse_grid(s: &str) -> Result<(usize, usize), String> {
-    let parts: Vec<&str> = s.split(['x', 'X']).collect();
-    if parts.len() != 2 {
-        return Err(format!("expected \"NxM\", got \"{s}\""));
-    }
-    let a: usize = parts[0]
-        .trim()
-        .parse()
-        .map_err(|_| format!("\"{}\" is not a count", parts[0]))?;
-    let b: usize = parts[1]
-        .trim()
-        .parse()
-        .map_err(|_| format!("\"{}\" is not a count", parts[1]))?;
+    let (a, b) = parse_two::<usize>(s, &['x', 'X'], "\"NxM\"", "a count")?;
     if a < 2 || b < 2 {
         return Err("the grid needs at least 2 points per direction".into());
     }

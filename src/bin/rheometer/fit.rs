@@ -8,7 +8,7 @@ pub struct FitArgs {
     /// The experiments file (TOML).
     pub experiments: PathBuf,
     /// Start point "N,KAPPA" (default: the paper's start heuristic).
-    #[arg(long, value_parser = parse_pair, allow_hyphen_values = true)]
+    #[arg(long, value_parser = checks::parse_pair, allow_hyphen_values = true)]
     pub start: Option<(f64, f64)>,
     /// The estimator.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Principled)]

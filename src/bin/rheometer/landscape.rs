@@ -11,10 +11,10 @@ pub struct LandscapeArgs {
     #[arg(long, default_value = "41x41", value_parser = checks::parse_grid)]
     pub grid: (usize, usize),
     /// Range of n "MIN,MAX" (within the fit's bounds [0, 1]).
-    #[arg(long, default_value = "0,1", value_parser = parse_pair, allow_hyphen_values = true)]
+    #[arg(long, default_value = "0,1", value_parser = checks::parse_pair, allow_hyphen_values = true)]
     pub n_range: (f64, f64),
     /// Range of kappa "MIN,MAX" (within the fit's bounds [7, 20]).
-    #[arg(long, default_value = "9,16", value_parser = parse_pair, allow_hyphen_values = true)]
+    #[arg(long, default_value = "9,16", value_parser = checks::parse_pair, allow_hyphen_values = true)]
     pub kappa_range: (f64, f64),
     /// The estimator whose cost is mapped.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Paper)]

@@ -251,25 +251,6 @@ impl Global {
     }
 }
 
-fn parse_pair(s: &str) -> Result<(f64, f64), String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    if parts.len() != 2 {
-        return Err(format!("expected two numbers \"A,B\", got \"{s}\""));
-    }
-    let a: f64 = parts[0]
-        .trim()
-        .parse()
-        .map_err(|_| format!("\"{}\" is not a number", parts[0]))?;
-    let b: f64 = parts[1]
-        .trim()
-        .parse()
-        .map_err(|_| format!("\"{}\" is not a number", parts[1]))?;
-    if !a.is_finite() || !b.is_finite() {
-        return Err(format!("\"{s}\" contains a non-finite number"));
-    }
-    Ok((a, b))
-}
-
 fn inputs_of(path: &Path, loaded: &LoadedExperiments) -> Vec<PathBuf> {
     let mut v = vec![path.to_path_buf()];
     v.extend(loaded.details.iter().filter_map(|d| d.data.clone()));
