@@ -67,21 +67,17 @@ impl ContinuationOptions {
     /// `enlarge >= 1`, `0 < shrink < 1`, `divergence_divisor > 1`, `max_steps >= 1`. The error
     /// names the option and its value. [`continuation`] calls this before any solve.
     pub fn validate(&self) -> Result<(), BvpError> {
-        let bad = |name: &str, value: f64, rule: &str| {
-            Err(BvpError::InvalidInput(format!(
-                "ContinuationOptions::{name} = {value} {rule}"
-            )))
-        };
-        let positive = [
-            ("initial_step", self.initial_step),
-            ("min_step", self.min_step),
-            ("max_step", self.max_step),
-        ];
-        for (name, v) in positive {
-            if !(v > 0.0 && v.is_finite()) {
-                return bad(name, v, "must be positive and finite");
-            }
-        }
+        let owner = "ContinuationOptions";
+        let bad = |name: &str, value: f64, rule: &str| bad_option(owner, name, value, rule);
+        check_positive(
+            owner,
+            &[
+                ("initial_step", self.initial_step),
+                ("min_step", self.min_step),
+                ("max_step", self.max_step),
+            ],
+            true,
+        )?;
         if self.min_step > self.max_step {
             return bad(
                 "min_step",
@@ -92,9 +88,7 @@ impl ContinuationOptions {
         if !(self.enlarge >= 1.0 && self.enlarge.is_finite()) {
             return bad("enlarge", self.enlarge, "must be finite and at least 1");
         }
-        if !(self.shrink > 0.0 && self.shrink < 1.0) {
-            return bad("shrink", self.shrink, "must lie in (0, 1)");
-        }
+        check_shrink(owner, self.shrink)?;
         if !(self.divergence_divisor > 1.0 && self.divergence_divisor.is_finite()) {
             return bad(
                 "divergence_divisor",
@@ -204,6 +198,26 @@ fn empty_path(start: &Solution) -> ContinuationPath {
     }
 }
 
+/// Start value, direction (±1) and length of the path from `start` to `target`; `None` if the
+/// path is empty.
+fn span(start: &Solution, index: usize, target: f64) -> Option<(f64, f64, f64)> {
+    let c0 = start.params[index];
+    let span = target - c0;
+    (span != 0.0).then(|| (c0, span.signum(), span.abs()))
+}
+
+/// Appends an attempted step that ended at `reached` and proposed `next_step`.
+fn push_record(path: &mut ContinuationPath, mut record: StepRecord, reached: f64, next_step: f64) {
+    record.reached = reached;
+    record.next_step = next_step;
+    if record.accepted {
+        path.steps_accepted += 1;
+    } else {
+        path.steps_rejected += 1;
+    }
+    path.history.push(record);
+}
+
 /// Adds one converged solve to the path's statistics.
 fn count_solve(path: &mut ContinuationPath, s: &Solution) {
     add_stats(&mut path.stats, &s.stats);
@@ -219,14 +233,10 @@ fn adapter<P: Bvp>(
     options: &ContinuationOptions,
     solve_options: &SolveOptions,
 ) -> Result<ContinuationPath, BvpError> {
-    let c0 = start.params[index];
-    let span = target - c0;
     let mut path = empty_path(start);
-    if span == 0.0 {
+    let Some((c0, dir, total)) = span(start, index, target) else {
         return Ok(path);
-    }
-    let dir = span.signum();
-    let total = span.abs();
+    };
     let mut step = (options.initial_step * total).min(options.max_step * total);
     let min_step = options.min_step * total;
     let mut current = start.clone();
@@ -327,14 +337,7 @@ fn adapter<P: Bvp>(
                 step = h / options.divergence_divisor;
             }
         }
-        record.reached = c;
-        record.next_step = step;
-        if record.accepted {
-            path.steps_accepted += 1;
-        } else {
-            path.steps_rejected += 1;
-        }
-        path.history.push(record);
+        push_record(&mut path, record, c, step);
     }
     path.solution = current;
     Ok(path)
@@ -375,27 +378,48 @@ impl SimpleSteps {
     /// (NaN fails every check). The error names the option and its value. [`follow`] calls
     /// this before any solve.
     pub fn validate(&self) -> Result<(), BvpError> {
-        let bad = |name: &str, value: f64, rule: &str| {
-            Err(BvpError::InvalidInput(format!(
-                "SimpleSteps::{name} = {value} {rule}"
-            )))
-        };
-        let positive = [
-            ("initial_step", self.initial_step),
-            ("min_step", self.min_step),
-        ];
-        for (name, v) in positive {
-            if v.is_nan() || v <= 0.0 {
-                return bad(name, v, "must be positive");
-            }
-        }
+        let owner = "SimpleSteps";
+        check_positive(
+            owner,
+            &[
+                ("initial_step", self.initial_step),
+                ("min_step", self.min_step),
+            ],
+            false,
+        )?;
         if self.grow.is_nan() || self.grow < 1.0 {
-            return bad("grow", self.grow, "must be at least 1");
+            return bad_option(owner, "grow", self.grow, "must be at least 1");
         }
-        if !(self.shrink > 0.0 && self.shrink < 1.0) {
-            return bad("shrink", self.shrink, "must lie in (0, 1)");
+        check_shrink(owner, self.shrink)
+    }
+}
+
+/// The error for the option `owner::name = value`, which breaks `rule`.
+fn bad_option(owner: &str, name: &str, value: f64, rule: &str) -> Result<(), BvpError> {
+    Err(BvpError::InvalidInput(format!(
+        "{owner}::{name} = {value} {rule}"
+    )))
+}
+
+/// Step options must be positive (and finite if `finite`).
+fn check_positive(owner: &str, steps: &[(&str, f64)], finite: bool) -> Result<(), BvpError> {
+    for &(name, v) in steps {
+        if finite && !(v > 0.0 && v.is_finite()) {
+            return bad_option(owner, name, v, "must be positive and finite");
         }
+        if v.is_nan() || v <= 0.0 {
+            return bad_option(owner, name, v, "must be positive");
+        }
+    }
+    Ok(())
+}
+
+/// A shrinking factor lies in (0, 1).
+fn check_shrink(owner: &str, shrink: f64) -> Result<(), BvpError> {
+    if shrink > 0.0 && shrink < 1.0 {
         Ok(())
+    } else {
+        bad_option(owner, "shrink", shrink, "must lie in (0, 1)")
     }
 }
 
@@ -457,14 +481,10 @@ fn simple<P: Bvp>(
     control: &SimpleSteps,
     options: &SolveOptions,
 ) -> Result<ContinuationPath, BvpError> {
-    let c0 = start.params[index];
-    let span = target - c0;
     let mut path = empty_path(start);
-    if span == 0.0 {
+    let Some((c0, dir, total)) = span(start, index, target) else {
         return Ok(path);
-    }
-    let dir = span.signum();
-    let total = span.abs();
+    };
     let mut step = control.initial_step * total;
     let min_step = control.min_step * total;
     let mut current = start.clone();
@@ -505,11 +525,9 @@ fn simple<P: Bvp>(
                 current = s;
                 c = c_new;
                 step *= control.grow;
-                path.steps_accepted += 1;
             }
             Err(e) => {
                 step *= control.shrink;
-                path.steps_rejected += 1;
                 if step < min_step || steps > control.max_steps {
                     return Err(BvpError::ContinuationStalled {
                         reached: c,
@@ -521,9 +539,7 @@ fn simple<P: Bvp>(
                 }
             }
         }
-        record.reached = c;
-        record.next_step = step;
-        path.history.push(record);
+        push_record(&mut path, record, c, step);
     }
     path.solution = current;
     Ok(path)

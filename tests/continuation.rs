@@ -78,30 +78,25 @@ fn continuation_reaches_target_where_plain_newton_fails() {
     assert_eq!(path.steps_accepted + path.steps_rejected, h.len());
 }
 
-#[test]
-fn continuation_stops_with_the_parameter_reached() {
-    // y' = y^2 with y(0) = 1 + c: blows up before x = 1 once 1 + c >= 1; from c = -0.5 upwards
-    struct Blowup;
-    impl Bvp for Blowup {
-        fn dim(&self) -> usize {
-            1
-        }
-        fn num_params(&self) -> usize {
-            1
-        }
-        fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-            f[0] = y[0] * y[0];
-        }
-        fn bc<D: DualNum<Primitive = f64> + Copy>(
-            &self,
-            ya: &[D],
-            _yb: &[D],
-            p: &[D],
-            r: &mut [D],
-        ) {
-            r[0] = ya[0] - (p[0] + 1.0);
-        }
+/// y' = y^2 with y(0) = 1 + c: blows up before x = 1 once 1 + c >= 1.
+struct Blowup;
+impl Bvp for Blowup {
+    fn dim(&self) -> usize {
+        1
     }
+    fn num_params(&self) -> usize {
+        1
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
+        f[0] = y[0] * y[0];
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], _yb: &[D], p: &[D], r: &mut [D]) {
+        r[0] = ya[0] - (p[0] + 1.0);
+    }
+}
+
+/// A solver for [`Blowup`] (tol 1e-4, at most 2000 nodes) and its solution at c = -0.5.
+fn blowup_start() -> (Solver<'static, Blowup>, diffbvp::Solution) {
     let opts = SolveOptions {
         max_nodes: 2000,
         ..SolveOptions::with_tol(1e-4)
@@ -111,8 +106,20 @@ fn continuation_stops_with_the_parameter_reached() {
         y[0] = 0.5 / (1.0 - 0.5 * x)
     });
     let start = solver.solve(&[-0.5], &g).unwrap();
+    (solver, start)
+}
+
+#[test]
+fn continuation_stops_with_the_parameter_reached() {
+    // from c = -0.5 upwards
+    let (mut solver, start) = blowup_start();
     let err =
         continuation(&mut solver, &start, 0, 0.5, &ContinuationOptions::default()).unwrap_err();
+    assert_stalled_before_blowup(err);
+}
+
+/// The path from c = -0.5 towards 0.5 stalls between -0.5 and 0.
+fn assert_stalled_before_blowup(err: diffbvp::BvpError) {
     match err {
         diffbvp::BvpError::ContinuationStalled {
             reached, target, ..
@@ -242,50 +249,13 @@ fn solve_by_continuation_goes_from_a_guess_to_the_target() {
 #[test]
 fn simple_steps_stop_with_the_parameter_reached() {
     use diffbvp::continuation::{follow, SimpleSteps, StepControl};
-    // y' = y^2, y(0) = 1 + c: no solution on [0, 1] once c >= 0
-    struct Blowup;
-    impl Bvp for Blowup {
-        fn dim(&self) -> usize {
-            1
-        }
-        fn num_params(&self) -> usize {
-            1
-        }
-        fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-            f[0] = y[0] * y[0];
-        }
-        fn bc<D: DualNum<Primitive = f64> + Copy>(
-            &self,
-            ya: &[D],
-            _yb: &[D],
-            p: &[D],
-            r: &mut [D],
-        ) {
-            r[0] = ya[0] - (p[0] + 1.0);
-        }
-    }
-    let opts = SolveOptions {
-        max_nodes: 2000,
-        ..SolveOptions::with_tol(1e-4)
-    };
-    let mut solver = Solver::new(&Blowup, opts.clone());
-    let g = Guess::from_fn(linspace(0.0, 1.0, 11), 1, |x, y| {
-        y[0] = 0.5 / (1.0 - 0.5 * x)
-    });
-    let start = solver.solve(&[-0.5], &g).unwrap();
+    let (mut solver, start) = blowup_start();
+    let opts = solver.options.clone();
     let control = StepControl::Simple(SimpleSteps {
         min_step: 1e-3,
         ..SimpleSteps::default()
     });
-    match follow(&mut solver, &start, 0, 0.5, &control, &opts).unwrap_err() {
-        diffbvp::BvpError::ContinuationStalled {
-            reached, target, ..
-        } => {
-            assert!(reached <= 1e-9 && reached > -0.5, "reached {reached}");
-            assert_eq!(target, 0.5);
-        }
-        other => panic!("expected ContinuationStalled, got {other}"),
-    }
+    assert_stalled_before_blowup(follow(&mut solver, &start, 0, 0.5, &control, &opts).unwrap_err());
 }
 
 /// y'' = 0, y(0) = 0, y(1) = c: the solution `y = c x` is linear in `c`.

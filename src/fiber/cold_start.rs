@@ -35,13 +35,10 @@ pub fn continuation_in_c<P: Bvp>(
     path: &PathOptions,
     options: &SolveOptions,
 ) -> Result<Solution, BvpError> {
-    if index >= params.len() {
-        return Err(BvpError::InvalidInput(format!(
-            "continuation parameter index {index} out of range ({} parameters)",
-            params.len()
-        )));
-    }
     let mut p = params.to_vec();
-    p[index] = 0.0;
+    // an index out of range is refused by `solve_by_continuation`
+    if let Some(c) = p.get_mut(index) {
+        *c = 0.0;
+    }
     solve_by_continuation(solver, &p, index, 1.0, guess, path, options)
 }
