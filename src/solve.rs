@@ -151,7 +151,10 @@ impl SolveOptions {
     }
 }
 
-/// An initial guess: mesh, states at the nodes and unknown parameters.
+/// An initial guess: mesh, states at the nodes and unknown parameters. It is also the warm-start
+/// type: [`Guess::from`] a previous [`Solution`], or a predicted one such as the secant
+/// predictor [`secant_guess`](crate::continuation::secant_guess), carries exactly what a solve
+/// starts from, nothing of a solve that did not happen.
 #[derive(Debug, Clone)]
 pub struct Guess {
     /// Mesh nodes (strictly increasing; `x[0] = a`, `x[m-1] = b`).
@@ -264,14 +267,19 @@ impl<'a, P: Bvp> Solver<'a, P> {
         Ok(p)
     }
 
-    fn validate(&self, params: &[f64], guess: &Guess) -> Result<(), BvpError> {
+    fn validate(
+        &self,
+        params: &[f64],
+        guess: &Guess,
+        options: &SolveOptions,
+    ) -> Result<(), BvpError> {
         let (n, k, q) = (self.col.n, self.col.k, self.col.q);
         if n == 0 {
             return Err(BvpError::InvalidInput(
                 "the problem has no states (dim() = 0)".into(),
             ));
         }
-        self.options.validate(n)?;
+        options.validate(n)?;
         mesh::validate(&guess.x)?;
         if guess.y.len() != guess.x.len() * n {
             return Err(BvpError::InvalidInput(format!(
@@ -311,19 +319,19 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 "parameter {i} of p = (unknowns, model parameters) is not finite"
             )));
         }
-        if guess.x.len() > self.options.max_nodes {
+        if guess.x.len() > options.max_nodes {
             return Err(BvpError::InvalidInput(format!(
                 "the initial mesh has {} nodes, more than max_nodes = {}",
                 guess.x.len(),
-                self.options.max_nodes
+                options.max_nodes
             )));
         }
         Ok(())
     }
 
-    fn scale_for(&self, y: &[f64]) -> Vec<f64> {
+    fn scale_for(&self, y: &[f64], scale: &ResidualScale) -> Vec<f64> {
         let n = self.col.n;
-        match &self.options.scale {
+        match scale {
             ResidualScale::Relative => vec![1.0; n],
             ResidualScale::PerComponent(s) => s.clone(),
             ResidualScale::Auto => {
@@ -336,11 +344,25 @@ impl<'a, P: Bvp> Solver<'a, P> {
         }
     }
 
-    /// Solves the problem with model parameters `params` (length `num_params()`) from `guess`.
+    /// Solves the problem with model parameters `params` (length `num_params()`) from `guess`,
+    /// with the solver's [`options`](Self::options).
     pub fn solve(&mut self, params: &[f64], guess: &Guess) -> Result<Solution, BvpError> {
-        self.validate(params, guess)?;
-        let problem = self.problem;
         let opts = self.options.clone();
+        self.solve_with(params, guess, &opts)
+    }
+
+    /// [`solve`](Self::solve) with `options` for this call only (the solver's own
+    /// [`options`](Self::options) are neither used nor changed): a path that solves its
+    /// intermediate points loosely and its last point tightly passes the two option sets per
+    /// call and keeps one workspace.
+    pub fn solve_with(
+        &mut self,
+        params: &[f64],
+        guess: &Guess,
+        opts: &SolveOptions,
+    ) -> Result<Solution, BvpError> {
+        self.validate(params, guess, opts)?;
+        let problem = self.problem;
         let (n, k) = (self.col.n, self.col.k);
         let bc_tol = opts.bc_tol.unwrap_or(opts.tol);
         let settings = NewtonSettings {
@@ -373,7 +395,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
             self.col.set_mesh(&x);
             let pattern = self.pattern(m)?;
             let mut lin = LinearSystem::new(pattern);
-            let scale = self.scale_for(&y);
+            let scale = self.scale_for(&y, &opts.scale);
             let report = newton(
                 problem,
                 &mut self.col,
@@ -402,7 +424,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
 
             if !opts.adapt {
                 if report.converged {
-                    return self.finish(problem, lin, x, y, p, scale, stats);
+                    return self.finish(problem, lin, x, y, p, scale, stats, opts);
                 }
                 return Err(BvpError::NewtonFailed {
                     iterations: report.iterations,
@@ -451,7 +473,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                         continue;
                     }
                 }
-                return self.finish(problem, lin, x, y, p, scale, stats);
+                return self.finish(problem, lin, x, y, p, scale, stats, opts);
             }
             if iteration >= opts.max_mesh_iterations {
                 return Err(BvpError::ToleranceNotMet {
@@ -476,10 +498,11 @@ impl<'a, P: Bvp> Solver<'a, P> {
         p: Vec<f64>,
         scale: Vec<f64>,
         mut stats: SolveStats,
+        opts: &SolveOptions,
     ) -> Result<Solution, BvpError> {
         let k = self.col.k;
         // `col` holds values at the final iterate (the error estimate used them)
-        let factorization = if self.options.factor_at_solution {
+        let factorization = if opts.factor_at_solution {
             self.col.jacobians(problem, &y, &p, k)?;
             lin.factor(&self.col)?;
             stats.jacobian_factorizations += 1;

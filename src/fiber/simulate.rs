@@ -19,7 +19,7 @@
 //! # Ok::<(), diffbvp::fiber::FiberError>(())
 //! ```
 
-use super::cold_start::{continuation_in_c, ContinuationOptions};
+use super::cold_start::{continuation_in_c, PathOptions};
 use super::contributions::{Balance, NusseltLaw};
 use super::error::FiberError;
 use super::material_law::ViscosityLaw;
@@ -42,7 +42,7 @@ pub struct SimulateOptions {
     /// Nodes of the initial uniform mesh of a cold start (default 21).
     pub initial_nodes: usize,
     /// Continuation settings of a cold start.
-    pub continuation: ContinuationOptions,
+    pub continuation: PathOptions,
     /// Keep the factorised Jacobian at the solution (for sensitivities; default `false`).
     pub factor_at_solution: bool,
     /// Positions \[m\] added as nodes to the mesh of the final solve, e.g. output positions
@@ -58,7 +58,7 @@ impl Default for SimulateOptions {
             max_nodes: 20_000,
             scale: [1e2, 1e4, 1.0, 1e3],
             initial_nodes: 21,
-            continuation: ContinuationOptions::default(),
+            continuation: PathOptions::default(),
             factor_at_solution: false,
             required_positions: Vec::new(),
         }
@@ -295,7 +295,6 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
             .map(|s| s / l_si * model.length())
             .collect();
         let solve_opts = options.solve_options();
-        self.solver.options = solve_opts.clone();
         if let Some(prev) = start {
             if prev.n == 4 && prev.nodes() >= 2 {
                 let guess = if required.is_empty() {
@@ -304,7 +303,7 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
                     let x = insert_required(&prev.x, &required);
                     Guess::from_fn(x, 4, |x, y| prev.eval_into(x, y, &mut [0.0; 4]))
                 };
-                if let Ok(sol) = self.solver.solve(p, &guess) {
+                if let Ok(sol) = self.solver.solve_with(p, &guess, &solve_opts) {
                     return Ok(FiberSolution { solution: sol });
                 }
             }
@@ -312,21 +311,19 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
         let x = linspace(0.0, model.length(), options.initial_nodes);
         let y0 = [model.inlet_velocity(), 0.0, model.inlet_temperature(), 0.0];
         let guess = Guess::constant(x, &y0);
+        let path = &options.continuation;
         if required.is_empty() {
-            let sol = continuation_in_c(&mut self.solver, p, 0, &guess, &options.continuation)?;
+            let sol = continuation_in_c(&mut self.solver, p, 0, &guess, path, &solve_opts)?;
             return Ok(FiberSolution { solution: sol });
         }
         // continuation without the required nodes, then a final solve on a mesh with them
         let mut loose = solve_opts.clone();
-        loose.tol = solve_opts.tol.max(options.continuation.intermediate_tol);
+        loose.tol = solve_opts.tol.max(path.intermediate_tol);
         loose.bc_tol = None;
-        self.solver.options = loose;
-        let sol = continuation_in_c(&mut self.solver, p, 0, &guess, &options.continuation);
-        self.solver.options = solve_opts;
-        let sol = sol?;
+        let sol = continuation_in_c(&mut self.solver, p, 0, &guess, path, &loose)?;
         let x = insert_required(&sol.x, &required);
         let guess = Guess::from_fn(x, 4, |x, y| sol.eval_into(x, y, &mut [0.0; 4]));
-        let sol = self.solver.solve(p, &guess)?;
+        let sol = self.solver.solve_with(p, &guess, &solve_opts)?;
         Ok(FiberSolution { solution: sol })
     }
 }

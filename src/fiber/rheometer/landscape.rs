@@ -2,13 +2,14 @@
 //!
 //! Rows are computed in parallel. Each κ-row is walked from the Newtonian end (largest `n`)
 //! towards smaller `n`; the row starts from the Newtonian solution (`n = 1` does not depend on
-//! κ). Every point is warm-started from a secant predictor: the last two solutions of the row,
-//! extrapolated linearly in `n` onto the newest mesh (about a third fewer Newton iterations than
-//! starting from the neighbour itself). Only costs are evaluated (no sensitivities, no
-//! factorisation kept).
+//! κ). Every point is warm-started from the toolkit's secant predictor
+//! ([`secant_guess`]): the last two solutions of the row, extrapolated linearly in `n` onto the
+//! newest mesh (about a third fewer Newton iterations than starting from the neighbour itself).
+//! Only costs are evaluated (no sensitivities, no factorisation kept).
 //!
-//! Where a point fails, the step from the last good point is halved recursively (once on fine
-//! grids, up to three times on coarse ones); if that fails too, the rest of the row
+//! Where a point fails, the step from the last good point is halved recursively
+//! ([`bisect_step`]; once on fine grids, up to three times on coarse ones); if that fails too,
+//! the rest of the row
 //! (smaller `n`, i.e. stronger strain thinning) is marked `NaN`: there the BVP has no solution,
 //! the strain rate explodes at the take-up, as the paper notes. Approaching that edge the
 //! meshes grow quickly and a failing solve refines until it exceeds its node budget, so the
@@ -20,8 +21,9 @@
 //! ([`PointStatus`]).
 
 use super::identify::{IdentifyOptions, Rheometer, RheometerError};
-use super::objective::Objective;
+use crate::continuation::{bisect_step, secant_guess};
 use crate::solution::Solution;
+use crate::solve::Guess;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -39,47 +41,6 @@ fn retry_bisections(step: f64) -> u32 {
         depth += 1;
     }
     depth
-}
-
-/// Cost at `(to, κ)` reached from the current warm starts (at `from`): directly, or by
-/// recursively halving the step up to `depth` times (giving up early once `cancel` is set).
-fn walk(
-    obj: &mut Objective<'_>,
-    from: f64,
-    to: f64,
-    kappa: f64,
-    depth: u32,
-    cancel: &AtomicBool,
-) -> Result<f64, RheometerError> {
-    if cancel.load(Ordering::Relaxed) {
-        return Err(RheometerError::Data("the landscape was cancelled".into()));
-    }
-    match obj.try_cost_at(to, kappa) {
-        Ok(c) => Ok(c),
-        Err(e) if depth == 0 => Err(e),
-        Err(_) => {
-            let mid = 0.5 * (from + to);
-            walk(obj, from, mid, kappa, depth - 1, cancel)?;
-            walk(obj, mid, to, kappa, depth - 1, cancel)
-        }
-    }
-}
-
-/// Secant predictor: `a + t (a − b)` evaluated on the mesh of `a` (both solutions of the same
-/// experiment at consecutive grid values of `n`, `t = (n_new − n_a) / (n_a − n_b)`).
-fn extrapolate(a: &Solution, b: &Solution, t: f64) -> Solution {
-    let mut out = a.clone();
-    let n = a.n;
-    let (mut yb, mut ypb) = (vec![0.0; n], vec![0.0; n]);
-    for (i, &x) in a.x.iter().enumerate() {
-        b.eval_into(x, &mut yb, &mut ypb);
-        for c in 0..n {
-            let k = i * n + c;
-            out.y[k] = a.y[k] + t * (a.y[k] - yb[c]);
-            out.yp[k] = a.yp[k] + t * (a.yp[k] - ypb[c]);
-        }
-    }
-    out
 }
 
 /// A computed landscape.
@@ -217,22 +178,38 @@ impl Rheometer {
                                 break;
                             }
                             let n = ns[i];
-                            if let Some((nb, sb)) = &before {
-                                let t = (n - last.0) / (last.0 - nb);
-                                if t.is_finite() && t.abs() <= 2.0 {
-                                    let guesses: Vec<Solution> = last
-                                        .1
-                                        .iter()
-                                        .zip(sb)
-                                        .map(|(a, b)| extrapolate(a, b, t))
-                                        .collect();
-                                    obj.set_solutions(&guesses);
-                                }
-                            }
-                            let r = obj.try_cost_at(n, k).or_else(|_| {
-                                // retry from the neighbour itself, bisecting the step
-                                obj.set_solutions(&last.1);
-                                walk(obj, last.0, n, k, retry_bisections(n - last.0), cancel)
+                            let predicted: Option<Vec<Guess>> =
+                                before.as_ref().and_then(|(nb, sb)| {
+                                    let t = (n - last.0) / (last.0 - nb);
+                                    (t.is_finite() && t.abs() <= 2.0).then(|| {
+                                        last.1
+                                            .iter()
+                                            .zip(sb)
+                                            .map(|(a, b)| secant_guess(a, b, t))
+                                            .collect()
+                                    })
+                                });
+                            let first = match &predicted {
+                                Some(guesses) => obj.try_cost_from(n, k, guesses),
+                                None => obj.try_cost_at(n, k),
+                            };
+                            // on failure the warm starts are still the neighbour's solutions:
+                            // retry from them, bisecting the step (giving up early once
+                            // `cancel` is set)
+                            let r = first.or_else(|_| {
+                                bisect_step(
+                                    last.0,
+                                    n,
+                                    retry_bisections(n - last.0),
+                                    &mut |to| obj.try_cost_at(to, k),
+                                    &|| {
+                                        cancel.load(Ordering::Relaxed).then(|| {
+                                            RheometerError::Data(
+                                                "the landscape was cancelled".into(),
+                                            )
+                                        })
+                                    },
+                                )
                             });
                             match r {
                                 Ok(c) => {

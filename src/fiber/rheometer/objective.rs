@@ -173,6 +173,26 @@ impl<'a> Objective<'a> {
         p: &[f64],
         with_jacobian: bool,
     ) -> Result<(Vec<f64>, Vec<f64>), RheometerError> {
+        self.eval_from(p, with_jacobian, None)
+    }
+
+    /// [`eval`](Self::eval) warm-started from `starts` (one per experiment) instead of the
+    /// accepted solutions.
+    fn eval_from(
+        &mut self,
+        p: &[f64],
+        with_jacobian: bool,
+        starts: Option<&[Guess]>,
+    ) -> Result<(Vec<f64>, Vec<f64>), RheometerError> {
+        if let Some(g) = starts {
+            if g.len() != self.runs.len() {
+                return Err(RheometerError::Data(format!(
+                    "{} warm starts for {} experiments",
+                    g.len(),
+                    self.runs.len()
+                )));
+            }
+        }
         let np = p.len();
         let ns = self.layout.num_shared();
         let layout = &self.layout;
@@ -197,9 +217,17 @@ impl<'a> Objective<'a> {
                     source,
                 };
                 let lp = layout.local(&p[..ns], phi, run.model.take_up_factor_index());
+                let own;
+                let guess = match starts {
+                    Some(g) => &g[k],
+                    None => {
+                        own = Guess::from(&run.accepted);
+                        &own
+                    }
+                };
                 let sol = run
                     .solver
-                    .solve(&lp, &Guess::from(&run.accepted))
+                    .solve(&lp, guess)
                     .map_err(|e| err(FiberError::from(e)))?;
                 let (r, jl) = if with_jacobian {
                     let sens = Sensitivities::compute(run.model, &sol)
@@ -323,6 +351,22 @@ impl<'a> Objective<'a> {
     pub fn try_cost_at(&mut self, n: f64, kappa: f64) -> Result<f64, RheometerError> {
         let p = self.global_at(n, kappa);
         let (r, _) = self.eval(&p, false)?;
+        self.accept_pending();
+        Ok(r.iter().map(|v| v * v).sum())
+    }
+
+    /// Cost at `(n, κ)` warm-started from `starts` (one per experiment, e.g. predicted by
+    /// [`secant_guess`](crate::continuation::secant_guess)) instead of the current warm starts;
+    /// on success the solutions become the new warm starts, on failure the warm starts are
+    /// unchanged.
+    pub fn try_cost_from(
+        &mut self,
+        n: f64,
+        kappa: f64,
+        starts: &[Guess],
+    ) -> Result<f64, RheometerError> {
+        let p = self.global_at(n, kappa);
+        let (r, _) = self.eval_from(&p, false, Some(starts))?;
         self.accept_pending();
         Ok(r.iter().map(|v| v * v).sum())
     }
