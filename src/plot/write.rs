@@ -3,14 +3,14 @@
 
 use std::error::Error as StdError;
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::error::{invalid, PlotError};
 use super::fonts::ensure_font;
+use crate::atomic_write::temporary_sibling;
 
 /// Largest accepted figure side, in pixels (guards against huge allocations).
 pub const MAX_SIDE: u32 = 16_384;
@@ -127,21 +127,6 @@ where
     figure.draw(root)?;
     root.present()?;
     Ok(())
-}
-
-/// A fresh temporary path next to `path` with the same extension (`.NAME.tmp-PID-N.EXT`).
-fn temporary_sibling(path: &Path) -> PathBuf {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let name = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "figure".into());
-    let ext = path
-        .extension()
-        .map(|e| format!(".{}", e.to_string_lossy()))
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp-{}-{n}{ext}", std::process::id()))
 }
 
 #[cfg(test)]
