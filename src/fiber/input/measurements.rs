@@ -8,7 +8,8 @@ use super::schema::{MAX_PLAUSIBLE_DIAMETER_M, MIN_PLAUSIBLE_DIAMETER_M};
 use crate::fiber::error::Readable;
 use crate::fiber::setup::Measurements;
 
-/// Minimum number of measurement rows per CSV file used by [`load_experiments`].
+/// Minimum number of measurement rows per CSV file used by
+/// [`load_experiments`](super::load_experiments).
 pub const DEFAULT_MIN_POINTS: usize = 4;
 
 /// The required CSV header (column names carry the unit: metres).
