@@ -76,7 +76,8 @@ impl<'a> Heatmap<'a> {
 /// `.svg`).
 ///
 /// Errors if the grid is empty or not finite and strictly monotonic, if `values` does not have
-/// `xs.len() * ys.len()` entries, or if the size is 0 or larger than [`MAX_SIDE`](super::MAX_SIDE).
+/// `xs.len() * ys.len()` entries, or if the size is 0 or larger than
+/// [`MAX_SIDE`](super::MAX_SIDE).
 pub fn save_heatmap(path: &Path, heatmap: &Heatmap<'_>) -> Result<(), PlotError> {
     let hm = heatmap;
     for (name, c, log) in [("xs", hm.xs, hm.log_x), ("ys", hm.ys, hm.log_y)] {
