@@ -55,6 +55,8 @@
 #![warn(missing_docs)]
 // Numerical kernels index several arrays with the same loop variable, as the formulas do.
 #![allow(clippy::needless_range_loop)]
+#[cfg(feature = "plots")]
+mod atomic_write;
 mod collocation;
 pub mod continuation;
 mod dual_jacobian;

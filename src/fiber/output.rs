@@ -13,7 +13,6 @@ use super::simulate::Profiles;
 use std::fs;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use thiserror::Error;
 
 /// Writing an output failed.
@@ -177,21 +176,7 @@ pub fn create_output_dir(dir: &Path, inputs: &[PathBuf]) -> Result<(), OutputErr
     create_dir(dir)
 }
 
-/// A fresh temporary path next to `path`: `.NAME.tmp-PID-N` followed by `path`'s extension
-/// (so that writers choosing the format by extension still work).
-pub fn temporary_sibling(path: &Path) -> PathBuf {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let name = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "output".into());
-    let ext = path
-        .extension()
-        .map(|e| format!(".{}", e.to_string_lossy()))
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp-{}-{n}{ext}", std::process::id()))
-}
+pub use crate::atomic_write::temporary_sibling;
 
 /// Writes `path` atomically: `write` fills a temporary sibling (see [`temporary_sibling`]),
 /// which is then renamed over `path`. Refuses an input first ([`ensure_not_input`]). On any
