@@ -1,32 +1,4 @@
 //! [`BvpResiduals`]: a [`LeastSquaresProblem`] whose residuals come from BVP solves.
-//!
-//! A fit has parameters `p ∈ ℝⁿᵖ` and one or more *runs* (experiments, data sets). Run `k` is a
-//! BVP `y' = f(x, y, q_k)`, `g(y(a), y(b), q_k) = 0` with model parameters `q_k = M_k(p)` (an
-//! affine [`ParamMap`]), observation points `x_{k,j}` and residuals
-//!
-//! ```text
-//! r_{k,j}(p) = g_k(j, x_{k,j}, y_k(x_{k,j}; q_k), (u_k, q_k))
-//! ```
-//!
-//! (`g_k` a [`PointFunction`], `u_k` the unknown parameters of the BVP). The residual vector is
-//! the concatenation of the runs' residuals, in run order. Its Jacobian is exact, by the chain
-//! rule through the forward [`Sensitivities`] `D_q Y` of each solution (dual numbers and one
-//! linear solve with the factorisation kept by the solve, never finite differences):
-//!
-//! ```text
-//! ∂r_{k,j}/∂p_i = Σ_{links l of run k with fit index i} scale_l · (dr_{k,j}/dq)_{model index of l}
-//! ```
-//!
-//! Each run keeps a warm-started [`Solver`] and two solutions: the *accepted* one (the solution
-//! at the current iterate of the fit, the warm start of every evaluation) and a *pending* one (the
-//! solution at the last evaluated trial point). [`LeastSquaresProblem::accept`] promotes the
-//! pending solutions; a rejected trial step leaves the accepted ones alone, so a bad trial point
-//! never spoils the warm start. A BVP that does not converge at a trial point is a failed
-//! evaluation ([`RunError`] naming the run): the driver rejects the step and shrinks its trust
-//! region.
-//!
-//! With the `parallel` cargo feature (on with `rheometer`) the runs are solved in parallel
-//! (rayon); without it, one after the other. The results are the same either way.
 
 use super::LeastSquaresProblem;
 use crate::error::BvpError;
@@ -301,9 +273,36 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
     }
 }
 
-/// A [`LeastSquaresProblem`] over BVP runs (see the [module](self) documentation for the math):
-/// residuals of every run at the fit parameters `p`, exact Jacobian from forward sensitivities,
-/// warm starts from the last accepted solutions.
+/// A [`LeastSquaresProblem`] over BVP runs: residuals of every run at the fit parameters `p`,
+/// exact Jacobian from forward sensitivities, warm starts from the last accepted solutions.
+///
+/// A fit has parameters `p ∈ ℝⁿᵖ` and one or more *runs* (experiments, data sets). Run `k` is a
+/// BVP `y' = f(x, y, q_k)`, `g(y(a), y(b), q_k) = 0` with model parameters `q_k = M_k(p)` (an
+/// affine [`ParamMap`]), observation points `x_{k,j}` and residuals
+///
+/// ```text
+/// r_{k,j}(p) = g_k(j, x_{k,j}, y_k(x_{k,j}; q_k), (u_k, q_k))
+/// ```
+///
+/// (`g_k` a [`PointFunction`], `u_k` the unknown parameters of the BVP). The residual vector is
+/// the concatenation of the runs' residuals, in run order. Its Jacobian is exact, by the chain
+/// rule through the forward [`Sensitivities`] `D_q Y` of each solution (dual numbers and one
+/// linear solve with the factorisation kept by the solve, never finite differences):
+///
+/// ```text
+/// ∂r_{k,j}/∂p_i = Σ_{links l of run k with fit index i} scale_l · (dr_{k,j}/dq)_{model index of l}
+/// ```
+///
+/// Each run keeps a warm-started [`Solver`] and two solutions: the *accepted* one (the solution
+/// at the current iterate of the fit, the warm start of every evaluation) and a *pending* one (the
+/// solution at the last evaluated trial point). [`LeastSquaresProblem::accept`] promotes the
+/// pending solutions; a rejected trial step leaves the accepted ones alone, so a bad trial point
+/// never spoils the warm start. A BVP that does not converge at a trial point is a failed
+/// evaluation ([`RunError`] naming the run): the driver rejects the step and shrinks its trust
+/// region.
+///
+/// With the `parallel` cargo feature (on with `rheometer`) the runs are solved in parallel
+/// (rayon); without it, one after the other. The results are the same either way.
 ///
 /// ```
 /// use diffbvp::least_squares::{fit, BvpResiduals, BvpRun, FitOptions, ParamMap};
