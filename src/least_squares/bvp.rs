@@ -115,7 +115,9 @@ impl ParamMap {
 }
 
 /// A failed evaluation of a [`BvpResiduals`]: the run whose BVP solve (or sensitivity or residual
-/// evaluation) failed, and why.
+/// evaluation) failed, and why. With runs solved in parallel and several failing, one of them.
+/// Input errors that concern no single run (a parameter vector of the wrong length) name run 0;
+/// a wrong number of warm starts names the first run without one.
 #[derive(Debug, Clone, thiserror::Error)]
 #[error("run {run}: {source}")]
 pub struct RunError {
