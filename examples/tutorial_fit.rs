@@ -9,10 +9,12 @@
 // `tests/book_examples.rs` includes this file as a module and checks `run()`'s numbers.
 #![allow(dead_code)]
 
-use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem};
+use diffbvp::least_squares::{
+    fit_observed, BvpResiduals, BvpRun, FitIteration, FitOptions, ParamMap,
+};
 use diffbvp::mesh::linspace;
-use diffbvp::sensitivity::{adjoint_gradient, residual_jacobian, PointFunction, Sensitivities};
-use diffbvp::{Bvp, BvpError, DualNum, Guess, Solution, SolveOptions, Solver};
+use diffbvp::sensitivity::{adjoint_gradient, PointFunction, Sensitivities};
+use diffbvp::{Bvp, DualNum, Guess, SolveOptions, Solver};
 
 // ANCHOR: problem
 /// y'' = −a e^y, y(0) = b, y(1) = 0 with model parameters p = (a, b).
@@ -49,43 +51,13 @@ impl PointFunction for Square {
 
 // ANCHOR: misfit
 /// The residual r_j = y(x_j) − data_j.
-struct Misfit<'a> {
-    data: &'a [f64],
+struct Misfit {
+    data: Vec<f64>,
 }
 
-impl PointFunction for Misfit<'_> {
+impl PointFunction for Misfit {
     fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], _p: &[D]) -> D {
         y[0] - self.data[j]
-    }
-}
-
-/// The fit: residuals and their exact Jacobian from one solve and one sensitivity solve, warm
-/// started from the last accepted point.
-struct BvpFit<'a> {
-    solver: Solver<'a, BratuAB>,
-    xs: Vec<f64>,
-    data: Vec<f64>,
-    accepted: Solution,
-    pending: Option<Solution>,
-}
-
-impl LeastSquaresProblem for BvpFit<'_> {
-    type Error = BvpError;
-    fn num_params(&self) -> usize {
-        2
-    }
-    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), BvpError> {
-        let sol = self.solver.solve(p, &Guess::from(&self.accepted))?;
-        let sens = Sensitivities::compute(&BratuAB, &sol)?;
-        let misfit = Misfit { data: &self.data };
-        let out = residual_jacobian(&BratuAB, &sol, &sens, &self.xs, &misfit)?;
-        self.pending = Some(sol);
-        Ok(out)
-    }
-    fn accept(&mut self, _p: &[f64]) {
-        if let Some(s) = self.pending.take() {
-            self.accepted = s;
-        }
     }
 }
 // ANCHOR_END: misfit
@@ -173,21 +145,27 @@ pub fn run() -> Result<FitSummary, Box<dyn std::error::Error>> {
         .map(|(j, &x)| truth.eval(x)[0] + noise(j))
         .collect();
     let start = [0.5, 0.0];
-    let accepted = solver.solve(&start, &guess)?;
-    let mut problem = BvpFit {
-        solver,
-        xs: xs.clone(),
-        data,
-        accepted,
-        pending: None,
-    };
+    let accepted = solver.solve(&start, &guess)?; // the first warm start
+                                                  // the model parameters (a, b) are the fit parameters (p₀, p₁)
+    let map = ParamMap::new(vec![0.0; 2]).link(0, 0).link(1, 1);
+    let run = BvpRun::new(solver, accepted, xs.clone(), Misfit { data }, map)?;
+    let mut problem = BvpResiduals::new(2).with_run(run)?;
     let bounds = FitOptions::with_bounds(vec![0.0, -1.0], vec![3.0, 1.0]);
-    let result = fit(&mut problem, &start, &bounds)?;
+    let mut progress = |it: &FitIteration| {
+        let cost = it.cost.map_or("failed".into(), |c| format!("{c:.3e}"));
+        let verdict = if it.accepted { "accepted" } else { "rejected" };
+        println!(
+            "  step {:>2}: cost {cost}, {verdict}, radius {:.3}",
+            it.iteration, it.radius
+        );
+    };
+    println!("\nfit from (0.5, 0):");
+    let result = fit_observed(&mut problem, &start, &bounds, &mut progress)?;
     let se = result
         .standard_errors()
         .ok_or("singular Jacobian at the optimum")?;
     println!(
-        "\nfit from (0.5, 0): a = {:.5} ± {:.5}, b = {:.5} ± {:.5}",
+        "a = {:.5} ± {:.5}, b = {:.5} ± {:.5}",
         result.p[0], se[0], result.p[1], se[1]
     );
     println!(

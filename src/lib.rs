@@ -47,11 +47,12 @@
 //!
 //! | feature | default | what it adds |
 //! |---|---|---|
+//! | `parallel` | yes (through `rheometer`) | [`least_squares::BvpResiduals`] solves its runs in parallel (rayon) |
 //! | `plots` | yes | [`plot`]: PNG/SVG figures through plotters (shipped font, no system fonts) |
 //! | `rheometer` | yes | `fiber`: the fiber-spinning model, the rheometer, TOML/CSV input, the `rheometer` program (implies `plots`) |
 //!
 //! The toolkit alone (`default-features = false`) depends on num-dual, faer, nalgebra,
-//! num-traits and thiserror only.
+//! num-traits and thiserror only (plus rayon with `parallel`).
 #![warn(missing_docs)]
 // Numerical kernels index several arrays with the same loop variable, as the formulas do.
 #![allow(clippy::needless_range_loop)]

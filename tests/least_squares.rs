@@ -1,10 +1,12 @@
 #![allow(clippy::needless_range_loop)]
 //! The bounded trust-region Gauss–Newton driver on BVP parameter fits.
 
-use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem, Termination};
+use diffbvp::least_squares::{
+    fit, fit_observed, BvpResiduals, BvpRun, FitIteration, FitOptions, ParamMap, Termination,
+};
 use diffbvp::mesh::linspace;
-use diffbvp::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
-use diffbvp::{Bvp, BvpError, DualNum, Guess, Solution, SolveOptions, Solver};
+use diffbvp::sensitivity::PointFunction;
+use diffbvp::{Bvp, DualNum, Guess, SolveOptions, Solver};
 
 /// y'' = -a e^y, y(0) = b, y(1) = 0 with model parameters (a, b).
 struct BratuAB;
@@ -26,50 +28,19 @@ impl Bvp for BratuAB {
 }
 
 /// r_j = y(x_j) - data_j
-struct Misfit<'a> {
-    data: &'a [f64],
+struct Misfit {
+    data: Vec<f64>,
 }
-impl PointFunction for Misfit<'_> {
+impl PointFunction for Misfit {
     fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], _p: &[D]) -> D {
         y[0] - self.data[j]
     }
 }
 
-struct BvpFit<'a> {
-    solver: Solver<'a, BratuAB>,
-    xs: Vec<f64>,
-    data: Vec<f64>,
-    accepted: Solution,
-    pending: Option<Solution>,
-}
+/// The fit of (a, b) to y at 19 points: one run, model parameters = fit parameters.
+type BvpFit = BvpResiduals<'static, BratuAB, Misfit>;
 
-impl LeastSquaresProblem for BvpFit<'_> {
-    type Error = BvpError;
-    fn num_params(&self) -> usize {
-        2
-    }
-    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), BvpError> {
-        // warm start from the last accepted solution
-        let sol = self.solver.solve(p, &Guess::from(&self.accepted))?;
-        let sens = Sensitivities::compute(&BratuAB, &sol)?;
-        let out = residual_jacobian(
-            &BratuAB,
-            &sol,
-            &sens,
-            &self.xs,
-            &Misfit { data: &self.data },
-        )?;
-        self.pending = Some(sol);
-        Ok(out)
-    }
-    fn accept(&mut self, _p: &[f64]) {
-        if let Some(s) = self.pending.take() {
-            self.accepted = s;
-        }
-    }
-}
-
-fn make_fit(truth: [f64; 2], start: [f64; 2]) -> BvpFit<'static> {
+fn make_fit(truth: [f64; 2], start: [f64; 2]) -> BvpFit {
     let opts = SolveOptions::with_tol(1e-8);
     let mut solver = Solver::new(&BratuAB, opts);
     let g = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
@@ -77,13 +48,9 @@ fn make_fit(truth: [f64; 2], start: [f64; 2]) -> BvpFit<'static> {
     let truth_sol = solver.solve(&truth, &g).unwrap();
     let data: Vec<f64> = xs.iter().map(|&x| truth_sol.eval(x)[0]).collect();
     let accepted = solver.solve(&start, &g).unwrap();
-    BvpFit {
-        solver,
-        xs,
-        data,
-        accepted,
-        pending: None,
-    }
+    let map = ParamMap::new(vec![0.0; 2]).link(0, 0).link(1, 1);
+    let run = BvpRun::new(solver, accepted, xs, Misfit { data }, map).unwrap();
+    BvpResiduals::new(2).with_run(run).unwrap()
 }
 
 #[test]
@@ -132,4 +99,38 @@ fn bad_start_is_an_error() {
     let opts = FitOptions::with_bounds(vec![0.0, -1.0], vec![3.0, 1.0]);
     assert!(fit(&mut prob, &[5.0, 0.0], &opts).is_err());
     assert!(fit(&mut prob, &[0.5], &opts).is_err());
+}
+
+#[test]
+fn observer_sees_every_iteration() {
+    let mut prob = make_fit([1.7, 0.4], [0.5, 0.0]);
+    let opts = FitOptions::with_bounds(vec![0.0, -1.0], vec![3.0, 1.0]);
+    let mut seen: Vec<FitIteration> = Vec::new();
+    let res = fit_observed(&mut prob, &[0.5, 0.0], &opts, &mut |it: &FitIteration| {
+        seen.push(it.clone())
+    })
+    .unwrap();
+    assert_eq!(seen.len(), res.iterations);
+    assert_eq!(res.history.len(), res.iterations);
+    for (k, (a, b)) in seen.iter().zip(&res.history).enumerate() {
+        assert_eq!(a.iteration, k + 1);
+        assert_eq!(a.p, b.p);
+        assert_eq!(a.cost, b.cost);
+    }
+    assert_eq!(
+        seen.iter().filter(|h| h.accepted).count(),
+        res.accepted_steps
+    );
+    // the accepted costs decrease
+    let costs: Vec<f64> = seen
+        .iter()
+        .filter(|h| h.accepted)
+        .filter_map(|h| h.cost)
+        .collect();
+    assert!(costs.windows(2).all(|w| w[1] < w[0]), "{costs:?}");
+    // the same fit without an observer
+    let mut prob2 = make_fit([1.7, 0.4], [0.5, 0.0]);
+    let res2 = fit(&mut prob2, &[0.5, 0.0], &opts).unwrap();
+    assert_eq!(res.p, res2.p);
+    assert_eq!(res.iterations, res2.iterations);
 }

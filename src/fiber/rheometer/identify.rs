@@ -264,7 +264,7 @@ impl Rheometer {
             ..FitOptions::with_bounds(lower.clone(), upper.clone())
         };
         let fit_result = fit(&mut obj, &p0, &fo)?;
-        let solutions: Vec<Solution> = obj.runs.iter().map(|r| r.accepted.clone()).collect();
+        let solutions: Vec<Solution> = obj.solutions();
         let rms = self.rms_relative_residual(&solutions);
         let ns = obj.layout.num_shared();
         let residual_profiles = solutions

@@ -9,34 +9,67 @@ use super::identify::{CarreauFiber, IdentifyOptions, Rheometer, RheometerError};
 use super::layout::{FitStart, Layout};
 use crate::fiber::error::FiberError;
 use crate::fiber::simulate::simulate_params;
-use crate::least_squares::LeastSquaresProblem;
-use crate::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
+use crate::least_squares::{BvpResiduals, BvpRun, LeastSquaresProblem, ParamMap, RunError};
+use crate::sensitivity::PointFunction;
 use crate::solution::Solution;
 use crate::solve::{Guess, Solver};
+use num_dual::DualNum;
 use rayon::prelude::*;
 
-/// Residuals and row-major Jacobian of one experiment.
-type ResidualsAndJacobian = (Vec<f64>, Vec<f64>);
-
-pub(super) struct Run<'a> {
-    model: &'a CarreauFiber,
-    solver: Solver<'a, CarreauFiber>,
-    pub(super) accepted: Solution,
-    pending: Option<Solution>,
-    /// Evaluation points (dimensionless `s̃`).
-    points: Vec<f64>,
-    /// Paper: `d_fit` at the points; principled: measured diameters (dimensionless).
-    targets: Vec<f64>,
-    sqrt_delta: Vec<f64>,
-    name: String,
+/// The residual of one experiment at its evaluation points: the estimator's residual with the
+/// experiment's data (owned, so that a [`BvpRun`] can hold it).
+pub(super) enum FiberResidual<'a> {
+    /// [`PaperResidual`]: `√Δ_j` and `d_fit(s_j)` (dimensionless).
+    Paper {
+        model: &'a CarreauFiber,
+        sqrt_delta: Vec<f64>,
+        d_fit: Vec<f64>,
+    },
+    /// [`RelativeResidual`]: measured diameters (dimensionless) and `σ`.
+    Relative {
+        model: &'a CarreauFiber,
+        d_meas: Vec<f64>,
+        sigma: f64,
+    },
 }
 
-/// The least-squares objective of the rheometer over all experiments.
+impl PointFunction for FiberResidual<'_> {
+    #[inline]
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, x: f64, y: &[D], p: &[D]) -> D {
+        match self {
+            FiberResidual::Paper {
+                model,
+                sqrt_delta,
+                d_fit,
+            } => PaperResidual {
+                model: *model,
+                sqrt_delta,
+                d_fit,
+            }
+            .eval(j, x, y, p),
+            FiberResidual::Relative {
+                model,
+                d_meas,
+                sigma,
+            } => RelativeResidual {
+                model: *model,
+                d_meas,
+                sigma: *sigma,
+            }
+            .eval(j, x, y, p),
+        }
+    }
+}
+
+/// The least-squares objective of the rheometer over all experiments: a [`BvpResiduals`] with
+/// one run per experiment (the local parameters `[c, n, κ, strengths..., φ]` of experiment `k`
+/// map the shared free parameters and, for the principled estimator, `φ_k`), plus the
+/// rheometer's parameter layout and error reporting.
 pub struct Objective<'a> {
     estimator: Estimator,
-    pub(super) runs: Vec<Run<'a>>,
+    pub(super) runs: BvpResiduals<'a, CarreauFiber, FiberResidual<'a>>,
+    names: Vec<String>,
     options: IdentifyOptions,
-    sigma: f64,
     pub(super) layout: Layout,
 }
 
@@ -67,66 +100,116 @@ impl<'a> Objective<'a> {
             .relative_uncertainty
             .or(rheo.relative_uncertainty)
             .unwrap_or(1.0);
-        let runs: Result<Vec<Run<'a>>, RheometerError> = rheo
+        let estimator = options.estimator;
+        let ns = layout.num_shared();
+        let runs: Result<Vec<BvpRun<'a, CarreauFiber, FiberResidual<'a>>>, RheometerError> = rheo
             .models
             .par_iter()
             .enumerate()
             .map(|(k, model)| {
-                let p = layout.local(&shared0, 1.0, model.take_up_factor_index());
+                let phi_idx = model.take_up_factor_index();
+                let p = layout.local(&shared0, 1.0, phi_idx);
                 let warm = fit_start.warm.as_ref().map(|w| &w[k]);
-                let sol =
-                    simulate_params(model, &p, warm, &options.simulate).map_err(|source| {
-                        RheometerError::Simulation {
-                            experiment: rheo.experiments[k].name.clone(),
-                            n: start[0],
-                            kappa: start[1],
-                            source,
-                        }
-                    })?;
+                let sim_err = |source: FiberError| RheometerError::Simulation {
+                    experiment: rheo.experiments[k].name.clone(),
+                    n: start[0],
+                    kappa: start[1],
+                    source,
+                };
+                let sol = simulate_params(model, &p, warm, &options.simulate).map_err(&sim_err)?;
                 let lo = model.scaling.reference.length;
                 let dd = model.scaling.diameter();
                 let length = rheo.experiments[k].spinline_length;
-                let (points, targets, sqrt_delta) = match options.estimator {
+                let (points, residual) = match estimator {
                     Estimator::Paper => {
                         let no = options.n_opt_points;
                         let delta = length / no as f64;
                         let s: Vec<f64> = (1..=no).map(|i| i as f64 * delta).collect();
                         (
                             s.iter().map(|v| v / lo).collect(),
-                            s.iter()
-                                .map(|&v| rheo.smoothing[k].diameter(v) / dd)
-                                .collect(),
-                            vec![(delta / lo).sqrt(); no],
+                            FiberResidual::Paper {
+                                model,
+                                sqrt_delta: vec![(delta / lo).sqrt(); no],
+                                d_fit: s
+                                    .iter()
+                                    .map(|&v| rheo.smoothing[k].diameter(v) / dd)
+                                    .collect(),
+                            },
                         )
                     }
                     Estimator::Principled => {
                         let m = &rheo.measurements[k];
                         (
                             m.positions.iter().map(|v| v / lo).collect(),
-                            m.diameters.iter().map(|v| v / dd).collect(),
-                            Vec::new(),
+                            FiberResidual::Relative {
+                                model,
+                                d_meas: m.diameters.iter().map(|v| v / dd).collect(),
+                                sigma,
+                            },
                         )
                     }
                 };
-                Ok(Run {
-                    model,
-                    solver: Solver::new(model, options.simulate.solve_options()),
-                    accepted: sol.solution,
-                    pending: None,
+                let map = Self::param_map(&layout, estimator, ns, k, phi_idx);
+                BvpRun::new(
+                    Solver::new(model, options.simulate.solve_options()),
+                    sol.solution,
                     points,
-                    targets,
-                    sqrt_delta,
-                    name: rheo.experiments[k].name.clone(),
-                })
+                    residual,
+                    map,
+                )
+                .map_err(|e| sim_err(FiberError::from(e)))
             })
             .collect();
+        let num_params = match estimator {
+            Estimator::Paper => ns,
+            Estimator::Principled => ns + rheo.len(),
+        };
+        let mut fit = BvpResiduals::new(num_params);
+        for run in runs? {
+            fit.push(run)
+                .map_err(|e| RheometerError::Data(format!("parameter layout: {e}")))?;
+        }
         Ok(Objective {
-            estimator: options.estimator,
-            runs: runs?,
+            estimator,
+            runs: fit,
+            names: rheo.experiments.iter().map(|e| e.name.clone()).collect(),
             options: options.clone(),
-            sigma,
             layout,
         })
+    }
+
+    /// Experiment `k`'s local parameters `[c, n, κ, strengths..., φ]` as a map of the fit
+    /// parameters `[shared free..., φ_1, ..., φ_M]`: the template, the shared free parameters
+    /// linked to their columns, `φ = 1` (paper) or linked to column `ns + k` (principled).
+    fn param_map(
+        layout: &Layout,
+        estimator: Estimator,
+        ns: usize,
+        k: usize,
+        phi_idx: usize,
+    ) -> ParamMap {
+        let mut base = layout.template.clone();
+        base[phi_idx] = 1.0;
+        let mut map = ParamMap::new(base);
+        for (c, &li) in layout.free.iter().enumerate() {
+            map = map.link(li, c);
+        }
+        if estimator == Estimator::Principled {
+            map = map.link(phi_idx, ns + k);
+        }
+        map
+    }
+
+    /// Copies the layout's template (changed by [`global_at`](Self::global_at)) into the runs'
+    /// parameter maps.
+    fn sync_maps(&mut self) {
+        let template = &self.layout.template;
+        for run in self.runs.runs_mut() {
+            let phi_idx = run.problem().take_up_factor_index();
+            let base = &mut run.map_mut().base;
+            base.copy_from_slice(template);
+            base[phi_idx] = 1.0;
+        }
     }
 
     /// The parameter layout of this objective.
@@ -147,6 +230,7 @@ impl<'a> Objective<'a> {
     fn global_at(&mut self, n: f64, kappa: f64) -> Vec<f64> {
         self.layout.template[1] = n;
         self.layout.template[2] = kappa;
+        self.sync_maps();
         self.initial_parameters()
     }
 
@@ -164,6 +248,26 @@ impl<'a> Objective<'a> {
             ));
         }
         (lo, hi)
+    }
+
+    /// `(n, κ)` at global parameters `p` (for error messages).
+    fn law_at(&self, p: &[f64]) -> (f64, f64) {
+        let ns = self.layout.num_shared();
+        let probe = self
+            .layout
+            .local(&p[..ns], 1.0, self.layout.template.len() - 1);
+        (probe[1], probe[2])
+    }
+
+    /// A failed run as the rheometer's error (naming the experiment).
+    fn run_error(&self, p: &[f64], e: RunError) -> RheometerError {
+        let (n, kappa) = self.law_at(p);
+        RheometerError::Simulation {
+            experiment: self.names[e.run.min(self.names.len() - 1)].clone(),
+            n,
+            kappa,
+            source: FiberError::from(e.source),
+        }
     }
 
     /// Residuals (and the Jacobian if `with_jacobian`) at global parameters `p`; the solutions
@@ -193,120 +297,9 @@ impl<'a> Objective<'a> {
                 )));
             }
         }
-        let np = p.len();
-        let ns = self.layout.num_shared();
-        let layout = &self.layout;
-        let probe = layout.local(&p[..ns], 1.0, layout.template.len() - 1);
-        let (n, kappa) = (probe[1], probe[2]);
-        let estimator = self.estimator;
-        let sigma = self.sigma;
-        let parts: Result<Vec<ResidualsAndJacobian>, RheometerError> = self
-            .runs
-            .par_iter_mut()
-            .enumerate()
-            .map(|(k, run)| {
-                let phi = if estimator == Estimator::Principled {
-                    p[ns + k]
-                } else {
-                    1.0
-                };
-                let err = |source: FiberError| RheometerError::Simulation {
-                    experiment: run.name.clone(),
-                    n,
-                    kappa,
-                    source,
-                };
-                let lp = layout.local(&p[..ns], phi, run.model.take_up_factor_index());
-                let own;
-                let guess = match starts {
-                    Some(g) => &g[k],
-                    None => {
-                        own = Guess::from(&run.accepted);
-                        &own
-                    }
-                };
-                let sol = run
-                    .solver
-                    .solve(&lp, guess)
-                    .map_err(|e| err(FiberError::from(e)))?;
-                let (r, jl) = if with_jacobian {
-                    let sens = Sensitivities::compute(run.model, &sol)
-                        .map_err(|e| err(FiberError::from(e)))?;
-                    match estimator {
-                        Estimator::Paper => residual_jacobian(
-                            run.model,
-                            &sol,
-                            &sens,
-                            &run.points,
-                            &PaperResidual {
-                                model: run.model,
-                                sqrt_delta: &run.sqrt_delta,
-                                d_fit: &run.targets,
-                            },
-                        ),
-                        Estimator::Principled => residual_jacobian(
-                            run.model,
-                            &sol,
-                            &sens,
-                            &run.points,
-                            &RelativeResidual {
-                                model: run.model,
-                                d_meas: &run.targets,
-                                sigma,
-                            },
-                        ),
-                    }
-                    .map_err(|e| err(FiberError::from(e)))?
-                } else {
-                    let r = match estimator {
-                        Estimator::Paper => values(
-                            &sol,
-                            &run.points,
-                            &PaperResidual {
-                                model: run.model,
-                                sqrt_delta: &run.sqrt_delta,
-                                d_fit: &run.targets,
-                            },
-                        ),
-                        Estimator::Principled => values(
-                            &sol,
-                            &run.points,
-                            &RelativeResidual {
-                                model: run.model,
-                                d_meas: &run.targets,
-                                sigma,
-                            },
-                        ),
-                    };
-                    (r, Vec::new())
-                };
-                // map local parameter columns (c, n, κ, strengths, φ) to global ones
-                let q = lp.len();
-                let phi_idx = run.model.take_up_factor_index();
-                let mut jg = Vec::new();
-                if with_jacobian {
-                    jg = vec![0.0; r.len() * np];
-                    for i in 0..r.len() {
-                        for (c, &li) in layout.free.iter().enumerate() {
-                            jg[i * np + c] = jl[i * q + li];
-                        }
-                        if estimator == Estimator::Principled {
-                            jg[i * np + ns + k] = jl[i * q + phi_idx];
-                        }
-                    }
-                }
-                run.pending = Some(sol);
-                Ok((r, jg))
-            })
-            .collect();
-        let parts = parts?;
-        let mut r = Vec::new();
-        let mut j = Vec::new();
-        for (ri, ji) in parts {
-            r.extend(ri);
-            j.extend(ji);
-        }
-        Ok((r, j))
+        self.runs
+            .evaluate_from(p, with_jacobian, starts)
+            .map_err(|e| self.run_error(p, e))
     }
 
     /// The cost `J = Σ r²` at `(n, κ)` with take-up factors 1, accepting the solutions as new
@@ -317,32 +310,32 @@ impl<'a> Objective<'a> {
             Ok((r, _)) => r,
             Err(_) => {
                 // cold starts
-                let opts = self.options.simulate.clone();
-                let layout = &self.layout;
-                let ns = layout.num_shared();
-                let res: Result<Vec<()>, RheometerError> = self
-                    .runs
-                    .par_iter_mut()
-                    .map(|run| {
-                        let lp = layout.local(&p[..ns], 1.0, run.model.take_up_factor_index());
-                        let sol =
-                            simulate_params(run.model, &lp, None, &opts).map_err(|source| {
-                                RheometerError::Simulation {
-                                    experiment: run.name.clone(),
+                let opts = &self.options.simulate;
+                let names = &self.names;
+                let res: Result<Vec<()>, RheometerError> =
+                    self.runs
+                        .runs_mut()
+                        .par_iter_mut()
+                        .enumerate()
+                        .map(|(k, run)| {
+                            let lp = run.map().model_params(&p);
+                            let sol = simulate_params(run.problem(), &lp, None, opts).map_err(
+                                |source| RheometerError::Simulation {
+                                    experiment: names[k].clone(),
                                     n,
                                     kappa,
                                     source,
-                                }
-                            })?;
-                        run.accepted = sol.solution;
-                        Ok(())
-                    })
-                    .collect();
+                                },
+                            )?;
+                            run.set_accepted(sol.solution);
+                            Ok(())
+                        })
+                        .collect();
                 res?;
                 self.eval(&p, false)?.0
             }
         };
-        self.accept_pending();
+        self.runs.accept_pending();
         Ok(r.iter().map(|v| v * v).sum())
     }
 
@@ -351,7 +344,7 @@ impl<'a> Objective<'a> {
     pub fn try_cost_at(&mut self, n: f64, kappa: f64) -> Result<f64, RheometerError> {
         let p = self.global_at(n, kappa);
         let (r, _) = self.eval(&p, false)?;
-        self.accept_pending();
+        self.runs.accept_pending();
         Ok(r.iter().map(|v| v * v).sum())
     }
 
@@ -367,56 +360,30 @@ impl<'a> Objective<'a> {
     ) -> Result<f64, RheometerError> {
         let p = self.global_at(n, kappa);
         let (r, _) = self.eval_from(&p, false, Some(starts))?;
-        self.accept_pending();
+        self.runs.accept_pending();
         Ok(r.iter().map(|v| v * v).sum())
     }
 
     /// The current warm-start solutions, one per experiment.
     pub fn solutions(&self) -> Vec<Solution> {
-        self.runs.iter().map(|r| r.accepted.clone()).collect()
+        self.runs.solutions()
     }
 
     /// Replaces the warm-start solutions (same order as [`solutions`](Self::solutions)).
     pub fn set_solutions(&mut self, sols: &[Solution]) {
-        for (r, s) in self.runs.iter_mut().zip(sols) {
-            r.accepted = s.clone();
-        }
+        self.runs.set_solutions(sols);
     }
-
-    fn accept_pending(&mut self) {
-        for run in &mut self.runs {
-            if let Some(s) = run.pending.take() {
-                run.accepted = s;
-            }
-        }
-    }
-}
-
-fn values<G: PointFunction>(sol: &Solution, xs: &[f64], g: &G) -> Vec<f64> {
-    let p = sol.full_params();
-    let mut y = [0.0; 4];
-    let mut yp = [0.0; 4];
-    xs.iter()
-        .enumerate()
-        .map(|(j, &x)| {
-            sol.eval_into(x, &mut y, &mut yp);
-            g.eval(j, x, &y, &p)
-        })
-        .collect()
 }
 
 impl LeastSquaresProblem for Objective<'_> {
     type Error = RheometerError;
     fn num_params(&self) -> usize {
-        match self.estimator {
-            Estimator::Paper => self.layout.num_shared(),
-            Estimator::Principled => self.layout.num_shared() + self.runs.len(),
-        }
+        self.runs.num_params()
     }
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), RheometerError> {
         self.eval(p, true)
     }
     fn accept(&mut self, _p: &[f64]) {
-        self.accept_pending();
+        self.runs.accept_pending();
     }
 }

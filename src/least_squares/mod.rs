@@ -15,6 +15,17 @@
 //!
 //! The problem keeps its own state (warm starts): [`LeastSquaresProblem::evaluate`] is called at
 //! trial points, [`LeastSquaresProblem::accept`] when a trial point is accepted.
+//!
+//! For the common case — residuals of one or more BVPs at observation points, the model
+//! parameters of each BVP an affine function of the fit parameters — [`BvpResiduals`] is a ready
+//! [`LeastSquaresProblem`]: warm-started solvers, exact Jacobians from forward sensitivities, a
+//! rejected trial point leaving the warm starts alone. [`fit_observed`] reports every iteration
+//! to an [`Observer`] (progress bars, logs, early inspection); [`FitResult::history`] keeps the
+//! same records.
+
+mod bvp;
+
+pub use bvp::{BvpResiduals, BvpRun, ParamLink, ParamMap, RunError};
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::fmt;
@@ -97,19 +108,50 @@ impl fmt::Display for Termination {
     }
 }
 
-/// One iteration of the fit (for progress reports).
+/// One iteration of the fit (one trial step): what [`Observer::observe`] receives and
+/// [`FitResult::history`] keeps.
+///
+/// With `p_k` the iterate before the step, `s` the step and `m(s) = ½‖J s + r‖²` the
+/// Gauss–Newton model, the gain ratio is `ρ = (½‖r(p_k)‖² − ½‖r(p_k + s)‖²) / (½‖r‖² − m(s))`;
+/// the step is accepted when `ρ > 10⁻⁴`.
 #[derive(Debug, Clone)]
 pub struct FitIteration {
-    /// Trial point.
+    /// Number of the iteration, from 1.
+    pub iteration: usize,
+    /// Trial point `p_k + s`.
     pub p: Vec<f64>,
     /// Cost `½‖r‖²` at the trial point (`None` if its evaluation failed).
     pub cost: Option<f64>,
+    /// Cost `½‖r(p_k)‖²` of the iterate the step was taken from.
+    pub previous_cost: f64,
+    /// Gain ratio `ρ` (`None` if the evaluation failed).
+    pub gain_ratio: Option<f64>,
+    /// Euclidean norm `‖s‖` of the step (parameter units).
+    pub step_norm: f64,
+    /// Coleman–Li scaled gradient `max_i |v_i (Jᵀr)_i|` at `p_k` (the `gtol` measure).
+    pub scaled_gradient: f64,
     /// Whether the trial point was accepted.
     pub accepted: bool,
     /// Trust radius after the iteration.
     pub radius: f64,
     /// The evaluation error, if any.
     pub failure: Option<String>,
+    /// Wall time since the start of the fit \[s\].
+    pub elapsed_s: f64,
+}
+
+/// Watches a fit: [`fit_observed`] calls [`observe`](Self::observe) once per iteration (accepted,
+/// rejected or failed trial step), after the iteration's bookkeeping and before the stopping
+/// tests, in the style of argmin's observers. Any `FnMut(&FitIteration)` is an observer.
+pub trait Observer {
+    /// Called with the record of the iteration just done.
+    fn observe(&mut self, iteration: &FitIteration);
+}
+
+impl<F: FnMut(&FitIteration)> Observer for F {
+    fn observe(&mut self, iteration: &FitIteration) {
+        self(iteration)
+    }
 }
 
 /// Result of a least-squares fit.
@@ -133,7 +175,7 @@ pub struct FitResult {
     pub termination: Termination,
     /// Wall time \[s\].
     pub wall_time_s: f64,
-    /// Every iteration.
+    /// Every iteration, in order (the records [`fit_observed`]'s observer saw).
     pub history: Vec<FitIteration>,
 }
 
@@ -274,6 +316,17 @@ pub fn fit<L: LeastSquaresProblem>(
     p0: &[f64],
     options: &FitOptions,
 ) -> Result<FitResult, FitError> {
+    fit_observed(problem, p0, options, &mut |_: &FitIteration| {})
+}
+
+/// [`fit`], calling `observer` once per iteration with its [`FitIteration`] record (the same
+/// record [`FitResult::history`] keeps).
+pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
+    problem: &mut L,
+    p0: &[f64],
+    options: &FitOptions,
+    observer: &mut O,
+) -> Result<FitResult, FitError> {
     let t0 = Instant::now();
     let np = problem.num_params();
     if p0.len() != np || options.lower.len() != np || options.upper.len() != np {
@@ -324,6 +377,10 @@ pub fn fit<L: LeastSquaresProblem>(
     let mut cost = cost_of(&r);
     let mut radius = options.initial_radius.min(options.max_radius);
     let mut history = Vec::new();
+    let mut record = |it: FitIteration| {
+        observer.observe(&it);
+        history.push(it);
+    };
     let (mut iterations, mut accepted_steps, mut failed) = (0, 0, 0);
     let termination;
     loop {
@@ -388,12 +445,18 @@ pub fn fit<L: LeastSquaresProblem>(
                 {
                     radius = (2.0 * radius).min(options.max_radius);
                 }
-                history.push(FitIteration {
+                record(FitIteration {
+                    iteration: iterations,
                     p: trial.clone(),
                     cost: Some(cost_new),
+                    previous_cost: cost,
+                    gain_ratio: Some(rho),
+                    step_norm: snorm,
+                    scaled_gradient: scaled_g,
                     accepted,
                     radius,
                     failure: None,
+                    elapsed_s: t0.elapsed().as_secs_f64(),
                 });
                 if accepted {
                     problem.accept(&trial);
@@ -419,23 +482,35 @@ pub fn fit<L: LeastSquaresProblem>(
             Ok(_) => {
                 failed += 1;
                 radius *= 0.25;
-                history.push(FitIteration {
+                record(FitIteration {
+                    iteration: iterations,
                     p: trial,
                     cost: None,
+                    previous_cost: cost,
+                    gain_ratio: None,
+                    step_norm: snorm,
+                    scaled_gradient: scaled_g,
                     accepted: false,
                     radius,
                     failure: Some("non-finite or mis-sized residuals".into()),
+                    elapsed_s: t0.elapsed().as_secs_f64(),
                 });
             }
             Err(e) => {
                 failed += 1;
                 radius *= 0.25;
-                history.push(FitIteration {
+                record(FitIteration {
+                    iteration: iterations,
                     p: trial,
                     cost: None,
+                    previous_cost: cost,
+                    gain_ratio: None,
+                    step_norm: snorm,
+                    scaled_gradient: scaled_g,
                     accepted: false,
                     radius,
                     failure: Some(e.to_string()),
+                    elapsed_s: t0.elapsed().as_secs_f64(),
                 });
             }
         }
