@@ -1,5 +1,5 @@
 //! Which model parameters a fit frees: the law's `(n, κ)`, effect strengths (see
-//! [`candidates`](crate::fiber::diagnostics::candidates)) and, for the principled estimator,
+//! [`effects`](crate::fiber::effects)) and, for the principled estimator,
 //! one take-up factor per experiment.
 //!
 //! Every experiment's model has the same parameter layout
@@ -8,10 +8,8 @@
 //! fitted) followed by the fitted strengths (in model-parameter units, e.g. `1 + s` for
 //! `nusselt_scale`).
 
-use super::identify::{CarreauFiber, IdentifyOptions, RheometerError};
-use crate::fiber::diagnostics::candidates::{
-    Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
-};
+use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
+use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::solution::Solution;
 
 /// Start of a fit.
