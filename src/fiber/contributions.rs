@@ -20,6 +20,7 @@
 //! ([`Physics::with_warm_air`]) and an aspirator co-flow ([`Physics::with_coflow`]).
 //! Users add their own SI terms with [`Physics::with_custom`] (a [`FiberTerm`]).
 
+use super::error::FiberError;
 use super::setup::Air;
 use crate::dyn_dual::{eval_dyn, DualScalarFn, DynDualScalarFn};
 use num_dual::DualNum;
@@ -256,6 +257,18 @@ pub struct Term {
     pub kind: TermKind,
 }
 
+impl Term {
+    /// Name of its strength as a model parameter: the candidate effect's name where the term's
+    /// strength is one (`nusselt_scale` for `convection`, see `fiber::effects`), else the term's
+    /// name.
+    pub fn parameter_name(&self) -> &'static str {
+        match self.kind {
+            TermKind::Convection => "nusselt_scale",
+            _ => self.name,
+        }
+    }
+}
+
 /// Air speed along the fiber `v_air(s)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum AirSpeed {
@@ -267,7 +280,7 @@ pub enum AirSpeed {
         speed: f64,
         /// Decay length `ℓ` \[m\].
         length: f64,
-        /// Factor on `V` (`Parameter` makes it a model parameter named `"coflow"`).
+        /// Factor on `V` (`Parameter` makes it a model parameter named `"air_coflow"`).
         strength: Strength,
     },
 }
@@ -283,7 +296,8 @@ pub enum AirTemperature {
         excess: f64,
         /// Decay length `ℓ` \[m\].
         length: f64,
-        /// Factor on `ΔT` (`Parameter` makes it a model parameter named `"warm_air"`).
+        /// Factor on `ΔT` (`Parameter` makes it a model parameter named
+        /// `"air_temperature_profile"`).
         strength: Strength,
     },
 }
@@ -400,45 +414,67 @@ impl<H: NusseltLaw> Physics<H> {
         self
     }
 
-    /// Sets the strength of the term named `name` (or of `"coflow"` / `"warm_air"`); returns
-    /// `false` if there is no such term.
-    pub fn set_strength(&mut self, name: &str, strength: Strength) -> bool {
-        if let Some(t) = self.terms.iter_mut().find(|t| t.name == name) {
+    /// Sets the strength named `name`: a term's (by its name or [`Term::parameter_name`], e.g.
+    /// `"convection"` or `"nusselt_scale"`), `"air_coflow"` (needs
+    /// [`with_coflow`](Self::with_coflow)), `"air_temperature_profile"` (needs
+    /// [`with_warm_air`](Self::with_warm_air)) or `"inlet_velocity"`. An unknown name, or an
+    /// air profile that is not there, is an error.
+    pub fn set_strength(&mut self, name: &str, strength: Strength) -> Result<(), FiberError> {
+        if let Some(t) = self
+            .terms
+            .iter_mut()
+            .find(|t| t.name == name || t.parameter_name() == name)
+        {
             t.strength = strength;
-            return true;
+            return Ok(());
         }
         match (name, &mut self.air_speed, &mut self.air_temperature) {
-            ("coflow", AirSpeed::CoFlow { strength: s, .. }, _) => {
-                *s = strength;
-                true
+            ("air_coflow", AirSpeed::CoFlow { strength: s, .. }, _) => *s = strength,
+            ("air_coflow", AirSpeed::Still, _) => {
+                return Err(FiberError::InvalidInput(
+                    "strength air_coflow: the physics has no air co-flow (add it with \
+                     with_coflow)"
+                        .into(),
+                ))
             }
-            ("warm_air", _, AirTemperature::WarmNozzle { strength: s, .. }) => {
-                *s = strength;
-                true
+            ("air_temperature_profile", _, AirTemperature::WarmNozzle { strength: s, .. }) => {
+                *s = strength
             }
-            ("inlet_velocity", _, _) => {
-                self.inlet_velocity = strength;
-                true
+            ("air_temperature_profile", _, AirTemperature::Uniform) => {
+                return Err(FiberError::InvalidInput(
+                    "strength air_temperature_profile: the physics has no warm-air profile (add \
+                     it with with_warm_air)"
+                        .into(),
+                ))
             }
-            _ => false,
+            ("inlet_velocity", _, _) => self.inlet_velocity = strength,
+            _ => {
+                let mut known: Vec<&str> = self.terms.iter().map(|t| t.parameter_name()).collect();
+                known.extend(["air_coflow", "air_temperature_profile", "inlet_velocity"]);
+                return Err(FiberError::InvalidInput(format!(
+                    "unknown strength \"{name}\"; the strengths are {}",
+                    known.join(", ")
+                )));
+            }
         }
+        Ok(())
     }
 
-    /// Builder form of [`set_strength`](Self::set_strength) (unknown names are ignored).
-    pub fn strength(mut self, name: &str, strength: Strength) -> Self {
-        self.set_strength(name, strength);
-        self
+    /// Builder form of [`set_strength`](Self::set_strength).
+    pub fn strength(mut self, name: &str, strength: Strength) -> Result<Self, FiberError> {
+        self.set_strength(name, strength)?;
+        Ok(self)
     }
 
     /// Names and default values of the strengths that are model parameters, in `p` order:
-    /// terms first (in term order), then `"coflow"`, then `"warm_air"`, then
-    /// `"inlet_velocity"`.
+    /// terms first (in term order, by [`Term::parameter_name`]), then `"air_coflow"`, then
+    /// `"air_temperature_profile"`, then `"inlet_velocity"`.
     pub fn strength_parameters(&self) -> Vec<(&'static str, f64)> {
         let mut v: Vec<(&'static str, f64)> = self
             .terms
             .iter()
             .filter_map(|t| match t.strength {
-                Strength::Parameter(d) => Some((t.name, d)),
+                Strength::Parameter(d) => Some((t.parameter_name(), d)),
                 _ => None,
             })
             .collect();
@@ -447,14 +483,14 @@ impl<H: NusseltLaw> Physics<H> {
             ..
         } = self.air_speed
         {
-            v.push(("coflow", d));
+            v.push(("air_coflow", d));
         }
         if let AirTemperature::WarmNozzle {
             strength: Strength::Parameter(d),
             ..
         } = self.air_temperature
         {
-            v.push(("warm_air", d));
+            v.push(("air_temperature_profile", d));
         }
         if let Strength::Parameter(d) = self.inlet_velocity {
             v.push(("inlet_velocity", d));
