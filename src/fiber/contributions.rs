@@ -499,6 +499,27 @@ impl<H: NusseltLaw> Physics<H> {
     }
 }
 
+/// The reference values that turn dimensionless states into SI ones (`x_SI = x̃ · scale`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SiScales {
+    /// `u_o` \[m/s\]: speed (also of the air).
+    pub velocity: f64,
+    /// `N_o` \[N\]: axial force.
+    pub force: f64,
+    /// `T_o` \[K\]: temperature (also of the air).
+    pub temperature: f64,
+    /// `u_o/L_o` \[1/s\]: strain rate.
+    pub strain_rate: f64,
+    /// `d_o` \[m\]: diameter.
+    pub diameter: f64,
+    /// `ρ_o` \[kg/m³\]: density.
+    pub density: f64,
+    /// `c_p,o` \[J/(kg K)\]: heat capacity.
+    pub heat_capacity: f64,
+    /// `L_o` \[m\]: position along the spin line.
+    pub length: f64,
+}
+
 /// Dimensionless coefficients of the built-in terms, computed once from the scaling.
 #[derive(Debug, Clone, Copy)]
 pub struct Coefficients {
@@ -524,8 +545,8 @@ pub struct Coefficients {
     pub t_air: f64,
     /// Dimensionless spin-line length `L̃` \[-\].
     pub length: f64,
-    /// SI factors: `[u_o, N_o, T_o, u_o/L_o, d_o, ρ_o, c_p,o, L_o]`.
-    pub si: [f64; 8],
+    /// SI factors of the states and of `s`.
+    pub si: SiScales,
     /// `f_o` \[N/m\].
     pub force_per_length: f64,
     /// `h_o` \[W/m\].
@@ -565,16 +586,16 @@ impl Coefficients {
                 / (r.heat_capacity * r.mass_flow),
             t_air: t_air_si / r.temperature,
             length: length_si / r.length,
-            si: [
-                r.velocity,
-                scaling.force(),
-                r.temperature,
-                scaling.strain_rate(),
-                scaling.diameter(),
-                r.density,
-                r.heat_capacity,
-                r.length,
-            ],
+            si: SiScales {
+                velocity: r.velocity,
+                force: scaling.force(),
+                temperature: r.temperature,
+                strain_rate: scaling.strain_rate(),
+                diameter: scaling.diameter(),
+                density: r.density,
+                heat_capacity: r.heat_capacity,
+                length: r.length,
+            },
             force_per_length: scaling.force_per_length(),
             heat_per_length: scaling.heat_per_length(),
         }
@@ -665,7 +686,7 @@ impl<H: NusseltLaw> Physics<H> {
             .iter()
             .filter(|t| t.strength.is_parameter())
             .count();
-        let l_o = co.si[7];
+        let l_o = co.si.length;
         let v = match &self.air_speed {
             AirSpeed::Still => D::zero(),
             AirSpeed::CoFlow {
@@ -673,7 +694,7 @@ impl<H: NusseltLaw> Physics<H> {
                 length,
                 strength,
             } => match strength_value(strength, sp, &mut k) {
-                Some(f) => f * (speed / co.si[0] * (-(co.length - s) * l_o / length).exp()),
+                Some(f) => f * (speed / co.si.velocity * (-(co.length - s) * l_o / length).exp()),
                 None => D::zero(),
             },
         };
@@ -684,7 +705,7 @@ impl<H: NusseltLaw> Physics<H> {
                 length,
                 strength,
             } => match strength_value(strength, sp, &mut k) {
-                Some(f) => f * (excess / co.si[2] * (-s * l_o / length).exp()) + co.t_air,
+                Some(f) => f * (excess / co.si.temperature * (-s * l_o / length).exp()) + co.t_air,
                 None => D::from(co.t_air),
             },
         };
@@ -708,7 +729,7 @@ impl<H: NusseltLaw> Physics<H> {
                 let nu = match self.air_speed {
                     AirSpeed::Still => self.nusselt.nusselt(re_tau, re_tau * re_tau, co.pr_arg),
                     AirSpeed::CoFlow { .. } => {
-                        let w = st.v_air * (co.si[0] / COFLOW_REGULARISATION_SPEED);
+                        let w = st.v_air * (co.si.velocity / COFLOW_REGULARISATION_SPEED);
                         let w2 = w * w;
                         let extra = w2 / (w2 + 1.0)
                             * (COFLOW_INCLINATION_REGULARISATION
@@ -728,17 +749,17 @@ impl<H: NusseltLaw> Physics<H> {
             TermKind::Custom(f) => {
                 let si = &co.si;
                 let args = [
-                    st.u * si[0],
-                    st.n * si[1],
-                    st.t * si[2],
-                    st.rate * si[3],
-                    st.d * si[4],
-                    st.rho * si[5],
-                    st.cp * si[6],
-                    st.t_air * si[2],
-                    st.v_air * si[0],
+                    st.u * si.velocity,
+                    st.n * si.force,
+                    st.t * si.temperature,
+                    st.rate * si.strain_rate,
+                    st.d * si.diameter,
+                    st.rho * si.density,
+                    st.cp * si.heat_capacity,
+                    st.t_air * si.temperature,
+                    st.v_air * si.velocity,
                 ];
-                let v = eval_dyn(f.as_ref(), st.s * si[7], &args[..SI_ARGS]);
+                let v = eval_dyn(f.as_ref(), st.s * si.length, &args[..SI_ARGS]);
                 let scale = match term.balance {
                     Balance::Momentum => co.force_per_length,
                     Balance::Energy => co.heat_per_length,

@@ -48,6 +48,6 @@ pub use contributions::{
 };
 pub use error::FiberError;
 pub use material_law::{CarreauLike, CarreauYasuda, Newtonian, ViscosityLaw};
-pub use model::FiberModel;
+pub use model::{FiberModel, ParamLayout};
 pub use scaling::{ReferenceValues, Scaling};
 pub use simulate::{simulate, simulate_from, FiberSolution, Profiles, SimulateOptions, Simulator};

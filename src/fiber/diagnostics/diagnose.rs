@@ -290,7 +290,7 @@ fn linearisation(
             };
             let (r, jl) = residual_jacobian(model, sol, &sens, &xs, &g)
                 .map_err(|e| sim_err(rh, k, FiberError::from(e)))?;
-            Ok((r, jl, model.take_up_factor_index()))
+            Ok((r, jl, model.param_layout().take_up_factor()))
         })
         .collect::<Result<_, RheometerError>>()?;
     let mut r = Vec::new();

@@ -71,16 +71,15 @@ impl Rheometer {
                 )
             })
             .collect();
-        let local = obj.layout.local(
-            &fit_result.p[..ns],
-            1.0,
-            self.models[0].take_up_factor_index(),
-        );
+        let local = obj
+            .layout
+            .local(&fit_result.p[..ns], 1.0, obj.layout.params.take_up_factor());
+        let [n, kappa] = obj.layout.law_of(&local);
         Ok(Identification {
             estimator: options.estimator,
             start: start.law,
-            n: local[1],
-            kappa: local[2],
+            n,
+            kappa,
             take_up_factors: if options.estimator == Estimator::Principled {
                 fit_result.p[ns..].to_vec()
             } else {

@@ -166,8 +166,7 @@ impl<'a> Objective<'a> {
     /// Global parameters at `(n, κ)` (overriding the template's law values), strengths at their
     /// start values, take-up factors 1.
     fn global_at(&mut self, n: f64, kappa: f64) -> Vec<f64> {
-        self.layout.template[1] = n;
-        self.layout.template[2] = kappa;
+        self.layout.set_law(n, kappa);
         self.initial_parameters()
     }
 
@@ -217,8 +216,8 @@ impl<'a> Objective<'a> {
         let np = p.len();
         let ns = self.layout.num_shared();
         let layout = &self.layout;
-        let probe = layout.local(&p[..ns], 1.0, layout.template.len() - 1);
-        let (n, kappa) = (probe[1], probe[2]);
+        let probe = layout.local(&p[..ns], 1.0, layout.params.take_up_factor());
+        let [n, kappa] = layout.law_of(&probe);
         let estimator = self.estimator;
         let sigma = self.sigma;
         let parts: Result<Vec<ResidualsAndJacobian>, RheometerError> = self

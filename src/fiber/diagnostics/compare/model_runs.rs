@@ -125,7 +125,7 @@ pub fn simulate_experiments(
             .map_err(sim_err)?;
             let mut p = model.parameters(1.0, &setup.law_params).map_err(sim_err)?;
             if let Some(f) = &setup.take_up_factors {
-                p[model.take_up_factor_index()] = f[k];
+                p[model.param_layout().take_up_factor()] = f[k];
             }
             let sol = simulate_params(&model, &p, None, &setup.simulate).map_err(sim_err)?;
             let curve = if setup.curve_points >= 2 {
