@@ -102,6 +102,18 @@ impl Rheometer {
         })
     }
 
+    /// The Newtonian model (`n = 1`) at `kappa` with take-up factors 1, one solution per
+    /// experiment (cold starts; paper Fig. 3 draws it against the identified law).
+    pub fn newtonian_solutions(
+        &self,
+        kappa: f64,
+        options: &IdentifyOptions,
+    ) -> Result<Vec<Solution>, RheometerError> {
+        let mut obj = self.objective([1.0, kappa], options)?;
+        obj.cost_at(1.0, kappa)?;
+        Ok(obj.solutions())
+    }
+
     /// Paper Algorithm 2: with `n = n_init` (0.5), walk κ down from the upper bound in steps of
     /// 1 until the cost differs from the Newtonian cost by more than 10%.
     pub fn start_heuristic(&self, options: &IdentifyOptions) -> Result<StartPoint, RheometerError> {
