@@ -2,8 +2,8 @@
 //! built-in candidates, refits of the top 3) on the 9 shipped experiments. Target: < 5 s median.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use diffbvp::fiber::diagnostics::candidates::ModelSpec;
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
+use diffbvp::fiber::effects::ModelSpec;
 use diffbvp::fiber::input::load_experiments;
 use std::hint::black_box;
 use std::path::Path;

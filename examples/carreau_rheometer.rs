@@ -92,7 +92,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Figures: paper Fig. 2, 3, 5 for the principled fit, and Fig. 4, the cost landscape.
     std::fs::create_dir_all(&out)?;
-    for path in identification_figures(&rheometer, &id, &principled, &out, "png", &inputs)? {
+    let newtonian = rheometer.newtonian_solutions(id.kappa, &principled)?;
+    for path in identification_figures(&rheometer, &id, &newtonian, &out, "png", &inputs)? {
         println!("wrote {}", path.display());
     }
     let (ns, kappas) = (linspace(0.0, 1.0, 41), linspace(9.0, 16.0, 41));

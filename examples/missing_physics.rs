@@ -11,11 +11,11 @@
 //!
 //! `cargo run --release --example missing_physics [-- OUT_DIR]`
 
-use diffbvp::fiber::diagnostics::candidates::{physics_with, Effect, EffectSetting, ModelSpec};
 use diffbvp::fiber::diagnostics::compare::{
     compare_set, CompareOptions, FigureFormat, FitParameters, ModelSetup,
 };
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
+use diffbvp::fiber::effects::{physics_with, Effect, EffectSetting, ModelSpec};
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::rheometer::{FitReport, Identification, IdentifyOptions, Rheometer};
 use diffbvp::fiber::setup::ExperimentSet;

@@ -43,6 +43,31 @@
 //! Modules read like the method: [`mesh`], collocation, Newton, [`solve`](mod@solve) (adaptive
 //! loop), [`solution`] (interpolant), [`continuation`], [`sensitivity`], [`inspect`].
 //!
+//! ## Layers
+//!
+//! Each module imports only from its own layer's peers without cycles and from the layers below
+//! it. The toolkit, bottom to top:
+//!
+//! 1. [`error`], [`problem`], [`mesh`], [`dyn_dual`];
+//! 2. dual Jacobians, collocation, [`linear`] (sparse LU), error control, Newton, [`solution`];
+//! 3. [`solve`](mod@solve) (the adaptive loop);
+//! 4. [`continuation`], [`sensitivity`], [`inspect`];
+//! 5. [`least_squares`] and `plot` stand apart (no solver imports).
+//!
+//! The toolkit never imports `fiber`. The fiber model and rheometer (`fiber`, feature
+//! `rheometer`), bottom to top:
+//!
+//! 1. `setup`, `error`, `scaling`, `material_law`;
+//! 2. `contributions` (force and heat terms) and `effects` (the candidate effects vocabulary);
+//! 3. `model` (the BVP);
+//! 4. `cold_start`, `simulate`;
+//! 5. `smoothing`, `synthetic`, `input`, `output`, `statistics`, `take_up`;
+//! 6. `rheometer` (inside: `options`, `estimator` → `data` → `layout` → `objective` →
+//!    `identify` → `report`, `landscape`);
+//! 7. `figures`;
+//! 8. `diagnostics` (`compare`, `diagnose`, `report`);
+//! 9. `failure_hints`.
+//!
 //! ## Cargo features
 //!
 //! | feature | default | what it adds |

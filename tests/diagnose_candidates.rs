@@ -1,7 +1,7 @@
 //! Candidate effects: neutral strengths reproduce the base model exactly, dual-number
 //! derivatives with respect to a strength agree with finite differences, CLI parsing.
 
-use diffbvp::fiber::diagnostics::candidates::{
+use diffbvp::fiber::effects::{
     Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
 };
 use diffbvp::fiber::setup::{Air, Experiment, Material};
@@ -143,7 +143,7 @@ fn strength_derivatives_match_finite_differences() {
 
 #[test]
 fn settings_parse_names_and_values() {
-    for name in diffbvp::fiber::diagnostics::candidates::BUILTIN_NAMES {
+    for name in diffbvp::fiber::effects::BUILTIN_NAMES {
         let s: EffectSetting = name.parse().unwrap();
         assert_eq!(s.effect.name(), name);
         assert!(s.value.is_none());

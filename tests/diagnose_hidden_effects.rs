@@ -5,8 +5,8 @@
 //! RMS relative residual to within 20% of the noise level and cover the true (n, κ) by the
 //! reported 95% CIs. On data without a hidden effect no candidate may earn its place.
 
-use diffbvp::fiber::diagnostics::candidates::{Effect, LawChoice, ModelSpec};
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
+use diffbvp::fiber::effects::{Effect, LawChoice, ModelSpec};
 use diffbvp::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
 use diffbvp::fiber::simulate::simulate_params;
 use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};

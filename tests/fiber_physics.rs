@@ -92,9 +92,10 @@ fn newtonian_strain_rate_form_equals_explicit_three_state_form() {
 fn isothermal_newtonian_fiber_matches_riccati_closed_form() {
     let physics = Physics::paper()
         .strength("gravity", Strength::Off)
-        .strength("air_drag", Strength::Off)
-        .strength("convection", Strength::Off)
-        .strength("viscous_heating", Strength::Off);
+        .and_then(|p| p.strength("air_drag", Strength::Off))
+        .and_then(|p| p.strength("convection", Strength::Off))
+        .and_then(|p| p.strength("viscous_heating", Strength::Off))
+        .unwrap();
     let u_in_si = 4.0 * 3.08e-5
         / (std::f64::consts::PI * Material::pmma7n().density(513.15) * 1.134e-3f64.powi(2));
     let m = FiberModel::new(

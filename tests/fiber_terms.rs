@@ -121,6 +121,7 @@ fn user_term_reproduces_builtin_gravity() {
         &experiment(),
         Physics::paper()
             .strength("gravity", Strength::Off)
+            .unwrap()
             .with_custom("user_gravity", Balance::Momentum, UserGravity),
     )
     .unwrap();
@@ -182,15 +183,17 @@ fn term_report_units_and_signs() {
 
 #[test]
 fn strength_parameters_extend_p_and_are_neutral_at_default() {
-    let physics = Physics::paper().strength("convection", Strength::Parameter(1.0));
+    let physics = Physics::paper()
+        .strength("convection", Strength::Parameter(1.0))
+        .unwrap();
     let m = build(&experiment(), physics).unwrap();
     assert_eq!(
         m.param_names(),
-        vec!["c", "n", "kappa", "convection", "take_up_factor"]
+        vec!["c", "n", "kappa", "nusselt_scale", "take_up_factor"]
     );
     let p = m.parameters(1.0, &[0.8, 11.71]).unwrap();
     assert_eq!(p, vec![1.0, 0.8, 11.71, 1.0, 1.0]);
-    assert_eq!(m.param_index("convection"), Some(3));
+    assert_eq!(m.param_index("nusselt_scale"), Some(3));
     let opts = SimulateOptions::with_tol(1e-8);
     let a = simulate_params(&m, &p, None, &opts).unwrap();
     let r = build(&experiment(), Physics::paper()).unwrap();
@@ -283,4 +286,42 @@ fn velocity_take_up_and_newtonian_law_work() {
     let sol = simulate(&m, &[], &SimulateOptions::with_tol(1e-8)).unwrap();
     let p = sol.profiles(&m, &[0.51]);
     assert!((p.velocity[0] / 3.0 - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn unknown_or_absent_strengths_are_errors() {
+    // one name per effect: the old internal names are not strengths
+    assert!(Physics::paper().strength("coflow", Strength::Off).is_err());
+    assert!(Physics::paper()
+        .strength("warm_air", Strength::Off)
+        .is_err());
+    assert!(Physics::paper()
+        .strength("no_such_term", Strength::Off)
+        .is_err());
+    // an air profile that is not there cannot get a strength
+    assert!(Physics::paper()
+        .strength("air_coflow", Strength::Off)
+        .is_err());
+    assert!(Physics::paper()
+        .strength("air_temperature_profile", Strength::Off)
+        .is_err());
+    // the effect names
+    let p = Physics::paper()
+        .with_coflow(1.0, 0.1)
+        .with_warm_air(10.0, 0.05)
+        .strength("air_coflow", Strength::Parameter(0.0))
+        .and_then(|p| p.strength("air_temperature_profile", Strength::Parameter(0.0)))
+        .and_then(|p| p.strength("nusselt_scale", Strength::Parameter(1.0)))
+        .and_then(|p| p.strength("inlet_velocity", Strength::Parameter(0.0)))
+        .unwrap();
+    let names: Vec<&str> = p.strength_parameters().iter().map(|(n, _)| *n).collect();
+    assert_eq!(
+        names,
+        [
+            "nusselt_scale",
+            "air_coflow",
+            "air_temperature_profile",
+            "inlet_velocity"
+        ]
+    );
 }

@@ -20,6 +20,7 @@
 //! ([`Physics::with_warm_air`]) and an aspirator co-flow ([`Physics::with_coflow`]).
 //! Users add their own SI terms with [`Physics::with_custom`] (a [`FiberTerm`]).
 
+use super::error::FiberError;
 use super::setup::Air;
 use crate::dyn_dual::{eval_dyn, DualScalarFn, DynDualScalarFn};
 use num_dual::DualNum;
@@ -256,6 +257,18 @@ pub struct Term {
     pub kind: TermKind,
 }
 
+impl Term {
+    /// Name of its strength as a model parameter: the candidate effect's name where the term's
+    /// strength is one (`nusselt_scale` for `convection`, see `fiber::effects`), else the term's
+    /// name.
+    pub fn parameter_name(&self) -> &'static str {
+        match self.kind {
+            TermKind::Convection => "nusselt_scale",
+            _ => self.name,
+        }
+    }
+}
+
 /// Air speed along the fiber `v_air(s)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum AirSpeed {
@@ -267,7 +280,7 @@ pub enum AirSpeed {
         speed: f64,
         /// Decay length `ℓ` \[m\].
         length: f64,
-        /// Factor on `V` (`Parameter` makes it a model parameter named `"coflow"`).
+        /// Factor on `V` (`Parameter` makes it a model parameter named `"air_coflow"`).
         strength: Strength,
     },
 }
@@ -283,7 +296,8 @@ pub enum AirTemperature {
         excess: f64,
         /// Decay length `ℓ` \[m\].
         length: f64,
-        /// Factor on `ΔT` (`Parameter` makes it a model parameter named `"warm_air"`).
+        /// Factor on `ΔT` (`Parameter` makes it a model parameter named
+        /// `"air_temperature_profile"`).
         strength: Strength,
     },
 }
@@ -400,45 +414,67 @@ impl<H: NusseltLaw> Physics<H> {
         self
     }
 
-    /// Sets the strength of the term named `name` (or of `"coflow"` / `"warm_air"`); returns
-    /// `false` if there is no such term.
-    pub fn set_strength(&mut self, name: &str, strength: Strength) -> bool {
-        if let Some(t) = self.terms.iter_mut().find(|t| t.name == name) {
+    /// Sets the strength named `name`: a term's (by its name or [`Term::parameter_name`], e.g.
+    /// `"convection"` or `"nusselt_scale"`), `"air_coflow"` (needs
+    /// [`with_coflow`](Self::with_coflow)), `"air_temperature_profile"` (needs
+    /// [`with_warm_air`](Self::with_warm_air)) or `"inlet_velocity"`. An unknown name, or an
+    /// air profile that is not there, is an error.
+    pub fn set_strength(&mut self, name: &str, strength: Strength) -> Result<(), FiberError> {
+        if let Some(t) = self
+            .terms
+            .iter_mut()
+            .find(|t| t.name == name || t.parameter_name() == name)
+        {
             t.strength = strength;
-            return true;
+            return Ok(());
         }
         match (name, &mut self.air_speed, &mut self.air_temperature) {
-            ("coflow", AirSpeed::CoFlow { strength: s, .. }, _) => {
-                *s = strength;
-                true
+            ("air_coflow", AirSpeed::CoFlow { strength: s, .. }, _) => *s = strength,
+            ("air_coflow", AirSpeed::Still, _) => {
+                return Err(FiberError::InvalidInput(
+                    "strength air_coflow: the physics has no air co-flow (add it with \
+                     with_coflow)"
+                        .into(),
+                ))
             }
-            ("warm_air", _, AirTemperature::WarmNozzle { strength: s, .. }) => {
-                *s = strength;
-                true
+            ("air_temperature_profile", _, AirTemperature::WarmNozzle { strength: s, .. }) => {
+                *s = strength
             }
-            ("inlet_velocity", _, _) => {
-                self.inlet_velocity = strength;
-                true
+            ("air_temperature_profile", _, AirTemperature::Uniform) => {
+                return Err(FiberError::InvalidInput(
+                    "strength air_temperature_profile: the physics has no warm-air profile (add \
+                     it with with_warm_air)"
+                        .into(),
+                ))
             }
-            _ => false,
+            ("inlet_velocity", _, _) => self.inlet_velocity = strength,
+            _ => {
+                let mut known: Vec<&str> = self.terms.iter().map(|t| t.parameter_name()).collect();
+                known.extend(["air_coflow", "air_temperature_profile", "inlet_velocity"]);
+                return Err(FiberError::InvalidInput(format!(
+                    "unknown strength \"{name}\"; the strengths are {}",
+                    known.join(", ")
+                )));
+            }
         }
+        Ok(())
     }
 
-    /// Builder form of [`set_strength`](Self::set_strength) (unknown names are ignored).
-    pub fn strength(mut self, name: &str, strength: Strength) -> Self {
-        self.set_strength(name, strength);
-        self
+    /// Builder form of [`set_strength`](Self::set_strength).
+    pub fn strength(mut self, name: &str, strength: Strength) -> Result<Self, FiberError> {
+        self.set_strength(name, strength)?;
+        Ok(self)
     }
 
     /// Names and default values of the strengths that are model parameters, in `p` order:
-    /// terms first (in term order), then `"coflow"`, then `"warm_air"`, then
-    /// `"inlet_velocity"`.
+    /// terms first (in term order, by [`Term::parameter_name`]), then `"air_coflow"`, then
+    /// `"air_temperature_profile"`, then `"inlet_velocity"`.
     pub fn strength_parameters(&self) -> Vec<(&'static str, f64)> {
         let mut v: Vec<(&'static str, f64)> = self
             .terms
             .iter()
             .filter_map(|t| match t.strength {
-                Strength::Parameter(d) => Some((t.name, d)),
+                Strength::Parameter(d) => Some((t.parameter_name(), d)),
                 _ => None,
             })
             .collect();
@@ -447,20 +483,41 @@ impl<H: NusseltLaw> Physics<H> {
             ..
         } = self.air_speed
         {
-            v.push(("coflow", d));
+            v.push(("air_coflow", d));
         }
         if let AirTemperature::WarmNozzle {
             strength: Strength::Parameter(d),
             ..
         } = self.air_temperature
         {
-            v.push(("warm_air", d));
+            v.push(("air_temperature_profile", d));
         }
         if let Strength::Parameter(d) = self.inlet_velocity {
             v.push(("inlet_velocity", d));
         }
         v
     }
+}
+
+/// The reference values that turn dimensionless states into SI ones (`x_SI = x̃ · scale`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SiScales {
+    /// `u_o` \[m/s\]: speed (also of the air).
+    pub velocity: f64,
+    /// `N_o` \[N\]: axial force.
+    pub force: f64,
+    /// `T_o` \[K\]: temperature (also of the air).
+    pub temperature: f64,
+    /// `u_o/L_o` \[1/s\]: strain rate.
+    pub strain_rate: f64,
+    /// `d_o` \[m\]: diameter.
+    pub diameter: f64,
+    /// `ρ_o` \[kg/m³\]: density.
+    pub density: f64,
+    /// `c_p,o` \[J/(kg K)\]: heat capacity.
+    pub heat_capacity: f64,
+    /// `L_o` \[m\]: position along the spin line.
+    pub length: f64,
 }
 
 /// Dimensionless coefficients of the built-in terms, computed once from the scaling.
@@ -488,8 +545,8 @@ pub struct Coefficients {
     pub t_air: f64,
     /// Dimensionless spin-line length `L̃` \[-\].
     pub length: f64,
-    /// SI factors: `[u_o, N_o, T_o, u_o/L_o, d_o, ρ_o, c_p,o, L_o]`.
-    pub si: [f64; 8],
+    /// SI factors of the states and of `s`.
+    pub si: SiScales,
     /// `f_o` \[N/m\].
     pub force_per_length: f64,
     /// `h_o` \[W/m\].
@@ -529,16 +586,16 @@ impl Coefficients {
                 / (r.heat_capacity * r.mass_flow),
             t_air: t_air_si / r.temperature,
             length: length_si / r.length,
-            si: [
-                r.velocity,
-                scaling.force(),
-                r.temperature,
-                scaling.strain_rate(),
-                scaling.diameter(),
-                r.density,
-                r.heat_capacity,
-                r.length,
-            ],
+            si: SiScales {
+                velocity: r.velocity,
+                force: scaling.force(),
+                temperature: r.temperature,
+                strain_rate: scaling.strain_rate(),
+                diameter: scaling.diameter(),
+                density: r.density,
+                heat_capacity: r.heat_capacity,
+                length: r.length,
+            },
             force_per_length: scaling.force_per_length(),
             heat_per_length: scaling.heat_per_length(),
         }
@@ -629,7 +686,7 @@ impl<H: NusseltLaw> Physics<H> {
             .iter()
             .filter(|t| t.strength.is_parameter())
             .count();
-        let l_o = co.si[7];
+        let l_o = co.si.length;
         let v = match &self.air_speed {
             AirSpeed::Still => D::zero(),
             AirSpeed::CoFlow {
@@ -637,7 +694,7 @@ impl<H: NusseltLaw> Physics<H> {
                 length,
                 strength,
             } => match strength_value(strength, sp, &mut k) {
-                Some(f) => f * (speed / co.si[0] * (-(co.length - s) * l_o / length).exp()),
+                Some(f) => f * (speed / co.si.velocity * (-(co.length - s) * l_o / length).exp()),
                 None => D::zero(),
             },
         };
@@ -648,7 +705,7 @@ impl<H: NusseltLaw> Physics<H> {
                 length,
                 strength,
             } => match strength_value(strength, sp, &mut k) {
-                Some(f) => f * (excess / co.si[2] * (-s * l_o / length).exp()) + co.t_air,
+                Some(f) => f * (excess / co.si.temperature * (-s * l_o / length).exp()) + co.t_air,
                 None => D::from(co.t_air),
             },
         };
@@ -672,7 +729,7 @@ impl<H: NusseltLaw> Physics<H> {
                 let nu = match self.air_speed {
                     AirSpeed::Still => self.nusselt.nusselt(re_tau, re_tau * re_tau, co.pr_arg),
                     AirSpeed::CoFlow { .. } => {
-                        let w = st.v_air * (co.si[0] / COFLOW_REGULARISATION_SPEED);
+                        let w = st.v_air * (co.si.velocity / COFLOW_REGULARISATION_SPEED);
                         let w2 = w * w;
                         let extra = w2 / (w2 + 1.0)
                             * (COFLOW_INCLINATION_REGULARISATION
@@ -692,17 +749,17 @@ impl<H: NusseltLaw> Physics<H> {
             TermKind::Custom(f) => {
                 let si = &co.si;
                 let args = [
-                    st.u * si[0],
-                    st.n * si[1],
-                    st.t * si[2],
-                    st.rate * si[3],
-                    st.d * si[4],
-                    st.rho * si[5],
-                    st.cp * si[6],
-                    st.t_air * si[2],
-                    st.v_air * si[0],
+                    st.u * si.velocity,
+                    st.n * si.force,
+                    st.t * si.temperature,
+                    st.rate * si.strain_rate,
+                    st.d * si.diameter,
+                    st.rho * si.density,
+                    st.cp * si.heat_capacity,
+                    st.t_air * si.temperature,
+                    st.v_air * si.velocity,
                 ];
-                let v = eval_dyn(f.as_ref(), st.s * si[7], &args[..SI_ARGS]);
+                let v = eval_dyn(f.as_ref(), st.s * si.length, &args[..SI_ARGS]);
                 let scale = match term.balance {
                     Balance::Momentum => co.force_per_length,
                     Balance::Energy => co.heat_per_length,

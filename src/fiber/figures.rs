@@ -7,7 +7,7 @@
 //! [`ensure_not_input`]); the format follows the extension (`.png` or `.svg`).
 
 use super::output::{ensure_not_input, OutputError};
-use super::rheometer::{Identification, IdentifyOptions, Landscape, Rheometer, RheometerError};
+use super::rheometer::{Identification, Landscape, Rheometer, RheometerError};
 use super::simulate::FiberSolution;
 use super::simulate::Profiles;
 use super::smoothing::SmoothFit;
@@ -24,7 +24,7 @@ pub enum FigureError {
     /// Drawing or writing the figure failed.
     #[error(transparent)]
     Plot(#[from] PlotError),
-    /// The model curves could not be computed.
+    /// The model curves could not be computed (by a caller that computes them for a figure).
     #[error(transparent)]
     Model(#[from] RheometerError),
 }
@@ -270,10 +270,13 @@ pub fn landscape_map(
 /// take-up diameters `d_fit(L)`, and the identified law), and `fig5_inverse_square` (the
 /// velocity-like `1/d²` view), each split into `NAME_1`, `NAME_2`, … beyond
 /// [`MAX_PANELS_PER_FIGURE`] experiments. Returns the paths written.
+///
+/// Draws only: the identified profiles are `id.solutions`, the Newtonian ones `newtonian` (one
+/// solution per experiment, from [`Rheometer::newtonian_solutions`] at `id.kappa`).
 pub fn identification_figures(
     rh: &Rheometer,
     id: &Identification,
-    opts: &IdentifyOptions,
+    newtonian: &[crate::Solution],
     dir: &Path,
     ext: &str,
     inputs: &[PathBuf],
@@ -303,9 +306,7 @@ pub fn identification_figures(
             .collect()
     };
     let identified = profiles(&id.solutions);
-    let mut newt = rh.objective([1.0, id.kappa], opts)?;
-    newt.cost_at(1.0, id.kappa)?;
-    let newtonian = profiles(&newt.solutions());
+    let newtonian = profiles(newtonian);
     let label = format!("identified n = {:.3}, κ = {:.2}", id.n, id.kappa);
     let fitted = ModelCurves {
         label: &label,

@@ -108,6 +108,11 @@ pub struct CarreauLike {
 }
 
 impl CarreauLike {
+    /// Position of the power index `n` among the law's parameters.
+    pub const N: usize = 0;
+    /// Position of `κ = ln(K / 1 Pa)` among the law's parameters.
+    pub const KAPPA: usize = 1;
+
     /// The law with `K_o = 1 Pa` (paper Table 2).
     pub fn new() -> Self {
         CarreauLike { stress_scale: 1.0 }

@@ -7,6 +7,8 @@
 //! * [`scaling`]: non-dimensionalisation (paper Table 2);
 //! * [`material_law`]: elongational viscosity laws (Newtonian, Carreau-type, Carreau–Yasuda);
 //! * [`contributions`]: named force and heat terms, air environment, Nusselt law;
+//! * [`effects`]: the candidate effects (canonical names, strength parameters, neutral values)
+//!   and the model specification (law + effects) a rheometer fit uses;
 //! * [`model`]: the strain-rate formulation as a [`Bvp`](crate::Bvp);
 //! * [`cold_start`]: continuation from the stress-free fiber;
 //! * [`failure_hints`]: simulation failures naming their experiment, with likely causes;
@@ -14,12 +16,17 @@
 //! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
 //! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
 //! * [`figures`]: profile, fit and landscape figures (PNG/SVG);
+//! * [`statistics`]: noise estimates, runs test, autocorrelation and rank correlation of
+//!   residuals;
+//! * [`take_up`]: the take-up condition a model uses (the data set's, a given diameter, or
+//!   `d_fit(L)` of the smoothed data);
 //! * [`synthetic`]: reproducible measurement noise for synthetic data sets;
 //! * [`diagnostics`]: model vs measurement comparison (where and how the model misses the data).
 
 pub mod cold_start;
 pub mod contributions;
 pub mod diagnostics;
+pub mod effects;
 pub mod error;
 pub mod failure_hints;
 pub mod figures;
@@ -32,13 +39,15 @@ pub mod scaling;
 pub mod setup;
 pub mod simulate;
 pub mod smoothing;
+pub mod statistics;
 pub mod synthetic;
+pub mod take_up;
 
 pub use contributions::{
     Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength,
 };
 pub use error::FiberError;
 pub use material_law::{CarreauLike, CarreauYasuda, Newtonian, ViscosityLaw};
-pub use model::FiberModel;
+pub use model::{FiberModel, ParamLayout};
 pub use scaling::{ReferenceValues, Scaling};
 pub use simulate::{simulate, simulate_from, FiberSolution, Profiles, SimulateOptions, Simulator};

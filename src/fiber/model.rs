@@ -77,8 +77,70 @@ pub struct FiberModel<L: ViscosityLaw, H: NusseltLaw = InclinedChurchillBernstei
     t_in: f64,
     re0: f64,
     take_up: DimensionlessTakeUp,
+    params: ParamLayout,
+}
+
+/// Where each model parameter sits in `p = [c, law parameters..., strengths..., φ]`
+/// ([`FiberModel::param_layout`]): plain index arithmetic, no lookups (the right-hand side
+/// decodes `p` with it on every evaluation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ParamLayout {
     n_law: usize,
     n_strength: usize,
+}
+
+impl ParamLayout {
+    /// Index of the continuation parameter `c` (0: the stress-free fiber, 1: the model).
+    pub const CONTINUATION: usize = 0;
+
+    /// The layout for a law with `n_law` parameters and `n_strength` strength parameters.
+    pub fn new(n_law: usize, n_strength: usize) -> Self {
+        ParamLayout { n_law, n_strength }
+    }
+
+    /// Index of the continuation parameter `c`.
+    #[inline]
+    pub fn continuation(&self) -> usize {
+        Self::CONTINUATION
+    }
+
+    /// Indices of the viscosity law's parameters.
+    #[inline]
+    pub fn law(&self) -> std::ops::Range<usize> {
+        1..1 + self.n_law
+    }
+
+    /// Index of the law's parameter number `k` (for the Carreau-type law
+    /// [`CarreauLike::N`](crate::fiber::CarreauLike::N) is `n`,
+    /// [`CarreauLike::KAPPA`](crate::fiber::CarreauLike::KAPPA) is `κ`).
+    #[inline]
+    pub fn law_param(&self, k: usize) -> usize {
+        debug_assert!(k < self.n_law, "law parameter {k} of {}", self.n_law);
+        1 + k
+    }
+
+    /// Indices of the strength parameters (in [`Physics::strength_parameters`] order).
+    #[inline]
+    pub fn strengths(&self) -> std::ops::Range<usize> {
+        1 + self.n_law..1 + self.n_law + self.n_strength
+    }
+
+    /// Index of the take-up factor `φ` (the last parameter).
+    #[inline]
+    pub fn take_up_factor(&self) -> usize {
+        1 + self.n_law + self.n_strength
+    }
+
+    /// Number of model parameters.
+    #[inline]
+    pub fn len(&self) -> usize {
+        2 + self.n_law + self.n_strength
+    }
+
+    /// Always `false` (`c` and `φ` are always there).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
 }
 
 fn positive(name: &str, v: f64) -> Result<f64, FiberError> {
@@ -231,9 +293,8 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             b: material.vft_b / r.temperature,
             t_vf: material.vft_t_vf / r.temperature,
         };
-        let n_strength = physics.num_strength_params();
+        let params = ParamLayout::new(law.num_params(), physics.num_strength_params());
         Ok(FiberModel {
-            n_law: law.num_params(),
             law,
             rho_a: material.density_slope * r.temperature / r.density,
             rho_b: material.density_intercept / r.density,
@@ -250,7 +311,7 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             air: air.clone(),
             experiment: experiment.clone(),
             scaling,
-            n_strength,
+            params,
         })
     }
 
@@ -270,14 +331,21 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         v
     }
 
-    /// Index of the take-up factor `φ` in `p` (the last parameter).
-    pub fn take_up_factor_index(&self) -> usize {
-        1 + self.n_law + self.n_strength
+    /// Where each parameter sits in `p`.
+    #[inline]
+    pub fn param_layout(&self) -> ParamLayout {
+        self.params
     }
 
-    /// Index of the first law parameter in `p`.
+    /// Index of the take-up factor `φ` in `p` (the last parameter;
+    /// [`ParamLayout::take_up_factor`]).
+    pub fn take_up_factor_index(&self) -> usize {
+        self.params.take_up_factor()
+    }
+
+    /// Index of the first law parameter in `p` ([`ParamLayout::law`]).
     pub fn law_param_offset(&self) -> usize {
-        1
+        self.params.law().start
     }
 
     /// Index of the parameter `name` in `p`.
@@ -291,7 +359,7 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             .check_params(law_params)
             .map_err(FiberError::InvalidInput)?;
         finite("continuation parameter c", c)?;
-        let mut p = Vec::with_capacity(2 + self.n_law + self.n_strength);
+        let mut p = Vec::with_capacity(self.params.len());
         p.push(c);
         p.extend_from_slice(law_params);
         p.extend(self.physics.strength_parameters().iter().map(|(_, d)| *d));
@@ -301,10 +369,10 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
 
     /// Checks a full parameter vector (length, finiteness, law admissibility).
     pub fn check_parameters(&self, p: &[f64]) -> Result<(), FiberError> {
-        if p.len() != 2 + self.n_law + self.n_strength {
+        if p.len() != self.params.len() {
             return Err(FiberError::InvalidInput(format!(
                 "expected {} model parameters {:?}, got {}",
-                2 + self.n_law + self.n_strength,
+                self.params.len(),
                 self.param_names(),
                 p.len()
             )));
@@ -315,7 +383,7 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             )));
         }
         self.law
-            .check_params(&p[1..1 + self.n_law])
+            .check_params(&p[self.params.law()])
             .map_err(FiberError::InvalidInput)
     }
 
@@ -411,8 +479,8 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
     /// Values of all named terms at `s̃ = x` for `y` and full parameters `p`:
     /// `(name, balance, dimensionless value)` (strength applied, continuation factor `c` not).
     pub fn terms_at(&self, x: f64, y: &[f64], p: &[f64]) -> Vec<(&'static str, Balance, f64)> {
-        let lo = (1 + self.n_law).min(p.len());
-        let sp = &p[lo..(lo + self.n_strength).min(p.len())];
+        let strengths = self.params.strengths();
+        let sp = &p[strengths.start.min(p.len())..strengths.end.min(p.len())];
         let st = self.local_state(x, y, sp);
         self.physics.report(&st, sp, &self.co)
     }
@@ -424,14 +492,14 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
     }
 
     fn num_params(&self) -> usize {
-        2 + self.n_law + self.n_strength
+        self.params.len()
     }
 
     #[inline]
     fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        let c = p[0];
-        let lp = &p[1..1 + self.n_law];
-        let sp = &p[1 + self.n_law..1 + self.n_law + self.n_strength];
+        let c = p[ParamLayout::CONTINUATION];
+        let lp = &p[self.params.law()];
+        let sp = &p[self.params.strengths()];
         let st = self.local_state(x, y, sp);
         let (force, heat) = self.physics.sums(&st, sp, &self.co);
         let q = self.co.q;
@@ -449,9 +517,9 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
     }
 
     fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
-        let c = p[0];
-        let lp = &p[1..1 + self.n_law];
-        let sp = &p[1 + self.n_law..1 + self.n_law + self.n_strength];
+        let c = p[ParamLayout::CONTINUATION];
+        let lp = &p[self.params.law()];
+        let sp = &p[self.params.strengths()];
         let q = self.co.q;
         // inlet-velocity error (die swell): u(0) = (1 + δ) u_in; the stress-free fiber of c = 0
         // then has d = d_in/√(1 + δ)
@@ -460,12 +528,12 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
         r[0] = ya[0] - u_in;
         r[1] = match self.take_up {
             DimensionlessTakeUp::Diameter { d_out, d_in } => {
-                let phi = p[1 + self.n_law + self.n_strength];
+                let phi = p[self.params.take_up_factor()];
                 let target = c * phi * d_out + (-c + 1.0) * f_in.sqrt().recip() * d_in;
                 self.diameter(yb[0], self.density(yb[2])) / target - 1.0
             }
             DimensionlessTakeUp::Velocity { u_out } => {
-                let phi = p[1 + self.n_law + self.n_strength];
+                let phi = p[self.params.take_up_factor()];
                 let target = c * phi * u_out + (-c + 1.0) * u_in;
                 yb[0] / target - 1.0
             }

@@ -20,7 +20,7 @@
 //! ```
 
 use super::cold_start::{continuation_in_c, PathOptions};
-use super::contributions::{Balance, NusseltLaw};
+use super::contributions::{Balance, NusseltLaw, SiScales};
 use super::error::FiberError;
 use super::material_law::ViscosityLaw;
 use super::model::FiberModel;
@@ -128,11 +128,19 @@ impl FiberSolution {
         positions: &[f64],
     ) -> Profiles {
         let co = *model.coefficients();
-        let [u_o, n_o, t_o, rate_o, d_o, _, _, l_o] = co.si;
+        let SiScales {
+            velocity: u_o,
+            force: n_o,
+            temperature: t_o,
+            strain_rate: rate_o,
+            diameter: d_o,
+            length: l_o,
+            ..
+        } = co.si;
         let mu_o = model.scaling.reference.viscosity;
         let p = &self.solution.params;
-        let n_law = model.law.num_params();
-        let lp = &p[1..(1 + n_law).min(p.len())];
+        let law = model.param_layout().law();
+        let lp = &p[law.start..law.end.min(p.len())];
         let mut out = Profiles::default();
         let mut y = [0.0; 4];
         let mut yp = [0.0; 4];

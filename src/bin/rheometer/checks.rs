@@ -2,7 +2,7 @@
 //! refused with the flag and value named before any work starts, and failures of one
 //! experiment's simulation named with the experiment and its TOML line.
 
-use diffbvp::fiber::diagnostics::candidates::Effect;
+use diffbvp::fiber::effects::Effect;
 use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::input::{parse_experiments, Location, MAX_PLAUSIBLE_DIAMETER_M};
 use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;

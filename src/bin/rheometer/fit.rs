@@ -141,8 +141,11 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
                 &inputs,
             )?;
         }
+        let newtonian = rh
+            .newtonian_solutions(id.kappa, &opts)
+            .map_err(figures::FigureError::Model)?;
         let written =
-            figures::identification_figures(&rh, &id, &opts, &dir, g.format.ext(), &inputs)?;
+            figures::identification_figures(&rh, &id, &newtonian, &dir, g.format.ext(), &inputs)?;
         for w in written {
             g.say(format!("wrote {}", w.display()));
         }

@@ -2,15 +2,15 @@
 //! from your own TOML + CSV measurements.
 
 use clap::{Parser, Subcommand, ValueEnum};
-use diffbvp::fiber::diagnostics::candidates::{
-    physics_with, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
-};
 use diffbvp::fiber::diagnostics::compare::{
     compare, simulate_experiments, CompareOptions, FigureFormat, FitParameters, MissingTakeUp,
     ModelSetup,
 };
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, ResidualProfiles};
 use diffbvp::fiber::diagnostics::report::save_residual_figure;
+use diffbvp::fiber::effects::{
+    physics_with, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+};
 use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
@@ -21,8 +21,6 @@ use diffbvp::fiber::output::{
 use diffbvp::fiber::rheometer::{
     Estimator, FitReport, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
 };
-use diffbvp::fiber::setup::TakeUp;
-use diffbvp::fiber::smoothing::smooth;
 use diffbvp::fiber::{CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::error::Error;

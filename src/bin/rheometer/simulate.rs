@@ -3,6 +3,7 @@
 use crate::*;
 use diffbvp::fiber::input::Location;
 use diffbvp::fiber::simulate;
+use diffbvp::fiber::take_up::{resolve_take_up, TakeUpError};
 
 /// Arguments of `rheometer simulate`.
 #[derive(clap::Args)]
@@ -79,19 +80,21 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             .into());
         }
         let mut e = e.clone();
-        let mut from_data = None;
-        if e.take_up.is_none() {
-            if let Some(d) = take_up_diameter {
-                e.take_up = Some(TakeUp::Diameter(d));
-            } else if take_up_from_data {
-                let m = set.measurements[k].as_ref().ok_or_else(|| {
-                    format!(
+        let rule = if let Some(d) = take_up_diameter {
+            MissingTakeUp::Diameter(d)
+        } else if take_up_from_data {
+            MissingTakeUp::FromData
+        } else {
+            MissingTakeUp::Error
+        };
+        let resolved = resolve_take_up(&e, set.measurements[k].as_ref(), rule, None).map_err(
+            |err| -> Box<dyn std::error::Error> {
+                match err {
+                    TakeUpError::NoMeasurements => format!(
                         "experiment {}: --take-up-from-data needs measurements",
                         e.name
-                    )
-                })?;
-                let f = smooth(&m.positions, &m.diameters).map_err(|err| {
-                    format!(
+                    ),
+                    TakeUpError::Smoothing(err) => format!(
                         "experiment {} ({}): --take-up-from-data: smoothing the measurements \
                          failed: {err}",
                         e.name,
@@ -99,21 +102,19 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
                             path: experiments.clone(),
                             line: loaded.details[k].line,
                         }
-                    )
-                })?;
-                let d = f.diameter(e.spinline_length);
-                from_data = Some(d);
-                e.take_up = Some(TakeUp::Diameter(d));
-            } else {
-                return Err(format!(
-                    "experiment {} has no take-up condition: give take_up_diameter_m or take_up_velocity_m_s \
-                     in {}, or use --take-up-diameter M or --take-up-from-data",
-                    e.name,
-                    experiments.display()
-                )
-                .into());
-            }
-        }
+                    ),
+                    TakeUpError::Missing => format!(
+                        "experiment {} has no take-up condition: give take_up_diameter_m or take_up_velocity_m_s \
+                         in {}, or use --take-up-diameter M or --take-up-from-data",
+                        e.name,
+                        experiments.display()
+                    ),
+                }
+                .into()
+            },
+        )?;
+        let from_data = resolved.from_data;
+        e.take_up = Some(resolved.take_up);
         // a failure names the experiment, its TOML line and likely causes
         let failed = |source: diffbvp::fiber::FiberError| {
             let mut f = ExperimentFailure::new(

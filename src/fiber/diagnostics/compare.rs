@@ -19,30 +19,30 @@
 //! **Statistics** (all on the relative residuals):
 //! * *noise level* `σ`: the data set's `relative_uncertainty` if given (or
 //!   [`CompareOptions::relative_uncertainty`]), else estimated from the data by
-//!   [`residual_stats::estimate_noise`] — the robust (MAD) standard deviation of normalised
+//!   [`noise_mad_second_differences`](crate::fiber::statistics::noise_mad_second_differences) — the robust (MAD) standard deviation of normalised
 //!   second differences of consecutive residuals along `s`, which cancel any residual that is
 //!   locally linear in `s`, so a smooth systematic misfit does not inflate the noise estimate;
 //! * `χ² = Σ r²/σ²` over all points with `dof = N − p` (`p` fitted parameters);
 //! * whiteness: the Wald–Wolfowitz runs test on the residual signs
-//!   ([`residual_stats::RunsTest`]) and the lag-1 autocorrelation, per experiment and pooled;
+//!   ([`RunsTest`]) and the lag-1 autocorrelation, per experiment and pooled;
 //! * where: systematic segments of the pooled residual profile ([`segments`]), pooled over all
 //!   experiments and per experiment;
 //! * trends: Spearman rank correlations of the residual with strain rate, temperature, speed.
 
 pub mod compare_figures;
 pub mod model_runs;
-pub mod residual_stats;
 pub mod segments;
 pub mod summary_text;
 
+pub use crate::fiber::statistics::RunsTest;
 pub use model_runs::{compare_set, simulate_experiments, FitParameters, MissingTakeUp, ModelSetup};
-pub use residual_stats::RunsTest;
 pub use segments::{Segment, SegmentOptions, Station};
 
 use crate::fiber::error::FiberError;
 use crate::fiber::output::{create_output_dir, write_text, OutputError};
 use crate::fiber::simulate::Profiles;
 use crate::fiber::smoothing::SmoothingError;
+use crate::fiber::statistics;
 use crate::plot::PlotError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -242,7 +242,7 @@ pub fn compare(
             )
         })
         .collect();
-    let sigma_estimated = residual_stats::estimate_noise(&series);
+    let sigma_estimated = statistics::noise_mad_second_differences(&series);
     let given = options.relative_uncertainty.or(set_uncertainty);
     if let Some(s) = given {
         if !(s > 0.0 && s.is_finite()) {
@@ -272,7 +272,7 @@ pub fn compare(
     let dof = n_points.saturating_sub(options.fitted_parameters);
     let runs_each: Vec<RunsTest> = experiments.iter().map(|e| e.runs).collect();
     let seqs: Vec<&[f64]> = series.iter().map(|(_, r)| r.as_slice()).collect();
-    let (lag1, pairs) = residual_stats::lag1_autocorrelation(&seqs);
+    let (lag1, pairs) = statistics::lag1_autocorrelation_about_mean(&seqs);
     let all = |f: fn(&ComparedPoint) -> f64| -> Vec<f64> {
         experiments
             .iter()
@@ -288,7 +288,7 @@ pub fn compare(
     .into_iter()
     .map(|(q, x)| Trend {
         quantity: q.into(),
-        spearman: residual_stats::spearman(&x, &residuals),
+        spearman: statistics::spearman(&x, &residuals),
     })
     .collect();
     Ok(Comparison {
@@ -358,7 +358,7 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
     }
     let r: Vec<f64> = points.iter().map(|p| p.residual).collect();
     let m = n as f64;
-    let (lag1, _) = residual_stats::lag1_autocorrelation(&[&r]);
+    let (lag1, _) = statistics::lag1_autocorrelation_about_mean(&[&r]);
     Ok(ComparedExperiment {
         name: run.name.clone(),
         curve_position_m: run.curve.position.clone(),

@@ -23,14 +23,15 @@
 //! 5. **Indistinguishable** candidates: cosine of their orthogonalised signatures above
 //!    [`DiagnoseOptions::indistinguishable_cosine`] (0.9) in absolute value.
 
-use super::candidates::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use super::scores::{cosine, linear_scores};
+use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::fiber::rheometer::estimator::RelativeResidual;
 use crate::fiber::rheometer::{
     AtBound, Estimator, FitReport, FitStart, Identification, IdentifyOptions, Layout, Rheometer,
     RheometerError,
 };
 use crate::fiber::setup::ExperimentSet;
+use crate::fiber::statistics::{lag1_autocorrelation_about_zero, noise_rms_second_differences};
 use crate::fiber::FiberError;
 use crate::sensitivity::{residual_jacobian, Sensitivities};
 use crate::solution::Solution;
@@ -190,31 +191,12 @@ fn residual_profiles(rh: &Rheometer, sols: &[Solution]) -> ResidualProfiles {
         .collect()
 }
 
-/// Noise estimate from second differences of the residuals along each spin line (which removes
-/// locally linear misfit): `σ̂² = Σ (r_{j+1} − 2 r_j + r_{j−1})² / (6 · count)`.
-pub fn difference_noise(profiles: &ResidualProfiles) -> f64 {
-    let (mut s, mut c) = (0.0, 0usize);
-    for (_, p) in profiles {
-        for w in p.windows(3) {
-            let d = w[2].1 - 2.0 * w[1].1 + w[0].1;
-            s += d * d;
-            c += 1;
-        }
-    }
-    (s / (6 * c.max(1)) as f64).sqrt()
-}
-
-/// Pooled lag-1 autocorrelation of the residuals and the number of pairs.
-pub fn lag1_autocorrelation(profiles: &ResidualProfiles) -> (f64, usize) {
-    let (mut num, mut den, mut c) = (0.0, 0.0, 0usize);
-    for (_, p) in profiles {
-        for w in p.windows(2) {
-            num += w[0].1 * w[1].1;
-            c += 1;
-        }
-        den += p.iter().map(|v| v.1 * v.1).sum::<f64>();
-    }
-    (if den > 0.0 { num / den } else { 0.0 }, c)
+/// The residuals of each profile (without positions), for [`statistics`](crate::fiber::statistics).
+fn residual_sequences(profiles: &ResidualProfiles) -> Vec<Vec<f64>> {
+    profiles
+        .iter()
+        .map(|(_, p)| p.iter().map(|v| v.1).collect())
+        .collect()
 }
 
 /// Where along `s` a residual change lies: the position of the largest pooled change and the
@@ -308,7 +290,7 @@ fn linearisation(
             };
             let (r, jl) = residual_jacobian(model, sol, &sens, &xs, &g)
                 .map_err(|e| sim_err(rh, k, FiberError::from(e)))?;
-            Ok((r, jl, model.take_up_factor_index()))
+            Ok((r, jl, model.param_layout().take_up_factor()))
         })
         .collect::<Result<_, RheometerError>>()?;
     let mut r = Vec::new();
@@ -369,12 +351,14 @@ pub fn diagnose(
 
     // systematic?
     let before = residual_profiles(&rh, &base.solutions);
+    let sequences = residual_sequences(&before);
+    let sequences: Vec<&[f64]> = sequences.iter().map(Vec::as_slice).collect();
     let (noise_level, noise_source) = match opts.relative_uncertainty.or(rh.relative_uncertainty) {
         Some(u) => (u, "data set"),
-        None => (difference_noise(&before), "estimated"),
+        None => (noise_rms_second_differences(&sequences), "estimated"),
     };
     let rms0 = base.rms_relative_residual;
-    let (rho1, pairs) = lag1_autocorrelation(&before);
+    let (rho1, pairs) = lag1_autocorrelation_about_zero(&sequences);
     let rms_over_noise = rms0 / noise_level;
     let mut systematic = rms_over_noise > 1.2 || rho1 * (pairs as f64).sqrt() > 3.0;
 

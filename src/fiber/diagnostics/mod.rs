@@ -4,12 +4,12 @@
 //! * [`compare`]: measured vs simulated diameters per experiment, residual statistics
 //!   (noise level, χ²/dof, runs test, lag-1 autocorrelation), systematic segments along the
 //!   spin line, text/JSON summaries and figures;
-//! * [`candidates`]: the candidate effects (canonical names, strength parameters, neutral
-//!   values), the model specification (law + effects) a rheometer fit uses;
+//! * the candidate effects themselves (canonical names, strength parameters, neutral values,
+//!   the model specification a rheometer fit uses) live below the model, in
+//!   [`effects`](crate::fiber::effects);
 //! * [`diagnose`]: ranking the candidates by the excess misfit they explain (linearised scores,
 //!   refits, information criteria) and the report in words.
 
-pub mod candidates;
 pub mod compare;
 pub mod diagnose;
 pub mod report;

@@ -16,8 +16,8 @@ impl Diagnosis {
         s.push_str(&format!(
             "[[Diagnosis: which effect is missing from the {} model?]]\n",
             match self.model {
-                super::candidates::LawChoice::Newtonian => "Newtonian",
-                super::candidates::LawChoice::Carreau => "Carreau-type",
+                crate::fiber::effects::LawChoice::Newtonian => "Newtonian",
+                crate::fiber::effects::LawChoice::Carreau => "Carreau-type",
             }
         ));
         s.push_str(&format!(

@@ -1,5 +1,5 @@
-//! Identification of `(n, κ)`: the prepared data, the start heuristic (paper Algorithm 2) and
-//! the bounded trust-region Gauss–Newton fit on the [`Objective`].
+//! Identification of `(n, κ)`: the start heuristic (paper Algorithm 2) and the bounded
+//! trust-region Gauss–Newton fit on the [`Objective`](super::objective::Objective).
 //!
 //! Every evaluation solves the `M` fiber BVPs in parallel (rayon), each warm-started from its
 //! last accepted solution (no continuation inside the fit, as in the paper), and builds the exact
@@ -7,108 +7,14 @@
 //! experiment). A BVP that fails at a trial point makes the whole trial point fail, which the
 //! driver treats as a rejected step.
 
+use super::data::Rheometer;
 use super::estimator::Estimator;
 use super::layout::{EffectSlot, FitStart};
-use super::objective::Objective;
-use super::report::{FitWarning, WarningCode};
-use crate::fiber::diagnostics::candidates::{LawChoice, ModelSpec};
-use crate::fiber::diagnostics::compare::residual_stats::median;
-use crate::fiber::error::FiberError;
-use crate::fiber::material_law::CarreauLike;
-use crate::fiber::model::FiberModel;
-use crate::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements, TakeUp};
-use crate::fiber::simulate::SimulateOptions;
-use crate::fiber::smoothing::{smooth, SmoothFit, SmoothingError};
-use crate::least_squares::{fit, FitError, FitOptions, FitResult};
+use super::options::{FitWarning, IdentifyOptions, RheometerError};
+use crate::fiber::effects::LawChoice;
+use crate::least_squares::{fit, FitOptions, FitResult};
 use crate::solution::Solution;
 use std::time::Instant;
-use thiserror::Error;
-
-/// The fiber model the rheometer identifies: Carreau-type law (a Newtonian model is `n = 1`),
-/// the paper's physics plus the effects of its [`ModelSpec`].
-pub type CarreauFiber = FiberModel<CarreauLike>;
-
-/// What can go wrong in the rheometer.
-#[derive(Debug, Error)]
-pub enum RheometerError {
-    /// Unusable data.
-    #[error("{0}")]
-    Data(String),
-    /// Smoothing an experiment's data failed.
-    #[error("experiment {experiment}: {source}")]
-    Smoothing {
-        /// Experiment name.
-        experiment: String,
-        /// Cause.
-        source: SmoothingError,
-    },
-    /// A fiber simulation failed.
-    #[error("experiment {experiment}: simulation at (n, κ) = ({n}, {kappa}) failed: {source}")]
-    Simulation {
-        /// Experiment name.
-        experiment: String,
-        /// Power index.
-        n: f64,
-        /// κ = ln K.
-        kappa: f64,
-        /// Cause.
-        source: FiberError,
-    },
-    /// The least-squares fit could not run.
-    #[error("fit: {0}")]
-    Fit(#[from] FitError),
-}
-
-/// Options of the identification.
-#[derive(Debug, Clone)]
-pub struct IdentifyOptions {
-    /// The cost to minimise.
-    pub estimator: Estimator,
-    /// Regular optimisation points per experiment for the paper's cost (`n_o`, default 20).
-    pub n_opt_points: usize,
-    /// BVP settings (tolerance 1e-6 by default).
-    pub simulate: SimulateOptions,
-    /// Lower bounds of `(n, κ)` (default `(0, 7)`, the paper's Ω).
-    pub lower: [f64; 2],
-    /// Upper bounds of `(n, κ)` (default `(1, 20)`).
-    pub upper: [f64; 2],
-    /// Bounds of the take-up factors `φ_k = d_out,k / d_fit,k(L)` (principled estimator;
-    /// default `(0.5, 1.5)`).
-    pub take_up_bounds: [f64; 2],
-    /// Gauss–Newton iteration limit (default 100).
-    pub max_iterations: usize,
-    /// Relative measurement uncertainty σ of the diameters; `None`: the data set's value, or 1.
-    pub relative_uncertainty: Option<f64>,
-}
-
-impl Default for IdentifyOptions {
-    fn default() -> Self {
-        let simulate = SimulateOptions {
-            factor_at_solution: true,
-            ..SimulateOptions::default()
-        };
-        IdentifyOptions {
-            estimator: Estimator::Principled,
-            n_opt_points: 20,
-            simulate,
-            lower: [0.0, 7.0],
-            upper: [1.0, 20.0],
-            take_up_bounds: [0.5, 1.5],
-            max_iterations: 100,
-            relative_uncertainty: None,
-        }
-    }
-}
-
-impl IdentifyOptions {
-    /// Default options with the given estimator.
-    pub fn with_estimator(estimator: Estimator) -> Self {
-        IdentifyOptions {
-            estimator,
-            ..Default::default()
-        }
-    }
-}
 
 /// The eleven start points `(n, κ)` of the paper's Table 3 (κ = ln 10⁴, ln 10⁵, ln 10⁶).
 pub const PAPER_TABLE3_STARTS: [[f64; 2]; 11] = [
@@ -125,119 +31,7 @@ pub const PAPER_TABLE3_STARTS: [[f64; 2]; 11] = [
     [0.9, 13.82],
 ];
 
-/// Prepared data: smoothed measurements and one fiber model per experiment.
-#[derive(Debug)]
-pub struct Rheometer {
-    /// The polymer.
-    pub material: Material,
-    /// The air.
-    pub air: Air,
-    /// Experiments (take-up condition set to `d_fit(L)` where the data set gives none).
-    pub experiments: Vec<Experiment>,
-    /// Raw measurements.
-    pub measurements: Vec<Measurements>,
-    /// Ansatz fits of the measurements.
-    pub smoothing: Vec<SmoothFit>,
-    /// One model per experiment.
-    pub models: Vec<CarreauFiber>,
-    /// Relative measurement uncertainty from the data set, if given.
-    pub relative_uncertainty: Option<f64>,
-    /// The model: law, effects, neutral candidates.
-    pub spec: ModelSpec,
-}
-
 impl Rheometer {
-    /// Smooths every experiment's data and builds its model (the paper's: Carreau-type law,
-    /// no extra effects). Experiments without measurements are an error (the rheometer needs
-    /// data for each).
-    pub fn new(set: &ExperimentSet) -> Result<Self, RheometerError> {
-        Self::with_spec(set, ModelSpec::default())
-    }
-
-    /// As [`new`](Self::new) with the model `spec` (law, effects fitted or fixed, neutral
-    /// candidates).
-    pub fn with_spec(set: &ExperimentSet, spec: ModelSpec) -> Result<Self, RheometerError> {
-        spec.validate().map_err(RheometerError::Data)?;
-        if set.experiments.is_empty() {
-            return Err(RheometerError::Data(
-                "the data set has no experiments".into(),
-            ));
-        }
-        let mut experiments = Vec::new();
-        let mut measurements = Vec::new();
-        let mut smoothing = Vec::new();
-        let mut models = Vec::new();
-        for (e, m) in set.experiments.iter().zip(&set.measurements) {
-            let m = m.as_ref().ok_or_else(|| {
-                RheometerError::Data(format!("experiment {} has no measurements", e.name))
-            })?;
-            let f =
-                smooth(&m.positions, &m.diameters).map_err(|source| RheometerError::Smoothing {
-                    experiment: e.name.clone(),
-                    source,
-                })?;
-            let mut e = e.clone();
-            if e.take_up.is_none() {
-                e.take_up = Some(TakeUp::Diameter(f.diameter(e.spinline_length)));
-            }
-            let model = FiberModel::new(
-                &set.material,
-                &set.air,
-                &e,
-                CarreauLike::new(),
-                spec.physics(),
-            )
-            .map_err(|source| RheometerError::Simulation {
-                experiment: e.name.clone(),
-                n: f64::NAN,
-                kappa: f64::NAN,
-                source,
-            })?;
-            experiments.push(e);
-            measurements.push(m.clone());
-            smoothing.push(f);
-            models.push(model);
-        }
-        Ok(Rheometer {
-            material: set.material.clone(),
-            air: set.air.clone(),
-            experiments,
-            measurements,
-            smoothing,
-            models,
-            relative_uncertainty: set.relative_uncertainty,
-            spec,
-        })
-    }
-
-    /// Number of experiments.
-    pub fn len(&self) -> usize {
-        self.models.len()
-    }
-
-    /// Whether there are no experiments.
-    pub fn is_empty(&self) -> bool {
-        self.models.is_empty()
-    }
-
-    /// An objective at start point `(n, κ)` (cold starts of all experiments, in parallel).
-    pub fn objective(
-        &self,
-        start: [f64; 2],
-        options: &IdentifyOptions,
-    ) -> Result<Objective<'_>, RheometerError> {
-        Objective::new(self, &FitStart::at(start), options)
-    }
-
-    /// An objective for a general start (free candidates, start strengths, warm starts).
-    pub fn objective_from(
-        &self,
-        start: &FitStart,
-        options: &IdentifyOptions,
-    ) -> Result<Objective<'_>, RheometerError> {
-        Objective::new(self, start, options)
-    }
-
     /// Runs the identification from `start = (n, κ)`.
     pub fn identify(
         &self,
@@ -277,16 +71,15 @@ impl Rheometer {
                 )
             })
             .collect();
-        let local = obj.layout.local(
-            &fit_result.p[..ns],
-            1.0,
-            self.models[0].take_up_factor_index(),
-        );
+        let local = obj
+            .layout
+            .local(&fit_result.p[..ns], 1.0, obj.layout.params.take_up_factor());
+        let [n, kappa] = obj.layout.law_of(&local);
         Ok(Identification {
             estimator: options.estimator,
             start: start.law,
-            n: local[1],
-            kappa: local[2],
+            n,
+            kappa,
             take_up_factors: if options.estimator == Estimator::Principled {
                 fit_result.p[ns..].to_vec()
             } else {
@@ -309,6 +102,18 @@ impl Rheometer {
         })
     }
 
+    /// The Newtonian model (`n = 1`) at `kappa` with take-up factors 1, one solution per
+    /// experiment (cold starts; paper Fig. 3 draws it against the identified law).
+    pub fn newtonian_solutions(
+        &self,
+        kappa: f64,
+        options: &IdentifyOptions,
+    ) -> Result<Vec<Solution>, RheometerError> {
+        let mut obj = self.objective([1.0, kappa], options)?;
+        obj.cost_at(1.0, kappa)?;
+        Ok(obj.solutions())
+    }
+
     /// Paper Algorithm 2: with `n = n_init` (0.5), walk κ down from the upper bound in steps of
     /// 1 until the cost differs from the Newtonian cost by more than 10%.
     pub fn start_heuristic(&self, options: &IdentifyOptions) -> Result<StartPoint, RheometerError> {
@@ -329,67 +134,6 @@ impl Rheometer {
             newtonian_cost: j1,
             trace,
         })
-    }
-
-    /// Checks of the measured data that the model cannot describe, one warning per experiment:
-    /// the spin-line model draws the fiber down, so its diameter decreases along the spin line;
-    /// measured diameters whose last third lies above their first third (median against median)
-    /// cannot be fitted (reversed positions, a swapped column or the wrong file).
-    pub fn data_warnings(&self) -> Vec<FitWarning> {
-        let mut out = Vec::new();
-        for (e, m) in self.experiments.iter().zip(&self.measurements) {
-            let d = &m.diameters;
-            let third = d.len() / 3;
-            if third == 0 {
-                continue;
-            }
-            let first = median(&mut d[..third].to_vec());
-            let last = median(&mut d[d.len() - third..].to_vec());
-            if last >= first {
-                out.push(FitWarning::new(
-                    WarningCode::DataTrend,
-                    format!(
-                        "experiment {}: the measured diameters do not decrease along the spin \
-                         line (median {:.4e} m over the first third of the points, {:.4e} m over \
-                         the last third); a drawn fiber thins towards the take-up, so the model \
-                         cannot describe these data: check the data file (reversed positions, \
-                         swapped columns, wrong file)",
-                        e.name, first, last
-                    ),
-                ));
-            }
-        }
-        out
-    }
-
-    /// RMS of `(d_model − d_meas)/d_meas` over all measurements for the given solutions.
-    pub fn rms_relative_residual(&self, solutions: &[Solution]) -> f64 {
-        let (mut sum, mut count) = (0.0, 0usize);
-        for (k, sol) in solutions.iter().enumerate() {
-            for r in self.relative_residuals(k, sol) {
-                sum += r * r;
-                count += 1;
-            }
-        }
-        (sum / count.max(1) as f64).sqrt()
-    }
-
-    /// `(d_model − d_meas)/d_meas` at the measurement positions of experiment `k`.
-    pub fn relative_residuals(&self, k: usize, sol: &Solution) -> Vec<f64> {
-        let model = &self.models[k];
-        let lo = model.scaling.reference.length;
-        let m = &self.measurements[k];
-        let mut y = [0.0; 4];
-        let mut yp = [0.0; 4];
-        m.positions
-            .iter()
-            .zip(&m.diameters)
-            .map(|(&s, &d)| {
-                sol.eval_into(s / lo, &mut y, &mut yp);
-                let dm = model.diameter(y[0], model.density(y[2])) * model.scaling.diameter();
-                dm / d - 1.0
-            })
-            .collect()
     }
 }
 

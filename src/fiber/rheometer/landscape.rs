@@ -20,7 +20,8 @@
 //! every grid point) and says for every point whether it was computed, failed, or not reached
 //! ([`PointStatus`]).
 
-use super::identify::{IdentifyOptions, Rheometer, RheometerError};
+use super::data::Rheometer;
+use super::options::{IdentifyOptions, RheometerError};
 use crate::continuation::{bisect_step, secant_guess};
 use crate::solution::Solution;
 use crate::solve::Guess;

@@ -1,5 +1,5 @@
 //! Which model parameters a fit frees: the law's `(n, κ)`, effect strengths (see
-//! [`candidates`](crate::fiber::diagnostics::candidates)) and, for the principled estimator,
+//! [`effects`](crate::fiber::effects)) and, for the principled estimator,
 //! one take-up factor per experiment.
 //!
 //! Every experiment's model has the same parameter layout
@@ -8,10 +8,10 @@
 //! fitted) followed by the fitted strengths (in model-parameter units, e.g. `1 + s` for
 //! `nusselt_scale`).
 
-use super::identify::{CarreauFiber, IdentifyOptions, RheometerError};
-use crate::fiber::diagnostics::candidates::{
-    Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
-};
+use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
+use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::fiber::material_law::CarreauLike;
+use crate::fiber::model::ParamLayout;
 use crate::solution::Solution;
 
 /// Start of a fit.
@@ -72,6 +72,9 @@ pub struct Layout {
     pub upper: Vec<f64>,
     /// The effects of the model (fixed or fitted; neutral candidates not freed are left out).
     pub effects: Vec<EffectSlot>,
+    /// Where `n`, `κ`, the strengths and `φ` sit in the local parameters (the same for every
+    /// experiment's model).
+    pub params: ParamLayout,
 }
 
 impl Layout {
@@ -91,7 +94,11 @@ impl Layout {
         let mut template = model.parameters(1.0, &start.law).map_err(|e| {
             RheometerError::Data(format!("start (n, kappa) = {:?}: {e}", start.law))
         })?;
-        let (ni, ki) = (1, 2);
+        let params = model.param_layout();
+        let (ni, ki) = (
+            params.law_param(CarreauLike::N),
+            params.law_param(CarreauLike::KAPPA),
+        );
         let (mut n_free, mut k_free) = (spec.law == LawChoice::Carreau, false);
         if spec.law == LawChoice::Newtonian {
             template[ni] = 1.0;
@@ -193,6 +200,7 @@ impl Layout {
             lower: l2,
             upper: u2,
             effects,
+            params,
         })
     }
 
@@ -206,7 +214,22 @@ impl Layout {
         self.free.iter().map(|&i| self.template[i]).collect()
     }
 
-    /// The local parameters for shared values `shared` and take-up factor `phi`.
+    /// `(n, κ)` of local parameters `local`.
+    pub fn law_of(&self, local: &[f64]) -> [f64; 2] {
+        [
+            local[self.params.law_param(CarreauLike::N)],
+            local[self.params.law_param(CarreauLike::KAPPA)],
+        ]
+    }
+
+    /// Sets `(n, κ)` of the template (overriding the start or fixed values).
+    pub fn set_law(&mut self, n: f64, kappa: f64) {
+        self.template[self.params.law_param(CarreauLike::N)] = n;
+        self.template[self.params.law_param(CarreauLike::KAPPA)] = kappa;
+    }
+
+    /// The local parameters for shared values `shared` and take-up factor `phi` (at
+    /// `phi_index`, [`ParamLayout::take_up_factor`]).
     pub fn local(&self, shared: &[f64], phi: f64, phi_index: usize) -> Vec<f64> {
         let mut p = self.template.clone();
         for (&i, &v) in self.free.iter().zip(shared) {

@@ -4,8 +4,12 @@
 //! * [`estimator`]: the two cost functions — the paper's strain-rate-weighted distance to the
 //!   smoothed data, and the statistically principled relative least squares against the raw
 //!   measurements with the take-up diameters as nuisance parameters;
-//! * [`identify`]: the prepared data ([`Rheometer`]), the start-point heuristic (paper
-//!   Algorithm 2) and the bounded trust-region Gauss–Newton fit;
+//! * [`options`]: what the modules share (the model type, the error, the options of an
+//!   identification, the warnings of a fit);
+//! * [`data`]: the prepared data ([`Rheometer`]: smoothed measurements, one model per
+//!   experiment);
+//! * [`identify`]: the start-point heuristic (paper Algorithm 2) and the bounded trust-region
+//!   Gauss–Newton fit;
 //! * [`objective`]: the least-squares objective over all experiments (solved in parallel,
 //!   warm-started, exact Jacobians from forward sensitivities);
 //! * [`layout`]: which parameters are fitted (law, effect strengths, take-up factors);
@@ -14,17 +18,19 @@
 //!   of a fit (estimates at bounds, misfit, huge errors, data the model cannot describe) and the
 //!   text and JSON reports.
 
+pub mod data;
 pub mod estimator;
 pub mod identify;
 pub mod landscape;
 pub mod layout;
 pub mod objective;
+pub mod options;
 pub mod report;
 
+pub use data::Rheometer;
 pub use estimator::Estimator;
-pub use identify::{
-    Identification, IdentifyOptions, Rheometer, RheometerError, StartPoint, PAPER_TABLE3_STARTS,
-};
+pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout};
+pub use options::{CarreauFiber, IdentifyOptions, RheometerError};
 pub use report::{AtBound, BoundSide, EffectReport, FitReport, FitWarning, WarningCode};

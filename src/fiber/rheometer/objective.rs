@@ -4,9 +4,10 @@
 //! point is reported to the driver as a failed evaluation (a rejected step), and the last
 //! accepted solutions stay the warm starts.
 
+use super::data::Rheometer;
 use super::estimator::{Estimator, PaperResidual, RelativeResidual};
-use super::identify::{CarreauFiber, IdentifyOptions, Rheometer, RheometerError};
 use super::layout::{FitStart, Layout};
+use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
 use crate::fiber::error::FiberError;
 use crate::fiber::simulate::simulate_params;
 use crate::least_squares::{BvpResiduals, BvpRun, LeastSquaresProblem, ParamMap, RunError};
@@ -71,6 +72,26 @@ pub struct Objective<'a> {
     names: Vec<String>,
     options: IdentifyOptions,
     pub(super) layout: Layout,
+}
+
+impl Rheometer {
+    /// An objective at start point `(n, κ)` (cold starts of all experiments, in parallel).
+    pub fn objective(
+        &self,
+        start: [f64; 2],
+        options: &IdentifyOptions,
+    ) -> Result<Objective<'_>, RheometerError> {
+        Objective::new(self, &FitStart::at(start), options)
+    }
+
+    /// An objective for a general start (free candidates, start strengths, warm starts).
+    pub fn objective_from(
+        &self,
+        start: &FitStart,
+        options: &IdentifyOptions,
+    ) -> Result<Objective<'_>, RheometerError> {
+        Objective::new(self, start, options)
+    }
 }
 
 impl<'a> Objective<'a> {
@@ -228,8 +249,7 @@ impl<'a> Objective<'a> {
     /// Global parameters at `(n, κ)` (overriding the template's law values), strengths at their
     /// start values, take-up factors 1.
     fn global_at(&mut self, n: f64, kappa: f64) -> Vec<f64> {
-        self.layout.template[1] = n;
-        self.layout.template[2] = kappa;
+        self.layout.set_law(n, kappa);
         self.sync_maps();
         self.initial_parameters()
     }

@@ -15,7 +15,7 @@
 //!   JSON) and the text prints no interval for it.
 //! * **Misfit far above the noise.** The RMS relative residual is compared with the noise level:
 //!   the declared `relative_uncertainty` (options or TOML) if given, else the robust estimate of
-//!   [`estimate_noise`] (second differences of the residuals along each spin line). Above
+//!   [`noise_mad_second_differences`] (second differences of the residuals along each spin line). Above
 //!   [`MISFIT_RATIO`] times the noise the report warns and names the worst experiments.
 //! * **Huge standard errors**: `SE(n) >` [`LARGE_STDERR_N`], `SE(κ) >` [`LARGE_STDERR_KAPPA`],
 //!   a fitted strength with a standard error above [`LARGE_STDERR_STRENGTH_FRACTION`] of its
@@ -32,11 +32,11 @@
 
 use super::estimator::Estimator;
 use super::identify::Identification;
-use crate::fiber::diagnostics::candidates::LawChoice;
-use crate::fiber::diagnostics::compare::residual_stats::estimate_noise;
+pub use super::options::{FitWarning, WarningCode};
+use crate::fiber::effects::LawChoice;
+use crate::fiber::statistics::noise_mad_second_differences;
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::{Deserialize, Serialize};
-use std::fmt;
 
 /// An estimate counts as at a bound when it is within this fraction of the width of its search
 /// range from the bound (e.g. `0.001` for `n ∈ [0, 1]`, `0.013` for `κ ∈ [7, 20]`).
@@ -96,60 +96,6 @@ pub struct AtBound {
     pub bound: f64,
     /// The estimate (same unit).
     pub value: f64,
-}
-
-/// What a [`FitWarning`] is about.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum WarningCode {
-    /// An estimate at a bound of its search range (its interval is not valid).
-    AtBound,
-    /// RMS relative residual far above the noise level.
-    Misfit,
-    /// A huge standard error or an unbounded interval: the data do not determine a parameter.
-    LargeUncertainty,
-    /// `JᵀJ` is singular: no standard errors.
-    SingularCovariance,
-    /// The covariance is numerically ill-conditioned.
-    IllConditioned,
-    /// Measured data the model cannot describe (e.g. diameters increasing along the spin line).
-    DataTrend,
-}
-
-impl WarningCode {
-    /// The code as written in JSON (`"at_bound"`, `"misfit"`, ...).
-    pub fn name(&self) -> &'static str {
-        match self {
-            WarningCode::AtBound => "at_bound",
-            WarningCode::Misfit => "misfit",
-            WarningCode::LargeUncertainty => "large_uncertainty",
-            WarningCode::SingularCovariance => "singular_covariance",
-            WarningCode::IllConditioned => "ill_conditioned",
-            WarningCode::DataTrend => "data_trend",
-        }
-    }
-}
-
-/// A warning about a fit (JSON: `{"code": "at_bound", "message": "..."}`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FitWarning {
-    /// What it is about.
-    pub code: WarningCode,
-    /// The finding in words, naming the parameter or experiment.
-    pub message: String,
-}
-
-impl FitWarning {
-    /// A warning with `code` and `message`.
-    pub fn new(code: WarningCode, message: String) -> Self {
-        FitWarning { code, message }
-    }
-}
-
-impl fmt::Display for FitWarning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "[{}] {}", self.code.name(), self.message)
-    }
 }
 
 /// Which bound `value` is at (within [`AT_BOUND_TOLERANCE`] of the range width), if any.
@@ -437,7 +383,7 @@ impl FitReport {
         let (noise_level, noise_source) = match id.relative_uncertainty {
             Some(s) => (s, "declared relative_uncertainty".to_string()),
             None => (
-                estimate_noise(&id.residual_profiles),
+                noise_mad_second_differences(&id.residual_profiles),
                 "estimated from second differences of the residuals".to_string(),
             ),
         };

@@ -2,27 +2,17 @@
 //! conditions (from the data set, from the smoothed data, or as fitted) and the physics.
 
 use super::{compare, CompareError, CompareOptions, Comparison, SimulatedExperiment};
-use crate::fiber::diagnostics::candidates::Effect;
+use crate::fiber::effects::Effect;
 use crate::fiber::error::Readable;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
-use crate::fiber::setup::{ExperimentSet, TakeUp};
+use crate::fiber::setup::ExperimentSet;
 use crate::fiber::simulate::{simulate_params, SimulateOptions};
-use crate::fiber::smoothing::smooth;
+pub use crate::fiber::take_up::MissingTakeUp;
+use crate::fiber::take_up::{resolve_take_up, TakeUpError};
 use crate::fiber::Physics;
 use crate::mesh::linspace;
 use rayon::prelude::*;
-
-/// What to do for an experiment whose data set gives no take-up condition.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum MissingTakeUp {
-    /// An error naming the experiment.
-    Error,
-    /// `d_fit(L)` of the smoothed measurements (the rheometer's convention).
-    FromData,
-    /// This take-up diameter (m).
-    Diameter(f64),
-}
 
 /// The model to compare with: Carreau-type law parameters, take-up conditions and physics.
 pub struct ModelSetup<'a> {
@@ -99,36 +89,32 @@ pub fn simulate_experiments(
                 ))
             })?;
             let mut e = e.clone();
-            if e.take_up.is_none() {
-                e.take_up = Some(match setup.missing_take_up {
-                    MissingTakeUp::Error => {
-                        return Err(CompareError::Data(format!(
+            let resolved = resolve_take_up(&e, Some(m), setup.missing_take_up, None).map_err(
+                |err| match err {
+                    TakeUpError::Smoothing(source) => CompareError::Smoothing {
+                        experiment: e.name.clone(),
+                        source,
+                    },
+                    TakeUpError::Missing | TakeUpError::NoMeasurements => {
+                        CompareError::Data(format!(
                             "experiment {} has no take-up condition: give take_up_diameter_m \
                              or take_up_velocity_m_s in the TOML, or take it from the data",
                             e.name
-                        )))
+                        ))
                     }
-                    MissingTakeUp::Diameter(d) => TakeUp::Diameter(d),
-                    MissingTakeUp::FromData => {
-                        let f = smooth(&m.positions, &m.diameters).map_err(|source| {
-                            CompareError::Smoothing {
-                                experiment: e.name.clone(),
-                                source,
-                            }
-                        })?;
-                        let d = f.diameter(e.spinline_length);
-                        if !(d.is_finite() && d > 0.0) {
-                            return Err(CompareError::Data(format!(
-                                "experiment {}: the take-up diameter d_fit(L) = {d} m of the \
-                                 smoothed measurements is not a positive number; give \
-                                 take_up_diameter_m in the TOML",
-                                e.name
-                            )));
-                        }
-                        TakeUp::Diameter(d)
-                    }
-                });
+                },
+            )?;
+            if let Some(d) = resolved.from_data {
+                if !(d.is_finite() && d > 0.0) {
+                    return Err(CompareError::Data(format!(
+                        "experiment {}: the take-up diameter d_fit(L) = {d} m of the \
+                         smoothed measurements is not a positive number; give \
+                         take_up_diameter_m in the TOML",
+                        e.name
+                    )));
+                }
             }
+            e.take_up = Some(resolved.take_up);
             let model = FiberModel::new(
                 &set.material,
                 &set.air,
@@ -139,7 +125,7 @@ pub fn simulate_experiments(
             .map_err(sim_err)?;
             let mut p = model.parameters(1.0, &setup.law_params).map_err(sim_err)?;
             if let Some(f) = &setup.take_up_factors {
-                p[model.take_up_factor_index()] = f[k];
+                p[model.param_layout().take_up_factor()] = f[k];
             }
             let sol = simulate_params(&model, &p, None, &setup.simulate).map_err(sim_err)?;
             let curve = if setup.curve_points >= 2 {

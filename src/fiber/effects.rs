@@ -206,10 +206,10 @@ impl Effect {
         match self {
             Effect::StrainThinning => "n",
             Effect::Radiation => "radiation",
-            Effect::AirCoflow { .. } => "coflow",
-            Effect::AirTemperatureProfile { .. } => "warm_air",
+            Effect::AirCoflow { .. } => "air_coflow",
+            Effect::AirTemperatureProfile { .. } => "air_temperature_profile",
             Effect::InletVelocity => "inlet_velocity",
-            Effect::NusseltScale => "convection",
+            Effect::NusseltScale => "nusselt_scale",
             Effect::Custom(u) => u.name,
         }
     }
@@ -245,19 +245,20 @@ impl Effect {
     /// `strain_thinning`, which lives in the law).
     pub fn apply(&self, physics: Physics) -> Physics {
         let par = Strength::Parameter(self.param_value(self.neutral()));
-        match self {
-            Effect::StrainThinning => physics,
-            Effect::Radiation => physics.with_radiation(1.0).strength("radiation", par),
-            Effect::AirCoflow { decay_length } => physics
-                .with_coflow(1.0, *decay_length)
-                .strength("coflow", par),
-            Effect::AirTemperatureProfile { decay_length } => physics
-                .with_warm_air(1.0, *decay_length)
-                .strength("warm_air", par),
-            Effect::InletVelocity => physics.with_inlet_velocity_error(0.0),
-            Effect::NusseltScale => physics.strength("convection", par),
-            Effect::Custom(u) => (u.add)(physics).strength(u.name, par),
-        }
+        let added = match self {
+            Effect::StrainThinning => return physics,
+            Effect::Radiation => physics.with_radiation(1.0),
+            Effect::AirCoflow { decay_length } => physics.with_coflow(1.0, *decay_length),
+            Effect::AirTemperatureProfile { decay_length } => {
+                physics.with_warm_air(1.0, *decay_length)
+            }
+            Effect::InletVelocity => physics,
+            Effect::NusseltScale => physics,
+            Effect::Custom(u) => (u.add)(physics),
+        };
+        added
+            .strength(self.model_param(), par)
+            .expect("the effect's strength exists once the effect is added")
     }
 }
 
@@ -280,7 +281,9 @@ impl Effect {
             ));
         }
         let par = Strength::Parameter(self.param_value(strength));
-        Ok(self.apply(physics).strength(self.model_param(), par))
+        self.apply(physics)
+            .strength(self.model_param(), par)
+            .map_err(|e| e.to_string())
     }
 }
 

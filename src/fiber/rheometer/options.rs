@@ -1,0 +1,155 @@
+//! Types the rheometer's modules share: the model type, the error, the options of an
+//! identification and the warnings of a fit. The layers inside the rheometer, bottom to top:
+//! `options`, `estimator` → `data` → `layout` → `objective` → `identify` → `report`,
+//! `landscape`.
+
+use super::estimator::Estimator;
+use crate::fiber::error::FiberError;
+use crate::fiber::material_law::CarreauLike;
+use crate::fiber::model::FiberModel;
+use crate::fiber::simulate::SimulateOptions;
+use crate::fiber::smoothing::SmoothingError;
+use crate::least_squares::FitError;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use thiserror::Error;
+
+/// The fiber model the rheometer identifies: Carreau-type law (a Newtonian model is `n = 1`),
+/// the paper's physics plus the effects of its [`ModelSpec`](crate::fiber::effects::ModelSpec).
+pub type CarreauFiber = FiberModel<CarreauLike>;
+
+/// What can go wrong in the rheometer.
+#[derive(Debug, Error)]
+pub enum RheometerError {
+    /// Unusable data.
+    #[error("{0}")]
+    Data(String),
+    /// Smoothing an experiment's data failed.
+    #[error("experiment {experiment}: {source}")]
+    Smoothing {
+        /// Experiment name.
+        experiment: String,
+        /// Cause.
+        source: SmoothingError,
+    },
+    /// A fiber simulation failed.
+    #[error("experiment {experiment}: simulation at (n, κ) = ({n}, {kappa}) failed: {source}")]
+    Simulation {
+        /// Experiment name.
+        experiment: String,
+        /// Power index.
+        n: f64,
+        /// κ = ln K.
+        kappa: f64,
+        /// Cause.
+        source: FiberError,
+    },
+    /// The least-squares fit could not run.
+    #[error("fit: {0}")]
+    Fit(#[from] FitError),
+}
+
+/// Options of the identification.
+#[derive(Debug, Clone)]
+pub struct IdentifyOptions {
+    /// The cost to minimise.
+    pub estimator: Estimator,
+    /// Regular optimisation points per experiment for the paper's cost (`n_o`, default 20).
+    pub n_opt_points: usize,
+    /// BVP settings (tolerance 1e-6 by default).
+    pub simulate: SimulateOptions,
+    /// Lower bounds of `(n, κ)` (default `(0, 7)`, the paper's Ω).
+    pub lower: [f64; 2],
+    /// Upper bounds of `(n, κ)` (default `(1, 20)`).
+    pub upper: [f64; 2],
+    /// Bounds of the take-up factors `φ_k = d_out,k / d_fit,k(L)` (principled estimator;
+    /// default `(0.5, 1.5)`).
+    pub take_up_bounds: [f64; 2],
+    /// Gauss–Newton iteration limit (default 100).
+    pub max_iterations: usize,
+    /// Relative measurement uncertainty σ of the diameters; `None`: the data set's value, or 1.
+    pub relative_uncertainty: Option<f64>,
+}
+
+impl Default for IdentifyOptions {
+    fn default() -> Self {
+        let simulate = SimulateOptions {
+            factor_at_solution: true,
+            ..SimulateOptions::default()
+        };
+        IdentifyOptions {
+            estimator: Estimator::Principled,
+            n_opt_points: 20,
+            simulate,
+            lower: [0.0, 7.0],
+            upper: [1.0, 20.0],
+            take_up_bounds: [0.5, 1.5],
+            max_iterations: 100,
+            relative_uncertainty: None,
+        }
+    }
+}
+
+impl IdentifyOptions {
+    /// Default options with the given estimator.
+    pub fn with_estimator(estimator: Estimator) -> Self {
+        IdentifyOptions {
+            estimator,
+            ..Default::default()
+        }
+    }
+}
+
+/// What a [`FitWarning`] is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WarningCode {
+    /// An estimate at a bound of its search range (its interval is not valid).
+    AtBound,
+    /// RMS relative residual far above the noise level.
+    Misfit,
+    /// A huge standard error or an unbounded interval: the data do not determine a parameter.
+    LargeUncertainty,
+    /// `JᵀJ` is singular: no standard errors.
+    SingularCovariance,
+    /// The covariance is numerically ill-conditioned.
+    IllConditioned,
+    /// Measured data the model cannot describe (e.g. diameters increasing along the spin line).
+    DataTrend,
+}
+
+impl WarningCode {
+    /// The code as written in JSON (`"at_bound"`, `"misfit"`, ...).
+    pub fn name(&self) -> &'static str {
+        match self {
+            WarningCode::AtBound => "at_bound",
+            WarningCode::Misfit => "misfit",
+            WarningCode::LargeUncertainty => "large_uncertainty",
+            WarningCode::SingularCovariance => "singular_covariance",
+            WarningCode::IllConditioned => "ill_conditioned",
+            WarningCode::DataTrend => "data_trend",
+        }
+    }
+}
+
+/// A warning about a fit (JSON: `{"code": "at_bound", "message": "..."}`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitWarning {
+    /// What it is about.
+    pub code: WarningCode,
+    /// The finding in words, naming the parameter or experiment.
+    pub message: String,
+}
+
+impl FitWarning {
+    /// A warning with `code` and `message`.
+    pub fn new(code: WarningCode, message: String) -> Self {
+        FitWarning { code, message }
+    }
+}
+
+impl fmt::Display for FitWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "[{}] {}", self.code.name(), self.message)
+    }
+}
