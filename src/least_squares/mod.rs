@@ -479,7 +479,11 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                     break;
                 }
             }
-            Ok(_) => {
+            other => {
+                let failure = match other {
+                    Err(e) => e.to_string(),
+                    Ok(_) => "non-finite or mis-sized residuals".to_string(),
+                };
                 failed += 1;
                 radius *= 0.25;
                 record(FitIteration {
@@ -492,24 +496,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                     scaled_gradient: scaled_g,
                     accepted: false,
                     radius,
-                    failure: Some("non-finite or mis-sized residuals".into()),
-                    elapsed_s: t0.elapsed().as_secs_f64(),
-                });
-            }
-            Err(e) => {
-                failed += 1;
-                radius *= 0.25;
-                record(FitIteration {
-                    iteration: iterations,
-                    p: trial,
-                    cost: None,
-                    previous_cost: cost,
-                    gain_ratio: None,
-                    step_norm: snorm,
-                    scaled_gradient: scaled_g,
-                    accepted: false,
-                    radius,
-                    failure: Some(e.to_string()),
+                    failure: Some(failure),
                     elapsed_s: t0.elapsed().as_secs_f64(),
                 });
             }
