@@ -52,7 +52,10 @@
 //! 2. dual Jacobians, collocation, [`linear`] (sparse LU), error control, Newton, [`solution`];
 //! 3. [`solve`](mod@solve) (the adaptive loop);
 //! 4. [`continuation`], [`sensitivity`], [`inspect`];
-//! 5. [`least_squares`] and `plot` stand apart (no solver imports).
+//! 5. [`least_squares`] (the bounded driver; its [`BvpResiduals`](least_squares::BvpResiduals)
+//!    adaptor solves BVPs and takes their sensitivities).
+//!
+//! `plot` (with the atomic file writing it shares with `fiber`) stands apart: no solver imports.
 //!
 //! The toolkit never imports `fiber`. The fiber model and rheometer (`fiber`, feature
 //! `rheometer`), bottom to top:
