@@ -67,4 +67,4 @@ pub use colors::PALETTE;
 pub use error::PlotError;
 pub use heatmap::{save_heatmap, Heatmap};
 pub use panels::{save_panels, Panel, Series, Style};
-pub use write::MAX_SIDE;
+pub use write::{FigureFormat, MAX_SIDE};

@@ -25,23 +25,36 @@ pub(super) trait Figure {
         DB::ErrorType: 'static;
 }
 
+/// Image format of a figure file; the one place that maps formats to file extensions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Format {
+pub enum FigureFormat {
+    /// Bitmap (PNG).
     Png,
+    /// Vector graphics (SVG).
     Svg,
 }
 
-fn format_of(path: &Path) -> Result<Format, PlotError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("png") => Ok(Format::Png),
-        Some("svg") => Ok(Format::Svg),
-        _ => Err(PlotError::UnsupportedFormat {
-            path: path.to_path_buf(),
-        }),
+impl FigureFormat {
+    /// The file extension (`"png"`, `"svg"`).
+    pub fn extension(self) -> &'static str {
+        match self {
+            FigureFormat::Png => "png",
+            FigureFormat::Svg => "svg",
+        }
+    }
+
+    /// The format a figure written to `path` gets, from its extension (case-insensitive).
+    pub fn of_path(path: &Path) -> Result<Self, PlotError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        [FigureFormat::Png, FigureFormat::Svg]
+            .into_iter()
+            .find(|f| ext.as_deref() == Some(f.extension()))
+            .ok_or_else(|| PlotError::UnsupportedFormat {
+                path: path.to_path_buf(),
+            })
     }
 }
 
@@ -52,7 +65,7 @@ pub(super) fn write_figure<F: Figure>(
     size: (u32, u32),
     figure: &F,
 ) -> Result<(), PlotError> {
-    let format = format_of(path)?;
+    let format = FigureFormat::of_path(path)?;
     let (w, h) = size;
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(invalid(
@@ -81,12 +94,12 @@ pub(super) fn write_figure<F: Figure>(
     let mut rgb = Vec::new();
     let mut svg = String::new();
     match format {
-        Format::Png => {
+        FigureFormat::Png => {
             rgb = vec![255u8; w as usize * h as usize * 3];
             let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
             render(&root, figure).map_err(draw_err)?;
         }
-        Format::Svg => {
+        FigureFormat::Svg => {
             let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
             render(&root, figure).map_err(draw_err)?;
         }
@@ -101,14 +114,14 @@ pub(super) fn write_figure<F: Figure>(
     // an existing file (or hard link) at `path` is replaced, not truncated
     let tmp = temporary_sibling(path);
     let written = match format {
-        Format::Png => {
+        FigureFormat::Png => {
             let mut backend = BitMapBackend::new(&tmp, size);
             backend
                 .blit_bitmap((0, 0), size, &rgb)
                 .and_then(|()| backend.present())
                 .map_err(|e| draw_err(Box::new(e)))
         }
-        Format::Svg => fs::write(&tmp, svg).map_err(io_err),
+        FigureFormat::Svg => fs::write(&tmp, svg).map_err(io_err),
     }
     .and_then(|()| fs::rename(&tmp, path).map_err(io_err));
     if written.is_err() {
@@ -135,12 +148,18 @@ mod tests {
 
     #[test]
     fn format_follows_extension() {
-        assert_eq!(format_of(Path::new("a/b.PNG")).ok(), Some(Format::Png));
-        assert_eq!(format_of(Path::new("b.svg")).ok(), Some(Format::Svg));
+        assert_eq!(
+            FigureFormat::of_path(Path::new("a/b.PNG")).ok(),
+            Some(FigureFormat::Png)
+        );
+        assert_eq!(
+            FigureFormat::of_path(Path::new("b.svg")).ok(),
+            Some(FigureFormat::Svg)
+        );
         assert!(matches!(
-            format_of(Path::new("b.pdf")),
+            FigureFormat::of_path(Path::new("b.pdf")),
             Err(PlotError::UnsupportedFormat { .. })
         ));
-        assert!(format_of(Path::new("noext")).is_err());
+        assert!(FigureFormat::of_path(Path::new("noext")).is_err());
     }
 }

@@ -112,11 +112,7 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let runs = simulate_experiments(set, &setup)
         .map_err(|e| checks::name_experiment(Box::new(e), &experiments, Some(setup.law_params)))?;
     let cmp = compare(&runs, set.relative_uncertainty, &options)?;
-    let fmt = match g.format {
-        FormatArg::Png => FigureFormat::Png,
-        FormatArg::Svg => FigureFormat::Svg,
-    };
-    let written = cmp.write(&out, fmt, &inputs)?;
+    let written = cmp.write(&out, g.format.format(), &inputs)?;
     outln!("{}", cmp.to_text());
     g.say(format!(
         "compared {} experiments in {:.1} s; wrote {} files to {}",

@@ -172,11 +172,16 @@ pub enum FormatArg {
 }
 
 impl FormatArg {
-    fn ext(self) -> &'static str {
+    /// The library's format.
+    pub fn format(self) -> FigureFormat {
         match self {
-            FormatArg::Png => "png",
-            FormatArg::Svg => "svg",
+            FormatArg::Png => FigureFormat::Png,
+            FormatArg::Svg => FigureFormat::Svg,
         }
+    }
+
+    fn ext(self) -> &'static str {
+        self.format().extension()
     }
 }
 

@@ -373,24 +373,8 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
     })
 }
 
-/// Output image format of the figures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FigureFormat {
-    /// Bitmap.
-    Png,
-    /// Vector graphics.
-    Svg,
-}
-
-impl FigureFormat {
-    /// The file extension.
-    pub fn extension(self) -> &'static str {
-        match self {
-            FigureFormat::Png => "png",
-            FigureFormat::Svg => "svg",
-        }
-    }
-}
+/// Output image format of the figures (the plotting module's).
+pub use crate::plot::FigureFormat;
 
 impl Comparison {
     /// The JSON summary (all numbers, per point).
