@@ -43,7 +43,7 @@ fn model(spec: &ModelSpec) -> FiberModel<CarreauLike> {
         &Air::paper(),
         &experiment(),
         CarreauLike::new(),
-        spec.physics(),
+        spec.physics().unwrap(),
     )
     .unwrap()
 }
@@ -159,4 +159,27 @@ fn settings_parse_names_and_values() {
         .with(EffectSetting::fitted(Effect::StrainThinning))
         .validate();
     assert!(bad.is_err());
+}
+
+#[test]
+fn a_user_effect_named_like_a_builtin_strength_is_an_error_not_a_panic() {
+    // a user effect named after a base-model term or a built-in effect would set the other
+    // strength: the spec refuses it, naming the effect
+    for name in ["convection", "nusselt_scale", "radiation", "air_coflow", "kappa"] {
+        let spec = ModelSpec::default().with_candidates(&[Effect::custom(
+            name,
+            Balance::Energy,
+            NozzleConvection,
+        )]);
+        let e = spec.validate().unwrap_err();
+        assert!(e.contains(name) && e.contains("taken"), "{name}: {e}");
+    }
+    // a fresh name is accepted and its strength exists in the physics
+    let spec = ModelSpec::default().with_candidates(&all_effects());
+    spec.validate().unwrap();
+    let physics = spec.physics().unwrap();
+    assert!(physics
+        .strength_parameters()
+        .iter()
+        .any(|(n, _)| *n == "nozzle_convection"));
 }

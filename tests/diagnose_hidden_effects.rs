@@ -74,7 +74,7 @@ fn make_data(
             &Air::paper(),
             &e,
             CarreauLike::new(),
-            spec.physics(),
+            spec.physics().unwrap(),
         )
         .unwrap();
         let mut p = m.parameters(1.0, &law).unwrap();

@@ -24,6 +24,7 @@
 //! [`EffectSetting`].
 
 use crate::fiber::contributions::{Balance, FiberTerm, Physics, Strength};
+use crate::fiber::error::FiberError;
 use std::fmt;
 use std::str::FromStr;
 use std::sync::Arc;
@@ -205,12 +206,8 @@ impl Effect {
     pub fn model_param(&self) -> &'static str {
         match self {
             Effect::StrainThinning => "n",
-            Effect::Radiation => "radiation",
-            Effect::AirCoflow { .. } => "air_coflow",
-            Effect::AirTemperatureProfile { .. } => "air_temperature_profile",
-            Effect::InletVelocity => "inlet_velocity",
-            Effect::NusseltScale => "nusselt_scale",
-            Effect::Custom(u) => u.name,
+            // one name per effect: the strength parameter carries the effect's name
+            _ => self.name(),
         }
     }
 
@@ -242,11 +239,12 @@ impl Effect {
     }
 
     /// Adds the effect to `physics` at its neutral strength, as a model parameter (nothing for
-    /// `strain_thinning`, which lives in the law).
-    pub fn apply(&self, physics: Physics) -> Physics {
+    /// `strain_thinning`, which lives in the law). Errors if the strength cannot be named in
+    /// `physics` (a user effect whose term does not carry its name).
+    pub fn apply(&self, physics: Physics) -> Result<Physics, FiberError> {
         let par = Strength::Parameter(self.param_value(self.neutral()));
         let added = match self {
-            Effect::StrainThinning => return physics,
+            Effect::StrainThinning => return Ok(physics),
             Effect::Radiation => physics.with_radiation(1.0),
             Effect::AirCoflow { decay_length } => physics.with_coflow(1.0, *decay_length),
             Effect::AirTemperatureProfile { decay_length } => {
@@ -256,9 +254,9 @@ impl Effect {
             Effect::NusseltScale => physics,
             Effect::Custom(u) => (u.add)(physics),
         };
-        added
-            .strength(self.model_param(), par)
-            .expect("the effect's strength exists once the effect is added")
+        // a user effect whose name is taken by another strength is refused by
+        // `ModelSpec::validate`; here a missing strength is an error, not a panic
+        added.strength(self.model_param(), par)
     }
 }
 
@@ -282,7 +280,7 @@ impl Effect {
         }
         let par = Strength::Parameter(self.param_value(strength));
         self.apply(physics)
-            .strength(self.model_param(), par)
+            .and_then(|p| p.strength(self.model_param(), par))
             .map_err(|e| e.to_string())
     }
 }
@@ -464,6 +462,20 @@ impl ModelSpec {
             if names.contains(&e.name()) {
                 return Err(format!("effect {} given twice", e.name()));
             }
+            if let Effect::Custom(u) = e {
+                let paper = Physics::paper();
+                let taken = BUILTIN_NAMES.contains(&u.name)
+                    || paper.terms.iter().any(|t| t.name == u.name)
+                    || paper.strength_parameters().iter().any(|(n, _)| *n == u.name)
+                    || ["n", "kappa"].contains(&u.name);
+                if taken {
+                    return Err(format!(
+                        "user effect \"{}\": the name is taken by a built-in term or effect; \
+                         choose another",
+                        u.name
+                    ));
+                }
+            }
             if self.law == LawChoice::Carreau && matches!(e, Effect::StrainThinning) {
                 return Err(
                     "strain_thinning is already part of the Carreau model (use --model newtonian)"
@@ -475,17 +487,13 @@ impl ModelSpec {
         Ok(())
     }
 
-    /// The physics: the paper's terms plus every effect and candidate at neutral strength.
-    pub fn physics(&self) -> Physics {
-        let mut p = Physics::paper();
-        for e in self
-            .effects
+    /// The physics: the paper's terms plus every effect and candidate at neutral strength (an
+    /// error names a strength that cannot be set; run [`validate`](Self::validate) first).
+    pub fn physics(&self) -> Result<Physics, FiberError> {
+        self.effects
             .iter()
             .map(|s| &s.effect)
             .chain(self.candidates.iter())
-        {
-            p = e.apply(p);
-        }
-        p
+            .try_fold(Physics::paper(), |p, e| e.apply(p))
     }
 }

@@ -66,14 +66,12 @@ impl Rheometer {
             let resolved = resolve_take_up(&e, Some(m), MissingTakeUp::FromData, Some(&f))
                 .map_err(|err| RheometerError::Data(format!("experiment {}: {err}", e.name)))?;
             e.take_up = Some(resolved.take_up);
-            let model = FiberModel::new(
-                &set.material,
-                &set.air,
-                &e,
-                CarreauLike::new(),
-                spec.physics(),
-            )
-            .map_err(|source| RheometerError::Simulation {
+            let model = spec
+                .physics()
+                .and_then(|physics| {
+                    FiberModel::new(&set.material, &set.air, &e, CarreauLike::new(), physics)
+                })
+                .map_err(|source| RheometerError::Simulation {
                 experiment: e.name.clone(),
                 n: f64::NAN,
                 kappa: f64::NAN,
