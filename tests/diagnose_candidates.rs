@@ -165,7 +165,13 @@ fn settings_parse_names_and_values() {
 fn a_user_effect_named_like_a_builtin_strength_is_an_error_not_a_panic() {
     // a user effect named after a base-model term or a built-in effect would set the other
     // strength: the spec refuses it, naming the effect
-    for name in ["convection", "nusselt_scale", "radiation", "air_coflow", "kappa"] {
+    for name in [
+        "convection",
+        "nusselt_scale",
+        "radiation",
+        "air_coflow",
+        "kappa",
+    ] {
         let spec = ModelSpec::default().with_candidates(&[Effect::custom(
             name,
             Balance::Energy,

@@ -466,7 +466,10 @@ impl ModelSpec {
                 let paper = Physics::paper();
                 let taken = BUILTIN_NAMES.contains(&u.name)
                     || paper.terms.iter().any(|t| t.name == u.name)
-                    || paper.strength_parameters().iter().any(|(n, _)| *n == u.name)
+                    || paper
+                        .strength_parameters()
+                        .iter()
+                        .any(|(n, _)| *n == u.name)
                     || ["n", "kappa"].contains(&u.name);
                 if taken {
                     return Err(format!(

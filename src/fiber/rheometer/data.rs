@@ -72,11 +72,11 @@ impl Rheometer {
                     FiberModel::new(&set.material, &set.air, &e, CarreauLike::new(), physics)
                 })
                 .map_err(|source| RheometerError::Simulation {
-                experiment: e.name.clone(),
-                n: f64::NAN,
-                kappa: f64::NAN,
-                source,
-            })?;
+                    experiment: e.name.clone(),
+                    n: f64::NAN,
+                    kappa: f64::NAN,
+                    source,
+                })?;
             experiments.push(e);
             measurements.push(m.clone());
             smoothing.push(f);
