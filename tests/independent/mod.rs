@@ -1,0 +1,9 @@
+//! An independent test-data generator for the missing-physics diagnosis (issue 11): its own
+//! implementation of the paper's stationary fiber-spinning model with hidden effects written
+//! directly into the balances ([`model`]), solved with the crate's generic collocation solver
+//! ([`solve`]), its own noise ([`rng`]) and data sets written in the project's TOML + CSV
+//! input format ([`dataset`], [`scenarios`]). Nothing here calls `diffbvp::fiber`.
+#![allow(dead_code)]
+
+pub mod model;
+pub mod solve;
