@@ -7,3 +7,6 @@
 
 pub mod model;
 pub mod solve;
+pub mod dataset;
+pub mod rng;
+pub mod scenarios;
