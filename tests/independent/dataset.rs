@@ -164,7 +164,9 @@ impl Scenario {
     pub fn generate(&self) -> Result<Generated, String> {
         let clean: Vec<Vec<f64>> = std::thread::scope(|scope| {
             let handles: Vec<_> = (0..self.experiments.len())
-                .map(|k| scope.spawn(move || diameters(&self.line(k), &self.experiments[k].positions)))
+                .map(|k| {
+                    scope.spawn(move || diameters(&self.line(k), &self.experiments[k].positions))
+                })
                 .collect();
             handles
                 .into_iter()
@@ -178,7 +180,8 @@ impl Scenario {
             .map(|d| {
                 d.iter()
                     .map(|&di| {
-                        (di * f.gauge_factor + f.gauge_offset_m) * (1.0 + self.noise_sd * rng.normal())
+                        (di * f.gauge_factor + f.gauge_offset_m)
+                            * (1.0 + self.noise_sd * rng.normal())
                     })
                     .collect()
             })

@@ -5,8 +5,8 @@
 //! input format ([`dataset`], [`scenarios`]). Nothing here calls `diffbvp::fiber`.
 #![allow(dead_code)]
 
-pub mod model;
-pub mod solve;
 pub mod dataset;
+pub mod model;
 pub mod rng;
 pub mod scenarios;
+pub mod solve;

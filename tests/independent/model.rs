@@ -214,11 +214,7 @@ impl Line {
     }
     /// (u [m/s], N [N], T [K]) from a state vector.
     pub fn physical(&self, y: &[f64]) -> (f64, f64, f64) {
-        (
-            self.inlet_speed() * y[0].exp(),
-            N_REF * y[1],
-            T_REF * y[2],
-        )
+        (self.inlet_speed() * y[0].exp(), N_REF * y[1], T_REF * y[2])
     }
     /// Diameter [m] from a state vector.
     pub fn diameter(&self, y: &[f64]) -> f64 {
@@ -228,7 +224,7 @@ impl Line {
     /// Strain rate ε̇ [1/s] from a state vector.
     pub fn strain_rate(&self, y: &[f64]) -> f64 {
         let mut f = [0.0; 3];
-        self.rhs(0.0, y, &[1.0], &mut f);
+        self.rhs(0.0, y, &[1.0, 1.0], &mut f);
         f[0] * self.inlet_speed() * y[0].exp() / self.length
     }
     /// Initial guess at c = 0: isothermal, exponential speed.
@@ -259,8 +255,16 @@ fn carreau_inverse(r: f64, n: f64) -> f64 {
     let mut t = lr;
     for _ in 0..100 {
         let e = (-2.0 * t.abs()).exp();
-        let l1 = if t > 0.0 { 2.0 * t + e.ln_1p() } else { e.ln_1p() };
-        let logistic = if t > 0.0 { 1.0 / (1.0 + e) } else { e / (1.0 + e) };
+        let l1 = if t > 0.0 {
+            2.0 * t + e.ln_1p()
+        } else {
+            e.ln_1p()
+        };
+        let logistic = if t > 0.0 {
+            1.0 / (1.0 + e)
+        } else {
+            e / (1.0 + e)
+        };
         let f = t + m * l1 - lr;
         let fp = 1.0 + 2.0 * m * logistic;
         let dt = f / fp;
@@ -277,7 +281,7 @@ impl Bvp for Line {
         3
     }
     fn num_params(&self) -> usize {
-        1
+        2
     }
     fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
         let m = &self.material;
@@ -302,7 +306,7 @@ impl Bvp for Line {
         let a = (ratio - phi0) / dphi0 + a0;
         let rate = a * k / mu0;
         // air
-        let v_air = self.air_flow.speed(s, self.length);
+        let v_air = p[1] * self.air_flow.speed(s, self.length);
         let t_air = self.air_temperature + self.air_heat.excess(s);
         let v_rel = -u + v_air;
         let drag = v_rel * (m.air_rho * m.air_nu * stokes_tangential());
@@ -322,8 +326,7 @@ impl Bvp for Line {
         let nusselt = nu_cb * inclination;
         let convection = nusselt * (t - t_air) * (PI * m.air_lambda);
         let t2 = t * t;
-        let radiation =
-            d * (t2 * t2 - t_air.powi(4)) * (PI * self.emissivity * STEFAN_BOLTZMANN);
+        let radiation = d * (t2 * t2 - t_air.powi(4)) * (PI * self.emissivity * STEFAN_BOLTZMANN);
         let dn = rate * q - (c * (u.recip() * (q * GRAVITY) + drag));
         let dt = (c * (tension * rate - convection - radiation)) / (cp * q);
         let l = self.length;

@@ -4,7 +4,7 @@
 //! are deliberately far from the project's candidate defaults (co-flow `V e^{−(L−s)/0.1 m}`,
 //! warm air `ΔT e^{−s/0.05 m}`).
 
-use super::dataset::{ExperimentSpec, Expected, Faults, Scenario};
+use super::dataset::{Expected, ExperimentSpec, Faults, Scenario};
 use super::model::{AirFlow, AirHeat, Law, Material};
 
 /// Relative noise σ of every scenario [-].

@@ -1,7 +1,7 @@
 //! Solving a [`Line`] by continuation in its homotopy parameter `c` (0 → 1) with the crate's
 //! generic collocation solver and continuation (tested separately), and its profiles.
 
-use super::model::Line;
+use super::model::{AirFlow, Line};
 use diffbvp::continuation::{solve_by_continuation, PathOptions};
 use diffbvp::{Guess, ResidualScale, Solution, SolveOptions, Solver};
 
@@ -25,7 +25,8 @@ pub struct Profile {
     pub diameter: Vec<f64>,
 }
 
-/// Solves `line` at c = 1 (tolerance [`TOLERANCE`]).
+/// Solves `line` at c = 1 in still air, then (if it has an air flow) continues the air speed
+/// from 0 to its full value (tolerance [`TOLERANCE`]).
 pub fn solve_line(line: &Line) -> Result<Solution, String> {
     let x: Vec<f64> = (0..=40).map(|i| i as f64 / 40.0).collect();
     let guess = Guess::from_fn(x, 3, |x, y| line.guess_state(x, y));
@@ -34,16 +35,30 @@ pub fn solve_line(line: &Line) -> Result<Solution, String> {
     options.factor_at_solution = false;
     options.max_nodes = 50_000;
     let mut solver = Solver::new(line, options.clone());
-    solve_by_continuation(
+    let err = |e| format!("independent model: {e}");
+    let still = solve_by_continuation(
         &mut solver,
-        &[0.0],
+        &[0.0, 0.0],
         0,
         1.0,
         &guess,
         &PathOptions::default(),
         &options,
     )
-    .map_err(|e| format!("independent model: {e}"))
+    .map_err(err)?;
+    if matches!(line.air_flow, AirFlow::Still) {
+        return Ok(still);
+    }
+    solve_by_continuation(
+        &mut solver,
+        &[1.0, 0.0],
+        1,
+        1.0,
+        &Guess::from(&still),
+        &PathOptions::default(),
+        &options,
+    )
+    .map_err(err)
 }
 
 /// Profiles of a solution at positions `s` [m].
