@@ -157,3 +157,37 @@ fn every_scenario_generates_and_its_effect_is_visible() {
     let other = sc::other_material().generate().unwrap();
     assert_eq!(other.clean.len(), 6);
 }
+
+/// Physical direction and size of the air-flow terms near the take-up, where the fiber is frozen
+/// and the tension changes only by drag and weight: an aspirator jet faster than the fiber pulls
+/// it, so over the last 5 cm the tension falls by `μ_* r_τ ∫ v_air ds` = μ_* r_τ V ℓ atan(1)
+/// more than in still air (within 5 %). The jet also cools (the take-up temperature drops).
+#[test]
+fn an_aspirator_jet_pulls_and_cools_the_fiber() {
+    let law = Law {
+        n: 0.8,
+        kappa: 11.71,
+    };
+    let still = line(3.08e-5, 90e-6, law);
+    let jet = Line {
+        air_flow: AirFlow::Aspirator {
+            speed: 100.0,
+            length: 0.05,
+        },
+        ..still.clone()
+    };
+    let end = [0.46, 0.51];
+    let a = profile(&still, &solve_line(&still).unwrap(), &end);
+    let b = profile(&jet, &solve_line(&jet).unwrap(), &end);
+    eprintln!(
+        "tension over the last 5 cm: still {:.4e} -> {:.4e} N, jet {:.4e} -> {:.4e} N; T(L) {:.2} K -> {:.2} K; u(L) {:.3} m/s",
+        a.force[0], a.force[1], b.force[0], b.force[1], a.temperature[1], b.temperature[1], b.velocity[1]
+    );
+    assert!(b.velocity[1] < 100.0, "the jet is faster than the fiber");
+    let mu_r = 2e-5 * independent::model::stokes_tangential();
+    let expected = mu_r * 100.0 * 0.05 * 1f64.atan();
+    let extra_drop = (b.force[0] - b.force[1]) - (a.force[0] - a.force[1]);
+    eprintln!("extra tension drop {extra_drop:.4e} N, μ r ∫v_air ds = {expected:.4e} N");
+    assert!((extra_drop / expected - 1.0).abs() < 0.05);
+    assert!(b.temperature[1] < a.temperature[1]);
+}
