@@ -101,7 +101,11 @@ fn assert_found(sc: &Scenario, r: &DiagnosisRun) {
     );
     let c = &d.candidates[0];
     assert_eq!(Some(c.effect.as_str()), named, "named is not ranked first");
-    if let Some(truth) = sc.expected.and_then(|e| e.in_unit(&c.unit)) {
+    let expected = sc
+        .expected
+        .filter(|(name, _)| *name == c.effect)
+        .and_then(|(_, e)| e.in_unit(&c.unit, c.strength));
+    if let Some(truth) = expected {
         assert!(
             (c.strength - truth).abs() <= 3.0 * c.stderr_strength,
             "{}: {} = {} ± {} {}, truth {truth}",

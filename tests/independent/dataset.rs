@@ -71,11 +71,14 @@ pub enum Expected {
 }
 
 impl Expected {
-    /// The truth in `unit` (the candidate's unit string), if the unit is understood.
-    pub fn in_unit(&self, unit: &str) -> Option<f64> {
+    /// The truth in the unit of a candidate's reported `strength` (`unit` its unit string), if
+    /// the unit is understood. A dimensionless factor may be reported as the factor (neutral 1)
+    /// or as the relative change (neutral 0): a strength within 0.5 of 1 is taken as the factor.
+    pub fn in_unit(&self, unit: &str, strength: f64) -> Option<f64> {
         let u = unit.trim();
         let factor = |f: f64| match u {
-            "-" | "" | "1" => Some(f),
+            "-" | "" | "1" if (strength - 1.0).abs() < 0.5 => Some(f),
+            "-" | "" | "1" => Some(f - 1.0),
             "%" => Some(100.0 * (f - 1.0)),
             _ => None,
         };
@@ -125,8 +128,9 @@ pub struct Scenario {
     pub seed: u64,
     /// Candidate names accepted as the cause ranked first (empty: nothing may be named).
     pub acceptable: Vec<&'static str>,
-    /// The strength a named candidate must recover (same parametrisation as the truth).
-    pub expected: Option<Expected>,
+    /// The candidate whose parametrisation equals the truth's, and the strength it must
+    /// recover when it is named.
+    pub expected: Option<(&'static str, Expected)>,
 }
 
 /// A generated data set.

@@ -133,7 +133,7 @@ pub fn radiation() -> Scenario {
     Scenario {
         emissivity: 0.6,
         acceptable: vec!["radiation"],
-        expected: Some(Expected::Emissivity(0.6)),
+        expected: Some(("radiation", Expected::Emissivity(0.6))),
         ..base("radiation", 107)
     }
 }
@@ -146,7 +146,7 @@ pub fn die_colder() -> Scenario {
             ..Faults::none()
         },
         acceptable: vec!["die_temperature_offset"],
-        expected: Some(Expected::DieOffsetK(-10.0)),
+        expected: Some(("die_temperature_offset", Expected::DieOffsetK(-10.0))),
         ..base("die_colder", 108)
     }
 }
@@ -159,7 +159,7 @@ pub fn mass_flow_low() -> Scenario {
             ..Faults::none()
         },
         acceptable: vec!["mass_flow_scale", "inlet_velocity", "inlet_diameter"],
-        expected: Some(Expected::MassFlowFactor(0.96)),
+        expected: Some(("mass_flow_scale", Expected::MassFlowFactor(0.96))),
         ..base("mass_flow_low", 109)
     }
 }
@@ -172,7 +172,7 @@ pub fn gauge_scale() -> Scenario {
             ..Faults::none()
         },
         acceptable: vec!["gauge_scale"],
-        expected: Some(Expected::GaugeFactor(1.03)),
+        expected: Some(("gauge_scale", Expected::GaugeFactor(1.03))),
         ..base("gauge_scale", 110)
     }
 }
@@ -185,7 +185,7 @@ pub fn gauge_offset() -> Scenario {
             ..Faults::none()
         },
         acceptable: vec!["gauge_offset"],
-        expected: Some(Expected::GaugeOffsetM(3e-6)),
+        expected: Some(("gauge_offset", Expected::GaugeOffsetM(3e-6))),
         ..base("gauge_offset", 111)
     }
 }
@@ -260,7 +260,7 @@ pub fn other_material() -> Scenario {
         air_temperature: 298.15,
         emissivity: 0.45,
         acceptable: vec!["radiation"],
-        expected: Some(Expected::Emissivity(0.45)),
+        expected: Some(("radiation", Expected::Emissivity(0.45))),
         ..base("other_material", 114)
     }
 }
