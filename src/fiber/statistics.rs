@@ -3,8 +3,9 @@
 //! (its fit report and data checks), the comparison (`diagnostics::compare`) and the diagnosis
 //! (`diagnostics::diagnose`) compute.
 //!
-//! Two noise estimators and two lag-1 autocorrelations, because their callers' thresholds were
-//! calibrated on them (switching would change published results):
+//! **The noise model of record is [`NoiseModel`]** (robust scale, scale along the line,
+//! outliers, one lag-1 autocorrelation, the judgement numbers); the comparison uses it. The
+//! older estimators below remain until the diagnosis is switched over:
 //!
 //! | function | used by | what |
 //! |---|---|---|
@@ -18,6 +19,8 @@
 //! control (RMS 1.682 %, robust noise 1.36 %) it would call the noise systematic.
 
 use serde::{Deserialize, Serialize};
+
+pub use crate::fiber::noise_model::{NoiseModel, NoiseOptions, Outlier, ResidualSeries};
 
 /// `1/Φ⁻¹(3/4)`: turns a median absolute deviation into a normal standard deviation.
 const MAD_TO_SD: f64 = 1.482_602_218_505_602;
