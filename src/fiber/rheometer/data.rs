@@ -7,6 +7,7 @@ use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
 use crate::fiber::smoothing::{smooth, SmoothFit};
+use crate::fiber::noise_model::{NoiseModel, NoiseOptions};
 use crate::fiber::statistics::median;
 use crate::fiber::take_up::{resolve_take_up, MissingTakeUp};
 use crate::solution::Solution;
@@ -145,6 +146,36 @@ impl Rheometer {
             }
         }
         (sum / count.max(1) as f64).sqrt()
+    }
+
+    /// The robust noise scale of the data \[-\] (relative): the [`NoiseModel`] `σ` of
+    /// `d_fit(s)/d_meas − 1` about each experiment's smoothing ansatz (second differences, so
+    /// the ansatz's own misfit hardly enters). The default soft margin of a robust loss.
+    pub fn data_noise_scale(&self) -> Result<f64, RheometerError> {
+        let profiles: Vec<(Vec<f64>, Vec<f64>)> = self
+            .measurements
+            .iter()
+            .zip(&self.smoothing)
+            .map(|(m, f)| {
+                let r = m
+                    .positions
+                    .iter()
+                    .zip(&m.diameters)
+                    .map(|(&s, &d)| f.diameter(s) / d - 1.0)
+                    .collect();
+                (m.positions.clone(), r)
+            })
+            .collect();
+        let nm = NoiseModel::from_profiles(&profiles, &NoiseOptions::default())
+            .map_err(RheometerError::Data)?;
+        if nm.sigma > 0.0 && nm.sigma.is_finite() {
+            Ok(nm.sigma)
+        } else {
+            Err(RheometerError::Data(format!(
+                "cannot estimate the noise scale of the data (got {}); give f_scale",
+                nm.sigma
+            )))
+        }
     }
 
     /// `(d_model − d_meas)/d_meas` at the measurement positions of experiment `k`.
