@@ -301,7 +301,9 @@ where
                         Style::Line => (color.stroke_width(stroke), TRANSPARENT.filled(), 20),
                         Style::Dashed => (color.stroke_width(stroke), TRANSPARENT.filled(), 7),
                         Style::Markers => (TRANSPARENT.stroke_width(0), color.filled(), 20),
-                        Style::Rings => (TRANSPARENT.stroke_width(0), color.stroke_width(stroke), 20),
+                        Style::Rings => {
+                            (TRANSPARENT.stroke_width(0), color.stroke_width(stroke), 20)
+                        }
                     };
                     EmptyElement::at((x, y))
                         + PathElement::new(vec![(0, 0), (gap, 0)], line)

@@ -302,7 +302,11 @@ pub fn compare(
         }
         chi2 += e.chi2;
         sum2 += r.iter().map(|v| v * v).sum::<f64>();
-        e.lag1 = noise.lag1_per_experiment.get(k).copied().unwrap_or(f64::NAN);
+        e.lag1 = noise
+            .lag1_per_experiment
+            .get(k)
+            .copied()
+            .unwrap_or(f64::NAN);
         e.segments = segments::find_segments(&[(s.clone(), r.clone())], sigma, &options.segments);
     }
     let dof = n_points
