@@ -481,3 +481,30 @@ fn the_correct_model_stays_consistent_with_noise_and_outliers_are_reported() {
     assert!(written.len() >= 4);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_noise_model_of_a_fit_names_the_outliers_with_their_diameters() {
+    // the call the diagnosis makes on an identification's residuals
+    let rh = Rheometer::new(&with_outliers(shipped())).unwrap();
+    let id = rh.identify(TRUTH, &IdentifyOptions::default()).unwrap();
+    let nm = rh.noise_model(&id.residual_profiles).unwrap();
+    eprintln!(
+        "linear fit with outliers: sigma {:.4}, RMS/noise {:.3}, robust {:.3}, lag1 z {:.2}, flagged {:?}",
+        nm.sigma,
+        nm.rms_over_noise,
+        nm.robust_rms_over_noise,
+        nm.lag1_z,
+        flagged(&nm)
+    );
+    let f = flagged(&nm);
+    for &(e, i, _) in &OUTLIERS {
+        assert!(f.contains(&(e, i)), "({e}, {i}) missed; flagged {f:?}");
+    }
+    assert!(f.len() <= OUTLIERS.len() + 1, "{f:?}");
+    let o = &nm.outliers[0];
+    assert_eq!(o.experiment, rh.experiments[o.experiment_index].name);
+    let m = &rh.measurements[o.experiment_index];
+    assert_eq!(o.d_meas_m, m.diameters[o.point_index]);
+    assert!(nm.sigma < 0.02 && nm.rms_over_noise < 1.2, "{nm:?}");
+    assert!(rh.noise_model(&id.residual_profiles[1..]).is_err());
+}

@@ -223,7 +223,7 @@ fn merge_bins(counts: &[usize], min_count: usize) -> Vec<usize> {
             acc = 0;
         }
     }
-    if acc < min_count && g > 0 && (acc > 0 || group.iter().any(|&x| x == g)) {
+    if acc < min_count && g > 0 && (acc > 0 || group.contains(&g)) {
         for x in group.iter_mut() {
             if *x == g {
                 *x = g - 1;
