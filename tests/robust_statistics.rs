@@ -508,3 +508,38 @@ fn the_noise_model_of_a_fit_names_the_outliers_with_their_diameters() {
     assert!(nm.sigma < 0.02 && nm.rms_over_noise < 1.2, "{nm:?}");
     assert!(rh.noise_model(&id.residual_profiles[1..]).is_err());
 }
+
+#[test]
+fn the_cli_takes_a_loss_and_refuses_unknown_ones() {
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_rheometer"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stdout).to_string()
+                + &String::from_utf8_lossy(&out.stderr),
+        )
+    };
+    let toml = "data/pmma7n_synthetic/experiments.toml";
+    let (ok, text) = run(&["fit", toml, "--loss", "arctan"]);
+    assert!(!ok && text.contains("soft_l1"), "{text}");
+    let (ok, text) = run(&["fit", toml, "--loss", "huber", "--f-scale", "-0.1"]);
+    assert!(!ok && text.contains("f_scale"), "{text}");
+    let (ok, text) = run(&[
+        "fit",
+        toml,
+        "--loss",
+        "soft_l1",
+        "--f-scale",
+        "0.02",
+        "--start",
+        "0.8,11.7",
+    ]);
+    assert!(ok, "{text}");
+    assert!(
+        text.contains("loss              = soft_l1 (f_scale 2.000 %"),
+        "{text}"
+    );
+}

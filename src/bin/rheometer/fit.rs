@@ -31,7 +31,7 @@ pub struct FitArgs {
     pub loss: diffbvp::least_squares::Loss,
     /// Soft margin of a robust loss as a relative residual (e.g. 0.02 for 2 %; default: the
     /// robust noise scale of the data).
-    #[arg(long = "f-scale", value_parser = checks::parse_f_scale)]
+    #[arg(long = "f-scale", value_parser = checks::parse_f_scale, allow_hyphen_values = true)]
     pub f_scale: Option<f64>,
     /// Write the result as JSON to FILE.
     #[arg(long)]
