@@ -33,6 +33,7 @@ pub mod figures;
 pub mod input;
 pub mod material_law;
 pub mod model;
+pub mod noise_model;
 pub mod output;
 pub mod rheometer;
 pub mod scaling;

@@ -3,14 +3,15 @@
 //! (its fit report and data checks), the comparison (`diagnostics::compare`) and the diagnosis
 //! (`diagnostics::diagnose`) compute.
 //!
-//! Two noise estimators and two lag-1 autocorrelations, because their callers' thresholds were
-//! calibrated on them (switching would change published results):
+//! **The noise model of record is [`NoiseModel`]** (robust scale, scale along the line,
+//! outliers, one lag-1 autocorrelation, the judgement numbers); the comparison uses it. The
+//! older estimators below remain until the diagnosis is switched over:
 //!
 //! | function | used by | what |
 //! |---|---|---|
-//! | [`noise_mad_second_differences`] | the comparison, the fit report | robust (MAD) SD of spacing-normalised second differences: ignores kinks and outliers |
+//! | [`noise_mad_second_differences`] | the fit report | robust (MAD) SD of spacing-normalised second differences: ignores kinks and outliers (the [`NoiseModel`]'s `sigma` without excluding outliers) |
 //! | [`noise_rms_second_differences`] | the diagnosis | RMS of plain second differences (uniform spacing assumed): every point counts |
-//! | [`lag1_autocorrelation_about_mean`] | the comparison | each sequence about its own mean (`NaN` without spread) |
+//! | [`lag1_autocorrelation_about_mean`] | nobody (deprecated: the comparison now uses [`NoiseModel::lag1`]) | each sequence about its own mean (`NaN` without spread) |
 //! | [`lag1_autocorrelation_about_zero`] | the diagnosis | about zero, i.e. an offset counts as correlation (`0` without spread) |
 //!
 //! The diagnosis's "systematic" test `rms/noise > 1.2` is calibrated on the RMS estimate: the
@@ -18,6 +19,8 @@
 //! control (RMS 1.682 %, robust noise 1.36 %) it would call the noise systematic.
 
 use serde::{Deserialize, Serialize};
+
+pub use crate::fiber::noise_model::{NoiseModel, NoiseOptions, Outlier, ResidualSeries};
 
 /// `1/Φ⁻¹(3/4)`: turns a median absolute deviation into a normal standard deviation.
 const MAD_TO_SD: f64 = 1.482_602_218_505_602;
@@ -188,6 +191,7 @@ pub fn lag1_autocorrelation_about_zero(sequences: &[&[f64]]) -> (f64, usize) {
 /// The comparison's lag-1 autocorrelation, of each sequence about its own mean, pooled:
 /// `ρ₁ = Σ (r_i − r̄)(r_{i+1} − r̄) / Σ (r_i − r̄)²` with both sums over all sequences.
 /// Returns `(ρ₁, number of lag pairs)`; for white noise `ρ₁ ≈ N(0, 1/pairs)` (to `O(1/n)`).
+#[deprecated(note = "use NoiseModel::lag1 (noise-normalised, about zero, outliers excluded)")]
 pub fn lag1_autocorrelation_about_mean(sequences: &[&[f64]]) -> (f64, usize) {
     let (mut num, mut den, mut pairs) = (0.0, 0.0, 0usize);
     for r in sequences {

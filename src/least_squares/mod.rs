@@ -22,10 +22,17 @@
 //! rejected trial point leaving the warm starts alone. [`fit_observed`] reports every iteration
 //! to an [`Observer`] (progress bars, logs, early inspection); [`FitResult::history`] keeps the
 //! same records.
+//!
+//! **Robust losses.** [`FitOptions::loss`] (default [`Loss::Linear`]) and
+//! [`FitOptions::f_scale`] minimise scipy's `½ C² Σ ρ((rᵢ/C)²)` instead (soft-L1, Huber,
+//! Cauchy; see [`loss`]); the iteration stays Gauss–Newton on rescaled residuals and Jacobian.
+//! The covariance under a robust loss is the sandwich (see [`FitResult::covariance`]).
 
 mod bvp;
+pub mod loss;
 
 pub use bvp::{BvpResiduals, BvpRun, ParamLink, ParamMap, RunError};
+pub use loss::Loss;
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::fmt;
@@ -62,6 +69,11 @@ pub struct FitOptions {
     pub ftol: f64,
     /// Maximum iterations (accepted or rejected trial steps) (default 100).
     pub max_iterations: usize,
+    /// The loss `ρ` (default [`Loss::Linear`]: ordinary least squares, results unchanged).
+    pub loss: Loss,
+    /// Soft margin `C` between inlier and outlier residuals, in residual units (default 1;
+    /// unused by the linear loss).
+    pub f_scale: f64,
 }
 
 impl FitOptions {
@@ -76,6 +88,8 @@ impl FitOptions {
             xtol: 1e-8,
             ftol: 1e-10,
             max_iterations: 100,
+            loss: Loss::Linear,
+            f_scale: 1.0,
         }
     }
 }
@@ -159,7 +173,7 @@ impl<F: FnMut(&FitIteration)> Observer for F {
 pub struct FitResult {
     /// Parameters found.
     pub p: Vec<f64>,
-    /// Cost `½‖r‖²` at `p`.
+    /// Cost at `p`: `½‖r‖²`, or `½ C² Σ ρ((rᵢ/C)²)` under a robust loss.
     pub cost: f64,
     /// Residuals at `p`.
     pub residuals: Vec<f64>,
@@ -177,6 +191,10 @@ pub struct FitResult {
     pub wall_time_s: f64,
     /// Every iteration, in order (the records [`fit_observed`]'s observer saw).
     pub history: Vec<FitIteration>,
+    /// The loss minimised.
+    pub loss: Loss,
+    /// Its soft margin `C` (residual units).
+    pub f_scale: f64,
 }
 
 /// Errors of [`fit`] itself (the model failing at the start point, bad bounds).
@@ -201,21 +219,66 @@ impl FitResult {
         self.residuals.len()
     }
 
-    /// Residual variance `‖r‖²/(N − p)` (the Gauss–Newton estimate of σ² for unit weights).
+    /// Residual variance `‖r‖²/(N − p)` (the Gauss–Newton estimate of σ² for unit weights;
+    /// of the raw residuals under a robust loss).
     pub fn residual_variance(&self) -> f64 {
         let np = self.p.len();
         let dof = self.residuals.len().saturating_sub(np).max(1);
-        2.0 * self.cost / dof as f64
+        let cost = if self.loss.is_linear() {
+            self.cost
+        } else {
+            cost_of(&self.residuals)
+        };
+        2.0 * cost / dof as f64
     }
 
-    /// Covariance `σ² (JᵀJ)⁻¹` of the parameters (row-major), `None` if `JᵀJ` is singular.
+    /// Number of residuals a robust loss down-weights (`|rᵢ| > f_scale`; 0 for the linear
+    /// loss).
+    pub fn down_weighted(&self) -> usize {
+        loss::down_weighted(self.loss, self.f_scale, &self.residuals)
+    }
+
+    /// Covariance of the parameters (row-major), `None` if it cannot be inverted.
+    ///
+    /// Linear loss: `σ² (JᵀJ)⁻¹` with `σ²` = [`residual_variance`](Self::residual_variance).
+    /// Robust loss: the sandwich (Huber–White) covariance of the M-estimator,
+    /// `N/(N − p) · H⁻¹ B H⁻¹` with `H = J̃ᵀJ̃ = Σ wᵢ JᵢᵀJᵢ` the Gauss–Newton Hessian of the
+    /// robust cost (the rescaled Jacobian of [`loss`]) and `B = Σ (ρ'ᵢ rᵢ)² JᵢᵀJᵢ` the spread of
+    /// the per-residual gradients; it needs no noise level and stays valid when the residuals
+    /// are not Gaussian.
     pub fn covariance(&self) -> Option<Vec<f64>> {
         let np = self.p.len();
+        if !self.loss.is_linear() {
+            return self.sandwich_covariance();
+        }
         let j = DMatrix::from_row_slice(self.residuals.len(), np, &self.jacobian);
         let jtj = j.transpose() * &j;
         let inv = jtj.try_inverse()?;
         let s2 = self.residual_variance();
         Some((0..np * np).map(|i| inv[(i / np, i % np)] * s2).collect())
+    }
+
+    fn sandwich_covariance(&self) -> Option<Vec<f64>> {
+        let np = self.p.len();
+        let nr = self.residuals.len();
+        let w = loss::weights(self.loss, self.f_scale, &self.residuals);
+        let mut h: DMatrix<f64> = DMatrix::zeros(np, np);
+        let mut b: DMatrix<f64> = DMatrix::zeros(np, np);
+        for (i, ((d1, wi), ri)) in w.iter().zip(&self.residuals).enumerate() {
+            let row = &self.jacobian[i * np..(i + 1) * np];
+            let psi2 = (d1 * ri).powi(2);
+            for a in 0..np {
+                for c in 0..np {
+                    let jj = row[a] * row[c];
+                    h[(a, c)] += wi * jj;
+                    b[(a, c)] += psi2 * jj;
+                }
+            }
+        }
+        let hi = h.try_inverse()?;
+        let dof = nr.saturating_sub(np).max(1) as f64;
+        let cov: DMatrix<f64> = &hi * b * &hi * (nr as f64 / dof);
+        Some((0..np * np).map(|i| cov[(i / np, i % np)]).collect())
     }
 
     /// Standard errors of the parameters.
@@ -352,6 +415,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         ("gtol", options.gtol, false),
         ("xtol", options.xtol, false),
         ("ftol", options.ftol, false),
+        ("f_scale", options.f_scale, true),
     ] {
         let valid = v.is_finite() && if strictly { v > 0.0 } else { v >= 0.0 };
         if !valid {
@@ -374,7 +438,10 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             "{nr} residuals for {np} parameters: the fit is underdetermined"
         )));
     }
-    let mut cost = cost_of(&r);
+    let (loss, f_scale) = (options.loss, options.f_scale);
+    // the Gauss–Newton view (rescaled under a robust loss; `None`: `r`, `jac` themselves)
+    let mut scaled = loss::rescale(loss, f_scale, &r, &jac, np);
+    let mut cost = loss::robust_cost(loss, f_scale, &r);
     let mut radius = options.initial_radius.min(options.max_radius);
     let mut history = Vec::new();
     let mut record = |it: FitIteration| {
@@ -384,8 +451,12 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
     let (mut iterations, mut accepted_steps, mut failed) = (0, 0, 0);
     let termination;
     loop {
-        let jm = DMatrix::from_row_slice(nr, np, &jac);
-        let rv = DVector::from_column_slice(&r);
+        let (r_gn, jac_gn) = match &scaled {
+            Some((rs, js)) => (rs.as_slice(), js.as_slice()),
+            None => (r.as_slice(), jac.as_slice()),
+        };
+        let jm = DMatrix::from_row_slice(nr, np, jac_gn);
+        let rv = DVector::from_column_slice(r_gn);
         let g = jm.transpose() * &rv;
         let v = cl_scaling(&p, g.as_slice(), lo, hi);
         let scaled_g = (0..np).map(|i| (g[i] * v[i]).abs()).fold(0.0, f64::max);
@@ -430,7 +501,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         let snorm = step_vec.norm();
         match problem.evaluate(&trial) {
             Ok((r_new, j_new)) if r_new.len() == nr && r_new.iter().all(|x| x.is_finite()) => {
-                let cost_new = cost_of(&r_new);
+                let cost_new = loss::robust_cost(loss, f_scale, &r_new);
                 let actual = cost - cost_new;
                 let rho = if pred_trial > 0.0 {
                     actual / pred_trial
@@ -463,6 +534,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                     accepted_steps += 1;
                     let rel_change = actual.abs() / cost.max(1e-300);
                     p = trial;
+                    scaled = loss::rescale(loss, f_scale, &r_new, &j_new, np);
                     r = r_new;
                     jac = j_new;
                     cost = cost_new;
@@ -513,5 +585,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         termination,
         wall_time_s: t0.elapsed().as_secs_f64(),
         history,
+        loss,
+        f_scale,
     })
 }

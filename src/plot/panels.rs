@@ -24,6 +24,9 @@ pub enum Style {
     Markers,
     /// A dashed line through the points (broken at non-finite points).
     Dashed,
+    /// Open circles, twice the marker size, around the points (to flag points drawn by
+    /// another series, e.g. outliers).
+    Rings,
 }
 
 /// One labelled set of points in a [`Panel`].
@@ -63,6 +66,11 @@ impl Series {
     /// Markers only.
     pub fn markers(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
         Self::new(label, points, Style::Markers)
+    }
+
+    /// Open rings around the points (see [`Style::Rings`]).
+    pub fn rings(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self::new(label, points, Style::Rings)
     }
 
     /// Sets the palette index (so that, e.g., data and model of one experiment share a colour).
@@ -261,6 +269,12 @@ where
                     chart
                         .draw_series(run.iter().map(|&p| Circle::new(p, radius, color.filled())))?;
                 }
+                Style::Rings => {
+                    chart.draw_series(
+                        run.iter()
+                            .map(|&p| Circle::new(p, 2 * radius, color.stroke_width(stroke))),
+                    )?;
+                }
                 _ if run.len() == 1 => {
                     // An isolated point between gaps would be invisible as a line.
                     chart.draw_series(
@@ -287,6 +301,9 @@ where
                         Style::Line => (color.stroke_width(stroke), TRANSPARENT.filled(), 20),
                         Style::Dashed => (color.stroke_width(stroke), TRANSPARENT.filled(), 7),
                         Style::Markers => (TRANSPARENT.stroke_width(0), color.filled(), 20),
+                        Style::Rings => {
+                            (TRANSPARENT.stroke_width(0), color.stroke_width(stroke), 20)
+                        }
                     };
                     EmptyElement::at((x, y))
                         + PathElement::new(vec![(0, 0), (gap, 0)], line)

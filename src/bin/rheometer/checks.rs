@@ -83,6 +83,17 @@ pub fn parse_fraction(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
+/// `--f-scale`: a positive, finite relative residual below 1.
+pub fn parse_f_scale(s: &str) -> Result<f64, String> {
+    let v = number(s)?;
+    if !(v > 0.0 && v < 1.0) {
+        return Err(format!(
+            "f_scale is a relative residual in (0, 1) (got {v}; 0.02 is 2 %)"
+        ));
+    }
+    Ok(v)
+}
+
 /// `--tol`: in [`TOL_RANGE`].
 pub fn parse_tol(s: &str) -> Result<f64, String> {
     let v = number(s)?;

@@ -24,6 +24,15 @@ pub struct FitArgs {
     /// air_temperature_profile, inlet_velocity, nusselt_scale.
     #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
     pub with: Vec<EffectSetting>,
+    /// The loss of the fit: linear (least squares), or a robust loss that down-weights
+    /// outliers: soft_l1, huber, cauchy (as in scipy's least_squares; needs the principled
+    /// estimator).
+    #[arg(long, default_value = "linear", value_parser = diffbvp::least_squares::Loss::parse)]
+    pub loss: diffbvp::least_squares::Loss,
+    /// Soft margin of a robust loss as a relative residual (e.g. 0.02 for 2 %; default: the
+    /// robust noise scale of the data).
+    #[arg(long = "f-scale", value_parser = checks::parse_f_scale, allow_hyphen_values = true)]
+    pub f_scale: Option<f64>,
     /// Write the result as JSON to FILE.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -42,10 +51,14 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         newtonian,
         model,
         with,
+        loss,
+        f_scale,
         json,
         out,
     } = args;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
+    opts.loss = loss;
+    opts.f_scale = f_scale;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     if let Some(s) = start {
         checks::check_start(s, &opts)?;

@@ -17,14 +17,16 @@
 //! ```
 //!
 //! **Statistics** (all on the relative residuals):
+//! * the *noise model* ([`NoiseModel`], the project's one estimator): a robust noise scale
+//!   from second differences along `s`, the noise scale along the line `σ(s/L)`, gross
+//!   outliers by experiment and position, the lag-1 autocorrelation and `RMS/noise`;
 //! * *noise level* `σ`: the data set's `relative_uncertainty` if given (or
-//!   [`CompareOptions::relative_uncertainty`]), else estimated from the data by
-//!   [`noise_mad_second_differences`](crate::fiber::statistics::noise_mad_second_differences) — the robust (MAD) standard deviation of normalised
-//!   second differences of consecutive residuals along `s`, which cancel any residual that is
-//!   locally linear in `s`, so a smooth systematic misfit does not inflate the noise estimate;
-//! * `χ² = Σ r²/σ²` over all points with `dof = N − p` (`p` fitted parameters);
-//! * whiteness: the Wald–Wolfowitz runs test on the residual signs
-//!   ([`RunsTest`]) and the lag-1 autocorrelation, per experiment and pooled;
+//!   [`CompareOptions::relative_uncertainty`]), else the noise model's robust scale;
+//! * `χ² = Σ r²/σᵢ²` over the points that are not outliers, with `σᵢ = σ` if given, else the
+//!   local `σ(sᵢ/L)` (so a noisier take-up region does not pass for a misfit), and
+//!   `dof = N − outliers − p` (`p` fitted parameters);
+//! * whiteness: the Wald–Wolfowitz runs test on the residual signs ([`RunsTest`]) and the noise
+//!   model's lag-1 autocorrelation, per experiment and pooled;
 //! * where: systematic segments of the pooled residual profile ([`segments`]), pooled over all
 //!   experiments and per experiment;
 //! * trends: Spearman rank correlations of the residual with strain rate, temperature, speed.
@@ -39,6 +41,7 @@ pub use model_runs::{compare_set, simulate_experiments, FitParameters, MissingTa
 pub use segments::{Segment, SegmentOptions, Station};
 
 use crate::fiber::error::FiberError;
+pub use crate::fiber::noise_model::{NoiseModel, NoiseOptions, Outlier, ResidualSeries};
 use crate::fiber::output::{create_output_dir, write_text, OutputError};
 use crate::fiber::simulate::Profiles;
 use crate::fiber::smoothing::SmoothingError;
@@ -109,6 +112,9 @@ pub struct CompareOptions {
     pub fitted_parameters: usize,
     /// Thresholds of the segment search.
     pub segments: SegmentOptions,
+    /// Settings of the noise model.
+    #[serde(default)]
+    pub noise: NoiseOptions,
 }
 
 /// One measurement point.
@@ -132,6 +138,9 @@ pub struct ComparedPoint {
     pub temperature_k: f64,
     /// Model fiber speed (m/s).
     pub speed_m_s: f64,
+    /// Whether the noise model flags the point as a gross outlier.
+    #[serde(default)]
+    pub outlier: bool,
 }
 
 /// The comparison of one experiment.
@@ -151,11 +160,12 @@ pub struct ComparedExperiment {
     pub rms: f64,
     /// Mean relative residual \[-\].
     pub mean: f64,
-    /// `Σ r²/σ²` of this experiment.
+    /// `Σ r²/σᵢ²` of this experiment, outliers excluded.
     pub chi2: f64,
     /// Runs test on the residual signs.
     pub runs: RunsTest,
-    /// Lag-1 autocorrelation of the residuals (about their mean).
+    /// Lag-1 autocorrelation of the noise-normalised residuals about zero, outliers excluded
+    /// ([`NoiseModel::lag1_per_experiment`]).
     pub lag1: f64,
     /// Systematic segments of this experiment alone.
     pub segments: Vec<Segment>,
@@ -189,15 +199,17 @@ pub struct Comparison {
     pub sigma: f64,
     /// Where `σ` came from.
     pub sigma_source: NoiseSource,
-    /// The data-based estimate of `σ` (always computed, for reference) \[-\].
+    /// The data-based estimate of `σ` (the noise model's robust scale, always computed) \[-\].
     pub sigma_estimated: f64,
+    /// The noise model of the residuals: scale along the line, outliers, lag-1, RMS/noise.
+    pub noise: NoiseModel,
     /// Number of measurement points `N`.
     pub points: usize,
     /// Number of fitted parameters `p`.
     pub fitted_parameters: usize,
-    /// `χ² = Σ r²/σ²`.
+    /// `χ² = Σ r²/σᵢ²` over the points that are not outliers.
     pub chi2: f64,
-    /// `dof = N − p`.
+    /// `dof = N − outliers − p`.
     pub dof: usize,
     /// `χ²/dof`.
     pub chi2_per_dof: f64,
@@ -205,7 +217,7 @@ pub struct Comparison {
     pub rms: f64,
     /// Pooled runs test.
     pub runs: RunsTest,
-    /// Pooled lag-1 autocorrelation.
+    /// Pooled lag-1 autocorrelation ([`NoiseModel::lag1`]).
     pub lag1: f64,
     /// `z` of the lag-1 autocorrelation against white noise (`ρ₁ √pairs`).
     pub lag1_z: f64,
@@ -242,7 +254,19 @@ pub fn compare(
             )
         })
         .collect();
-    let sigma_estimated = statistics::noise_mad_second_differences(&series);
+    let input: Vec<ResidualSeries> = runs
+        .iter()
+        .zip(&series)
+        .map(|(run, (s, r))| ResidualSeries {
+            name: run.name.clone(),
+            positions_m: s.clone(),
+            residuals: r.clone(),
+            measured_m: run.measured.clone(),
+            length_m: run.curve.position.last().copied().filter(|l| *l > 0.0),
+        })
+        .collect();
+    let noise = NoiseModel::estimate(&input, &options.noise).map_err(CompareError::Data)?;
+    let sigma_estimated = noise.sigma;
     let given = options.relative_uncertainty.or(set_uncertainty);
     if let Some(s) = given {
         if !(s > 0.0 && s.is_finite()) {
@@ -262,17 +286,34 @@ pub fn compare(
         )));
     }
     let n_points: usize = experiments.iter().map(|e| e.points.len()).sum();
-    let mut sum2 = 0.0;
-    for (e, (s, r)) in experiments.iter_mut().zip(&series) {
-        e.chi2 = r.iter().map(|v| v * v).sum::<f64>() / (sigma * sigma);
+    let (mut sum2, mut chi2) = (0.0, 0.0);
+    for (k, (e, (s, r))) in experiments.iter_mut().zip(&series).enumerate() {
+        e.chi2 = 0.0;
+        for (i, p) in e.points.iter_mut().enumerate() {
+            p.outlier = noise.is_outlier(k, i);
+            if p.outlier {
+                continue;
+            }
+            let sd = match sigma_source {
+                NoiseSource::Given => sigma,
+                NoiseSource::Estimated => noise.local_sigma_at(k, p.position_m),
+            };
+            e.chi2 += (p.residual / sd).powi(2);
+        }
+        chi2 += e.chi2;
         sum2 += r.iter().map(|v| v * v).sum::<f64>();
+        e.lag1 = noise
+            .lag1_per_experiment
+            .get(k)
+            .copied()
+            .unwrap_or(f64::NAN);
         e.segments = segments::find_segments(&[(s.clone(), r.clone())], sigma, &options.segments);
     }
-    let chi2 = sum2 / (sigma * sigma);
-    let dof = n_points.saturating_sub(options.fitted_parameters);
+    let dof = n_points
+        .saturating_sub(noise.outliers.len())
+        .saturating_sub(options.fitted_parameters);
     let runs_each: Vec<RunsTest> = experiments.iter().map(|e| e.runs).collect();
-    let seqs: Vec<&[f64]> = series.iter().map(|(_, r)| r.as_slice()).collect();
-    let (lag1, pairs) = statistics::lag1_autocorrelation_about_mean(&seqs);
+    let (lag1, lag1_z) = (noise.lag1, noise.lag1_z);
     let all = |f: fn(&ComparedPoint) -> f64| -> Vec<f64> {
         experiments
             .iter()
@@ -303,7 +344,8 @@ pub fn compare(
         rms: (sum2 / n_points.max(1) as f64).sqrt(),
         runs: RunsTest::pooled(&runs_each),
         lag1,
-        lag1_z: lag1 * (pairs as f64).sqrt(),
+        lag1_z,
+        noise,
         stations: segments::station_profile(&series, sigma),
         segments: segments::find_segments(&series, sigma, &options.segments),
         trends,
@@ -354,11 +396,11 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
             strain_rate_1_s: p.strain_rate[i],
             temperature_k: p.temperature[i],
             speed_m_s: p.velocity[i],
+            outlier: false,
         });
     }
     let r: Vec<f64> = points.iter().map(|p| p.residual).collect();
     let m = n as f64;
-    let (lag1, _) = statistics::lag1_autocorrelation_about_mean(&[&r]);
     Ok(ComparedExperiment {
         name: run.name.clone(),
         curve_position_m: run.curve.position.clone(),
@@ -367,7 +409,7 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
         mean: r.iter().sum::<f64>() / m,
         chi2: f64::NAN,
         runs: RunsTest::of(&r),
-        lag1,
+        lag1: f64::NAN,
         segments: Vec::new(),
         points,
     })

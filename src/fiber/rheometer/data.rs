@@ -5,6 +5,7 @@ use super::options::{CarreauFiber, FitWarning, RheometerError, WarningCode};
 use crate::fiber::effects::ModelSpec;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
+use crate::fiber::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
 use crate::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
 use crate::fiber::smoothing::{smooth, SmoothFit};
 use crate::fiber::statistics::median;
@@ -145,6 +146,65 @@ impl Rheometer {
             }
         }
         (sum / count.max(1) as f64).sqrt()
+    }
+
+    /// The robust noise scale of the data \[-\] (relative): the [`NoiseModel`] `σ` of
+    /// `d_fit(s)/d_meas − 1` about each experiment's smoothing ansatz (second differences, so
+    /// the ansatz's own misfit hardly enters). The default soft margin of a robust loss.
+    pub fn data_noise_scale(&self) -> Result<f64, RheometerError> {
+        let profiles: Vec<(Vec<f64>, Vec<f64>)> = self
+            .measurements
+            .iter()
+            .zip(&self.smoothing)
+            .map(|(m, f)| {
+                let r = m
+                    .positions
+                    .iter()
+                    .zip(&m.diameters)
+                    .map(|(&s, &d)| f.diameter(s) / d - 1.0)
+                    .collect();
+                (m.positions.clone(), r)
+            })
+            .collect();
+        let nm = NoiseModel::from_profiles(&profiles, &NoiseOptions::default())
+            .map_err(RheometerError::Data)?;
+        if nm.sigma > 0.0 && nm.sigma.is_finite() {
+            Ok(nm.sigma)
+        } else {
+            Err(RheometerError::Data(format!(
+                "cannot estimate the noise scale of the data (got {}); give f_scale",
+                nm.sigma
+            )))
+        }
+    }
+
+    /// The [`NoiseModel`] of a fit's residuals (`residual_profiles` of an
+    /// [`Identification`](super::Identification), one per experiment in order): experiment
+    /// names, measured diameters and spin-line lengths from the data, default options. The
+    /// call for the diagnosis: `rh.noise_model(&id.residual_profiles)?`.
+    pub fn noise_model(
+        &self,
+        residual_profiles: &[(Vec<f64>, Vec<f64>)],
+    ) -> Result<NoiseModel, RheometerError> {
+        if residual_profiles.len() != self.len() {
+            return Err(RheometerError::Data(format!(
+                "{} residual profiles for {} experiments",
+                residual_profiles.len(),
+                self.len()
+            )));
+        }
+        let series: Vec<ResidualSeries> = residual_profiles
+            .iter()
+            .enumerate()
+            .map(|(k, (s, r))| ResidualSeries {
+                name: self.experiments[k].name.clone(),
+                positions_m: s.clone(),
+                residuals: r.clone(),
+                measured_m: self.measurements[k].diameters.clone(),
+                length_m: Some(self.experiments[k].spinline_length),
+            })
+            .collect();
+        NoiseModel::estimate(&series, &NoiseOptions::default()).map_err(RheometerError::Data)
     }
 
     /// `(d_model − d_meas)/d_meas` at the measurement positions of experiment `k`.

@@ -12,7 +12,7 @@ use super::estimator::Estimator;
 use super::layout::{EffectSlot, FitStart};
 use super::options::{FitWarning, IdentifyOptions, RheometerError};
 use crate::fiber::effects::LawChoice;
-use crate::least_squares::{fit, FitOptions, FitResult};
+use crate::least_squares::{fit, FitOptions, FitResult, Loss};
 use crate::solution::Solution;
 use std::time::Instant;
 
@@ -51,10 +51,22 @@ impl Rheometer {
         let mut obj = self.objective_from(start, options)?;
         let p0 = obj.initial_parameters();
         let (lower, upper) = obj.bounds();
+        let (f_scale, f_scale_source) = self.robust_margin(options)?;
+        let sigma = options
+            .relative_uncertainty
+            .or(self.relative_uncertainty)
+            .unwrap_or(1.0);
         let fo = FitOptions {
             initial_radius: 0.3,
             max_radius: 1.0,
             max_iterations: options.max_iterations,
+            loss: options.loss,
+            // the principled residual is the relative residual over σ
+            f_scale: if options.loss.is_linear() {
+                1.0
+            } else {
+                f_scale / sigma
+            },
             ..FitOptions::with_bounds(lower.clone(), upper.clone())
         };
         let fit_result = fit(&mut obj, &p0, &fo)?;
@@ -96,10 +108,40 @@ impl Rheometer {
             residual_profiles,
             relative_uncertainty: options.relative_uncertainty.or(self.relative_uncertainty),
             data_warnings: self.data_warnings(),
+            loss: options.loss,
+            f_scale,
+            f_scale_source,
+            down_weighted: fit_result.down_weighted(),
             solutions,
             fit: fit_result,
             wall_time_s: t0.elapsed().as_secs_f64(),
         })
+    }
+
+    /// The soft margin `C` \[-\] (relative residual) of a robust loss and where it comes from
+    /// (`NaN` and `""` for the linear loss). Errors: a robust loss with the paper's estimator,
+    /// a non-positive `f_scale`.
+    fn robust_margin(&self, options: &IdentifyOptions) -> Result<(f64, String), RheometerError> {
+        if options.loss.is_linear() {
+            return Ok((f64::NAN, String::new()));
+        }
+        if options.estimator != Estimator::Principled {
+            return Err(RheometerError::Data(format!(
+                "the {} loss needs the principled estimator (relative residuals); the paper's \
+                 estimator fits with the linear loss only",
+                options.loss
+            )));
+        }
+        match options.f_scale {
+            Some(c) if c > 0.0 && c.is_finite() => Ok((c, "given".into())),
+            Some(c) => Err(RheometerError::Data(format!(
+                "f_scale must be a positive relative residual (e.g. 0.02), got {c}"
+            ))),
+            None => Ok((
+                self.data_noise_scale()?,
+                "robust noise scale of the data about the smoothing ansatz".into(),
+            )),
+        }
     }
 
     /// The Newtonian model (`n = 1`) at `kappa` with take-up factors 1, one solution per
@@ -191,4 +233,12 @@ pub struct Identification {
     pub relative_uncertainty: Option<f64>,
     /// Warnings about the data found before fitting ([`Rheometer::data_warnings`]).
     pub data_warnings: Vec<FitWarning>,
+    /// The loss of the fit.
+    pub loss: Loss,
+    /// Its soft margin `C` \[-\] in relative-residual units (`NaN` for the linear loss).
+    pub f_scale: f64,
+    /// Where `f_scale` came from (`"given"` or the data's robust noise scale; empty for linear).
+    pub f_scale_source: String,
+    /// Residuals beyond the soft margin (down-weighted by the robust loss; 0 for linear).
+    pub down_weighted: usize,
 }

@@ -9,7 +9,7 @@ use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::simulate::SimulateOptions;
 use crate::fiber::smoothing::SmoothingError;
-use crate::least_squares::FitError;
+use crate::least_squares::{FitError, Loss};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use thiserror::Error;
@@ -69,6 +69,12 @@ pub struct IdentifyOptions {
     pub max_iterations: usize,
     /// Relative measurement uncertainty σ of the diameters; `None`: the data set's value, or 1.
     pub relative_uncertainty: Option<f64>,
+    /// The loss of the least-squares fit (default [`Loss::Linear`]; a robust loss needs the
+    /// principled estimator).
+    pub loss: Loss,
+    /// Soft margin `C` of a robust loss, in relative-residual units \[-\] (e.g. 0.02 = 2 %);
+    /// `None`: the robust noise scale of the data ([`Rheometer::data_noise_scale`](super::Rheometer::data_noise_scale)).
+    pub f_scale: Option<f64>,
 }
 
 impl Default for IdentifyOptions {
@@ -86,6 +92,8 @@ impl Default for IdentifyOptions {
             take_up_bounds: [0.5, 1.5],
             max_iterations: 100,
             relative_uncertainty: None,
+            loss: Loss::Linear,
+            f_scale: None,
         }
     }
 }

@@ -35,6 +35,7 @@ use super::identify::Identification;
 pub use super::options::{FitWarning, WarningCode};
 use crate::fiber::effects::LawChoice;
 use crate::fiber::statistics::noise_mad_second_differences;
+use crate::least_squares::Loss;
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::{Deserialize, Serialize};
 
@@ -163,7 +164,7 @@ pub struct FitReport {
     /// Correlation of `n` and `κ`.
     #[serde(deserialize_with = "nullable::f64")]
     pub correlation_n_kappa: f64,
-    /// Cost `J = ‖r‖²` of the estimator at the optimum.
+    /// Cost `J = ‖r‖²` of the estimator at the optimum (`C² Σ ρ((rᵢ/C)²)` under a robust loss).
     pub cost: f64,
     /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements \[-\].
     pub rms_relative_residual: f64,
@@ -198,6 +199,18 @@ pub struct FitReport {
     /// Everything that makes this fit doubtful (empty for a good fit).
     #[serde(default)]
     pub warnings: Vec<FitWarning>,
+    /// The loss of the fit (`"linear"`, `"soft_l1"`, `"huber"`, `"cauchy"`).
+    #[serde(default)]
+    pub loss: Loss,
+    /// Soft margin `C` of a robust loss \[-\] (relative residual; `null` for linear).
+    #[serde(default = "nan", deserialize_with = "nullable::f64")]
+    pub f_scale: f64,
+    /// Where `f_scale` came from (empty for linear).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub f_scale_source: String,
+    /// Residuals beyond the soft margin, down-weighted by the robust loss (0 for linear).
+    #[serde(default)]
+    pub down_weighted: usize,
 }
 
 fn nan() -> f64 {
@@ -416,6 +429,10 @@ impl FitReport {
             effects,
             at_bound,
             warnings: Vec::new(),
+            loss: id.loss,
+            f_scale: id.f_scale,
+            f_scale_source: id.f_scale_source.clone(),
+            down_weighted: id.down_weighted,
         };
         let mut w = id.data_warnings.clone();
         rep.check_bounds(&mut w);
@@ -721,6 +738,17 @@ impl FitReport {
         ));
         s.push_str(&format!("    residuals         = {}\n", self.residuals));
         s.push_str(&format!("    cost J            = {:.6e}\n", self.cost));
+        if !self.loss.is_linear() {
+            s.push_str(&format!(
+                "    loss              = {} (f_scale {:.3} % relative residual, {}; {} of {} \
+                 residuals beyond it, down-weighted; CIs from the sandwich covariance)\n",
+                self.loss,
+                100.0 * self.f_scale,
+                self.f_scale_source,
+                self.down_weighted,
+                self.residuals
+            ));
+        }
         s.push_str(&format!(
             "    RMS (d_model - d_meas)/d_meas = {:.4} %\n",
             100.0 * self.rms_relative_residual

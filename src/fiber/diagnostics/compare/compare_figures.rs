@@ -5,6 +5,7 @@ use super::{CompareError, Comparison, FigureFormat};
 use crate::fiber::figures::{experiment_panel_pages, ExperimentView, ModelCurves, View};
 use crate::fiber::output::ensure_not_input;
 use crate::fiber::simulate::Profiles;
+use crate::fiber::statistics::median;
 use crate::plot::{save_panels, Panel, Series};
 use std::path::{Path, PathBuf};
 
@@ -13,13 +14,41 @@ fn grid_size(panels: usize, columns: usize) -> (u32, u32) {
     ((420 * columns as u32).max(900), 320 * rows)
 }
 
+/// Bins of `s/L` of the pooled trend.
+const TREND_BINS: usize = 12;
+
+/// The pooled trend across experiments: per bin of `s/L` with at least 3 points, the median
+/// residual (outliers left out) at the bin's mean position, as `(s [m], residual [%])` with
+/// `s = (s/L) · length`.
+fn pooled_trend(cmp: &Comparison, length: f64) -> Vec<(f64, f64)> {
+    let mut bins: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); TREND_BINS];
+    for (k, e) in cmp.experiments.iter().enumerate() {
+        let l = cmp.noise.lengths_m.get(k).copied().unwrap_or(length);
+        for p in e.points.iter().filter(|p| !p.outlier) {
+            let x = p.position_m / l;
+            let b = ((x * TREND_BINS as f64).floor().max(0.0) as usize).min(TREND_BINS - 1);
+            bins[b].0.push(x);
+            bins[b].1.push(p.residual);
+        }
+    }
+    bins.into_iter()
+        .filter(|(x, _)| x.len() >= 3)
+        .map(|(x, mut r)| {
+            let xm = x.iter().sum::<f64>() / x.len() as f64;
+            (xm * length, 100.0 * median(&mut r))
+        })
+        .collect()
+}
+
 /// Writes into `dir` (which must exist):
 /// * `compare_diameters.EXT`: measured and simulated diameters per experiment (µm);
 /// * `compare_inverse_d2.EXT`: `1/d²` measured and simulated per experiment (1/mm²);
 ///   (both split into `NAME_1.EXT`, `NAME_2.EXT`, … beyond
 ///   [`MAX_PANELS_PER_FIGURE`](crate::fiber::figures::MAX_PANELS_PER_FIGURE) experiments);
-/// * `compare_residuals.EXT`: relative residual vs `s`, per experiment and the pooled station
-///   mean, with the `±2σ` band of single points and the `±2 se` band of the pooled mean;
+/// * `compare_residuals.EXT`: relative residual vs `s`, per experiment, with the noise model's
+///   `±2σ(s/L)` band (varying along the line; plus the given `±2σ` if one was given), the
+///   pooled trend across experiments (median of the residuals in bins of `s/L`, outliers left
+///   out) and the outliers ringed; below, the pooled station mean with its `±2 se` band;
 /// * `compare_residual_trends.EXT`: residuals against strain rate, temperature and speed, one
 ///   colour per experiment.
 ///
@@ -79,7 +108,6 @@ pub fn write_figures(
         out.push(path);
         Ok(())
     };
-    let two_sigma = 200.0 * cmp.sigma;
     let (s_lo, s_hi) = cmp
         .stations
         .iter()
@@ -99,13 +127,39 @@ pub fn write_figures(
             .with_color(k),
         );
     }
+    let length = cmp.noise.lengths_m.iter().copied().fold(0.0, f64::max);
+    let band: Vec<(f64, f64)> = (0..=60)
+        .map(|i| {
+            let s = s_lo + (s_hi - s_lo) * f64::from(i) / 60.0;
+            (s, 200.0 * cmp.noise.local_sigma(s / length))
+        })
+        .collect();
+    let lower: Vec<(f64, f64)> = band.iter().map(|(s, v)| (*s, -v)).collect();
     each = each
-        .with_series(
-            Series::dashed("±2σ", vec![(s_lo, two_sigma), (s_hi, two_sigma)]).with_color(9),
-        )
-        .with_series(
-            Series::dashed("", vec![(s_lo, -two_sigma), (s_hi, -two_sigma)]).with_color(9),
-        );
+        .with_series(Series::dashed("±2σ(s) noise model", band).with_color(9))
+        .with_series(Series::dashed("", lower).with_color(9));
+    if cmp.sigma_source == super::NoiseSource::Given {
+        let two_sigma = 200.0 * cmp.sigma;
+        each = each
+            .with_series(
+                Series::dashed("±2σ given", vec![(s_lo, two_sigma), (s_hi, two_sigma)])
+                    .with_color(7),
+            )
+            .with_series(
+                Series::dashed("", vec![(s_lo, -two_sigma), (s_hi, -two_sigma)]).with_color(7),
+            );
+    }
+    each = each.with_series(Series::line("pooled trend", pooled_trend(cmp, length)).with_color(3));
+    let outliers: Vec<(f64, f64)> = cmp
+        .experiments
+        .iter()
+        .flat_map(|e| e.points.iter().filter(|p| p.outlier))
+        .map(|p| (p.position_m, 100.0 * p.residual))
+        .collect();
+    if !outliers.is_empty() {
+        let label = format!("outliers ({})", outliers.len());
+        each = each.with_series(Series::rings(label, outliers).with_color(3));
+    }
     let st = &cmp.stations;
     let pooled = Panel::new("pooled residual (station mean)", "s (m)", "residual (%)")
         .with_series(

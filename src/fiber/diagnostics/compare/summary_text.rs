@@ -46,7 +46,79 @@ fn segment_line(seg: &Segment, total: usize, names: &[String], pooled: bool) -> 
     s
 }
 
+/// Most outliers listed in the text (all are in the JSON).
+const MAX_LISTED_OUTLIERS: usize = 30;
+
 impl Comparison {
+    /// The noise model in words: scale along the line, RMS/noise, outliers.
+    fn noise_lines(&self, s: &mut String) {
+        let nm = &self.noise;
+        let bins: Vec<String> = nm
+            .bins
+            .iter()
+            .map(|b| format!("{:.2} % on s/L {:.1}-{:.1}", pct(b.sigma), b.from, b.to))
+            .collect();
+        let along = if nm.varies_along_line {
+            format!(
+                "the noise VARIES along the line ({:.1}x between bins, z = {:.1})",
+                nm.variation_ratio, nm.variation_z
+            )
+        } else {
+            format!(
+                "no significant variation along the line ({:.1}x, z = {:.1})",
+                nm.variation_ratio, nm.variation_z
+            )
+        };
+        let _ = writeln!(
+            s,
+            "noise model: robust scale {:.2} %; along the line {}: {along}",
+            pct(nm.sigma),
+            bins.join(", ")
+        );
+        let _ = writeln!(
+            s,
+            "RMS/noise = {:.2} (RMS {:.2} % vs local noise RMS {:.2} % over the same {} points,              outliers left out); robust RMS/noise = {:.2}",
+            nm.rms_over_noise,
+            pct(nm.rms),
+            pct(nm.noise_rms),
+            nm.points,
+            nm.robust_rms_over_noise
+        );
+        if nm.outliers.is_empty() {
+            let _ = writeln!(
+                s,
+                "outliers: none (no point deviates from its neighbours' robust line by more than                  {} local sigma)",
+                nm.options.outlier_threshold
+            );
+            return;
+        }
+        let _ = writeln!(
+            s,
+            "OUTLIERS: {} points deviate from their neighbours' robust line by more than {} local              sigma (left out of chi2, RMS/noise and lag-1):",
+            nm.outliers.len(),
+            nm.options.outlier_threshold
+        );
+        for o in nm.outliers.iter().take(MAX_LISTED_OUTLIERS) {
+            let _ = writeln!(
+                s,
+                "  - {} at s = {:.3} m: measured {:.2} um, model {:.2} um, residual {:+.1} %                  ({:+.1} sigma)",
+                o.experiment,
+                o.position_m,
+                1e6 * o.d_meas_m,
+                1e6 * o.d_model_m,
+                pct(o.residual),
+                o.deviation_sigmas
+            );
+        }
+        if nm.outliers.len() > MAX_LISTED_OUTLIERS {
+            let _ = writeln!(
+                s,
+                "  ... and {} more (see compare.json, noise.outliers)",
+                nm.outliers.len() - MAX_LISTED_OUTLIERS
+            );
+        }
+    }
+
     /// The summary in words.
     pub fn to_text(&self) -> String {
         let mut s = String::new();
@@ -79,6 +151,7 @@ impl Comparison {
                 );
             }
         }
+        self.noise_lines(&mut s);
         let dof = self.dof as f64;
         let excess = (self.chi2 - dof) / (2.0 * dof).sqrt();
         let verdict = if self.dof == 0 {
@@ -94,8 +167,15 @@ impl Comparison {
         };
         let _ = writeln!(
             s,
-            "chi2/dof = {:.1}/{} = {:.2} ({} fitted parameters): {verdict}",
-            self.chi2, self.dof, self.chi2_per_dof, self.fitted_parameters
+            "chi2/dof = {:.1}/{} = {:.2} ({} fitted parameters{}): {verdict}",
+            self.chi2,
+            self.dof,
+            self.chi2_per_dof,
+            self.fitted_parameters,
+            match self.noise.outliers.len() {
+                0 => String::new(),
+                k => format!(", {k} outliers left out"),
+            }
         );
         // evidence against whiteness: the larger of −z(runs) and z(lag-1)
         let evidence = (-self.runs.z).max(self.lag1_z);
@@ -109,7 +189,8 @@ impl Comparison {
         let _ = writeln!(
             s,
             "whiteness: runs test z = {:.1} ({} runs of residual signs, {:.1} expected for \
-             random signs), lag-1 autocorrelation {:.2} (z = {:.1}): {verdict}",
+             random signs), lag-1 autocorrelation {:.2} of the noise-normalised residuals \
+             (z = {:.1}): {verdict}",
             self.runs.z, self.runs.runs, self.runs.expected, self.lag1, self.lag1_z,
         );
         let names: Vec<String> = self.experiments.iter().map(|e| e.name.clone()).collect();
