@@ -30,6 +30,7 @@
 //! The report states the law that was fitted ([`FitReport::law`]); it never infers it from the
 //! values (a Carreau fit that ends at `n = 1` stays a Carreau fit, at its bound).
 
+use super::error_budget::ErrorBudget;
 use super::estimator::Estimator;
 use super::identify::Identification;
 pub use super::options::{FitWarning, WarningCode};
@@ -198,6 +199,10 @@ pub struct FitReport {
     /// Everything that makes this fit doubtful (empty for a good fit).
     #[serde(default)]
     pub warnings: Vec<FitWarning>,
+    /// The systematic uncertainty from what the data cannot identify (process conditions,
+    /// instrument, material data), if computed ([`with_error_budget`](Self::with_error_budget)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error_budget: Option<ErrorBudget>,
 }
 
 fn nan() -> f64 {
@@ -416,6 +421,7 @@ impl FitReport {
             effects,
             at_bound,
             warnings: Vec::new(),
+            error_budget: None,
         };
         let mut w = id.data_warnings.clone();
         rep.check_bounds(&mut w);
@@ -640,6 +646,15 @@ impl FitReport {
         w.push(FitWarning::new(WarningCode::Misfit, m));
     }
 
+    /// The report with the error budget `budget`: its section in the text, its object in JSON,
+    /// and a [`WarningCode::Systematic`] warning for each source that shifts `κ` or `n` by more
+    /// than the statistical standard error.
+    pub fn with_error_budget(mut self, budget: ErrorBudget) -> Self {
+        self.warnings.extend(budget.warnings());
+        self.error_budget = Some(budget);
+        self
+    }
+
     /// Whether `(n, κ)` lies in the 95% confidence region box (false where an interval is not
     /// valid).
     pub fn covers(&self, n: f64, kappa: f64) -> bool {
@@ -831,6 +846,9 @@ impl FitReport {
                 "    C(n, kappa) = {:+.4}\n",
                 self.correlation_n_kappa
             ));
+        }
+        if let Some(b) = &self.error_budget {
+            s.push_str(&b.to_text());
         }
         s
     }
