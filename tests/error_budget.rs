@@ -17,8 +17,8 @@ mod probe;
 use diffbvp::fiber::effects::{Effect, EffectSetting, ModelSpec};
 use diffbvp::fiber::input::{load_experiments_with, parse_experiments, LoadedExperiments};
 use diffbvp::fiber::rheometer::{
-    error_budget, ErrorBudget, FitReport, Identification, IdentifyOptions, Rheometer,
-    SourceStatus, WarningCode,
+    error_budget, ErrorBudget, FitReport, Identification, IdentifyOptions, Rheometer, SourceStatus,
+    WarningCode,
 };
 use diffbvp::fiber::setup::{ExperimentSet, Inlet};
 use diffbvp::fiber::uncertainty::{Origin, Scope, Uncertainties};
@@ -101,7 +101,10 @@ fn uncertainty_tables_read_back() {
     );
     assert_eq!(u.experiments, vec![vec![], vec![("mass_flow_rel", 0.05)]]);
     assert_eq!(u.sigma("mass_flow_rel", 0), Some((0.02, Origin::Declared)));
-    assert_eq!(u.sigma("mass_flow_rel", 1), Some((0.05, Origin::Experiment)));
+    assert_eq!(
+        u.sigma("mass_flow_rel", 1),
+        Some((0.05, Origin::Experiment))
+    );
     assert_eq!(u.sigma("vft_B_K", 1), Some((30.0, Origin::Default)));
     // an inline table works too, and nothing declared is nothing declared
     let inline = format!(
@@ -179,7 +182,10 @@ fn invalid_declarations_name_file_line_table_and_key() {
         (
             format!("{MATERIAL}\n{EXPERIMENTS}[experiment.uncertainty]\ngauge_scale_rel = -1\n"),
             "gauge_scale_rel = -1",
-            vec!["[[experiment]] #2 \"b\" uncertainty table", "must be positive"],
+            vec![
+                "[[experiment]] #2 \"b\" uncertainty table",
+                "must be positive",
+            ],
         ),
         (
             format!(
@@ -187,7 +193,10 @@ fn invalid_declarations_name_file_line_table_and_key() {
                 MATERIAL.replace("[defaults]\n", "[defaults]\ngauge_scale_rel = 0.01\n")
             ),
             "gauge_scale_rel",
-            vec!["unknown key `gauge_scale_rel` in [defaults]", "belongs in [uncertainty]"],
+            vec![
+                "unknown key `gauge_scale_rel` in [defaults]",
+                "belongs in [uncertainty]",
+            ],
         ),
         (
             format!("uncertainty = 0.01\n{MATERIAL}\n{EXPERIMENTS}"),
@@ -210,7 +219,9 @@ fn invalid_declarations_name_file_line_table_and_key() {
 
 #[test]
 fn library_declarations_are_checked() {
-    assert!(Uncertainties::defaults().with("inlet_temperature_K", 3.0).is_ok());
+    assert!(Uncertainties::defaults()
+        .with("inlet_temperature_K", 3.0)
+        .is_ok());
     for (k, v) in [
         ("inlet_temperature_K", 0.0),
         ("inlet_temperature_K", f64::INFINITY),
@@ -268,7 +279,11 @@ fn sensitivities_agree_with_central_differences_of_refits() {
     // % per % of the source); the refits stop at ftol = 1e-8 relative cost change, i.e. at
     // |Δκ| ~ 1e-4 (SE 0.09 × √(1e-8 N)), which is 2 % of the κ change over 2h (~0.01). Hence 5 %.
     for (key, h, change) in [
-        ("inlet_diameter_rel", 0.005, &inlet as &dyn Fn(&mut ExperimentSet, f64)),
+        (
+            "inlet_diameter_rel",
+            0.005,
+            &inlet as &dyn Fn(&mut ExperimentSet, f64),
+        ),
         ("gauge_scale_rel", 0.005, &scale),
         ("gauge_offset_um", 2.0, &offset),
     ] {
@@ -381,7 +396,10 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
                 assert!(m.contains(needle), "{needle:?} not in {m}");
             }
         }
-        assert_eq!(rep.to_text().contains("WARNING [systematic]"), !w.is_empty());
+        assert_eq!(
+            rep.to_text().contains("WARNING [systematic]"),
+            !w.is_empty()
+        );
     }
 }
 
@@ -407,7 +425,10 @@ fn effects_in_the_model_are_used_or_reported_fitted() {
         entry(&b2, "inlet_diameter_rel").dkappa_dq.unwrap(),
         entry(&b0, "inlet_diameter_rel").dkappa_dq.unwrap(),
     );
-    assert_eq!(entry(&b2, "inlet_diameter_rel").status, SourceStatus::Effect);
+    assert_eq!(
+        entry(&b2, "inlet_diameter_rel").status,
+        SourceStatus::Effect
+    );
     assert!((a - c).abs() < 1e-3 * c.abs(), "{a} vs {c}");
 }
 
@@ -501,14 +522,13 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
 
     // declared in the TOML: read, marked declared, an experiment's own value used
     let text = std::fs::read_to_string(&toml).unwrap();
-    let text = format!(
-        "{text}\n[uncertainty]\ninlet_diameter_rel = 0.001\ngauge_scale_rel = 0.001\n"
-    )
-    .replacen(
-        "data = \"v0p27_p1.csv\"\n",
-        "data = \"v0p27_p1.csv\"\nuncertainty = { inlet_diameter_rel = 0.003 }\n",
-        1,
-    );
+    let text =
+        format!("{text}\n[uncertainty]\ninlet_diameter_rel = 0.001\ngauge_scale_rel = 0.001\n")
+            .replacen(
+                "data = \"v0p27_p1.csv\"\n",
+                "data = \"v0p27_p1.csv\"\nuncertainty = { inlet_diameter_rel = 0.003 }\n",
+                1,
+            );
     std::fs::write(&toml, text).unwrap();
     let p = probe::rheometer(
         &["fit", probe::s(&toml), "--json", probe::s(&json)],
@@ -516,7 +536,9 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
         LIMIT,
     );
     p.assert_success();
-    assert!(p.stdout.contains("(declared uncertainties, defaults for the rest"));
+    assert!(p
+        .stdout
+        .contains("(declared uncertainties, defaults for the rest"));
     assert!(p.stdout.contains("0.100 % (declared)"), "{}", p.stdout);
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let d = v["error_budget"]["sources"]

@@ -324,7 +324,9 @@ mod tests {
 
     #[test]
     fn sigma_prefers_experiment_then_set_then_default() {
-        let mut u = Uncertainties::defaults().with("mass_flow_rel", 0.03).unwrap();
+        let mut u = Uncertainties::defaults()
+            .with("mass_flow_rel", 0.03)
+            .unwrap();
         u.experiments = vec![vec![], vec![("mass_flow_rel", 0.05)]];
         assert_eq!(u.sigma("mass_flow_rel", 0), Some((0.03, Origin::Declared)));
         assert_eq!(
@@ -343,9 +345,13 @@ mod tests {
     fn check_refuses_bad_values() {
         assert!(check("inlet_temperature_K", 0.0).is_err());
         assert!(check("inlet_temperature_K", f64::NAN).is_err());
-        assert!(check("inlet_temperature_K", 51.0).unwrap_err().contains("implausibly"));
+        assert!(check("inlet_temperature_K", 51.0)
+            .unwrap_err()
+            .contains("implausibly"));
         assert!(check("mass_flow_rel", 2.0).unwrap_err().contains("2 %"));
-        assert!(check("mass_flow", 0.1).unwrap_err().contains("mass_flow_rel"));
+        assert!(check("mass_flow", 0.1)
+            .unwrap_err()
+            .contains("mass_flow_rel"));
         for s in SOURCES {
             assert!(s.default > 0.0 && s.default <= s.max, "{}", s.key);
         }

@@ -11,13 +11,13 @@ use super::error::{InputError, Location};
 use super::measurements::{load_measurements, DEFAULT_MIN_POINTS};
 use super::read_text;
 use super::schema::{
-    names, rule_of, Rule, EXPERIMENT_NUMBERS, EXPERIMENT_TABLES, MATERIAL_NUMBERS, MAX_PLAUSIBLE_DIAMETER_M,
-    MIN_PLAUSIBLE_DIAMETER_M, STRING_KEYS, TOP_KEYS,
+    names, rule_of, Rule, EXPERIMENT_NUMBERS, EXPERIMENT_TABLES, MATERIAL_NUMBERS,
+    MAX_PLAUSIBLE_DIAMETER_M, MIN_PLAUSIBLE_DIAMETER_M, STRING_KEYS, TOP_KEYS,
 };
 use super::spanned::{toml_error, Doc, Field, Tab};
 use super::uncertainty::uncertainty_table;
-use crate::fiber::uncertainty::Uncertainties;
 use crate::fiber::setup::{Air, Experiment, ExperimentSet, Inlet, Material, TakeUp};
+use crate::fiber::uncertainty::Uncertainties;
 
 /// Largest plausible zero-shear viscosity of the melt at the inlet \[Pa s\]: 1e12 Pa s is the
 /// conventional viscosity of a glass at its glass transition; above it the polymer is not a melt.

@@ -29,8 +29,8 @@ use super::identify::Identification;
 use super::layout::FitStart;
 use super::options::{FitWarning, IdentifyOptions, RheometerError, WarningCode};
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
-use crate::fiber::model::FiberModel;
 use crate::fiber::material_law::CarreauLike;
+use crate::fiber::model::FiberModel;
 use crate::fiber::uncertainty::{GaugeColumn, Origin, Scope, Source, Uncertainties, SOURCES};
 use crate::least_squares::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector};
@@ -189,7 +189,11 @@ pub fn error_budget(
         let applies = rh.experiments.iter().any(|e| (s.per_unit)(e).is_some());
         let status = if !applies {
             Err(SourceStatus::NotApplicable)
-        } else if let Some(set) = spec.effects.iter_mut().find(|x| x.effect.name() == s.effect) {
+        } else if let Some(set) = spec
+            .effects
+            .iter_mut()
+            .find(|x| x.effect.name() == s.effect)
+        {
             match set.value {
                 None if !free.iter().any(|f| f == s.effect) => Err(SourceStatus::Fitted),
                 None => Ok(s.effect.to_string()),
@@ -277,7 +281,9 @@ pub fn error_budget(
     }
     let mut entries = Vec::new();
     for (s, col) in SOURCES.iter().zip(&columns) {
-        let (sigma, origin) = unc.sigma(s.key, usize::MAX).unwrap_or((s.default, Origin::Default));
+        let (sigma, origin) = unc
+            .sigma(s.key, usize::MAX)
+            .unwrap_or((s.default, Origin::Default));
         let overridden_in: Vec<String> = (0..m)
             .filter(|&k| matches!(unc.sigma(s.key, k), Some((_, Origin::Experiment))))
             .map(|k| rh.experiments[k].name.clone())
@@ -310,7 +316,9 @@ pub fn error_budget(
         let mut per: Vec<(f64, f64, f64)> = Vec::new(); // (σ_k, dn, dκ)
         for k in 0..m {
             let e = &rh.experiments[k];
-            let Some(factor) = (s.per_unit)(e) else { continue };
+            let Some(factor) = (s.per_unit)(e) else {
+                continue;
+            };
             let mut c = DVector::zeros(n_res);
             for i in offsets[k]..offsets[k + 1] {
                 c[i] = factor * column_value(col, &aug, i, r, rh, k, i - offsets[k], sigma_r);
@@ -519,7 +527,10 @@ impl ErrorBudget {
     pub fn sentences(&self) -> Vec<String> {
         let mut out = Vec::new();
         for (label, get) in [
-            ("kappa", (|e: &BudgetEntry| e.dkappa_dq) as fn(&BudgetEntry) -> Option<f64>),
+            (
+                "kappa",
+                (|e: &BudgetEntry| e.dkappa_dq) as fn(&BudgetEntry) -> Option<f64>,
+            ),
             ("n", |e: &BudgetEntry| e.dn_dq),
         ] {
             let parts: Vec<String> = self
@@ -527,7 +538,12 @@ impl ErrorBudget {
                 .filter_map(|e| {
                     let s = SOURCES.iter().find(|s| s.key == e.key)?;
                     let d = get(e)? * s.word_unit.1;
-                    Some(format!("by {} per {} of {}", sign(d), s.word_unit.0, s.what))
+                    Some(format!(
+                        "by {} per {} of {}",
+                        sign(d),
+                        s.word_unit.0,
+                        s.what
+                    ))
                 })
                 .collect();
             if !parts.is_empty() {
@@ -600,7 +616,12 @@ impl ErrorBudget {
             )
         };
         if self.systematic_n.is_some() {
-            s.push_str(&line("n    ", self.systematic_n, self.statistical_n, self.total_n));
+            s.push_str(&line(
+                "n    ",
+                self.systematic_n,
+                self.statistical_n,
+                self.total_n,
+            ));
         }
         if self.systematic_kappa.is_some() {
             s.push_str(&line(
