@@ -387,8 +387,7 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
             assert_eq!(w.len(), 1, "{w:?}");
             let m = &w[0].message;
             for needle in [
-                "error of the inlet diameter",
-                "declared uncertainty",
+                "uncertainty of the inlet diameter (declared)",
                 "would shift kappa by",
                 "statistical standard errors: the data cannot tell",
                 "inlet_velocity",
@@ -503,7 +502,7 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
         let big = s["shift_kappa"].as_f64().is_some_and(|x| x > stat)
             || s["shift_n"].as_f64().is_some_and(|x| x > stat_n);
         let what = format!(
-            "error of the {} (default uncertainty)",
+            "uncertainty of the {} (default)",
             match s["key"].as_str().unwrap() {
                 "inlet_diameter_rel" => "inlet diameter",
                 "gauge_scale_rel" => "diameter gauge scale",

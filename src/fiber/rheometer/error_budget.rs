@@ -508,12 +508,12 @@ impl ErrorBudget {
             w.push(FitWarning::new(
                 WarningCode::Systematic,
                 format!(
-                    "a {} error of the {} ({}) would {}: the data cannot tell; {}",
+                    "a {} uncertainty of the {} ({}) would {}: the data cannot tell; {}",
                     sigma_words(s, e.sigma),
                     s.what,
                     match e.origin {
-                        Origin::Default => "default uncertainty",
-                        _ => "declared uncertainty",
+                        Origin::Default => "default",
+                        _ => "declared",
                     },
                     parts.join(" and "),
                     s.remedy
