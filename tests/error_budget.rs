@@ -389,7 +389,7 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
             for needle in [
                 "uncertainty of the inlet diameter (declared)",
                 "would shift kappa by",
-                "statistical standard errors: the data cannot tell",
+                "times its statistical uncertainty: the data cannot tell",
                 "inlet_velocity",
             ] {
                 assert!(m.contains(needle), "{needle:?} not in {m}");

@@ -495,7 +495,7 @@ impl ErrorBudget {
                 if let (Some(shift), Some(stat)) = (shift, stat) {
                     if stat > 0.0 && shift > stat {
                         parts.push(format!(
-                            "shift {label} by {}, {:.1} statistical standard errors",
+                            "shift {label} by {}, {:.1} times its statistical uncertainty",
                             g3(shift),
                             shift / stat
                         ));
