@@ -87,16 +87,14 @@ fn home_of(key: &str) -> Option<&'static str> {
         Some("the top level (before the first [table] header)")
     } else if key == "uncertainty" {
         Some("the top level ([uncertainty]) or an [[experiment]] (its own `uncertainty` table)")
-    } else if crate::fiber::uncertainty::source(key).is_some()
-        && rule_of(EXPERIMENT_NUMBERS, key).is_none()
-    {
-        Some("[uncertainty] (or an experiment's `uncertainty` table)")
     } else if rule_of(MATERIAL_NUMBERS, key).is_some() {
         Some("[material]")
     } else if STRING_KEYS.contains(&key) {
         Some("[[experiment]] (it cannot be a default)")
     } else if rule_of(EXPERIMENT_NUMBERS, key).is_some() {
         Some("[defaults] or [[experiment]]")
+    } else if crate::fiber::uncertainty::source(key).is_some() {
+        Some("[uncertainty] (or an experiment's `uncertainty` table)")
     } else {
         None
     }
