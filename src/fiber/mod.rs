@@ -43,6 +43,7 @@ pub mod smoothing;
 pub mod statistics;
 pub mod synthetic;
 pub mod take_up;
+pub mod uncertainty;
 
 pub use contributions::{
     Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength,

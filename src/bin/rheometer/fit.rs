@@ -106,7 +106,15 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         }
     };
     let id = rh.identify(start, &opts)?;
-    let rep = FitReport::new(&id);
+    // the systematic uncertainty of what the data cannot identify (declared or default
+    // uncertainties); a budget that cannot be computed does not fail the fit
+    let rep = match error_budget(&rh, &id, &loaded.uncertainty, &opts) {
+        Ok(budget) => FitReport::new(&id).with_error_budget(budget),
+        Err(e) => {
+            g.say(format!("warning: error budget not computed: {e}"));
+            FitReport::new(&id)
+        }
+    };
     outln!("{}", rep.to_text());
     for w in &rep.warnings {
         g.say(format!("warning: {w}"));

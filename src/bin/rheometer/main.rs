@@ -19,7 +19,7 @@ use diffbvp::fiber::output::{
     write_text,
 };
 use diffbvp::fiber::rheometer::{
-    Estimator, FitReport, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
+    error_budget, Estimator, FitReport, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
 };
 use diffbvp::fiber::{CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions};
 use indicatif::{ProgressBar, ProgressStyle};

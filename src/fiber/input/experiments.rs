@@ -11,11 +11,13 @@ use super::error::{InputError, Location};
 use super::measurements::{load_measurements, DEFAULT_MIN_POINTS};
 use super::read_text;
 use super::schema::{
-    names, rule_of, Rule, EXPERIMENT_NUMBERS, MATERIAL_NUMBERS, MAX_PLAUSIBLE_DIAMETER_M,
-    MIN_PLAUSIBLE_DIAMETER_M, STRING_KEYS, TOP_KEYS,
+    names, rule_of, Rule, EXPERIMENT_NUMBERS, EXPERIMENT_TABLES, MATERIAL_NUMBERS,
+    MAX_PLAUSIBLE_DIAMETER_M, MIN_PLAUSIBLE_DIAMETER_M, STRING_KEYS, TOP_KEYS,
 };
 use super::spanned::{toml_error, Doc, Field, Tab};
+use super::uncertainty::uncertainty_table;
 use crate::fiber::setup::{Air, Experiment, ExperimentSet, Inlet, Material, TakeUp};
+use crate::fiber::uncertainty::Uncertainties;
 
 /// Largest plausible zero-shear viscosity of the melt at the inlet \[Pa s\]: 1e12 Pa s is the
 /// conventional viscosity of a glass at its glass transition; above it the polymer is not a melt.
@@ -45,6 +47,9 @@ pub struct LoadedExperiments {
     pub set: ExperimentSet,
     /// Descriptive metadata and data-file paths.
     pub details: Vec<ExperimentDetails>,
+    /// Declared standard uncertainties (`[uncertainty]` and the experiments' own tables; empty
+    /// when nothing is declared).
+    pub uncertainty: Uncertainties,
 }
 
 /// Loads a TOML experiment file and the CSV files it refers to, requiring at least
@@ -95,6 +100,10 @@ pub fn parse_experiments(text: &str, path: &Path) -> Result<LoadedExperiments, I
         Some(field) => Some(relative_uncertainty(&field)?),
         None => None,
     };
+    let mut uncertainty = Uncertainties::default();
+    if let Some(tab) = top.sub_table("uncertainty", "[uncertainty]")? {
+        uncertainty.set = uncertainty_table(&tab)?;
+    }
     let material_tab = top
         .sub_table("material", "[material]")?
         .ok_or_else(|| top.missing("material", " (the [material] table)"))?;
@@ -114,6 +123,18 @@ pub fn parse_experiments(text: &str, path: &Path) -> Result<LoadedExperiments, I
     let mut seen: Vec<(String, Option<usize>)> = Vec::new();
     for tab in tables {
         let label = tab.name.clone();
+        let own_name = match tab
+            .get("name")
+            .and_then(|f| f.string().ok().map(str::to_string))
+        {
+            Some(name) => format!("{label} \"{name}\" uncertainty table"),
+            None => format!("{label} uncertainty table"),
+        };
+        let own = match tab.sub_table("uncertainty", &own_name)? {
+            Some(t) => uncertainty_table(&t)?,
+            None => Vec::new(),
+        };
+        uncertainty.experiments.push(own);
         let (experiment, mut detail, name_at) = experiment(tab, defaults.as_ref(), &material)?;
         detail.line = name_at.line;
         if let Some((_, first)) = seen.iter().find(|(n, _)| *n == experiment.name) {
@@ -140,6 +161,7 @@ pub fn parse_experiments(text: &str, path: &Path) -> Result<LoadedExperiments, I
             relative_uncertainty,
         },
         details,
+        uncertainty,
     })
 }
 
@@ -243,7 +265,7 @@ fn experiment(
     {
         tab.name = format!("{} \"{name}\"", tab.name);
     }
-    tab.check_keys(&[STRING_KEYS, &names(EXPERIMENT_NUMBERS)].concat())?;
+    tab.check_keys(&[STRING_KEYS, EXPERIMENT_TABLES, &names(EXPERIMENT_NUMBERS)].concat())?;
     let name_field = tab.get("name").ok_or_else(|| tab.missing("name", ""))?;
     let name = name_field.string()?.to_string();
     if name.trim().is_empty() || name.contains(['/', '\\']) || name.chars().any(char::is_control) {

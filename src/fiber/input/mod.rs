@@ -40,6 +40,26 @@
 //! spinline_length_m = 0.51                 # any [defaults] key may be overridden here
 //! ```
 //!
+//! Optional standard uncertainties of what the data cannot identify (process conditions,
+//! instrument, material data), for the error budget of a fit; each experiment may override them
+//! in its own table (see [`fiber::uncertainty`](crate::fiber::uncertainty) for the keys,
+//! defaults and scopes):
+//!
+//! ```toml
+//! [uncertainty]                            # optional, top level
+//! inlet_temperature_K = 3.0                # melt temperature at the die, ± K
+//! mass_flow_rel = 0.02                     # relative: 0.02 = 2 %
+//! inlet_diameter_rel = 0.03
+//! gauge_scale_rel = 0.01
+//! gauge_offset_um = 2.0                    # µm
+//!
+//! [[experiment]]
+//! name = "a"
+//! # ...
+//! [experiment.uncertainty]                 # optional, this experiment only
+//! mass_flow_rel = 0.05
+//! ```
+//!
 //! Required per experiment (in its table or in `[defaults]`): `mass_flow_kg_s`,
 //! `spinline_length_m`, `inlet_temperature_K`, `air_temperature_K` and one inlet key. The inlet
 //! keys (`inlet_diameter_m`/`inlet_velocity_m_s`) and the take-up keys
@@ -76,13 +96,17 @@
 //! * `spanned`: reading the TOML document with spans, so that every error names a line;
 //! * `experiments`: building the [`ExperimentSet`](super::setup::ExperimentSet) from the
 //!   tables, with the plausibility checks of each experiment;
-//! * `measurements`: reading the measurement CSV files.
+//! * `measurements`: reading the measurement CSV files;
+//! * `uncertainty`: reading the `[uncertainty]` tables (declared standard uncertainties of
+//!   process conditions, instrument and material data, see
+//!   [`fiber::uncertainty`](crate::fiber::uncertainty)).
 
 mod error;
 mod experiments;
 mod measurements;
 mod schema;
 mod spanned;
+mod uncertainty;
 
 use std::path::Path;
 

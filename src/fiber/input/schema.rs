@@ -31,8 +31,16 @@ pub(super) enum Rule {
     Fraction,
 }
 
-pub(super) const TOP_KEYS: &[&str] =
-    &["relative_uncertainty", "material", "defaults", "experiment"];
+pub(super) const TOP_KEYS: &[&str] = &[
+    "relative_uncertainty",
+    "uncertainty",
+    "material",
+    "defaults",
+    "experiment",
+];
+
+/// Sub-table keys of an `[[experiment]]` table (its own `uncertainty` overrides).
+pub(super) const EXPERIMENT_TABLES: &[&str] = &["uncertainty"];
 
 pub(super) const MATERIAL_NUMBERS: &[(&str, Rule)] = &[
     ("density_slope_kg_m3_K", Rule::Finite),
@@ -77,12 +85,16 @@ pub(super) fn rule_of(rules: &[(&str, Rule)], key: &str) -> Option<Rule> {
 fn home_of(key: &str) -> Option<&'static str> {
     if key == "relative_uncertainty" {
         Some("the top level (before the first [table] header)")
+    } else if key == "uncertainty" {
+        Some("the top level ([uncertainty]) or an [[experiment]] (its own `uncertainty` table)")
     } else if rule_of(MATERIAL_NUMBERS, key).is_some() {
         Some("[material]")
     } else if STRING_KEYS.contains(&key) {
         Some("[[experiment]] (it cannot be a default)")
     } else if rule_of(EXPERIMENT_NUMBERS, key).is_some() {
         Some("[defaults] or [[experiment]]")
+    } else if crate::fiber::uncertainty::source(key).is_some() {
+        Some("[uncertainty] (or an experiment's `uncertainty` table)")
     } else {
         None
     }
@@ -103,6 +115,18 @@ pub(super) fn key_hint(key: &str, allowed: &[&str]) -> String {
         }
         _ => format!("; expected one of: {}", allowed.join(", ")),
     }
+}
+
+/// The element of `allowed` closest to `key` (case-insensitive edit distance), if close enough
+/// to be a probable typo.
+pub(super) fn closest<'a>(key: &str, allowed: &[&'a str]) -> Option<&'a str> {
+    let lower = key.to_lowercase();
+    allowed
+        .iter()
+        .map(|a| (levenshtein(&lower, &a.to_lowercase()), *a))
+        .min()
+        .filter(|(d, _)| *d <= (key.len() / 3).max(2))
+        .map(|(_, a)| a)
 }
 
 fn levenshtein(a: &str, b: &str) -> usize {

@@ -127,6 +127,15 @@ impl<'a> Tab<'a> {
 
     /// Errors on the first (in file order) key not in `allowed`.
     pub(super) fn check_keys(&self, allowed: &[&str]) -> Result<(), InputError> {
+        self.check_keys_hinted(allowed, |key| key_hint(key, allowed))
+    }
+
+    /// As [`check_keys`](Self::check_keys), with the hint for an unknown key from `hint`.
+    pub(super) fn check_keys_hinted(
+        &self,
+        allowed: &[&str],
+        hint: impl Fn(&str) -> String,
+    ) -> Result<(), InputError> {
         let unknown = self
             .table
             .iter()
@@ -138,7 +147,7 @@ impl<'a> Tab<'a> {
                 at: self.doc.at(&key.span()),
                 table: self.name.clone(),
                 key: key.get_ref().to_string(),
-                hint: key_hint(key.get_ref(), allowed),
+                hint: hint(key.get_ref()),
             }),
         }
     }

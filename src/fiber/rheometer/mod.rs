@@ -14,11 +14,14 @@
 //!   warm-started, exact Jacobians from forward sensitivities);
 //! * [`layout`]: which parameters are fitted (law, effect strengths, take-up factors);
 //! * [`landscape`]: the cost on a grid (paper Fig. 4);
+//! * [`error_budget`]: what the data cannot identify (process conditions, instrument,
+//!   material data) propagated through exact sensitivities into a systematic uncertainty;
 //! * [`report`]: uncertainty (standard errors, 95% confidence intervals, correlation), the checks
 //!   of a fit (estimates at bounds, misfit, huge errors, data the model cannot describe) and the
 //!   text and JSON reports.
 
 pub mod data;
+pub mod error_budget;
 pub mod estimator;
 pub mod identify;
 pub mod landscape;
@@ -28,6 +31,7 @@ pub mod options;
 pub mod report;
 
 pub use data::Rheometer;
+pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
 pub use estimator::Estimator;
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};

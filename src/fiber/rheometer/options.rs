@@ -124,6 +124,10 @@ pub enum WarningCode {
     IllConditioned,
     /// Measured data the model cannot describe (e.g. diameters increasing along the spin line).
     DataTrend,
+    /// A declared (or default) uncertainty of what the data cannot identify (process
+    /// conditions, instrument, material data) shifts an estimate by more than its statistical
+    /// standard error (see [`error_budget`](super::error_budget)).
+    Systematic,
 }
 
 impl WarningCode {
@@ -136,6 +140,7 @@ impl WarningCode {
             WarningCode::SingularCovariance => "singular_covariance",
             WarningCode::IllConditioned => "ill_conditioned",
             WarningCode::DataTrend => "data_trend",
+            WarningCode::Systematic => "systematic",
         }
     }
 }

@@ -30,6 +30,7 @@
 //! The report states the law that was fitted ([`FitReport::law`]); it never infers it from the
 //! values (a Carreau fit that ends at `n = 1` stays a Carreau fit, at its bound).
 
+use super::error_budget::ErrorBudget;
 use super::estimator::Estimator;
 use super::identify::Identification;
 pub use super::options::{FitWarning, WarningCode};
@@ -211,6 +212,10 @@ pub struct FitReport {
     /// Residuals beyond the soft margin, down-weighted by the robust loss (0 for linear).
     #[serde(default)]
     pub down_weighted: usize,
+    /// The systematic uncertainty from what the data cannot identify (process conditions,
+    /// instrument, material data), if computed ([`with_error_budget`](Self::with_error_budget)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error_budget: Option<ErrorBudget>,
 }
 
 fn nan() -> f64 {
@@ -433,6 +438,7 @@ impl FitReport {
             f_scale: id.f_scale,
             f_scale_source: id.f_scale_source.clone(),
             down_weighted: id.down_weighted,
+            error_budget: None,
         };
         let mut w = id.data_warnings.clone();
         rep.check_bounds(&mut w);
@@ -657,6 +663,15 @@ impl FitReport {
         w.push(FitWarning::new(WarningCode::Misfit, m));
     }
 
+    /// The report with the error budget `budget`: its section in the text, its object in JSON,
+    /// and a [`WarningCode::Systematic`] warning for each source that shifts `κ` or `n` by more
+    /// than the statistical standard error.
+    pub fn with_error_budget(mut self, budget: ErrorBudget) -> Self {
+        self.warnings.extend(budget.warnings());
+        self.error_budget = Some(budget);
+        self
+    }
+
     /// Whether `(n, κ)` lies in the 95% confidence region box (false where an interval is not
     /// valid).
     pub fn covers(&self, n: f64, kappa: f64) -> bool {
@@ -859,6 +874,9 @@ impl FitReport {
                 "    C(n, kappa) = {:+.4}\n",
                 self.correlation_n_kappa
             ));
+        }
+        if let Some(b) = &self.error_budget {
+            s.push_str(&b.to_text());
         }
         s
     }
