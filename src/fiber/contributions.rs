@@ -17,7 +17,13 @@
 //! Built in ([`Physics::paper`] switches on the first four, as the paper's model):
 //! gravity, Stokes air drag, convective cooling (pluggable [`NusseltLaw`]), viscous heating;
 //! off by default: grey-body radiation ([`Physics::with_radiation`]), a warm-air profile
-//! ([`Physics::with_warm_air`]) and an aspirator co-flow ([`Physics::with_coflow`]).
+//! ([`Physics::with_warm_air`]), an aspirator co-flow ([`Physics::with_coflow`]) and a co-flow
+//! along the line ([`Physics::with_line_coflow`]), whose decay lengths and onset may be model
+//! parameters too ([`Physics::set_strength`] with `"air_coflow.decay_length"` etc.).
+//! Process parameters (inlet velocity and diameter, die temperature offset, mass-flow scale,
+//! [`Physics::process`]) change the boundary conditions and the mass flow; instrument
+//! parameters (gauge scale and offset, [`Physics::gauge_reading`]) only the predicted
+//! measurement.
 //! Users add their own SI terms with [`Physics::with_custom`] (a [`FiberTerm`]).
 
 use super::error::FiberError;
@@ -876,7 +882,7 @@ impl<H: NusseltLaw> Physics<H> {
         };
         if let Some(d) = v[S_INLET_DIAMETER] {
             let f = d + 1.0;
-            inlet = inlet / (f * f);
+            inlet /= f * f;
         }
         ProcessFactors {
             inlet_velocity: inlet,
