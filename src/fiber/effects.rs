@@ -915,3 +915,60 @@ impl ModelSpec {
             .try_fold(Physics::paper(), |p, e| e.apply(p))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn search_ranges_contain_physical_ranges_and_neutral() {
+        for e in Effect::all() {
+            let (lo, hi) = e.bounds();
+            let (plo, phi) = e.physical_range();
+            assert!(lo <= plo && plo <= phi && phi <= hi, "{}", e.name());
+            assert!((plo..=phi).contains(&e.neutral()), "{}", e.name());
+            for s in e.shape_parameters() {
+                assert!(
+                    s.bounds.0 <= s.default && s.default <= s.bounds.1,
+                    "{}",
+                    s.name
+                );
+                assert!(s.model_param.starts_with(e.name()));
+            }
+        }
+        assert_eq!(Effect::all().len(), ALL_NAMES.len());
+        let names: Vec<&str> = Effect::builtin().iter().map(|e| e.name()).collect();
+        assert_eq!(names, BUILTIN_NAMES);
+    }
+
+    #[test]
+    fn judge_words_and_shape_bounds_for_length() {
+        assert_eq!(
+            Effect::Radiation.judge(2.0).as_deref(),
+            Some("radiation would need ε = 2 > 1: not physical")
+        );
+        assert_eq!(
+            Effect::GaugeOffset.judge(-25.0).as_deref(),
+            Some("gauge_offset would need o = -25 µm < -20 µm: not physical")
+        );
+        assert!(Effect::MassFlowScale.judge(0.1).is_none());
+        assert_eq!(COFLOW_DECAY.bounds_for_length(0.5), (0.01, 0.75));
+        assert_eq!(WARM_AIR_DECAY.bounds_for_length(2.0), (0.005, 1.0));
+        assert_eq!(
+            COFLOW_DECAY.bounds_for_length(f64::NAN),
+            COFLOW_DECAY.bounds
+        );
+    }
+
+    #[test]
+    fn shapes_fixed_by_settings_are_not_freed() {
+        let s: EffectSetting = "air_coflow_line:onset=0.25".parse().unwrap();
+        // the ramp width is never fitted by default, the fixed onset not either
+        assert!(s.effect.free_shapes().is_empty());
+        let vals: Vec<f64> = s.effect.shape_values().iter().map(|v| v.1).collect();
+        assert_eq!(vals, [0.25, DEFAULT_COFLOW_LINE_RAMP_WIDTH]);
+        let free = Effect::AirCoflow { decay_length: None }.free_shapes();
+        assert_eq!(free.len(), 1);
+        assert_eq!(free[0].model_param, "air_coflow.decay_length");
+    }
+}
