@@ -593,8 +593,10 @@ fn fit_files_are_checked_by_the_library_too() {
 
 /// `diagnose` refits candidates: a refit whose strength ends at a bound of its search range is
 /// marked in the text and the JSON and gets no credible-estimate wording. On the shipped
-/// hidden-radiation data the co-flow candidate is pushed to its lower bound; radiation (the
-/// hidden effect) is not.
+/// hidden-radiation data no refit ends at a bound since the co-flow's search range covers real
+/// aspirator speeds (before, the co-flow candidate was pushed to its lower bound −5 m/s): every
+/// marked candidate (none here) must be marked in the text too, radiation (the hidden effect)
+/// is not marked, and the co-flow's refit lies inside its range.
 #[test]
 fn diagnose_marks_a_candidate_refit_at_its_bound() {
     let dir = probe::scratch("fit_warn_diagnose_bound");
@@ -626,14 +628,28 @@ fn diagnose_marks_a_candidate_refit_at_its_bound() {
         })
         .map(|c| c["effect"].as_str().unwrap())
         .collect();
-    assert!(marked.contains(&"air_coflow"), "{marked:?}\n{}", p.stdout);
     assert!(!marked.contains(&"radiation"), "{marked:?}\n{}", p.stdout);
+    for name in &marked {
+        let line = p
+            .stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{name} ")))
+            .unwrap();
+        assert!(line.contains("BOUND"), "{line}");
+    }
+    let coflow = cands.iter().find(|c| c["effect"] == "air_coflow").unwrap();
+    let (lo, hi) = "air_coflow"
+        .parse::<diffbvp::fiber::effects::Effect>()
+        .unwrap()
+        .bounds();
+    let s = coflow["strength"].as_f64().unwrap();
+    assert!(lo < s && s < hi, "co-flow strength {s}");
     let coflow_line = p
         .stdout
         .lines()
-        .find(|l| l.trim_start().starts_with("air_coflow"))
+        .find(|l| l.trim_start().starts_with("air_coflow "))
         .unwrap();
-    assert!(coflow_line.contains("AT LOWER BOUND"), "{coflow_line}");
+    assert!(!coflow_line.contains("BOUND"), "{coflow_line}");
     let radiation_line = p
         .stdout
         .lines()

@@ -17,7 +17,13 @@
 //! Built in ([`Physics::paper`] switches on the first four, as the paper's model):
 //! gravity, Stokes air drag, convective cooling (pluggable [`NusseltLaw`]), viscous heating;
 //! off by default: grey-body radiation ([`Physics::with_radiation`]), a warm-air profile
-//! ([`Physics::with_warm_air`]) and an aspirator co-flow ([`Physics::with_coflow`]).
+//! ([`Physics::with_warm_air`]), an aspirator co-flow ([`Physics::with_coflow`]) and a co-flow
+//! along the line ([`Physics::with_line_coflow`]), whose decay lengths and onset may be model
+//! parameters too ([`Physics::set_strength`] with `"air_coflow.decay_length"` etc.).
+//! Process parameters (inlet velocity and diameter, die temperature offset, mass-flow scale,
+//! [`Physics::process`]) change the boundary conditions and the mass flow; instrument
+//! parameters (gauge scale and offset, [`Physics::gauge_reading`]) only the predicted
+//! measurement.
 //! Users add their own SI terms with [`Physics::with_custom`] (a [`FiberTerm`]).
 
 use super::error::FiberError;
@@ -278,8 +284,9 @@ pub enum AirSpeed {
     CoFlow {
         /// `V` \[m/s\].
         speed: f64,
-        /// Decay length `ℓ` \[m\].
-        length: f64,
+        /// Decay length `ℓ` \[m\] (`Parameter` makes it a model parameter named
+        /// `"air_coflow.decay_length"`).
+        length: Strength,
         /// Factor on `V` (`Parameter` makes it a model parameter named `"air_coflow"`).
         strength: Strength,
     },
@@ -294,12 +301,82 @@ pub enum AirTemperature {
     WarmNozzle {
         /// `ΔT` \[K\].
         excess: f64,
-        /// Decay length `ℓ` \[m\].
-        length: f64,
+        /// Decay length `ℓ` \[m\] (`Parameter` makes it a model parameter named
+        /// `"air_temperature_profile.decay_length"`).
+        length: Strength,
         /// Factor on `ΔT` (`Parameter` makes it a model parameter named
         /// `"air_temperature_profile"`).
         strength: Strength,
     },
+}
+
+/// Air co-flow along the spin line, added to [`AirSpeed`]: switched on smoothly after an
+/// onset position, `v_air(s) = strength · V / (1 + exp(−(s − s₀)/w))`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LineCoflow {
+    /// No co-flow along the line.
+    Off,
+    /// The logistic ramp.
+    On {
+        /// `V` \[m/s\].
+        speed: f64,
+        /// Onset `s₀` \[m\] (`Parameter`: model parameter `"air_coflow_line.onset"`).
+        onset: Strength,
+        /// Ramp width `w` \[m\] (`Parameter`: model parameter `"air_coflow_line.ramp_width"`).
+        ramp_width: Strength,
+        /// Factor on `V` (`Parameter`: model parameter `"air_coflow_line"`).
+        strength: Strength,
+    },
+}
+
+/// Number of parameter slots after the terms' strengths ([`Physics::strength_parameters`]).
+const SLOTS: usize = 13;
+const S_COFLOW: usize = 0;
+const S_COFLOW_LEN: usize = 1;
+const S_LINE: usize = 2;
+const S_LINE_ONSET: usize = 3;
+const S_LINE_RAMP: usize = 4;
+const S_WARM: usize = 5;
+const S_WARM_LEN: usize = 6;
+const S_INLET_VELOCITY: usize = 7;
+const S_INLET_DIAMETER: usize = 8;
+const S_DIE_TEMPERATURE: usize = 9;
+const S_MASS_FLOW: usize = 10;
+const S_GAUGE_SCALE: usize = 11;
+const S_GAUGE_OFFSET: usize = 12;
+
+/// Names of the parameter slots after the terms, in `p` order.
+const SLOT_NAMES: [&str; SLOTS] = [
+    "air_coflow",
+    "air_coflow.decay_length",
+    "air_coflow_line",
+    "air_coflow_line.onset",
+    "air_coflow_line.ramp_width",
+    "air_temperature_profile",
+    "air_temperature_profile.decay_length",
+    "inlet_velocity",
+    "inlet_diameter",
+    "die_temperature_offset",
+    "mass_flow_scale",
+    "gauge_scale",
+    "gauge_offset",
+];
+
+/// Process and instrument factors of a model evaluation (dual numbers, so that derivatives with
+/// respect to the process parameters are exact).
+#[derive(Debug, Clone, Copy)]
+pub struct ProcessFactors<D> {
+    /// Factor on the nominal inlet velocity from `inlet_velocity` and `inlet_diameter`:
+    /// `(1 + δ_u)/(1 + δ_d)²` \[-\].
+    pub inlet_velocity: D,
+    /// Offset of the die temperature `ΔT/T_o` \[-\] (dimensionless).
+    pub die_temperature: D,
+    /// Factor `1 + δ` on the mass flow \[-\].
+    pub mass_flow: D,
+    /// Whether the die temperature offset is present (else `die_temperature` is exactly 0).
+    pub has_die_temperature: bool,
+    /// Whether the mass-flow scale is present (else `mass_flow` is exactly 1).
+    pub has_mass_flow: bool,
 }
 
 /// The set of contributions and the air environment.
@@ -319,6 +396,22 @@ pub struct Physics<H: NusseltLaw = InclinedChurchillBernstein> {
     /// `u(0) = (1 + δ) u_in` (`Off` by default; `Parameter` makes `δ` a model parameter named
     /// `"inlet_velocity"`, neutral value 0).
     pub inlet_velocity: Strength,
+    /// Air co-flow along the line (in addition to [`air_speed`](Self::air_speed)).
+    pub line_coflow: LineCoflow,
+    /// Die swell `δ` \[-\]: inlet diameter `(1 + δ) d_in` at the same mass flow, `u(0) =
+    /// u_in/(1 + δ)²` (model parameter `"inlet_diameter"`).
+    pub inlet_diameter: Strength,
+    /// Die temperature offset `ΔT` \[K\]: `T(0) = T_in + ΔT` (model parameter
+    /// `"die_temperature_offset"`).
+    pub die_temperature_offset: Strength,
+    /// Mass-flow error `δ` \[-\]: true mass flow `(1 + δ) Q` (model parameter
+    /// `"mass_flow_scale"`).
+    pub mass_flow_scale: Strength,
+    /// Gauge scale error `g` \[-\]: the gauge reads `(1 + g) d + o` (model parameter
+    /// `"gauge_scale"`; not in the balances, only in the predicted measurement).
+    pub gauge_scale: Strength,
+    /// Gauge offset `o` \[µm\] (model parameter `"gauge_offset"`).
+    pub gauge_offset: Strength,
 }
 
 impl Default for Physics {
@@ -356,6 +449,12 @@ impl<H: NusseltLaw> Physics<H> {
             air_temperature: AirTemperature::Uniform,
             slenderness: super::scaling::PAPER_SLENDERNESS,
             inlet_velocity: Strength::Off,
+            line_coflow: LineCoflow::Off,
+            inlet_diameter: Strength::Off,
+            die_temperature_offset: Strength::Off,
+            mass_flow_scale: Strength::Off,
+            gauge_scale: Strength::Off,
+            gauge_offset: Strength::Off,
         }
     }
 
@@ -382,7 +481,7 @@ impl<H: NusseltLaw> Physics<H> {
     pub fn with_warm_air(mut self, excess: f64, length: f64) -> Self {
         self.air_temperature = AirTemperature::WarmNozzle {
             excess,
-            length,
+            length: Strength::Fixed(length),
             strength: Strength::Fixed(1.0),
         };
         self
@@ -392,10 +491,80 @@ impl<H: NusseltLaw> Physics<H> {
     pub fn with_coflow(mut self, speed: f64, length: f64) -> Self {
         self.air_speed = AirSpeed::CoFlow {
             speed,
-            length,
+            length: Strength::Fixed(length),
             strength: Strength::Fixed(1.0),
         };
         self
+    }
+
+    /// Air co-flow along the line `v_air(s) = V / (1 + exp(−(s − s₀)/w))`, `speed` = V \[m/s\],
+    /// `onset` = s₀ \[m\], `ramp_width` = w \[m\] (added to an aspirator co-flow).
+    pub fn with_line_coflow(mut self, speed: f64, onset: f64, ramp_width: f64) -> Self {
+        self.line_coflow = LineCoflow::On {
+            speed,
+            onset: Strength::Fixed(onset),
+            ramp_width: Strength::Fixed(ramp_width),
+            strength: Strength::Fixed(1.0),
+        };
+        self
+    }
+
+    /// Whether the air moves (an aspirator co-flow or a co-flow along the line).
+    pub fn has_air_flow(&self) -> bool {
+        !matches!(self.air_speed, AirSpeed::Still) || !matches!(self.line_coflow, LineCoflow::Off)
+    }
+
+    /// The parameter slots after the terms' strengths, in `p` order (`Off` where absent).
+    fn slots(&self) -> [Strength; SLOTS] {
+        let mut v = [Strength::Off; SLOTS];
+        if let AirSpeed::CoFlow {
+            length, strength, ..
+        } = self.air_speed
+        {
+            v[S_COFLOW] = strength;
+            v[S_COFLOW_LEN] = length;
+        }
+        if let LineCoflow::On {
+            onset,
+            ramp_width,
+            strength,
+            ..
+        } = self.line_coflow
+        {
+            v[S_LINE] = strength;
+            v[S_LINE_ONSET] = onset;
+            v[S_LINE_RAMP] = ramp_width;
+        }
+        if let AirTemperature::WarmNozzle {
+            length, strength, ..
+        } = self.air_temperature
+        {
+            v[S_WARM] = strength;
+            v[S_WARM_LEN] = length;
+        }
+        v[S_INLET_VELOCITY] = self.inlet_velocity;
+        v[S_INLET_DIAMETER] = self.inlet_diameter;
+        v[S_DIE_TEMPERATURE] = self.die_temperature_offset;
+        v[S_MASS_FLOW] = self.mass_flow_scale;
+        v[S_GAUGE_SCALE] = self.gauge_scale;
+        v[S_GAUGE_OFFSET] = self.gauge_offset;
+        v
+    }
+
+    /// The values of the slots with strength parameters `sp` (`None` where `Off`).
+    #[inline]
+    fn slot_values<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> [Option<D>; SLOTS] {
+        let mut k = self
+            .terms
+            .iter()
+            .filter(|t| t.strength.is_parameter())
+            .count();
+        let slots = self.slots();
+        let mut out = [None; SLOTS];
+        for (o, s) in out.iter_mut().zip(&slots) {
+            *o = strength_value(s, sp, &mut k);
+        }
+        out
     }
 
     /// Adds a user term (SI) named `name` to `balance`.
@@ -415,10 +584,14 @@ impl<H: NusseltLaw> Physics<H> {
     }
 
     /// Sets the strength named `name`: a term's (by its name or [`Term::parameter_name`], e.g.
-    /// `"convection"` or `"nusselt_scale"`), `"air_coflow"` (needs
-    /// [`with_coflow`](Self::with_coflow)), `"air_temperature_profile"` (needs
-    /// [`with_warm_air`](Self::with_warm_air)) or `"inlet_velocity"`. An unknown name, or an
-    /// air profile that is not there, is an error.
+    /// `"convection"` or `"nusselt_scale"`), `"air_coflow"` and `"air_coflow.decay_length"`
+    /// (need [`with_coflow`](Self::with_coflow)), `"air_coflow_line"`,
+    /// `"air_coflow_line.onset"`, `"air_coflow_line.ramp_width"` (need
+    /// [`with_line_coflow`](Self::with_line_coflow)), `"air_temperature_profile"` and
+    /// `"air_temperature_profile.decay_length"` (need [`with_warm_air`](Self::with_warm_air)),
+    /// or a process or instrument parameter (`"inlet_velocity"`, `"inlet_diameter"`,
+    /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"`). An
+    /// unknown name, or an air profile that is not there, is an error.
     pub fn set_strength(&mut self, name: &str, strength: Strength) -> Result<(), FiberError> {
         if let Some(t) = self
             .terms
@@ -428,29 +601,68 @@ impl<H: NusseltLaw> Physics<H> {
             t.strength = strength;
             return Ok(());
         }
-        match (name, &mut self.air_speed, &mut self.air_temperature) {
-            ("air_coflow", AirSpeed::CoFlow { strength: s, .. }, _) => *s = strength,
-            ("air_coflow", AirSpeed::Still, _) => {
-                return Err(FiberError::InvalidInput(
-                    "strength air_coflow: the physics has no air co-flow (add it with \
-                     with_coflow)"
-                        .into(),
-                ))
+        let missing = |what: &str, how: &str| {
+            Err(FiberError::InvalidInput(format!(
+                "strength {name}: the physics has no {what} (add it with {how})"
+            )))
+        };
+        match name {
+            "air_coflow" | "air_coflow.decay_length" => match &mut self.air_speed {
+                AirSpeed::CoFlow {
+                    length,
+                    strength: s,
+                    ..
+                } => {
+                    if name == "air_coflow" {
+                        *s = strength
+                    } else {
+                        *length = strength
+                    }
+                }
+                AirSpeed::Still => return missing("air co-flow", "with_coflow"),
+            },
+            "air_coflow_line" | "air_coflow_line.onset" | "air_coflow_line.ramp_width" => {
+                match &mut self.line_coflow {
+                    LineCoflow::On {
+                        onset,
+                        ramp_width,
+                        strength: s,
+                        ..
+                    } => match name {
+                        "air_coflow_line" => *s = strength,
+                        "air_coflow_line.onset" => *onset = strength,
+                        _ => *ramp_width = strength,
+                    },
+                    LineCoflow::Off => {
+                        return missing("air co-flow along the line", "with_line_coflow")
+                    }
+                }
             }
-            ("air_temperature_profile", _, AirTemperature::WarmNozzle { strength: s, .. }) => {
-                *s = strength
+            "air_temperature_profile" | "air_temperature_profile.decay_length" => {
+                match &mut self.air_temperature {
+                    AirTemperature::WarmNozzle {
+                        length,
+                        strength: s,
+                        ..
+                    } => {
+                        if name == "air_temperature_profile" {
+                            *s = strength
+                        } else {
+                            *length = strength
+                        }
+                    }
+                    AirTemperature::Uniform => return missing("warm-air profile", "with_warm_air"),
+                }
             }
-            ("air_temperature_profile", _, AirTemperature::Uniform) => {
-                return Err(FiberError::InvalidInput(
-                    "strength air_temperature_profile: the physics has no warm-air profile (add \
-                     it with with_warm_air)"
-                        .into(),
-                ))
-            }
-            ("inlet_velocity", _, _) => self.inlet_velocity = strength,
+            "inlet_velocity" => self.inlet_velocity = strength,
+            "inlet_diameter" => self.inlet_diameter = strength,
+            "die_temperature_offset" => self.die_temperature_offset = strength,
+            "mass_flow_scale" => self.mass_flow_scale = strength,
+            "gauge_scale" => self.gauge_scale = strength,
+            "gauge_offset" => self.gauge_offset = strength,
             _ => {
                 let mut known: Vec<&str> = self.terms.iter().map(|t| t.parameter_name()).collect();
-                known.extend(["air_coflow", "air_temperature_profile", "inlet_velocity"]);
+                known.extend(SLOT_NAMES);
                 return Err(FiberError::InvalidInput(format!(
                     "unknown strength \"{name}\"; the strengths are {}",
                     known.join(", ")
@@ -467,8 +679,12 @@ impl<H: NusseltLaw> Physics<H> {
     }
 
     /// Names and default values of the strengths that are model parameters, in `p` order:
-    /// terms first (in term order, by [`Term::parameter_name`]), then `"air_coflow"`, then
-    /// `"air_temperature_profile"`, then `"inlet_velocity"`.
+    /// terms first (in term order, by [`Term::parameter_name`]), then `"air_coflow"`,
+    /// `"air_coflow.decay_length"`, `"air_coflow_line"`, `"air_coflow_line.onset"`,
+    /// `"air_coflow_line.ramp_width"`, `"air_temperature_profile"`,
+    /// `"air_temperature_profile.decay_length"`, `"inlet_velocity"`, `"inlet_diameter"`,
+    /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"` (each
+    /// where it is a parameter).
     pub fn strength_parameters(&self) -> Vec<(&'static str, f64)> {
         let mut v: Vec<(&'static str, f64)> = self
             .terms
@@ -478,22 +694,10 @@ impl<H: NusseltLaw> Physics<H> {
                 _ => None,
             })
             .collect();
-        if let AirSpeed::CoFlow {
-            strength: Strength::Parameter(d),
-            ..
-        } = self.air_speed
-        {
-            v.push(("air_coflow", d));
-        }
-        if let AirTemperature::WarmNozzle {
-            strength: Strength::Parameter(d),
-            ..
-        } = self.air_temperature
-        {
-            v.push(("air_temperature_profile", d));
-        }
-        if let Strength::Parameter(d) = self.inlet_velocity {
-            v.push(("inlet_velocity", d));
+        for (name, s) in SLOT_NAMES.iter().zip(self.slots()) {
+            if let Strength::Parameter(d) = s {
+                v.push((name, d));
+            }
         }
         v
     }
@@ -621,6 +825,8 @@ pub struct LocalState<D> {
     pub cp: D,
     /// `d̃ = 2√(Q̃/(π ρ̃ ũ))` \[-\].
     pub d: D,
+    /// Mass flow `Q̃` \[-\] (the nominal one times the mass-flow factor).
+    pub q: D,
     /// `T̃_air(s̃)` \[-\].
     pub t_air: D,
     /// `ṽ_air(s̃)` \[-\].
@@ -650,27 +856,63 @@ impl<H: NusseltLaw> Physics<H> {
         self.strength_parameters().len()
     }
 
-    /// The inlet-velocity factor `1 + δ` with strength parameters `sp` (1 when the error is off).
+    /// The inlet-velocity factor `1 + δ` of `inlet_velocity` with strength parameters `sp` (1
+    /// when the error is off); see [`process`](Self::process) for all process factors.
     #[inline]
     pub fn inlet_velocity_factor<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> D {
-        match self.inlet_velocity {
-            Strength::Off => D::one(),
-            Strength::Fixed(v) => D::from(1.0 + v),
-            Strength::Parameter(_) => {
-                let mut k = self
-                    .terms
-                    .iter()
-                    .filter(|t| t.strength.is_parameter())
-                    .count();
-                if let AirSpeed::CoFlow { strength, .. } = &self.air_speed {
-                    k += usize::from(strength.is_parameter());
-                }
-                if let AirTemperature::WarmNozzle { strength, .. } = &self.air_temperature {
-                    k += usize::from(strength.is_parameter());
-                }
-                sp.get(k).copied().unwrap_or_else(|| D::from(f64::NAN)) + 1.0
-            }
+        match self.slot_values(sp)[S_INLET_VELOCITY] {
+            Some(d) => d + 1.0,
+            None => D::one(),
         }
+    }
+
+    /// The process factors with strength parameters `sp` (`temperature_scale` = `T_o` \[K\]):
+    /// inlet-velocity factor `(1 + δ_u)/(1 + δ_d)²`, die temperature offset `ΔT/T_o`, mass-flow
+    /// factor `1 + δ`. Exactly 1, 0, 1 where the parameters are off or neutral.
+    #[inline]
+    pub fn process<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        sp: &[D],
+        temperature_scale: f64,
+    ) -> ProcessFactors<D> {
+        let v = self.slot_values(sp);
+        let mut inlet = match v[S_INLET_VELOCITY] {
+            Some(d) => d + 1.0,
+            None => D::one(),
+        };
+        if let Some(d) = v[S_INLET_DIAMETER] {
+            let f = d + 1.0;
+            inlet /= f * f;
+        }
+        ProcessFactors {
+            inlet_velocity: inlet,
+            die_temperature: v[S_DIE_TEMPERATURE]
+                .map_or(D::zero(), |d| d * temperature_scale.recip()),
+            mass_flow: v[S_MASS_FLOW].map_or(D::one(), |d| d + 1.0),
+            has_die_temperature: v[S_DIE_TEMPERATURE].is_some(),
+            has_mass_flow: v[S_MASS_FLOW].is_some(),
+        }
+    }
+
+    /// The gauge's reading of a true diameter: `(1 + g) d + o` with `d`, the result and
+    /// `diameter_scale` = `d_o` \[m\] (the offset `o` is in µm); `d` itself where the gauge
+    /// parameters are off.
+    #[inline]
+    pub fn gauge_reading<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        d: D,
+        sp: &[D],
+        diameter_scale: f64,
+    ) -> D {
+        let v = self.slot_values(sp);
+        let mut out = d;
+        if let Some(g) = v[S_GAUGE_SCALE] {
+            out = d * (g + 1.0);
+        }
+        if let Some(o) = v[S_GAUGE_OFFSET] {
+            out += o * (1e-6 / diameter_scale);
+        }
+        out
     }
 
     /// `(T̃_air(s̃), ṽ_air(s̃))` with strength parameters `sp`.
@@ -681,33 +923,35 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         co: &Coefficients,
     ) -> (D, D) {
-        let mut k = self
-            .terms
-            .iter()
-            .filter(|t| t.strength.is_parameter())
-            .count();
+        let val = self.slot_values(sp);
         let l_o = co.si.length;
-        let v = match &self.air_speed {
-            AirSpeed::Still => D::zero(),
-            AirSpeed::CoFlow {
-                speed,
-                length,
-                strength,
-            } => match strength_value(strength, sp, &mut k) {
-                Some(f) => f * (speed / co.si.velocity * (-(co.length - s) * l_o / length).exp()),
-                None => D::zero(),
-            },
+        let mut v = match (&self.air_speed, val[S_COFLOW], val[S_COFLOW_LEN]) {
+            (AirSpeed::CoFlow { speed, .. }, Some(f), Some(ell)) => {
+                f * (D::from(-(co.length - s) * l_o) / ell).exp() * (speed / co.si.velocity)
+            }
+            _ => D::zero(),
         };
-        let t = match &self.air_temperature {
-            AirTemperature::Uniform => D::from(co.t_air),
-            AirTemperature::WarmNozzle {
-                excess,
-                length,
-                strength,
-            } => match strength_value(strength, sp, &mut k) {
-                Some(f) => f * (excess / co.si.temperature * (-s * l_o / length).exp()) + co.t_air,
-                None => D::from(co.t_air),
-            },
+        if let (LineCoflow::On { speed, .. }, Some(f), Some(s0), Some(w)) = (
+            &self.line_coflow,
+            val[S_LINE],
+            val[S_LINE_ONSET],
+            val[S_LINE_RAMP],
+        ) {
+            // logistic 1/(1 + e^(−z)) written without overflow for either sign of z
+            let z = (-s0 + s * l_o) / w;
+            let ramp = if z.re() >= 0.0 {
+                ((-z).exp() + 1.0).recip()
+            } else {
+                let e = z.exp();
+                e / (e + 1.0)
+            };
+            v += f * ramp * (speed / co.si.velocity);
+        }
+        let t = match (&self.air_temperature, val[S_WARM], val[S_WARM_LEN]) {
+            (AirTemperature::WarmNozzle { excess, .. }, Some(f), Some(ell)) => {
+                f * (D::from(-s * l_o) / ell).exp() * (excess / co.si.temperature) + co.t_air
+            }
+            _ => D::from(co.t_air),
         };
         (t, v)
     }
@@ -722,13 +966,13 @@ impl<H: NusseltLaw> Physics<H> {
         co: &Coefficients,
     ) -> D {
         match &term.kind {
-            TermKind::Gravity => st.u.recip() * (co.q * co.inv_fr2),
+            TermKind::Gravity => st.u.recip() * (st.q * co.inv_fr2),
             TermKind::AirDrag => (st.v_air - st.u) * co.drag,
             TermKind::Convection => {
                 let re_tau = st.d * (st.v_air - st.u) * co.re_air;
-                let nu = match self.air_speed {
-                    AirSpeed::Still => self.nusselt.nusselt(re_tau, re_tau * re_tau, co.pr_arg),
-                    AirSpeed::CoFlow { .. } => {
+                let nu = match self.has_air_flow() {
+                    false => self.nusselt.nusselt(re_tau, re_tau * re_tau, co.pr_arg),
+                    true => {
                         let w = st.v_air * (co.si.velocity / COFLOW_REGULARISATION_SPEED);
                         let w2 = w * w;
                         let extra = w2 / (w2 + 1.0)

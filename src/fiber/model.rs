@@ -25,6 +25,7 @@
 
 use super::contributions::{
     Balance, Coefficients, InclinedChurchillBernstein, LocalState, NusseltLaw, Physics,
+    ProcessFactors,
 };
 use super::error::FiberError;
 use super::material_law::{viscosity, viscosity_with_partials, ViscosityLaw, ZeroRateViscosity};
@@ -75,6 +76,7 @@ pub struct FiberModel<L: ViscosityLaw, H: NusseltLaw = InclinedChurchillBernstei
     cp_b: f64,
     u_in: f64,
     t_in: f64,
+    inlet_is_diameter: bool,
     re0: f64,
     take_up: DimensionlessTakeUp,
     params: ParamLayout,
@@ -302,6 +304,7 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             cp_b: material.heat_capacity_intercept / r.heat_capacity,
             u_in: u_in_si / r.velocity,
             t_in: t_in / r.temperature,
+            inlet_is_diameter: matches!(e.inlet, Inlet::Diameter(_)),
             re0: scaling.re,
             take_up,
             zero,
@@ -434,10 +437,94 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         t * self.cp_a + self.cp_b
     }
 
-    /// `d̃(ũ, ρ̃) = 2√(Q̃/(π ρ̃ ũ))` \[-\].
+    /// `d̃(ũ, ρ̃) = 2√(Q̃/(π ρ̃ ũ))` \[-\] with the nominal mass flow (see
+    /// [`fiber_diameter`](Self::fiber_diameter) for the diameter with a `mass_flow_scale`).
     #[inline]
     pub fn diameter<D: DualNum<Primitive = f64> + Copy>(&self, u: D, rho: D) -> D {
         ((rho * u).recip() * (4.0 * self.co.q / PI)).sqrt()
+    }
+
+    /// `d̃ = 2√(Q̃ f_Q/(π ρ̃ ũ))` \[-\] with the mass-flow factor `f_Q` ([`ProcessFactors`]).
+    #[inline]
+    fn diameter_q<D: DualNum<Primitive = f64> + Copy>(&self, u: D, rho: D, f_q: D) -> D {
+        ((rho * u).recip() * f_q * (4.0 * self.co.q / PI)).sqrt()
+    }
+
+    /// The true fiber diameter `d̃` \[-\] of the state `y` with the full model parameters `p`
+    /// (the mass flow scaled by `mass_flow_scale` where present). Times
+    /// [`Scaling::diameter`] gives metres.
+    #[inline]
+    pub fn fiber_diameter<D: DualNum<Primitive = f64> + Copy>(&self, y: &[D], p: &[D]) -> D {
+        let sp = self.strength_slice(p);
+        let pf = self.physics.process(sp, self.scaling.reference.temperature);
+        let rho = self.density(y[2]);
+        if pf.has_mass_flow {
+            self.diameter_q(y[0], rho, pf.mass_flow)
+        } else {
+            self.diameter(y[0], rho)
+        }
+    }
+
+    /// The diameter the gauge reads \[-\]: `(1 + g) d̃ + õ` of
+    /// [`fiber_diameter`](Self::fiber_diameter) with the gauge parameters (`gauge_scale`,
+    /// `gauge_offset`) of `p`; the true diameter where they are absent. This is the predicted
+    /// measurement the rheometer's residuals compare with the data.
+    #[inline]
+    pub fn observed_diameter<D: DualNum<Primitive = f64> + Copy>(&self, y: &[D], p: &[D]) -> D {
+        let d = self.fiber_diameter(y, p);
+        let sp = self.strength_slice(p);
+        self.physics.gauge_reading(d, sp, self.scaling.diameter())
+    }
+
+    /// Whether the mass flow is scaled (`mass_flow_scale` present in the physics).
+    #[inline]
+    fn has_mass_flow_scale(&self) -> bool {
+        !matches!(
+            self.physics.mass_flow_scale,
+            super::contributions::Strength::Off
+        )
+    }
+
+    /// The strength parameters within full parameters `p` (empty if `p` is too short).
+    #[inline]
+    fn strength_slice<'p, D>(&self, p: &'p [D]) -> &'p [D] {
+        let r = self.params.strengths();
+        &p[r.start.min(p.len())..r.end.min(p.len())]
+    }
+
+    /// The inlet state `(ũ(0), T̃(0))` \[-\] with full parameters `p`: the nominal inlet
+    /// velocity and temperature changed by the process parameters (`inlet_velocity`,
+    /// `inlet_diameter`, `die_temperature_offset`, `mass_flow_scale`).
+    pub fn inlet_state(&self, p: &[f64]) -> (f64, f64) {
+        let sp = self.strength_slice(p);
+        let (u, t, _) = self.inlet_conditions(sp);
+        (u, t)
+    }
+
+    /// `(ũ(0), T̃(0), process factors)` with strength parameters `sp`. With an inlet diameter
+    /// in the experiment file, `u(0) = 4 Q f_Q/(π ρ(T(0)) d²) · (1 + δ_u)/(1 + δ_d)²`; with an
+    /// inlet velocity, `u(0) = u_in (1 + δ_u)/(1 + δ_d)²`.
+    #[inline]
+    fn inlet_conditions<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        sp: &[D],
+    ) -> (D, D, ProcessFactors<D>) {
+        let pf = self.physics.process(sp, self.scaling.reference.temperature);
+        let mut u = pf.inlet_velocity * self.u_in;
+        let t = if pf.has_die_temperature {
+            pf.die_temperature + self.t_in
+        } else {
+            D::from(self.t_in)
+        };
+        if self.inlet_is_diameter {
+            if pf.has_mass_flow {
+                u *= pf.mass_flow;
+            }
+            if pf.has_die_temperature {
+                u = u * self.density(self.t_in) / self.density(t);
+            }
+        }
+        (u, t, pf)
     }
 
     /// Reynolds number of the continuation, `Re_c = c Re + (1 − c) Re_0`.
@@ -457,6 +544,15 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         let (u, n, t, rate) = (y[0], y[1], y[2], y[3]);
         let rho = self.density(t);
         let (t_air, v_air) = self.physics.environment(x, sp, &self.co);
+        let pf = self.physics.process(sp, self.scaling.reference.temperature);
+        let (d, q) = if pf.has_mass_flow {
+            (
+                self.diameter_q(u, rho, pf.mass_flow),
+                pf.mass_flow * self.co.q,
+            )
+        } else {
+            (self.diameter(u, rho), D::from(self.co.q))
+        };
         LocalState {
             s: x,
             u,
@@ -465,7 +561,8 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             rate,
             rho,
             cp: self.heat_capacity(t),
-            d: self.diameter(u, rho),
+            d,
+            q,
             t_air,
             v_air,
         }
@@ -502,12 +599,17 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
         let sp = &p[self.params.strengths()];
         let st = self.local_state(x, y, sp);
         let (force, heat) = self.physics.sums(&st, sp, &self.co);
-        let q = self.co.q;
+        let q = st.q;
         let f_n = st.rate * q - c * force;
         let f_t = c * heat / (st.cp * q);
         let (mu, mu_t, mu_r) =
             viscosity_with_partials(&self.law, &self.zero, self.scaling.de, st.t, st.rate, lp);
-        let num = self.re_c(c) / q
+        let re_over_q = if self.has_mass_flow_scale() {
+            self.re_c(c) / q
+        } else {
+            self.re_c(c) / self.co.q
+        };
+        let num = re_over_q
             * (st.rho * st.n * st.rate + st.rho * st.u * f_n + st.u * st.n * f_t * self.rho_a)
             - st.rate * mu_t * f_t;
         f[0] = st.rate;
@@ -520,17 +622,18 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
         let c = p[ParamLayout::CONTINUATION];
         let lp = &p[self.params.law()];
         let sp = &p[self.params.strengths()];
-        let q = self.co.q;
-        // inlet-velocity error (die swell): u(0) = (1 + δ) u_in; the stress-free fiber of c = 0
-        // then has d = d_in/√(1 + δ)
-        let f_in = self.physics.inlet_velocity_factor(sp);
-        let u_in = f_in * self.u_in;
+        // process conditions: u(0) and T(0) off their nominal values, mass flow scaled
+        let (u_in, t_in, pf) = self.inlet_conditions(sp);
+        let q = pf.mass_flow * self.co.q;
+        let rho_in = self.density(t_in);
         r[0] = ya[0] - u_in;
         r[1] = match self.take_up {
-            DimensionlessTakeUp::Diameter { d_out, d_in } => {
+            DimensionlessTakeUp::Diameter { d_out, .. } => {
                 let phi = p[self.params.take_up_factor()];
-                let target = c * phi * d_out + (-c + 1.0) * f_in.sqrt().recip() * d_in;
-                self.diameter(yb[0], self.density(yb[2])) / target - 1.0
+                // at c = 0 the target is the stress-free fiber's diameter d(u(0), ρ(T(0)))
+                let d_free = self.diameter_q(u_in, rho_in, pf.mass_flow);
+                let target = c * phi * d_out + (-c + 1.0) * d_free;
+                self.diameter_q(yb[0], self.density(yb[2]), pf.mass_flow) / target - 1.0
             }
             DimensionlessTakeUp::Velocity { u_out } => {
                 let phi = p[self.params.take_up_factor()];
@@ -538,10 +641,12 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
                 yb[0] / target - 1.0
             }
         };
-        r[2] = ya[2] - self.t_in;
-        let t_in = D::from(self.t_in);
-        let rho_in = self.density(self.t_in);
-        r[3] =
-            self.re_c(c) / q * (ya[1] * (u_in * rho_in)) - ya[3] * self.viscosity(t_in, ya[3], lp);
+        r[2] = ya[2] - t_in;
+        let re_over_q = if pf.has_mass_flow {
+            self.re_c(c) / q
+        } else {
+            self.re_c(c) / self.co.q
+        };
+        r[3] = re_over_q * (ya[1] * (u_in * rho_in)) - ya[3] * self.viscosity(t_in, ya[3], lp);
     }
 }

@@ -317,7 +317,9 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
             }
         }
         let x = linspace(0.0, model.length(), options.initial_nodes);
-        let y0 = [model.inlet_velocity(), 0.0, model.inlet_temperature(), 0.0];
+        // the stress-free fiber of c = 0 with the process parameters of `p`
+        let (u0, t0) = model.inlet_state(p);
+        let y0 = [u0, 0.0, t0, 0.0];
         let guess = Guess::constant(x, &y0);
         let path = &options.continuation;
         if required.is_empty() {

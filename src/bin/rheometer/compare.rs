@@ -24,9 +24,12 @@ pub struct CompareArgs {
     #[arg(long)]
     pub take_up_from_data: bool,
     /// An effect in the model with its strength, "EFFECT=VALUE" (repeatable; "EFFECT" alone
-    /// takes the strength from --fit): radiation, air_coflow, air_temperature_profile,
-    /// inlet_velocity, nusselt_scale. Effects in the fit file are included automatically.
-    #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
+    /// takes the strength from --fit), shape parameters after colons
+    /// ("air_coflow=40:decay_length=0.2"): radiation, air_coflow, air_coflow_line,
+    /// air_temperature_profile, nusselt_scale, inlet_diameter, inlet_velocity,
+    /// die_temperature_offset, mass_flow_scale, gauge_scale, gauge_offset. Effects in the fit
+    /// file are included automatically (with their fitted shapes).
+    #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,
     /// Relative measurement uncertainty (overrides the TOML's relative_uncertainty; default:
     /// the TOML's, else estimated from the data; in (0, 1)).

@@ -10,8 +10,9 @@ pub struct DiagnoseArgs {
     /// The viscosity law of your model: carreau or newtonian.
     #[arg(long, default_value = "carreau")]
     pub model: LawChoice,
-    /// Effects already in your model (fitted or "=VALUE" fixed); repeatable.
-    #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
+    /// Effects already in your model (fitted or "=VALUE" fixed, shapes fixed after colons as
+    /// in "air_coflow:decay_length=0.2"); repeatable.
+    #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,
     /// How many of the best linearised candidates are refitted.
     #[arg(long, default_value_t = 3, allow_hyphen_values = true, value_parser = checks::parse_refit_top)]

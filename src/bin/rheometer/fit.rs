@@ -19,10 +19,12 @@ pub struct FitArgs {
     /// The viscosity law of the model: carreau (n, kappa fitted) or newtonian.
     #[arg(long, default_value = "carreau")]
     pub model: LawChoice,
-    /// Add an effect, its strength fitted ("radiation") or fixed ("radiation=0.9");
-    /// repeatable. Effects: strain_thinning, radiation, air_coflow,
-    /// air_temperature_profile, inlet_velocity, nusselt_scale.
-    #[arg(long = "with", value_name = "EFFECT[=VALUE]")]
+    /// Add an effect, its strength fitted ("radiation") or fixed ("radiation=0.9"), shape
+    /// parameters fixed after colons ("air_coflow=40:decay_length=0.2"); repeatable.
+    /// Physics: strain_thinning, radiation, air_coflow, air_coflow_line,
+    /// air_temperature_profile, nusselt_scale; process: inlet_diameter, inlet_velocity,
+    /// die_temperature_offset, mass_flow_scale; instrument: gauge_scale, gauge_offset.
+    #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,
     /// The loss of the fit: linear (least squares), or a robust loss that down-weights
     /// outliers: soft_l1, huber, cauchy (as in scipy's least_squares; needs the principled

@@ -306,7 +306,7 @@ fn compare_effects(
     let mut out: Vec<(Effect, f64)> = Vec::new();
     if let Some(f) = fit {
         for e in &f.effects {
-            let effect: Effect = e.effect.parse()?;
+            let effect: Effect = e.to_effect()?;
             out.push((effect, e.strength));
         }
     }

@@ -376,10 +376,11 @@ pub fn diagnose(
         .iter()
         .zip(&lin)
         .map(|(e, l)| {
+            // shape parameters fitted with the strength count as extra parameters too
             let k = if matches!(e, Effect::StrainThinning) {
                 2
             } else {
-                1
+                1 + e.free_shapes().len()
             };
             let after = (cost_before - l.score).max(0.0);
             let (bic, aic) = ic(after, k);

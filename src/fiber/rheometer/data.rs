@@ -207,7 +207,9 @@ impl Rheometer {
         NoiseModel::estimate(&series, &NoiseOptions::default()).map_err(RheometerError::Data)
     }
 
-    /// `(d_model − d_meas)/d_meas` at the measurement positions of experiment `k`.
+    /// `(d_model − d_meas)/d_meas` at the measurement positions of experiment `k`; `d_model` is
+    /// the gauge's reading of the model diameter ([`FiberModel::observed_diameter`] with the
+    /// solution's parameters, so instrument effects enter).
     pub fn relative_residuals(&self, k: usize, sol: &Solution) -> Vec<f64> {
         let model = &self.models[k];
         let lo = model.scaling.reference.length;
@@ -219,7 +221,7 @@ impl Rheometer {
             .zip(&m.diameters)
             .map(|(&s, &d)| {
                 sol.eval_into(s / lo, &mut y, &mut yp);
-                let dm = model.diameter(y[0], model.density(y[2])) * model.scaling.diameter();
+                let dm = model.observed_diameter(&y, &sol.params) * model.scaling.diameter();
                 dm / d - 1.0
             })
             .collect()

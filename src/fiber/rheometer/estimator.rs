@@ -29,7 +29,8 @@ impl Estimator {
     }
 }
 
-/// The paper's weighted residual `√Δ_j √ε̇(s_j) (d(s_j) − d_fit(s_j))` (dimensionless).
+/// The paper's weighted residual `√Δ_j √ε̇(s_j) (d(s_j) − d_fit(s_j))` (dimensionless), `d` the
+/// gauge's reading ([`FiberModel::observed_diameter`]).
 pub struct PaperResidual<'a, L: ViscosityLaw, H: NusseltLaw> {
     /// The fiber model.
     pub model: &'a FiberModel<L, H>,
@@ -40,8 +41,9 @@ pub struct PaperResidual<'a, L: ViscosityLaw, H: NusseltLaw> {
 }
 
 impl<L: ViscosityLaw, H: NusseltLaw> PointFunction for PaperResidual<'_, L, H> {
-    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], _p: &[D]) -> D {
-        let d = self.model.diameter(y[0], self.model.density(y[2]));
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], p: &[D]) -> D {
+        // the gauge's reading (instrument parameters, if any, enter here)
+        let d = self.model.observed_diameter(y, p);
         let rate = y[3];
         let w = if rate.re() > 0.0 {
             rate.sqrt()
@@ -52,7 +54,8 @@ impl<L: ViscosityLaw, H: NusseltLaw> PointFunction for PaperResidual<'_, L, H> {
     }
 }
 
-/// The relative residual `(d(s_j) − d_meas,j)/(σ d_meas,j)`.
+/// The relative residual `(d(s_j) − d_meas,j)/(σ d_meas,j)`, `d` the gauge's reading
+/// ([`FiberModel::observed_diameter`]: `(1 + g) d + o` with the instrument parameters).
 pub struct RelativeResidual<'a, L: ViscosityLaw, H: NusseltLaw> {
     /// The fiber model.
     pub model: &'a FiberModel<L, H>,
@@ -63,8 +66,9 @@ pub struct RelativeResidual<'a, L: ViscosityLaw, H: NusseltLaw> {
 }
 
 impl<L: ViscosityLaw, H: NusseltLaw> PointFunction for RelativeResidual<'_, L, H> {
-    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], _p: &[D]) -> D {
-        let d = self.model.diameter(y[0], self.model.density(y[2]));
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], p: &[D]) -> D {
+        // the gauge's reading (instrument parameters, if any, enter here)
+        let d = self.model.observed_diameter(y, p);
         (d / self.d_meas[j] - 1.0) / self.sigma
     }
 }

@@ -9,7 +9,9 @@
 //! `nusselt_scale`).
 
 use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
-use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::fiber::effects::{
+    Effect, LawChoice, ModelSpec, ShapeParameter, STRAIN_THINNING_REFERENCE_KAPPA,
+};
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::ParamLayout;
 use crate::solution::Solution;
@@ -21,7 +23,9 @@ pub struct FitStart {
     pub law: [f64; 2],
     /// Candidates of the model whose strengths this fit frees (by effect name).
     pub free_candidates: Vec<String>,
-    /// Start strengths by effect name (default: neutral).
+    /// Start strengths by effect name (default: neutral), and start values of shape parameters
+    /// by model-parameter name (e.g. `"air_coflow.decay_length"`, default: the effect's fixed
+    /// or default value).
     pub strengths: Vec<(String, f64)>,
     /// Warm-start solutions, one per experiment (default: cold starts).
     pub warm: Option<Vec<Solution>>,
@@ -51,6 +55,19 @@ impl FitStart {
 pub struct EffectSlot {
     /// The effect.
     pub effect: Effect,
+    /// Index of its model parameter in the local `p`.
+    pub local: usize,
+    /// Its column in the fit's parameter vector (`None` if fixed).
+    pub column: Option<usize>,
+    /// Its shape parameters (decay lengths, onset), fixed or fitted.
+    pub shapes: Vec<ShapeSlot>,
+}
+
+/// Where a shape parameter of an effect sits.
+#[derive(Debug, Clone)]
+pub struct ShapeSlot {
+    /// The shape parameter.
+    pub parameter: ShapeParameter,
     /// Index of its model parameter in the local `p`.
     pub local: usize,
     /// Its column in the fit's parameter vector (`None` if fixed).
@@ -109,6 +126,9 @@ impl Layout {
         let (mut lower, mut upper) = (Vec::new(), Vec::new());
         let mut effects = Vec::new();
         let mut st_free = false;
+        // shape bounds limited by the spin-line length (the longest of the experiments'
+        // models is not known here: the first model's)
+        let length = model.experiment.spinline_length;
         let settings = spec.effects.iter().map(|s| (&s.effect, s.value)).chain(
             spec.candidates
                 .iter()
@@ -132,10 +152,22 @@ impl Layout {
                     effect: e.clone(),
                     local: ni,
                     column: None,
+                    shapes: Vec::new(),
                 });
                 continue;
             }
             let li = idx(e.model_param())?;
+            // shape parameters: at their fixed or default values in the template
+            let mut shapes = Vec::new();
+            for (sp, v) in e.shape_values() {
+                let si = idx(sp.model_param)?;
+                template[si] = v;
+                shapes.push(ShapeSlot {
+                    parameter: sp,
+                    local: si,
+                    column: None,
+                });
+            }
             match value {
                 Some(v) => {
                     template[li] = e.param_value(v);
@@ -143,6 +175,7 @@ impl Layout {
                         effect: e.clone(),
                         local: li,
                         column: None,
+                        shapes,
                     });
                 }
                 None => {
@@ -150,15 +183,34 @@ impl Layout {
                     template[li] = e.param_value(s);
                     let (lo, hi) = e.bounds();
                     let (a, b) = (e.param_value(lo), e.param_value(hi));
-                    effects.push(EffectSlot {
-                        effect: e.clone(),
-                        local: li,
-                        column: Some(free.len()),
-                    });
+                    let column = Some(free.len());
                     free.push(li);
                     names.push(e.name().to_string());
                     lower.push(a.min(b));
                     upper.push(a.max(b));
+                    // shape parameters fitted with the strength (unless fixed)
+                    let free_shapes = e.free_shapes();
+                    for slot in &mut shapes {
+                        if !free_shapes.contains(&slot.parameter) {
+                            continue;
+                        }
+                        let sp = &slot.parameter;
+                        if let Some(v) = start.strength(sp.model_param) {
+                            template[slot.local] = v;
+                        }
+                        let (slo, shi) = sp.bounds_for_length(length);
+                        slot.column = Some(free.len());
+                        free.push(slot.local);
+                        names.push(sp.model_param.to_string());
+                        lower.push(slo);
+                        upper.push(shi);
+                    }
+                    effects.push(EffectSlot {
+                        effect: e.clone(),
+                        local: li,
+                        column,
+                        shapes,
+                    });
                 }
             }
         }
@@ -177,6 +229,11 @@ impl Layout {
         for slot in &mut effects {
             if let Some(c) = slot.column.as_mut() {
                 *c += shift;
+            }
+            for sh in &mut slot.shapes {
+                if let Some(c) = sh.column.as_mut() {
+                    *c += shift;
+                }
             }
             if st_free && matches!(slot.effect, Effect::StrainThinning) {
                 slot.column = Some(0);

@@ -35,6 +35,8 @@ pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
 pub use estimator::Estimator;
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
-pub use layout::{EffectSlot, FitStart, Layout};
+pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
 pub use options::{CarreauFiber, IdentifyOptions, RheometerError};
-pub use report::{AtBound, BoundSide, EffectReport, FitReport, FitWarning, WarningCode};
+pub use report::{
+    AtBound, BoundSide, EffectReport, FitReport, FitWarning, ShapeReport, WarningCode,
+};

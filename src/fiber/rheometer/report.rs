@@ -259,6 +259,29 @@ pub struct EffectReport {
     /// The bound of its search range the fitted strength sits at, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub at_bound: Option<BoundSide>,
+    /// Category of the effect (`"physics"`, `"process"`, `"instrument"`; `None` in reports
+    /// written before categories existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub category: Option<crate::fiber::effects::Category>,
+    /// Its shape parameters (decay lengths, onset), fitted or fixed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shapes: Vec<ShapeReport>,
+}
+
+/// A shape parameter of an effect in a fit report.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShapeReport {
+    /// Shape name in settings (e.g. `"decay_length"`).
+    pub name: String,
+    /// Its value (in `unit`).
+    pub value: f64,
+    /// Its standard error (`0` if fixed).
+    #[serde(deserialize_with = "nullable::f64")]
+    pub stderr: f64,
+    /// Unit (`"m"`).
+    pub unit: String,
+    /// Whether it was fitted (else fixed).
+    pub fitted: bool,
 }
 
 /// A symmetric 95% interval, or `NaN` where it is not valid.
@@ -389,6 +412,18 @@ impl FitReport {
                     unit: e.unit().to_string(),
                     fitted: slot.column.is_some(),
                     at_bound: side,
+                    category: Some(e.category()),
+                    shapes: slot
+                        .shapes
+                        .iter()
+                        .map(|sh| ShapeReport {
+                            name: sh.parameter.name.to_string(),
+                            value: id.local_params[sh.local],
+                            stderr: sh.column.map_or(0.0, |c| se[c]),
+                            unit: sh.parameter.unit.to_string(),
+                            fitted: sh.column.is_some(),
+                        })
+                        .collect(),
                 }
             })
             .collect();
@@ -866,6 +901,19 @@ impl FitReport {
                     e.ci95_strength[0],
                     e.ci95_strength[1]
                 ));
+            }
+            for sh in &e.shapes {
+                if sh.fitted {
+                    s.push_str(&format!(
+                        "      {}.{}: {:.5} +/- {:.5} {}\n",
+                        e.effect, sh.name, sh.value, sh.stderr, sh.unit
+                    ));
+                } else {
+                    s.push_str(&format!(
+                        "      {}.{}: {:.5} {} (fixed)\n",
+                        e.effect, sh.name, sh.value, sh.unit
+                    ));
+                }
             }
         }
         if self.correlation_n_kappa.is_finite() {

@@ -206,6 +206,31 @@ pub struct FittedEffect {
     /// Whether the strength was fitted (else fixed).
     #[serde(default)]
     pub fitted: bool,
+    /// Its shape parameters (e.g. a fitted decay length), empty for effects without them.
+    #[serde(default)]
+    pub shapes: Vec<FittedShape>,
+}
+
+/// A shape parameter of a fitted effect (e.g. `{"name": "decay_length", "value": 0.07}`, in
+/// the shape's unit, metres).
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+pub struct FittedShape {
+    /// Shape name (`"decay_length"`, `"onset"`, `"ramp_width"`).
+    pub name: String,
+    /// Its value.
+    pub value: f64,
+}
+
+impl FittedEffect {
+    /// The effect with its shape parameters fixed at the fitted values; errors name the
+    /// effect or shape.
+    pub fn to_effect(&self) -> Result<Effect, String> {
+        let mut effect: Effect = self.effect.parse()?;
+        for sh in &self.shapes {
+            effect = effect.with_shape(&sh.name, sh.value)?;
+        }
+        Ok(effect)
+    }
 }
 
 impl FitParameters {
@@ -358,7 +383,7 @@ impl FitParameters {
         }
         for (i, e) in self.effects.iter().enumerate() {
             let field = format!("\"effects\"[{i}]");
-            let effect: Effect = match e.effect.parse() {
+            let effect: Effect = match e.to_effect() {
                 Ok(effect) => effect,
                 Err(msg) => return bad(format!("{field}.effect"), msg),
             };
