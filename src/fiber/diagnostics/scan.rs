@@ -25,21 +25,21 @@ use crate::fiber::rheometer::{
     Estimator, FitReport, FitStart, Identification, IdentifyOptions, Rheometer, RheometerError,
 };
 use crate::least_squares::{fit, FitOptions};
-use std::time::Instant;
 use crate::solution::Solution;
 use serde::{Deserialize, Serialize};
+use std::time::Instant;
 
 /// Settings of the global search.
 #[derive(Debug, Clone)]
 pub struct ScanOptions {
-    /// Grid points per side of the neutral value (default 6).
+    /// Grid points per side of the neutral value (default 5).
     pub points_per_sign: usize,
     /// Smallest grid magnitude relative to the side's extent (default 1e-3).
     pub smallest_relative: f64,
     /// Grid points (local minima of the profiles, lowest first) refined with the strength freed,
     /// per candidate over all its shapes (default 2).
     pub refine: usize,
-    /// Gauss–Newton iteration limit of a grid point's fit (default 8; the best points are
+    /// Gauss–Newton iteration limit of a grid point's fit (default 6; the best points are
     /// refined with the full budget).
     pub inner_max_iterations: usize,
     /// Whether effects with a shape are scanned for several shapes (default true).
@@ -49,10 +49,10 @@ pub struct ScanOptions {
 impl Default for ScanOptions {
     fn default() -> Self {
         ScanOptions {
-            points_per_sign: 6,
+            points_per_sign: 5,
             smallest_relative: 1e-3,
             refine: 2,
-            inner_max_iterations: 8,
+            inner_max_iterations: 6,
             scan_shapes: true,
         }
     }
@@ -305,11 +305,11 @@ fn rheometer_for(rh: &Rheometer, spec: ModelSpec) -> Result<Rheometer, Rheometer
                     FiberModel::new(&rh.material, &rh.air, e, CarreauLike::new(), physics)
                 })
                 .map_err(|source| RheometerError::Simulation {
-                experiment: e.name.clone(),
-                n: f64::NAN,
-                kappa: f64::NAN,
-                source,
-            })
+                    experiment: e.name.clone(),
+                    n: f64::NAN,
+                    kappa: f64::NAN,
+                    source,
+                })
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(Rheometer {
@@ -673,7 +673,10 @@ mod tests {
                 Ok(v * 10.0)
             }
         });
-        assert_eq!(done.iter().map(|d| d.0).collect::<Vec<_>>(), [1.0, 2.0, 3.0]);
+        assert_eq!(
+            done.iter().map(|d| d.0).collect::<Vec<_>>(),
+            [1.0, 2.0, 3.0]
+        );
         assert_eq!(fail, Some((4.0, "diverged at 4".to_string())));
         // each point started from its inner neighbour's result; nothing after the failure
         assert_eq!(seen, [0.0, 10.0, 20.0, 30.0]);
