@@ -217,6 +217,12 @@ pub fn strength_status(
     }
 }
 
+/// Whether a candidate may be named as the missing effect: refitted, `ΔBIC` below `threshold`,
+/// and its strength credible (never one at a search bound or outside the physical range).
+pub fn earns_its_place(c: &CandidateResult, threshold: f64) -> bool {
+    c.refitted && c.status == StrengthStatus::Physical && c.delta_bic < threshold
+}
+
 /// Ranking: credible refits by `ΔBIC`, then refits that are not credible by `ΔBIC`, then
 /// candidates without a refit by linear score.
 pub fn rank_order(a: &CandidateResult, b: &CandidateResult) -> std::cmp::Ordering {
@@ -591,10 +597,13 @@ pub fn diagnose(
             })
             .collect();
         starts.sort_by(|a, b| a.2.total_cmp(&b.2));
+        // the lowest start, and the next ones only where their J is close to it
+        let lowest = starts.first().map_or(f64::INFINITY, |s| s.2);
         refine_jobs.extend(
             starts
                 .into_iter()
                 .take(options.scan.refine.max(1))
+                .filter(|s| s.2 <= lowest * (1.0 + options.scan.refine_within))
                 .map(|(j, k, _)| (i, j, k)),
         );
     }
@@ -672,11 +681,10 @@ pub fn diagnose(
             }
         }
     }
-    // never name a candidate whose best strength is at a bound or not physical
-    let best_i = ranked.iter().copied().find(|&i| {
-        let r = &results[i];
-        r.refitted && r.status == StrengthStatus::Physical && r.delta_bic < options.earn_threshold
-    });
+    let best_i = ranked
+        .iter()
+        .copied()
+        .find(|&i| earns_its_place(&results[i], options.earn_threshold));
     let most_likely = best_i.map(|i| cands[i].name().to_string());
     // a physical effect that explains part of the residuals significantly shows they are
     // systematic, even where the noise level is too uncertain for the RMS test
@@ -708,4 +716,107 @@ pub fn diagnose(
         base,
         best,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fiber::rheometer::BoundSide;
+
+    fn result(
+        effect: &str,
+        refitted: bool,
+        status: StrengthStatus,
+        dbic: f64,
+        lin: f64,
+    ) -> CandidateResult {
+        CandidateResult {
+            effect: effect.into(),
+            unit: "-".into(),
+            refitted,
+            linear_score: lin,
+            linear_strength: 0.0,
+            strength: 0.5,
+            stderr_strength: 0.1,
+            cost_before: 1.0,
+            cost_after: 0.5,
+            rms_relative_residual_after: f64::NAN,
+            extra_parameters: 1,
+            delta_bic: dbic,
+            delta_aic: dbic,
+            signature_peak_m: 0.0,
+            signature_range_m: [0.0, 0.0],
+            n: f64::NAN,
+            kappa: f64::NAN,
+            ci95_n: [f64::NAN; 2],
+            ci95_kappa: [f64::NAN; 2],
+            at_bound: Vec::new(),
+            status,
+            status_note: None,
+            physical_range: [0.0, 1.0],
+            search_range: [0.0, 1.0],
+            shape: Vec::new(),
+            profiles: Vec::new(),
+            scan_errors: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn ranking_uses_the_refits_not_the_linearised_scores() {
+        use StrengthStatus::*;
+        // b has the larger linear score but the worse refit; c is not credible; d not refitted
+        let mut v = [
+            result("a", true, Physical, -40.0, 1.0),
+            result("b", true, Physical, -5.0, 100.0),
+            result("c", true, Unphysical, -90.0, 50.0),
+            result("d", false, NotRefitted, 0.0, 500.0),
+        ];
+        v.sort_by(rank_order);
+        let names: Vec<&str> = v.iter().map(|c| c.effect.as_str()).collect();
+        assert_eq!(names, ["a", "b", "c", "d"]);
+        assert!(earns_its_place(&v[0], -10.0));
+        assert!(!earns_its_place(&v[1], -10.0)); // ΔBIC above the threshold
+        assert!(!earns_its_place(&v[2], -10.0)); // best ΔBIC, but not physical
+        assert!(!earns_its_place(&v[3], -10.0));
+    }
+
+    #[test]
+    fn a_strength_at_a_bound_or_beyond_the_physical_range_is_not_credible() {
+        let rad = Effect::Radiation;
+        let (s, note) = strength_status(&rad, 0.9, &[]);
+        assert_eq!((s, note), (StrengthStatus::Physical, None));
+        let (s, note) = strength_status(&rad, 1.6, &[]);
+        assert_eq!(s, StrengthStatus::Unphysical);
+        assert!(note.unwrap().contains("> 1: not physical"));
+        // at the search bound 2 (found by value, without an at_bound entry)
+        let (s, note) = strength_status(&rad, 2.0, &[]);
+        assert_eq!(s, StrengthStatus::AtBound);
+        assert!(note.unwrap().contains("upper bound 2"));
+        // listed by the fit report
+        let c = Effect::AirCoflow { decay_length: 0.25 };
+        let ab = AtBound {
+            parameter: "air_coflow".into(),
+            side: BoundSide::Lower,
+            bound: -5.0,
+            value: -5.0,
+        };
+        let (s, note) = strength_status(&c, -5.0, &[ab]);
+        assert_eq!(s, StrengthStatus::AtBound);
+        let note = note.unwrap();
+        assert!(
+            note.contains("air_coflow best at its lower bound -5 m/s"),
+            "{note}"
+        );
+        // an estimate at a bound of another parameter does not matter
+        let other = AtBound {
+            parameter: "kappa".into(),
+            side: BoundSide::Upper,
+            bound: 20.0,
+            value: 20.0,
+        };
+        assert_eq!(
+            strength_status(&c, 3.0, &[other]).0,
+            StrengthStatus::Physical
+        );
+    }
 }

@@ -8,7 +8,8 @@
 //!   scales the Nusselt number; one stronger reverses the relative speed).
 //! * **Walk** ([`walk_out`]): each side is walked outwards from the neutral value, every point
 //!   warm-started from its inner neighbour (law and fiber solutions); the first point whose fit
-//!   fails ends that side, and the failure is recorded in the profile, not an error.
+//!   fails ends that side, and the failure is recorded in the profile, not an error; so does a
+//!   point whose `J` exceeds [`ScanOptions::stop_above`] times the user's.
 //! * **Shapes** ([`shape_variants`]): effects with a shape (today the decay lengths of
 //!   `air_coflow` and `air_temperature_profile`) are scanned for a few shapes, each a variant of
 //!   the effect.
@@ -44,6 +45,12 @@ pub struct ScanOptions {
     pub inner_max_iterations: usize,
     /// Whether effects with a shape are scanned for several shapes (default true).
     pub scan_shapes: bool,
+    /// Further grid points of a candidate are refined only if their `J` is within this
+    /// fraction of its lowest grid point's (default 0.05).
+    pub refine_within: f64,
+    /// A side's walk ends once a point's `J` exceeds this multiple of the user's `J`
+    /// (default 20: far from any useful fit, and the fits there are the expensive ones).
+    pub stop_above: f64,
 }
 
 impl Default for ScanOptions {
@@ -54,6 +61,8 @@ impl Default for ScanOptions {
             refine: 2,
             inner_max_iterations: 6,
             scan_shapes: true,
+            stop_above: 20.0,
+            refine_within: 0.05,
         }
     }
 }
@@ -473,8 +482,15 @@ pub fn scan_profile(
     let mut sides: Vec<Vec<(f64, GridStart)>> = Vec::new();
     for values in [&grid.below, &grid.above] {
         let (done, fail) = walk_out(values, Some(&base_point), |v, prev| {
-            vrh.spec.effects[slot].value = Some(v);
             let prev = prev.unwrap_or(&base_point);
+            if prev.cost > scan.stop_above * cost_base {
+                return Err(RheometerError::Data(format!(
+                    "not scanned further: J = {:.1} J_base at {}",
+                    prev.cost / cost_base,
+                    prev.strength
+                )));
+            }
+            vrh.spec.effects[slot].value = Some(v);
             let start = FitStart {
                 law: prev.law,
                 free_candidates: Vec::new(),
@@ -491,11 +507,7 @@ pub fn scan_profile(
             })
         });
         if let Some((v, e)) = fail {
-            stopped.push(format!(
-                "no fit at {} = {v} {}: {e}",
-                effect.name(),
-                effect.unit()
-            ));
+            stopped.push(format!("at {v} {}: {e}", effect.unit()));
         }
         sides.push(done);
     }
