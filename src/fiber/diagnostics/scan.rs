@@ -282,6 +282,10 @@ pub fn shape_variants(effect: &Effect, scan_shapes: bool) -> Vec<(Effect, Vec<Sh
     }
 }
 
+/// What a [`walk_out`] gives: the values reached with their results, and the value where it
+/// stopped with the failure, if any.
+pub type Walk<T, E> = (Vec<(f64, T)>, Option<(f64, E)>);
+
 /// Evaluates `eval` at `values` in order, each call given the previous result (the warm
 /// start; `None` for the first), and stops at the first failure, which is returned with its
 /// value.
@@ -289,7 +293,7 @@ pub fn walk_out<T, E>(
     values: &[f64],
     first: Option<&T>,
     mut eval: impl FnMut(f64, Option<&T>) -> Result<T, E>,
-) -> (Vec<(f64, T)>, Option<(f64, E)>) {
+) -> Walk<T, E> {
     let mut done: Vec<(f64, T)> = Vec::with_capacity(values.len());
     for &v in values {
         let prev = done.last().map(|d| &d.1).or(first);
@@ -507,7 +511,11 @@ pub fn scan_profile(
             })
         });
         if let Some((v, e)) = fail {
-            stopped.push(format!("at {v} {}: {e}", effect.unit()));
+            let unit = match effect.unit() {
+                "-" => String::new(),
+                u => format!(" {u}"),
+            };
+            stopped.push(format!("at {v}{unit}: {e}"));
         }
         sides.push(done);
     }
