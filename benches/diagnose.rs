@@ -1,5 +1,6 @@
 //! A full `diagnose` (user's Carreau fit from the start heuristic, linearised scores of all six
-//! built-in candidates, refits of the top 3) on the 9 shipped experiments. Target: < 5 s median.
+//! built-in candidates, global search of every candidate (strength and shape profiles, refits of
+//! the best grid points)) on the 9 shipped experiments. Target: < 10 s median on 2 cores.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};

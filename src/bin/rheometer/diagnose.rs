@@ -14,9 +14,10 @@ pub struct DiagnoseArgs {
     /// in "air_coflow:decay_length=0.2"); repeatable.
     #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,
-    /// How many of the best linearised candidates are refitted.
-    #[arg(long, default_value_t = 3, allow_hyphen_values = true, value_parser = checks::parse_refit_top)]
-    pub refit_top: usize,
+    /// How many candidates (best linearised score first) get the global search and refits
+    /// (default: all).
+    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_refit_top)]
+    pub refit_top: Option<usize>,
     /// Write the diagnosis as JSON to FILE.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -43,10 +44,10 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         candidates: Vec::new(),
     };
     spec.validate()?;
-    let mut opts = DiagnoseOptions {
-        refit_top,
-        ..DiagnoseOptions::default()
-    };
+    let mut opts = DiagnoseOptions::default();
+    if let Some(k) = refit_top {
+        opts.refit_top = k;
+    }
     opts.identify.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     // a spinner on a terminal (indicatif draws nothing when stderr is not a terminal)
     let spinner = if g.quiet {
@@ -73,9 +74,13 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let fig = out.join(format!("residuals_before_after.{}", g.format.ext()));
     ensure_not_input(&fig, &inputs)?;
     run.save_figure(&fig)?;
+    let prof = out.join(format!("j_profiles.{}", g.format.ext()));
+    ensure_not_input(&prof, &inputs)?;
+    run.save_profile_figure(&prof)?;
     g.say(format!(
-        "wrote the report and {} to {}",
+        "wrote the report, {} and {} to {}",
         fig.display(),
+        prof.display(),
         out.display()
     ));
     Ok(())

@@ -13,19 +13,29 @@
 //!    direction at the fit (one sensitivity solve per experiment, reusing the factorisation of
 //!    the last Newton step, gives all of them), orthogonalised against the fitted parameters'
 //!    directions; its projection of the residual is the cost it would remove to first order.
-//! 4. **Refits** of the top candidates with their strength freed and the material parameters
-//!    refitted (warm-started from the user's fit): the achieved cost `J`, RMS, fitted strength
-//!    with standard error, and information criteria
+//! 4. **Global search and refits** ([`scan`](super::scan)) of every candidate, in parallel: its
+//!    strength scanned over its search range (and, for effects with a shape, a few shapes), each
+//!    grid point a warm-started refit of the material parameters with the strength fixed; the
+//!    best grid points refined with the strength freed. The best refit gives the achieved cost
+//!    `J`, RMS, fitted strength with standard error, and information criteria
 //!    `ΔBIC = N ln(J_after/J_before) + Δk ln N`, `ΔAIC = N ln(J_after/J_before) + 2 Δk`
 //!    (Gaussian errors with unknown variance; `Δk` extra parameters, 2 for strain thinning:
-//!    `n` and `κ`). A candidate earns its place when `ΔBIC` is below
-//!    [`DiagnoseOptions::earn_threshold`] (−10: "very strong" evidence on the Kass–Raftery scale).
+//!    `n` and `κ`; one more for a shape chosen among several). Candidates are ranked by `ΔBIC`,
+//!    credible ones first. A candidate earns its place when `ΔBIC` is below
+//!    [`DiagnoseOptions::earn_threshold`] (−10: "very strong" evidence on the Kass–Raftery scale)
+//!    **and** its strength is credible ([`StrengthStatus::Physical`]): a best strength at a
+//!    search bound or outside the physical range is reported as such and never named.
 //! 5. **Indistinguishable** candidates: cosine of their orthogonalised signatures above
 //!    [`DiagnoseOptions::indistinguishable_cosine`] (0.9) in absolute value.
 
+use super::scan::{
+    physical, refine, scan_profile, search_range, shape_variants, Profile, ProfileScan, Refit,
+    ScanOptions, ShapeParameter,
+};
 use super::scores::{cosine, linear_scores};
 use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::fiber::rheometer::estimator::RelativeResidual;
+use crate::fiber::rheometer::report::bound_side;
 use crate::fiber::rheometer::{
     AtBound, Estimator, FitReport, FitStart, Identification, IdentifyOptions, Layout, Rheometer,
     RheometerError,
@@ -46,8 +56,11 @@ pub struct DiagnoseOptions {
     pub identify: IdentifyOptions,
     /// The candidates (default: the six built-in effects).
     pub candidates: Vec<Effect>,
-    /// How many of the best linearised candidates are refitted (default 3).
+    /// How many candidates, best linearised score first, get the global search and refits
+    /// (default: all of them).
     pub refit_top: usize,
+    /// Settings of the global search of each candidate's strength (and shape).
+    pub scan: ScanOptions,
     /// `|cos|` of orthogonalised signatures above which two candidates are indistinguishable
     /// (default 0.9).
     pub indistinguishable_cosine: f64,
@@ -62,7 +75,8 @@ impl Default for DiagnoseOptions {
         DiagnoseOptions {
             identify: IdentifyOptions::with_estimator(Estimator::Principled),
             candidates: Effect::builtin(),
-            refit_top: 3,
+            refit_top: usize::MAX,
+            scan: ScanOptions::default(),
             indistinguishable_cosine: 0.9,
             earn_threshold: -10.0,
             start: None,
@@ -116,6 +130,113 @@ pub struct CandidateResult {
     /// intervals of those estimates are not valid).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub at_bound: Vec<AtBound>,
+    /// Whether the refitted strength is credible: physical and inside its search range (only a
+    /// [`StrengthStatus::Physical`] candidate can be named as the missing effect).
+    #[serde(default)]
+    pub status: StrengthStatus,
+    /// Why the strength is not credible, in words (`"radiation would need 2.0000 > 1: not
+    /// physical"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub status_note: Option<String>,
+    /// Physical range of the strength (the effect's unit).
+    pub physical_range: [f64; 2],
+    /// Search range of the strength (the effect's unit).
+    pub search_range: [f64; 2],
+    /// Shape of the best variant (e.g. the co-flow's decay length in m; empty for effects
+    /// without a shape).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shape: Vec<ShapeParameter>,
+    /// Profiles of `J` against the strength, one per scanned shape.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub profiles: Vec<Profile>,
+    /// Scans that could not start (one per variant, in words).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub scan_errors: Vec<String>,
+}
+
+/// Whether a candidate's refitted strength may be named as found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StrengthStatus {
+    /// Not refitted (linearised numbers only).
+    #[default]
+    NotRefitted,
+    /// Inside the physical range and away from the search bounds.
+    Physical,
+    /// At a bound of its search range: the data push it beyond the range.
+    AtBound,
+    /// Outside the physical range.
+    Unphysical,
+}
+
+impl StrengthStatus {
+    /// The status as written in JSON (`"physical"`, `"at_bound"`, ...).
+    pub fn name(&self) -> &'static str {
+        match self {
+            StrengthStatus::NotRefitted => "not_refitted",
+            StrengthStatus::Physical => "physical",
+            StrengthStatus::AtBound => "at_bound",
+            StrengthStatus::Unphysical => "unphysical",
+        }
+    }
+}
+
+/// The status of a refitted `strength` of `effect` with the fit's estimates at a bound: at a
+/// search bound (listed in `at_bound`, or within the report's tolerance of the range) comes
+/// first, then outside the physical range.
+pub fn strength_status(
+    effect: &Effect,
+    strength: f64,
+    at_bound: &[AtBound],
+) -> (StrengthStatus, Option<String>) {
+    let (lo, hi) = search_range(effect);
+    let unit = effect.unit();
+    let side = at_bound
+        .iter()
+        .find(|b| b.parameter == effect.name())
+        .map(|b| (b.side, b.bound))
+        .or_else(|| {
+            bound_side(strength, lo, hi).map(|s| {
+                let b = if s.name() == "lower" { lo } else { hi };
+                (s, b)
+            })
+        });
+    if let Some((s, b)) = side {
+        return (
+            StrengthStatus::AtBound,
+            Some(format!(
+                "{} best at its {} bound {b} {unit}: the data push it beyond its search range",
+                effect.name(),
+                s.name()
+            )),
+        );
+    }
+    match physical(effect, strength) {
+        Ok(()) => (StrengthStatus::Physical, None),
+        Err(why) => (StrengthStatus::Unphysical, Some(why)),
+    }
+}
+
+/// Whether a candidate may be named as the missing effect: refitted, `ΔBIC` below `threshold`,
+/// and its strength credible (never one at a search bound or outside the physical range).
+pub fn earns_its_place(c: &CandidateResult, threshold: f64) -> bool {
+    c.refitted && c.status == StrengthStatus::Physical && c.delta_bic < threshold
+}
+
+/// Ranking: credible refits by `ΔBIC`, then refits that are not credible by `ΔBIC`, then
+/// candidates without a refit by linear score.
+pub fn rank_order(a: &CandidateResult, b: &CandidateResult) -> std::cmp::Ordering {
+    let class = |c: &CandidateResult| match (c.refitted, c.status) {
+        (true, StrengthStatus::Physical) => 0,
+        (true, _) => 1,
+        (false, _) => 2,
+    };
+    class(a)
+        .cmp(&class(b))
+        .then_with(|| match (a.refitted, b.refitted) {
+            (true, true) => a.delta_bic.total_cmp(&b.delta_bic),
+            _ => b.linear_score.total_cmp(&a.linear_score),
+        })
 }
 
 /// A pair of candidates the data cannot tell apart.
@@ -411,60 +532,123 @@ pub fn diagnose(
                 ci95_n: [f64::NAN; 2],
                 ci95_kappa: [f64::NAN; 2],
                 at_bound: Vec::new(),
+                status: StrengthStatus::NotRefitted,
+                status_note: None,
+                physical_range: {
+                    let r = super::scan::physical_range(e);
+                    [r.0, r.1]
+                },
+                search_range: {
+                    let r = search_range(e);
+                    [r.0, r.1]
+                },
+                shape: Vec::new(),
+                profiles: Vec::new(),
+                scan_errors: Vec::new(),
             }
         })
         .collect();
     let mut order: Vec<usize> = (0..cands.len()).collect();
     order.sort_by(|&a, &b| lin[b].score.total_cmp(&lin[a].score));
 
-    // refits of the top candidates
-    let mut refits: Vec<(usize, Identification)> = Vec::new();
-    for &i in order.iter().take(options.refit_top) {
-        let e = &cands[i];
-        let (lo, hi) = e.bounds();
-        let s_lin = lin[i].strength;
-        let s_start = if matches!(e, Effect::StrainThinning) {
-            s_lin.clamp(0.05, 0.5)
-        } else {
-            s_lin.clamp(
-                lo + 0.25 * (e.neutral() - lo),
-                hi - 0.25 * (hi - e.neutral()),
+    // global search of each candidate (best linearised first, at most `refit_top`), all
+    // variants in parallel
+    let scanned: Vec<usize> = order.iter().copied().take(options.refit_top).collect();
+    let jobs: Vec<(usize, Effect, Vec<ShapeParameter>)> = scanned
+        .iter()
+        .flat_map(|&i| {
+            shape_variants(&cands[i], options.scan.scan_shapes)
+                .into_iter()
+                .map(move |(v, s)| (i, v, s))
+        })
+        .collect();
+    let scans: Vec<(usize, Result<ProfileScan, RheometerError>)> = jobs
+        .into_par_iter()
+        .map(|(i, v, s)| {
+            (
+                i,
+                scan_profile(&rh, &v, s, &base, cost_before, &opts, &options.scan),
             )
-        };
-        let mk = |s: f64| FitStart {
-            law: [base.n, base.kappa],
-            free_candidates: vec![e.name().to_string()],
-            strengths: vec![(e.name().to_string(), s)],
-            warm: Some(base.solutions.clone()),
-        };
-        let id = match rh.identify_from(&mk(s_start), &opts) {
-            Ok(id) => Ok(id),
-            Err(_) => rh.identify_from(
-                &mk(if matches!(e, Effect::StrainThinning) {
-                    0.05
-                } else {
-                    e.neutral()
-                }),
-                &opts,
-            ),
-        };
-        let id = match id {
-            Ok(id) => id,
-            Err(_) => continue, // stays a linearised result
-        };
-        let rep = FitReport::new(&id);
-        let after = 2.0 * id.fit.cost;
+        })
+        .collect();
+    let mut variants = vec![0usize; cands.len()];
+    let mut ok_scans: Vec<(usize, ProfileScan)> = Vec::new();
+    for (i, sc) in scans {
+        variants[i] += 1;
+        match sc {
+            Ok(sc) => {
+                results[i].profiles.push(sc.profile.clone());
+                ok_scans.push((i, sc));
+            }
+            Err(e) => results[i].scan_errors.push(e.to_string()),
+        }
+    }
+    // refine each candidate's best grid points over all its shapes, in parallel
+    let mut refine_jobs: Vec<(usize, usize, usize)> = Vec::new(); // (candidate, scan, start)
+    for &i in &scanned {
+        let mut starts: Vec<(usize, usize, f64)> = ok_scans
+            .iter()
+            .enumerate()
+            .filter(|(_, (c, _))| *c == i)
+            .flat_map(|(j, (_, sc))| {
+                sc.starts
+                    .iter()
+                    .enumerate()
+                    .map(move |(k, st)| (j, k, st.cost))
+            })
+            .collect();
+        starts.sort_by(|a, b| a.2.total_cmp(&b.2));
+        // the lowest start, and the next ones only where their J is close to it
+        let lowest = starts.first().map_or(f64::INFINITY, |s| s.2);
+        refine_jobs.extend(
+            starts
+                .into_iter()
+                .take(options.scan.refine.max(1))
+                .filter(|s| s.2 <= lowest * (1.0 + options.scan.refine_within))
+                .map(|(j, k, _)| (i, j, k)),
+        );
+    }
+    let refined: Vec<(usize, usize, Refit)> = refine_jobs
+        .into_par_iter()
+        .filter_map(|(i, j, k)| {
+            let sc = &ok_scans[j].1;
+            refine(sc, &sc.starts[k], &opts).ok().map(|r| (i, j, r))
+        })
+        .collect();
+    let mut best_refit: Vec<Option<(Effect, Refit)>> = vec![None; cands.len()];
+    for (i, j, r) in refined {
+        if best_refit[i].as_ref().is_none_or(|(_, b)| r.cost < b.cost) {
+            best_refit[i] = Some((ok_scans[j].1.effect.clone(), r));
+        }
+    }
+    let mut refits: Vec<(usize, Identification)> = Vec::new();
+    for (i, br) in best_refit.into_iter().enumerate() {
+        let Some((variant, refit)) = br else { continue };
+        let e = &cands[i];
+        let rep = &refit.report;
+        let id = refit.identification;
+        let after = refit.cost;
         let res = &mut results[i];
+        // a shape chosen among several scanned ones is one more fitted parameter
+        res.extra_parameters += usize::from(variants[i] > 1);
         let (bic, aic) = ic(after, res.extra_parameters);
         let er = rep.effects.iter().find(|x| x.effect == e.name());
         res.refitted = true;
         res.strength = er.map_or(f64::NAN, |x| x.strength);
         res.stderr_strength = er.map_or(f64::NAN, |x| x.stderr_strength);
+        res.shape = shape_variants(&variant, false)
+            .into_iter()
+            .next()
+            .map(|v| v.1)
+            .unwrap_or_default();
         res.cost_after = after;
         res.rms_relative_residual_after = id.rms_relative_residual;
         res.at_bound = rep.at_bound.clone();
         res.delta_bic = bic;
         res.delta_aic = aic;
+        let (status, note) = strength_status(&variant, res.strength, &res.at_bound);
+        res.status = status;
+        res.status_note = note;
         if rep.stderr_n.is_finite() || spec.law == LawChoice::Carreau {
             res.n = rep.n;
             res.kappa = rep.kappa;
@@ -482,17 +666,10 @@ pub fn diagnose(
         res.signature_range_m = range;
         refits.push((i, id));
     }
-    // best first: refitted by ΔBIC, then the rest by linear score
+    // best first: credible refits by ΔBIC, then refits not credible (at a bound or not
+    // physical) by ΔBIC, then the rest by linear score
     let mut ranked: Vec<usize> = (0..cands.len()).collect();
-    ranked.sort_by(|&a, &b| {
-        let (ra, rb) = (&results[a], &results[b]);
-        match (ra.refitted, rb.refitted) {
-            (true, true) => ra.delta_bic.total_cmp(&rb.delta_bic),
-            (true, false) => std::cmp::Ordering::Less,
-            (false, true) => std::cmp::Ordering::Greater,
-            (false, false) => rb.linear_score.total_cmp(&ra.linear_score),
-        }
-    });
+    ranked.sort_by(|&a, &b| rank_order(&results[a], &results[b]));
     let mut indist = Vec::new();
     for a in 0..cands.len() {
         for b in a + 1..cands.len() {
@@ -506,9 +683,9 @@ pub fn diagnose(
         }
     }
     let best_i = ranked
-        .first()
+        .iter()
         .copied()
-        .filter(|&i| results[i].refitted && results[i].delta_bic < options.earn_threshold);
+        .find(|&i| earns_its_place(&results[i], options.earn_threshold));
     let most_likely = best_i.map(|i| cands[i].name().to_string());
     // a physical effect that explains part of the residuals significantly shows they are
     // systematic, even where the noise level is too uncertain for the RMS test
@@ -540,4 +717,107 @@ pub fn diagnose(
         base,
         best,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fiber::rheometer::BoundSide;
+
+    fn result(
+        effect: &str,
+        refitted: bool,
+        status: StrengthStatus,
+        dbic: f64,
+        lin: f64,
+    ) -> CandidateResult {
+        CandidateResult {
+            effect: effect.into(),
+            unit: "-".into(),
+            refitted,
+            linear_score: lin,
+            linear_strength: 0.0,
+            strength: 0.5,
+            stderr_strength: 0.1,
+            cost_before: 1.0,
+            cost_after: 0.5,
+            rms_relative_residual_after: f64::NAN,
+            extra_parameters: 1,
+            delta_bic: dbic,
+            delta_aic: dbic,
+            signature_peak_m: 0.0,
+            signature_range_m: [0.0, 0.0],
+            n: f64::NAN,
+            kappa: f64::NAN,
+            ci95_n: [f64::NAN; 2],
+            ci95_kappa: [f64::NAN; 2],
+            at_bound: Vec::new(),
+            status,
+            status_note: None,
+            physical_range: [0.0, 1.0],
+            search_range: [0.0, 1.0],
+            shape: Vec::new(),
+            profiles: Vec::new(),
+            scan_errors: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn ranking_uses_the_refits_not_the_linearised_scores() {
+        use StrengthStatus::*;
+        // b has the larger linear score but the worse refit; c is not credible; d not refitted
+        let mut v = [
+            result("a", true, Physical, -40.0, 1.0),
+            result("b", true, Physical, -5.0, 100.0),
+            result("c", true, Unphysical, -90.0, 50.0),
+            result("d", false, NotRefitted, 0.0, 500.0),
+        ];
+        v.sort_by(rank_order);
+        let names: Vec<&str> = v.iter().map(|c| c.effect.as_str()).collect();
+        assert_eq!(names, ["a", "b", "c", "d"]);
+        assert!(earns_its_place(&v[0], -10.0));
+        assert!(!earns_its_place(&v[1], -10.0)); // ΔBIC above the threshold
+        assert!(!earns_its_place(&v[2], -10.0)); // best ΔBIC, but not physical
+        assert!(!earns_its_place(&v[3], -10.0));
+    }
+
+    #[test]
+    fn a_strength_at_a_bound_or_beyond_the_physical_range_is_not_credible() {
+        let rad = Effect::Radiation;
+        let (s, note) = strength_status(&rad, 0.9, &[]);
+        assert_eq!((s, note), (StrengthStatus::Physical, None));
+        let (s, note) = strength_status(&rad, 1.6, &[]);
+        assert_eq!(s, StrengthStatus::Unphysical);
+        assert!(note.unwrap().contains("> 1: not physical"));
+        // at the search bound 2 (found by value, without an at_bound entry)
+        let (s, note) = strength_status(&rad, 2.0, &[]);
+        assert_eq!(s, StrengthStatus::AtBound);
+        assert!(note.unwrap().contains("upper bound 2"));
+        // listed by the fit report
+        let c = Effect::AirCoflow { decay_length: 0.25 };
+        let ab = AtBound {
+            parameter: "air_coflow".into(),
+            side: BoundSide::Lower,
+            bound: -5.0,
+            value: -5.0,
+        };
+        let (s, note) = strength_status(&c, -5.0, &[ab]);
+        assert_eq!(s, StrengthStatus::AtBound);
+        let note = note.unwrap();
+        assert!(
+            note.contains("air_coflow best at its lower bound -5 m/s"),
+            "{note}"
+        );
+        // an estimate at a bound of another parameter does not matter
+        let other = AtBound {
+            parameter: "kappa".into(),
+            side: BoundSide::Upper,
+            bound: 20.0,
+            value: 20.0,
+        };
+        assert_eq!(
+            strength_status(&c, 3.0, &[other]).0,
+            StrengthStatus::Physical
+        );
+    }
 }

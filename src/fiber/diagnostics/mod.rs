@@ -8,9 +8,12 @@
 //!   the model specification a rheometer fit uses) live below the model, in
 //!   [`effects`](crate::fiber::effects);
 //! * [`diagnose`]: ranking the candidates by the excess misfit they explain (linearised scores,
-//!   refits, information criteria) and the report in words.
+//!   global search and refits, information criteria) and the report in words;
+//! * [`scan`]: the global search of one candidate's strength (and shape): the profile of `J`
+//!   and the refits of its best points.
 
 pub mod compare;
 pub mod diagnose;
 pub mod report;
+pub mod scan;
 pub mod scores;

@@ -1,6 +1,7 @@
 //! The diagnosis in words, and the before/after residual figure.
 
-use super::diagnose::{CandidateResult, Diagnosis, DiagnosisRun, ResidualProfiles};
+use super::diagnose::{CandidateResult, Diagnosis, DiagnosisRun, ResidualProfiles, StrengthStatus};
+use super::scan::Profile;
 use crate::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
 
@@ -84,15 +85,30 @@ impl Diagnosis {
                  the model is adequate for these data (or the missing effect is not among the candidates).\n",
             ),
         }
-        s.push_str("[[Candidates, best first]]\n");
-        s.push_str("    effect                   refit  strength +/- stderr        J after      RMS after  dBIC     signature\n");
+        for c in self
+            .candidates
+            .iter()
+            .filter(|c| c.refitted && c.status != StrengthStatus::Physical && c.delta_bic < 0.0)
+        {
+            if let Some(note) = &c.status_note {
+                s.push_str(&format!(
+                    "NOT NAMED: {} lowers BIC by {:.1} but {note}; not a credible estimate of \
+                     the effect (a different effect, or a process or instrument error, may be \
+                     behind the misfit).\n",
+                    c.effect, -c.delta_bic
+                ));
+            }
+        }
+        s.push_str("[[Candidates, best first (credible refits by delta BIC, then refits at a bound or not physical)]]\n");
+        s.push_str("    effect                   refit  strength +/- stderr        J after      RMS after  dBIC     lin.dJ/J  status       signature\n");
         for c in &self.candidates {
-            let bound = match c.at_bound.iter().find(|b| b.parameter == c.effect) {
-                Some(b) => format!("  AT {} BOUND", b.side.name().to_uppercase()),
-                None => String::new(),
-            };
+            let shape: String = c
+                .shape
+                .iter()
+                .map(|p| format!("  [{} {} {}]", p.name, p.value, p.unit))
+                .collect();
             s.push_str(&format!(
-                "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {} (peak {:.2} m){bound}\n",
+                "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {:>8.4}  {:<11}  {} (peak {:.2} m){shape}\n",
                 c.effect,
                 if c.refitted { "yes" } else { "lin" },
                 c.strength,
@@ -105,9 +121,32 @@ impl Diagnosis {
                     "-".into()
                 },
                 c.delta_bic,
+                if c.cost_before > 0.0 {
+                    c.linear_score / c.cost_before
+                } else {
+                    f64::NAN
+                },
+                c.status.name(),
                 fmt_range(c.signature_range_m),
                 c.signature_peak_m
             ));
+        }
+        s.push_str(
+            "(lin.dJ/J: the first-order (linearised) share of J the effect would remove at strength 0; \
+             a refit far better than it means the finite effect differs from its first-order signature.)\n",
+        );
+        let with_profiles: Vec<&CandidateResult> = self
+            .candidates
+            .iter()
+            .filter(|c| !c.profiles.is_empty())
+            .collect();
+        if !with_profiles.is_empty() {
+            s.push_str("[[Profiles: J/J_base against strength, material parameters refitted at each fixed strength; * = lowest, ! = outside the physical range]]\n");
+            for c in with_profiles {
+                for p in &c.profiles {
+                    s.push_str(&format!("    {}\n", profile_line(p)));
+                }
+            }
         }
         if self.indistinguishable.is_empty() {
             s.push_str("No two candidates have strongly correlated signatures.\n");
@@ -122,6 +161,122 @@ impl Diagnosis {
         s.push_str(&format!("wall time {:.2} s\n", self.wall_time_s));
         s
     }
+}
+
+/// One profile in a line: up to 9 points (the lowest always among them) as `strength: J/J_base`.
+fn profile_line(p: &Profile) -> String {
+    let n = p.points.len();
+    let imin = p
+        .points
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.cost.total_cmp(&b.1.cost))
+        .map(|x| x.0);
+    let step = n.div_ceil(9).max(1);
+    let mut idx: Vec<usize> = (0..n).step_by(step).collect();
+    if n > 0 && !idx.contains(&(n - 1)) {
+        idx.push(n - 1);
+    }
+    if let Some(i) = imin {
+        if !idx.contains(&i) {
+            idx.push(i);
+            idx.sort_unstable();
+        }
+    }
+    let unit = if p.unit == "-" { "" } else { p.unit.as_str() };
+    let cells: Vec<String> = idx
+        .iter()
+        .map(|&i| {
+            let q = &p.points[i];
+            let mark = if Some(i) == imin { "*" } else { "" };
+            let phys = if q.strength < p.physical_range[0] || q.strength > p.physical_range[1] {
+                "!"
+            } else {
+                ""
+            };
+            format!(
+                "{:.3}{phys}: {:.3}{mark}",
+                q.strength,
+                q.cost / p.cost_base.max(1e-300)
+            )
+        })
+        .collect();
+    let mut line = format!(
+        "{:<40} ({unit}{}physical {}..{}) {}",
+        p.label(),
+        if unit.is_empty() { "" } else { "; " },
+        p.physical_range[0],
+        p.physical_range[1],
+        cells.join(", ")
+    );
+    for st in &p.stopped {
+        line.push_str(&format!(" [{st}]"));
+    }
+    line
+}
+
+/// Profiles of `J/J_base` against strength, one panel per candidate (one curve per scanned
+/// shape; dashed vertical lines: the physical range of the strength).
+pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), PlotError> {
+    let panels: Vec<Panel> = diagnosis
+        .candidates
+        .iter()
+        .filter(|c| !c.profiles.is_empty())
+        .map(|c| {
+            let unit = if c.unit == "-" { "-" } else { c.unit.as_str() };
+            let mut p = Panel::new(
+                format!("{} ({})", c.effect, c.status.name()),
+                format!("strength / {unit}"),
+                "J / J_base",
+            )
+            .with_log_y(true);
+            let (mut ylo, mut yhi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for (k, pr) in c.profiles.iter().enumerate() {
+                let pts: Vec<(f64, f64)> = pr
+                    .points
+                    .iter()
+                    .map(|q| (q.strength, q.cost / pr.cost_base))
+                    .filter(|q| q.1.is_finite() && q.1 > 0.0)
+                    .collect();
+                for q in &pts {
+                    ylo = ylo.min(q.1);
+                    yhi = yhi.max(q.1);
+                }
+                let label = if pr.shape.is_empty() {
+                    "J/J_base".to_string()
+                } else {
+                    pr.shape
+                        .iter()
+                        .map(|s| format!("{} {} {}", s.name, s.value, s.unit))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                p = p
+                    .with_series(Series::markers("", pts.clone()).with_color(k))
+                    .with_series(Series::line(label, pts).with_color(k));
+            }
+            if ylo.is_finite() && yhi.is_finite() {
+                for (j, x) in c.physical_range.iter().enumerate() {
+                    if x.is_finite() {
+                        let label = if j == 0 { "physical range" } else { "" };
+                        p = p.with_series(
+                            Series::dashed(label, vec![(*x, ylo), (*x, yhi)]).with_color(7),
+                        );
+                    }
+                }
+            }
+            if c.refitted && c.strength.is_finite() && c.cost_before > 0.0 {
+                p = p.with_series(
+                    Series::markers("refit", vec![(c.strength, c.cost_after / c.cost_before)])
+                        .with_color(3),
+                );
+            }
+            p
+        })
+        .collect();
+    let cols = 3.min(panels.len().max(1));
+    let rows = panels.len().div_ceil(cols).max(1) as u32;
+    save_panels(path, &panels, cols, (440 * cols as u32, 340 * rows))
 }
 
 /// `"0.8040 (95% CI [0.79, 0.82])"`, or the estimate marked at its bound without an interval.
@@ -169,6 +324,11 @@ pub fn save_residual_figure(
 }
 
 impl DiagnosisRun {
+    /// Writes the figure of the `J` profiles ([`save_profile_figure`]).
+    pub fn save_profile_figure(&self, path: &Path) -> Result<(), PlotError> {
+        save_profile_figure(path, &self.diagnosis)
+    }
+
     /// Writes the before/after residual figure.
     pub fn save_figure(&self, path: &Path) -> Result<(), PlotError> {
         let name = self

@@ -1,0 +1,750 @@
+//! Global search of one candidate effect: its strength scanned over the search range, each grid
+//! point a refit of the user's material parameters with the strength **fixed**, then the best
+//! grid points refined by the bounded least-squares fit with the strength freed.
+//!
+//! * **Grid** ([`scan_grid`]): the neutral value plus, on each side with room, a geometric
+//!   sequence of magnitudes from [`ScanOptions::smallest_relative`] of that side's extent up to
+//!   the bound, so small and large strengths are both seen (a co-flow weaker than the fiber only
+//!   scales the Nusselt number; one stronger reverses the relative speed).
+//! * **Walk** ([`walk_out`]): each side is walked outwards from the neutral value, every point
+//!   warm-started from its inner neighbour (law and fiber solutions); the first point whose fit
+//!   fails ends that side, and the failure is recorded in the profile, not an error; so does a
+//!   point whose `J` exceeds [`ScanOptions::stop_above`] times the user's.
+//! * **Shapes** ([`shape_variants`]): effects with a shape (today the decay lengths of
+//!   `air_coflow` and `air_temperature_profile`) are scanned for a few shapes, each a variant of
+//!   the effect.
+//! * **Refinement**: the lowest local minima of the profile (at most
+//!   [`ScanOptions::refine`]) are refitted with the strength freed.
+//! * **Physical range** ([`physical_range`], [`physical`]): what the diagnosis may name as
+//!   found. Everything this module needs from an [`Effect`] goes through [`search_range`],
+//!   [`physical_range`] and [`shape_variants`].
+
+use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
+use crate::fiber::material_law::CarreauLike;
+use crate::fiber::model::FiberModel;
+use crate::fiber::rheometer::{
+    Estimator, FitReport, FitStart, Identification, IdentifyOptions, Rheometer, RheometerError,
+};
+use crate::least_squares::{fit, FitOptions};
+use crate::solution::Solution;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// Settings of the global search.
+#[derive(Debug, Clone)]
+pub struct ScanOptions {
+    /// Grid points per side of the neutral value (default 5).
+    pub points_per_sign: usize,
+    /// Smallest grid magnitude relative to the side's extent (default 1e-3).
+    pub smallest_relative: f64,
+    /// Grid points (local minima of the profiles, lowest first) refined with the strength freed,
+    /// per candidate over all its shapes (default 2).
+    pub refine: usize,
+    /// Gauss–Newton iteration limit of a grid point's fit (default 6; the best points are
+    /// refined with the full budget).
+    pub inner_max_iterations: usize,
+    /// Whether effects with a shape are scanned for several shapes (default true).
+    pub scan_shapes: bool,
+    /// Further grid points of a candidate are refined only if their `J` is within this
+    /// fraction of its lowest grid point's (default 0.05).
+    pub refine_within: f64,
+    /// A side's walk ends once a point's `J` exceeds this multiple of the user's `J`
+    /// (default 20: far from any useful fit, and the fits there are the expensive ones).
+    pub stop_above: f64,
+}
+
+impl Default for ScanOptions {
+    fn default() -> Self {
+        ScanOptions {
+            points_per_sign: 5,
+            smallest_relative: 1e-3,
+            refine: 2,
+            inner_max_iterations: 6,
+            scan_shapes: true,
+            stop_above: 20.0,
+            refine_within: 0.05,
+        }
+    }
+}
+
+/// A shape parameter of a candidate variant (e.g. a decay length).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShapeParameter {
+    /// Name (e.g. `"decay_length"`).
+    pub name: String,
+    /// Value in `unit`.
+    pub value: f64,
+    /// Unit (e.g. `"m"`).
+    pub unit: String,
+}
+
+/// One point of a profile: the user's material parameters refitted with the strength fixed.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ProfilePoint {
+    /// Strength (the effect's unit).
+    pub strength: f64,
+    /// `J = Σ r²` of the fit (dimensionless, the diagnosis' scale).
+    pub cost: f64,
+    /// RMS relative residual `(d_model − d_meas)/d_meas` \[-\].
+    pub rms_relative_residual: f64,
+    /// Power index `n` \[-\] of the fit.
+    pub n: f64,
+    /// `κ = ln(K / 1 Pa)` \[-\] of the fit.
+    pub kappa: f64,
+}
+
+/// The profile of `J` against one candidate variant's strength.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Profile {
+    /// Canonical effect name.
+    pub effect: String,
+    /// Unit of the strength.
+    pub unit: String,
+    /// The variant's shape (empty for effects without one).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shape: Vec<ShapeParameter>,
+    /// Search range of the strength (the effect's unit).
+    pub search_range: [f64; 2],
+    /// Physical range of the strength (the effect's unit).
+    pub physical_range: [f64; 2],
+    /// `J` of the user's model (the neutral point).
+    pub cost_base: f64,
+    /// The points, by increasing strength (the neutral point included).
+    pub points: Vec<ProfilePoint>,
+    /// Sides ended by a failed fit, in words (strength and cause).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stopped: Vec<String>,
+}
+
+impl Profile {
+    /// The point of lowest `J`, if any.
+    pub fn minimum(&self) -> Option<&ProfilePoint> {
+        self.points.iter().min_by(|a, b| a.cost.total_cmp(&b.cost))
+    }
+
+    /// Label of the variant: `"air_coflow (decay_length 0.25 m)"`.
+    pub fn label(&self) -> String {
+        if self.shape.is_empty() {
+            self.effect.clone()
+        } else {
+            let s: Vec<String> = self
+                .shape
+                .iter()
+                .map(|p| format!("{} {} {}", p.name, p.value, p.unit))
+                .collect();
+            format!("{} ({})", self.effect, s.join(", "))
+        }
+    }
+}
+
+/// A refinement: the fit with the strength freed, started from a grid point.
+#[derive(Debug, Clone)]
+pub struct Refit {
+    /// Strength of the grid point it started from.
+    pub start_strength: f64,
+    /// The fit.
+    pub identification: Identification,
+    /// Its report.
+    pub report: FitReport,
+    /// `J = Σ r²` (dimensionless).
+    pub cost: f64,
+}
+
+/// The global search of one candidate variant.
+#[derive(Debug, Clone)]
+pub struct CandidateScan {
+    /// The variant scanned.
+    pub effect: Effect,
+    /// The profile.
+    pub profile: Profile,
+    /// Refinements, lowest `J` first (empty if all failed).
+    pub refits: Vec<Refit>,
+}
+
+/// Grid of a scan: strengths on each side of the neutral value, each ordered outwards.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScanGrid {
+    /// The neutral value.
+    pub neutral: f64,
+    /// Strengths below the neutral value, decreasing.
+    pub below: Vec<f64>,
+    /// Strengths above the neutral value, increasing.
+    pub above: Vec<f64>,
+}
+
+/// Search range of an effect's strength (its fit bounds, the effect's unit).
+pub fn search_range(effect: &Effect) -> (f64, f64) {
+    effect.bounds()
+}
+
+/// Physical range of an effect's strength (the effect's unit): for now the search range,
+/// except for `radiation`, whose emissivity is physical only in `[0, 1]`.
+pub fn physical_range(effect: &Effect) -> (f64, f64) {
+    match effect {
+        Effect::Radiation => (0.0, 1.0),
+        e => search_range(e),
+    }
+}
+
+/// `Ok` if `value` lies in the physical range of `effect`, else the reason in words
+/// (`"radiation would need 2 - > 1: not physical"`).
+pub fn physical(effect: &Effect, value: f64) -> Result<(), String> {
+    let (lo, hi) = physical_range(effect);
+    let unit = match effect.unit() {
+        "-" => String::new(),
+        u => format!(" {u}"),
+    };
+    if !value.is_finite() {
+        Err(format!("{} has no finite strength", effect.name()))
+    } else if value > hi {
+        Err(format!(
+            "{} would need {:.4}{unit} > {hi}{unit}: not physical",
+            effect.name(),
+            value
+        ))
+    } else if value < lo {
+        Err(format!(
+            "{} would need {:.4}{unit} < {lo}{unit}: not physical",
+            effect.name(),
+            value
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// The scan grid of `effect`: on each side of the neutral value with room up to the search
+/// bound, `points_per_sign` magnitudes geometrically from `smallest_relative ×` the side's
+/// extent up to the bound itself.
+pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
+    let neutral = effect.neutral();
+    let (lo, hi) = search_range(effect);
+    let side = |extent: f64, sign: f64| -> Vec<f64> {
+        let n = options.points_per_sign;
+        if !(extent.is_finite() && extent > 0.0) || n == 0 {
+            return Vec::new();
+        }
+        let r0 = options.smallest_relative.clamp(1e-12, 1.0);
+        (0..n)
+            .map(|i| {
+                let t = if n == 1 {
+                    1.0
+                } else {
+                    i as f64 / (n - 1) as f64
+                };
+                let rel = r0.powf(1.0 - t);
+                if i + 1 == n {
+                    neutral + sign * extent // the bound itself, exactly
+                } else {
+                    neutral + sign * extent * rel
+                }
+            })
+            .collect()
+    };
+    ScanGrid {
+        neutral,
+        below: side(neutral - lo, -1.0),
+        above: side(hi - neutral, 1.0),
+    }
+}
+
+/// The variants of `effect` whose shapes are scanned, each with its shape parameters: the
+/// co-flow's decay length 0.03, 0.1, 0.4 m; the warm air's 0.02, 0.05, 0.2 m; the
+/// effect itself for effects without a shape (or without shape scanning).
+pub fn shape_variants(effect: &Effect, scan_shapes: bool) -> Vec<(Effect, Vec<ShapeParameter>)> {
+    let decay = |v: f64| {
+        vec![ShapeParameter {
+            name: "decay_length".into(),
+            value: v,
+            unit: "m".into(),
+        }]
+    };
+    match effect {
+        Effect::AirCoflow { decay_length } => {
+            if !scan_shapes {
+                return vec![(effect.clone(), decay(*decay_length))];
+            }
+            [0.03, 0.1, 0.4]
+                .iter()
+                .map(|&l| (Effect::AirCoflow { decay_length: l }, decay(l)))
+                .collect()
+        }
+        Effect::AirTemperatureProfile { decay_length } => {
+            if !scan_shapes {
+                return vec![(effect.clone(), decay(*decay_length))];
+            }
+            [0.02, 0.05, 0.2]
+                .iter()
+                .map(|&l| (Effect::AirTemperatureProfile { decay_length: l }, decay(l)))
+                .collect()
+        }
+        e => vec![(e.clone(), Vec::new())],
+    }
+}
+
+/// What a [`walk_out`] gives: the values reached with their results, and the value where it
+/// stopped with the failure, if any.
+pub type Walk<T, E> = (Vec<(f64, T)>, Option<(f64, E)>);
+
+/// Evaluates `eval` at `values` in order, each call given the previous result (the warm
+/// start; `None` for the first), and stops at the first failure, which is returned with its
+/// value.
+pub fn walk_out<T, E>(
+    values: &[f64],
+    first: Option<&T>,
+    mut eval: impl FnMut(f64, Option<&T>) -> Result<T, E>,
+) -> Walk<T, E> {
+    let mut done: Vec<(f64, T)> = Vec::with_capacity(values.len());
+    for &v in values {
+        let prev = done.last().map(|d| &d.1).or(first);
+        match eval(v, prev) {
+            Ok(t) => done.push((v, t)),
+            Err(e) => return (done, Some((v, e))),
+        }
+    }
+    (done, None)
+}
+
+/// A rheometer for `spec` on the data and models of `rh` (no new smoothing): the models are
+/// rebuilt with the physics of `spec`.
+fn rheometer_for(rh: &Rheometer, spec: ModelSpec) -> Result<Rheometer, RheometerError> {
+    spec.validate().map_err(RheometerError::Data)?;
+    let models = rh
+        .experiments
+        .iter()
+        .map(|e| {
+            spec.physics()
+                .and_then(|physics| {
+                    FiberModel::new(&rh.material, &rh.air, e, CarreauLike::new(), physics)
+                })
+                .map_err(|source| RheometerError::Simulation {
+                    experiment: e.name.clone(),
+                    n: f64::NAN,
+                    kappa: f64::NAN,
+                    source,
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Rheometer {
+        material: rh.material.clone(),
+        air: rh.air.clone(),
+        experiments: rh.experiments.clone(),
+        measurements: rh.measurements.clone(),
+        smoothing: rh.smoothing.clone(),
+        models,
+        relative_uncertainty: rh.relative_uncertainty,
+        spec,
+    })
+}
+
+/// Relative cost change, step and scaled gradient at which a grid point's fit stops (its `J`
+/// is a profile value, not an estimate: the best points are refined with the full tolerances).
+const GRID_TOLERANCE: f64 = 1e-6;
+
+/// [`Rheometer::identify_from`] with the take-up factors warm-started at `take_up` (the
+/// principled estimator; the factors follow the shared parameters in the fit's vector);
+/// `loose` stops at [`GRID_TOLERANCE`] and `options.max_iterations`.
+fn fit_warm(
+    rh: &Rheometer,
+    start: &FitStart,
+    take_up: &[f64],
+    options: &IdentifyOptions,
+    loose: bool,
+) -> Result<Identification, RheometerError> {
+    let t0 = Instant::now();
+    let mut obj = rh.objective_from(start, options)?;
+    let layout = obj.layout().clone();
+    let ns = layout.num_shared();
+    let m = rh.len();
+    let [tlo, thi] = options.take_up_bounds;
+    let mut p0 = layout.shared_start();
+    let (mut lower, mut upper) = (layout.lower.clone(), layout.upper.clone());
+    if options.estimator == Estimator::Principled {
+        if take_up.len() == m {
+            p0.extend(take_up.iter().map(|v| v.clamp(tlo, thi)));
+        } else {
+            p0.extend(std::iter::repeat_n(1.0, m));
+        }
+        lower.extend(std::iter::repeat_n(tlo, m));
+        upper.extend(std::iter::repeat_n(thi, m));
+    }
+    let mut fo = FitOptions {
+        initial_radius: 0.3,
+        max_radius: 1.0,
+        max_iterations: options.max_iterations,
+        ..FitOptions::with_bounds(lower.clone(), upper.clone())
+    };
+    if loose {
+        fo.gtol = GRID_TOLERANCE;
+        fo.xtol = GRID_TOLERANCE;
+        fo.ftol = GRID_TOLERANCE;
+    }
+    let fit_result = fit(&mut obj, &p0, &fo)?;
+    let solutions: Vec<Solution> = obj.solutions();
+    let rms = rh.rms_relative_residual(&solutions);
+    let phi_index = layout.params.take_up_factor();
+    let local = layout.local(&fit_result.p[..ns], 1.0, phi_index);
+    let [n, kappa] = layout.law_of(&local);
+    let residual_profiles = solutions
+        .iter()
+        .enumerate()
+        .map(|(k, sol)| {
+            (
+                rh.measurements[k].positions.clone(),
+                rh.relative_residuals(k, sol),
+            )
+        })
+        .collect();
+    Ok(Identification {
+        estimator: options.estimator,
+        start: start.law,
+        n,
+        kappa,
+        take_up_factors: if options.estimator == Estimator::Principled {
+            fit_result.p[ns..].to_vec()
+        } else {
+            vec![1.0; m]
+        },
+        names: layout.names.clone(),
+        effects: layout.effects.clone(),
+        local_params: local,
+        rms_relative_residual: rms,
+        law: rh.spec.law,
+        experiment_names: rh.experiments.iter().map(|e| e.name.clone()).collect(),
+        lower,
+        upper,
+        residual_profiles,
+        relative_uncertainty: options.relative_uncertainty.or(rh.relative_uncertainty),
+        data_warnings: rh.data_warnings(),
+        solutions,
+        fit: fit_result,
+        wall_time_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// A grid point's fit: the warm start of its outer neighbour and of a refinement.
+#[derive(Debug, Clone)]
+pub struct GridStart {
+    /// Strength (the effect's unit).
+    pub strength: f64,
+    /// `(n, κ)` of the fit.
+    pub law: [f64; 2],
+    /// Take-up factors of the fit.
+    pub take_up: Vec<f64>,
+    /// Fiber solutions, one per experiment.
+    pub solutions: Vec<Solution>,
+    /// `J = Σ r²`.
+    pub cost: f64,
+    /// RMS relative residual \[-\].
+    pub rms: f64,
+}
+
+/// The profile of one candidate variant, with what its refinement needs.
+#[derive(Debug)]
+pub struct ProfileScan {
+    /// The variant scanned.
+    pub effect: Effect,
+    /// The profile.
+    pub profile: Profile,
+    /// The grid points to refine (local minima of the profile, lowest first; see
+    /// [`refine_starts`]).
+    pub starts: Vec<GridStart>,
+    /// The user's model with the variant's strength freed (for [`refine`]).
+    pub rheometer: Rheometer,
+}
+
+/// Scans the candidate variant `effect` (with shape `shape`, for the report) on the rheometer
+/// `rh` (the user's model; its neutral candidates are dropped) from the user's fit `base`
+/// (`J` = `cost_base`): each side of [`scan_grid`] walked outwards with the strength fixed.
+pub fn scan_profile(
+    rh: &Rheometer,
+    effect: &Effect,
+    shape: Vec<ShapeParameter>,
+    base: &Identification,
+    cost_base: f64,
+    options: &IdentifyOptions,
+    scan: &ScanOptions,
+) -> Result<ProfileScan, RheometerError> {
+    let mut spec = rh.spec.clone();
+    spec.candidates.clear();
+    spec.effects
+        .push(EffectSetting::fixed(effect.clone(), effect.neutral()));
+    let mut vrh = rheometer_for(rh, spec)?;
+    let slot = vrh.spec.effects.len() - 1;
+    let grid = scan_grid(effect, scan);
+    let mut inner = options.clone();
+    inner.max_iterations = scan.inner_max_iterations.max(1);
+    let base_point = GridStart {
+        strength: grid.neutral,
+        law: [base.n, base.kappa],
+        take_up: base.take_up_factors.clone(),
+        solutions: base.solutions.clone(),
+        cost: cost_base,
+        rms: base.rms_relative_residual,
+    };
+    let mut stopped = Vec::new();
+    let mut sides: Vec<Vec<(f64, GridStart)>> = Vec::new();
+    for values in [&grid.below, &grid.above] {
+        let (done, fail) = walk_out(values, Some(&base_point), |v, prev| {
+            let prev = prev.unwrap_or(&base_point);
+            if prev.cost > scan.stop_above * cost_base {
+                return Err(RheometerError::Data(format!(
+                    "not scanned further: J = {:.1} J_base at {}",
+                    prev.cost / cost_base,
+                    prev.strength
+                )));
+            }
+            vrh.spec.effects[slot].value = Some(v);
+            let start = FitStart {
+                law: prev.law,
+                free_candidates: Vec::new(),
+                strengths: Vec::new(),
+                warm: Some(prev.solutions.clone()),
+            };
+            fit_warm(&vrh, &start, &prev.take_up, &inner, true).map(|id| GridStart {
+                strength: v,
+                law: [id.n, id.kappa],
+                take_up: id.take_up_factors,
+                cost: 2.0 * id.fit.cost,
+                rms: id.rms_relative_residual,
+                solutions: id.solutions,
+            })
+        });
+        if let Some((v, e)) = fail {
+            let unit = match effect.unit() {
+                "-" => String::new(),
+                u => format!(" {u}"),
+            };
+            stopped.push(format!("at {v}{unit}: {e}"));
+        }
+        sides.push(done);
+    }
+    vrh.spec.effects[slot].value = None;
+    // all points by increasing strength, the neutral one included
+    let mut pts: Vec<GridStart> = Vec::new();
+    let mut above = Vec::new();
+    for (k, side) in sides.into_iter().enumerate() {
+        let it = side.into_iter().map(|(_, p)| p);
+        if k == 0 {
+            pts.extend(it.rev());
+        } else {
+            above.extend(it);
+        }
+    }
+    let neutral = pts.len();
+    pts.push(base_point);
+    pts.extend(above);
+    let (lo, hi) = search_range(effect);
+    let (plo, phi) = physical_range(effect);
+    let profile = Profile {
+        effect: effect.name().to_string(),
+        unit: effect.unit().to_string(),
+        shape,
+        search_range: [lo, hi],
+        physical_range: [plo, phi],
+        cost_base,
+        points: pts
+            .iter()
+            .map(|p| ProfilePoint {
+                strength: p.strength,
+                cost: p.cost,
+                rms_relative_residual: p.rms,
+                n: p.law[0],
+                kappa: p.law[1],
+            })
+            .collect(),
+        stopped,
+    };
+    let costs: Vec<f64> = pts.iter().map(|p| p.cost).collect();
+    let chosen = refine_starts(&costs, Some(neutral), scan);
+    let starts = chosen.iter().map(|&i| pts[i].clone()).collect();
+    Ok(ProfileScan {
+        effect: effect.clone(),
+        profile,
+        starts,
+        rheometer: vrh,
+    })
+}
+
+/// Refines a grid point of [`scan_profile`]: the bounded least-squares fit with the strength
+/// freed, warm-started from the point (full tolerances and iteration budget of `options`).
+pub fn refine(
+    scan: &ProfileScan,
+    start: &GridStart,
+    options: &IdentifyOptions,
+) -> Result<Refit, RheometerError> {
+    let fs = FitStart {
+        law: start.law,
+        free_candidates: Vec::new(),
+        strengths: vec![(scan.effect.name().to_string(), start.strength)],
+        warm: Some(start.solutions.clone()),
+    };
+    let id = fit_warm(&scan.rheometer, &fs, &start.take_up, options, false)?;
+    let report = FitReport::new(&id);
+    Ok(Refit {
+        start_strength: start.strength,
+        cost: 2.0 * id.fit.cost,
+        identification: id,
+        report,
+    })
+}
+
+/// The global search of one candidate variant: [`scan_profile`], then [`refine`] of its best
+/// grid points (refits that fail are left out).
+pub fn scan_candidate(
+    rh: &Rheometer,
+    effect: &Effect,
+    shape: Vec<ShapeParameter>,
+    base: &Identification,
+    cost_base: f64,
+    options: &IdentifyOptions,
+    scan: &ScanOptions,
+) -> Result<CandidateScan, RheometerError> {
+    let ps = scan_profile(rh, effect, shape, base, cost_base, options, scan)?;
+    let mut refits: Vec<Refit> = ps
+        .starts
+        .iter()
+        .filter_map(|st| refine(&ps, st, options).ok())
+        .collect();
+    refits.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+    Ok(CandidateScan {
+        effect: ps.effect,
+        profile: ps.profile,
+        refits,
+    })
+}
+
+/// Indices of the grid points to refine: local minima of `costs` (by increasing strength)
+/// other than `neutral`, lowest first, at most `refine`; without such a minimum, the lowest
+/// point other than `neutral`.
+pub fn refine_starts(costs: &[f64], neutral: Option<usize>, scan: &ScanOptions) -> Vec<usize> {
+    let n = costs.len();
+    let candidates: Vec<usize> = (0..n).filter(|&i| Some(i) != neutral).collect();
+    let mut minima: Vec<usize> = candidates
+        .iter()
+        .copied()
+        .filter(|&i| {
+            (i == 0 || costs[i] <= costs[i - 1]) && (i + 1 == n || costs[i] <= costs[i + 1])
+        })
+        .collect();
+    if minima.is_empty() {
+        if let Some(&b) = candidates
+            .iter()
+            .min_by(|&&a, &&b| costs[a].total_cmp(&costs[b]))
+        {
+            minima.push(b);
+        }
+    }
+    minima.sort_by(|&a, &b| costs[a].total_cmp(&costs[b]));
+    minima.truncate(scan.refine.max(1));
+    minima
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fiber::effects::DEFAULT_COFLOW_DECAY_LENGTH;
+
+    #[test]
+    fn grid_spans_small_and_large_magnitudes_on_both_sides() {
+        let e = Effect::AirCoflow {
+            decay_length: DEFAULT_COFLOW_DECAY_LENGTH,
+        };
+        let (lo, hi) = e.bounds();
+        let o = ScanOptions::default();
+        let g = scan_grid(&e, &o);
+        assert_eq!(g.below.len(), o.points_per_sign);
+        assert_eq!(g.above.len(), o.points_per_sign);
+        // outwards, strictly monotone, from 1e-3 of the extent to the bound exactly
+        assert!(g.above.windows(2).all(|w| w[1] > w[0]));
+        assert!(g.below.windows(2).all(|w| w[1] < w[0]));
+        assert!((g.above[0] - 1e-3 * hi).abs() <= 1e-12 * hi);
+        assert!((g.below[0] - 1e-3 * lo).abs() <= 1e-12 * lo.abs());
+        assert_eq!(*g.above.last().unwrap(), hi);
+        assert_eq!(*g.below.last().unwrap(), lo);
+        // geometric: constant ratio
+        let r: Vec<f64> = g.above.windows(2).map(|w| w[1] / w[0]).collect();
+        assert!(r.iter().all(|x| (x / r[0] - 1.0).abs() < 1e-9), "{r:?}");
+    }
+
+    #[test]
+    fn grid_has_no_side_without_room() {
+        // strain thinning: strength in [0, 1], neutral 0: nothing below
+        let g = scan_grid(&Effect::StrainThinning, &ScanOptions::default());
+        assert!(g.below.is_empty());
+        assert_eq!(g.above.len(), ScanOptions::default().points_per_sign);
+        let one = ScanOptions {
+            points_per_sign: 1,
+            ..ScanOptions::default()
+        };
+        let g = scan_grid(&Effect::Radiation, &one);
+        assert_eq!((g.below.clone(), g.above.clone()), (vec![-1.0], vec![2.0]));
+    }
+
+    #[test]
+    fn walk_stops_at_the_first_failure_and_warm_starts_from_the_neighbour() {
+        let values = [1.0, 2.0, 3.0, 4.0, 5.0];
+        let mut seen = Vec::new();
+        let (done, fail) = walk_out(&values, Some(&0.0), |v, prev: Option<&f64>| {
+            seen.push(*prev.unwrap());
+            if v > 3.5 {
+                Err(format!("diverged at {v}"))
+            } else {
+                Ok(v * 10.0)
+            }
+        });
+        assert_eq!(
+            done.iter().map(|d| d.0).collect::<Vec<_>>(),
+            [1.0, 2.0, 3.0]
+        );
+        assert_eq!(fail, Some((4.0, "diverged at 4".to_string())));
+        // each point started from its inner neighbour's result; nothing after the failure
+        assert_eq!(seen, [0.0, 10.0, 20.0, 30.0]);
+        let (done, fail) = walk_out(&values, None, |v, _: Option<&f64>| Ok::<_, ()>(v));
+        assert_eq!(done.len(), 5);
+        assert!(fail.is_none());
+    }
+
+    #[test]
+    fn radiation_beyond_unit_emissivity_is_not_physical() {
+        assert!(physical(&Effect::Radiation, 0.9).is_ok());
+        let e = physical(&Effect::Radiation, 2.0).unwrap_err();
+        assert!(e.contains("radiation") && e.contains("> 1") && e.contains("not physical"));
+        assert!(physical(&Effect::Radiation, -0.2).is_err());
+        assert!(physical(&Effect::Radiation, f64::NAN).is_err());
+        let c = Effect::AirCoflow { decay_length: 0.1 };
+        assert!(physical(&c, 5.0).is_ok());
+        assert!(physical(&c, 1e3).unwrap_err().contains("m/s"));
+    }
+
+    #[test]
+    fn refinement_starts_at_the_lowest_local_minima_not_at_neutral() {
+        let o = ScanOptions::default();
+        // two minima (indices 1 and 5), neutral at 3 is lower than both neighbours
+        let costs = [5.0, 2.0, 4.0, 1.0, 3.0, 0.5, 0.6];
+        assert_eq!(refine_starts(&costs, Some(3), &o), vec![5, 1]);
+        // monotone: the lowest non-neutral point
+        let costs = [1.0, 2.0, 3.0];
+        assert_eq!(refine_starts(&costs, Some(0), &o), vec![1]);
+    }
+
+    #[test]
+    fn shapes_are_scanned_as_variants() {
+        let v = shape_variants(&Effect::AirCoflow { decay_length: 0.1 }, true);
+        assert!(v.len() >= 3);
+        assert!(v.iter().any(|(_, s)| s[0].value <= 0.03));
+        assert!(v.iter().any(|(_, s)| s[0].value >= 0.4));
+        for (e, s) in &v {
+            match e {
+                Effect::AirCoflow { decay_length } => assert_eq!(*decay_length, s[0].value),
+                _ => panic!("not a co-flow"),
+            }
+        }
+        assert_eq!(shape_variants(&Effect::Radiation, true).len(), 1);
+        assert_eq!(
+            shape_variants(&Effect::AirTemperatureProfile { decay_length: 0.2 }, false)[0].1[0]
+                .value,
+            0.2
+        );
+    }
+}
