@@ -34,6 +34,7 @@ use super::scan::{
 };
 use super::scores::{cosine, linear_scores};
 use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::fiber::noise_model::Outlier;
 use crate::fiber::rheometer::estimator::RelativeResidual;
 use crate::fiber::rheometer::report::bound_side;
 use crate::fiber::rheometer::{
@@ -41,7 +42,6 @@ use crate::fiber::rheometer::{
     RheometerError,
 };
 use crate::fiber::setup::ExperimentSet;
-use crate::fiber::statistics::{lag1_autocorrelation_about_zero, noise_rms_second_differences};
 use crate::fiber::FiberError;
 use crate::sensitivity::{residual_jacobian, Sensitivities};
 use crate::solution::Solution;
@@ -257,12 +257,19 @@ pub struct Diagnosis {
     pub base_fit: FitReport,
     /// Noise level (relative) used for the judgement.
     pub noise_level: f64,
-    /// `"data set"` (relative_uncertainty) or `"estimated"` (successive differences).
+    /// `"data set"` (relative_uncertainty) or `"estimated"` (the
+    /// [`NoiseModel`](crate::fiber::noise_model::NoiseModel) of the residuals: RMS of the local
+    /// noise level along the line, from second differences, outliers excluded).
     pub noise_source: String,
-    /// RMS relative residual of the user's fit over the noise level.
+    /// RMS relative residual of the user's fit (outliers excluded) over the noise level.
     pub rms_over_noise: f64,
-    /// Pooled lag-1 autocorrelation of the residuals along the spin lines.
+    /// Pooled lag-1 autocorrelation of the noise-normalised residuals along the spin lines
+    /// (about zero, outliers excluded).
     pub lag1_autocorrelation: f64,
+    /// Gross outliers of the user's fit, by experiment and position (left out of the noise
+    /// level, the RMS and the autocorrelation; a robust loss in `fit` down-weights them).
+    #[serde(default)]
+    pub outliers: Vec<Outlier>,
     /// Whether the residuals are systematic: `rms_over_noise > 1.2`, or `ρ₁ √N > 3`, or a
     /// candidate earns its place (its refit lowers BIC below the threshold).
     pub systematic: bool,
@@ -312,11 +319,18 @@ fn residual_profiles(rh: &Rheometer, sols: &[Solution]) -> ResidualProfiles {
         .collect()
 }
 
-/// The residuals of each profile (without positions), for [`statistics`](crate::fiber::statistics).
-fn residual_sequences(profiles: &ResidualProfiles) -> Vec<Vec<f64>> {
-    profiles
+/// The residuals of a fit on its own model (a refit's parameter vector belongs to the
+/// candidate's model, not to the diagnosis' one), named by experiment.
+fn own_residual_profiles(rh: &Rheometer, id: &Identification) -> ResidualProfiles {
+    id.residual_profiles
         .iter()
-        .map(|(_, p)| p.iter().map(|v| v.1).collect())
+        .enumerate()
+        .map(|(k, (s, r))| {
+            (
+                rh.experiments[k].name.clone(),
+                s.iter().copied().zip(r.iter().copied()).collect(),
+            )
+        })
         .collect()
 }
 
@@ -472,15 +486,15 @@ pub fn diagnose(
 
     // systematic?
     let before = residual_profiles(&rh, &base.solutions);
-    let sequences = residual_sequences(&before);
-    let sequences: Vec<&[f64]> = sequences.iter().map(Vec::as_slice).collect();
-    let (noise_level, noise_source) = match opts.relative_uncertainty.or(rh.relative_uncertainty) {
-        Some(u) => (u, "data set"),
-        None => (noise_rms_second_differences(&sequences), "estimated"),
-    };
-    let rms0 = base.rms_relative_residual;
-    let (rho1, pairs) = lag1_autocorrelation_about_zero(&sequences);
-    let rms_over_noise = rms0 / noise_level;
+    // the one noise model of compare and diagnose: robust, varying along the line, outliers
+    // flagged and left out of the RMS, the noise level and the lag-1 autocorrelation
+    let nm = rh.noise_model(&base.residual_profiles)?;
+    let (noise_level, noise_source, rms_over_noise) =
+        match opts.relative_uncertainty.or(rh.relative_uncertainty) {
+            Some(u) => (u, "data set", nm.rms / u),
+            None => (nm.noise_rms, "estimated", nm.rms_over_noise),
+        };
+    let (rho1, pairs) = (nm.lag1, nm.lag1_pairs);
     let mut systematic = rms_over_noise > 1.2 || rho1 * (pairs as f64).sqrt() > 3.0;
 
     let positions: Vec<f64> = rh
@@ -554,10 +568,16 @@ pub fn diagnose(
     // global search of each candidate (best linearised first, at most `refit_top`), all
     // variants in parallel
     let scanned: Vec<usize> = order.iter().copied().take(options.refit_top).collect();
+    // spin-line length \[m\] that bounds the shapes (the shortest line)
+    let length = rh
+        .experiments
+        .iter()
+        .map(|e| e.spinline_length)
+        .fold(f64::INFINITY, f64::min);
     let jobs: Vec<(usize, Effect, Vec<ShapeParameter>)> = scanned
         .iter()
         .flat_map(|&i| {
-            shape_variants(&cands[i], options.scan.scan_shapes)
+            shape_variants(&cands[i], options.scan.scan_shapes, length)
                 .into_iter()
                 .map(move |(v, s)| (i, v, s))
         })
@@ -567,7 +587,16 @@ pub fn diagnose(
         .map(|(i, v, s)| {
             (
                 i,
-                scan_profile(&rh, &v, s, &base, cost_before, &opts, &options.scan),
+                scan_profile(
+                    &rh,
+                    &cands[i],
+                    &v,
+                    s,
+                    &base,
+                    cost_before,
+                    &opts,
+                    &options.scan,
+                ),
             )
         })
         .collect();
@@ -629,24 +658,49 @@ pub fn diagnose(
         let id = refit.identification;
         let after = refit.cost;
         let res = &mut results[i];
-        // a shape chosen among several scanned ones is one more fitted parameter
-        res.extra_parameters += usize::from(variants[i] > 1);
         let (bic, aic) = ic(after, res.extra_parameters);
         let er = rep.effects.iter().find(|x| x.effect == e.name());
         res.refitted = true;
         res.strength = er.map_or(f64::NAN, |x| x.strength);
         res.stderr_strength = er.map_or(f64::NAN, |x| x.stderr_strength);
-        res.shape = shape_variants(&variant, false)
-            .into_iter()
-            .next()
-            .map(|v| v.1)
+        // the refit's shapes (fitted ones freed again by the refinement, counted in
+        // `extra_parameters` through `free_shapes`)
+        res.shape = er
+            .map(|x| {
+                x.shapes
+                    .iter()
+                    .map(|sh| ShapeParameter {
+                        name: sh.name.clone(),
+                        value: sh.value,
+                        unit: sh.unit.clone(),
+                    })
+                    .collect()
+            })
             .unwrap_or_default();
         res.cost_after = after;
         res.rms_relative_residual_after = id.rms_relative_residual;
         res.at_bound = rep.at_bound.clone();
         res.delta_bic = bic;
         res.delta_aic = aic;
-        let (status, note) = strength_status(&variant, res.strength, &res.at_bound);
+        let (mut status, mut note) = strength_status(&variant, res.strength, &res.at_bound);
+        // a shape parameter at a bound of its range is no credible estimate either
+        if status == StrengthStatus::Physical {
+            let prefix = format!("{}.", e.name());
+            if let Some(b) = res
+                .at_bound
+                .iter()
+                .find(|b| b.parameter.starts_with(&prefix))
+            {
+                status = StrengthStatus::AtBound;
+                note = Some(format!(
+                    "its shape parameter {} is best at its {} bound {}: the data push the \
+                     effect's shape beyond its range",
+                    b.parameter,
+                    b.side.name(),
+                    b.bound
+                ));
+            }
+        }
         res.status = status;
         res.status_note = note;
         if rep.stderr_n.is_finite() || spec.law == LawChoice::Carreau {
@@ -655,7 +709,7 @@ pub fn diagnose(
             res.ci95_n = rep.ci95_n;
             res.ci95_kappa = rep.ci95_kappa;
         }
-        let a = residual_profiles(&rh, &id.solutions);
+        let a = own_residual_profiles(&rh, &id);
         let change: Vec<f64> = a
             .iter()
             .zip(&before)
@@ -692,7 +746,7 @@ pub fn diagnose(
     systematic |= most_likely.is_some();
     let (residuals_after, best) = match best_i {
         Some(i) => match refits.into_iter().find(|(j, _)| *j == i) {
-            Some((_, id)) => (Some(residual_profiles(&rh, &id.solutions)), Some(id)),
+            Some((_, id)) => (Some(own_residual_profiles(&rh, &id)), Some(id)),
             None => (None, None),
         },
         None => (None, None),
@@ -706,6 +760,7 @@ pub fn diagnose(
             noise_source: noise_source.to_string(),
             rms_over_noise,
             lag1_autocorrelation: rho1,
+            outliers: nm.outliers.clone(),
             systematic,
             candidates,
             indistinguishable: indist,
@@ -794,7 +849,9 @@ mod tests {
         assert_eq!(s, StrengthStatus::AtBound);
         assert!(note.unwrap().contains("upper bound 2"));
         // listed by the fit report
-        let c = Effect::AirCoflow { decay_length: 0.25 };
+        let c = Effect::AirCoflow {
+            decay_length: Some(0.25),
+        };
         let ab = AtBound {
             parameter: "air_coflow".into(),
             side: BoundSide::Lower,

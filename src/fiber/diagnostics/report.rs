@@ -43,6 +43,24 @@ impl Diagnosis {
             self.rms_over_noise,
             self.lag1_autocorrelation
         ));
+        if !self.outliers.is_empty() {
+            s.push_str(&format!(
+                "OUTLIERS ({}; left out of the noise level, the RMS and the autocorrelation; \
+                 `fit --loss huber` down-weights them):\n",
+                self.outliers.len()
+            ));
+            for o in &self.outliers {
+                s.push_str(&format!(
+                    "    {} at s = {:.3} m: measured {:.2} um, model {:.2} um, residual {:+.1} % ({:.1} robust sd)\n",
+                    o.experiment,
+                    o.position_m,
+                    1e6 * o.d_meas_m,
+                    1e6 * o.d_model_m,
+                    100.0 * o.residual,
+                    o.deviation_sigmas
+                ));
+            }
+        }
         match (&self.most_likely_missing, self.candidates.first()) {
             (Some(name), Some(c)) => {
                 s.push_str(&format!(
@@ -105,7 +123,7 @@ impl Diagnosis {
             let shape: String = c
                 .shape
                 .iter()
-                .map(|p| format!("  [{} {} {}]", p.name, p.value, p.unit))
+                .map(|p| format!("  [{} {:.4} {}]", p.name, p.value, p.unit))
                 .collect();
             s.push_str(&format!(
                 "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {:>8.4}  {:<11}  {} (peak {:.2} m){shape}\n",
@@ -247,7 +265,7 @@ pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), Plo
                 } else {
                     pr.shape
                         .iter()
-                        .map(|s| format!("{} {} {}", s.name, s.value, s.unit))
+                        .map(|s| format!("{} {:.3} {}", s.name, s.value, s.unit))
                         .collect::<Vec<_>>()
                         .join(", ")
                 };

@@ -33,14 +33,15 @@ use std::time::Instant;
 /// Settings of the global search.
 #[derive(Debug, Clone)]
 pub struct ScanOptions {
-    /// Grid points per side of the neutral value (default 5).
+    /// Grid points per side of the neutral value for physical effects (default 4; process and
+    /// instrument candidates get half as many, see [`scan_grid`]).
     pub points_per_sign: usize,
-    /// Smallest grid magnitude relative to the side's extent (default 1e-3).
+    /// Smallest grid magnitude relative to the side's extent (default 1e-2).
     pub smallest_relative: f64,
     /// Grid points (local minima of the profiles, lowest first) refined with the strength freed,
     /// per candidate over all its shapes (default 2).
     pub refine: usize,
-    /// Gauss–Newton iteration limit of a grid point's fit (default 6; the best points are
+    /// Gauss–Newton iteration limit of a grid point's fit (default 3; the best points are
     /// refined with the full budget).
     pub inner_max_iterations: usize,
     /// Whether effects with a shape are scanned for several shapes (default true).
@@ -56,10 +57,10 @@ pub struct ScanOptions {
 impl Default for ScanOptions {
     fn default() -> Self {
         ScanOptions {
-            points_per_sign: 5,
-            smallest_relative: 1e-3,
+            points_per_sign: 4,
+            smallest_relative: 1e-2,
             refine: 2,
-            inner_max_iterations: 6,
+            inner_max_iterations: 3,
             scan_shapes: true,
             stop_above: 20.0,
             refine_within: 0.05,
@@ -130,7 +131,7 @@ impl Profile {
             let s: Vec<String> = self
                 .shape
                 .iter()
-                .map(|p| format!("{} {} {}", p.name, p.value, p.unit))
+                .map(|p| format!("{} {:.3} {}", p.name, p.value, p.unit))
                 .collect();
             format!("{} ({})", self.effect, s.join(", "))
         }
@@ -177,50 +178,38 @@ pub fn search_range(effect: &Effect) -> (f64, f64) {
     effect.bounds()
 }
 
-/// Physical range of an effect's strength (the effect's unit): for now the search range,
-/// except for `radiation`, whose emissivity is physical only in `[0, 1]`.
+/// Physical range of an effect's strength (the effect's unit): [`Effect::physical_range`].
 pub fn physical_range(effect: &Effect) -> (f64, f64) {
-    match effect {
-        Effect::Radiation => (0.0, 1.0),
-        e => search_range(e),
-    }
+    effect.physical_range()
 }
 
 /// `Ok` if `value` lies in the physical range of `effect`, else the reason in words
-/// (`"radiation would need 2 - > 1: not physical"`).
+/// ([`Effect::judge`]: `"radiation would need ε = 2 > 1: not physical"`).
 pub fn physical(effect: &Effect, value: f64) -> Result<(), String> {
-    let (lo, hi) = physical_range(effect);
-    let unit = match effect.unit() {
-        "-" => String::new(),
-        u => format!(" {u}"),
-    };
-    if !value.is_finite() {
-        Err(format!("{} has no finite strength", effect.name()))
-    } else if value > hi {
-        Err(format!(
-            "{} would need {:.4}{unit} > {hi}{unit}: not physical",
-            effect.name(),
-            value
-        ))
-    } else if value < lo {
-        Err(format!(
-            "{} would need {:.4}{unit} < {lo}{unit}: not physical",
-            effect.name(),
-            value
-        ))
-    } else {
-        Ok(())
+    match effect.judge(value) {
+        None => Ok(()),
+        Some(why) => Err(why),
     }
 }
 
-/// The scan grid of `effect`: on each side of the neutral value with room up to the search
-/// bound, `points_per_sign` magnitudes geometrically from `smallest_relative ×` the side's
-/// extent up to the bound itself.
+/// The scan grid of `effect`: on each side of the neutral value with room up to the bound of
+/// its **physical range** (within the search range), `points_per_sign` magnitudes
+/// geometrically from `smallest_relative ×` the side's extent up to the bound itself. Values
+/// beyond the physical range are reached by the refinement (bounded by the search range), so a
+/// best fit outside physics is still found and reported as such.
 pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
     let neutral = effect.neutral();
-    let (lo, hi) = search_range(effect);
+    let (slo, shi) = search_range(effect);
+    let (plo, phi) = physical_range(effect);
+    let (lo, hi) = (slo.max(plo), shi.min(phi));
+    // process and instrument errors act nearly linearly within their (small) physical ranges:
+    // half the points
+    let n_side = match effect.category() {
+        crate::fiber::effects::Category::Physics => options.points_per_sign,
+        _ => options.points_per_sign.div_ceil(2),
+    };
     let side = |extent: f64, sign: f64| -> Vec<f64> {
-        let n = options.points_per_sign;
+        let n = n_side;
         if !(extent.is_finite() && extent > 0.0) || n == 0 {
             return Vec::new();
         }
@@ -248,38 +237,53 @@ pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
     }
 }
 
-/// The variants of `effect` whose shapes are scanned, each with its shape parameters: the
-/// co-flow's decay length 0.03, 0.1, 0.4 m; the warm air's 0.02, 0.05, 0.2 m; the
-/// effect itself for effects without a shape (or without shape scanning).
-pub fn shape_variants(effect: &Effect, scan_shapes: bool) -> Vec<(Effect, Vec<ShapeParameter>)> {
-    let decay = |v: f64| {
-        vec![ShapeParameter {
-            name: "decay_length".into(),
-            value: v,
-            unit: "m".into(),
-        }]
-    };
-    match effect {
-        Effect::AirCoflow { decay_length } => {
-            if !scan_shapes {
-                return vec![(effect.clone(), decay(*decay_length))];
-            }
-            [0.03, 0.1, 0.4]
-                .iter()
-                .map(|&l| (Effect::AirCoflow { decay_length: l }, decay(l)))
-                .collect()
-        }
-        Effect::AirTemperatureProfile { decay_length } => {
-            if !scan_shapes {
-                return vec![(effect.clone(), decay(*decay_length))];
-            }
-            [0.02, 0.05, 0.2]
-                .iter()
-                .map(|&l| (Effect::AirTemperatureProfile { decay_length: l }, decay(l)))
-                .collect()
-        }
-        e => vec![(e.clone(), Vec::new())],
+/// The variants of `effect` whose shapes are scanned, each with its shape parameters: every
+/// shape parameter the effect fits with its strength ([`Effect::free_shapes`]) is fixed at
+/// two values across its range (lengths `0.4 ×` and `2.5 ×` the default, an onset at 30 % and
+/// 70 % of the spin line of length `length` \[m\]), clamped to its bounds; shapes fixed by the user stay fixed. Without
+/// `scan_shapes`, one variant with the free shapes at their defaults. The refinement frees the
+/// shapes again ([`refine`]).
+pub fn shape_variants(
+    effect: &Effect,
+    scan_shapes: bool,
+    length: f64,
+) -> Vec<(Effect, Vec<ShapeParameter>)> {
+    let mut variants = vec![effect.clone()];
+    for sp in effect.free_shapes() {
+        let (lo, hi) = sp.bounds_for_length(length);
+        let values: Vec<f64> = if !scan_shapes {
+            vec![sp.default]
+        } else if sp.name == "onset" {
+            [0.3, 0.7].iter().map(|f| f * length).collect()
+        } else {
+            [0.4 * sp.default, 2.5 * sp.default].to_vec()
+        };
+        let mut values: Vec<f64> = values.into_iter().map(|v| v.clamp(lo, hi)).collect();
+        values.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-300));
+        variants = variants
+            .into_iter()
+            .flat_map(|v| {
+                values
+                    .iter()
+                    .filter_map(move |&x| v.clone().with_shape(sp.name, x).ok())
+            })
+            .collect();
     }
+    variants
+        .into_iter()
+        .map(|v| {
+            let shape = v
+                .shape_values()
+                .into_iter()
+                .map(|(sp, value)| ShapeParameter {
+                    name: sp.name.to_string(),
+                    value,
+                    unit: sp.unit.to_string(),
+                })
+                .collect();
+            (v, shape)
+        })
+        .collect()
 }
 
 /// What a [`walk_out`] gives: the values reached with their results, and the value where it
@@ -416,6 +420,11 @@ fn fit_warm(
         residual_profiles,
         relative_uncertainty: options.relative_uncertainty.or(rh.relative_uncertainty),
         data_warnings: rh.data_warnings(),
+        // the grid fits and refinements of the search use ordinary least squares
+        loss: crate::least_squares::Loss::Linear,
+        f_scale: f64::NAN,
+        f_scale_source: String::new(),
+        down_weighted: 0,
         solutions,
         fit: fit_result,
         wall_time_s: t0.elapsed().as_secs_f64(),
@@ -451,13 +460,17 @@ pub struct ProfileScan {
     pub starts: Vec<GridStart>,
     /// The user's model with the variant's strength freed (for [`refine`]).
     pub rheometer: Rheometer,
+    /// The candidate as given (the shapes the scan fixed free again), for [`refine`].
+    pub candidate: Effect,
 }
 
 /// Scans the candidate variant `effect` (with shape `shape`, for the report) on the rheometer
 /// `rh` (the user's model; its neutral candidates are dropped) from the user's fit `base`
 /// (`J` = `cost_base`): each side of [`scan_grid`] walked outwards with the strength fixed.
+#[allow(clippy::too_many_arguments)] // the candidate, its variant and its shape describe one job
 pub fn scan_profile(
     rh: &Rheometer,
+    candidate: &Effect,
     effect: &Effect,
     shape: Vec<ShapeParameter>,
     base: &Identification,
@@ -489,7 +502,7 @@ pub fn scan_profile(
             let prev = prev.unwrap_or(&base_point);
             if prev.cost > scan.stop_above * cost_base {
                 return Err(RheometerError::Data(format!(
-                    "not scanned further: J = {:.1} J_base at {}",
+                    "not scanned further: J = {:.1} J_base at {:.4}",
                     prev.cost / cost_base,
                     prev.strength
                 )));
@@ -515,7 +528,7 @@ pub fn scan_profile(
                 "-" => String::new(),
                 u => format!(" {u}"),
             };
-            stopped.push(format!("at {v}{unit}: {e}"));
+            stopped.push(format!("at {v:.4}{unit}: {e}"));
         }
         sides.push(done);
     }
@@ -563,6 +576,7 @@ pub fn scan_profile(
         profile,
         starts,
         rheometer: vrh,
+        candidate: candidate.clone(),
     })
 }
 
@@ -573,13 +587,35 @@ pub fn refine(
     start: &GridStart,
     options: &IdentifyOptions,
 ) -> Result<Refit, RheometerError> {
+    // the shapes the scan fixed are fitted again, started at the variant's values
+    let mut strengths = vec![(scan.effect.name().to_string(), start.strength)];
+    let free = scan.candidate.free_shapes();
+    let fixed_by_scan: Vec<(&'static str, f64)> = scan
+        .effect
+        .shape_values()
+        .into_iter()
+        .filter(|(sp, _)| free.iter().any(|f| f.name == sp.name))
+        .map(|(sp, v)| (sp.model_param, v))
+        .collect();
+    strengths.extend(fixed_by_scan.iter().map(|(n, v)| (n.to_string(), *v)));
+    let freed;
+    let rh = if fixed_by_scan.is_empty() {
+        &scan.rheometer
+    } else {
+        let mut spec = scan.rheometer.spec.clone();
+        if let Some(last) = spec.effects.last_mut() {
+            last.effect = scan.candidate.clone();
+        }
+        freed = rheometer_for(&scan.rheometer, spec)?;
+        &freed
+    };
     let fs = FitStart {
         law: start.law,
         free_candidates: Vec::new(),
-        strengths: vec![(scan.effect.name().to_string(), start.strength)],
+        strengths,
         warm: Some(start.solutions.clone()),
     };
-    let id = fit_warm(&scan.rheometer, &fs, &start.take_up, options, false)?;
+    let id = fit_warm(rh, &fs, &start.take_up, options, false)?;
     let report = FitReport::new(&id);
     Ok(Refit {
         start_strength: start.strength,
@@ -600,7 +636,7 @@ pub fn scan_candidate(
     options: &IdentifyOptions,
     scan: &ScanOptions,
 ) -> Result<CandidateScan, RheometerError> {
-    let ps = scan_profile(rh, effect, shape, base, cost_base, options, scan)?;
+    let ps = scan_profile(rh, effect, effect, shape, base, cost_base, options, scan)?;
     let mut refits: Vec<Refit> = ps
         .starts
         .iter()
@@ -648,9 +684,9 @@ mod tests {
     #[test]
     fn grid_spans_small_and_large_magnitudes_on_both_sides() {
         let e = Effect::AirCoflow {
-            decay_length: DEFAULT_COFLOW_DECAY_LENGTH,
+            decay_length: Some(DEFAULT_COFLOW_DECAY_LENGTH),
         };
-        let (lo, hi) = e.bounds();
+        let (lo, hi) = e.physical_range();
         let o = ScanOptions::default();
         let g = scan_grid(&e, &o);
         assert_eq!(g.below.len(), o.points_per_sign);
@@ -658,8 +694,8 @@ mod tests {
         // outwards, strictly monotone, from 1e-3 of the extent to the bound exactly
         assert!(g.above.windows(2).all(|w| w[1] > w[0]));
         assert!(g.below.windows(2).all(|w| w[1] < w[0]));
-        assert!((g.above[0] - 1e-3 * hi).abs() <= 1e-12 * hi);
-        assert!((g.below[0] - 1e-3 * lo).abs() <= 1e-12 * lo.abs());
+        assert!((g.above[0] - o.smallest_relative * hi).abs() <= 1e-12 * hi);
+        assert!((g.below[0] - o.smallest_relative * lo).abs() <= 1e-12 * lo.abs());
         assert_eq!(*g.above.last().unwrap(), hi);
         assert_eq!(*g.below.last().unwrap(), lo);
         // geometric: constant ratio
@@ -712,8 +748,9 @@ mod tests {
         assert!(e.contains("radiation") && e.contains("> 1") && e.contains("not physical"));
         assert!(physical(&Effect::Radiation, -0.2).is_err());
         assert!(physical(&Effect::Radiation, f64::NAN).is_err());
-        let c = Effect::AirCoflow { decay_length: 0.1 };
+        let c = Effect::AirCoflow { decay_length: None };
         assert!(physical(&c, 5.0).is_ok());
+        assert!(physical(&c, 150.0).is_ok(), "aspirator speeds are physical");
         assert!(physical(&c, 1e3).unwrap_err().contains("m/s"));
     }
 
@@ -730,21 +767,47 @@ mod tests {
 
     #[test]
     fn shapes_are_scanned_as_variants() {
-        let v = shape_variants(&Effect::AirCoflow { decay_length: 0.1 }, true);
-        assert!(v.len() >= 3);
-        assert!(v.iter().any(|(_, s)| s[0].value <= 0.03));
-        assert!(v.iter().any(|(_, s)| s[0].value >= 0.4));
+        let v = shape_variants(&Effect::AirCoflow { decay_length: None }, true, 0.5);
+        assert_eq!(v.len(), 2);
+        assert!(v.iter().any(|(_, s)| s[0].value <= 0.04));
+        assert!(v.iter().any(|(_, s)| s[0].value >= 0.25));
         for (e, s) in &v {
             match e {
-                Effect::AirCoflow { decay_length } => assert_eq!(*decay_length, s[0].value),
+                Effect::AirCoflow { decay_length } => assert_eq!(*decay_length, Some(s[0].value)),
                 _ => panic!("not a co-flow"),
             }
         }
-        assert_eq!(shape_variants(&Effect::Radiation, true).len(), 1);
+        // a shape fixed by the user is not scanned
+        let fixed = shape_variants(
+            &Effect::AirCoflow {
+                decay_length: Some(0.2),
+            },
+            true,
+            0.5,
+        );
+        assert_eq!(fixed.len(), 1);
+        assert_eq!(fixed[0].1[0].value, 0.2);
+        assert_eq!(shape_variants(&Effect::Radiation, true, 0.5).len(), 1);
+        // the onset of the line co-flow across the line (its ramp width is not fitted)
+        let line = shape_variants(
+            &Effect::AirCoflowLine {
+                onset: None,
+                ramp_width: None,
+            },
+            true,
+            0.5,
+        );
+        let onsets: Vec<f64> = line.iter().map(|(_, s)| s[0].value).collect();
+        assert_eq!(onsets, vec![0.3 * 0.5, 0.7 * 0.5]);
         assert_eq!(
-            shape_variants(&Effect::AirTemperatureProfile { decay_length: 0.2 }, false)[0].1[0]
+            shape_variants(
+                &Effect::AirTemperatureProfile { decay_length: None },
+                false,
+                0.5
+            )[0]
+            .1[0]
                 .value,
-            0.2
+            crate::fiber::effects::DEFAULT_WARM_AIR_DECAY_LENGTH
         );
     }
 }
