@@ -313,7 +313,10 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
     let status = |k: &str| entry(&b, k).status;
     assert_eq!(status("inlet_diameter_rel"), SourceStatus::Effect);
     assert_eq!(status("inlet_velocity_rel"), SourceStatus::NotApplicable);
-    assert_eq!(status("gauge_scale_rel"), SourceStatus::MeasurementModel);
+    assert_eq!(status("gauge_scale_rel"), SourceStatus::Effect);
+    assert_eq!(status("gauge_offset_um"), SourceStatus::Effect);
+    assert_eq!(status("inlet_temperature_K"), SourceStatus::Effect);
+    assert_eq!(status("mass_flow_rel"), SourceStatus::Effect);
     for e in &b.sources {
         assert_eq!(e.status.has_numbers(), e.dkappa_dq.is_some(), "{}", e.key);
         if !e.status.has_numbers() {
@@ -336,18 +339,35 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
     let stat_k = b.statistical_kappa.unwrap();
     assert!((b.total_kappa.unwrap() - sys_k.hypot(stat_k)).abs() <= 1e-12 * sys_k);
     assert_eq!(b.systematic_k_rel, b.systematic_kappa);
-    // a common source's shift is |Σ_k s_k σ_k|, its sensitivity Σ_k s_k
+    // a common source's shift is |Σ_k s_k σ_k|, its sensitivity Σ_k s_k; a per-experiment
+    // source's shift is √Σ_k (s_k σ_k)²
     for e in b.available() {
-        assert_eq!(e.scope, Scope::Common, "{}", e.key);
-        let sum: f64 = e.by_experiment.iter().map(|x| x.dkappa_dq.unwrap()).sum();
-        let shift: f64 = e
-            .by_experiment
-            .iter()
-            .map(|x| x.sigma * x.dkappa_dq.unwrap())
-            .sum();
-        assert!((e.dkappa_dq.unwrap() - sum).abs() <= 1e-12 * sum.abs());
-        assert!((e.shift_kappa.unwrap() - shift.abs()).abs() <= 1e-12 * shift.abs());
         assert_eq!(e.by_experiment.len(), 9);
+        match e.scope {
+            Scope::Common => {
+                let sum: f64 = e.by_experiment.iter().map(|x| x.dkappa_dq.unwrap()).sum();
+                let shift: f64 = e
+                    .by_experiment
+                    .iter()
+                    .map(|x| x.sigma * x.dkappa_dq.unwrap())
+                    .sum();
+                assert!((e.dkappa_dq.unwrap() - sum).abs() <= 1e-12 * sum.abs());
+                assert!((e.shift_kappa.unwrap() - shift.abs()).abs() <= 1e-12 * shift.abs());
+            }
+            Scope::PerExperiment => {
+                let shift: f64 = e
+                    .by_experiment
+                    .iter()
+                    .map(|x| (x.sigma * x.dkappa_dq.unwrap()).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                assert!(
+                    (e.shift_kappa.unwrap() - shift).abs() <= 1e-12 * shift,
+                    "{}",
+                    e.key
+                );
+            }
+        }
     }
     // the statistical error is the fit report's
     let rep = FitReport::new(&id);
@@ -390,7 +410,7 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
                 "uncertainty of the inlet diameter (declared)",
                 "would shift kappa by",
                 "times its statistical uncertainty: the data cannot tell",
-                "inlet_velocity",
+                "inlet_diameter",
             ] {
                 assert!(m.contains(needle), "{needle:?} not in {m}");
             }
@@ -406,15 +426,15 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
 fn effects_in_the_model_are_used_or_reported_fitted() {
     let loaded = shipped();
     let opts = IdentifyOptions::default();
-    // inlet_velocity fitted: the inlet diameter's error is estimated by the fit
-    let spec = ModelSpec::default().with(EffectSetting::fitted(Effect::InletVelocity));
+    // inlet_diameter fitted: the inlet diameter's error is estimated by the fit
+    let spec = ModelSpec::default().with(EffectSetting::fitted(Effect::InletDiameter));
     let rh = Rheometer::with_spec(&loaded.set, spec).unwrap();
     let id = rh.identify([0.8, 11.7], &opts).unwrap();
     let b = error_budget(&rh, &id, &Uncertainties::defaults(), &opts).unwrap();
     assert_eq!(entry(&b, "inlet_diameter_rel").status, SourceStatus::Fitted);
-    assert!(b.to_text().contains("inlet_velocity is fitted"));
+    assert!(b.to_text().contains("inlet_diameter is fitted"));
     // fixed at its neutral value: the same sensitivities as without it
-    let spec = ModelSpec::default().with(EffectSetting::fixed(Effect::InletVelocity, 0.0));
+    let spec = ModelSpec::default().with(EffectSetting::fixed(Effect::InletDiameter, 0.0));
     let rh2 = Rheometer::with_spec(&loaded.set, spec).unwrap();
     let id2 = rh2.identify([0.8, 11.7], &opts).unwrap();
     let b2 = error_budget(&rh2, &id2, &Uncertainties::defaults(), &opts).unwrap();
@@ -453,7 +473,8 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
         " per % of inlet diameter",
         " per µm of diameter gauge offset",
         "n shifts by ",
-        "inlet_temperature_K   2.00 K (default)   not available (no effect die_temperature_offset",
+        "inlet_temperature_K   2.00 K (default)   ",
+        " per K of inlet (die) temperature",
         "kappa: systematic ",
     ] {
         assert!(p.stdout.contains(needle), "{needle:?} not in\n{}", p.stdout);
@@ -481,13 +502,18 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
     assert_eq!(d["origin"], "default");
     assert_eq!(d["status"], "effect");
     assert_eq!(d["scope"], "common");
-    assert_eq!(d["effect"], "inlet_velocity");
+    assert_eq!(d["effect"], "inlet_diameter");
     for key in ["sigma", "dn_dq", "dkappa_dq", "shift_n", "shift_kappa"] {
         assert!(d[key].is_number(), "{key} in {d}");
     }
     let t = get("inlet_temperature_K");
-    assert_eq!(t["status"], "not_available");
-    assert!(t["dkappa_dq"].is_null() && t["shift_kappa"].is_null());
+    assert_eq!(t["status"], "effect");
+    assert_eq!(t["effect"], "die_temperature_offset");
+    assert!(t["dkappa_dq"].is_number() && t["shift_kappa"].is_number());
+    // the VFT sources have no effect parameter yet
+    let vft = get("vft_B_K");
+    assert_eq!(vft["status"], "not_available");
+    assert!(vft["dkappa_dq"].is_null() && vft["shift_kappa"].is_null());
     // each warning of the budget names a source whose shift exceeds the statistical error
     let stat = b["statistical_kappa"].as_f64().unwrap();
     let stat_n = b["statistical_n"].as_f64().unwrap();

@@ -11,7 +11,7 @@
 //! |---|---|---|---|---|
 //! | `inlet_temperature_K` | K | 2 K | common | `die_temperature_offset` (1 K/K) |
 //! | `mass_flow_rel` | - | 0.01 | per experiment | `mass_flow_scale` (1 per unit) |
-//! | `inlet_diameter_rel` | - | 0.02 | common | `inlet_velocity` (−2: `u_in ∝ d_in⁻²`) |
+//! | `inlet_diameter_rel` | - | 0.02 | common | `inlet_diameter` (1; experiments that give `d_in`) |
 //! | `inlet_velocity_rel` | - | 0.04 | common | `inlet_velocity` (1) |
 //! | `gauge_scale_rel` | - | 0.01 | common | `gauge_scale` (1), else the measurement model |
 //! | `gauge_offset_um` | µm | 1 µm | common | `gauge_offset` (1 µm/µm), else the measurement model |
@@ -99,9 +99,10 @@ fn one(_: &Experiment) -> Option<f64> {
     Some(1.0)
 }
 
-/// `u_in = 4Q/(πρ d_in²)`: a relative error `a` of `d_in` is a relative error `−2a` of `u_in`.
+/// The effect `inlet_diameter` is the relative error of `d_in` itself (at the same mass flow;
+/// `u_in = 4Q/(πρ d_in²)` follows): it applies where the experiment gives `d_in`.
 fn from_inlet_diameter(e: &Experiment) -> Option<f64> {
-    matches!(e.inlet, Inlet::Diameter(_)).then_some(-2.0)
+    matches!(e.inlet, Inlet::Diameter(_)).then_some(1.0)
 }
 
 fn from_inlet_velocity(e: &Experiment) -> Option<f64> {
@@ -145,10 +146,10 @@ pub const SOURCES: &[Source] = &[
         default: 0.02,
         max: 0.5,
         scope: Scope::Common,
-        effect: "inlet_velocity",
+        effect: "inlet_diameter",
         per_unit: from_inlet_diameter,
         fallback: None,
-        remedy: "measure the swollen strand below the die or add inlet_velocity to the fit",
+        remedy: "measure the swollen strand below the die or add inlet_diameter to the fit",
     },
     Source {
         key: "inlet_velocity_rel",

@@ -49,6 +49,10 @@ pub struct ScanOptions {
     /// Further grid points of a candidate are refined only if their `J` is within this
     /// fraction of its lowest grid point's (default 0.05).
     pub refine_within: f64,
+    /// BVP tolerance of the grid points' solves (default 1e-4, looser than a fit's 1e-6: a
+    /// profile value needs the diameters to ~1e-5, far below the measurement noise; the
+    /// refinements solve at the fit's tolerance).
+    pub grid_tol: f64,
     /// A side's walk ends once a point's `J` exceeds this multiple of the user's `J`
     /// (default 20: far from any useful fit, and the fits there are the expensive ones).
     pub stop_above: f64,
@@ -63,6 +67,7 @@ impl Default for ScanOptions {
             inner_max_iterations: 3,
             scan_shapes: true,
             stop_above: 20.0,
+            grid_tol: 1e-4,
             refine_within: 0.05,
         }
     }
@@ -239,8 +244,8 @@ pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
 
 /// The variants of `effect` whose shapes are scanned, each with its shape parameters: every
 /// shape parameter the effect fits with its strength ([`Effect::free_shapes`]) is fixed at
-/// two values across its range (lengths `0.4 ×` and `2.5 ×` the default, an onset at 30 % and
-/// 70 % of the spin line of length `length` \[m\]), clamped to its bounds; shapes fixed by the user stay fixed. Without
+/// three values across its range (lengths `0.4 ×`, `1 ×` and `2.5 ×` the default, an onset at
+/// 30 %, 50 % and 70 % of the spin line of length `length` \[m\]), clamped to its bounds; shapes fixed by the user stay fixed. Without
 /// `scan_shapes`, one variant with the free shapes at their defaults. The refinement frees the
 /// shapes again ([`refine`]).
 pub fn shape_variants(
@@ -254,9 +259,9 @@ pub fn shape_variants(
         let values: Vec<f64> = if !scan_shapes {
             vec![sp.default]
         } else if sp.name == "onset" {
-            [0.3, 0.7].iter().map(|f| f * length).collect()
+            [0.3, 0.5, 0.7].iter().map(|f| f * length).collect()
         } else {
-            [0.4 * sp.default, 2.5 * sp.default].to_vec()
+            [0.4 * sp.default, sp.default, 2.5 * sp.default].to_vec()
         };
         let mut values: Vec<f64> = values.into_iter().map(|v| v.clamp(lo, hi)).collect();
         values.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-300));
@@ -487,6 +492,7 @@ pub fn scan_profile(
     let grid = scan_grid(effect, scan);
     let mut inner = options.clone();
     inner.max_iterations = scan.inner_max_iterations.max(1);
+    inner.simulate.tol = scan.grid_tol.max(options.simulate.tol);
     let base_point = GridStart {
         strength: grid.neutral,
         law: [base.n, base.kappa],
@@ -713,8 +719,12 @@ mod tests {
             points_per_sign: 1,
             ..ScanOptions::default()
         };
+        // radiation: the grid stays in the physical range [0, 1] (the search range is wider)
         let g = scan_grid(&Effect::Radiation, &one);
-        assert_eq!((g.below.clone(), g.above.clone()), (vec![-1.0], vec![2.0]));
+        assert_eq!(
+            (g.below.clone(), g.above.clone()),
+            (Vec::<f64>::new(), vec![1.0])
+        );
     }
 
     #[test]
@@ -768,8 +778,8 @@ mod tests {
     #[test]
     fn shapes_are_scanned_as_variants() {
         let v = shape_variants(&Effect::AirCoflow { decay_length: None }, true, 0.5);
-        assert_eq!(v.len(), 2);
-        assert!(v.iter().any(|(_, s)| s[0].value <= 0.04));
+        assert_eq!(v.len(), 3);
+        assert!(v.iter().any(|(_, s)| s[0].value <= 0.041));
         assert!(v.iter().any(|(_, s)| s[0].value >= 0.25));
         for (e, s) in &v {
             match e {
@@ -798,7 +808,7 @@ mod tests {
             0.5,
         );
         let onsets: Vec<f64> = line.iter().map(|(_, s)| s[0].value).collect();
-        assert_eq!(onsets, vec![0.3 * 0.5, 0.7 * 0.5]);
+        assert_eq!(onsets, vec![0.3 * 0.5, 0.5 * 0.5, 0.7 * 0.5]);
         assert_eq!(
             shape_variants(
                 &Effect::AirTemperatureProfile { decay_length: None },

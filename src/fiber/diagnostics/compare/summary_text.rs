@@ -77,7 +77,7 @@ impl Comparison {
         );
         let _ = writeln!(
             s,
-            "RMS/noise = {:.2} (RMS {:.2} % vs local noise RMS {:.2} % over the same {} points,              outliers left out); robust RMS/noise = {:.2}",
+            "RMS/noise = {:.2} (RMS {:.2} % vs local noise RMS {:.2} % over the same {} points, outliers left out); robust RMS/noise = {:.2}",
             nm.rms_over_noise,
             pct(nm.rms),
             pct(nm.noise_rms),
@@ -94,14 +94,14 @@ impl Comparison {
         }
         let _ = writeln!(
             s,
-            "OUTLIERS: {} points deviate from their neighbours' robust line by more than {} local              sigma (left out of chi2, RMS/noise and lag-1):",
+            "OUTLIERS: {} points deviate from their neighbours' robust line by more than {} local sigma (left out of chi2, RMS/noise and lag-1):",
             nm.outliers.len(),
             nm.options.outlier_threshold
         );
         for o in nm.outliers.iter().take(MAX_LISTED_OUTLIERS) {
             let _ = writeln!(
                 s,
-                "  - {} at s = {:.3} m: measured {:.2} um, model {:.2} um, residual {:+.1} %                  ({:+.1} sigma)",
+                "  - {} at s = {:.3} m: measured {:.2} um, model {:.2} um, residual {:+.1} % ({:+.1} sigma)",
                 o.experiment,
                 o.position_m,
                 1e6 * o.d_meas_m,
