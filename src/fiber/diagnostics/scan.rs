@@ -20,8 +20,6 @@
 //!   [`physical_range`] and [`shape_variants`].
 
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
-use crate::fiber::material_law::CarreauLike;
-use crate::fiber::model::FiberModel;
 use crate::fiber::rheometer::{
     Estimator, FitReport, FitStart, Identification, IdentifyOptions, Rheometer, RheometerError,
 };
@@ -314,36 +312,9 @@ pub fn walk_out<T, E>(
     (done, None)
 }
 
-/// A rheometer for `spec` on the data and models of `rh` (no new smoothing): the models are
-/// rebuilt with the physics of `spec`.
+/// A rheometer for `spec` on the data of `rh` ([`Rheometer::respecified`]).
 fn rheometer_for(rh: &Rheometer, spec: ModelSpec) -> Result<Rheometer, RheometerError> {
-    spec.validate().map_err(RheometerError::Data)?;
-    let models = rh
-        .experiments
-        .iter()
-        .map(|e| {
-            spec.physics()
-                .and_then(|physics| {
-                    FiberModel::new(&rh.material, &rh.air, e, CarreauLike::new(), physics)
-                })
-                .map_err(|source| RheometerError::Simulation {
-                    experiment: e.name.clone(),
-                    n: f64::NAN,
-                    kappa: f64::NAN,
-                    source,
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(Rheometer {
-        material: rh.material.clone(),
-        air: rh.air.clone(),
-        experiments: rh.experiments.clone(),
-        measurements: rh.measurements.clone(),
-        smoothing: rh.smoothing.clone(),
-        models,
-        relative_uncertainty: rh.relative_uncertainty,
-        spec,
-    })
+    rh.respecified(spec)
 }
 
 /// Relative cost change, step and scaled gradient at which a grid point's fit stops (its `J`

@@ -95,6 +95,38 @@ impl Rheometer {
         })
     }
 
+    /// The same data, experiments and smoothing (no new smoothing, take-up conditions as
+    /// resolved) with the models rebuilt for `spec` (e.g. a candidate effect added or fixed).
+    pub fn respecified(&self, spec: ModelSpec) -> Result<Rheometer, RheometerError> {
+        spec.validate().map_err(RheometerError::Data)?;
+        let models = self
+            .experiments
+            .iter()
+            .map(|e| {
+                spec.physics()
+                    .and_then(|physics| {
+                        FiberModel::new(&self.material, &self.air, e, CarreauLike::new(), physics)
+                    })
+                    .map_err(|source| RheometerError::Simulation {
+                        experiment: e.name.clone(),
+                        n: f64::NAN,
+                        kappa: f64::NAN,
+                        source,
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Rheometer {
+            material: self.material.clone(),
+            air: self.air.clone(),
+            experiments: self.experiments.clone(),
+            measurements: self.measurements.clone(),
+            smoothing: self.smoothing.clone(),
+            models,
+            relative_uncertainty: self.relative_uncertainty,
+            spec,
+        })
+    }
+
     /// Number of experiments.
     pub fn len(&self) -> usize {
         self.models.len()

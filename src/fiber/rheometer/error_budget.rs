@@ -29,8 +29,6 @@ use super::identify::Identification;
 use super::layout::FitStart;
 use super::options::{FitWarning, IdentifyOptions, RheometerError, WarningCode};
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
-use crate::fiber::material_law::CarreauLike;
-use crate::fiber::model::FiberModel;
 use crate::fiber::uncertainty::{GaugeColumn, Origin, Scope, Source, Uncertainties, SOURCES};
 use crate::least_squares::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector};
@@ -415,32 +413,17 @@ fn effect_columns(
     strengths: Vec<(String, f64)>,
     options: &IdentifyOptions,
 ) -> Result<(Vec<f64>, usize, Vec<String>), RheometerError> {
-    let models = rh
-        .experiments
-        .iter()
-        .map(|e| {
-            spec.physics()
-                .and_then(|physics| {
-                    FiberModel::new(&rh.material, &rh.air, e, CarreauLike::new(), physics)
-                })
-                .map_err(|source| RheometerError::Simulation {
-                    experiment: e.name.clone(),
-                    n: id.n,
-                    kappa: id.kappa,
-                    source,
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let aug = Rheometer {
-        material: rh.material.clone(),
-        air: rh.air.clone(),
-        experiments: rh.experiments.clone(),
-        measurements: rh.measurements.clone(),
-        smoothing: rh.smoothing.clone(),
-        models,
-        relative_uncertainty: rh.relative_uncertainty,
-        spec,
-    };
+    let aug = rh.respecified(spec).map_err(|e| match e {
+        RheometerError::Simulation {
+            experiment, source, ..
+        } => RheometerError::Simulation {
+            experiment,
+            n: id.n,
+            kappa: id.kappa,
+            source,
+        },
+        other => other,
+    })?;
     let mut opts = options.clone();
     opts.estimator = id.estimator;
     opts.relative_uncertainty = id.relative_uncertainty;
