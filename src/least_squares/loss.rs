@@ -17,15 +17,18 @@
 //!
 //! `Loss::Linear` leaves residuals and Jacobian untouched (bit for bit the plain driver).
 
-use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// Floor of the Gauss–Newton weight `ρ' + 2ρ''z` (scipy's `EPS`).
 const WEIGHT_FLOOR: f64 = f64::EPSILON;
 
 /// The loss `ρ(z)` of the residuals (see the module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "rheometer",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum Loss {
     /// `ρ(z) = z`: ordinary least squares.
     #[default]
