@@ -3,7 +3,7 @@
 //! the model effect whose strength represents it ([`SOURCES`]).
 //!
 //! The data cannot identify these quantities; the
-//! [error budget](crate::fiber::rheometer::error_budget) propagates their uncertainties through
+//! [error budget](crate::fiber::rheometer::error_budget()) propagates their uncertainties through
 //! the exact sensitivities into `(n, κ, K)` as a systematic uncertainty beside the statistical
 //! one.
 //!

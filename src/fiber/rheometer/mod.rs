@@ -14,7 +14,7 @@
 //!   warm-started, exact Jacobians from forward sensitivities);
 //! * [`layout`]: which parameters are fitted (law, effect strengths, take-up factors);
 //! * [`landscape`]: the cost on a grid (paper Fig. 4);
-//! * [`error_budget`]: what the data cannot identify (process conditions, instrument,
+//! * [`error_budget()`]: what the data cannot identify (process conditions, instrument,
 //!   material data) propagated through exact sensitivities into a systematic uncertainty;
 //! * [`report`]: uncertainty (standard errors, 95% confidence intervals, correlation), the checks
 //!   of a fit (estimates at bounds, misfit, huge errors, data the model cannot describe) and the

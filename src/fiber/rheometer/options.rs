@@ -126,7 +126,7 @@ pub enum WarningCode {
     DataTrend,
     /// A declared (or default) uncertainty of what the data cannot identify (process
     /// conditions, instrument, material data) shifts an estimate by more than its statistical
-    /// standard error (see [`error_budget`](super::error_budget)).
+    /// standard error (see [`error_budget`](super::error_budget())).
     Systematic,
 }
 
