@@ -106,7 +106,7 @@ pub mod sensitivity;
 pub mod solution;
 pub mod solve;
 pub use error::BvpError;
-pub use linear::Factorization;
+pub use linear::{Factorization, LinearSolverKind};
 pub use num_dual::DualNum;
 pub use problem::Bvp;
 pub use solution::{Solution, SolveStats};

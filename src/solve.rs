@@ -5,7 +5,7 @@
 use crate::collocation::Collocation;
 use crate::error::BvpError;
 use crate::error_control::rms_residuals;
-use crate::linear::{LinearSystem, Pattern};
+use crate::linear::{LinearSolverKind, LinearSystem, Pattern};
 use crate::mesh;
 use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork};
 use crate::problem::Bvp;
@@ -56,6 +56,9 @@ pub struct SolveOptions {
     pub factor_at_solution: bool,
     /// Progress on stderr: 0 silent (default), 1 one line per mesh, 2 also Newton iterations.
     pub verbose: u8,
+    /// Linear solver for the Newton matrix (default [`LinearSolverKind::Auto`]: structured
+    /// elimination for separated boundary conditions, faer's sparse LU otherwise).
+    pub linear_solver: LinearSolverKind,
 }
 
 impl Default for SolveOptions {
@@ -73,6 +76,7 @@ impl Default for SolveOptions {
             newton_step_tol: None,
             factor_at_solution: true,
             verbose: 0,
+            linear_solver: LinearSolverKind::Auto,
         }
     }
 }
@@ -394,7 +398,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
             let m = x.len();
             self.col.set_mesh(&x);
             let pattern = self.pattern(m)?;
-            let mut lin = LinearSystem::new(pattern);
+            let mut lin = LinearSystem::with_kind(pattern, opts.linear_solver);
             let scale = self.scale_for(&y, &opts.scale);
             let report = newton(
                 problem,

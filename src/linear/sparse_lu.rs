@@ -1,5 +1,7 @@
-//! The global Newton matrix: its sparsity pattern (built once per mesh from index arithmetic),
-//! assembly from the collocation blocks, and faer's sparse LU.
+//! The general fallback: the Newton matrix's sparsity pattern (built once per mesh from index
+//! arithmetic), assembly from the collocation blocks, and faer's sparse LU. Used for
+//! non-separated boundary conditions, many unknown parameters, or on request
+//! ([`LinearSolverKind::SparseLu`](super::LinearSolverKind::SparseLu)).
 //!
 //! The factorisation is faer's simplicial (left-looking, Gilbert–Peierls) sparse LU with partial
 //! pivoting, applied in the natural block order of the unknowns. That order is already a good
@@ -71,7 +73,7 @@ impl Pattern {
         })
     }
 
-    fn size(&self) -> usize {
+    pub(crate) fn size(&self) -> usize {
         self.m * self.n + self.k
     }
 
@@ -121,55 +123,20 @@ impl Pattern {
     }
 }
 
-/// A numeric LU factorisation of the collocation Jacobian, with everything needed to solve with
-/// it or its transpose again later (sensitivities, adjoints).
+/// A numeric sparse LU factorisation with everything needed to solve with it or its transpose.
 #[derive(Clone)]
-pub struct Factorization {
-    pattern: Arc<Pattern>,
+pub(crate) struct SparseFactor {
+    pub pattern: Arc<Pattern>,
     lu: SimplicialLu<usize, f64>,
     row_perm: Vec<usize>,
     row_perm_inv: Vec<usize>,
 }
 
-impl std::fmt::Debug for Factorization {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "Factorization {{ size: {}, nnz: {} }}",
-            self.size(),
-            self.pattern.nnz()
-        )
-    }
-}
-
-impl Factorization {
-    /// Dimension of the factored system.
-    pub fn size(&self) -> usize {
-        self.pattern.size()
-    }
-
-    /// Solves `J x = b` in place for the columns of `b` (column-major, `size × ncols`).
-    /// Errors if `b` does not hold `size × ncols` values.
-    pub fn solve_in_place(&self, b: &mut [f64], ncols: usize) -> Result<(), BvpError> {
-        self.solve_impl(b, ncols, false)
-    }
-
-    /// Solves `Jᵀ x = b` in place (adjoints). Errors if `b` does not hold `size × ncols`
-    /// values.
-    pub fn solve_transpose_in_place(&self, b: &mut [f64], ncols: usize) -> Result<(), BvpError> {
-        self.solve_impl(b, ncols, true)
-    }
-
-    fn solve_impl(&self, b: &mut [f64], ncols: usize, transpose: bool) -> Result<(), BvpError> {
-        let size = self.size();
-        if b.len() != size * ncols {
-            return Err(BvpError::InvalidInput(format!(
-                "right-hand side of {} values for a {size} × {size} system with {ncols} column(s) \
-                 (expected {})",
-                b.len(),
-                size * ncols
-            )));
-        }
+impl SparseFactor {
+    /// Solves `J x = b` or `Jᵀ x = b` in place (`b` column-major, `size × ncols`, checked by the
+    /// caller).
+    pub(crate) fn solve(&self, b: &mut [f64], ncols: usize, transpose: bool) {
+        let size = self.pattern.size();
         let mut buf = MemBuffer::new(solve_in_place_scratch::<usize, f64>(size, ncols, Par::Seq));
         let stack = MemStack::new(&mut buf);
         let rp = PermRef::new_checked(&self.row_perm, &self.row_perm_inv, size);
@@ -182,14 +149,12 @@ impl Factorization {
             self.lu
                 .solve_in_place_with_conj(rp, cp, Conj::No, rhs, Par::Seq, stack);
         }
-        Ok(())
     }
 }
 
-/// Newton-matrix workspace for one mesh: values, numeric LU and scratch, reused across
-/// iterations.
-pub(crate) struct LinearSystem {
-    pub pattern: Arc<Pattern>,
+/// Sparse-LU workspace for one mesh: values, numeric LU and scratch, reused across iterations.
+pub(crate) struct SparseLu {
+    pattern: Arc<Pattern>,
     values: Vec<f64>,
     work: Vec<f64>,
     lu: SimplicialLu<usize, f64>,
@@ -197,18 +162,16 @@ pub(crate) struct LinearSystem {
     row_perm_inv: Vec<usize>,
     factor_buf: MemBuffer,
     solve_buf: MemBuffer,
-    /// Number of numeric factorisations done.
-    pub factorizations: usize,
 }
 
-impl LinearSystem {
+impl SparseLu {
     pub(crate) fn new(pattern: Arc<Pattern>) -> Self {
         let size = pattern.size();
         let factor_buf = MemBuffer::new(factorize_simplicial_numeric_lu_scratch::<usize, f64>(
             size, size,
         ));
         let solve_buf = MemBuffer::new(solve_in_place_scratch::<usize, f64>(size, 1, Par::Seq));
-        LinearSystem {
+        SparseLu {
             pattern,
             values: Vec::new(),
             work: Vec::new(),
@@ -217,7 +180,6 @@ impl LinearSystem {
             row_perm_inv: vec![0; size],
             factor_buf,
             solve_buf,
-            factorizations: 0,
         }
     }
 
@@ -226,7 +188,6 @@ impl LinearSystem {
         self.pattern.assemble(col, &mut self.values, &mut self.work);
         let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.values);
         let stack = MemStack::new(&mut self.factor_buf);
-        self.factorizations += 1;
         factorize_simplicial_numeric_lu(
             &mut self.row_perm,
             &mut self.row_perm_inv,
@@ -240,7 +201,7 @@ impl LinearSystem {
         })
     }
 
-    /// Solves `J x = b` in place with the current factorisation.
+    /// Solves `J x = b` in place with the current factorisation (one column).
     pub(crate) fn solve(&mut self, b: &mut [f64]) {
         let size = b.len();
         let stack = MemStack::new(&mut self.solve_buf);
@@ -256,8 +217,8 @@ impl LinearSystem {
     }
 
     /// A copy of the current factorisation for later solves.
-    pub(crate) fn snapshot(&self) -> Factorization {
-        Factorization {
+    pub(crate) fn snapshot(&self) -> SparseFactor {
+        SparseFactor {
             pattern: self.pattern.clone(),
             lu: self.lu.clone(),
             row_perm: self.row_perm.clone(),
