@@ -184,7 +184,10 @@ fn assert_agree<P: Bvp>(name: &str, problem: &P, a: &Solution, b: &Solution) {
     let w: Vec<f64> = xs.iter().map(|x| 1.0 + 0.1 * x).collect();
     let (va, ga) = adjoint_gradient(problem, a, &xs, &w, &Observe).expect("adjoint");
     let (vb, gb) = adjoint_gradient(problem, b, &xs, &w, &Observe).expect("adjoint");
-    assert!((va - vb).abs() <= AGREE * va.abs().max(1e-300), "{name}: functional");
+    assert!(
+        (va - vb).abs() <= AGREE * va.abs().max(1e-300),
+        "{name}: functional"
+    );
     let e = rel_diff(&gb, &ga);
     assert!(e <= AGREE, "{name}: adjoint gradients differ by {e:e}");
 }
@@ -204,8 +207,7 @@ fn check<P: Bvp>(
             factor_at_solution: true,
             ..base.clone()
         };
-        solve(problem, params, guess, &opts)
-            .unwrap_or_else(|e| panic!("{name} with {kind:?}: {e}"))
+        solve(problem, params, guess, &opts).unwrap_or_else(|e| panic!("{name} with {kind:?}: {e}"))
     };
     let sparse = run(LinearSolverKind::SparseLu);
     let structured = run(LinearSolverKind::Structured);
