@@ -62,8 +62,8 @@ pub fn discrete_system<P: Bvp>(
     let mut work = Vec::new();
     pattern.assemble(&col, &mut values, &mut work);
     let mut jacobian = vec![0.0; size * size];
-    let cp = pattern.symbolic.col_ptr();
-    let ri = pattern.symbolic.row_idx();
+    let cp = pattern.symbolic().col_ptr();
+    let ri = pattern.symbolic().row_idx();
     for c in 0..size {
         for idx in cp[c]..cp[c + 1] {
             jacobian[ri[idx] * size + c] = values[idx];

@@ -141,8 +141,7 @@ fn eliminate(
                 p = r;
             }
         }
-        // `!(best > 0)` also catches NaN
-        if !(best > 0.0) {
+        if best.is_nan() || best <= 0.0 {
             return Err(j);
         }
         piv[j] = p;

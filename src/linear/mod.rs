@@ -49,7 +49,7 @@ pub enum LinearSolverKind {
 #[derive(Clone)]
 enum Inner {
     Sparse(SparseFactor),
-    Structured(Box<BlockLu>),
+    Structured(BlockLu),
 }
 
 /// A numeric LU factorisation of the collocation Jacobian, with everything needed to solve with
@@ -311,7 +311,7 @@ impl LinearSystem {
         let size = self.pattern.size();
         let inner = match (self.active, self.sparse.as_ref()) {
             (Active::Sparse, Some(s)) => Inner::Sparse(s.snapshot()),
-            _ => Inner::Structured(Box::new(self.block.clone())),
+            _ => Inner::Structured(self.block.clone()),
         };
         Factorization { size, inner }
     }

@@ -8,7 +8,7 @@
 //! elimination order for this block-bidiagonal matrix (fill stays within the bandwidth plus the
 //! `n + k` boundary rows and the parameter columns), so no fill-reducing analysis (COLAMD) is run:
 //! profiling showed COLAMD and the symbolic analysis at ~20% of a solve. The pattern and the
-//! (identity) column permutation are built once per mesh and reused for every numeric
+//! (identity) column permutation are built once per mesh (on first use) and reused for every numeric
 //! factorisation; the factor storage and scratch are reused across Newton iterations.
 //!
 //! Rows: `(m-1) n` collocation rows (interval by interval), then `n + k` boundary rows.
@@ -26,51 +26,76 @@ use faer::sparse::linalg::lu::simplicial::{
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
-/// Sparsity pattern of the collocation Jacobian for one `(n, k, m)`, with the column order.
+/// Dimensions of the collocation Jacobian for one `(n, k, m)`, with its sparsity pattern and
+/// column order for the sparse LU (built on first use: the structured elimination needs
+/// neither).
 pub(crate) struct Pattern {
     pub n: usize,
     pub k: usize,
     pub m: usize,
-    pub symbolic: SymbolicSparseColMat<usize>,
+    sparse: OnceLock<SparseStructure>,
+}
+
+struct SparseStructure {
+    symbolic: SymbolicSparseColMat<usize>,
     /// Identity column permutation (natural block order).
     identity: Vec<usize>,
 }
 
 impl Pattern {
     pub(crate) fn new(n: usize, k: usize, m: usize) -> Result<Self, BvpError> {
-        let size = m * n + k;
-        let nb = n + k;
-        let mut col_ptr = Vec::with_capacity(size + 1);
-        let mut row_idx = Vec::new();
-        col_ptr.push(0usize);
-        for i in 0..m {
-            for _c in 0..n {
-                if i >= 1 {
-                    row_idx.extend((i - 1) * n..i * n);
-                }
-                if i + 1 < m {
-                    row_idx.extend(i * n..(i + 1) * n);
-                }
-                if i == 0 || i == m - 1 {
-                    row_idx.extend((m - 1) * n..(m - 1) * n + nb);
-                }
-                col_ptr.push(row_idx.len());
-            }
+        if m < 2 || n == 0 {
+            return Err(BvpError::InvalidInput(format!(
+                "a collocation system needs at least 1 state and 2 nodes (got {n} states, {m} \
+                 nodes)"
+            )));
         }
-        for _l in 0..k {
-            row_idx.extend(0..size);
-            col_ptr.push(row_idx.len());
-        }
-        let symbolic = SymbolicSparseColMat::new_checked(size, size, col_ptr, None, row_idx);
         Ok(Pattern {
             n,
             k,
             m,
-            symbolic,
-            identity: (0..size).collect(),
+            sparse: OnceLock::new(),
         })
+    }
+
+    fn structure(&self) -> &SparseStructure {
+        self.sparse.get_or_init(|| {
+            let (n, k, m) = (self.n, self.k, self.m);
+            let size = m * n + k;
+            let nb = n + k;
+            let mut col_ptr = Vec::with_capacity(size + 1);
+            let mut row_idx = Vec::new();
+            col_ptr.push(0usize);
+            for i in 0..m {
+                for _c in 0..n {
+                    if i >= 1 {
+                        row_idx.extend((i - 1) * n..i * n);
+                    }
+                    if i + 1 < m {
+                        row_idx.extend(i * n..(i + 1) * n);
+                    }
+                    if i == 0 || i == m - 1 {
+                        row_idx.extend((m - 1) * n..(m - 1) * n + nb);
+                    }
+                    col_ptr.push(row_idx.len());
+                }
+            }
+            for _l in 0..k {
+                row_idx.extend(0..size);
+                col_ptr.push(row_idx.len());
+            }
+            SparseStructure {
+                symbolic: SymbolicSparseColMat::new_checked(size, size, col_ptr, None, row_idx),
+                identity: (0..size).collect(),
+            }
+        })
+    }
+
+    /// The sparsity pattern (column-compressed), built on first use.
+    pub(crate) fn symbolic(&self) -> &SymbolicSparseColMat<usize> {
+        &self.structure().symbolic
     }
 
     pub(crate) fn size(&self) -> usize {
@@ -78,12 +103,13 @@ impl Pattern {
     }
 
     fn col_perm(&self) -> PermRef<'_, usize> {
-        PermRef::new_checked(&self.identity, &self.identity, self.size())
+        let id = &self.structure().identity;
+        PermRef::new_checked(id, id, self.size())
     }
 
     /// Number of stored entries.
     pub(crate) fn nnz(&self) -> usize {
-        self.symbolic.row_idx().len()
+        self.symbolic().row_idx().len()
     }
 
     /// Writes the Jacobian of the collocation system into `values` (in the pattern's order).
@@ -91,7 +117,7 @@ impl Pattern {
         let (n, k, m) = (self.n, self.k, self.m);
         let size = m * n + k;
         values.resize(self.nnz(), 0.0);
-        let cp = self.symbolic.col_ptr();
+        let cp = self.symbolic().col_ptr();
         work.resize(2 * n * n + size, 0.0);
         let (a, rest) = work.split_at_mut(n * n);
         let (b, pcol) = rest.split_at_mut(n * n);
@@ -186,7 +212,7 @@ impl SparseLu {
     /// Assembles and factors the Jacobian held in `col`.
     pub(crate) fn factor(&mut self, col: &Collocation) -> Result<(), BvpError> {
         self.pattern.assemble(col, &mut self.values, &mut self.work);
-        let a = SparseColMatRef::new(self.pattern.symbolic.as_ref(), &self.values);
+        let a = SparseColMatRef::new(self.pattern.symbolic().as_ref(), &self.values);
         let stack = MemStack::new(&mut self.factor_buf);
         factorize_simplicial_numeric_lu(
             &mut self.row_perm,
