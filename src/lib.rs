@@ -92,6 +92,7 @@ mod dual_jacobian;
 pub mod dyn_dual;
 pub mod error;
 mod error_control;
+mod linearization;
 #[cfg(feature = "rheometer")]
 pub mod fiber;
 pub mod inspect;
