@@ -635,6 +635,28 @@ mod tests {
     }
 
     #[test]
+    fn a_re_solve_from_a_converged_solution_takes_no_newton_step() {
+        let opts = SolveOptions {
+            factor_at_solution: false,
+            ..SolveOptions::with_tol(1e-8)
+        };
+        let mut solver = Solver::new(&Bratu, opts);
+        let guess = Guess::constant(linspace(0.0, 1.0, 7), &[0.1, 0.0]);
+        let first = solver.solve(&[1.0], &guess).unwrap();
+        let again = solver.solve(&[1.0], &Guess::from(&first)).unwrap();
+        assert_eq!(again.stats.newton_iterations, 0);
+        assert_eq!(again.stats.jacobian_factorizations, 0);
+        assert_eq!(again.stats.rhs_dual_evaluations, 0);
+        assert_eq!(again.y, first.y);
+        assert!(again.stats.max_residual <= 1e-8);
+        // a step criterion needs a step: the fixed-mesh options still take one
+        let fixed = solver
+            .solve_with(&[1.0], &Guess::from(&first), &SolveOptions::fixed_mesh())
+            .unwrap();
+        assert!(fixed.stats.newton_iterations >= 1);
+    }
+
+    #[test]
     fn factor_at_solution_off_computes_no_linearisation() {
         let opts = SolveOptions {
             factor_at_solution: false,
