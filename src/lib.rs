@@ -92,12 +92,12 @@ mod dual_jacobian;
 pub mod dyn_dual;
 pub mod error;
 mod error_control;
-mod linearization;
 #[cfg(feature = "rheometer")]
 pub mod fiber;
 pub mod inspect;
 pub mod least_squares;
 pub mod linear;
+mod linearization;
 pub mod mesh;
 mod newton;
 #[cfg(feature = "plots")]

@@ -48,7 +48,10 @@ impl<G: PointFunction> DualFn for PointFn<'_, G> {
 
 /// The solution's linearisation (cached in it, computed now if neither the solve nor an earlier
 /// derivative request did), after checking that `sol` belongs to `problem`.
-fn linearization<'s, P: Bvp>(problem: &P, sol: &'s Solution) -> Result<&'s Linearization, BvpError> {
+fn linearization<'s, P: Bvp>(
+    problem: &P,
+    sol: &'s Solution,
+) -> Result<&'s Linearization, BvpError> {
     let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
     if sol.n != n || sol.unknowns.len() != k || sol.params.len() != q {
         return Err(BvpError::InvalidInput(

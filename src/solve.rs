@@ -624,9 +624,16 @@ mod tests {
         assert!(patterns >= 1 && systems >= 1);
         let warm = Guess::from(&first);
         let again = solver.solve(&[1.01], &warm).unwrap();
-        assert_eq!(again.nodes(), first.nodes(), "the warm re-solve keeps the mesh");
+        assert_eq!(
+            again.nodes(),
+            first.nodes(),
+            "the warm re-solve keeps the mesh"
+        );
         assert_eq!(solver.patterns_built, patterns, "no new sparsity pattern");
-        assert_eq!(solver.systems_built, systems, "no new Newton-matrix workspace");
+        assert_eq!(
+            solver.systems_built, systems,
+            "no new Newton-matrix workspace"
+        );
         // the reused workspace gives exactly what a fresh solver gives
         let fresh = solve(&Bratu, &[1.01], &warm, &opts).unwrap();
         assert_eq!(again.x, fresh.x);
@@ -667,7 +674,10 @@ mod tests {
         let eager = solve(&Bratu, &[1.0], &guess, &SolveOptions::with_tol(1e-8)).unwrap();
         assert!(lazy.factorization().is_none());
         assert!(eager.factorization().is_some());
-        assert_eq!(lazy.y, eager.y, "the linearisation does not change the solution");
+        assert_eq!(
+            lazy.y, eager.y,
+            "the linearisation does not change the solution"
+        );
         assert_eq!(
             eager.stats.jacobian_factorizations,
             lazy.stats.jacobian_factorizations + 1
