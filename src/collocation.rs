@@ -95,6 +95,37 @@ impl Collocation {
         self.res.resize((m - 1) * n + n + self.k, 0.0);
     }
 
+    /// Sets the node slopes `f` and the midpoint states from node values `y` and their slopes
+    /// `yp = f(x_i, y_i, p)` without evaluating `f` (the midpoint formula of
+    /// [`residual`](Self::residual), bit for bit). Enough for [`jacobians`](Self::jacobians).
+    pub(crate) fn set_midpoints_from_slopes(&mut self, y: &[f64], yp: &[f64]) {
+        let (n, m) = (self.n, self.m());
+        self.f.clear();
+        self.f.extend_from_slice(&yp[..m * n]);
+        for i in 0..m - 1 {
+            let h = self.h[i];
+            for c in 0..n {
+                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
+                let (fi, fj) = (self.f[i * n + c], self.f[(i + 1) * n + c]);
+                self.y_mid[i * n + c] = 0.5 * (yi + yj) - 0.125 * h * (fj - fi);
+            }
+        }
+    }
+
+    /// A copy of the mesh and the Jacobians (`jn`, `jm`, `jbc`, as last evaluated), without the
+    /// value buffers: what [`param_column`](Self::param_column) and the Newton-matrix assembly
+    /// read.
+    pub(crate) fn jacobian_copy(&self) -> Collocation {
+        let mut c = Collocation::new(self.n, self.k, self.q);
+        c.x.extend_from_slice(&self.x);
+        c.h.extend_from_slice(&self.h);
+        c.seeded_params = self.seeded_params;
+        c.jn.extend_from_slice(&self.jn);
+        c.jm.extend_from_slice(&self.jm);
+        c.jbc.extend_from_slice(&self.jbc);
+        c
+    }
+
     /// Evaluates `f` at the nodes and midpoints and the full residual vector.
     pub(crate) fn residual<P: Bvp>(
         &mut self,

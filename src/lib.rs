@@ -97,6 +97,7 @@ pub mod fiber;
 pub mod inspect;
 pub mod least_squares;
 pub mod linear;
+mod linearization;
 pub mod mesh;
 mod newton;
 #[cfg(feature = "plots")]

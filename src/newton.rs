@@ -6,7 +6,8 @@
 //! most four times). After a full step with good contraction (`‖Δ̄_{k+1}‖ ≤ ‖Δ_k‖/4`) the
 //! factorisation is reused (simplified Newton); otherwise the Jacobian is recomputed. Iteration stops when the collocation residuals are
 //! 1.5 orders of magnitude below the tolerance at the interval midpoints and the boundary
-//! residuals below `bc_tol`, or when the Jacobian budget is spent.
+//! residuals below `bc_tol`, or when the Jacobian budget is spent. A start that already passes
+//! this test (without a step criterion) is returned as it is: no Jacobian, no factorisation.
 
 use crate::collocation::Collocation;
 use crate::error::BvpError;
@@ -59,6 +60,19 @@ pub(crate) fn newton<P: Bvp>(
     work.p_new.resize(p.len(), 0.0);
 
     col.residual(problem, y, p)?;
+    // A start that already passes the termination test (a warm start at the parameters it was
+    // solved for, or values interpolated onto a refined mesh that already satisfy the
+    // collocation equations this well) needs no Newton step: no Jacobian, no factorisation. Not
+    // with a step criterion, which needs a step to measure.
+    if settings.step_tol.is_none()
+        && residuals_small(col, scale, settings.tol)
+        && bc_small(col, settings.bc_tol)
+    {
+        return Ok(NewtonReport {
+            iterations: 0,
+            converged: true,
+        });
+    }
     let mut recompute = true;
     let mut cost = 0.0;
     let mut njev = 0;

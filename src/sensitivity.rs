@@ -7,19 +7,21 @@
 //! * adjoint: for `G(Y, p)`, `dG/dp = ∂_p G - λᵀ ∂_p S` with `(∂_Y S)ᵀ λ = (∂_Y G)ᵀ` — one
 //!   transposed solve.
 //!
-//! `∂_p S` and `∂G` come from dual numbers; `∂_Y S` is the factorisation kept in the
-//! [`Solution`] (no refactorisation). Values between nodes go through the C1 interpolant, whose
-//! node slopes `f(x_i, y_i, p)` depend on `p` too; the derivatives here are those of the
-//! interpolated discrete solution, consistent with it to round-off.
+//! `∂_p S`, `∂_Y S` and `∂G` come from dual numbers. The Jacobians at the solution and the
+//! factorisation of `∂_Y S` are the solution's cached linearisation: computed by the solve
+//! ([`SolveOptions::factor_at_solution`](crate::SolveOptions::factor_at_solution)) or by the
+//! first derivative request, and shared by every later one (forward and adjoint alike).
+//!
+//! Values between nodes go through the C1 interpolant, whose node slopes `f(x_i, y_i, p)` depend
+//! on `p` too; the derivatives here are those of the interpolated discrete solution, consistent
+//! with it to round-off.
 
-use crate::collocation::Collocation;
 use crate::dual_jacobian::{DualFn, DualJacobian};
 use crate::error::BvpError;
-use crate::linear::{Factorization, LinearSystem, Pattern};
+use crate::linearization::Linearization;
 use crate::problem::Bvp;
 use crate::solution::{hermite_weights, interval_of, Solution};
 use num_dual::DualNum;
-use std::sync::Arc;
 
 /// A scalar function `g(x, y, p)` of a point, the state there and all parameters
 /// `p = (unknowns, model parameters)`, written generically over dual numbers. `index` numbers
@@ -44,50 +46,19 @@ impl<G: PointFunction> DualFn for PointFn<'_, G> {
     }
 }
 
-/// Collocation data at a solution with Jacobians seeded in all parameters.
-struct Linearization {
-    col: Collocation,
-    p: Vec<f64>,
-}
-
-impl Linearization {
-    fn new<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
-        let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
-        if sol.n != n || sol.unknowns.len() != k || sol.params.len() != q {
-            return Err(BvpError::InvalidInput(
-                "the solution does not belong to this problem (dimensions differ)".into(),
-            ));
-        }
-        let mut col = Collocation::new(n, k, q);
-        col.set_mesh(&sol.x);
-        let p = sol.full_params();
-        col.residual(problem, &sol.y, &p)?;
-        col.jacobians(problem, &sol.y, &p, k + q)?;
-        Ok(Linearization { col, p })
+/// The solution's linearisation (cached in it, computed now if neither the solve nor an earlier
+/// derivative request did), after checking that `sol` belongs to `problem`.
+fn linearization<'s, P: Bvp>(
+    problem: &P,
+    sol: &'s Solution,
+) -> Result<&'s Linearization, BvpError> {
+    let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
+    if sol.n != n || sol.unknowns.len() != k || sol.params.len() != q {
+        return Err(BvpError::InvalidInput(
+            "the solution does not belong to this problem (dimensions differ)".into(),
+        ));
     }
-
-    /// Node Jacobian entry `∂f_c/∂(y, p)_l` at node `i`.
-    #[inline]
-    fn jn(&self, i: usize, c: usize, l: usize) -> f64 {
-        let n = self.col.n;
-        let w = n + self.col.seeded_params;
-        self.col.jn[i * n * w + c * w + l]
-    }
-
-    /// The factorisation of `∂_Y S`: the one kept in the solution, or a fresh one.
-    fn factorization<'s>(
-        &self,
-        sol: &'s Solution,
-        owned: &'s mut Option<Factorization>,
-    ) -> Result<&'s Factorization, BvpError> {
-        if let Some(f) = sol.factorization.as_ref() {
-            return Ok(f);
-        }
-        let pattern = Arc::new(Pattern::new(self.col.n, self.col.k, self.col.m())?);
-        let mut lin = LinearSystem::new(pattern);
-        lin.factor(&self.col)?;
-        Ok(owned.insert(lin.snapshot()))
-    }
+    sol.linearization(problem)
 }
 
 /// Forward sensitivities `dy/dp` of a solution with respect to the fixed model parameters.
@@ -106,9 +77,10 @@ pub struct Sensitivities {
 
 impl Sensitivities {
     /// Computes `D_p Y` at `sol` with one solve of `q` right-hand sides, reusing the
-    /// factorisation stored in `sol` (computed once if `sol` has none).
+    /// linearisation cached in `sol` (Jacobians and factorisation; computed once and cached if
+    /// `sol` has none yet: one dual pass and one factorisation, no other evaluation).
     pub fn compute<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
-        let lz = Linearization::new(problem, sol)?;
+        let lz = linearization(problem, sol)?;
         let (n, k, q, m) = (lz.col.n, lz.col.k, lz.col.q, lz.col.m());
         let size = m * n + k;
         let mut rhs = vec![0.0; size * q];
@@ -119,9 +91,7 @@ impl Sensitivities {
         for v in rhs.iter_mut() {
             *v = -*v;
         }
-        let mut owned = None;
-        let fact = lz.factorization(sol, &mut owned)?;
-        fact.solve_in_place(&mut rhs, q)?;
+        lz.factorization.solve_in_place(&mut rhs, q)?;
         if let Some(pos) = rhs.iter().position(|v| !v.is_finite()) {
             return Err(BvpError::SingularJacobian {
                 detail: format!("sensitivity solve gave a non-finite value (entry {pos})"),
@@ -302,7 +272,8 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
             weights[j]
         )));
     }
-    let lz = Linearization::new(problem, sol)?;
+    let lz = linearization(problem, sol)?;
+    let p = sol.full_params();
     let (n, k, q, m) = (lz.col.n, lz.col.k, lz.col.q, lz.col.m());
     let size = m * n + k;
     let np = k + q;
@@ -320,7 +291,7 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
         let (v, _) = hermite_weights((x - sol.x[i]) / h, h);
         sol.eval_into(x, &mut y, &mut yp);
         input[..n].copy_from_slice(&y);
-        input[n..].copy_from_slice(&lz.p);
+        input[n..].copy_from_slice(&p);
         let f = PointFn {
             g,
             index: idx,
@@ -365,9 +336,7 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
             dg_dp[j] += w * grad[n + k + j];
         }
     }
-    let mut owned = None;
-    let fact = lz.factorization(sol, &mut owned)?;
-    fact.solve_transpose_in_place(&mut b, 1)?;
+    lz.factorization.solve_transpose_in_place(&mut b, 1)?;
     let mut col = vec![0.0; size];
     for (j, d) in dg_dp.iter_mut().enumerate() {
         lz.col.param_column(k + j, &mut col);

@@ -1,7 +1,11 @@
 //! The solution object: mesh, values, derivatives, unknown parameters, the C1 piecewise-cubic
 //! interpolant, per-interval residuals and statistics.
 
+use crate::error::BvpError;
 use crate::linear::Factorization;
+use crate::linearization::Linearization;
+use crate::problem::Bvp;
+use std::sync::{Arc, OnceLock};
 
 /// Counters of one solve.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -53,7 +57,9 @@ pub struct Solution {
     pub residual_scale: Vec<f64>,
     /// Statistics.
     pub stats: SolveStats,
-    pub(crate) factorization: Option<Factorization>,
+    /// The linearisation at this solution (Jacobians seeded in all parameters, factorised Newton
+    /// matrix), computed at most once: by the solve or by the first derivative request.
+    pub(crate) linearization: OnceLock<Arc<Linearization>>,
 }
 
 impl Solution {
@@ -158,10 +164,32 @@ impl Solution {
         yp
     }
 
-    /// The factorisation of the collocation Jacobian at this solution, if it was kept
-    /// ([`SolveOptions::factor_at_solution`](crate::SolveOptions::factor_at_solution)).
+    /// The factorisation of the collocation Jacobian at this solution, if it has been computed:
+    /// by the solve ([`SolveOptions::factor_at_solution`](crate::SolveOptions::factor_at_solution))
+    /// or by an earlier sensitivity or adjoint computation on this solution (or the solution it
+    /// was cloned from after that).
     pub fn factorization(&self) -> Option<&Factorization> {
-        self.factorization.as_ref()
+        self.linearization.get().map(|l| &l.factorization)
+    }
+
+    /// The linearisation at this solution: the cached one, or computed now (once) with a fresh
+    /// workspace and cached. Assumes the public fields are those the solve returned.
+    pub(crate) fn linearization<P: Bvp>(&self, problem: &P) -> Result<&Linearization, BvpError> {
+        if let Some(l) = self.linearization.get() {
+            return Ok(l);
+        }
+        let l = Linearization::with_fresh_workspace(
+            problem,
+            &self.x,
+            &self.y,
+            &self.yp,
+            &self.full_params(),
+        )?;
+        // another thread may have set it meanwhile: either value is the same linearisation
+        let _ = self.linearization.set(Arc::new(l));
+        self.linearization.get().map(|l| &**l).ok_or_else(|| {
+            BvpError::InvalidInput("the solution's linearisation could not be cached".into())
+        })
     }
 }
 

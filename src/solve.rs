@@ -6,11 +6,12 @@ use crate::collocation::Collocation;
 use crate::error::BvpError;
 use crate::error_control::rms_residuals;
 use crate::linear::{LinearSolverKind, LinearSystem, Pattern};
+use crate::linearization::Linearization;
 use crate::mesh;
 use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork};
 use crate::problem::Bvp;
 use crate::solution::{resample, Solution, SolveStats};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// How collocation residuals are scaled per component before comparison with `tol`:
 /// residual component `c` is divided by `s_c + |f_c|`.
@@ -51,8 +52,14 @@ pub struct SolveOptions {
     /// Additionally require the last Newton correction to be below
     /// `newton_step_tol (1 + ‖Y‖∞)` (default: off).
     pub newton_step_tol: Option<f64>,
-    /// Factor the Jacobian at the accepted solution and keep it in the [`Solution`] for
-    /// sensitivities and adjoints (default `true`; costs one factorisation).
+    /// Compute the solution's linearisation at the end of the solve, with the solver's own
+    /// workspace: the Jacobians in the states, the unknowns and the model parameters (one
+    /// dual-number pass seeded in all of them) and the factorisation of the Newton matrix, kept
+    /// in the [`Solution`] ([`Solution::factorization`]) and used as they are by
+    /// [`Sensitivities`](crate::sensitivity::Sensitivities) and adjoint gradients (no further
+    /// evaluation). Default `true`. With `false` the solve does none of this work; the first
+    /// sensitivity or adjoint request on the solution computes the same linearisation once
+    /// (with a fresh workspace) and caches it in the solution for every later request.
     pub factor_at_solution: bool,
     /// Progress on stderr: 0 silent (default), 1 one line per mesh, 2 also Newton iterations.
     pub verbose: u8,
@@ -220,10 +227,22 @@ pub struct Solver<'a, P: Bvp> {
     pub options: SolveOptions,
     col: Collocation,
     patterns: Vec<Arc<Pattern>>,
+    /// Newton-matrix workspaces of recently used mesh sizes (most recent last).
+    systems: Vec<LinearSystem>,
+    /// Sparsity patterns built so far (for tests of the reuse).
+    patterns_built: usize,
+    /// Newton-matrix workspaces created so far (for tests of the reuse).
+    systems_built: usize,
     newton_work: NewtonWork,
     rms: Vec<f64>,
     buf: Vec<f64>,
     marks: Vec<u8>,
+}
+
+/// Creates the Newton-matrix workspace for a pattern: the one place where a solve makes one
+/// (the choice of linear solver belongs here).
+fn new_system(pattern: Arc<Pattern>, opts: &SolveOptions) -> LinearSystem {
+    LinearSystem::with_kind(pattern, opts.linear_solver)
 }
 
 /// Solves `problem` once: a convenience around [`Solver`].
@@ -245,6 +264,9 @@ impl<'a, P: Bvp> Solver<'a, P> {
             options,
             col: Collocation::new(n, k, q),
             patterns: Vec::new(),
+            systems: Vec::new(),
+            patterns_built: 0,
+            systems_built: 0,
             newton_work: NewtonWork::default(),
             rms: Vec::new(),
             buf: Vec::new(),
@@ -264,11 +286,36 @@ impl<'a, P: Bvp> Solver<'a, P> {
             return Ok(p);
         }
         let p = Arc::new(Pattern::new(self.col.n, self.col.k, m)?);
+        self.patterns_built += 1;
         if self.patterns.len() >= 4 {
             self.patterns.remove(0);
         }
         self.patterns.push(p.clone());
         Ok(p)
+    }
+
+    /// The Newton-matrix workspace for `m` nodes: the cached one (its factor storage and
+    /// scratch already sized), or a new one. Give it back with
+    /// [`keep_system`](Self::keep_system).
+    fn take_system(&mut self, m: usize, opts: &SolveOptions) -> Result<LinearSystem, BvpError> {
+        if let Some(pos) = self
+            .systems
+            .iter()
+            .position(|s| s.pattern.m == m && s.kind() == opts.linear_solver)
+        {
+            return Ok(self.systems.remove(pos));
+        }
+        let pattern = self.pattern(m)?;
+        self.systems_built += 1;
+        Ok(new_system(pattern, opts))
+    }
+
+    /// Returns a workspace to the cache (at most 4 mesh sizes, least recently used dropped).
+    fn keep_system(&mut self, lin: LinearSystem) {
+        if self.systems.len() >= 4 {
+            self.systems.remove(0);
+        }
+        self.systems.push(lin);
     }
 
     fn validate(
@@ -367,7 +414,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
     ) -> Result<Solution, BvpError> {
         self.validate(params, guess, opts)?;
         let problem = self.problem;
-        let (n, k) = (self.col.n, self.col.k);
+        let n = self.col.n;
         let bc_tol = opts.bc_tol.unwrap_or(opts.tol);
         let settings = NewtonSettings {
             tol: opts.tol,
@@ -397,8 +444,8 @@ impl<'a, P: Bvp> Solver<'a, P> {
             iteration += 1;
             let m = x.len();
             self.col.set_mesh(&x);
-            let pattern = self.pattern(m)?;
-            let mut lin = LinearSystem::with_kind(pattern, opts.linear_solver);
+            let mut lin = self.take_system(m, opts)?;
+            let factorizations_before = lin.factorizations;
             let scale = self.scale_for(&y, &opts.scale);
             let report = newton(
                 problem,
@@ -409,9 +456,16 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 &scale,
                 &settings,
                 &mut self.newton_work,
-            )?;
+            );
+            let report = match report {
+                Ok(r) => r,
+                Err(e) => {
+                    self.keep_system(lin);
+                    return Err(e);
+                }
+            };
             stats.newton_iterations += report.iterations;
-            stats.jacobian_factorizations += lin.factorizations;
+            stats.jacobian_factorizations += lin.factorizations - factorizations_before;
             let max_bc_res = max_bc(&self.col);
             rms_residuals(
                 problem,
@@ -430,6 +484,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 if report.converged {
                     return self.finish(problem, lin, x, y, p, scale, stats, opts);
                 }
+                self.keep_system(lin);
                 return Err(BvpError::NewtonFailed {
                     iterations: report.iterations,
                     nodes: m,
@@ -451,6 +506,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 );
             }
             if added > 0 {
+                self.keep_system(lin);
                 if m + added > opts.max_nodes {
                     return Err(BvpError::MaxNodesExceeded {
                         nodes: m + added,
@@ -469,6 +525,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 if coarsenings_left > 0 && m > 8 && iteration < opts.max_mesh_iterations {
                     let new_x = mesh::coarsen(&x, &self.rms, opts.tol / 20.0);
                     if (m - new_x.len()) * 10 >= m {
+                        self.keep_system(lin);
                         coarsenings_left -= 1;
                         y = resample(&x, &y, &self.col.f, n, &new_x);
                         x = new_x;
@@ -478,6 +535,8 @@ impl<'a, P: Bvp> Solver<'a, P> {
                     }
                 }
                 return self.finish(problem, lin, x, y, p, scale, stats, opts);
+            } else {
+                self.keep_system(lin);
             }
             if iteration >= opts.max_mesh_iterations {
                 return Err(BvpError::ToleranceNotMet {
@@ -488,7 +547,6 @@ impl<'a, P: Bvp> Solver<'a, P> {
                     bc_tol,
                 });
             }
-            let _ = k;
         }
     }
 
@@ -505,15 +563,17 @@ impl<'a, P: Bvp> Solver<'a, P> {
         opts: &SolveOptions,
     ) -> Result<Solution, BvpError> {
         let k = self.col.k;
-        // `col` holds values at the final iterate (the error estimate used them)
-        let factorization = if opts.factor_at_solution {
-            self.col.jacobians(problem, &y, &p, k)?;
-            lin.factor(&self.col)?;
+        // `col` holds values at the final iterate (the error estimate used them), among them the
+        // midpoint states the Jacobians need
+        let linearization = OnceLock::new();
+        if opts.factor_at_solution {
+            let lz = Linearization::compute(problem, &mut self.col, &mut lin, &y, &p);
             stats.jacobian_factorizations += 1;
-            Some(lin.snapshot())
+            self.keep_system(lin);
+            let _ = linearization.set(Arc::new(lz?));
         } else {
-            None
-        };
+            self.keep_system(lin);
+        }
         stats.rhs_evaluations = self.col.rhs_evals;
         stats.rhs_dual_evaluations = self.col.jac_evals;
         Ok(Solution {
@@ -526,7 +586,111 @@ impl<'a, P: Bvp> Solver<'a, P> {
             rms_residuals: self.rms.clone(),
             residual_scale: scale,
             stats,
-            factorization,
+            linearization,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::linspace;
+    use num_dual::DualNum;
+
+    /// y'' = -a e^y, y(0) = 0, y(1) = 0 (Bratu, a = p[0]).
+    struct Bratu;
+    impl Bvp for Bratu {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn num_params(&self) -> usize {
+            1
+        }
+        fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+            f[0] = y[1];
+            f[1] = -p[0] * y[0].exp();
+        }
+        fn bc<D: DualNum<Primitive = f64> + Copy>(
+            &self,
+            ya: &[D],
+            yb: &[D],
+            _p: &[D],
+            r: &mut [D],
+        ) {
+            r[0] = ya[0];
+            r[1] = yb[0];
+        }
+    }
+
+    #[test]
+    fn a_warm_re_solve_on_the_same_mesh_reuses_pattern_and_workspace() {
+        let opts = SolveOptions::with_tol(1e-8);
+        let mut solver = Solver::new(&Bratu, opts.clone());
+        let guess = Guess::constant(linspace(0.0, 1.0, 7), &[0.1, 0.0]);
+        let first = solver.solve(&[1.0], &guess).unwrap();
+        let (patterns, systems) = (solver.patterns_built, solver.systems_built);
+        assert!(patterns >= 1 && systems >= 1);
+        let warm = Guess::from(&first);
+        let again = solver.solve(&[1.01], &warm).unwrap();
+        assert_eq!(
+            again.nodes(),
+            first.nodes(),
+            "the warm re-solve keeps the mesh"
+        );
+        assert_eq!(solver.patterns_built, patterns, "no new sparsity pattern");
+        assert_eq!(
+            solver.systems_built, systems,
+            "no new Newton-matrix workspace"
+        );
+        // the reused workspace gives exactly what a fresh solver gives
+        let fresh = solve(&Bratu, &[1.01], &warm, &opts).unwrap();
+        assert_eq!(again.x, fresh.x);
+        assert_eq!(again.y, fresh.y);
+        assert_eq!(again.stats, fresh.stats);
+    }
+
+    #[test]
+    fn a_re_solve_from_a_converged_solution_takes_no_newton_step() {
+        let opts = SolveOptions {
+            factor_at_solution: false,
+            ..SolveOptions::with_tol(1e-8)
+        };
+        let mut solver = Solver::new(&Bratu, opts);
+        let guess = Guess::constant(linspace(0.0, 1.0, 7), &[0.1, 0.0]);
+        let first = solver.solve(&[1.0], &guess).unwrap();
+        let again = solver.solve(&[1.0], &Guess::from(&first)).unwrap();
+        assert_eq!(again.stats.newton_iterations, 0);
+        assert_eq!(again.stats.jacobian_factorizations, 0);
+        assert_eq!(again.stats.rhs_dual_evaluations, 0);
+        assert_eq!(again.y, first.y);
+        assert!(again.stats.max_residual <= 1e-8);
+        // a step criterion needs a step: the fixed-mesh options still take one
+        let fixed = solver
+            .solve_with(&[1.0], &Guess::from(&first), &SolveOptions::fixed_mesh())
+            .unwrap();
+        assert!(fixed.stats.newton_iterations >= 1);
+    }
+
+    #[test]
+    fn factor_at_solution_off_computes_no_linearisation() {
+        let opts = SolveOptions {
+            factor_at_solution: false,
+            ..SolveOptions::with_tol(1e-8)
+        };
+        let guess = Guess::constant(linspace(0.0, 1.0, 7), &[0.1, 0.0]);
+        let lazy = solve(&Bratu, &[1.0], &guess, &opts).unwrap();
+        let eager = solve(&Bratu, &[1.0], &guess, &SolveOptions::with_tol(1e-8)).unwrap();
+        assert!(lazy.factorization().is_none());
+        assert!(eager.factorization().is_some());
+        assert_eq!(
+            lazy.y, eager.y,
+            "the linearisation does not change the solution"
+        );
+        assert_eq!(
+            eager.stats.jacobian_factorizations,
+            lazy.stats.jacobian_factorizations + 1
+        );
+        assert!(eager.stats.rhs_dual_evaluations > lazy.stats.rhs_dual_evaluations);
+        assert_eq!(eager.stats.rhs_evaluations, lazy.stats.rhs_evaluations);
     }
 }

@@ -267,3 +267,80 @@ fn factorization_solve_checks_the_right_hand_side_size() {
     fact.solve_in_place(&mut ok, 2).unwrap();
     assert!(ok.iter().all(|v| v.is_finite()));
 }
+
+/// `BratuAB` counting its right-hand-side evaluations (`f64` and dual separately).
+#[derive(Default)]
+struct CountingBratuAB {
+    values: std::sync::atomic::AtomicUsize,
+    duals: std::sync::atomic::AtomicUsize,
+}
+impl CountingBratuAB {
+    fn counts(&self) -> (usize, usize) {
+        use std::sync::atomic::Ordering::Relaxed;
+        (self.values.load(Relaxed), self.duals.load(Relaxed))
+    }
+}
+impl Bvp for CountingBratuAB {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        use std::sync::atomic::Ordering::Relaxed;
+        if std::mem::size_of::<D>() > std::mem::size_of::<f64>() {
+            self.duals.fetch_add(1, Relaxed);
+        } else {
+            self.values.fetch_add(1, Relaxed);
+        }
+        BratuAB.rhs(x, y, p, f)
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
+        BratuAB.bc(ya, yb, p, r)
+    }
+}
+
+#[test]
+fn derivatives_after_a_solve_reuse_its_linearisation() {
+    let problem = CountingBratuAB::default();
+    let pp = [1.0, 0.2];
+    let g = Guess::constant(linspace(0.0, 1.0, 6), &[0.2, 0.0]);
+    let xs = points();
+    let weights = vec![1.0; xs.len()];
+    // factor_at_solution (default): the solve leaves everything the derivatives need
+    let eager = solve(&problem, &pp, &g, &SolveOptions::with_tol(1e-8)).unwrap();
+    assert!(eager.factorization().is_some());
+    let before = problem.counts();
+    let sens_eager = Sensitivities::compute(&problem, &eager).unwrap();
+    let (_, grad_eager) = adjoint_gradient(&problem, &eager, &xs, &weights, &Observe).unwrap();
+    assert_eq!(problem.counts(), before, "no evaluation after the solve");
+
+    // without it the solve pays nothing and the first request computes the linearisation
+    // once: one dual pass (2 states + 2 parameters seeded at once) over nodes and midpoints,
+    // no evaluation in f64; the adjoint that follows reuses it
+    let opts = SolveOptions {
+        factor_at_solution: false,
+        ..SolveOptions::with_tol(1e-8)
+    };
+    let lazy = solve(&problem, &pp, &g, &opts).unwrap();
+    assert!(lazy.factorization().is_none());
+    assert_eq!(lazy.y, eager.y);
+    let before = problem.counts();
+    let sens_lazy = Sensitivities::compute(&problem, &lazy).unwrap();
+    let after = problem.counts();
+    assert_eq!(after.0, before.0, "no f64 evaluation");
+    assert_eq!(after.1 - before.1, 2 * lazy.nodes() - 1, "one dual pass");
+    assert!(lazy.factorization().is_some(), "cached in the solution");
+    let copy = lazy.clone();
+    let (_, grad_lazy) = adjoint_gradient(&problem, &copy, &xs, &weights, &Observe).unwrap();
+    let _ = Sensitivities::compute(&problem, &lazy).unwrap();
+    assert_eq!(problem.counts(), after, "the adjoint and a clone reuse it");
+
+    for (a, b) in sens_eager.dy.iter().zip(&sens_lazy.dy) {
+        assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs()), "{a} vs {b}");
+    }
+    for (a, b) in grad_eager.iter().zip(&grad_lazy) {
+        assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs()), "{a} vs {b}");
+    }
+}

@@ -43,7 +43,10 @@ pub struct SimulateOptions {
     pub initial_nodes: usize,
     /// Continuation settings of a cold start.
     pub continuation: PathOptions,
-    /// Keep the factorised Jacobian at the solution (for sensitivities; default `false`).
+    /// Compute the solution's linearisation (Jacobians in all parameters and the factorised
+    /// Newton matrix) at the end of the solve, for sensitivities and adjoints (default `false`:
+    /// the first derivative request computes it once instead; see
+    /// [`SolveOptions::factor_at_solution`]).
     pub factor_at_solution: bool,
     /// Positions \[m\] added as nodes to the mesh of the final solve, e.g. output positions
     /// (default none; mesh coarsening may remove some again — the interpolant is used anyway).

@@ -210,6 +210,11 @@ impl LinearSystem {
         }
     }
 
+    /// The solver kind this workspace was built for (as requested, possibly `Auto`).
+    pub(crate) fn kind(&self) -> LinearSolverKind {
+        self.kind
+    }
+
     /// Which solver holds the current factorisation (`None` before the first).
     #[allow(dead_code)]
     pub(crate) fn active_kind(&self) -> Option<LinearSolverKind> {
