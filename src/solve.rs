@@ -387,6 +387,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
         let mut stats = SolveStats::default();
         self.col.rhs_evals = 0;
         self.col.jac_evals = 0;
+        let mesh_opts = mesh::MeshOptions::default();
         let mut coarsenings_left = if opts.coarsen && opts.adapt { 3 } else { 0 };
         let mut iteration = 0;
         loop {
@@ -435,27 +436,39 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 });
             }
 
-            let added = mesh::mark_refinement(&self.rms, opts.tol, &mut self.marks);
+            let above = mesh::plan(&self.rms, opts.tol, &mesh_opts, &mut self.marks);
+            let refined = if above > 0 {
+                Some(mesh::apply(
+                    &x,
+                    &self.rms,
+                    &self.marks,
+                    opts.tol,
+                    &mesh_opts,
+                    opts.max_nodes,
+                ))
+            } else {
+                None
+            };
             if opts.verbose >= 1 {
                 // a failed write to stderr must not panic
                 use std::io::Write as _;
                 let _ = writeln!(
                     std::io::stderr(),
-                    "mesh {iteration:>3}: {m:>6} nodes, Newton {:>2} it ({}), max rms residual {max_res:.2e}, max bc residual {max_bc_res:.2e}, nodes to add {added}",
+                    "mesh {iteration:>3}: {m:>6} nodes, Newton {:>2} it ({}), max rms residual {max_res:.2e}, max bc residual {max_bc_res:.2e}, intervals above tol {above}, next mesh {} nodes",
                     report.iterations,
-                    if report.converged { "converged" } else { "not converged" }
+                    if report.converged { "converged" } else { "not converged" },
+                    refined.as_ref().map_or(m, Vec::len)
                 );
             }
-            if added > 0 {
-                if m + added > opts.max_nodes {
+            if let Some(new_x) = refined {
+                if new_x.len() > opts.max_nodes {
                     return Err(BvpError::MaxNodesExceeded {
-                        nodes: m + added,
+                        nodes: new_x.len(),
                         max_nodes: opts.max_nodes,
                         max_residual: max_res,
                         tol: opts.tol,
                     });
                 }
-                let new_x = mesh::refine(&x, &self.marks);
                 y = resample(&x, &y, &self.col.f, n, &new_x);
                 x = new_x;
                 stats.mesh_refinements += 1;
