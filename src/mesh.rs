@@ -187,7 +187,7 @@ impl MeshOptions {
 /// the mesh is final. For [`RefineRule::Scipy`] it also writes the nodes to insert per interval
 /// into `marks` ([`mark_refinement`]); the equidistribution needs no marks and clears them.
 pub fn plan(rms: &[f64], tol: f64, opts: &MeshOptions, marks: &mut Vec<u8>) -> usize {
-    let above = rms.iter().filter(|&&r| !(r <= tol)).count();
+    let above = rms.iter().filter(|&&r| r.is_nan() || r > tol).count();
     marks.clear();
     if above > 0 && opts.rule == RefineRule::Scipy {
         mark_refinement(rms, tol, marks);
