@@ -66,6 +66,10 @@ pub struct SolveOptions {
     /// Linear solver for the Newton matrix (default [`LinearSolverKind::Auto`]: structured
     /// elimination for separated boundary conditions, faer's sparse LU otherwise).
     pub linear_solver: LinearSolverKind,
+    /// How the mesh is refined when the residual is above `tol` (default: equidistribution of
+    /// the predicted residual, [`MeshOptions::default`](crate::mesh::MeshOptions::default);
+    /// [`MeshOptions::scipy`](crate::mesh::MeshOptions::scipy) gives scipy's 1-or-2-node rule).
+    pub mesh: mesh::MeshOptions,
 }
 
 impl Default for SolveOptions {
@@ -84,6 +88,7 @@ impl Default for SolveOptions {
             factor_at_solution: true,
             verbose: 0,
             linear_solver: LinearSolverKind::Auto,
+            mesh: mesh::MeshOptions::default(),
         }
     }
 }
@@ -151,6 +156,7 @@ impl SolveOptions {
                 )));
             }
         }
+        self.mesh.validate()?;
         if let ResidualScale::PerComponent(s) = &self.scale {
             if s.len() != n || s.iter().any(|v| !(*v > 0.0 && v.is_finite())) {
                 return Err(BvpError::InvalidInput(format!(
@@ -438,6 +444,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
         let mut stats = SolveStats::default();
         self.col.rhs_evals = 0;
         self.col.jac_evals = 0;
+        let mesh_opts = &opts.mesh;
         let mut coarsenings_left = if opts.coarsen && opts.adapt { 3 } else { 0 };
         let mut iteration = 0;
         loop {
@@ -494,28 +501,40 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 });
             }
 
-            let added = mesh::mark_refinement(&self.rms, opts.tol, &mut self.marks);
+            let above = mesh::plan(&self.rms, opts.tol, mesh_opts, &mut self.marks);
+            let refined = if above > 0 {
+                Some(mesh::apply(
+                    &x,
+                    &self.rms,
+                    &self.marks,
+                    opts.tol,
+                    mesh_opts,
+                    opts.max_nodes,
+                ))
+            } else {
+                None
+            };
             if opts.verbose >= 1 {
                 // a failed write to stderr must not panic
                 use std::io::Write as _;
                 let _ = writeln!(
                     std::io::stderr(),
-                    "mesh {iteration:>3}: {m:>6} nodes, Newton {:>2} it ({}), max rms residual {max_res:.2e}, max bc residual {max_bc_res:.2e}, nodes to add {added}",
+                    "mesh {iteration:>3}: {m:>6} nodes, Newton {:>2} it ({}), max rms residual {max_res:.2e}, max bc residual {max_bc_res:.2e}, intervals above tol {above}, next mesh {} nodes",
                     report.iterations,
-                    if report.converged { "converged" } else { "not converged" }
+                    if report.converged { "converged" } else { "not converged" },
+                    refined.as_ref().map_or(m, Vec::len)
                 );
             }
-            if added > 0 {
+            if let Some(new_x) = refined {
                 self.keep_system(lin);
-                if m + added > opts.max_nodes {
+                if new_x.len() > opts.max_nodes {
                     return Err(BvpError::MaxNodesExceeded {
-                        nodes: m + added,
+                        nodes: new_x.len(),
                         max_nodes: opts.max_nodes,
                         max_residual: max_res,
                         tol: opts.tol,
                     });
                 }
-                let new_x = mesh::refine(&x, &self.marks);
                 y = resample(&x, &y, &self.col.f, n, &new_x);
                 x = new_x;
                 stats.mesh_refinements += 1;
