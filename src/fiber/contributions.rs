@@ -551,22 +551,6 @@ impl<H: NusseltLaw> Physics<H> {
         v
     }
 
-    /// The values of the slots with strength parameters `sp` (`None` where `Off`).
-    #[inline]
-    fn slot_values<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> [Option<D>; SLOTS] {
-        let mut k = self
-            .terms
-            .iter()
-            .filter(|t| t.strength.is_parameter())
-            .count();
-        let slots = self.slots();
-        let mut out = [None; SLOTS];
-        for (o, s) in out.iter_mut().zip(&slots) {
-            *o = strength_value(s, sp, &mut k);
-        }
-        out
-    }
-
     /// Adds a user term (SI) named `name` to `balance`.
     pub fn with_custom<T: FiberTerm + 'static>(
         mut self,
@@ -850,6 +834,100 @@ fn strength_value<D: DualNum<Primitive = f64> + Copy>(
     }
 }
 
+/// Where one strength comes from, resolved once ([`StrengthPlan`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Source {
+    /// Switched off.
+    Off,
+    /// A fixed factor.
+    Fixed(f64),
+    /// Entry `i` of the strength parameters `sp`.
+    Param(usize),
+}
+
+impl Source {
+    /// The value with strength parameters `sp` (`NaN` where `sp` is too short), as
+    /// [`strength_value`] gives it.
+    #[inline]
+    fn value<D: DualNum<Primitive = f64> + Copy>(self, sp: &[D]) -> Option<D> {
+        match self {
+            Source::Off => None,
+            Source::Fixed(v) => Some(D::from(v)),
+            Source::Param(i) => Some(sp.get(i).copied().unwrap_or_else(|| D::from(f64::NAN))),
+        }
+    }
+}
+
+/// The strengths of a [`Physics`] resolved once: for every term and every parameter slot
+/// (co-flow, warm air, process and instrument parameters) whether it is off, a fixed factor or
+/// which entry of the strength parameters `sp` it reads. [`FiberModel`](super::FiberModel)
+/// builds it at construction so that its right-hand side neither counts the parameterised terms
+/// nor rebuilds the slots on every call; the `*_planned` methods of [`Physics`] take it (the
+/// plain methods build it on the fly and give bit-identical results). A plan belongs to the
+/// physics it was made from: rebuild it ([`Physics::plan`]) after changing a strength.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StrengthPlan {
+    slots: [Source; SLOTS],
+    terms: Vec<Source>,
+}
+
+impl StrengthPlan {
+    /// The value of slot `i` with strength parameters `sp`.
+    #[inline]
+    fn slot<D: DualNum<Primitive = f64> + Copy>(&self, i: usize, sp: &[D]) -> Option<D> {
+        self.slots[i].value(sp)
+    }
+}
+
+fn source(s: &Strength, k: &mut usize) -> Source {
+    match *s {
+        Strength::Off => Source::Off,
+        Strength::Fixed(v) => Source::Fixed(v),
+        Strength::Parameter(_) => {
+            *k += 1;
+            Source::Param(*k - 1)
+        }
+    }
+}
+
+impl<H: NusseltLaw> Physics<H> {
+    /// The strengths resolved once (see [`StrengthPlan`]).
+    pub fn plan(&self) -> StrengthPlan {
+        let mut k = 0;
+        let terms = self
+            .terms
+            .iter()
+            .map(|t| source(&t.strength, &mut k))
+            .collect();
+        StrengthPlan {
+            slots: self.slot_plan(),
+            terms,
+        }
+    }
+
+    /// The slots' sources (after the terms' parameters).
+    fn slot_plan(&self) -> [Source; SLOTS] {
+        let mut k = self
+            .terms
+            .iter()
+            .filter(|t| t.strength.is_parameter())
+            .count();
+        let mut out = [Source::Off; SLOTS];
+        for (o, s) in out.iter_mut().zip(&self.slots()) {
+            *o = source(s, &mut k);
+        }
+        out
+    }
+
+    /// A plan with the slots only (no allocation), for the plain methods.
+    fn slots_only(&self) -> StrengthPlan {
+        StrengthPlan {
+            slots: self.slot_plan(),
+            terms: Vec::new(),
+        }
+    }
+}
+
 impl<H: NusseltLaw> Physics<H> {
     /// Number of strength parameters in `p`.
     pub fn num_strength_params(&self) -> usize {
@@ -860,7 +938,7 @@ impl<H: NusseltLaw> Physics<H> {
     /// when the error is off); see [`process`](Self::process) for all process factors.
     #[inline]
     pub fn inlet_velocity_factor<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> D {
-        match self.slot_values(sp)[S_INLET_VELOCITY] {
+        match self.slot_plan()[S_INLET_VELOCITY].value(sp) {
             Some(d) => d + 1.0,
             None => D::one(),
         }
@@ -875,22 +953,36 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         temperature_scale: f64,
     ) -> ProcessFactors<D> {
-        let v = self.slot_values(sp);
-        let mut inlet = match v[S_INLET_VELOCITY] {
+        self.process_planned(&self.slots_only(), sp, temperature_scale)
+    }
+
+    /// [`process`](Self::process) with the strengths resolved by `plan` (made by
+    /// [`plan`](Self::plan) from this physics).
+    #[inline]
+    pub fn process_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        sp: &[D],
+        temperature_scale: f64,
+    ) -> ProcessFactors<D> {
+        let velocity = plan.slot(S_INLET_VELOCITY, sp);
+        let diameter = plan.slot(S_INLET_DIAMETER, sp);
+        let die = plan.slot(S_DIE_TEMPERATURE, sp);
+        let mass = plan.slot(S_MASS_FLOW, sp);
+        let mut inlet = match velocity {
             Some(d) => d + 1.0,
             None => D::one(),
         };
-        if let Some(d) = v[S_INLET_DIAMETER] {
+        if let Some(d) = diameter {
             let f = d + 1.0;
             inlet /= f * f;
         }
         ProcessFactors {
             inlet_velocity: inlet,
-            die_temperature: v[S_DIE_TEMPERATURE]
-                .map_or(D::zero(), |d| d * temperature_scale.recip()),
-            mass_flow: v[S_MASS_FLOW].map_or(D::one(), |d| d + 1.0),
-            has_die_temperature: v[S_DIE_TEMPERATURE].is_some(),
-            has_mass_flow: v[S_MASS_FLOW].is_some(),
+            die_temperature: die.map_or(D::zero(), |d| d * temperature_scale.recip()),
+            mass_flow: mass.map_or(D::one(), |d| d + 1.0),
+            has_die_temperature: die.is_some(),
+            has_mass_flow: mass.is_some(),
         }
     }
 
@@ -904,12 +996,23 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         diameter_scale: f64,
     ) -> D {
-        let v = self.slot_values(sp);
+        self.gauge_reading_planned(&self.slots_only(), d, sp, diameter_scale)
+    }
+
+    /// [`gauge_reading`](Self::gauge_reading) with the strengths resolved by `plan`.
+    #[inline]
+    pub fn gauge_reading_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        d: D,
+        sp: &[D],
+        diameter_scale: f64,
+    ) -> D {
         let mut out = d;
-        if let Some(g) = v[S_GAUGE_SCALE] {
+        if let Some(g) = plan.slot(S_GAUGE_SCALE, sp) {
             out = d * (g + 1.0);
         }
-        if let Some(o) = v[S_GAUGE_OFFSET] {
+        if let Some(o) = plan.slot(S_GAUGE_OFFSET, sp) {
             out += o * (1e-6 / diameter_scale);
         }
         out
@@ -923,9 +1026,21 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         co: &Coefficients,
     ) -> (D, D) {
-        let val = self.slot_values(sp);
+        self.environment_planned(&self.slots_only(), s, sp, co)
+    }
+
+    /// [`environment`](Self::environment) with the strengths resolved by `plan`.
+    #[inline]
+    pub fn environment_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        s: f64,
+        sp: &[D],
+        co: &Coefficients,
+    ) -> (D, D) {
+        let val = |i| plan.slot(i, sp);
         let l_o = co.si.length;
-        let mut v = match (&self.air_speed, val[S_COFLOW], val[S_COFLOW_LEN]) {
+        let mut v = match (&self.air_speed, val(S_COFLOW), val(S_COFLOW_LEN)) {
             (AirSpeed::CoFlow { speed, .. }, Some(f), Some(ell)) => {
                 f * (D::from(-(co.length - s) * l_o) / ell).exp() * (speed / co.si.velocity)
             }
@@ -933,9 +1048,9 @@ impl<H: NusseltLaw> Physics<H> {
         };
         if let (LineCoflow::On { speed, .. }, Some(f), Some(s0), Some(w)) = (
             &self.line_coflow,
-            val[S_LINE],
-            val[S_LINE_ONSET],
-            val[S_LINE_RAMP],
+            val(S_LINE),
+            val(S_LINE_ONSET),
+            val(S_LINE_RAMP),
         ) {
             // logistic 1/(1 + e^(−z)) written without overflow for either sign of z
             let z = (-s0 + s * l_o) / w;
@@ -947,7 +1062,7 @@ impl<H: NusseltLaw> Physics<H> {
             };
             v += f * ramp * (speed / co.si.velocity);
         }
-        let t = match (&self.air_temperature, val[S_WARM], val[S_WARM_LEN]) {
+        let t = match (&self.air_temperature, val(S_WARM), val(S_WARM_LEN)) {
             (AirTemperature::WarmNozzle { excess, .. }, Some(f), Some(ell)) => {
                 f * (D::from(-s * l_o) / ell).exp() * (excess / co.si.temperature) + co.t_air
             }
@@ -1027,6 +1142,30 @@ impl<H: NusseltLaw> Physics<H> {
         let mut k = 0;
         for term in &self.terms {
             if let Some(f) = strength_value(&term.strength, sp, &mut k) {
+                let v = self.term_value(term, st, co) * f;
+                match term.balance {
+                    Balance::Momentum => force += v,
+                    Balance::Energy => heat += v,
+                }
+            }
+        }
+        (force, heat)
+    }
+
+    /// [`sums`](Self::sums) with the strengths resolved by `plan` (made by [`plan`](Self::plan)
+    /// from this physics: one source per term).
+    #[inline]
+    pub fn sums_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        st: &LocalState<D>,
+        sp: &[D],
+        co: &Coefficients,
+    ) -> (D, D) {
+        let mut force = D::zero();
+        let mut heat = D::zero();
+        for (term, src) in self.terms.iter().zip(&plan.terms) {
+            if let Some(f) = src.value(sp) {
                 let v = self.term_value(term, st, co) * f;
                 match term.balance {
                     Balance::Momentum => force += v,
