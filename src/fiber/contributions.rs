@@ -1217,4 +1217,72 @@ mod tests {
         let cross = law.nusselt(0.0, re * re, law.prandtl_argument(pr));
         assert!((cross - cb).abs() < 1e-6 * cb);
     }
+
+    /// The planned evaluations (strengths resolved once) give bit-identical results to the
+    /// plain ones, with terms, air profiles, process and instrument parameters mixed.
+    #[test]
+    fn planned_evaluation_is_bit_identical() {
+        let physics = Physics::paper()
+            .with_radiation(0.9)
+            .with_coflow(2.0, 0.1)
+            .with_warm_air(30.0, 0.05)
+            .strength("radiation", Strength::Parameter(0.8))
+            .and_then(|p| p.strength("air_coflow", Strength::Parameter(1.1)))
+            .and_then(|p| p.strength("air_coflow.decay_length", Strength::Parameter(0.12)))
+            .and_then(|p| p.strength("air_temperature_profile", Strength::Fixed(0.7)))
+            .and_then(|p| p.strength("inlet_diameter", Strength::Parameter(0.05)))
+            .and_then(|p| p.strength("mass_flow_scale", Strength::Parameter(-0.02)))
+            .and_then(|p| p.strength("die_temperature_offset", Strength::Parameter(3.0)))
+            .and_then(|p| p.strength("gauge_offset", Strength::Parameter(1.5)))
+            .and_then(|p| p.strength("gauge_scale", Strength::Fixed(0.01)))
+            .unwrap();
+        let plan = physics.plan();
+        let n = physics.num_strength_params();
+        let sp: Vec<f64> = (0..n).map(|i| 0.3 + 0.1 * i as f64).collect();
+        let co = Coefficients::new(
+            &super::super::scaling::Scaling::default(),
+            &Air::paper(),
+            physics.slenderness,
+            1e-4,
+            300.0,
+            1.0,
+        );
+        for short in [false, true] {
+            // a too short `sp` gives NaN strengths, the same way in both
+            let sp = if short { &sp[..n - 2] } else { &sp[..] };
+            let (a, b) = (
+                physics.process(sp, 500.0),
+                physics.process_planned(&plan, sp, 500.0),
+            );
+            let bits = |v: f64| v.to_bits();
+            assert_eq!(bits(a.inlet_velocity), bits(b.inlet_velocity));
+            assert_eq!(bits(a.die_temperature), bits(b.die_temperature));
+            assert_eq!(bits(a.mass_flow), bits(b.mass_flow));
+            assert_eq!(
+                bits(physics.gauge_reading(0.7, sp, 1e-4)),
+                bits(physics.gauge_reading_planned(&plan, 0.7, sp, 1e-4))
+            );
+            for s in [0.0, 0.4, 0.9] {
+                let (t, v) = physics.environment(s, sp, &co);
+                let (tp, vp) = physics.environment_planned(&plan, s, sp, &co);
+                assert_eq!((bits(t), bits(v)), (bits(tp), bits(vp)));
+                let st = LocalState {
+                    s,
+                    u: 2.0,
+                    n: 5000.0,
+                    t: 0.9,
+                    rate: 3.0,
+                    rho: 1.1,
+                    cp: 1.2,
+                    d: 0.4,
+                    q: 1.0,
+                    t_air: t,
+                    v_air: v,
+                };
+                let (f, h) = physics.sums(&st, sp, &co);
+                let (fp, hp) = physics.sums_planned(&plan, &st, sp, &co);
+                assert_eq!((bits(f), bits(h)), (bits(fp), bits(hp)));
+            }
+        }
+    }
 }
