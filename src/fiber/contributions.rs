@@ -551,22 +551,6 @@ impl<H: NusseltLaw> Physics<H> {
         v
     }
 
-    /// The values of the slots with strength parameters `sp` (`None` where `Off`).
-    #[inline]
-    fn slot_values<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> [Option<D>; SLOTS] {
-        let mut k = self
-            .terms
-            .iter()
-            .filter(|t| t.strength.is_parameter())
-            .count();
-        let slots = self.slots();
-        let mut out = [None; SLOTS];
-        for (o, s) in out.iter_mut().zip(&slots) {
-            *o = strength_value(s, sp, &mut k);
-        }
-        out
-    }
-
     /// Adds a user term (SI) named `name` to `balance`.
     pub fn with_custom<T: FiberTerm + 'static>(
         mut self,
@@ -850,6 +834,100 @@ fn strength_value<D: DualNum<Primitive = f64> + Copy>(
     }
 }
 
+/// Where one strength comes from, resolved once ([`StrengthPlan`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Source {
+    /// Switched off.
+    Off,
+    /// A fixed factor.
+    Fixed(f64),
+    /// Entry `i` of the strength parameters `sp`.
+    Param(usize),
+}
+
+impl Source {
+    /// The value with strength parameters `sp` (`NaN` where `sp` is too short), as
+    /// [`strength_value`] gives it.
+    #[inline]
+    fn value<D: DualNum<Primitive = f64> + Copy>(self, sp: &[D]) -> Option<D> {
+        match self {
+            Source::Off => None,
+            Source::Fixed(v) => Some(D::from(v)),
+            Source::Param(i) => Some(sp.get(i).copied().unwrap_or_else(|| D::from(f64::NAN))),
+        }
+    }
+}
+
+/// The strengths of a [`Physics`] resolved once: for every term and every parameter slot
+/// (co-flow, warm air, process and instrument parameters) whether it is off, a fixed factor or
+/// which entry of the strength parameters `sp` it reads. [`FiberModel`](super::FiberModel)
+/// builds it at construction so that its right-hand side neither counts the parameterised terms
+/// nor rebuilds the slots on every call; the `*_planned` methods of [`Physics`] take it (the
+/// plain methods build it on the fly and give bit-identical results). A plan belongs to the
+/// physics it was made from: rebuild it ([`Physics::plan`]) after changing a strength.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StrengthPlan {
+    slots: [Source; SLOTS],
+    terms: Vec<Source>,
+}
+
+impl StrengthPlan {
+    /// The value of slot `i` with strength parameters `sp`.
+    #[inline]
+    fn slot<D: DualNum<Primitive = f64> + Copy>(&self, i: usize, sp: &[D]) -> Option<D> {
+        self.slots[i].value(sp)
+    }
+}
+
+fn source(s: &Strength, k: &mut usize) -> Source {
+    match *s {
+        Strength::Off => Source::Off,
+        Strength::Fixed(v) => Source::Fixed(v),
+        Strength::Parameter(_) => {
+            *k += 1;
+            Source::Param(*k - 1)
+        }
+    }
+}
+
+impl<H: NusseltLaw> Physics<H> {
+    /// The strengths resolved once (see [`StrengthPlan`]).
+    pub fn plan(&self) -> StrengthPlan {
+        let mut k = 0;
+        let terms = self
+            .terms
+            .iter()
+            .map(|t| source(&t.strength, &mut k))
+            .collect();
+        StrengthPlan {
+            slots: self.slot_plan(),
+            terms,
+        }
+    }
+
+    /// The slots' sources (after the terms' parameters).
+    fn slot_plan(&self) -> [Source; SLOTS] {
+        let mut k = self
+            .terms
+            .iter()
+            .filter(|t| t.strength.is_parameter())
+            .count();
+        let mut out = [Source::Off; SLOTS];
+        for (o, s) in out.iter_mut().zip(&self.slots()) {
+            *o = source(s, &mut k);
+        }
+        out
+    }
+
+    /// A plan with the slots only (no allocation), for the plain methods.
+    fn slots_only(&self) -> StrengthPlan {
+        StrengthPlan {
+            slots: self.slot_plan(),
+            terms: Vec::new(),
+        }
+    }
+}
+
 impl<H: NusseltLaw> Physics<H> {
     /// Number of strength parameters in `p`.
     pub fn num_strength_params(&self) -> usize {
@@ -860,7 +938,7 @@ impl<H: NusseltLaw> Physics<H> {
     /// when the error is off); see [`process`](Self::process) for all process factors.
     #[inline]
     pub fn inlet_velocity_factor<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> D {
-        match self.slot_values(sp)[S_INLET_VELOCITY] {
+        match self.slot_plan()[S_INLET_VELOCITY].value(sp) {
             Some(d) => d + 1.0,
             None => D::one(),
         }
@@ -875,22 +953,36 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         temperature_scale: f64,
     ) -> ProcessFactors<D> {
-        let v = self.slot_values(sp);
-        let mut inlet = match v[S_INLET_VELOCITY] {
+        self.process_planned(&self.slots_only(), sp, temperature_scale)
+    }
+
+    /// [`process`](Self::process) with the strengths resolved by `plan` (made by
+    /// [`plan`](Self::plan) from this physics).
+    #[inline]
+    pub fn process_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        sp: &[D],
+        temperature_scale: f64,
+    ) -> ProcessFactors<D> {
+        let velocity = plan.slot(S_INLET_VELOCITY, sp);
+        let diameter = plan.slot(S_INLET_DIAMETER, sp);
+        let die = plan.slot(S_DIE_TEMPERATURE, sp);
+        let mass = plan.slot(S_MASS_FLOW, sp);
+        let mut inlet = match velocity {
             Some(d) => d + 1.0,
             None => D::one(),
         };
-        if let Some(d) = v[S_INLET_DIAMETER] {
+        if let Some(d) = diameter {
             let f = d + 1.0;
             inlet /= f * f;
         }
         ProcessFactors {
             inlet_velocity: inlet,
-            die_temperature: v[S_DIE_TEMPERATURE]
-                .map_or(D::zero(), |d| d * temperature_scale.recip()),
-            mass_flow: v[S_MASS_FLOW].map_or(D::one(), |d| d + 1.0),
-            has_die_temperature: v[S_DIE_TEMPERATURE].is_some(),
-            has_mass_flow: v[S_MASS_FLOW].is_some(),
+            die_temperature: die.map_or(D::zero(), |d| d * temperature_scale.recip()),
+            mass_flow: mass.map_or(D::one(), |d| d + 1.0),
+            has_die_temperature: die.is_some(),
+            has_mass_flow: mass.is_some(),
         }
     }
 
@@ -904,12 +996,23 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         diameter_scale: f64,
     ) -> D {
-        let v = self.slot_values(sp);
+        self.gauge_reading_planned(&self.slots_only(), d, sp, diameter_scale)
+    }
+
+    /// [`gauge_reading`](Self::gauge_reading) with the strengths resolved by `plan`.
+    #[inline]
+    pub fn gauge_reading_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        d: D,
+        sp: &[D],
+        diameter_scale: f64,
+    ) -> D {
         let mut out = d;
-        if let Some(g) = v[S_GAUGE_SCALE] {
+        if let Some(g) = plan.slot(S_GAUGE_SCALE, sp) {
             out = d * (g + 1.0);
         }
-        if let Some(o) = v[S_GAUGE_OFFSET] {
+        if let Some(o) = plan.slot(S_GAUGE_OFFSET, sp) {
             out += o * (1e-6 / diameter_scale);
         }
         out
@@ -923,9 +1026,21 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         co: &Coefficients,
     ) -> (D, D) {
-        let val = self.slot_values(sp);
+        self.environment_planned(&self.slots_only(), s, sp, co)
+    }
+
+    /// [`environment`](Self::environment) with the strengths resolved by `plan`.
+    #[inline]
+    pub fn environment_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        s: f64,
+        sp: &[D],
+        co: &Coefficients,
+    ) -> (D, D) {
+        let val = |i| plan.slot(i, sp);
         let l_o = co.si.length;
-        let mut v = match (&self.air_speed, val[S_COFLOW], val[S_COFLOW_LEN]) {
+        let mut v = match (&self.air_speed, val(S_COFLOW), val(S_COFLOW_LEN)) {
             (AirSpeed::CoFlow { speed, .. }, Some(f), Some(ell)) => {
                 f * (D::from(-(co.length - s) * l_o) / ell).exp() * (speed / co.si.velocity)
             }
@@ -933,9 +1048,9 @@ impl<H: NusseltLaw> Physics<H> {
         };
         if let (LineCoflow::On { speed, .. }, Some(f), Some(s0), Some(w)) = (
             &self.line_coflow,
-            val[S_LINE],
-            val[S_LINE_ONSET],
-            val[S_LINE_RAMP],
+            val(S_LINE),
+            val(S_LINE_ONSET),
+            val(S_LINE_RAMP),
         ) {
             // logistic 1/(1 + e^(−z)) written without overflow for either sign of z
             let z = (-s0 + s * l_o) / w;
@@ -947,7 +1062,7 @@ impl<H: NusseltLaw> Physics<H> {
             };
             v += f * ramp * (speed / co.si.velocity);
         }
-        let t = match (&self.air_temperature, val[S_WARM], val[S_WARM_LEN]) {
+        let t = match (&self.air_temperature, val(S_WARM), val(S_WARM_LEN)) {
             (AirTemperature::WarmNozzle { excess, .. }, Some(f), Some(ell)) => {
                 f * (D::from(-s * l_o) / ell).exp() * (excess / co.si.temperature) + co.t_air
             }
@@ -1037,6 +1152,30 @@ impl<H: NusseltLaw> Physics<H> {
         (force, heat)
     }
 
+    /// [`sums`](Self::sums) with the strengths resolved by `plan` (made by [`plan`](Self::plan)
+    /// from this physics: one source per term).
+    #[inline]
+    pub fn sums_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        st: &LocalState<D>,
+        sp: &[D],
+        co: &Coefficients,
+    ) -> (D, D) {
+        let mut force = D::zero();
+        let mut heat = D::zero();
+        for (term, src) in self.terms.iter().zip(&plan.terms) {
+            if let Some(f) = src.value(sp) {
+                let v = self.term_value(term, st, co) * f;
+                match term.balance {
+                    Balance::Momentum => force += v,
+                    Balance::Energy => heat += v,
+                }
+            }
+        }
+        (force, heat)
+    }
+
     /// Value of every term (strength applied) at `st`: `(name, balance, dimensionless value)`.
     pub fn report(
         &self,
@@ -1077,5 +1216,73 @@ mod tests {
         assert!((v - 0.5 * cb).abs() < 1e-6 * cb, "{v} {cb}");
         let cross = law.nusselt(0.0, re * re, law.prandtl_argument(pr));
         assert!((cross - cb).abs() < 1e-6 * cb);
+    }
+
+    /// The planned evaluations (strengths resolved once) give bit-identical results to the
+    /// plain ones, with terms, air profiles, process and instrument parameters mixed.
+    #[test]
+    fn planned_evaluation_is_bit_identical() {
+        let physics = Physics::paper()
+            .with_radiation(0.9)
+            .with_coflow(2.0, 0.1)
+            .with_warm_air(30.0, 0.05)
+            .strength("radiation", Strength::Parameter(0.8))
+            .and_then(|p| p.strength("air_coflow", Strength::Parameter(1.1)))
+            .and_then(|p| p.strength("air_coflow.decay_length", Strength::Parameter(0.12)))
+            .and_then(|p| p.strength("air_temperature_profile", Strength::Fixed(0.7)))
+            .and_then(|p| p.strength("inlet_diameter", Strength::Parameter(0.05)))
+            .and_then(|p| p.strength("mass_flow_scale", Strength::Parameter(-0.02)))
+            .and_then(|p| p.strength("die_temperature_offset", Strength::Parameter(3.0)))
+            .and_then(|p| p.strength("gauge_offset", Strength::Parameter(1.5)))
+            .and_then(|p| p.strength("gauge_scale", Strength::Fixed(0.01)))
+            .unwrap();
+        let plan = physics.plan();
+        let n = physics.num_strength_params();
+        let sp: Vec<f64> = (0..n).map(|i| 0.3 + 0.1 * i as f64).collect();
+        let co = Coefficients::new(
+            &super::super::scaling::Scaling::default(),
+            &Air::paper(),
+            physics.slenderness,
+            1e-4,
+            300.0,
+            1.0,
+        );
+        for short in [false, true] {
+            // a too short `sp` gives NaN strengths, the same way in both
+            let sp = if short { &sp[..n - 2] } else { &sp[..] };
+            let (a, b) = (
+                physics.process(sp, 500.0),
+                physics.process_planned(&plan, sp, 500.0),
+            );
+            let bits = |v: f64| v.to_bits();
+            assert_eq!(bits(a.inlet_velocity), bits(b.inlet_velocity));
+            assert_eq!(bits(a.die_temperature), bits(b.die_temperature));
+            assert_eq!(bits(a.mass_flow), bits(b.mass_flow));
+            assert_eq!(
+                bits(physics.gauge_reading(0.7, sp, 1e-4)),
+                bits(physics.gauge_reading_planned(&plan, 0.7, sp, 1e-4))
+            );
+            for s in [0.0, 0.4, 0.9] {
+                let (t, v) = physics.environment(s, sp, &co);
+                let (tp, vp) = physics.environment_planned(&plan, s, sp, &co);
+                assert_eq!((bits(t), bits(v)), (bits(tp), bits(vp)));
+                let st = LocalState {
+                    s,
+                    u: 2.0,
+                    n: 5000.0,
+                    t: 0.9,
+                    rate: 3.0,
+                    rho: 1.1,
+                    cp: 1.2,
+                    d: 0.4,
+                    q: 1.0,
+                    t_air: t,
+                    v_air: v,
+                };
+                let (f, h) = physics.sums(&st, sp, &co);
+                let (fp, hp) = physics.sums_planned(&plan, &st, sp, &co);
+                assert_eq!((bits(f), bits(h)), (bits(fp), bits(hp)));
+            }
+        }
     }
 }

@@ -47,6 +47,7 @@ pub mod uncertainty;
 
 pub use contributions::{
     Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength,
+    StrengthPlan,
 };
 pub use error::FiberError;
 pub use material_law::{CarreauLike, CarreauYasuda, Newtonian, ViscosityLaw};

@@ -25,7 +25,7 @@
 
 use super::contributions::{
     Balance, Coefficients, InclinedChurchillBernstein, LocalState, NusseltLaw, Physics,
-    ProcessFactors,
+    ProcessFactors, StrengthPlan,
 };
 use super::error::FiberError;
 use super::material_law::{viscosity, viscosity_with_partials, ViscosityLaw, ZeroRateViscosity};
@@ -58,7 +58,8 @@ pub enum DimensionlessTakeUp {
 pub struct FiberModel<L: ViscosityLaw, H: NusseltLaw = InclinedChurchillBernstein> {
     /// The elongational viscosity law.
     pub law: L,
-    /// The contributions to the balances.
+    /// The contributions to the balances. Their strengths (off, fixed or which model parameter)
+    /// are resolved once at construction ([`Physics::plan`]); build a new model to change them.
     pub physics: Physics<H>,
     /// The non-dimensionalisation.
     pub scaling: Scaling,
@@ -80,6 +81,10 @@ pub struct FiberModel<L: ViscosityLaw, H: NusseltLaw = InclinedChurchillBernstei
     re0: f64,
     take_up: DimensionlessTakeUp,
     params: ParamLayout,
+    // the strengths of `physics` resolved at construction (the right-hand side reads them)
+    plan: StrengthPlan,
+    // whether the mass-flow scale is on (resolved at construction)
+    mass_flow_scaled: bool,
 }
 
 /// Where each model parameter sits in `p = [c, law parameters..., strengths..., φ]`
@@ -296,6 +301,9 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             t_vf: material.vft_t_vf / r.temperature,
         };
         let params = ParamLayout::new(law.num_params(), physics.num_strength_params());
+        let plan = physics.plan();
+        let mass_flow_scaled =
+            !matches!(physics.mass_flow_scale, super::contributions::Strength::Off);
         Ok(FiberModel {
             law,
             rho_a: material.density_slope * r.temperature / r.density,
@@ -315,6 +323,8 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             experiment: experiment.clone(),
             scaling,
             params,
+            plan,
+            mass_flow_scaled,
         })
     }
 
@@ -456,7 +466,9 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
     #[inline]
     pub fn fiber_diameter<D: DualNum<Primitive = f64> + Copy>(&self, y: &[D], p: &[D]) -> D {
         let sp = self.strength_slice(p);
-        let pf = self.physics.process(sp, self.scaling.reference.temperature);
+        let pf = self
+            .physics
+            .process_planned(&self.plan, sp, self.scaling.reference.temperature);
         let rho = self.density(y[2]);
         if pf.has_mass_flow {
             self.diameter_q(y[0], rho, pf.mass_flow)
@@ -473,16 +485,14 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
     pub fn observed_diameter<D: DualNum<Primitive = f64> + Copy>(&self, y: &[D], p: &[D]) -> D {
         let d = self.fiber_diameter(y, p);
         let sp = self.strength_slice(p);
-        self.physics.gauge_reading(d, sp, self.scaling.diameter())
+        self.physics
+            .gauge_reading_planned(&self.plan, d, sp, self.scaling.diameter())
     }
 
     /// Whether the mass flow is scaled (`mass_flow_scale` present in the physics).
     #[inline]
     fn has_mass_flow_scale(&self) -> bool {
-        !matches!(
-            self.physics.mass_flow_scale,
-            super::contributions::Strength::Off
-        )
+        self.mass_flow_scaled
     }
 
     /// The strength parameters within full parameters `p` (empty if `p` is too short).
@@ -509,7 +519,9 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         &self,
         sp: &[D],
     ) -> (D, D, ProcessFactors<D>) {
-        let pf = self.physics.process(sp, self.scaling.reference.temperature);
+        let pf = self
+            .physics
+            .process_planned(&self.plan, sp, self.scaling.reference.temperature);
         let mut u = pf.inlet_velocity * self.u_in;
         let t = if pf.has_die_temperature {
             pf.die_temperature + self.t_in
@@ -543,8 +555,12 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
     ) -> LocalState<D> {
         let (u, n, t, rate) = (y[0], y[1], y[2], y[3]);
         let rho = self.density(t);
-        let (t_air, v_air) = self.physics.environment(x, sp, &self.co);
-        let pf = self.physics.process(sp, self.scaling.reference.temperature);
+        let (t_air, v_air) = self
+            .physics
+            .environment_planned(&self.plan, x, sp, &self.co);
+        let pf = self
+            .physics
+            .process_planned(&self.plan, sp, self.scaling.reference.temperature);
         let (d, q) = if pf.has_mass_flow {
             (
                 self.diameter_q(u, rho, pf.mass_flow),
@@ -598,7 +614,7 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
         let lp = &p[self.params.law()];
         let sp = &p[self.params.strengths()];
         let st = self.local_state(x, y, sp);
-        let (force, heat) = self.physics.sums(&st, sp, &self.co);
+        let (force, heat) = self.physics.sums_planned(&self.plan, &st, sp, &self.co);
         let q = st.q;
         let f_n = st.rate * q - c * force;
         let f_t = c * heat / (st.cp * q);

@@ -5,7 +5,7 @@ use crate::error::BvpError;
 use crate::problem::Bvp;
 use crate::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
 use crate::solution::Solution;
-use crate::solve::{Guess, Solver};
+use crate::solve::{Guess, SolveOptions, Solver};
 
 /// One affine link of a [`ParamMap`]: model parameter `q[model] = offset + scale · p[fit]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -142,6 +142,15 @@ pub struct BvpRun<'a, P: Bvp, G> {
     y: Vec<f64>,
     yp: Vec<f64>,
     full: Vec<f64>,
+    // the mesh of the last solve at the solver's own tolerance, and whether the accepted and the
+    // pending solutions come from loose solves (a tight solve from a loose solution starts on
+    // that mesh, not on the loose solution's coarse one)
+    tight_mesh: Vec<f64>,
+    accepted_loose: bool,
+    pending_loose: bool,
+    // the calibration's loose solve at the accepted solution's parameters and its tolerance
+    // (the first loose evaluation, at the same point, reuses it)
+    calibration: Option<(f64, Solution)>,
 }
 
 impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
@@ -170,6 +179,7 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
             )));
         }
         map.validate(q, usize::MAX)?;
+        let tight_mesh = start.x.clone();
         Ok(BvpRun {
             solver,
             accepted: start,
@@ -181,6 +191,10 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
             y: vec![0.0; n],
             yp: vec![0.0; n],
             full: vec![0.0; k + q],
+            tight_mesh,
+            accepted_loose: false,
+            pending_loose: false,
+            calibration: None,
         })
     }
 
@@ -202,8 +216,19 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
 
     /// Replaces the accepted solution (e.g. by a cold-started one) and drops the pending one.
     pub fn set_accepted(&mut self, solution: Solution) {
+        self.tight_mesh = solution.x.clone();
+        self.calibration = None;
         self.accepted = solution;
+        self.accepted_loose = false;
         self.pending = None;
+    }
+
+    /// Promotes the pending solution, if any.
+    fn accept_pending(&mut self) {
+        if let Some(s) = self.pending.take() {
+            self.accepted = s;
+            self.accepted_loose = self.pending_loose;
+        }
     }
 
     /// The solution of the last successful evaluation not accepted yet.
@@ -244,34 +269,95 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         p: &[f64],
         jacobian: bool,
         start: Option<&Guess>,
+        tol: Option<f64>,
     ) -> Result<(Vec<f64>, Vec<f64>), BvpError> {
         self.map.model_params_into(p, &mut self.q);
         let own;
         let guess = match start {
             Some(g) => g,
+            None if tol.is_none() && self.accepted_loose => {
+                // a tight solve from a loose solution: its values on the last tight mesh
+                let (acc, n) = (&self.accepted, self.y.len());
+                let mut yp = vec![0.0; n];
+                own = Guess::from_fn(self.tight_mesh.clone(), n, |x, y| {
+                    acc.eval_into(x, y, &mut yp)
+                })
+                .with_unknowns(&acc.unknowns);
+                &own
+            }
             None => {
                 own = Guess::from(&self.accepted);
                 &own
             }
         };
-        let sol = self.solver.solve(&self.q, guess)?;
+        self.pending = None;
+        let cached = match (start, tol, self.calibration.take()) {
+            (None, Some(t), Some((tc, sol))) if t == tc && sol.params == self.q => Some(sol),
+            _ => None,
+        };
+        let sol = match (cached, tol) {
+            (Some(sol), _) => sol,
+            (None, Some(t)) => {
+                let opts = self.loose_options(t);
+                self.solver.solve_with(&self.q, guess, &opts)?
+            }
+            (None, None) => self.solver.solve(&self.q, guess)?,
+        };
+        self.pending_loose = tol.is_some();
+        if tol.is_none() {
+            self.tight_mesh.clone_from(&sol.x);
+        }
         let problem = self.solver.problem();
         let out = if jacobian {
             let sens = Sensitivities::compute(problem, &sol)?;
             residual_jacobian(problem, &sol, &sens, &self.points, &self.residual)?
         } else {
-            let k = sol.unknowns.len();
-            self.full[..k].copy_from_slice(&sol.unknowns);
-            self.full[k..].copy_from_slice(&sol.params);
-            let mut r = Vec::with_capacity(self.points.len());
-            for (j, &x) in self.points.iter().enumerate() {
-                sol.eval_into(x, &mut self.y, &mut self.yp);
-                r.push(self.residual.eval(j, x, &self.y, &self.full));
-            }
-            (r, Vec::new())
+            (self.residuals_of(&sol), Vec::new())
         };
         self.pending = Some(sol);
         Ok(out)
+    }
+
+    /// The solver's options with tolerance `tol` (a boundary tolerance of its own at least
+    /// `tol`).
+    fn loose_options(&self, tol: f64) -> SolveOptions {
+        let mut opts = self.solver.options.clone();
+        opts.tol = tol;
+        opts.bc_tol = opts.bc_tol.map(|b| b.max(tol));
+        opts
+    }
+
+    /// The residuals of solution `sol` at the observation points.
+    fn residuals_of(&mut self, sol: &Solution) -> Vec<f64> {
+        let k = sol.unknowns.len();
+        self.full[..k].copy_from_slice(&sol.unknowns);
+        self.full[k..].copy_from_slice(&sol.params);
+        let mut r = Vec::with_capacity(self.points.len());
+        for (j, &x) in self.points.iter().enumerate() {
+            sol.eval_into(x, &mut self.y, &mut self.yp);
+            r.push(self.residual.eval(j, x, &self.y, &self.full));
+        }
+        r
+    }
+
+    /// Squared differences, summed, between the residuals of the accepted solution and those
+    /// of a re-solve at its own parameters with tolerance `tol` (the calibration of
+    /// [`BvpResiduals::set_loose_tolerance`]), and the number of residuals.
+    fn loose_error(&mut self, tol: f64) -> Result<(f64, usize), BvpError> {
+        let accepted = self.accepted.clone();
+        let tight = self.residuals_of(&accepted);
+        let opts = self.loose_options(tol);
+        let sol = self
+            .solver
+            .solve_with(&accepted.params, &Guess::from(&accepted), &opts)?;
+        let loose = self.residuals_of(&sol);
+        let d2 = tight
+            .iter()
+            .zip(&loose)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum();
+        self.calibration = Some((tol, sol));
+        Ok((d2, tight.len()))
     }
 }
 
@@ -348,6 +434,11 @@ pub struct BvpResiduals<'a, P: Bvp, G> {
     num_params: usize,
     runs: Vec<BvpRun<'a, P, G>>,
     parallel: bool,
+    // loose evaluations: the loosest BVP tolerance, the calibrated RMS residual error per unit
+    // of tolerance, the tolerance of the next evaluations (`None`: the solvers' own)
+    loosest: Option<f64>,
+    error_per_tol: Option<f64>,
+    tol: Option<f64>,
 }
 
 impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
@@ -358,6 +449,9 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
             num_params,
             runs: Vec::new(),
             parallel: true,
+            loosest: None,
+            error_per_tol: None,
+            tol: None,
         }
     }
 
@@ -378,6 +472,66 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
     /// cargo feature the runs are always solved one after the other.
     pub fn set_parallel(&mut self, parallel: bool) {
         self.parallel = parallel;
+    }
+
+    /// Allows loose evaluations ([`LeastSquaresProblem::set_accuracy`], used by
+    /// [`Accuracy::Scheduled`](super::Accuracy::Scheduled)) with BVP tolerances up to
+    /// `loosest` (`None`: every solve with the solvers' own options, the default).
+    ///
+    /// An allowed RMS residual error `e` becomes the BVP tolerance
+    /// `clamp(e / c, tol_run, loosest)` (`tol_run` the smallest of the solvers' own
+    /// tolerances), where `c` is the RMS residual error per unit of tolerance, calibrated once
+    /// at the first loose request: every run's accepted solution is re-solved at its own
+    /// parameters with tolerance `loosest` and `c = RMS(r_loose − r_accepted)/loosest`. The
+    /// discretisation error falls at least linearly with the tolerance (a fourth-order
+    /// collocation: `h⁴` against a residual of `h³`), so below `loosest` the map overestimates
+    /// the error. A failed calibration solve turns the loose evaluations off.
+    pub fn set_loose_tolerance(&mut self, loosest: Option<f64>) {
+        self.loosest = loosest.filter(|t| t.is_finite() && *t > 0.0);
+        self.error_per_tol = None;
+        self.tol = None;
+    }
+
+    /// The BVP tolerance of the next evaluations (`None`: the solvers' own).
+    pub fn current_tolerance(&self) -> Option<f64> {
+        self.tol
+    }
+
+    /// The calibrated RMS residual error per unit of BVP tolerance (see
+    /// [`set_loose_tolerance`](Self::set_loose_tolerance); `None` before the first loose
+    /// request).
+    pub fn error_per_tolerance(&self) -> Option<f64> {
+        self.error_per_tol
+    }
+
+    /// The smallest of the runs' own tolerances.
+    fn tight_tol(&self) -> f64 {
+        self.runs
+            .iter()
+            .map(|r| r.solver.options.tol)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Calibrates [`error_per_tolerance`](Self::error_per_tolerance) at tolerance `loosest`.
+    fn calibrate(&mut self, loosest: f64) -> Result<f64, RunError> {
+        let one = |(k, run): (usize, &mut BvpRun<'a, P, G>)| {
+            run.loose_error(loosest)
+                .map_err(|source| RunError { run: k, source })
+        };
+        #[cfg(feature = "parallel")]
+        let parts: Result<Vec<(f64, usize)>, RunError> = if self.parallel && self.runs.len() > 1 {
+            use rayon::prelude::*;
+            self.runs.par_iter_mut().enumerate().map(one).collect()
+        } else {
+            self.runs.iter_mut().enumerate().map(one).collect()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let parts: Result<Vec<(f64, usize)>, RunError> =
+            self.runs.iter_mut().enumerate().map(one).collect();
+        let (d2, n) = parts?
+            .into_iter()
+            .fold((0.0, 0), |(a, b), (c, d)| (a + c, b + d));
+        Ok((d2 / n.max(1) as f64).sqrt() / loosest)
     }
 
     /// The runs.
@@ -481,8 +635,9 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
         jacobian: bool,
         starts: Option<&[Guess]>,
     ) -> Result<Vec<(Vec<f64>, Vec<f64>)>, RunError> {
+        let tol = self.tol;
         let one = |(k, run): (usize, &mut BvpRun<'a, P, G>)| {
-            run.eval(p, jacobian, starts.map(|g| &g[k]))
+            run.eval(p, jacobian, starts.map(|g| &g[k]), tol)
                 .map_err(|source| RunError { run: k, source })
         };
         #[cfg(feature = "parallel")]
@@ -504,9 +659,7 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
     /// Makes the pending solutions the accepted ones (the warm starts of the next evaluation).
     pub fn accept_pending(&mut self) {
         for run in &mut self.runs {
-            if let Some(s) = run.pending.take() {
-                run.accepted = s;
-            }
+            run.accept_pending();
         }
     }
 
@@ -541,6 +694,31 @@ impl<P: Bvp + Sync, G: PointFunction + Send> LeastSquaresProblem for BvpResidual
     }
     fn accept(&mut self, _p: &[f64]) {
         self.accept_pending();
+    }
+    fn set_accuracy(&mut self, rms_error: Option<f64>) -> bool {
+        let (Some(e), Some(loosest)) = (rms_error, self.loosest) else {
+            self.tol = None;
+            return false;
+        };
+        let c = match self.error_per_tol {
+            Some(c) => c,
+            None => match self.calibrate(loosest) {
+                Ok(c) => {
+                    self.error_per_tol = Some(c);
+                    c
+                }
+                Err(_) => {
+                    self.loosest = None;
+                    self.tol = None;
+                    return false;
+                }
+            },
+        };
+        let tight = self.tight_tol();
+        let tol = if c > 0.0 { e / c } else { loosest };
+        let tol = tol.min(loosest);
+        self.tol = (tol > tight).then_some(tol);
+        true
     }
 }
 

@@ -27,6 +27,21 @@
 //! [`FitOptions::f_scale`] minimise scipy's `½ C² Σ ρ((rᵢ/C)²)` instead (soft-L1, Huber,
 //! Cauchy; see [`loss`]); the iteration stays Gauss–Newton on rescaled residuals and Jacobian.
 //! The covariance under a robust loss is the sandwich (see [`FitResult::covariance`]).
+//!
+//! **Accuracy matched to the data.** With [`FitOptions::accuracy`] = [`Accuracy::Scheduled`]
+//! the driver asks the problem ([`LeastSquaresProblem::set_accuracy`]) for loose evaluations
+//! while the iterate is far from the optimum: a model error (e.g. the discretisation error of
+//! BVP solves) of RMS `e = η · max(σ̂, ‖J s‖/√N)` per residual is allowed (the start point is
+//! evaluated at the loosest accuracy the problem offers), with `σ̂` the RMS
+//! residual (the noise level at the optimum), `‖J s‖` the predicted effect of the trial step on
+//! the residuals and `η` = [`AccuracySchedule::fraction`] (default 10⁻²). Once the loose
+//! iteration has converged (any stopping test) or its step moves the estimate by less than
+//! [`AccuracySchedule::switch_below`] standard errors (`‖J s‖/σ̂`), the current iterate is
+//! re-evaluated at full accuracy and the iteration goes on there for at most
+//! [`AccuracySchedule::final_iterations`] trial steps, with the usual stopping tests: the
+//! returned optimum, residuals and Jacobian (hence the covariance) are those of full-accuracy
+//! evaluations. [`BvpResiduals::set_loose_tolerance`] turns an allowed residual error into a BVP
+//! tolerance.
 
 mod bvp;
 pub mod loss;
@@ -48,6 +63,61 @@ pub trait LeastSquaresProblem {
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Self::Error>;
     /// Called when `p` (the last point passed to `evaluate`) becomes the new iterate.
     fn accept(&mut self, _p: &[f64]) {}
+    /// Sets how accurate the following evaluations need to be: `Some(e)` allows a model error
+    /// (e.g. the discretisation error of BVP solves) of RMS `e` per residual (residual units);
+    /// `None` asks for the problem's full accuracy. Returns whether the problem evaluates
+    /// loosely when allowed to; the default ignores the request and returns `false` (every
+    /// evaluation at full accuracy, as [`Accuracy::Fixed`]).
+    fn set_accuracy(&mut self, _rms_error: Option<f64>) -> bool {
+        false
+    }
+}
+
+/// How accurately a fit evaluates its model ([`FitOptions::accuracy`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Accuracy {
+    /// Every evaluation at the problem's full accuracy (the default).
+    #[default]
+    Fixed,
+    /// Loose evaluations while far from the optimum, full accuracy for the final iterations
+    /// (see the [module documentation](self)).
+    Scheduled(AccuracySchedule),
+}
+
+impl Accuracy {
+    /// [`Accuracy::Scheduled`] with the default [`AccuracySchedule`].
+    pub fn scheduled() -> Self {
+        Accuracy::Scheduled(AccuracySchedule::default())
+    }
+}
+
+/// Settings of [`Accuracy::Scheduled`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AccuracySchedule {
+    /// `η`: allowed RMS model error per residual as a fraction of `max(σ̂, ‖J s‖/√N)`
+    /// (default 10⁻²).
+    pub fraction: f64,
+    /// Switch to full accuracy once a trial step moves the estimate by less than this many
+    /// standard errors, `‖J s‖/σ̂` (default 0.1).
+    pub switch_below: f64,
+    /// Trial steps allowed at full accuracy after the switch (default 10).
+    pub final_iterations: usize,
+    /// After the switch, a rejected trial step that moves the estimate by less than this many
+    /// standard errors (`‖J s‖/σ̂`) ends the fit ([`Termination::Step`]): such a step is at the
+    /// noise floor of the full-accuracy model itself, and the trust region would otherwise
+    /// re-evaluate it until the radius falls below it (default 10⁻⁴).
+    pub negligible_step: f64,
+}
+
+impl Default for AccuracySchedule {
+    fn default() -> Self {
+        AccuracySchedule {
+            fraction: 1e-2,
+            switch_below: 0.1,
+            final_iterations: 10,
+            negligible_step: 1e-4,
+        }
+    }
 }
 
 /// Options of [`fit`].
@@ -74,6 +144,8 @@ pub struct FitOptions {
     /// Soft margin `C` between inlier and outlier residuals, in residual units (default 1;
     /// unused by the linear loss).
     pub f_scale: f64,
+    /// How accurately the model is evaluated (default [`Accuracy::Fixed`]).
+    pub accuracy: Accuracy,
 }
 
 impl FitOptions {
@@ -90,6 +162,7 @@ impl FitOptions {
             max_iterations: 100,
             loss: Loss::Linear,
             f_scale: 1.0,
+            accuracy: Accuracy::Fixed,
         }
     }
 }
@@ -150,6 +223,9 @@ pub struct FitIteration {
     pub radius: f64,
     /// The evaluation error, if any.
     pub failure: Option<String>,
+    /// The RMS model error per residual allowed for the trial point's evaluation (`None`: full
+    /// accuracy; see [`Accuracy::Scheduled`]).
+    pub allowed_error: Option<f64>,
     /// Wall time since the start of the fit \[s\].
     pub elapsed_s: f64,
 }
@@ -195,6 +271,13 @@ pub struct FitResult {
     pub loss: Loss,
     /// Its soft margin `C` (residual units).
     pub f_scale: f64,
+    /// Trial steps evaluated at loose accuracy ([`Accuracy::Scheduled`]; 0 for
+    /// [`Accuracy::Fixed`] or a problem without loose evaluations).
+    pub loose_iterations: usize,
+    /// RMS difference per residual between the loose and the full-accuracy residuals at the
+    /// iterate where [`Accuracy::Scheduled`] switched to full accuracy (the model error the loose
+    /// phase actually had there; `None` without a switch).
+    pub switch_model_error: Option<f64>,
 }
 
 /// Errors of [`fit`] itself (the model failing at the start point, bad bounds).
@@ -207,6 +290,15 @@ pub enum FitError {
     #[error("the model could not be evaluated at the start point {p:?}: {cause}")]
     StartFailed {
         /// Start point.
+        p: Vec<f64>,
+        /// Cause.
+        cause: String,
+    },
+    /// [`Accuracy::Scheduled`]: the model could not be evaluated at full accuracy at the
+    /// iterate of the loose phase.
+    #[error("the model could not be evaluated at full accuracy at {p:?}: {cause}")]
+    RefineFailed {
+        /// The iterate.
         p: Vec<f64>,
         /// Cause.
         cause: String,
@@ -425,9 +517,39 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             )));
         }
     }
+    let schedule = match options.accuracy {
+        Accuracy::Fixed => None,
+        Accuracy::Scheduled(s) => {
+            for (name, v) in [
+                ("fraction", s.fraction),
+                ("switch_below", s.switch_below),
+                ("negligible_step", s.negligible_step),
+            ] {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(FitError::InvalidInput(format!(
+                        "AccuracySchedule::{name} must be non-negative and finite, got {v}"
+                    )));
+                }
+            }
+            Some(s)
+        }
+    };
     let (lo, hi) = (&options.lower, &options.upper);
     let mut p = p0.to_vec();
-    let (mut r, mut jac) = problem.evaluate(&p).map_err(|e| FitError::StartFailed {
+    // the start point at the loosest accuracy the problem offers (no residuals yet to scale
+    // the allowed error by), at full accuracy if that fails or without a schedule
+    let loose_start = schedule.is_some() && problem.set_accuracy(Some(f64::INFINITY));
+    if !loose_start {
+        problem.set_accuracy(None);
+    }
+    let start = match problem.evaluate(&p) {
+        Err(_) if loose_start => {
+            problem.set_accuracy(None);
+            problem.evaluate(&p)
+        }
+        other => other,
+    };
+    let (mut r, mut jac) = start.map_err(|e| FitError::StartFailed {
         p: p.clone(),
         cause: e.to_string(),
     })?;
@@ -449,8 +571,43 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         history.push(it);
     };
     let (mut iterations, mut accepted_steps, mut failed) = (0, 0, 0);
+    // Accuracy::Scheduled: whether the evaluations are loose, the iteration limit of the
+    // full-accuracy phase, the loose trial steps and the model error measured at the switch
+    let mut loose = schedule.is_some();
+    let mut tight_limit: Option<usize> = None;
+    let (mut loose_iterations, mut switch_model_error) = (0, None);
+    // a stopping test met: ends the fit, or (loose) switches to full accuracy
+    let mut stop: Option<Termination> = None;
     let termination;
     loop {
+        if let Some(t) = stop.take() {
+            if !loose {
+                termination = t;
+                break;
+            }
+            // re-evaluate the iterate at full accuracy and go on from there
+            loose = false;
+            problem.set_accuracy(None);
+            let (r_t, j_t) = problem.evaluate(&p).map_err(|e| FitError::RefineFailed {
+                p: p.clone(),
+                cause: e.to_string(),
+            })?;
+            if r_t.len() != nr || !r_t.iter().all(|x| x.is_finite()) {
+                return Err(FitError::RefineFailed {
+                    p: p.clone(),
+                    cause: "non-finite or mis-sized residuals".into(),
+                });
+            }
+            problem.accept(&p);
+            let d2: f64 = r_t.iter().zip(&r).map(|(a, b)| (a - b) * (a - b)).sum();
+            switch_model_error = Some((d2 / nr as f64).sqrt());
+            scaled = loss::rescale(loss, f_scale, &r_t, &j_t, np);
+            cost = loss::robust_cost(loss, f_scale, &r_t);
+            r = r_t;
+            jac = j_t;
+            radius = radius.max(options.initial_radius.min(options.max_radius));
+            tight_limit = Some(iterations + schedule.map_or(0, |s| s.final_iterations));
+        }
         let (r_gn, jac_gn) = match &scaled {
             Some((rs, js)) => (rs.as_slice(), js.as_slice()),
             None => (r.as_slice(), jac.as_slice()),
@@ -461,16 +618,16 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         let v = cl_scaling(&p, g.as_slice(), lo, hi);
         let scaled_g = (0..np).map(|i| (g[i] * v[i]).abs()).fold(0.0, f64::max);
         if scaled_g <= options.gtol {
-            termination = Termination::Gradient;
-            break;
+            stop = Some(Termination::Gradient);
+            continue;
         }
-        if iterations >= options.max_iterations {
-            termination = Termination::MaxIterations;
-            break;
+        if iterations >= tight_limit.unwrap_or(options.max_iterations) {
+            stop = Some(Termination::MaxIterations);
+            continue;
         }
         if radius < 1e-12 {
-            termination = Termination::RadiusCollapsed;
-            break;
+            stop = Some(Termination::RadiusCollapsed);
+            continue;
         }
         let d: Vec<f64> = v.iter().map(|x| 1.0 / x.sqrt()).collect();
         let s = trust_region_step(&jm, &rv, &d, radius);
@@ -496,6 +653,41 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         let step_vec = DVector::from_column_slice(&step);
         let jr = &jm * &step_vec;
         let pred_trial = -(jr.dot(&rv) + 0.5 * jr.norm_squared());
+        // Accuracy::Scheduled: the step's length in standard errors, ‖J s‖/σ̂, with σ̂ the RMS
+        // residual (at most the soft margin under a robust loss)
+        let (sigma, effect) = match schedule {
+            Some(_) => {
+                let dof = nr.saturating_sub(np).max(1) as f64;
+                let mut sigma = (r.iter().map(|x| x * x).sum::<f64>() / dof).sqrt();
+                if !loss.is_linear() {
+                    sigma = sigma.min(f_scale);
+                }
+                let effect = (&DMatrix::from_row_slice(nr, np, &jac) * &step_vec).norm();
+                (sigma, effect)
+            }
+            None => (f64::NAN, f64::NAN),
+        };
+        let allowed_error = match schedule {
+            Some(sch) if loose => {
+                if effect <= sch.switch_below * sigma {
+                    // the step moves the estimate by less than `switch_below` standard errors
+                    stop = Some(Termination::Step);
+                    continue;
+                }
+                let e = sch.fraction * sigma.max(effect / (nr as f64).sqrt());
+                if problem.set_accuracy(Some(e)) {
+                    Some(e)
+                } else {
+                    // the problem has no loose evaluations: a fixed-accuracy fit
+                    loose = false;
+                    None
+                }
+            }
+            _ => None,
+        };
+        if allowed_error.is_some() {
+            loose_iterations += 1;
+        }
         iterations += 1;
         let pnorm = p.iter().map(|x| x * x).sum::<f64>().sqrt();
         let snorm = step_vec.norm();
@@ -527,6 +719,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                     accepted,
                     radius,
                     failure: None,
+                    allowed_error,
                     elapsed_s: t0.elapsed().as_secs_f64(),
                 });
                 if accepted {
@@ -539,16 +732,16 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                     jac = j_new;
                     cost = cost_new;
                     if rel_change < options.ftol {
-                        termination = Termination::CostChange;
-                        break;
-                    }
-                    if snorm <= options.xtol * (options.xtol + pnorm) {
-                        termination = Termination::Step;
-                        break;
+                        stop = Some(Termination::CostChange);
+                    } else if snorm <= options.xtol * (options.xtol + pnorm) {
+                        stop = Some(Termination::Step);
                     }
                 } else if snorm <= options.xtol * (options.xtol + pnorm) {
-                    termination = Termination::Step;
-                    break;
+                    stop = Some(Termination::Step);
+                } else if let (Some(sch), Some(_)) = (schedule, tight_limit) {
+                    if effect <= sch.negligible_step * sigma {
+                        stop = Some(Termination::Step);
+                    }
                 }
             }
             other => {
@@ -569,6 +762,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                     accepted: false,
                     radius,
                     failure: Some(failure),
+                    allowed_error,
                     elapsed_s: t0.elapsed().as_secs_f64(),
                 });
             }
@@ -587,5 +781,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         history,
         loss,
         f_scale,
+        loose_iterations,
+        switch_model_error,
     })
 }

@@ -12,7 +12,7 @@ use super::estimator::Estimator;
 use super::layout::{EffectSlot, FitStart};
 use super::options::{FitWarning, IdentifyOptions, RheometerError};
 use crate::fiber::effects::LawChoice;
-use crate::least_squares::{fit, FitOptions, FitResult, Loss};
+use crate::least_squares::{fit, Accuracy, FitOptions, FitResult, Loss};
 use crate::solution::Solution;
 use std::time::Instant;
 
@@ -66,6 +66,11 @@ impl Rheometer {
                 1.0
             } else {
                 f_scale / sigma
+            },
+            accuracy: if options.loose_tolerance.is_some() {
+                Accuracy::scheduled()
+            } else {
+                Accuracy::Fixed
             },
             ..FitOptions::with_bounds(lower.clone(), upper.clone())
         };

@@ -186,6 +186,7 @@ impl<'a> Objective<'a> {
             Estimator::Principled => ns + rheo.len(),
         };
         let mut fit = BvpResiduals::new(num_params);
+        fit.set_loose_tolerance(options.loose_tolerance);
         for run in runs? {
             fit.push(run)
                 .map_err(|e| RheometerError::Data(format!("parameter layout: {e}")))?;
@@ -405,5 +406,8 @@ impl LeastSquaresProblem for Objective<'_> {
     }
     fn accept(&mut self, _p: &[f64]) {
         self.runs.accept_pending();
+    }
+    fn set_accuracy(&mut self, rms_error: Option<f64>) -> bool {
+        self.runs.set_accuracy(rms_error)
     }
 }

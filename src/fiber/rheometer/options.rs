@@ -75,6 +75,12 @@ pub struct IdentifyOptions {
     /// Soft margin `C` of a robust loss, in relative-residual units \[-\] (e.g. 0.02 = 2 %);
     /// `None`: the robust noise scale of the data ([`Rheometer::data_noise_scale`](super::Rheometer::data_noise_scale)).
     pub f_scale: Option<f64>,
+    /// Loosest BVP tolerance \[-\] of the inner Gauss–Newton iterations (default `Some(1e-3)`):
+    /// far from the optimum the BVPs are solved only as accurately as the noise and the step
+    /// need ([`Accuracy::Scheduled`](crate::least_squares::Accuracy::Scheduled), at most 1 % of
+    /// the noise or of the step's effect on the residuals), the final iterations, the estimate
+    /// and its covariance at `simulate.tol`. `None`: every solve at `simulate.tol`.
+    pub loose_tolerance: Option<f64>,
 }
 
 impl Default for IdentifyOptions {
@@ -94,6 +100,7 @@ impl Default for IdentifyOptions {
             relative_uncertainty: None,
             loss: Loss::Linear,
             f_scale: None,
+            loose_tolerance: Some(1e-3),
         }
     }
 }
