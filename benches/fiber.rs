@@ -27,6 +27,11 @@ fn bench(c: &mut Criterion) {
     let opts = SimulateOptions::with_tol(1e-6);
     let cold = simulate(&m, &[0.8, 11.71], &opts).expect("cold solve");
     let near = simulate(&m, &[0.79, 11.70], &opts).expect("nearby solve");
+    // as in a fit, where the previous iterate's sensitivities were computed: its linearisation
+    // is cached and the warm re-solve starts from the tangent predictor
+    let near_linearized = near.clone();
+    diffbvp::sensitivity::Sensitivities::compute(&m, &near_linearized.solution)
+        .expect("sensitivities");
     let warm = simulate_from(&m, &[0.8, 11.71], &near, &opts).expect("warm solve");
     eprintln!(
         "nodes: cold {} (newton its {}, rhs evals {}), warm {} (newton its {}, rhs evals {})",
@@ -62,6 +67,28 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             simulate_from(black_box(&m), black_box(&[0.8, 11.71]), &near, &opts).expect("warm")
         })
+    });
+    let tangent =
+        simulate_from(&m, &[0.8, 11.71], &near_linearized, &opts).expect("tangent warm solve");
+    eprintln!(
+        "warm from the tangent predictor: nodes {}, newton its {}, rhs evals {}",
+        tangent.nodes(),
+        tangent.solution.stats.newton_iterations,
+        tangent.solution.stats.total_rhs_evaluations()
+    );
+    c.bench_function("fiber_warm_tangent_v0p53_p2_tol1e-6", |b| {
+        b.iter(|| {
+            simulate_from(
+                black_box(&m),
+                black_box(&[0.8, 11.71]),
+                &near_linearized,
+                &opts,
+            )
+            .expect("warm")
+        })
+    });
+    c.bench_function("fiber_warm_tangent_reused_simulator_v0p53_p2_tol1e-6", |b| {
+        b.iter(|| sim.warm(black_box(&[0.8, 11.71]), &near_linearized).expect("warm"))
     });
 }
 

@@ -350,3 +350,66 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
     }
     Ok((value, dg_dp))
 }
+
+/// Tangent (first-order) predictor: the warm start for a solve at the model parameters
+/// `params` from the solution `sol` at `sol.params`, `Y + D_p Y · (params − sol.params)` on the
+/// mesh of `sol`, unknown parameters included. `D_p Y · Δp` costs one linear solve with the
+/// factorisation of the solution's linearisation (cached in `sol`; computed once and cached if
+/// it is not there yet). Newton started from it converges in fewer iterations than from `sol`
+/// itself when the step is small (on the fiber model: 1 iteration instead of 4 for a step of
+/// 0.01 in `n` and `κ`); far from `sol` it is no better than `sol` and may be worse, so a caller
+/// should keep `Guess::from(sol)` as the fallback.
+///
+/// Errors if `params` does not have `num_params()` finite values or `sol` does not belong to
+/// `problem`.
+pub fn tangent_guess<P: Bvp>(
+    problem: &P,
+    sol: &Solution,
+    params: &[f64],
+) -> Result<crate::solve::Guess, BvpError> {
+    let q = problem.num_params();
+    if params.len() != q {
+        return Err(BvpError::InvalidInput(format!(
+            "tangent_guess: the problem has {q} model parameters but {} values were given",
+            params.len()
+        )));
+    }
+    if let Some(j) = params.iter().position(|v| !v.is_finite()) {
+        return Err(BvpError::InvalidInput(format!(
+            "tangent_guess: model parameter {j} is not finite"
+        )));
+    }
+    let lz = linearization(problem, sol)?;
+    let (n, k, m) = (lz.col.n, lz.col.k, lz.col.m());
+    let size = m * n + k;
+    let mut rhs = vec![0.0; size];
+    let mut column = vec![0.0; size];
+    for (j, (new, old)) in params.iter().zip(&sol.params).enumerate() {
+        let dp = new - old;
+        if dp == 0.0 {
+            continue;
+        }
+        lz.col.param_column(k + j, &mut column);
+        for (r, c) in rhs.iter_mut().zip(&column) {
+            *r -= dp * c;
+        }
+    }
+    lz.factorization.solve_in_place(&mut rhs, 1)?;
+    if rhs.iter().any(|v| !v.is_finite()) {
+        return Err(BvpError::SingularJacobian {
+            detail: "the tangent predictor's solve gave a non-finite value".into(),
+        });
+    }
+    let y = sol.y.iter().zip(&rhs[..m * n]).map(|(y, d)| y + d).collect();
+    let unknowns = sol
+        .unknowns
+        .iter()
+        .zip(&rhs[m * n..])
+        .map(|(u, d)| u + d)
+        .collect();
+    Ok(crate::solve::Guess {
+        x: sol.x.clone(),
+        y,
+        unknowns,
+    })
+}

@@ -3,7 +3,7 @@
 use super::LeastSquaresProblem;
 use crate::error::BvpError;
 use crate::problem::Bvp;
-use crate::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
+use crate::sensitivity::{residual_jacobian, tangent_guess, PointFunction, Sensitivities};
 use crate::solution::Solution;
 use crate::solve::{Guess, SolveOptions, Solver};
 
@@ -273,6 +273,7 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
     ) -> Result<(Vec<f64>, Vec<f64>), BvpError> {
         self.map.model_params_into(p, &mut self.q);
         let own;
+        let mut predicted = false;
         let guess = match start {
             Some(g) => g,
             None if tol.is_none() && self.accepted_loose => {
@@ -286,7 +287,15 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
                 &own
             }
             None => {
-                own = Guess::from(&self.accepted);
+                // the tangent predictor from the accepted solution when its linearisation is
+                // cached (it is after a Jacobian evaluation): one linear solve, and Newton needs
+                // about half the iterations of a start from the accepted solution itself
+                let tangent = match self.accepted.factorization() {
+                    Some(_) => tangent_guess(self.solver.problem(), &self.accepted, &self.q).ok(),
+                    None => None,
+                };
+                predicted = tangent.is_some();
+                own = tangent.unwrap_or_else(|| Guess::from(&self.accepted));
                 &own
             }
         };
@@ -301,7 +310,14 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
                 let opts = self.loose_options(t);
                 self.solver.solve_with(&self.q, guess, &opts)?
             }
-            (None, None) => self.solver.solve(&self.q, guess)?,
+            (None, None) => match self.solver.solve(&self.q, guess) {
+                Ok(sol) => sol,
+                // a predictor that led Newton astray: the accepted solution itself
+                Err(_) if predicted => {
+                    self.solver.solve(&self.q, &Guess::from(&self.accepted))?
+                }
+                Err(e) => return Err(e),
+            },
         };
         self.pending_loose = tol.is_some();
         if tol.is_none() {

@@ -215,13 +215,20 @@ impl Scenario {
 
     fn write(&self, measured: &[Vec<f64>]) -> Result<PathBuf, String> {
         static COUNTER: AtomicUsize = AtomicUsize::new(0);
+        // one directory per test binary, scenario and data set made in this process: a later
+        // run of the same test overwrites its own data instead of adding to them
+        let binary = std::env::current_exe()
+            .ok()
+            .and_then(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+            .map(|s| s.split('-').next().unwrap_or("tests").to_string())
+            .unwrap_or_else(|| "tests".to_string());
         let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
             .join("target")
             .join("independent-data")
+            .join(binary)
             .join(format!(
-                "{}-{}-{}",
+                "{}-{}",
                 self.name,
-                std::process::id(),
                 COUNTER.fetch_add(1, Ordering::Relaxed)
             ));
         let _ = std::fs::remove_dir_all(&dir);
