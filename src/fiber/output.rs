@@ -176,7 +176,7 @@ pub fn create_output_dir(dir: &Path, inputs: &[PathBuf]) -> Result<(), OutputErr
     create_dir(dir)
 }
 
-pub use crate::atomic_write::temporary_sibling;
+pub use crate::atomic_write::{remove_pending_temporaries, temporary_sibling};
 
 /// Writes `path` atomically: `write` fills a temporary sibling (see [`temporary_sibling`]),
 /// which is then renamed over `path`. Refuses an input first ([`ensure_not_input`]). On any
@@ -187,7 +187,8 @@ pub fn write_atomically(
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), OutputError> {
     ensure_not_input(path, inputs)?;
-    let tmp = temporary_sibling(path);
+    let pending = crate::atomic_write::PendingTemporary::new(path);
+    let tmp = pending.path();
     let io = |source| OutputError::Io {
         path: path.to_path_buf(),
         source,
@@ -196,15 +197,15 @@ pub fn write_atomically(
         let file = fs::OpenOptions::new()
             .write(true)
             .create_new(true)
-            .open(&tmp)?;
+            .open(tmp)?;
         let mut w = BufWriter::with_capacity(1 << 16, file);
         write(&mut w)?;
         // flush errors (a full disk) surface here, before the rename
         w.into_inner().map_err(|e| e.into_error())?;
-        fs::rename(&tmp, path)
+        fs::rename(tmp, path)
     })();
     if let Err(e) = result {
-        let _ = fs::remove_file(&tmp);
+        let _ = fs::remove_file(tmp);
         return Err(io(e));
     }
     Ok(())

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::error::{invalid, PlotError};
 use super::fonts::ensure_font;
-use crate::atomic_write::temporary_sibling;
+use crate::atomic_write::PendingTemporary;
 
 /// Largest accepted figure side, in pixels (guards against huge allocations).
 pub const MAX_SIDE: u32 = 16_384;
@@ -112,20 +112,21 @@ pub(super) fn write_figure<F: Figure>(
     }
     // written to a temporary sibling and renamed into place: never a half-written figure, and
     // an existing file (or hard link) at `path` is replaced, not truncated
-    let tmp = temporary_sibling(path);
+    let pending = PendingTemporary::new(path);
+    let tmp = pending.path();
     let written = match format {
         FigureFormat::Png => {
-            let mut backend = BitMapBackend::new(&tmp, size);
+            let mut backend = BitMapBackend::new(tmp, size);
             backend
                 .blit_bitmap((0, 0), size, &rgb)
                 .and_then(|()| backend.present())
                 .map_err(|e| draw_err(Box::new(e)))
         }
-        FigureFormat::Svg => fs::write(&tmp, svg).map_err(io_err),
+        FigureFormat::Svg => fs::write(tmp, svg).map_err(io_err),
     }
-    .and_then(|()| fs::rename(&tmp, path).map_err(io_err));
+    .and_then(|()| fs::rename(tmp, path).map_err(io_err));
     if written.is_err() {
-        let _ = fs::remove_file(&tmp);
+        let _ = fs::remove_file(tmp);
     }
     written
 }

@@ -39,9 +39,9 @@ macro_rules! outln {
 /// The first error writing to stdout other than a closed pipe.
 static STDOUT_ERROR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
 
-/// Set by the first SIGINT while `simulate` or `landscape` runs: they stop between experiments
-/// or grid points, keep and mark what they finished, and exit with code 130. A second SIGINT
-/// ends the program at once.
+/// Set by the first SIGINT: `simulate` and `landscape` stop between experiments or grid points,
+/// keep and mark what they finished, and exit with code 130; the other commands end at once
+/// (code 130, no temporary left). A second SIGINT ends the program at once.
 pub static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// Whether SIGINT was received (see [`INTERRUPTED`]).
@@ -378,9 +378,14 @@ fn main() -> ExitCode {
             };
         }
     };
+    // `simulate` and `landscape` stop cleanly (they check the flag between experiments or grid
+    // points); the other commands end at once, without leaving a temporary of a write in
+    // progress behind
+    sigint::install();
     if matches!(cli.command, Command::Simulate(_) | Command::Landscape(_)) {
-        sigint::install();
-        interrupt_watchdog();
+        interrupt_watchdog(INTERRUPT_GRACE);
+    } else {
+        interrupt_watchdog(std::time::Duration::ZERO);
     }
     let result = run(cli);
     let stdout_ok = finish_stdout();
@@ -419,13 +424,15 @@ fn main() -> ExitCode {
 /// `PARTIAL.txt` manifest up to date, so ending here loses no finished file.
 const INTERRUPT_GRACE: std::time::Duration = std::time::Duration::from_millis(1500);
 
-/// Starts a thread that ends the program [`INTERRUPT_GRACE`] after SIGINT.
-fn interrupt_watchdog() {
-    std::thread::spawn(|| {
+/// Starts a thread that ends the program `grace` after SIGINT (within 25 ms of it for a zero
+/// grace), after removing the temporaries of writes in progress.
+fn interrupt_watchdog(grace: std::time::Duration) {
+    std::thread::spawn(move || {
         while !interrupted() {
             std::thread::sleep(std::time::Duration::from_millis(25));
         }
-        std::thread::sleep(INTERRUPT_GRACE);
+        std::thread::sleep(grace);
+        diffbvp::fiber::output::remove_pending_temporaries();
         err_line("interrupted: stopped before the current step finished; finished files are kept");
         std::process::exit(i32::from(EXIT_INTERRUPTED));
     });
