@@ -87,9 +87,15 @@ fn bench(c: &mut Criterion) {
             .expect("warm")
         })
     });
-    c.bench_function("fiber_warm_tangent_reused_simulator_v0p53_p2_tol1e-6", |b| {
-        b.iter(|| sim.warm(black_box(&[0.8, 11.71]), &near_linearized).expect("warm"))
-    });
+    c.bench_function(
+        "fiber_warm_tangent_reused_simulator_v0p53_p2_tol1e-6",
+        |b| {
+            b.iter(|| {
+                sim.warm(black_box(&[0.8, 11.71]), &near_linearized)
+                    .expect("warm")
+            })
+        },
+    );
 }
 
 fn bench_rhs(c: &mut Criterion) {

@@ -400,7 +400,12 @@ pub fn tangent_guess<P: Bvp>(
             detail: "the tangent predictor's solve gave a non-finite value".into(),
         });
     }
-    let y = sol.y.iter().zip(&rhs[..m * n]).map(|(y, d)| y + d).collect();
+    let y = sol
+        .y
+        .iter()
+        .zip(&rhs[..m * n])
+        .map(|(y, d)| y + d)
+        .collect();
     let unknowns = sol
         .unknowns
         .iter()

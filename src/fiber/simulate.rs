@@ -25,8 +25,8 @@ use super::error::FiberError;
 use super::material_law::ViscosityLaw;
 use super::model::FiberModel;
 use crate::mesh::linspace;
-use crate::solution::Solution;
 use crate::sensitivity::tangent_guess;
+use crate::solution::Solution;
 use crate::solve::{Guess, ResidualScale, SolveOptions, Solver};
 
 /// Options of [`simulate`].

@@ -313,9 +313,7 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
             (None, None) => match self.solver.solve(&self.q, guess) {
                 Ok(sol) => sol,
                 // a predictor that led Newton astray: the accepted solution itself
-                Err(_) if predicted => {
-                    self.solver.solve(&self.q, &Guess::from(&self.accepted))?
-                }
+                Err(_) if predicted => self.solver.solve(&self.q, &Guess::from(&self.accepted))?,
                 Err(e) => return Err(e),
             },
         };
