@@ -11,7 +11,7 @@
 
 use crate::collocation::Collocation;
 use crate::error::BvpError;
-use crate::linear::LinearSystem;
+use crate::linear::{Factorization, LinearSystem};
 use crate::problem::Bvp;
 
 /// Settings of one Newton run.
@@ -51,9 +51,13 @@ pub(crate) fn newton<P: Bvp>(
     scale: &[f64],
     settings: &NewtonSettings,
     work: &mut NewtonWork,
+    initial: Option<&Factorization>,
 ) -> Result<NewtonReport, BvpError> {
     let (n, k, m) = (col.n, col.k, col.m());
     let size = m * n + k;
+    // a factorisation from a nearby solution on this mesh (simplified Newton from its Jacobian)
+    // is used until the contraction test asks for a fresh one
+    let mut borrowed = initial.filter(|f| f.size() == size);
     work.step.resize(size, 0.0);
     work.step_new.resize(size, 0.0);
     work.y_new.resize(m * n, 0.0);
@@ -79,6 +83,17 @@ pub(crate) fn newton<P: Bvp>(
     let mut iterations = 0;
     let mut converged = false;
     while iterations < settings.max_iterations {
+        if let (true, Some(f)) = (recompute, borrowed) {
+            work.step.copy_from_slice(&col.res);
+            f.solve_in_place(&mut work.step, 1)?;
+            if work.step.iter().any(|v| !v.is_finite()) {
+                // not usable here: factor the Jacobian of this iterate instead
+                borrowed = None;
+            } else {
+                cost = dot(&work.step, &work.step);
+                recompute = false;
+            }
+        }
         if recompute {
             col.jacobians(problem, y, p, k)?;
             lin.factor(col)?;
@@ -107,7 +122,10 @@ pub(crate) fn newton<P: Bvp>(
             match col.residual(problem, &work.y_new, &work.p_new) {
                 Ok(()) => {
                     work.step_new.copy_from_slice(&col.res);
-                    lin.solve(&mut work.step_new);
+                    match borrowed {
+                        Some(f) => f.solve_in_place(&mut work.step_new, 1)?,
+                        None => lin.solve(&mut work.step_new),
+                    }
                     let cost_new = dot(&work.step_new, &work.step_new);
                     accepted_finite = cost_new.is_finite();
                     if accepted_finite && cost_new < (1.0 - 2.0 * alpha * SIGMA) * cost {
@@ -165,6 +183,7 @@ pub(crate) fn newton<P: Bvp>(
             recompute = false;
         } else {
             recompute = true;
+            borrowed = None;
         }
     }
     Ok(NewtonReport {

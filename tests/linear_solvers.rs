@@ -322,7 +322,10 @@ fn more_unknowns_than_states_fall_back_under_auto() {
 fn periodic_conditions_fall_back_under_auto_and_are_refused_by_structured() {
     let two_pi = 2.0 * std::f64::consts::PI;
     let g = Guess::constant(linspace(0.0, two_pi, 12), &[0.0, 0.0]);
-    let opts = SolveOptions::with_tol(1e-6);
+    let opts = SolveOptions {
+        factor_at_solution: true,
+        ..SolveOptions::with_tol(1e-6)
+    };
     let auto = solve(&Periodic, &[0.3], &g, &opts).expect("periodic solve");
     assert_eq!(kind_of(&auto), LinearSolverKind::SparseLu);
     let sparse = solve(

@@ -308,8 +308,12 @@ fn derivatives_after_a_solve_reuse_its_linearisation() {
     let g = Guess::constant(linspace(0.0, 1.0, 6), &[0.2, 0.0]);
     let xs = points();
     let weights = vec![1.0; xs.len()];
-    // factor_at_solution (default): the solve leaves everything the derivatives need
-    let eager = solve(&problem, &pp, &g, &SolveOptions::with_tol(1e-8)).unwrap();
+    // factor_at_solution: the solve leaves everything the derivatives need
+    let eager_opts = SolveOptions {
+        factor_at_solution: true,
+        ..SolveOptions::with_tol(1e-8)
+    };
+    let eager = solve(&problem, &pp, &g, &eager_opts).unwrap();
     assert!(eager.factorization().is_some());
     let before = problem.counts();
     let sens_eager = Sensitivities::compute(&problem, &eager).unwrap();
@@ -343,4 +347,77 @@ fn derivatives_after_a_solve_reuse_its_linearisation() {
     for (a, b) in grad_eager.iter().zip(&grad_lazy) {
         assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs()), "{a} vs {b}");
     }
+}
+
+/// The tangent predictor is second-order accurate: its error at the new parameters is far below
+/// the change of the solution, and an order smaller again for half the step.
+#[test]
+fn tangent_guess_is_a_second_order_predictor() {
+    use diffbvp::sensitivity::tangent_guess;
+    let opts = SolveOptions {
+        mesh: diffbvp::mesh::MeshOptions::scipy(),
+        ..SolveOptions::with_tol(1e-8)
+    };
+    let g = Guess::constant(linspace(0.0, 1.0, 6), &[0.2, 0.0]);
+    let p0 = [1.0, 0.2];
+    let base = solve(&BratuAB, &p0, &g, &opts).unwrap();
+    let mut fixed = SolveOptions::fixed_mesh();
+    fixed.tol = 1e-8;
+    let errors: Vec<(f64, f64)> = [0.04, 0.02]
+        .iter()
+        .map(|h| {
+            let p1 = [p0[0] + h, p0[1] - 0.5 * h];
+            let exact = solve(&BratuAB, &p1, &Guess::from(&base), &fixed).unwrap();
+            let pred = tangent_guess(&BratuAB, &base, &p1).unwrap();
+            assert_eq!(pred.x, base.x);
+            let change = max_diff(&exact.y, &base.y);
+            let err = max_diff(&exact.y, &pred.y);
+            (change, err)
+        })
+        .collect();
+    for (change, err) in &errors {
+        assert!(*err < 0.05 * change, "error {err:e} for a change of {change:e}");
+    }
+    // halving the step divides the error by about 4
+    let ratio = errors[0].1 / errors[1].1;
+    assert!((3.0..5.5).contains(&ratio), "error ratio {ratio}");
+    assert!(tangent_guess(&BratuAB, &base, &[1.0]).is_err());
+    assert!(tangent_guess(&BratuAB, &base, &[f64::NAN, 0.2]).is_err());
+}
+
+/// `solve_near` starts with simplified Newton on the nearby solution's factorisation: the same
+/// solution as an ordinary solve from the same guess (within the Newton tolerance), fewer
+/// factorisations.
+#[test]
+fn solve_near_reuses_the_nearby_factorisation() {
+    use diffbvp::sensitivity::tangent_guess;
+    use diffbvp::Solver;
+    let opts = SolveOptions {
+        factor_at_solution: true,
+        ..SolveOptions::with_tol(1e-8)
+    };
+    let g = Guess::constant(linspace(0.0, 1.0, 6), &[0.2, 0.0]);
+    let base = solve(&BratuAB, &[1.0, 0.2], &g, &opts).unwrap();
+    let p1 = [1.02, 0.19];
+    let guess = tangent_guess(&BratuAB, &base, &p1).unwrap();
+    let plain = Solver::new(&BratuAB, opts.clone())
+        .solve(&p1, &guess)
+        .unwrap();
+    let near = Solver::new(&BratuAB, opts.clone())
+        .solve_near(&p1, &guess, &base, &opts)
+        .unwrap();
+    assert_eq!(near.x, plain.x);
+    assert!(max_diff(&near.y, &plain.y) < 1e-8, "{:e}", max_diff(&near.y, &plain.y));
+    assert!(near.stats.max_residual <= 1e-8);
+    // one factorisation fewer (the final linearisation is counted in both)
+    assert!(
+        near.stats.jacobian_factorizations < plain.stats.jacobian_factorizations,
+        "near {} vs plain {}",
+        near.stats.jacobian_factorizations,
+        plain.stats.jacobian_factorizations
+    );
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }

@@ -308,14 +308,30 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
             (Some(sol), _) => sol,
             (None, Some(t)) => {
                 let opts = self.loose_options(t);
-                self.solver.solve_with(&self.q, guess, &opts)?
+                if predicted {
+                    self.solver
+                        .solve_near(&self.q, guess, &self.accepted, &opts)?
+                } else {
+                    self.solver.solve_with(&self.q, guess, &opts)?
+                }
             }
-            (None, None) => match self.solver.solve(&self.q, guess) {
-                Ok(sol) => sol,
-                // a predictor that led Newton astray: the accepted solution itself
-                Err(_) if predicted => self.solver.solve(&self.q, &Guess::from(&self.accepted))?,
-                Err(e) => return Err(e),
-            },
+            (None, None) => {
+                let result = if predicted {
+                    let opts = self.solver.options.clone();
+                    self.solver
+                        .solve_near(&self.q, guess, &self.accepted, &opts)
+                } else {
+                    self.solver.solve(&self.q, guess)
+                };
+                match result {
+                    Ok(sol) => sol,
+                    // a predictor that led Newton astray: the accepted solution itself
+                    Err(_) if predicted => {
+                        self.solver.solve(&self.q, &Guess::from(&self.accepted))?
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
         };
         self.pending_loose = tol.is_some();
         if tol.is_none() {
