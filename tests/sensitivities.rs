@@ -376,7 +376,10 @@ fn tangent_guess_is_a_second_order_predictor() {
         })
         .collect();
     for (change, err) in &errors {
-        assert!(*err < 0.05 * change, "error {err:e} for a change of {change:e}");
+        assert!(
+            *err < 0.05 * change,
+            "error {err:e} for a change of {change:e}"
+        );
     }
     // halving the step divides the error by about 4
     let ratio = errors[0].1 / errors[1].1;
@@ -407,7 +410,11 @@ fn solve_near_reuses_the_nearby_factorisation() {
         .solve_near(&p1, &guess, &base, &opts)
         .unwrap();
     assert_eq!(near.x, plain.x);
-    assert!(max_diff(&near.y, &plain.y) < 1e-8, "{:e}", max_diff(&near.y, &plain.y));
+    assert!(
+        max_diff(&near.y, &plain.y) < 1e-8,
+        "{:e}",
+        max_diff(&near.y, &plain.y)
+    );
     assert!(near.stats.max_residual <= 1e-8);
     // one factorisation fewer (the final linearisation is counted in both)
     assert!(
@@ -419,5 +426,7 @@ fn solve_near_reuses_the_nearby_factorisation() {
 }
 
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }
