@@ -37,8 +37,8 @@
 //! the residuals and `η` = [`AccuracySchedule::fraction`] (default 10⁻²). Once the loose
 //! iteration has converged (any stopping test) or its step moves the estimate by less than
 //! [`AccuracySchedule::switch_below`] standard errors (`‖J s‖/σ̂`), the current iterate is
-//! re-evaluated at full accuracy and the iteration goes on there for at most
-//! [`AccuracySchedule::final_iterations`] trial steps, with the usual stopping tests: the
+//! re-evaluated at full accuracy and the iteration goes on there with the usual stopping tests
+//! (and at least [`AccuracySchedule::final_iterations`] trial steps of budget): the
 //! returned optimum, residuals and Jacobian (hence the covariance) are those of full-accuracy
 //! evaluations. [`BvpResiduals::set_loose_tolerance`] turns an allowed residual error into a BVP
 //! tolerance.
@@ -100,7 +100,11 @@ pub struct AccuracySchedule {
     /// Switch to full accuracy once a trial step moves the estimate by less than this many
     /// standard errors, `‖J s‖/σ̂` (default 0.1).
     pub switch_below: f64,
-    /// Trial steps allowed at full accuracy after the switch (default 10).
+    /// Trial steps allowed at full accuracy after the switch even when
+    /// [`FitOptions::max_iterations`] would end the fit sooner (default 10); otherwise the
+    /// full-accuracy phase runs to a stopping test or to `max_iterations`, as a fixed-accuracy
+    /// fit would (a slowly converging fit is never cut short and reported as stopped by its
+    /// iteration limit only because its first iterations were loose).
     pub final_iterations: usize,
     /// After the switch, a rejected trial step that moves the estimate by less than this many
     /// standard errors (`‖J s‖/σ̂`) ends the fit ([`Termination::Step`]): such a step is at the
@@ -606,7 +610,11 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             r = r_t;
             jac = j_t;
             radius = radius.max(options.initial_radius.min(options.max_radius));
-            tight_limit = Some(iterations + schedule.map_or(0, |s| s.final_iterations));
+            tight_limit = Some(
+                options
+                    .max_iterations
+                    .max(iterations + schedule.map_or(0, |s| s.final_iterations)),
+            );
         }
         let (r_gn, jac_gn) = match &scaled {
             Some((rs, js)) => (rs.as_slice(), js.as_slice()),
