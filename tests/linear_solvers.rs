@@ -10,63 +10,10 @@ use diffbvp::{
     solve, Bvp, BvpError, DualNum, Guess, LinearSolverKind, Solution, SolveOptions, Solver,
 };
 
+mod common;
+use common::{Bratu, CoupledTroesch, Shock};
+
 const AGREE: f64 = 1e-12;
-
-/// y'' = -e^y, y(0) = y(1) = 0.
-struct Bratu;
-impl Bvp for Bratu {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -y[0].exp();
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0];
-    }
-}
-
-/// Shock layer ε = 1e-3 (scipy's test problem): ε y'' + x y' = -ε π² cos(πx) - πx sin(πx).
-struct Shock;
-impl Bvp for Shock {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-        let (pi, eps) = (std::f64::consts::PI, 1e-3);
-        f[0] = y[1];
-        f[1] = (y[1] * (-x) - eps * pi * pi * (pi * x).cos() - pi * x * (pi * x).sin()) / eps;
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0] + 2.0;
-        r[1] = yb[0];
-    }
-}
-
-/// Coupled Troesch (4 states, model parameters μ and b).
-struct CoupledTroesch;
-impl Bvp for CoupledTroesch {
-    fn dim(&self) -> usize {
-        4
-    }
-    fn num_params(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = (y[0] * p[0]).sinh() * p[0] + y[2];
-        f[2] = y[3];
-        f[3] = y[2] - y[0];
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0] - p[1];
-        r[2] = ya[2];
-        r[3] = yb[2];
-    }
-}
 
 /// Nonlinear oscillator with an unknown frequency λ (an eigenvalue problem, k = 1):
 /// y'' = -λ² y - a y³, y(0) = y(1) = 0, y'(0) = b.
@@ -239,7 +186,7 @@ fn bratu_agrees() {
     let g = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
     check(
         "bratu",
-        &Bratu,
+        &Bratu { k: 1.0 },
         &[],
         &g,
         &SolveOptions::with_tol(1e-6),
@@ -252,7 +199,7 @@ fn shock_layer_agrees() {
     let g = Guess::constant(linspace(-1.0, 1.0, 5), &[0.0, 0.0]);
     check(
         "shock",
-        &Shock,
+        &Shock { eps: 1e-3 },
         &[],
         &g,
         &SolveOptions::with_tol(1e-6),

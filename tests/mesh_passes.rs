@@ -5,62 +5,9 @@
 //! (Bratu 4 meshes, shock 10, Troesch 7; `diffbvp::mesh::RefineRule::Scipy`).
 
 mod common;
-use common::shock_exact;
+use common::{shock_exact, Bratu, CoupledTroesch, Shock};
 use diffbvp::mesh::linspace;
-use diffbvp::{solve, Bvp, DualNum, Guess, Solution, SolveOptions};
-
-struct Bratu;
-impl Bvp for Bratu {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -y[0].exp();
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0];
-    }
-}
-
-struct Shock;
-impl Bvp for Shock {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-        let (pi, eps) = (std::f64::consts::PI, 1e-3);
-        f[0] = y[1];
-        f[1] = (y[1] * (-x) - eps * pi * pi * (pi * x).cos() - pi * x * (pi * x).sin()) / eps;
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0] + 2.0;
-        r[1] = yb[0];
-    }
-}
-
-struct CoupledTroesch;
-impl Bvp for CoupledTroesch {
-    fn dim(&self) -> usize {
-        4
-    }
-    fn num_params(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = (y[0] * p[0]).sinh() * p[0] + y[2];
-        f[2] = y[3];
-        f[3] = y[2] - y[0];
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0] - p[1];
-        r[2] = ya[2];
-        r[3] = yb[2];
-    }
-}
+use diffbvp::{solve, Guess, Solution, SolveOptions};
 
 const TOL: f64 = 1e-6;
 
@@ -96,7 +43,7 @@ fn report(name: &str, s: &Solution) {
 #[test]
 fn bratu_nodes_and_passes() {
     let g = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
-    let s = solve(&Bratu, &[], &g, &opts()).unwrap();
+    let s = solve(&Bratu { k: 1.0 }, &[], &g, &opts()).unwrap();
     report("bratu", &s);
     assert!(s.nodes() <= 29, "{} nodes", s.nodes());
     assert!(meshes(&s) * 2 <= 4, "{} meshes", meshes(&s));
@@ -105,7 +52,7 @@ fn bratu_nodes_and_passes() {
 #[test]
 fn shock_layer_nodes_and_passes() {
     let g = Guess::constant(linspace(-1.0, 1.0, 5), &[0.0, 0.0]);
-    let s = solve(&Shock, &[], &g, &opts()).unwrap();
+    let s = solve(&Shock { eps: 1e-3 }, &[], &g, &opts()).unwrap();
     report("shock", &s);
     assert!(s.nodes() <= 645, "{} nodes", s.nodes());
     // the global error stays that of scipy's mesh (1e-9 at the nodes, benches/peers)

@@ -120,3 +120,27 @@ impl Bvp for SturmLiouville {
         r[2] = ya[1] - p[0];
     }
 }
+
+/// Coupled Troesch (4 states): y1'' = μ sinh(μ y1) + y3, y3'' = y3 − y1, y1(0) = 0, y1(1) = b,
+/// y3(0) = y3(1) = 0; model parameters (μ, b) (scipy's peer uses μ = 5, b = 1).
+pub struct CoupledTroesch;
+impl Bvp for CoupledTroesch {
+    fn dim(&self) -> usize {
+        4
+    }
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = (y[0] * p[0]).sinh() * p[0] + y[2];
+        f[2] = y[3];
+        f[3] = y[2] - y[0];
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
+        r[0] = ya[0];
+        r[1] = yb[0] - p[1];
+        r[2] = ya[2];
+        r[3] = yb[2];
+    }
+}
