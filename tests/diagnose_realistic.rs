@@ -184,7 +184,7 @@ fn short_aspirator_coflow_is_found() {
 }
 
 #[test]
-#[ignore = "issue 11 open: air_coflow_line is named (8.67 ± 0.24 m/s, RMS after 1.67 %) but κ after (11.20) misses the truth 11.71"]
+#[ignore = "issue 11 open: air_coflow_line is named, but n's CI after it ([0.807, 0.830], issue 14 solver) misses the truth 0.8 (κ 11.20 at stop 18)"]
 fn coflow_along_the_line_is_found() {
     let sc = scenarios::coflow_line();
     assert_found(&sc, &run(&sc));
@@ -209,7 +209,7 @@ fn radiation_is_found() {
 }
 
 #[test]
-#[ignore = "issue 11 open: die_temperature_offset is named (-9.97 ± 2.30 K, truth -10 K) but n's CI after (n 0.790) misses 0.8"]
+#[ignore = "issue 11 open: die_temperature_offset is named (-9.97 ± 2.30 K at stop 18, truth -10 K) but n's CI after it ([0.7805, 0.7997]) misses 0.8"]
 fn cold_die_is_found() {
     let sc = scenarios::die_colder();
     assert_found(&sc, &run(&sc));
