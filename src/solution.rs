@@ -36,7 +36,7 @@ impl SolveStats {
     }
 }
 
-/// A converged solution of a [`Bvp`](crate::Bvp).
+/// A converged solution of a [`Bvp`].
 #[derive(Debug, Clone)]
 pub struct Solution {
     /// Number of states.

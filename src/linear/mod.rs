@@ -7,11 +7,11 @@
 //!
 //! Two factorisations, chosen per factorisation by [`LinearSolverKind`]:
 //!
-//! * [`block_elimination`]: structured Gaussian elimination with partial pivoting for the
+//! * `block_elimination`: structured Gaussian elimination with partial pivoting for the
 //!   almost-block-diagonal form that *separated* boundary conditions give (SOLVEBLOK / COLROW
 //!   style, bordered by the parameter columns). Dense small blocks, no index structures, no
 //!   allocation per factorisation or solve.
-//! * [`sparse_lu`]: faer's general simplicial sparse LU, the fallback for boundary conditions
+//! * `sparse_lu`: faer's general simplicial sparse LU, the fallback for boundary conditions
 //!   that couple both ends (periodic and the like) and for many unknown parameters.
 //!
 //! [`LinearSolverKind::Auto`] (the default) uses the structured elimination when every boundary
