@@ -304,32 +304,27 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
             (None, Some(t), Some((tc, sol))) if t == tc && sol.params == self.q => Some(sol),
             _ => None,
         };
-        let sol = match (cached, tol) {
-            (Some(sol), _) => sol,
-            (None, Some(t)) => {
-                let opts = self.loose_options(t);
+        let sol = match cached {
+            Some(sol) => sol,
+            None => {
+                let opts = match tol {
+                    Some(t) => self.loose_options(t),
+                    None => self.solver.options.clone(),
+                };
                 if predicted {
-                    self.solver
-                        .solve_near(&self.q, guess, &self.accepted, &opts)?
+                    match self
+                        .solver
+                        .solve_near(&self.q, guess, &self.accepted, &opts)
+                    {
+                        Ok(sol) => sol,
+                        // a predictor that led Newton astray: the accepted solution itself
+                        Err(_) => {
+                            let plain = Guess::from(&self.accepted);
+                            self.solver.solve_with(&self.q, &plain, &opts)?
+                        }
+                    }
                 } else {
                     self.solver.solve_with(&self.q, guess, &opts)?
-                }
-            }
-            (None, None) => {
-                let result = if predicted {
-                    let opts = self.solver.options.clone();
-                    self.solver
-                        .solve_near(&self.q, guess, &self.accepted, &opts)
-                } else {
-                    self.solver.solve(&self.q, guess)
-                };
-                match result {
-                    Ok(sol) => sol,
-                    // a predictor that led Newton astray: the accepted solution itself
-                    Err(_) if predicted => {
-                        self.solver.solve(&self.q, &Guess::from(&self.accepted))?
-                    }
-                    Err(e) => return Err(e),
                 }
             }
         };
