@@ -11,33 +11,9 @@ use diffbvp::{
 };
 
 mod common;
-use common::{Bratu, CoupledTroesch, Shock};
+use common::{Bratu, CoupledTroesch, Oscillator, Shock};
 
 const AGREE: f64 = 1e-12;
-
-/// Nonlinear oscillator with an unknown frequency λ (an eigenvalue problem, k = 1):
-/// y'' = -λ² y - a y³, y(0) = y(1) = 0, y'(0) = b.
-struct Oscillator;
-impl Bvp for Oscillator {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_unknowns(&self) -> usize {
-        1
-    }
-    fn num_params(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -p[0] * p[0] * y[0] - p[1] * y[0].powi(3);
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0];
-        r[2] = ya[1] - p[2];
-    }
-}
 
 /// More unknowns than states (k = 2 > n = 1), one condition on the unknowns only:
 /// y' = u0 + u1 x, y(0) = 0, y(1) = c, u0 = u1.
