@@ -75,6 +75,84 @@ impl Linearization {
         Self::compute(problem, &mut col, &mut lin, y, p)
     }
 
+    /// Solves `∂_Y S · X = B` (or its transpose) for `ncols` right-hand sides stored column after
+    /// column in `b`, followed by one step of iterative refinement in working precision: the
+    /// residual `B − (∂_Y S) X` is formed from the Jacobian blocks (not from the factors) and the
+    /// correction solved with the same factorisation (Skeel: one step makes Gaussian elimination
+    /// with partial pivoting componentwise backward stable). The fiber system's rows and columns
+    /// differ in scale by orders of magnitude; without the step the structured and the sparse
+    /// elimination (each with its own pivoting) gave forward sensitivities differing by 3.5e-11,
+    /// with it by 1e-15. Costs one block product and one more solve with the factors.
+    pub(crate) fn solve_refined(
+        &self,
+        b: &mut [f64],
+        ncols: usize,
+        transpose: bool,
+    ) -> Result<(), BvpError> {
+        let solve = |v: &mut [f64]| {
+            if transpose {
+                self.factorization.solve_transpose_in_place(v, ncols)
+            } else {
+                self.factorization.solve_in_place(v, ncols)
+            }
+        };
+        let mut r = b.to_vec();
+        solve(b)?;
+        self.subtract_product(b, ncols, transpose, &mut r);
+        solve(&mut r)?;
+        for (x, d) in b.iter_mut().zip(&r) {
+            *x += d;
+        }
+        Ok(())
+    }
+
+    /// `r −= (∂_Y S) x` (or `(∂_Y S)ᵀ x`) for `ncols` columns.
+    fn subtract_product(&self, x: &[f64], ncols: usize, transpose: bool, r: &mut [f64]) {
+        let col = &self.col;
+        let (n, k, m) = (col.n, col.k, col.m());
+        let size = m * n + k;
+        let mut pcols = vec![0.0; k * size];
+        for l in 0..k {
+            col.param_column(l, &mut pcols[l * size..(l + 1) * size]);
+        }
+        let (mut a, mut bb) = (vec![0.0; n * n], vec![0.0; n * n]);
+        // Entry `v` at (row, column) of the Newton matrix, applied as A or Aᵀ to every column.
+        let mut add = |row: usize, column: usize, v: f64| {
+            let (out, from) = if transpose {
+                (column, row)
+            } else {
+                (row, column)
+            };
+            for j in 0..ncols {
+                let xv = x[j * size + from];
+                r[j * size + out] -= v * xv;
+            }
+        };
+        for i in 0..m - 1 {
+            col.interval_blocks(i, &mut a, &mut bb);
+            for rr in 0..n {
+                let row = i * n + rr;
+                for c in 0..n {
+                    add(row, i * n + c, a[rr * n + c]);
+                    add(row, (i + 1) * n + c, bb[rr * n + c]);
+                }
+                for l in 0..k {
+                    add(row, m * n + l, pcols[l * size + row]);
+                }
+            }
+        }
+        for rr in 0..n + k {
+            let row = (m - 1) * n + rr;
+            for c in 0..n {
+                add(row, c, col.bc_state(rr, 0, c));
+                add(row, (m - 1) * n + c, col.bc_state(rr, 1, c));
+            }
+            for l in 0..k {
+                add(row, m * n + l, pcols[l * size + row]);
+            }
+        }
+    }
+
     /// Node Jacobian entry `∂f_c/∂(y, p)_l` at node `i`.
     #[inline]
     pub(crate) fn jn(&self, i: usize, c: usize, l: usize) -> f64 {

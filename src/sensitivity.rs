@@ -91,7 +91,7 @@ impl Sensitivities {
         for v in rhs.iter_mut() {
             *v = -*v;
         }
-        lz.factorization.solve_in_place(&mut rhs, q)?;
+        lz.solve_refined(&mut rhs, q, false)?;
         if let Some(pos) = rhs.iter().position(|v| !v.is_finite()) {
             return Err(BvpError::SingularJacobian {
                 detail: format!("sensitivity solve gave a non-finite value (entry {pos})"),
@@ -336,7 +336,7 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
             dg_dp[j] += w * grad[n + k + j];
         }
     }
-    lz.factorization.solve_transpose_in_place(&mut b, 1)?;
+    lz.solve_refined(&mut b, 1, true)?;
     let mut col = vec![0.0; size];
     for (j, d) in dg_dp.iter_mut().enumerate() {
         lz.col.param_column(k + j, &mut col);
