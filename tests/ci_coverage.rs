@@ -20,10 +20,17 @@ use independent::model::AirFlow;
 use independent::scenarios;
 use std::time::Instant;
 
-/// Seeds per scenario (the scenario's own seed first).
-const SEEDS: u64 = 16;
+/// Seeds per scenario (the scenario's own seed first): 16, or `COVERAGE_SEEDS` from the
+/// environment.
+fn seeds() -> u64 {
+    std::env::var("COVERAGE_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(16)
+}
 
-/// One seed's outcome: (n̂, se n, κ̂, se κ, strength, se strength, n in CI, κ in CI).
+/// One seed's outcome: estimates, standard errors (from the 95 % CIs) and whether the CIs hold
+/// the truth.
 struct Row {
     n: f64,
     se_n: f64,
@@ -33,12 +40,12 @@ struct Row {
     kappa_in: bool,
 }
 
-/// Diagnoses `sc` with the single candidate `effect` for [`SEEDS`] seeds; `base` reads the
+/// Diagnoses `sc` with the single candidate `effect` for [`seeds`] seeds; `base` reads the
 /// user's plain fit instead of the refit with the candidate.
 fn coverage(sc: &Scenario, effect: Effect, base: bool) {
     let t0 = Instant::now();
     let mut rows = Vec::new();
-    for k in 0..SEEDS {
+    for k in 0..seeds() {
         let mut s = sc.clone();
         s.seed = sc.seed + 1000 * k;
         let generated = s.generate().unwrap();
@@ -140,7 +147,11 @@ fn control_with_die_offset() {
 #[test]
 #[ignore = "slow: coverage over seeds"]
 fn die_colder_with_die_offset() {
-    coverage(&scenarios::die_colder(), Effect::DieTemperatureOffset, false);
+    coverage(
+        &scenarios::die_colder(),
+        Effect::DieTemperatureOffset,
+        false,
+    );
 }
 
 #[test]
@@ -175,4 +186,56 @@ fn coflow_line_with_true_ramp_width() {
         ramp_width: Some(0.03),
     };
     coverage(&scenarios::coflow_line(), effect, false);
+}
+
+/// Cost of fitting the line co-flow's ramp width: full `diagnose` of the shipped 9-experiment
+/// set (the benchmark's) with the built-in candidates, `air_coflow_line`'s ramp width fixed at
+/// its default (as before it was fitted) against fitted, interleaved, median of 3 each.
+#[test]
+#[ignore = "slow: timing"]
+fn ramp_width_cost_on_the_shipped_set() {
+    let set = load_experiments(std::path::Path::new(
+        "data/pmma7n_synthetic/experiments.toml",
+    ))
+    .unwrap();
+    let with_ramp = |ramp_width: Option<f64>| DiagnoseOptions {
+        candidates: Effect::builtin()
+            .into_iter()
+            .map(|e| match e {
+                Effect::AirCoflowLine { onset, .. } => Effect::AirCoflowLine { onset, ramp_width },
+                e => e,
+            })
+            .collect(),
+        ..DiagnoseOptions::default()
+    };
+    let (fixed, fitted) = (
+        with_ramp(Some(
+            diffbvp::fiber::effects::DEFAULT_COFLOW_LINE_RAMP_WIDTH,
+        )),
+        with_ramp(None),
+    );
+    let spec = ModelSpec::default();
+    let (mut tf, mut tv) = (Vec::new(), Vec::new());
+    for _ in 0..3 {
+        for (label, opts, times) in [("fixed", &fixed, &mut tf), ("fitted", &fitted, &mut tv)] {
+            let t = Instant::now();
+            let d = diagnose(&set, &spec, opts).unwrap().diagnosis;
+            times.push(t.elapsed().as_secs_f64());
+            println!(
+                "TIMING | ramp width {} | {:.2} s | named {:?}",
+                label,
+                times[times.len() - 1],
+                d.most_likely_missing
+            );
+        }
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    println!(
+        "TIMING | median: ramp width fixed {:.2} s, fitted {:.2} s",
+        median(&mut tf),
+        median(&mut tv)
+    );
 }
