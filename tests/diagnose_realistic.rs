@@ -89,6 +89,26 @@ fn assert_named_is_credible(r: &DiagnosisRun) {
 
 /// The acceptance criteria for a scenario with a hidden cause.
 fn assert_found(sc: &Scenario, r: &DiagnosisRun) {
+    assert_found_but_ci(sc, r);
+    let c = &r.diagnosis.candidates[0];
+    let (n, k) = (sc.law.n, sc.law.kappa);
+    assert!(
+        c.ci95_n[0] <= n && n <= c.ci95_n[1],
+        "{}: n = {n} outside {:?}",
+        sc.name,
+        c.ci95_n
+    );
+    assert!(
+        c.ci95_kappa[0] <= k && k <= c.ci95_kappa[1],
+        "{}: κ = {k} outside {:?}",
+        sc.name,
+        c.ci95_kappa
+    );
+}
+
+/// The acceptance criteria for a scenario with a hidden cause, except the true (n, κ) inside
+/// the CIs after adding it.
+fn assert_found_but_ci(sc: &Scenario, r: &DiagnosisRun) {
     let d = &r.diagnosis;
     assert_named_is_credible(r);
     let named = d.most_likely_missing.as_deref();
@@ -122,19 +142,13 @@ fn assert_found(sc: &Scenario, r: &DiagnosisRun) {
         "{}: RMS after / noise = {ratio}",
         sc.name
     );
+}
+
+/// Whether the true (n, κ) lie inside the 95 % CIs reported with the cause ranked first.
+fn truth_in_ci(sc: &Scenario, r: &DiagnosisRun) -> bool {
+    let c = &r.diagnosis.candidates[0];
     let (n, k) = (sc.law.n, sc.law.kappa);
-    assert!(
-        c.ci95_n[0] <= n && n <= c.ci95_n[1],
-        "{}: n = {n} outside {:?}",
-        sc.name,
-        c.ci95_n
-    );
-    assert!(
-        c.ci95_kappa[0] <= k && k <= c.ci95_kappa[1],
-        "{}: κ = {k} outside {:?}",
-        sc.name,
-        c.ci95_kappa
-    );
+    c.ci95_n[0] <= n && n <= c.ci95_n[1] && c.ci95_kappa[0] <= k && k <= c.ci95_kappa[1]
 }
 
 /// The criteria without a physical cause: nothing named, the base fit covers the truth, the
@@ -171,7 +185,7 @@ fn control_names_nothing() {
 }
 
 #[test]
-#[ignore = "issue 11 open: the exponential air_coflow family does not fit a 150 m/s Lorentzian jet (named air_coflow_line 395 ± 836 m/s, RMS after 7.9 %)"]
+#[ignore = "issue 11 open: the exponential air_coflow family does not fit a 150 m/s Lorentzian jet (named air_coflow_line 400 m/s, the top of its physical range, with n at its bound 1; RMS after 5.2 %)"]
 fn strong_aspirator_coflow_is_found() {
     let sc = scenarios::aspirator_strong();
     assert_found(&sc, &run(&sc));
@@ -184,7 +198,6 @@ fn short_aspirator_coflow_is_found() {
 }
 
 #[test]
-#[ignore = "issue 11 open: air_coflow_line is named, but n's CI after it ([0.807, 0.830], issue 14 solver) misses the truth 0.8 (κ 11.20 at stop 18)"]
 fn coflow_along_the_line_is_found() {
     let sc = scenarios::coflow_line();
     assert_found(&sc, &run(&sc));
@@ -209,10 +222,33 @@ fn radiation_is_found() {
 }
 
 #[test]
-#[ignore = "issue 11 open: die_temperature_offset is named (-9.97 ± 2.30 K at stop 18, truth -10 K) but n's CI after it ([0.7805, 0.7997]) misses 0.8"]
+#[ignore = "chance miss of this seed: die_temperature_offset named (-9.97 ± 2.30 K, truth -10 K), n's CI [0.7805, 0.7997] misses 0.8 by 2.0 se; over 40 seeds the CIs hold n in 39, κ in 39 (tests/ci_coverage.rs); see cold_die_is_found_over_seeds"]
 fn cold_die_is_found() {
     let sc = scenarios::die_colder();
     assert_found(&sc, &run(&sc));
+}
+
+/// The cold die over three noise realisations (the scenario's seed and two more): every
+/// criterion but the CI on each, and the true (n, κ) inside the reported CIs on at least two of
+/// the three. With the 95 % CIs' measured joint miss rate (2 of 40 seeds, tests/ci_coverage.rs),
+/// two misses of three happen by chance with probability 3 p² − 2 p³ ≈ 0.7 % at p = 0.05.
+#[test]
+#[ignore = "issue 11 open: detection of a 10 K cold die is itself marginal: seed 2108 names nothing (mass_flow_scale first, dBIC -8.5 > -10), so 1 of 3 seeds passes (108 misses n's CI by chance, 1108 passes)"]
+fn cold_die_is_found_over_seeds() {
+    let base = scenarios::die_colder();
+    let held = [0u64, 1000, 2000]
+        .iter()
+        .filter(|&&k| {
+            let sc = Scenario {
+                seed: base.seed + k,
+                ..base.clone()
+            };
+            let r = run(&sc);
+            assert_found_but_ci(&sc, &r);
+            truth_in_ci(&sc, &r)
+        })
+        .count();
+    assert!(held >= 2, "true (n, κ) inside the CIs in {held} of 3 seeds");
 }
 
 #[test]

@@ -404,7 +404,9 @@ fn judge_and_categories() {
     }
     .shape_parameters();
     assert_eq!(shapes.len(), 2);
-    assert!(shapes[0].fitted_with_strength && !shapes[1].fitted_with_strength);
+    // both fitted with the speed; the global search scans the onset only
+    assert!(shapes[0].fitted_with_strength && shapes[1].fitted_with_strength);
+    assert!(shapes[0].scanned && !shapes[1].scanned);
 }
 
 /// Noisy data of experiments `exps` from `simulate` (true diameters in metres of each

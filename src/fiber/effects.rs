@@ -15,7 +15,7 @@
 //! | `strain_thinning` | `1 − n` (-) | Carreau-type law with power index `n = 1 − s` | – | physics | [0, 1] | 0 (Newtonian) |
 //! | `radiation` | emissivity `ε` (-) | heat loss `π d ε σ (T⁴ − T_air⁴)` | – | physics | [0, 1] | 0 |
 //! | `air_coflow` | amplitude `V` (m/s) | air speed `v_air = V exp(−(L − s)/ℓ)` (aspirator near the take-up) | `decay_length` ℓ (m, 0.1, [0.01, min(1.5, 1.5 L)]) | physics | [−50, 400] | 0 |
-//! | `air_coflow_line` | speed `V` (m/s) | air speed `v_air = V / (1 + exp(−(s − s₀)/w))` (co-flow along the line after `s₀`) | `onset` s₀ (m, 0.2, [0, L]), `ramp_width` w (m, 0.02, fixed unless given) | physics | [−50, 400] | 0 |
+//! | `air_coflow_line` | speed `V` (m/s) | air speed `v_air = V / (1 + exp(−(s − s₀)/w))` (co-flow along the line after `s₀`) | `onset` s₀ (m, 0.2, [0, L]), `ramp_width` w (m, 0.02, [0.002, min(0.5, L)]) | physics | [−50, 400] | 0 |
 //! | `air_temperature_profile` | excess `ΔT` (K) | `T_air(s) = T_air + ΔT exp(−s/ℓ)` | `decay_length` ℓ (m, 0.05, [0.005, min(1, L)]) | physics | [−50, 400] | 0 |
 //! | `nusselt_scale` | `s` (-) | Nusselt law `𝒩 → (1 + s) 𝒩` | – | physics | [−0.5, 1] | 0 |
 //! | `inlet_diameter` | die swell `δ` (-) | inlet diameter `(1 + δ) d_in` at the same mass flow: `u(0) = u_in/(1 + δ)²` | – | process | [−0.1, 0.6] | 0 |
@@ -69,7 +69,7 @@ pub const DEFAULT_WARM_AIR_DECAY_LENGTH: f64 = 0.05;
 /// Default onset position `s₀` \[m\] of the co-flow along the line.
 pub const DEFAULT_COFLOW_LINE_ONSET: f64 = 0.2;
 
-/// Default ramp width `w` \[m\] of the co-flow along the line (fixed unless given).
+/// Default (start) ramp width `w` \[m\] of the co-flow along the line.
 pub const DEFAULT_COFLOW_LINE_RAMP_WIDTH: f64 = 0.02;
 
 /// `κ = ln(K / 1 Pa)` \[-\] at which the strain-thinning direction of a Newtonian model is taken
@@ -124,6 +124,9 @@ pub struct ShapeParameter {
     /// Whether it is fitted with the strength when not fixed (`false`: fixed at its default
     /// unless given).
     pub fitted_with_strength: bool,
+    /// Whether `diagnose`'s global search scans it across its range as variants of the effect
+    /// (`false`: the scan holds it at its default and only the refinement fits it).
+    pub scanned: bool,
     /// What it is, in words.
     pub describe: &'static str,
 }
@@ -148,6 +151,7 @@ const COFLOW_DECAY: ShapeParameter = ShapeParameter {
     bounds: (0.01, 1.5),
     max_per_length: Some(1.5),
     fitted_with_strength: true,
+    scanned: true,
     describe: "decay length of the co-flow away from the take-up",
 };
 
@@ -159,6 +163,7 @@ const COFLOW_LINE_ONSET: ShapeParameter = ShapeParameter {
     bounds: (0.0, 2.0),
     max_per_length: Some(1.0),
     fitted_with_strength: true,
+    scanned: true,
     describe: "position where the co-flow along the line sets in",
 };
 
@@ -169,7 +174,8 @@ const COFLOW_LINE_RAMP: ShapeParameter = ShapeParameter {
     default: DEFAULT_COFLOW_LINE_RAMP_WIDTH,
     bounds: (0.002, 0.5),
     max_per_length: Some(1.0),
-    fitted_with_strength: false,
+    fitted_with_strength: true,
+    scanned: false,
     describe: "width of the logistic ramp of the co-flow along the line",
 };
 
@@ -181,6 +187,7 @@ const WARM_AIR_DECAY: ShapeParameter = ShapeParameter {
     bounds: (0.005, 1.0),
     max_per_length: Some(1.0),
     fitted_with_strength: true,
+    scanned: true,
     describe: "decay length of the warm air below the nozzle",
 };
 
@@ -246,7 +253,8 @@ pub enum Effect {
     AirCoflowLine {
         /// Onset `s₀` \[m\] fixed, or `None` (fitted, start [`DEFAULT_COFLOW_LINE_ONSET`]).
         onset: Option<f64>,
-        /// Ramp width `w` \[m\] fixed, or `None` ([`DEFAULT_COFLOW_LINE_RAMP_WIDTH`], not fitted).
+        /// Ramp width `w` \[m\] fixed, or `None` (fitted, start [`DEFAULT_COFLOW_LINE_RAMP_WIDTH`];
+        /// `diagnose` scans the onset and fits the width only in its refinement).
         ramp_width: Option<f64>,
     },
     /// `air_temperature_profile`: warm air near the nozzle, strength = excess `ΔT` \[K\].

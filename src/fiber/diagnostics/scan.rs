@@ -241,11 +241,13 @@ pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
 }
 
 /// The variants of `effect` whose shapes are scanned, each with its shape parameters: every
-/// shape parameter the effect fits with its strength ([`Effect::free_shapes`]) is fixed at
-/// three values across its range (lengths `0.4 ×`, `1 ×` and `2.5 ×` the default, an onset at
-/// 30 %, 50 % and 70 % of the spin line of length `length` \[m\]), clamped to its bounds; shapes fixed by the user stay fixed. Without
-/// `scan_shapes`, one variant with the free shapes at their defaults. The refinement frees the
-/// shapes again ([`refine`]).
+/// shape parameter the effect fits with its strength ([`Effect::free_shapes`]) and marks
+/// [`scanned`](crate::fiber::effects::ShapeParameter::scanned) is fixed at three values across
+/// its range (lengths `0.4 ×`, `1 ×` and `2.5 ×` the default, an onset at 30 %, 50 % and 70 % of
+/// the spin line of length `length` \[m\]), clamped to its bounds; the other free shapes (the
+/// line co-flow's ramp width) are held at their defaults; shapes fixed by the user stay fixed.
+/// Without `scan_shapes`, one variant with the free shapes at their defaults. The refinement
+/// frees every free shape again ([`refine`]).
 pub fn shape_variants(
     effect: &Effect,
     scan_shapes: bool,
@@ -254,7 +256,7 @@ pub fn shape_variants(
     let mut variants = vec![effect.clone()];
     for sp in effect.free_shapes() {
         let (lo, hi) = sp.bounds_for_length(length);
-        let values: Vec<f64> = if !scan_shapes {
+        let values: Vec<f64> = if !scan_shapes || !sp.scanned {
             vec![sp.default]
         } else if sp.name == "onset" {
             [0.3, 0.5, 0.7].iter().map(|f| f * length).collect()
@@ -769,7 +771,8 @@ mod tests {
         assert_eq!(fixed.len(), 1);
         assert_eq!(fixed[0].1[0].value, 0.2);
         assert_eq!(shape_variants(&Effect::Radiation, true, 0.5).len(), 1);
-        // the onset of the line co-flow across the line (its ramp width is not fitted)
+        // the onset of the line co-flow across the line (its ramp width held at its default:
+        // fitted by the refinement only)
         let line = shape_variants(
             &Effect::AirCoflowLine {
                 onset: None,
@@ -780,6 +783,9 @@ mod tests {
         );
         let onsets: Vec<f64> = line.iter().map(|(_, s)| s[0].value).collect();
         assert_eq!(onsets, vec![0.3 * 0.5, 0.5 * 0.5, 0.7 * 0.5]);
+        assert!(line.iter().all(|(_, s)| s.len() == 2
+            && s[1].name == "ramp_width"
+            && s[1].value == crate::fiber::effects::DEFAULT_COFLOW_LINE_RAMP_WIDTH));
         assert_eq!(
             shape_variants(
                 &Effect::AirTemperatureProfile { decay_length: None },
