@@ -278,29 +278,38 @@ impl Collocation {
         Ok(())
     }
 
-    /// The `n × n` blocks `A_i = ∂r_i/∂y_i` and `B_i = ∂r_i/∂y_{i+1}` (row-major).
-    pub(crate) fn interval_blocks(&self, i: usize, a: &mut [f64], b: &mut [f64]) {
+    /// The `n × n` blocks `A_i = ∂r_i/∂y_i` and `B_i = ∂r_i/∂y_{i+1}` side by side: row `r`
+    /// of `[A_i B_i]` is written to `out[r ld..r ld + 2n]` (`ld >= 2n`).
+    pub(crate) fn interval_rows(&self, i: usize, out: &mut [f64], ld: usize) {
         let n = self.n;
         let w = n + self.seeded_params;
         let h = self.h[i];
         let ji = &self.jn[i * n * w..(i + 1) * n * w];
         let jj = &self.jn[(i + 1) * n * w..(i + 2) * n * w];
         let jm = &self.jm[i * n * w..(i + 1) * n * w];
-        // A = -I - h/6 (J_i + 4 Jm (I/2 + h/8 J_i)),  B = I - h/6 (J_j + 4 Jm (I/2 - h/8 J_j))
+        // A = -I - h/6 (J_i + 4 Jm (I/2 + h/8 J_i)),  B = I - h/6 (J_j + 4 Jm (I/2 - h/8 J_j));
+        // the products Jm J_i and Jm J_j are accumulated row by row over contiguous rows of J
         for r in 0..n {
-            for c in 0..n {
-                let mut sa = 0.0;
-                let mut sb = 0.0;
-                for l in 0..n {
-                    let jml = jm[r * w + l];
-                    sa += jml * ji[l * w + c];
-                    sb += jml * jj[l * w + c];
+            let (sa, sb) = out[r * ld..r * ld + 2 * n].split_at_mut(n);
+            sa.fill(0.0);
+            sb.fill(0.0);
+            let jmr = &jm[r * w..r * w + n];
+            for (l, &jml) in jmr.iter().enumerate() {
+                let jil = &ji[l * w..l * w + n];
+                let jjl = &jj[l * w..l * w + n];
+                for (((a, b), &vi), &vj) in sa.iter_mut().zip(sb.iter_mut()).zip(jil).zip(jjl) {
+                    *a += jml * vi;
+                    *b += jml * vj;
                 }
+            }
+            let jir = &ji[r * w..r * w + n];
+            let jjr = &jj[r * w..r * w + n];
+            for c in 0..n {
                 let d = if r == c { 1.0 } else { 0.0 };
-                let m_a = 2.0 * jm[r * w + c] + 0.5 * h * sa;
-                let m_b = 2.0 * jm[r * w + c] - 0.5 * h * sb;
-                a[r * n + c] = -d - h / 6.0 * (ji[r * w + c] + m_a);
-                b[r * n + c] = d - h / 6.0 * (jj[r * w + c] + m_b);
+                let m_a = 2.0 * jmr[c] + 0.5 * h * sa[c];
+                let m_b = 2.0 * jmr[c] - 0.5 * h * sb[c];
+                sa[c] = -d - h / 6.0 * (jir[c] + m_a);
+                sb[c] = d - h / 6.0 * (jjr[c] + m_b);
             }
         }
     }

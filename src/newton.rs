@@ -121,6 +121,21 @@ pub(crate) fn newton<P: Bvp>(
             }
             match col.residual(problem, &work.y_new, &work.p_new) {
                 Ok(()) => {
+                    // A full step that lands on a point passing the termination test is taken
+                    // as it is: the merit value (one more solve) would only decide on damping.
+                    if trial == 0
+                        && terminates(
+                            col,
+                            &work.y_new,
+                            &work.p_new[..k],
+                            inf_norm(&work.step),
+                            scale,
+                            settings,
+                        )
+                    {
+                        accepted_finite = true;
+                        break;
+                    }
                     work.step_new.copy_from_slice(&col.res);
                     match borrowed {
                         Some(f) => f.solve_in_place(&mut work.step_new, 1)?,
@@ -163,12 +178,7 @@ pub(crate) fn newton<P: Bvp>(
         y.copy_from_slice(&work.y_new);
         p[..k].copy_from_slice(&work.p_new[..k]);
 
-        let mut ok = residuals_small(col, scale, settings.tol) && bc_small(col, settings.bc_tol);
-        if let Some(st) = settings.step_tol {
-            let ymax = inf_norm(y).max(inf_norm(&p[..k]));
-            ok = ok && step_inf <= st * (1.0 + ymax);
-        }
-        if ok {
+        if terminates(col, y, &p[..k], step_inf, scale, settings) {
             converged = true;
             break;
         }
@@ -190,6 +200,25 @@ pub(crate) fn newton<P: Bvp>(
         iterations,
         converged,
     })
+}
+
+/// The termination test at the iterate `y`, unknowns `pk`, reached by a correction of infinity
+/// norm `step_inf` (`col` holds its residuals): collocation and boundary residuals small, and
+/// the correction small if a step criterion is set.
+fn terminates(
+    col: &Collocation,
+    y: &[f64],
+    pk: &[f64],
+    step_inf: f64,
+    scale: &[f64],
+    settings: &NewtonSettings,
+) -> bool {
+    let mut ok = residuals_small(col, scale, settings.tol) && bc_small(col, settings.bc_tol);
+    if let Some(st) = settings.step_tol {
+        let ymax = inf_norm(y).max(inf_norm(pk));
+        ok = ok && step_inf <= st * (1.0 + ymax);
+    }
+    ok
 }
 
 /// Buffers of the Newton iteration, kept between runs.

@@ -11,6 +11,7 @@ use crate::mesh;
 use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork};
 use crate::problem::Bvp;
 use crate::solution::{resample, Solution, SolveStats};
+use std::cell::RefCell;
 use std::sync::{Arc, OnceLock};
 
 /// How collocation residuals are scaled per component before comparison with `tol`:
@@ -233,6 +234,13 @@ pub struct Solver<'a, P: Bvp> {
     problem: &'a P,
     /// The options used by [`solve`](Self::solve).
     pub options: SolveOptions,
+    ws: Workspace,
+}
+
+/// Everything a solve reuses that does not depend on the problem's type: the collocation
+/// buffers, the Newton-matrix workspaces of recently used mesh sizes and the scratch of Newton
+/// and the error estimate. [`solve`] borrows one per thread (`SPARE`).
+struct Workspace {
     col: Collocation,
     patterns: Vec<Arc<Pattern>>,
     /// Newton-matrix workspaces of recently used mesh sizes (most recent last).
@@ -245,6 +253,42 @@ pub struct Solver<'a, P: Bvp> {
     rms: Vec<f64>,
     buf: Vec<f64>,
     marks: Vec<u8>,
+}
+
+impl Workspace {
+    fn new(n: usize, k: usize, q: usize) -> Self {
+        Workspace {
+            col: Collocation::new(n, k, q),
+            patterns: Vec::new(),
+            systems: Vec::new(),
+            patterns_built: 0,
+            systems_built: 0,
+            newton_work: NewtonWork::default(),
+            rms: Vec::new(),
+            buf: Vec::new(),
+            marks: Vec::new(),
+        }
+    }
+
+    /// This workspace made fit for a problem with `n` states, `k` unknowns and `q` model
+    /// parameters: kept as it is for the same dimensions, otherwise the dimension-bound parts
+    /// (collocation buffers, patterns, Newton-matrix workspaces) are replaced.
+    fn for_dims(mut self, n: usize, k: usize, q: usize) -> Self {
+        if (self.col.n, self.col.k, self.col.q) != (n, k, q) {
+            self.col = Collocation::new(n, k, q);
+            self.patterns.clear();
+            self.systems.clear();
+        }
+        self
+    }
+}
+
+thread_local! {
+    /// The workspace of the last [`solve`] on this thread, lent to the next one: repeated
+    /// one-off solves (a benchmark loop, a sweep written with `solve`) reuse buffers and
+    /// Newton-matrix workspaces instead of allocating (and page-faulting) fresh ones per call.
+    /// A nested `solve` (from inside a right-hand side) finds it lent out and uses a fresh one.
+    static SPARE: RefCell<Option<Workspace>> = const { RefCell::new(None) };
 }
 
 /// Creates the Newton-matrix workspace for a pattern: the one place where a solve makes one
@@ -260,7 +304,22 @@ pub fn solve<P: Bvp>(
     guess: &Guess,
     options: &SolveOptions,
 ) -> Result<Solution, BvpError> {
-    Solver::new(problem, options.clone()).solve(params, guess)
+    let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
+    let spare = SPARE.try_with(|s| s.borrow_mut().take()).ok().flatten();
+    let ws = match spare {
+        Some(ws) => ws.for_dims(n, k, q),
+        None => Workspace::new(n, k, q),
+    };
+    let mut solver = Solver {
+        problem,
+        options: options.clone(),
+        ws,
+    };
+    let result = solver.solve(params, guess);
+    let ws = solver.ws;
+    // during thread teardown the slot may be gone: the workspace is then dropped
+    let _ = SPARE.try_with(|s| *s.borrow_mut() = Some(ws));
+    result
 }
 
 impl<'a, P: Bvp> Solver<'a, P> {
@@ -270,15 +329,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
         Solver {
             problem,
             options,
-            col: Collocation::new(n, k, q),
-            patterns: Vec::new(),
-            systems: Vec::new(),
-            patterns_built: 0,
-            systems_built: 0,
-            newton_work: NewtonWork::default(),
-            rms: Vec::new(),
-            buf: Vec::new(),
-            marks: Vec::new(),
+            ws: Workspace::new(n, k, q),
         }
     }
 
@@ -288,17 +339,17 @@ impl<'a, P: Bvp> Solver<'a, P> {
     }
 
     fn pattern(&mut self, m: usize) -> Result<Arc<Pattern>, BvpError> {
-        if let Some(pos) = self.patterns.iter().position(|p| p.m == m) {
-            let p = self.patterns.remove(pos);
-            self.patterns.push(p.clone());
+        if let Some(pos) = self.ws.patterns.iter().position(|p| p.m == m) {
+            let p = self.ws.patterns.remove(pos);
+            self.ws.patterns.push(p.clone());
             return Ok(p);
         }
-        let p = Arc::new(Pattern::new(self.col.n, self.col.k, m)?);
-        self.patterns_built += 1;
-        if self.patterns.len() >= 4 {
-            self.patterns.remove(0);
+        let p = Arc::new(Pattern::new(self.ws.col.n, self.ws.col.k, m)?);
+        self.ws.patterns_built += 1;
+        if self.ws.patterns.len() >= 4 {
+            self.ws.patterns.remove(0);
         }
-        self.patterns.push(p.clone());
+        self.ws.patterns.push(p.clone());
         Ok(p)
     }
 
@@ -307,23 +358,24 @@ impl<'a, P: Bvp> Solver<'a, P> {
     /// [`keep_system`](Self::keep_system).
     fn take_system(&mut self, m: usize, opts: &SolveOptions) -> Result<LinearSystem, BvpError> {
         if let Some(pos) = self
+            .ws
             .systems
             .iter()
             .position(|s| s.pattern.m == m && s.kind() == opts.linear_solver)
         {
-            return Ok(self.systems.remove(pos));
+            return Ok(self.ws.systems.remove(pos));
         }
         let pattern = self.pattern(m)?;
-        self.systems_built += 1;
+        self.ws.systems_built += 1;
         Ok(new_system(pattern, opts))
     }
 
     /// Returns a workspace to the cache (at most 4 mesh sizes, least recently used dropped).
     fn keep_system(&mut self, lin: LinearSystem) {
-        if self.systems.len() >= 4 {
-            self.systems.remove(0);
+        if self.ws.systems.len() >= 4 {
+            self.ws.systems.remove(0);
         }
-        self.systems.push(lin);
+        self.ws.systems.push(lin);
     }
 
     fn validate(
@@ -332,7 +384,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
         guess: &Guess,
         options: &SolveOptions,
     ) -> Result<(), BvpError> {
-        let (n, k, q) = (self.col.n, self.col.k, self.col.q);
+        let (n, k, q) = (self.ws.col.n, self.ws.col.k, self.ws.col.q);
         if n == 0 {
             return Err(BvpError::InvalidInput(
                 "the problem has no states (dim() = 0)".into(),
@@ -389,7 +441,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
     }
 
     fn scale_for(&self, y: &[f64], scale: &ResidualScale) -> Vec<f64> {
-        let n = self.col.n;
+        let n = self.ws.col.n;
         match scale {
             ResidualScale::Relative => vec![1.0; n],
             ResidualScale::PerComponent(s) => s.clone(),
@@ -450,7 +502,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
     ) -> Result<Solution, BvpError> {
         self.validate(params, guess, opts)?;
         let problem = self.problem;
-        let n = self.col.n;
+        let n = self.ws.col.n;
         let bc_tol = opts.bc_tol.unwrap_or(opts.tol);
         let settings = NewtonSettings {
             tol: opts.tol,
@@ -472,27 +524,27 @@ impl<'a, P: Bvp> Solver<'a, P> {
         let mut y = guess.y.clone();
         let mut p: Vec<f64> = guess.unknowns.iter().chain(params).copied().collect();
         let mut stats = SolveStats::default();
-        self.col.rhs_evals = 0;
-        self.col.jac_evals = 0;
+        self.ws.col.rhs_evals = 0;
+        self.ws.col.jac_evals = 0;
         let mesh_opts = &opts.mesh;
         let mut coarsenings_left = if opts.coarsen && opts.adapt { 3 } else { 0 };
         let mut iteration = 0;
         loop {
             iteration += 1;
             let m = x.len();
-            self.col.set_mesh(&x);
+            self.ws.col.set_mesh(&x);
             let mut lin = self.take_system(m, opts)?;
             let factorizations_before = lin.factorizations;
             let scale = self.scale_for(&y, &opts.scale);
             let report = newton(
                 problem,
-                &mut self.col,
+                &mut self.ws.col,
                 &mut lin,
                 &mut y,
                 &mut p,
                 &scale,
                 &settings,
-                &mut self.newton_work,
+                &mut self.ws.newton_work,
                 initial.take(),
             );
             let report = match report {
@@ -504,17 +556,17 @@ impl<'a, P: Bvp> Solver<'a, P> {
             };
             stats.newton_iterations += report.iterations;
             stats.jacobian_factorizations += lin.factorizations - factorizations_before;
-            let max_bc_res = max_bc(&self.col);
+            let max_bc_res = max_bc(&self.ws.col);
             rms_residuals(
                 problem,
-                &mut self.col,
+                &mut self.ws.col,
                 &y,
                 &p,
                 &scale,
-                &mut self.rms,
-                &mut self.buf,
+                &mut self.ws.rms,
+                &mut self.ws.buf,
             );
-            let max_res = self.rms.iter().fold(0.0f64, |a, &v| a.max(v));
+            let max_res = self.ws.rms.iter().fold(0.0f64, |a, &v| a.max(v));
             stats.max_residual = max_res;
             stats.max_bc_residual = max_bc_res;
 
@@ -532,12 +584,12 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 });
             }
 
-            let above = mesh::plan(&self.rms, opts.tol, mesh_opts, &mut self.marks);
+            let above = mesh::plan(&self.ws.rms, opts.tol, mesh_opts, &mut self.ws.marks);
             let refined = if above > 0 {
                 Some(mesh::apply(
                     &x,
-                    &self.rms,
-                    &self.marks,
+                    &self.ws.rms,
+                    &self.ws.marks,
                     opts.tol,
                     mesh_opts,
                     opts.max_nodes,
@@ -566,18 +618,18 @@ impl<'a, P: Bvp> Solver<'a, P> {
                         tol: opts.tol,
                     });
                 }
-                y = resample(&x, &y, &self.col.f, n, &new_x);
+                y = resample(&x, &y, &self.ws.col.f, n, &new_x);
                 x = new_x;
                 stats.mesh_refinements += 1;
             } else if max_bc_res <= bc_tol {
                 // coarsen only if the coarser mesh can still be solved and checked: the solution
                 // returned must belong to the mesh it was computed on
                 if coarsenings_left > 0 && m > 8 && iteration < opts.max_mesh_iterations {
-                    let new_x = mesh::coarsen(&x, &self.rms, opts.tol / 20.0);
+                    let new_x = mesh::coarsen(&x, &self.ws.rms, opts.tol / 20.0);
                     if (m - new_x.len()) * 10 >= m {
                         self.keep_system(lin);
                         coarsenings_left -= 1;
-                        y = resample(&x, &y, &self.col.f, n, &new_x);
+                        y = resample(&x, &y, &self.ws.col.f, n, &new_x);
                         x = new_x;
                         stats.mesh_refinements += 1;
                         stats.mesh_coarsenings += 1;
@@ -612,28 +664,28 @@ impl<'a, P: Bvp> Solver<'a, P> {
         mut stats: SolveStats,
         opts: &SolveOptions,
     ) -> Result<Solution, BvpError> {
-        let k = self.col.k;
+        let k = self.ws.col.k;
         // `col` holds values at the final iterate (the error estimate used them), among them the
         // midpoint states the Jacobians need
         let linearization = OnceLock::new();
         if opts.factor_at_solution {
-            let lz = Linearization::compute(problem, &mut self.col, &mut lin, &y, &p);
+            let lz = Linearization::compute(problem, &mut self.ws.col, &mut lin, &y, &p);
             stats.jacobian_factorizations += 1;
             self.keep_system(lin);
             let _ = linearization.set(Arc::new(lz?));
         } else {
             self.keep_system(lin);
         }
-        stats.rhs_evaluations = self.col.rhs_evals;
-        stats.rhs_dual_evaluations = self.col.jac_evals;
+        stats.rhs_evaluations = self.ws.col.rhs_evals;
+        stats.rhs_dual_evaluations = self.ws.col.jac_evals;
         Ok(Solution {
-            n: self.col.n,
+            n: self.ws.col.n,
             x,
-            yp: self.col.f.clone(),
+            yp: self.ws.col.f.clone(),
             y,
             unknowns: p[..k].to_vec(),
             params: p[k..].to_vec(),
-            rms_residuals: self.rms.clone(),
+            rms_residuals: self.ws.rms.clone(),
             residual_scale: scale,
             stats,
             linearization,
@@ -678,7 +730,7 @@ mod tests {
         let mut solver = Solver::new(&Bratu, opts.clone());
         let guess = Guess::constant(linspace(0.0, 1.0, 7), &[0.1, 0.0]);
         let first = solver.solve(&[1.0], &guess).unwrap();
-        let (patterns, systems) = (solver.patterns_built, solver.systems_built);
+        let (patterns, systems) = (solver.ws.patterns_built, solver.ws.systems_built);
         assert!(patterns >= 1 && systems >= 1);
         let warm = Guess::from(&first);
         let again = solver.solve(&[1.01], &warm).unwrap();
@@ -687,9 +739,12 @@ mod tests {
             first.nodes(),
             "the warm re-solve keeps the mesh"
         );
-        assert_eq!(solver.patterns_built, patterns, "no new sparsity pattern");
         assert_eq!(
-            solver.systems_built, systems,
+            solver.ws.patterns_built, patterns,
+            "no new sparsity pattern"
+        );
+        assert_eq!(
+            solver.ws.systems_built, systems,
             "no new Newton-matrix workspace"
         );
         // the reused workspace gives exactly what a fresh solver gives
@@ -697,6 +752,55 @@ mod tests {
         assert_eq!(again.x, fresh.x);
         assert_eq!(again.y, fresh.y);
         assert_eq!(again.stats, fresh.stats);
+    }
+
+    /// y' = -y, y(0) = 1: one state, no parameters.
+    struct Decay;
+    impl Bvp for Decay {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
+            f[0] = -y[0];
+        }
+        fn bc<D: DualNum<Primitive = f64> + Copy>(
+            &self,
+            ya: &[D],
+            _yb: &[D],
+            _p: &[D],
+            r: &mut [D],
+        ) {
+            r[0] = ya[0] - 1.0;
+        }
+    }
+
+    #[test]
+    fn one_off_solves_lend_a_thread_workspace_without_changing_results() {
+        let opts = SolveOptions::with_tol(1e-8);
+        let guess = Guess::constant(linspace(0.0, 1.0, 7), &[0.1, 0.0]);
+        let fresh = Solver::new(&Bratu, opts.clone())
+            .solve(&[1.0], &guess)
+            .unwrap();
+        let first = solve(&Bratu, &[1.0], &guess, &opts).unwrap();
+        assert!(
+            SPARE.with(|s| s.borrow().is_some()),
+            "the workspace is kept"
+        );
+        // a problem of other dimensions in between gets a workspace fit for it
+        let decay = solve(
+            &Decay,
+            &[],
+            &Guess::constant(linspace(0.0, 1.0, 5), &[1.0]),
+            &opts,
+        )
+        .unwrap();
+        assert!((decay.at_node(decay.nodes() - 1, 0) - (-1.0f64).exp()).abs() < 1e-7);
+        let second = solve(&Bratu, &[1.0], &guess, &opts).unwrap();
+        for s in [&first, &second] {
+            assert_eq!(s.x, fresh.x);
+            assert_eq!(s.y, fresh.y);
+            assert_eq!(s.stats, fresh.stats);
+        }
     }
 
     #[test]

@@ -122,8 +122,6 @@ impl Factorization {
 /// The collocation Jacobian seen block by block.
 struct CollocationBlocks<'a> {
     col: &'a Collocation,
-    a: &'a mut [f64],
-    b: &'a mut [f64],
     /// The `k` parameter columns, each of length `size`.
     pcols: &'a [f64],
     size: usize,
@@ -132,10 +130,8 @@ struct CollocationBlocks<'a> {
 impl BlockSource for CollocationBlocks<'_> {
     fn fill_interval(&mut self, i: usize, out: &mut [f64], w: usize) {
         let (n, k) = (self.col.n, self.col.k);
-        self.col.interval_blocks(i, self.a, self.b);
+        self.col.interval_rows(i, out, w);
         for (r, row) in out.chunks_exact_mut(w).take(n).enumerate() {
-            row[..n].copy_from_slice(&self.a[r * n..(r + 1) * n]);
-            row[n..2 * n].copy_from_slice(&self.b[r * n..(r + 1) * n]);
             for l in 0..k {
                 row[2 * n + l] = self.pcols[l * self.size + i * n + r];
             }
@@ -174,9 +170,7 @@ pub(crate) struct LinearSystem {
     kind: LinearSolverKind,
     sparse: Option<SparseLu>,
     block: BlockLu,
-    /// Factor scratch of the structured path: `A_i`, `B_i` and the parameter columns.
-    block_a: Vec<f64>,
-    block_b: Vec<f64>,
+    /// Factor scratch of the structured path: the parameter columns.
     pcols: Vec<f64>,
     /// Solve scratch of the structured path.
     scratch: Vec<f64>,
@@ -200,8 +194,6 @@ impl LinearSystem {
             kind,
             sparse: None,
             block: BlockLu::default(),
-            block_a: Vec::new(),
-            block_b: Vec::new(),
             pcols: Vec::new(),
             scratch: Vec::new(),
             active: Active::None,
@@ -277,16 +269,12 @@ impl LinearSystem {
     fn factor_structured(&mut self, col: &Collocation) -> Result<(), BlockError> {
         let (n, k, m) = (self.pattern.n, self.pattern.k, self.pattern.m);
         let size = self.pattern.size();
-        self.block_a.resize(n * n, 0.0);
-        self.block_b.resize(n * n, 0.0);
         self.pcols.resize(k * size, 0.0);
         for l in 0..k {
             col.param_column(l, &mut self.pcols[l * size..(l + 1) * size]);
         }
         let mut src = CollocationBlocks {
             col,
-            a: &mut self.block_a,
-            b: &mut self.block_b,
             pcols: &self.pcols,
             size,
         };

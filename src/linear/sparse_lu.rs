@@ -119,17 +119,16 @@ impl Pattern {
         values.resize(self.nnz(), 0.0);
         let cp = self.symbolic().col_ptr();
         work.resize(2 * n * n + size, 0.0);
-        let (a, rest) = work.split_at_mut(n * n);
-        let (b, pcol) = rest.split_at_mut(n * n);
+        let (ab, pcol) = work.split_at_mut(2 * n * n);
         for i in 0..m - 1 {
-            col.interval_blocks(i, a, b);
+            col.interval_rows(i, ab, 2 * n);
             let a_off = if i >= 1 { n } else { 0 };
             for c in 0..n {
                 let base_a = cp[i * n + c] + a_off;
                 let base_b = cp[(i + 1) * n + c];
                 for r in 0..n {
-                    values[base_a + r] = a[r * n + c];
-                    values[base_b + r] = b[r * n + c];
+                    values[base_a + r] = ab[r * 2 * n + c];
+                    values[base_b + r] = ab[r * 2 * n + n + c];
                 }
             }
         }
