@@ -171,7 +171,6 @@ fn control_names_nothing() {
 }
 
 #[test]
-#[ignore = "issue 11 open: the exponential air_coflow family does not fit a 150 m/s Lorentzian jet (named air_coflow_line 395 ± 836 m/s, RMS after 7.9 %)"]
 fn strong_aspirator_coflow_is_found() {
     let sc = scenarios::aspirator_strong();
     assert_found(&sc, &run(&sc));
