@@ -115,7 +115,7 @@ impl Linearization {
         for l in 0..k {
             col.param_column(l, &mut pcols[l * size..(l + 1) * size]);
         }
-        let (mut a, mut bb) = (vec![0.0; n * n], vec![0.0; n * n]);
+        let mut ab = vec![0.0; 2 * n * n];
         // Entry `v` at (row, column) of the Newton matrix, applied as A or Aᵀ to every column.
         let mut add = |row: usize, column: usize, v: f64| {
             let (out, from) = if transpose {
@@ -129,12 +129,11 @@ impl Linearization {
             }
         };
         for i in 0..m - 1 {
-            col.interval_blocks(i, &mut a, &mut bb);
+            col.interval_rows(i, &mut ab, 2 * n);
             for rr in 0..n {
                 let row = i * n + rr;
-                for c in 0..n {
-                    add(row, i * n + c, a[rr * n + c]);
-                    add(row, (i + 1) * n + c, bb[rr * n + c]);
+                for (c, v) in ab[rr * 2 * n..(rr + 1) * 2 * n].iter().enumerate() {
+                    add(row, i * n + c, *v);
                 }
                 for l in 0..k {
                     add(row, m * n + l, pcols[l * size + row]);

@@ -16,7 +16,10 @@
 //! 4. **Global search and refits** ([`scan`](super::scan)) of every candidate, in parallel: its
 //!    strength scanned over its search range (and, for effects with a shape, a few shapes), each
 //!    grid point a warm-started refit of the material parameters with the strength fixed; the
-//!    best grid points refined with the strength freed. The best refit gives the achieved cost
+//!    best grid points refined with the strength freed (the lowest, the next ones close to it,
+//!    and the lowest ones on the other side of the neutral value where they already earn their
+//!    place: the two signs are different regimes; a grid point whose `n` sits at a bound is
+//!    refined from the start law, since at `n = 1` the fit cannot move). The best refit gives the achieved cost
 //!    `J`, RMS, fitted strength with standard error, and information criteria
 //!    `ΔBIC = N ln(J_after/J_before) + Δk ln N`, `ΔAIC = N ln(J_after/J_before) + 2 Δk`
 //!    (Gaussian errors with unknown variance; `Δk` extra parameters, 2 for strain thinning:
@@ -29,8 +32,8 @@
 //!    [`DiagnoseOptions::indistinguishable_cosine`] (0.9) in absolute value.
 
 use super::scan::{
-    physical, refine, scan_profile, search_range, shape_variants, Profile, ProfileScan, Refit,
-    ScanOptions, ShapeParameter,
+    physical, refine, scan_profile, search_range, shape_variants, GridStart, Profile, ProfileScan,
+    Refit, ScanOptions, ShapeParameter,
 };
 use super::scores::{cosine, linear_scores};
 use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
@@ -629,19 +632,59 @@ pub fn diagnose(
         starts.sort_by(|a, b| a.2.total_cmp(&b.2));
         // the lowest start, and the next ones only where their J is close to it
         let lowest = starts.first().map_or(f64::INFINITY, |s| s.2);
-        refine_jobs.extend(
-            starts
-                .into_iter()
+        let chosen: Vec<(usize, usize, f64)> = starts
+            .iter()
+            .copied()
+            .take(options.scan.refine.max(1))
+            .filter(|s| s.2 <= lowest * (1.0 + options.scan.refine_within))
+            .collect();
+        // the two signs of a strength are different regimes (a co-flow faster than the fiber
+        // reverses the relative speed; warmer or colder air): the lowest starts on the other
+        // side of the neutral value (as many as `refine`, over all shapes) are refined too
+        // where they already earn their place at their grid point (a grid point's J, with the
+        // strength and shape fixed, bounds its refit's from above)
+        let neutral = cands[i].neutral();
+        let side = |&(j, k, _): &(usize, usize, f64)| {
+            (ok_scans[j].1.starts[k].strength - neutral).signum()
+        };
+        let other: Vec<(usize, usize, f64)> = match chosen.first().map(side) {
+            Some(first) => starts
+                .iter()
+                .copied()
+                .filter(|s| side(s) != first)
                 .take(options.scan.refine.max(1))
-                .filter(|s| s.2 <= lowest * (1.0 + options.scan.refine_within))
-                .map(|(j, k, _)| (i, j, k)),
-        );
+                .filter(|s| ic(s.2, results[i].extra_parameters).0 < options.earn_threshold)
+                .collect(),
+            None => Vec::new(),
+        };
+        refine_jobs.extend(chosen.into_iter().chain(other).map(|(j, k, _)| (i, j, k)));
     }
+    let n_bounds = layout
+        .names
+        .iter()
+        .position(|s| s == "n")
+        .map(|c| (layout.lower[c], layout.upper[c]));
     let refined: Vec<(usize, usize, Refit)> = refine_jobs
         .into_par_iter()
         .filter_map(|(i, j, k)| {
             let sc = &ok_scans[j].1;
-            refine(sc, &sc.starts[k], &opts).ok().map(|r| (i, j, r))
+            // a grid point whose n sits at a bound of its range (the Newtonian limit n = 1,
+            // where κ has no effect: the fit cannot leave it) is refined from the diagnosis'
+            // start law instead, with its own strength, shape and warm solutions
+            let start = &sc.starts[k];
+            let at_n_bound = n_bounds
+                .is_some_and(|(lo, hi)| start.law[0] <= lo + 1e-6 || start.law[0] >= hi - 1e-6);
+            let moved;
+            let start = if at_n_bound && spec.law == LawChoice::Carreau {
+                moved = GridStart {
+                    law: law0,
+                    ..start.clone()
+                };
+                &moved
+            } else {
+                start
+            };
+            refine(sc, start, &opts).ok().map(|r| (i, j, r))
         })
         .collect();
     let mut best_refit: Vec<Option<(Effect, Refit)>> = vec![None; cands.len()];
