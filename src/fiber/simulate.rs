@@ -19,7 +19,7 @@
 //! # Ok::<(), diffbvp::fiber::FiberError>(())
 //! ```
 
-use super::cold_start::{continuation_in_c, PathOptions};
+use super::cold_start::{continuation_in_c, continuation_in_c_with_loose, PathOptions};
 use super::contributions::{Balance, NusseltLaw, SiScales};
 use super::error::FiberError;
 use super::material_law::ViscosityLaw;
@@ -283,6 +283,45 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
         self.solve(&p, None)
     }
 
+    /// Cold start with full parameters `p` (see [`solve`](Self::solve)) that also returns the
+    /// end point of the continuation path: the solution at `p` at the path's loose tolerance
+    /// `max(tol, continuation.intermediate_tol)` (dimensionless collocation residual), which
+    /// the final solve at `tol` started from. Returns `(final, loose)`. Options with
+    /// [`required_positions`](SimulateOptions::required_positions) are refused (use
+    /// [`solve`](Self::solve)).
+    pub fn cold_with_loose(
+        &mut self,
+        p: &[f64],
+    ) -> Result<(FiberSolution, Solution), FiberError> {
+        let model = self.model;
+        model.check_parameters(p)?;
+        if self.options.initial_nodes < 2 {
+            return Err(FiberError::InvalidInput(
+                "initial_nodes must be at least 2".into(),
+            ));
+        }
+        if !self.options.required_positions.is_empty() {
+            return Err(FiberError::InvalidInput(
+                "cold_with_loose does not insert required positions; use solve".into(),
+            ));
+        }
+        let guess = self.stress_free_guess(p);
+        let solve_opts = self.options.solve_options();
+        let path = &self.options.continuation;
+        let (loose, last) =
+            continuation_in_c_with_loose(&mut self.solver, p, 0, &guess, path, &solve_opts)?;
+        Ok((FiberSolution { solution: last }, loose))
+    }
+
+    /// The stress-free fiber of `c = 0` with the process parameters of `p` on the initial
+    /// uniform mesh: the start of a cold start.
+    fn stress_free_guess(&self, p: &[f64]) -> Guess {
+        let model = self.model;
+        let x = linspace(0.0, model.length(), self.options.initial_nodes);
+        let (u0, t0) = model.inlet_state(p);
+        Guess::constant(x, &[u0, 0.0, t0, 0.0])
+    }
+
     /// Warm start from `start` with law parameters `law_params` (cold start if that fails).
     pub fn warm(
         &mut self,
@@ -342,11 +381,7 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
                 }
             }
         }
-        let x = linspace(0.0, model.length(), options.initial_nodes);
-        // the stress-free fiber of c = 0 with the process parameters of `p`
-        let (u0, t0) = model.inlet_state(p);
-        let y0 = [u0, 0.0, t0, 0.0];
-        let guess = Guess::constant(x, &y0);
+        let guess = self.stress_free_guess(p);
         let path = &options.continuation;
         if required.is_empty() {
             let sol = continuation_in_c(&mut self.solver, p, 0, &guess, path, &solve_opts)?;
