@@ -286,8 +286,12 @@ fn equidistribute(
         for j in 0..SUB {
             let xc = a + (j as f64 + 0.5) / SUB as f64 * h;
             // the neighbour on the side of the cell centre (the interval itself at the ends)
-            let nb = if xc < mid(i) { i.checked_sub(1) } else { Some(i + 1) }
-                .filter(|&k| k < n_int);
+            let nb = if xc < mid(i) {
+                i.checked_sub(1)
+            } else {
+                Some(i + 1)
+            }
+            .filter(|&k| k < n_int);
             let w = match (log_c[i], nb.and_then(|k| log_c[k].map(|c| (k, c)))) {
                 (Some(ci), Some((k, ck))) => {
                     let t = (xc - mid(i)) / (mid(k) - mid(i));
@@ -299,7 +303,11 @@ fn equidistribute(
                 _ => pieces_of(rms[i]),
             };
             ws.push(w / SUB as f64);
-            xs.push(if j + 1 == SUB { x[i + 1] } else { a + (j + 1) as f64 / SUB as f64 * h });
+            xs.push(if j + 1 == SUB {
+                x[i + 1]
+            } else {
+                a + (j + 1) as f64 / SUB as f64 * h
+            });
         }
     }
     distribute(&xs, &ws, max_intervals)

@@ -289,10 +289,7 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
     /// the final solve at `tol` started from. Returns `(final, loose)`. Options with
     /// [`required_positions`](SimulateOptions::required_positions) are refused (use
     /// [`solve`](Self::solve)).
-    pub fn cold_with_loose(
-        &mut self,
-        p: &[f64],
-    ) -> Result<(FiberSolution, Solution), FiberError> {
+    pub fn cold_with_loose(&mut self, p: &[f64]) -> Result<(FiberSolution, Solution), FiberError> {
         let model = self.model;
         model.check_parameters(p)?;
         if self.options.initial_nodes < 2 {

@@ -153,7 +153,10 @@ impl<'a> Objective<'a> {
                             .map_err(&sim_err)?;
                         (sol, Some(loose))
                     }
-                    None => (simulate_params(model, &p, warm, sim).map_err(&sim_err)?, None),
+                    None => (
+                        simulate_params(model, &p, warm, sim).map_err(&sim_err)?,
+                        None,
+                    ),
                 };
                 let lo = model.scaling.reference.length;
                 let dd = model.scaling.diameter();
