@@ -47,7 +47,7 @@ fn bench(c: &mut Criterion) {
     });
     // the mesh rule before the smooth error constants (a second full pass on this experiment)
     let mut constant = opts.clone();
-    constant.mesh.smooth = false;
+    constant.smooth_cold_final = false;
     c.bench_function("fiber_cold_constant_density_v0p53_p2_tol1e-6", |b| {
         b.iter(|| simulate(black_box(&m), black_box(&[0.8, 11.71]), &constant).expect("cold"))
     });

@@ -44,10 +44,11 @@ pub fn continuation_in_c<P: Bvp>(
 }
 
 /// [`continuation_in_c`] that also returns the end point of the loose path: the solution at
-/// `p[index] = 1` solved at [`PathOptions::intermediate`] options (tolerance
-/// `max(options.tol, path.intermediate_tol)`), from which the final solve at `options` started.
-/// Returns `(loose, final)`. A fit with loose inner iterations uses the loose end point as its
-/// loose solve at the start parameters instead of re-solving the final solution loosely.
+/// `p[index] = 1` solved at the [`PathOptions::intermediate`] options of `options` (tolerance
+/// `max(options.tol, path.intermediate_tol)`), from which the final solve at `final_options`
+/// started (e.g. `options` with another mesh rule). Returns `(loose, final)`. A fit with loose
+/// inner iterations uses the loose end point as its loose solve at the start parameters
+/// instead of re-solving the final solution loosely.
 pub fn continuation_in_c_with_loose<P: Bvp>(
     solver: &mut Solver<'_, P>,
     params: &[f64],
@@ -55,6 +56,7 @@ pub fn continuation_in_c_with_loose<P: Bvp>(
     guess: &Guess,
     path: &PathOptions,
     options: &SolveOptions,
+    final_options: &SolveOptions,
 ) -> Result<(Solution, Solution), BvpError> {
     let mut p = params.to_vec();
     // an index out of range is refused by `follow`
@@ -68,6 +70,6 @@ pub fn continuation_in_c_with_loose<P: Bvp>(
     if let Some(c) = p.get_mut(index) {
         *c = 1.0;
     }
-    let last = solver.solve_with(&p, &Guess::from(&reached), options)?;
+    let last = solver.solve_with(&p, &Guess::from(&reached), final_options)?;
     Ok((reached, last))
 }

@@ -52,13 +52,15 @@ pub struct SimulateOptions {
     /// Positions \[m\] added as nodes to the mesh of the final solve, e.g. output positions
     /// (default none; mesh coarsening may remove some again — the interpolant is used anyway).
     pub required_positions: Vec<f64>,
-    /// Mesh adaptation of every solve (default: [`MeshOptions::default`] with
-    /// [`smooth`](MeshOptions::smooth) error constants). The final pass of a cold start refines
-    /// the loose continuation mesh about tenfold (24 → ~224 nodes on v0p53_p2); with the error
-    /// constant held constant per old interval that prediction missed `tol` on two intervals
-    /// and a second full pass followed on 5 of the 9 shipped experiments; with the smooth
-    /// constant one pass reaches `tol` on all 9 (1–2 % more nodes).
+    /// Mesh adaptation of every solve (default [`MeshOptions::default`]).
     pub mesh: MeshOptions,
+    /// The final solve of a cold start with [`smooth`](MeshOptions::smooth) error constants
+    /// (default `true`). That solve refines the loose continuation mesh about tenfold
+    /// (24 → ~224 nodes on v0p53_p2); with the error constant held constant per old interval
+    /// the prediction missed `tol` on two intervals and a second full pass followed on 5 of
+    /// the 9 shipped experiments; with the smooth constant one pass reaches `tol` on all 9
+    /// (1–2 % more nodes).
+    pub smooth_cold_final: bool,
 }
 
 impl Default for SimulateOptions {
@@ -72,10 +74,8 @@ impl Default for SimulateOptions {
             continuation: PathOptions::default(),
             factor_at_solution: false,
             required_positions: Vec::new(),
-            mesh: MeshOptions {
-                smooth: true,
-                ..MeshOptions::default()
-            },
+            mesh: MeshOptions::default(),
+            smooth_cold_final: true,
         }
     }
 }
@@ -87,6 +87,14 @@ impl SimulateOptions {
             tol,
             ..Default::default()
         }
+    }
+
+    /// The toolkit options of a cold start's final solve: [`solve_options`](Self::solve_options)
+    /// with smooth error constants if [`smooth_cold_final`](Self::smooth_cold_final).
+    pub fn cold_final_options(&self) -> SolveOptions {
+        let mut o = self.solve_options();
+        o.mesh.smooth |= self.smooth_cold_final;
+        o
     }
 
     /// The toolkit options these settings translate to.
@@ -303,10 +311,20 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
             ));
         }
         let guess = self.stress_free_guess(p);
-        let solve_opts = self.options.solve_options();
+        let (path_opts, final_opts) = (
+            self.options.solve_options(),
+            self.options.cold_final_options(),
+        );
         let path = &self.options.continuation;
-        let (loose, last) =
-            continuation_in_c_with_loose(&mut self.solver, p, 0, &guess, path, &solve_opts)?;
+        let (loose, last) = continuation_in_c_with_loose(
+            &mut self.solver,
+            p,
+            0,
+            &guess,
+            path,
+            &path_opts,
+            &final_opts,
+        )?;
         Ok((FiberSolution { solution: last }, loose))
     }
 
@@ -380,8 +398,17 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
         }
         let guess = self.stress_free_guess(p);
         let path = &options.continuation;
+        let final_opts = options.cold_final_options();
         if required.is_empty() {
-            let sol = continuation_in_c(&mut self.solver, p, 0, &guess, path, &solve_opts)?;
+            let (_, sol) = continuation_in_c_with_loose(
+                &mut self.solver,
+                p,
+                0,
+                &guess,
+                path,
+                &solve_opts,
+                &final_opts,
+            )?;
             return Ok(FiberSolution { solution: sol });
         }
         // continuation without the required nodes, then a final solve on a mesh with them
@@ -391,7 +418,7 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
         let sol = continuation_in_c(&mut self.solver, p, 0, &guess, path, &loose)?;
         let x = insert_required(&sol.x, &required);
         let guess = Guess::from_fn(x, 4, |x, y| sol.eval_into(x, y, &mut [0.0; 4]));
-        let sol = self.solver.solve_with(p, &guess, &solve_opts)?;
+        let sol = self.solver.solve_with(p, &guess, &final_opts)?;
         Ok(FiberSolution { solution: sol })
     }
 }
