@@ -45,6 +45,12 @@ fn bench(c: &mut Criterion) {
     c.bench_function("fiber_cold_v0p53_p2_tol1e-6", |b| {
         b.iter(|| simulate(black_box(&m), black_box(&[0.8, 11.71]), &opts).expect("cold"))
     });
+    // the mesh rule before the smooth error constants (a second full pass on this experiment)
+    let mut constant = opts.clone();
+    constant.smooth_cold_final = false;
+    c.bench_function("fiber_cold_constant_density_v0p53_p2_tol1e-6", |b| {
+        b.iter(|| simulate(black_box(&m), black_box(&[0.8, 11.71]), &constant).expect("cold"))
+    });
     let mut sim = Simulator::new(&m, opts.clone());
     c.bench_function("fiber_warm_reused_simulator_v0p53_p2_tol1e-6", |b| {
         b.iter(|| sim.warm(black_box(&[0.8, 11.71]), &near).expect("warm"))

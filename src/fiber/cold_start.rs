@@ -16,7 +16,7 @@
 
 pub use crate::continuation::{PathOptions, SimpleSteps, StepControl};
 
-use crate::continuation::solve_by_continuation;
+use crate::continuation::{follow, solve_by_continuation};
 use crate::error::BvpError;
 use crate::problem::Bvp;
 use crate::solution::Solution;
@@ -41,4 +41,35 @@ pub fn continuation_in_c<P: Bvp>(
         *c = 0.0;
     }
     solve_by_continuation(solver, &p, index, 1.0, guess, path, options)
+}
+
+/// [`continuation_in_c`] that also returns the end point of the loose path: the solution at
+/// `p[index] = 1` solved at the [`PathOptions::intermediate`] options of `options` (tolerance
+/// `max(options.tol, path.intermediate_tol)`), from which the final solve at `final_options`
+/// started (e.g. `options` with another mesh rule). Returns `(loose, final)`. A fit with loose
+/// inner iterations uses the loose end point as its loose solve at the start parameters
+/// instead of re-solving the final solution loosely.
+pub fn continuation_in_c_with_loose<P: Bvp>(
+    solver: &mut Solver<'_, P>,
+    params: &[f64],
+    index: usize,
+    guess: &Guess,
+    path: &PathOptions,
+    options: &SolveOptions,
+    final_options: &SolveOptions,
+) -> Result<(Solution, Solution), BvpError> {
+    let mut p = params.to_vec();
+    // an index out of range is refused by `follow`
+    if let Some(c) = p.get_mut(index) {
+        *c = 0.0;
+    }
+    path.step_control.validate()?;
+    let loose = path.intermediate(options);
+    let start = solver.solve_with(&p, guess, &loose)?;
+    let reached = follow(solver, &start, index, 1.0, &path.step_control, &loose)?.solution;
+    if let Some(c) = p.get_mut(index) {
+        *c = 1.0;
+    }
+    let last = solver.solve_with(&p, &Guess::from(&reached), final_options)?;
+    Ok((reached, last))
 }

@@ -198,6 +198,21 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         })
     }
 
+    /// Supplies a solve at the start solution's own parameters with tolerance `tol`, e.g. the
+    /// end point of the loose continuation path that led to the start solution (builder style).
+    /// The calibration of [`BvpResiduals::set_loose_tolerance`] at `tol` then uses it instead of
+    /// re-solving the start solution loosely (and the first loose evaluation reuses it, as it
+    /// reuses the calibration's own solve). It must meet `tol` under this run's solver options
+    /// with `tol` as their tolerance; it is ignored unless its model and unknown parameters are
+    /// those of the start solution.
+    pub fn with_loose_solution(mut self, tol: f64, loose: Solution) -> Self {
+        let fits = loose.n == self.accepted.n
+            && loose.params == self.accepted.params
+            && loose.unknowns.len() == self.accepted.unknowns.len();
+        self.calibration = (fits && tol.is_finite() && tol > 0.0).then_some((tol, loose));
+        self
+    }
+
     /// The problem.
     pub fn problem(&self) -> &'a P {
         self.solver.problem()
@@ -371,10 +386,15 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
     fn loose_error(&mut self, tol: f64) -> Result<(f64, usize), BvpError> {
         let accepted = self.accepted.clone();
         let tight = self.residuals_of(&accepted);
-        let opts = self.loose_options(tol);
-        let sol = self
-            .solver
-            .solve_with(&accepted.params, &Guess::from(&accepted), &opts)?;
+        let sol = match self.calibration.take() {
+            // a loose solve supplied with the start solution (`with_loose_solution`)
+            Some((tc, sol)) if tc == tol && sol.params == accepted.params => sol,
+            _ => {
+                let opts = self.loose_options(tol);
+                self.solver
+                    .solve_with(&accepted.params, &Guess::from(&accepted), &opts)?
+            }
+        };
         let loose = self.residuals_of(&sol);
         let d2 = tight
             .iter()

@@ -9,7 +9,7 @@ use super::estimator::{Estimator, PaperResidual, RelativeResidual};
 use super::layout::{FitStart, Layout};
 use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
 use crate::fiber::error::FiberError;
-use crate::fiber::simulate::simulate_params;
+use crate::fiber::simulate::{simulate_params, Simulator};
 use crate::least_squares::{BvpResiduals, BvpRun, LeastSquaresProblem, ParamMap, RunError};
 use crate::sensitivity::PointFunction;
 use crate::solution::Solution;
@@ -137,7 +137,27 @@ impl<'a> Objective<'a> {
                     kappa: start[1],
                     source,
                 };
-                let sol = simulate_params(model, &p, warm, &options.simulate).map_err(&sim_err)?;
+                // a fit with loose inner iterations at the continuation's own loose tolerance:
+                // the cold start's loose end point is the calibration's loose solve
+                let sim = &options.simulate;
+                let loose_start = options.loose_tolerance.filter(|&t| {
+                    warm.is_none()
+                        && t == sim.continuation.intermediate_tol
+                        && sim.tol < t
+                        && sim.required_positions.is_empty()
+                });
+                let (sol, loose) = match loose_start {
+                    Some(_) => {
+                        let (sol, loose) = Simulator::new(model, sim.clone())
+                            .cold_with_loose(&p)
+                            .map_err(&sim_err)?;
+                        (sol, Some(loose))
+                    }
+                    None => (
+                        simulate_params(model, &p, warm, sim).map_err(&sim_err)?,
+                        None,
+                    ),
+                };
                 let lo = model.scaling.reference.length;
                 let dd = model.scaling.diameter();
                 let length = rheo.experiments[k].spinline_length;
@@ -171,14 +191,18 @@ impl<'a> Objective<'a> {
                     }
                 };
                 let map = Self::param_map(&layout, estimator, ns, k, phi_idx);
-                BvpRun::new(
+                let run = BvpRun::new(
                     Solver::new(model, options.simulate.solve_options()),
                     sol.solution,
                     points,
                     residual,
                     map,
                 )
-                .map_err(|e| sim_err(FiberError::from(e)))
+                .map_err(|e| sim_err(FiberError::from(e)))?;
+                Ok(match (loose_start, loose) {
+                    (Some(t), Some(l)) => run.with_loose_solution(t, l),
+                    _ => run,
+                })
             })
             .collect();
         let num_params = match estimator {
