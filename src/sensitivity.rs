@@ -79,7 +79,25 @@ impl Sensitivities {
     /// Computes `D_p Y` at `sol` with one solve of `q` right-hand sides, reusing the
     /// linearisation cached in `sol` (Jacobians and factorisation; computed once and cached if
     /// `sol` has none yet: one dual pass and one factorisation, no other evaluation).
+    ///
+    /// The solve takes one step of iterative refinement (the residual of the linear system
+    /// formed from the Jacobian blocks, the correction solved with the same factors): the
+    /// derivatives are then componentwise backward stable, and the structured and the sparse
+    /// elimination agree to round-off even on badly scaled systems (fiber model: 1e-15; 3.5e-11
+    /// without the step). [`Sensitivities::compute_unrefined`] skips the step.
     pub fn compute<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
+        Self::compute_with(problem, sol, true)
+    }
+
+    /// [`Sensitivities::compute`] without the refinement step: one solve with the cached factors,
+    /// accurate to about the system's condition number times `ε` (3.5e-11 relative on the fiber
+    /// model), about 60 % cheaper on the solver benchmarks. What a Gauss–Newton Jacobian needs
+    /// ([`BvpResiduals`](crate::least_squares::BvpResiduals) uses it).
+    pub fn compute_unrefined<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
+        Self::compute_with(problem, sol, false)
+    }
+
+    fn compute_with<P: Bvp>(problem: &P, sol: &Solution, refine: bool) -> Result<Self, BvpError> {
         let lz = linearization(problem, sol)?;
         let (n, k, q, m) = (lz.col.n, lz.col.k, lz.col.q, lz.col.m());
         let size = m * n + k;
@@ -91,7 +109,11 @@ impl Sensitivities {
         for v in rhs.iter_mut() {
             *v = -*v;
         }
-        lz.solve_refined(&mut rhs, q, false)?;
+        if refine {
+            lz.solve_refined(&mut rhs, q, false)?;
+        } else {
+            lz.factorization.solve_in_place(&mut rhs, q)?;
+        }
         if let Some(pos) = rhs.iter().position(|v| !v.is_finite()) {
             return Err(BvpError::SingularJacobian {
                 detail: format!("sensitivity solve gave a non-finite value (entry {pos})"),

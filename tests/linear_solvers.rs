@@ -320,4 +320,11 @@ fn fiber_model_agrees() {
     // (cond × ε, pivoting differs); with it, 9.9e-16.
     assert_agree("fiber", &model, &sparse, &structured);
     assert_agree("fiber", &model, &sparse, &auto);
+    // Without the step both are accurate to cond × ε only, but still close to the refined ones.
+    let refined = Sensitivities::compute(&model, &structured).expect("sensitivities");
+    for sol in [&sparse, &structured] {
+        let plain = Sensitivities::compute_unrefined(&model, sol).expect("sensitivities");
+        let e = rel_diff(&plain.dy, &refined.dy);
+        assert!(e <= 1e-9, "unrefined fiber sensitivities differ by {e:e}");
+    }
 }

@@ -349,7 +349,7 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         }
         let problem = self.solver.problem();
         let out = if jacobian {
-            let sens = Sensitivities::compute(problem, &sol)?;
+            let sens = Sensitivities::compute_unrefined(problem, &sol)?;
             residual_jacobian(problem, &sol, &sens, &self.points, &self.residual)?
         } else {
             (self.residuals_of(&sol), Vec::new())
