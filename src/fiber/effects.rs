@@ -971,10 +971,15 @@ mod tests {
     #[test]
     fn shapes_fixed_by_settings_are_not_freed() {
         let s: EffectSetting = "air_coflow_line:onset=0.25".parse().unwrap();
-        // the ramp width is never fitted by default, the fixed onset not either
-        assert!(s.effect.free_shapes().is_empty());
+        // the fixed onset is not fitted; the ramp width (not given) still is
+        let free: Vec<_> = s.effect.free_shapes().iter().map(|f| f.model_param).collect();
+        assert_eq!(free, ["air_coflow_line.ramp_width"]);
         let vals: Vec<f64> = s.effect.shape_values().iter().map(|v| v.1).collect();
         assert_eq!(vals, [0.25, DEFAULT_COFLOW_LINE_RAMP_WIDTH]);
+        let both: EffectSetting = "air_coflow_line:onset=0.25:ramp_width=0.05"
+            .parse()
+            .unwrap();
+        assert!(both.effect.free_shapes().is_empty());
         let free = Effect::AirCoflow { decay_length: None }.free_shapes();
         assert_eq!(free.len(), 1);
         assert_eq!(free[0].model_param, "air_coflow.decay_length");
