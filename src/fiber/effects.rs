@@ -972,7 +972,12 @@ mod tests {
     fn shapes_fixed_by_settings_are_not_freed() {
         let s: EffectSetting = "air_coflow_line:onset=0.25".parse().unwrap();
         // the fixed onset is not fitted; the ramp width (not given) still is
-        let free: Vec<_> = s.effect.free_shapes().iter().map(|f| f.model_param).collect();
+        let free: Vec<_> = s
+            .effect
+            .free_shapes()
+            .iter()
+            .map(|f| f.model_param)
+            .collect();
         assert_eq!(free, ["air_coflow_line.ramp_width"]);
         let vals: Vec<f64> = s.effect.shape_values().iter().map(|v| v.1).collect();
         assert_eq!(vals, [0.25, DEFAULT_COFLOW_LINE_RAMP_WIDTH]);
