@@ -35,12 +35,18 @@ pub fn continuation_in_c<P: Bvp>(
     path: &PathOptions,
     options: &SolveOptions,
 ) -> Result<Solution, BvpError> {
-    let mut p = params.to_vec();
-    // an index out of range is refused by `solve_by_continuation`
-    if let Some(c) = p.get_mut(index) {
-        *c = 0.0;
-    }
+    let p = with_value(params, index, 0.0);
     solve_by_continuation(solver, &p, index, 1.0, guess, path, options)
+}
+
+/// `params` with entry `index` set to `value` (an index out of range is left to the caller's
+/// continuation routine to refuse).
+fn with_value(params: &[f64], index: usize, value: f64) -> Vec<f64> {
+    let mut p = params.to_vec();
+    if let Some(c) = p.get_mut(index) {
+        *c = value;
+    }
+    p
 }
 
 /// [`continuation_in_c`] that also returns the end point of the loose path: the solution at
@@ -58,18 +64,11 @@ pub fn continuation_in_c_with_loose<P: Bvp>(
     options: &SolveOptions,
     final_options: &SolveOptions,
 ) -> Result<(Solution, Solution), BvpError> {
-    let mut p = params.to_vec();
-    // an index out of range is refused by `follow`
-    if let Some(c) = p.get_mut(index) {
-        *c = 0.0;
-    }
     path.step_control.validate()?;
     let loose = path.intermediate(options);
-    let start = solver.solve_with(&p, guess, &loose)?;
+    let start = solver.solve_with(&with_value(params, index, 0.0), guess, &loose)?;
     let reached = follow(solver, &start, index, 1.0, &path.step_control, &loose)?.solution;
-    if let Some(c) = p.get_mut(index) {
-        *c = 1.0;
-    }
+    let p = with_value(params, index, 1.0);
     let last = solver.solve_with(&p, &Guess::from(&reached), final_options)?;
     Ok((reached, last))
 }
