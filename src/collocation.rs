@@ -102,6 +102,13 @@ impl Collocation {
         let (n, m) = (self.n, self.m());
         self.f.clear();
         self.f.extend_from_slice(&yp[..m * n]);
+        self.midpoint_states(y);
+    }
+
+    /// The Hermite midpoint states `y_{i+1/2} = (y_i + y_{i+1})/2 − h_i (f_{i+1} − f_i)/8` from
+    /// the node values `y` and the node slopes in `f`.
+    fn midpoint_states(&mut self, y: &[f64]) {
+        let (n, m) = (self.n, self.m());
         for i in 0..m - 1 {
             let h = self.h[i];
             for c in 0..n {
@@ -144,15 +151,10 @@ impl Collocation {
         }
         self.rhs_evals += m;
         check_finite(&self.f, n, 1, |i| self.x[i], "right-hand side")?;
+        self.midpoint_states(y);
         for i in 0..m - 1 {
-            let h = self.h[i];
-            for c in 0..n {
-                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
-                let (fi, fj) = (self.f[i * n + c], self.f[(i + 1) * n + c]);
-                self.y_mid[i * n + c] = 0.5 * (yi + yj) - 0.125 * h * (fj - fi);
-            }
             problem.rhs(
-                self.x[i] + 0.5 * h,
+                self.x[i] + 0.5 * self.h[i],
                 &self.y_mid[i * n..(i + 1) * n],
                 p,
                 &mut self.f_mid[i * n..(i + 1) * n],
