@@ -4,63 +4,17 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use diffbvp::mesh::linspace;
 use diffbvp::sensitivity::{adjoint_gradient, PointFunction, Sensitivities};
-use diffbvp::{solve, Bvp, DualNum, Guess, SolveOptions};
+use diffbvp::{solve, DualNum, Guess, SolveOptions};
 use std::hint::black_box;
 
-struct Bratu;
-impl Bvp for Bratu {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -y[0].exp();
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0];
-    }
-}
+// the test problems of the integration tests, shared (Bratu k = 1, shock ε = 1e-3, coupled
+// Troesch with model parameters (μ, b))
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::{Bratu, CoupledTroesch, Shock};
 
-struct Shock;
-impl Bvp for Shock {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-        let (pi, eps) = (std::f64::consts::PI, 1e-3);
-        f[0] = y[1];
-        f[1] = (y[1] * (-x) - eps * pi * pi * (pi * x).cos() - pi * x * (pi * x).sin()) / eps;
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0] + 2.0;
-        r[1] = yb[0];
-    }
-}
-
-/// Coupled Troesch (4 states): y1'' = μ sinh(μ y1) + y3, y3'' = y3 - y1; μ = 5 (model
-/// parameter 0) and a boundary value b (parameter 1, b = 1): y1(1) = b.
-struct CoupledTroesch;
-impl Bvp for CoupledTroesch {
-    fn dim(&self) -> usize {
-        4
-    }
-    fn num_params(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = (y[0] * p[0]).sinh() * p[0] + y[2];
-        f[2] = y[3];
-        f[3] = y[2] - y[0];
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0] - p[1];
-        r[2] = ya[2];
-        r[3] = yb[2];
-    }
-}
+const BRATU: Bratu = Bratu { k: 1.0 };
+const SHOCK: Shock = Shock { eps: 1e-3 };
 
 fn troesch_guess() -> Guess {
     Guess::from_fn(linspace(0.0, 1.0, 11), 4, |x, y| {
@@ -82,16 +36,16 @@ fn solvers(c: &mut Criterion) {
     let opts = SolveOptions::with_tol(1e-6);
     let mut g = c.benchmark_group("solve_tol_1e-6");
     let bratu_guess = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
-    let s = solve(&Bratu, &[], &bratu_guess, &opts).unwrap();
+    let s = solve(&BRATU, &[], &bratu_guess, &opts).unwrap();
     println!("bratu: {} nodes", s.nodes());
     g.bench_function("bratu_k1", |b| {
-        b.iter(|| solve(&Bratu, &[], black_box(&bratu_guess), &opts).unwrap())
+        b.iter(|| solve(&BRATU, &[], black_box(&bratu_guess), &opts).unwrap())
     });
     let shock_guess = Guess::constant(linspace(-1.0, 1.0, 5), &[0.0, 0.0]);
-    let s = solve(&Shock, &[], &shock_guess, &opts).unwrap();
+    let s = solve(&SHOCK, &[], &shock_guess, &opts).unwrap();
     println!("shock eps=1e-3: {} nodes", s.nodes());
     g.bench_function("shock_eps_1e-3", |b| {
-        b.iter(|| solve(&Shock, &[], black_box(&shock_guess), &opts).unwrap())
+        b.iter(|| solve(&SHOCK, &[], black_box(&shock_guess), &opts).unwrap())
     });
     let tg = troesch_guess();
     let s = solve(&CoupledTroesch, &[5.0, 1.0], &tg, &opts).unwrap();

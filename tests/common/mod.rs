@@ -1,4 +1,5 @@
-//! Test problems with exact solutions shared by several integration tests.
+//! Test problems with exact solutions shared by several integration tests (and by
+//! `benches/solver.rs`).
 #![allow(dead_code)]
 
 use diffbvp::{Bvp, DualNum};
