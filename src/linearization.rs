@@ -89,17 +89,12 @@ impl Linearization {
         ncols: usize,
         transpose: bool,
     ) -> Result<(), BvpError> {
-        let solve = |v: &mut [f64]| {
-            if transpose {
-                self.factorization.solve_transpose_in_place(v, ncols)
-            } else {
-                self.factorization.solve_in_place(v, ncols)
-            }
-        };
+        let mut scratch = Vec::new();
         let mut r = b.to_vec();
-        solve(b)?;
+        let f = &self.factorization;
+        f.solve_with_scratch(b, ncols, transpose, &mut scratch)?;
         self.subtract_product(b, ncols, transpose, &mut r);
-        solve(&mut r)?;
+        f.solve_with_scratch(&mut r, ncols, transpose, &mut scratch)?;
         for (x, d) in b.iter_mut().zip(&r) {
             *x += d;
         }

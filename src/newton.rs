@@ -85,7 +85,7 @@ pub(crate) fn newton<P: Bvp>(
     while iterations < settings.max_iterations {
         if let (true, Some(f)) = (recompute, borrowed) {
             work.step.copy_from_slice(&col.res);
-            f.solve_in_place(&mut work.step, 1)?;
+            f.solve_with_scratch(&mut work.step, 1, false, &mut work.solve_scratch)?;
             if work.step.iter().any(|v| !v.is_finite()) {
                 // not usable here: factor the Jacobian of this iterate instead
                 borrowed = None;
@@ -138,7 +138,12 @@ pub(crate) fn newton<P: Bvp>(
                     }
                     work.step_new.copy_from_slice(&col.res);
                     match borrowed {
-                        Some(f) => f.solve_in_place(&mut work.step_new, 1)?,
+                        Some(f) => f.solve_with_scratch(
+                            &mut work.step_new,
+                            1,
+                            false,
+                            &mut work.solve_scratch,
+                        )?,
                         None => lin.solve(&mut work.step_new),
                     }
                     let cost_new = dot(&work.step_new, &work.step_new);
@@ -228,6 +233,8 @@ pub(crate) struct NewtonWork {
     step_new: Vec<f64>,
     y_new: Vec<f64>,
     p_new: Vec<f64>,
+    /// Scratch of solves with a borrowed factorisation (grown once).
+    solve_scratch: Vec<f64>,
 }
 
 /// scipy's termination test: `|r_i| < (2/3) h_i · 0.05 tol · (s_c + |f_mid|)`, i.e. the midpoint

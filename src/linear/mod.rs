@@ -99,6 +99,19 @@ impl Factorization {
     }
 
     fn solve_impl(&self, b: &mut [f64], ncols: usize, transpose: bool) -> Result<(), BvpError> {
+        self.solve_with_scratch(b, ncols, transpose, &mut Vec::new())
+    }
+
+    /// [`solve_in_place`](Self::solve_in_place) (or the transposed solve) with the structured
+    /// path's scratch kept by the caller: repeated solves (simplified Newton, refinement) grow it
+    /// once instead of allocating per call.
+    pub(crate) fn solve_with_scratch(
+        &self,
+        b: &mut [f64],
+        ncols: usize,
+        transpose: bool,
+        scratch: &mut Vec<f64>,
+    ) -> Result<(), BvpError> {
         let size = self.size;
         if Some(b.len()) != size.checked_mul(ncols) {
             return Err(BvpError::InvalidInput(format!(
@@ -111,8 +124,10 @@ impl Factorization {
         match &self.inner {
             Inner::Sparse(s) => s.solve(b, ncols, transpose),
             Inner::Structured(s) => {
-                let mut scratch = vec![0.0; s.scratch_len()];
-                s.solve(b, ncols, transpose, &mut scratch);
+                if scratch.len() < s.scratch_len() {
+                    scratch.resize(s.scratch_len(), 0.0);
+                }
+                s.solve(b, ncols, transpose, scratch);
             }
         }
         Ok(())
