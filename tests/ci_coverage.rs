@@ -3,12 +3,14 @@
 //! 95 % interval misses the truth in 5 % of realisations; one fixed seed cannot tell such a
 //! chance miss from a biased estimate or an interval too narrow, coverage over seeds can.
 //!
-//! All tests are `#[ignore]`d (each diagnoses one scenario per seed, minutes in release mode);
+//! All coverage tests are `#[ignore]`d (each diagnoses one scenario per seed, minutes in release mode);
 //! run with
 //! `cargo test --release --test ci_coverage -- --ignored --nocapture --test-threads 1`.
 //! Each prints one `COVERAGE` row per seed and a summary: the fraction of seeds whose interval
 //! holds the truth, and the mean and spread of the standardised errors `(n̂ − n)/se(n)`,
-//! `(κ̂ − κ)/se(κ)` (≈ 0 and ≈ 1 for unbiased estimates with honest standard errors).
+//! `(κ̂ − κ)/se(κ)` (≈ 0 and ≈ 1 for unbiased estimates with honest standard errors), and
+//! asserts what honest unbiased intervals give but for a < 1 % chance: no more misses than the
+//! binomial tail allows, and a mean standardised error within ±3.3/√N.
 
 mod independent;
 
@@ -123,6 +125,48 @@ fn coverage(sc: &Scenario, effect: Effect, base: bool) {
         szk,
         t0.elapsed().as_secs_f64()
     );
+    // Honest 95 % intervals: the number of misses is Binomial(N, 0.05); more than `allowed`
+    // happens by chance with probability < 1 %. Unbiased estimates: the mean standardised
+    // error has standard error 1/√N; |mean| > 3.3/√N happens by chance with probability < 0.1 %.
+    let allowed = allowed_misses(rows.len());
+    let n_missed = rows.iter().filter(|r| !r.n_in).count();
+    let k_missed = rows.iter().filter(|r| !r.kappa_in).count();
+    let z_max = 3.3 / m.sqrt();
+    assert!(
+        n_missed <= allowed && k_missed <= allowed,
+        "{}: CIs missed n in {n_missed}, κ in {k_missed} of {} seeds (allowed {allowed})",
+        sc.name,
+        rows.len()
+    );
+    assert!(
+        zn.abs() <= z_max && zk.abs() <= z_max,
+        "{}: mean standardised errors n {zn:+.2}, κ {zk:+.2} (allowed ±{z_max:.2}): biased",
+        sc.name
+    );
+}
+
+/// The largest number of misses `k` of `n` honest 95 % intervals with `P(misses > k) < 0.01`.
+fn allowed_misses(n: usize) -> usize {
+    let (p, q) = (0.05f64, 0.95f64);
+    let mut cdf = 0.0;
+    let mut term = q.powi(n as i32); // P(misses = 0)
+    for k in 0..=n {
+        cdf += term;
+        if 1.0 - cdf < 0.01 {
+            return k;
+        }
+        term *= (n - k) as f64 / (k + 1) as f64 * p / q;
+    }
+    n
+}
+
+#[test]
+fn allowed_misses_follow_the_binomial_tail() {
+    // P(Binomial(16, 0.05) > 3) = 0.0070, P(> 2) = 0.043; P(Binomial(40, 0.05) > 5) = 0.014,
+    // P(> 6) = 0.0034
+    assert_eq!(allowed_misses(16), 3);
+    assert_eq!(allowed_misses(40), 6);
+    assert_eq!(allowed_misses(1), 1);
 }
 
 fn coflow_line() -> Effect {
@@ -186,56 +230,4 @@ fn coflow_line_with_true_ramp_width() {
         ramp_width: Some(0.03),
     };
     coverage(&scenarios::coflow_line(), effect, false);
-}
-
-/// Cost of fitting the line co-flow's ramp width: full `diagnose` of the shipped 9-experiment
-/// set (the benchmark's) with the built-in candidates, `air_coflow_line`'s ramp width fixed at
-/// its default (as before it was fitted) against fitted, interleaved, median of 3 each.
-#[test]
-#[ignore = "slow: timing"]
-fn ramp_width_cost_on_the_shipped_set() {
-    let set = load_experiments(std::path::Path::new(
-        "data/pmma7n_synthetic/experiments.toml",
-    ))
-    .unwrap();
-    let with_ramp = |ramp_width: Option<f64>| DiagnoseOptions {
-        candidates: Effect::builtin()
-            .into_iter()
-            .map(|e| match e {
-                Effect::AirCoflowLine { onset, .. } => Effect::AirCoflowLine { onset, ramp_width },
-                e => e,
-            })
-            .collect(),
-        ..DiagnoseOptions::default()
-    };
-    let (fixed, fitted) = (
-        with_ramp(Some(
-            diffbvp::fiber::effects::DEFAULT_COFLOW_LINE_RAMP_WIDTH,
-        )),
-        with_ramp(None),
-    );
-    let spec = ModelSpec::default();
-    let (mut tf, mut tv) = (Vec::new(), Vec::new());
-    for _ in 0..3 {
-        for (label, opts, times) in [("fixed", &fixed, &mut tf), ("fitted", &fitted, &mut tv)] {
-            let t = Instant::now();
-            let d = diagnose(&set, &spec, opts).unwrap().diagnosis;
-            times.push(t.elapsed().as_secs_f64());
-            println!(
-                "TIMING | ramp width {} | {:.2} s | named {:?}",
-                label,
-                times[times.len() - 1],
-                d.most_likely_missing
-            );
-        }
-    }
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    println!(
-        "TIMING | median: ramp width fixed {:.2} s, fitted {:.2} s",
-        median(&mut tf),
-        median(&mut tv)
-    );
 }
