@@ -20,13 +20,13 @@
 //!   [`physical_range`] and [`shape_variants`].
 
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
+use crate::fiber::rheometer::identify::WarmFit;
 use crate::fiber::rheometer::{
-    Estimator, FitReport, FitStart, Identification, IdentifyOptions, Rheometer, RheometerError,
+    FitReport, FitStart, Identification, IdentifyOptions, Rheometer, RheometerError,
 };
-use crate::least_squares::{fit, FitOptions};
+use crate::least_squares::Loss;
 use crate::solution::Solution;
 use serde::{Deserialize, Serialize};
-use std::time::Instant;
 
 /// Settings of the global search.
 #[derive(Debug, Clone)]
@@ -323,9 +323,10 @@ fn rheometer_for(rh: &Rheometer, spec: ModelSpec) -> Result<Rheometer, Rheometer
 /// is a profile value, not an estimate: the best points are refined with the full tolerances).
 const GRID_TOLERANCE: f64 = 1e-6;
 
-/// [`Rheometer::identify_from`] with the take-up factors warm-started at `take_up` (the
-/// principled estimator; the factors follow the shared parameters in the fit's vector);
-/// `loose` stops at [`GRID_TOLERANCE`] and `options.max_iterations`.
+/// A warm-started fit of the search ([`Rheometer::identify_warm`]): the take-up factors start
+/// at `take_up`; `loose` stops at [`GRID_TOLERANCE`]. The grid fits and refinements use ordinary
+/// least squares at the solver's full accuracy (the ΔBIC of the ranking compares Gaussian
+/// costs), whatever loss and accuracy schedule `options` ask the user's fit for.
 fn fit_warm(
     rh: &Rheometer,
     start: &FitStart,
@@ -333,80 +334,16 @@ fn fit_warm(
     options: &IdentifyOptions,
     loose: bool,
 ) -> Result<Identification, RheometerError> {
-    let t0 = Instant::now();
-    let mut obj = rh.objective_from(start, options)?;
-    let layout = obj.layout().clone();
-    let ns = layout.num_shared();
-    let m = rh.len();
-    let [tlo, thi] = options.take_up_bounds;
-    let mut p0 = layout.shared_start();
-    let (mut lower, mut upper) = (layout.lower.clone(), layout.upper.clone());
-    if options.estimator == Estimator::Principled {
-        if take_up.len() == m {
-            p0.extend(take_up.iter().map(|v| v.clamp(tlo, thi)));
-        } else {
-            p0.extend(std::iter::repeat_n(1.0, m));
-        }
-        lower.extend(std::iter::repeat_n(tlo, m));
-        upper.extend(std::iter::repeat_n(thi, m));
-    }
-    let mut fo = FitOptions {
-        initial_radius: 0.3,
-        max_radius: 1.0,
-        max_iterations: options.max_iterations,
-        ..FitOptions::with_bounds(lower.clone(), upper.clone())
+    let options = IdentifyOptions {
+        loss: Loss::Linear,
+        loose_tolerance: None,
+        ..options.clone()
     };
-    if loose {
-        fo.gtol = GRID_TOLERANCE;
-        fo.xtol = GRID_TOLERANCE;
-        fo.ftol = GRID_TOLERANCE;
-    }
-    let fit_result = fit(&mut obj, &p0, &fo)?;
-    let solutions: Vec<Solution> = obj.solutions();
-    let rms = rh.rms_relative_residual(&solutions);
-    let phi_index = layout.params.take_up_factor();
-    let local = layout.local(&fit_result.p[..ns], 1.0, phi_index);
-    let [n, kappa] = layout.law_of(&local);
-    let residual_profiles = solutions
-        .iter()
-        .enumerate()
-        .map(|(k, sol)| {
-            (
-                rh.measurements[k].positions.clone(),
-                rh.relative_residuals(k, sol),
-            )
-        })
-        .collect();
-    Ok(Identification {
-        estimator: options.estimator,
-        start: start.law,
-        n,
-        kappa,
-        take_up_factors: if options.estimator == Estimator::Principled {
-            fit_result.p[ns..].to_vec()
-        } else {
-            vec![1.0; m]
-        },
-        names: layout.names.clone(),
-        effects: layout.effects.clone(),
-        local_params: local,
-        rms_relative_residual: rms,
-        law: rh.spec.law,
-        experiment_names: rh.experiments.iter().map(|e| e.name.clone()).collect(),
-        lower,
-        upper,
-        residual_profiles,
-        relative_uncertainty: options.relative_uncertainty.or(rh.relative_uncertainty),
-        data_warnings: rh.data_warnings(),
-        // the grid fits and refinements of the search use ordinary least squares
-        loss: crate::least_squares::Loss::Linear,
-        f_scale: f64::NAN,
-        f_scale_source: String::new(),
-        down_weighted: 0,
-        solutions,
-        fit: fit_result,
-        wall_time_s: t0.elapsed().as_secs_f64(),
-    })
+    let warm = WarmFit {
+        take_up: take_up.to_vec(),
+        stop_tolerance: loose.then_some(GRID_TOLERANCE),
+    };
+    rh.identify_warm(start, &options, &warm)
 }
 
 /// A grid point's fit: the warm start of its outer neighbour and of a refinement.

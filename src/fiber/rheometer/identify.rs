@@ -47,16 +47,35 @@ impl Rheometer {
         start: &FitStart,
         options: &IdentifyOptions,
     ) -> Result<Identification, RheometerError> {
+        self.identify_warm(start, options, &WarmFit::default())
+    }
+
+    /// [`identify_from`](Self::identify_from) with the take-up factors started at
+    /// `warm.take_up` and, with `warm.stop_tolerance`, looser stopping tests (the strength
+    /// scans of `diagnose`, which warm-start every grid point from its neighbour).
+    pub(crate) fn identify_warm(
+        &self,
+        start: &FitStart,
+        options: &IdentifyOptions,
+        warm: &WarmFit,
+    ) -> Result<Identification, RheometerError> {
         let t0 = Instant::now();
         let mut obj = self.objective_from(start, options)?;
-        let p0 = obj.initial_parameters();
+        let mut p0 = obj.initial_parameters();
         let (lower, upper) = obj.bounds();
+        let ns = obj.layout.num_shared();
+        if options.estimator == Estimator::Principled && warm.take_up.len() == self.len() {
+            let [lo, hi] = options.take_up_bounds;
+            for (p, t) in p0[ns..].iter_mut().zip(&warm.take_up) {
+                *p = t.clamp(lo, hi);
+            }
+        }
         let (f_scale, f_scale_source) = self.robust_margin(options)?;
         let sigma = options
             .relative_uncertainty
             .or(self.relative_uncertainty)
             .unwrap_or(1.0);
-        let fo = FitOptions {
+        let mut fo = FitOptions {
             initial_radius: 0.3,
             max_radius: 1.0,
             max_iterations: options.max_iterations,
@@ -74,10 +93,12 @@ impl Rheometer {
             },
             ..FitOptions::with_bounds(lower.clone(), upper.clone())
         };
+        if let Some(t) = warm.stop_tolerance {
+            (fo.gtol, fo.xtol, fo.ftol) = (t, t, t);
+        }
         let fit_result = fit(&mut obj, &p0, &fo)?;
         let solutions: Vec<Solution> = obj.solutions();
         let rms = self.rms_relative_residual(&solutions);
-        let ns = obj.layout.num_shared();
         let residual_profiles = solutions
             .iter()
             .enumerate()
@@ -182,6 +203,18 @@ impl Rheometer {
             trace,
         })
     }
+}
+
+/// How a fit started from a neighbouring fit differs from a plain identification
+/// ([`Rheometer::identify_warm`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct WarmFit {
+    /// Take-up factors to start from (principled estimator; one per experiment, clamped into
+    /// [`IdentifyOptions::take_up_bounds`]); any other length: 1.
+    pub take_up: Vec<f64>,
+    /// Stopping tolerance \[-\] of the gradient, step and cost-change tests (all three);
+    /// `None`: the driver's defaults.
+    pub stop_tolerance: Option<f64>,
 }
 
 /// Result of the start heuristic.
