@@ -385,6 +385,10 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
             .unwrap()
             .with("gauge_offset_um", 1e-2)
             .unwrap()
+            .with("vft_B_K", 0.1)
+            .unwrap()
+            .with("vft_T_VF_K", 0.01)
+            .unwrap()
             .with("inlet_diameter_rel", f * stat_k / d)
             .unwrap()
     };
@@ -510,10 +514,18 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
     assert_eq!(t["status"], "effect");
     assert_eq!(t["effect"], "die_temperature_offset");
     assert!(t["dkappa_dq"].is_number() && t["shift_kappa"].is_number());
-    // the VFT sources have no effect parameter yet
-    let vft = get("vft_B_K");
-    assert_eq!(vft["status"], "not_available");
-    assert!(vft["dkappa_dq"].is_null() && vft["shift_kappa"].is_null());
+    // the VFT sources through their material-data effects (level at T_o held)
+    for (key, effect) in [
+        ("vft_B_K", "vft_b_offset"),
+        ("vft_T_VF_K", "vft_t_vf_offset"),
+    ] {
+        let vft = get(key);
+        assert_eq!(vft["status"], "effect", "{key}");
+        assert_eq!(vft["effect"], effect);
+        assert_eq!(vft["unit"], "K");
+        assert!(vft["dkappa_dq"].is_number() && vft["shift_kappa"].is_number());
+        assert!(vft["dn_dq"].is_number() && vft["shift_n"].is_number());
+    }
     // each warning of the budget names a source whose shift exceeds the statistical error
     let stat = b["statistical_kappa"].as_f64().unwrap();
     let stat_n = b["statistical_n"].as_f64().unwrap();
@@ -533,6 +545,10 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
                 "inlet_diameter_rel" => "inlet diameter",
                 "gauge_scale_rel" => "diameter gauge scale",
                 "gauge_offset_um" => "diameter gauge offset",
+                "vft_B_K" => "VFT parameter B",
+                "vft_T_VF_K" => "VFT temperature T_VF",
+                "inlet_temperature_K" => "inlet (die) temperature",
+                "mass_flow_rel" => "mass flow",
                 _ => "NONE",
             }
         );

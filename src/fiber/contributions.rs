@@ -330,7 +330,7 @@ pub enum LineCoflow {
 }
 
 /// Number of parameter slots after the terms' strengths ([`Physics::strength_parameters`]).
-const SLOTS: usize = 13;
+const SLOTS: usize = 15;
 const S_COFLOW: usize = 0;
 const S_COFLOW_LEN: usize = 1;
 const S_LINE: usize = 2;
@@ -344,6 +344,8 @@ const S_DIE_TEMPERATURE: usize = 9;
 const S_MASS_FLOW: usize = 10;
 const S_GAUGE_SCALE: usize = 11;
 const S_GAUGE_OFFSET: usize = 12;
+const S_VFT_B: usize = 13;
+const S_VFT_T_VF: usize = 14;
 
 /// Names of the parameter slots after the terms, in `p` order.
 const SLOT_NAMES: [&str; SLOTS] = [
@@ -360,6 +362,8 @@ const SLOT_NAMES: [&str; SLOTS] = [
     "mass_flow_scale",
     "gauge_scale",
     "gauge_offset",
+    "vft_b_offset",
+    "vft_t_vf_offset",
 ];
 
 /// Process and instrument factors of a model evaluation (dual numbers, so that derivatives with
@@ -412,6 +416,13 @@ pub struct Physics<H: NusseltLaw = InclinedChurchillBernstein> {
     pub gauge_scale: Strength,
     /// Gauge offset `o` \[µm\] (model parameter `"gauge_offset"`).
     pub gauge_offset: Strength,
+    /// Offset `ΔB` \[K\] of the VFT parameter `B`, the zero-rate viscosity at the reference
+    /// temperature `T_o` held (model parameter `"vft_b_offset"`; see
+    /// [`ZeroRateViscosity::eval_shifted`](super::material_law::ZeroRateViscosity::eval_shifted)).
+    pub vft_b_offset: Strength,
+    /// Offset `ΔT_VF` \[K\] of the VFT temperature `T_VF`, the level at `T_o` held (model
+    /// parameter `"vft_t_vf_offset"`).
+    pub vft_t_vf_offset: Strength,
 }
 
 impl Default for Physics {
@@ -455,6 +466,8 @@ impl<H: NusseltLaw> Physics<H> {
             mass_flow_scale: Strength::Off,
             gauge_scale: Strength::Off,
             gauge_offset: Strength::Off,
+            vft_b_offset: Strength::Off,
+            vft_t_vf_offset: Strength::Off,
         }
     }
 
@@ -548,6 +561,8 @@ impl<H: NusseltLaw> Physics<H> {
         v[S_MASS_FLOW] = self.mass_flow_scale;
         v[S_GAUGE_SCALE] = self.gauge_scale;
         v[S_GAUGE_OFFSET] = self.gauge_offset;
+        v[S_VFT_B] = self.vft_b_offset;
+        v[S_VFT_T_VF] = self.vft_t_vf_offset;
         v
     }
 
@@ -573,9 +588,9 @@ impl<H: NusseltLaw> Physics<H> {
     /// `"air_coflow_line.onset"`, `"air_coflow_line.ramp_width"` (need
     /// [`with_line_coflow`](Self::with_line_coflow)), `"air_temperature_profile"` and
     /// `"air_temperature_profile.decay_length"` (need [`with_warm_air`](Self::with_warm_air)),
-    /// or a process or instrument parameter (`"inlet_velocity"`, `"inlet_diameter"`,
-    /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"`). An
-    /// unknown name, or an air profile that is not there, is an error.
+    /// a process or instrument parameter (`"inlet_velocity"`, `"inlet_diameter"`,
+    /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"`) or a
+    /// material-data offset (`"vft_b_offset"`, `"vft_t_vf_offset"`). An unknown name, or an air profile that is not there, is an error.
     pub fn set_strength(&mut self, name: &str, strength: Strength) -> Result<(), FiberError> {
         if let Some(t) = self
             .terms
@@ -644,6 +659,8 @@ impl<H: NusseltLaw> Physics<H> {
             "mass_flow_scale" => self.mass_flow_scale = strength,
             "gauge_scale" => self.gauge_scale = strength,
             "gauge_offset" => self.gauge_offset = strength,
+            "vft_b_offset" => self.vft_b_offset = strength,
+            "vft_t_vf_offset" => self.vft_t_vf_offset = strength,
             _ => {
                 let mut known: Vec<&str> = self.terms.iter().map(|t| t.parameter_name()).collect();
                 known.extend(SLOT_NAMES);
@@ -667,8 +684,8 @@ impl<H: NusseltLaw> Physics<H> {
     /// `"air_coflow.decay_length"`, `"air_coflow_line"`, `"air_coflow_line.onset"`,
     /// `"air_coflow_line.ramp_width"`, `"air_temperature_profile"`,
     /// `"air_temperature_profile.decay_length"`, `"inlet_velocity"`, `"inlet_diameter"`,
-    /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"` (each
-    /// where it is a parameter).
+    /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"`,
+    /// `"vft_b_offset"`, `"vft_t_vf_offset"` (each where it is a parameter).
     pub fn strength_parameters(&self) -> Vec<(&'static str, f64)> {
         let mut v: Vec<(&'static str, f64)> = self
             .terms
@@ -984,6 +1001,27 @@ impl<H: NusseltLaw> Physics<H> {
             has_die_temperature: die.is_some(),
             has_mass_flow: mass.is_some(),
         }
+    }
+
+    /// The shift of the VFT parameters `(ΔB/T_o, ΔT_VF/T_o)` (dimensionless) with the strengths
+    /// resolved by `plan` (`temperature_scale` = `T_o` \[K\]); `None` where both are off.
+    #[inline]
+    pub fn vft_shift_planned<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        plan: &StrengthPlan,
+        sp: &[D],
+        temperature_scale: f64,
+    ) -> Option<[D; 2]> {
+        let b = plan.slot(S_VFT_B, sp);
+        let t_vf = plan.slot(S_VFT_T_VF, sp);
+        if b.is_none() && t_vf.is_none() {
+            return None;
+        }
+        let per = temperature_scale.recip();
+        Some([
+            b.map_or(D::zero(), |v| v * per),
+            t_vf.map_or(D::zero(), |v| v * per),
+        ])
     }
 
     /// The gauge's reading of a true diameter: `(1 + g) d + o` with `d`, the result and

@@ -24,6 +24,8 @@
 //! | `mass_flow_scale` | `δ` (-) | true mass flow `(1 + δ) Q` | – | process | [−0.2, 0.2] | 0 |
 //! | `gauge_scale` | `g` (-) | measured diameter `(1 + g) d + o` | – | instrument | [−0.1, 0.1] | 0 |
 //! | `gauge_offset` | `o` (µm) | measured diameter `(1 + g) d + o` | – | instrument | [−20, 20] | 0 |
+//! | `vft_b_offset` | `ΔB` (K) | VFT `B + ΔB`, zero-rate viscosity at `T_o` held (not a default candidate) | – | material | [−400, 400] | 0 |
+//! | `vft_t_vf_offset` | `ΔT_VF` (K) | VFT `T_VF + ΔT_VF`, level at `T_o` held (not a default candidate) | – | material | [−30, 15] | 0 |
 //! | user term | its own factor (-) | `strength ×` the user's [`FiberTerm`] | – | physics | its bounds | 0 |
 //!
 //! **Sign conventions.** `die_temperature_offset = +10 K` means the melt leaves the die 10 K
@@ -86,15 +88,18 @@ pub enum Category {
     Process,
     /// The diameter gauge reads wrong (scale or offset).
     Instrument,
+    /// Material data of the model (the VFT law of the zero-rate viscosity) off.
+    Material,
 }
 
 impl Category {
-    /// Lower-case name (`"physics"`, `"process"`, `"instrument"`).
+    /// Lower-case name (`"physics"`, `"process"`, `"instrument"`, `"material"`).
     pub fn name(&self) -> &'static str {
         match self {
             Category::Physics => "physics",
             Category::Process => "process",
             Category::Instrument => "instrument",
+            Category::Material => "material",
         }
     }
 }
@@ -277,6 +282,12 @@ pub enum Effect {
     GaugeScale,
     /// `gauge_offset`: the gauge reads `(1 + g) d + o`, strength `o` \[µm\].
     GaugeOffset,
+    /// `vft_b_offset`: VFT parameter `B + ΔB`, the zero-rate viscosity at the reference
+    /// temperature `T_o` held, strength ΔB \[K\] (material data; not a default candidate).
+    VftBOffset,
+    /// `vft_t_vf_offset`: VFT temperature `T_VF + ΔT_VF`, the level at `T_o` held, strength
+    /// ΔT_VF \[K\] (material data; not a default candidate).
+    VftTvfOffset,
     /// A user-written term with its own strength.
     Custom(UserEffect),
 }
@@ -296,9 +307,12 @@ pub const BUILTIN_NAMES: [&str; 11] = [
     "gauge_offset",
 ];
 
-/// Every built-in effect name a setting may use: [`BUILTIN_NAMES`] and `inlet_velocity` (the
-/// same physics as `inlet_diameter` in another variable, so not a default candidate).
-pub const ALL_NAMES: [&str; 12] = [
+/// Every built-in effect name a setting may use: [`BUILTIN_NAMES`], `inlet_velocity` (the
+/// same physics as `inlet_diameter` in another variable, so not a default candidate) and the
+/// material-data offsets `vft_b_offset`, `vft_t_vf_offset` (for the error budget and `fit
+/// --with`; not default candidates: an error of the temperature dependence of the viscosity is
+/// a question for rheometry, not for the spin line).
+pub const ALL_NAMES: [&str; 14] = [
     "strain_thinning",
     "radiation",
     "air_coflow",
@@ -311,6 +325,8 @@ pub const ALL_NAMES: [&str; 12] = [
     "mass_flow_scale",
     "gauge_scale",
     "gauge_offset",
+    "vft_b_offset",
+    "vft_t_vf_offset",
 ];
 
 impl Effect {
@@ -335,10 +351,12 @@ impl Effect {
         ]
     }
 
-    /// Every built-in effect ([`ALL_NAMES`]): [`builtin`](Self::builtin) and `inlet_velocity`.
+    /// Every built-in effect ([`ALL_NAMES`]): [`builtin`](Self::builtin), `inlet_velocity` and
+    /// the VFT offsets.
     pub fn all() -> Vec<Effect> {
         let mut v = Self::builtin();
         v.insert(7, Effect::InletVelocity);
+        v.extend([Effect::VftBOffset, Effect::VftTvfOffset]);
         v
     }
 
@@ -366,6 +384,8 @@ impl Effect {
             Effect::MassFlowScale => "mass_flow_scale",
             Effect::GaugeScale => "gauge_scale",
             Effect::GaugeOffset => "gauge_offset",
+            Effect::VftBOffset => "vft_b_offset",
+            Effect::VftTvfOffset => "vft_t_vf_offset",
             Effect::Custom(u) => u.name,
         }
     }
@@ -374,7 +394,10 @@ impl Effect {
     pub fn unit(&self) -> &'static str {
         match self {
             Effect::AirCoflow { .. } | Effect::AirCoflowLine { .. } => "m/s",
-            Effect::AirTemperatureProfile { .. } | Effect::DieTemperatureOffset => "K",
+            Effect::AirTemperatureProfile { .. }
+            | Effect::DieTemperatureOffset
+            | Effect::VftBOffset
+            | Effect::VftTvfOffset => "K",
             Effect::GaugeOffset => "µm",
             _ => "-",
         }
@@ -391,6 +414,8 @@ impl Effect {
             Effect::InletVelocity | Effect::InletDiameter | Effect::MassFlowScale => "δ",
             Effect::GaugeScale => "g",
             Effect::GaugeOffset => "o",
+            Effect::VftBOffset => "ΔB",
+            Effect::VftTvfOffset => "ΔT_VF",
             Effect::Custom(_) => "factor",
         }
     }
@@ -420,6 +445,12 @@ impl Effect {
             Effect::MassFlowScale => "mass flow off its nominal value, strength = relative error",
             Effect::GaugeScale => "diameter gauge scale error, strength = relative error",
             Effect::GaugeOffset => "diameter gauge zero offset, strength = offset",
+            Effect::VftBOffset => {
+                "VFT parameter B off (viscosity at T_o held), strength = offset of B"
+            }
+            Effect::VftTvfOffset => {
+                "VFT temperature T_VF off (viscosity at T_o held), strength = offset of T_VF"
+            }
             Effect::Custom(_) => "user-written contribution, strength = its factor",
         }
     }
@@ -432,6 +463,7 @@ impl Effect {
             | Effect::DieTemperatureOffset
             | Effect::MassFlowScale => Category::Process,
             Effect::GaugeScale | Effect::GaugeOffset => Category::Instrument,
+            Effect::VftBOffset | Effect::VftTvfOffset => Category::Material,
             _ => Category::Physics,
         }
     }
@@ -456,6 +488,10 @@ impl Effect {
             Effect::MassFlowScale => (-0.5, 0.5),
             Effect::GaugeScale => (-0.3, 0.3),
             Effect::GaugeOffset => (-50.0, 50.0),
+            Effect::VftBOffset => (-1000.0, 1000.0),
+            // the VFT law is singular at T = T_VF, and the fiber cools towards the air (about
+            // 290–300 K against T_VF ≈ 273 K for PMMA): raising T_VF is searched less far
+            Effect::VftTvfOffset => (-60.0, 15.0),
             Effect::Custom(u) => u.bounds,
         }
     }
@@ -474,6 +510,8 @@ impl Effect {
             Effect::MassFlowScale => (-0.2, 0.2),
             Effect::GaugeScale => (-0.1, 0.1),
             Effect::GaugeOffset => (-20.0, 20.0),
+            Effect::VftBOffset => (-400.0, 400.0),
+            Effect::VftTvfOffset => (-30.0, 15.0),
             Effect::Custom(u) => u.bounds,
         }
     }

@@ -81,7 +81,27 @@ impl ZeroRateViscosity {
     pub fn eval<D: DualNum<Primitive = f64> + Copy>(&self, t: D) -> D {
         ((t - self.t_vf).recip() * self.b).exp() * self.a
     }
+
+    /// `μ̃_e0(T̃)` with the VFT parameters shifted, `b' = b + db` (`db = ΔB/T_o`) and
+    /// `t'_VF = t_VF + dt_vf` (`dt_vf = ΔT_VF/T_o`), **the level at `T̃ = 1` (`T = T_o`) held**:
+    /// `a exp(b/(1 − t_VF)) exp(b'/(T̃ − t'_VF) − b'/(1 − t'_VF))`. A VFT fit to shear rheometry
+    /// over the processing window pins the viscosity near the window and leaves the temperature
+    /// dependence (`B`, `T_VF`, strongly correlated with `μ_c`) uncertain; shifting `B` at fixed
+    /// `μ_c` would instead change the level by `exp(ΔB/(T − T_VF))` (13 % for 30 K at 513 K),
+    /// which no rheometry leaves open. Equals [`eval`](Self::eval) at `db = dt_vf = 0` up to
+    /// rounding.
+    #[inline]
+    pub fn eval_shifted<D: DualNum<Primitive = f64> + Copy>(&self, t: D, db: D, dt_vf: D) -> D {
+        let b = db + self.b;
+        let t_vf = dt_vf + self.t_vf;
+        let level = self.b / (1.0 - self.t_vf);
+        ((t - t_vf).recip() * b - (-t_vf + 1.0).recip() * b + level).exp() * self.a
+    }
 }
+
+/// Shifts `(ΔB/T_o, ΔT_VF/T_o)` of the VFT parameters (dimensionless; see
+/// [`ZeroRateViscosity::eval_shifted`]); `None`: the nominal VFT law.
+pub type VftShift<D> = Option<[D; 2]>;
 
 /// Newtonian law `μ_e = μ_e0(T)` (no parameters).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -210,6 +230,20 @@ pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Co
     rate: D,
     p: &[D],
 ) -> (D, D, D) {
+    viscosity_with_partials_shifted(law, zero, None, de, t, rate, p)
+}
+
+/// [`viscosity_with_partials`] with the VFT parameters shifted by `shift`.
+#[inline]
+pub fn viscosity_with_partials_shifted<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
+    law: &L,
+    zero: &ZeroRateViscosity,
+    shift: VftShift<D>,
+    de: f64,
+    t: D,
+    rate: D,
+    p: &[D],
+) -> (D, D, D) {
     let k = p.len().min(MAX_LAW_PARAMS);
     let mut pl = [DualSVec::<D, 2>::from_re(D::zero()); MAX_LAW_PARAMS];
     for (l, &v) in pl.iter_mut().zip(&p[..k]) {
@@ -217,9 +251,13 @@ pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Co
     }
     let pl = &pl[..k];
     let tt = DualSVec::<D, 2>::from_re(t).derivative(0);
+    let mu0 = match shift {
+        None => zero.eval(tt),
+        Some([db, dt_vf]) => zero.eval_shifted(tt, DualSVec::from_re(db), DualSVec::from_re(dt_vf)),
+    };
     let x = LawInputs {
         t: tt,
-        mu0: zero.eval(tt),
+        mu0,
         rate: DualSVec::from_re(rate).derivative(1),
         de,
     };
@@ -238,15 +276,25 @@ pub fn viscosity<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
     rate: D,
     p: &[D],
 ) -> D {
-    law.mu_e(
-        &LawInputs {
-            t,
-            mu0: zero.eval(t),
-            rate,
-            de,
-        },
-        p,
-    )
+    viscosity_shifted(law, zero, None, de, t, rate, p)
+}
+
+/// [`viscosity`] with the VFT parameters shifted by `shift`.
+#[inline]
+pub fn viscosity_shifted<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
+    law: &L,
+    zero: &ZeroRateViscosity,
+    shift: VftShift<D>,
+    de: f64,
+    t: D,
+    rate: D,
+    p: &[D],
+) -> D {
+    let mu0 = match shift {
+        None => zero.eval(t),
+        Some([db, dt_vf]) => zero.eval_shifted(t, db, dt_vf),
+    };
+    law.mu_e(&LawInputs { t, mu0, rate, de }, p)
 }
 
 #[cfg(test)]
@@ -260,6 +308,25 @@ mod tests {
             b: 3649.0 / 513.15,
             t_vf: 273.15 / 513.15,
         }
+    }
+
+    #[test]
+    fn shifted_vft_holds_the_level_at_the_reference_temperature() {
+        let z = zero();
+        for (db, dt) in [(0.0, 0.0), (0.1, 0.0), (0.0, -0.02), (-0.3, 0.01)] {
+            let at_ref = z.eval_shifted(1.0f64, db, dt);
+            assert!((at_ref / z.eval(1.0f64) - 1.0).abs() < 1e-14, "{db} {dt}");
+            // colder: a larger B (or T_VF) raises the viscosity below T_o
+            let cold = 0.8f64;
+            let ratio = z.eval_shifted(cold, db, dt) / z.eval(cold);
+            let expected = (db + z.b) / (cold - z.t_vf - dt)
+                - (db + z.b) / (1.0 - z.t_vf - dt)
+                - z.b / (cold - z.t_vf)
+                + z.b / (1.0 - z.t_vf);
+            assert!((ratio.ln() - expected).abs() < 1e-12, "{db} {dt}");
+        }
+        assert!(z.eval_shifted(0.8f64, 0.1, 0.0) > z.eval(0.8f64));
+        assert!(z.eval_shifted(0.8f64, 0.0, 0.01) > z.eval(0.8f64));
     }
 
     #[test]

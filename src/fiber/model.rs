@@ -28,7 +28,10 @@ use super::contributions::{
     ProcessFactors, StrengthPlan,
 };
 use super::error::FiberError;
-use super::material_law::{viscosity, viscosity_with_partials, ViscosityLaw, ZeroRateViscosity};
+use super::material_law::{
+    viscosity, viscosity_shifted, viscosity_with_partials_shifted, VftShift, ViscosityLaw,
+    ZeroRateViscosity,
+};
 use super::scaling::Scaling;
 use super::setup::{Air, Experiment, Inlet, Material, TakeUp};
 use crate::problem::Bvp;
@@ -584,9 +587,33 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         }
     }
 
-    /// Dimensionless `μ̃_e(T̃, ε̇̃)` with law parameters `lp`.
+    /// Dimensionless `μ̃_e(T̃, ε̇̃)` with law parameters `lp` and the nominal VFT law (no
+    /// `vft_b_offset`/`vft_t_vf_offset`; [`viscosity_at`](Self::viscosity_at) applies them).
     pub fn viscosity<D: DualNum<Primitive = f64> + Copy>(&self, t: D, rate: D, lp: &[D]) -> D {
         viscosity(&self.law, &self.zero, self.scaling.de, t, rate, lp)
+    }
+
+    /// Dimensionless `μ̃_e(T̃, ε̇̃)` with the full model parameters `p` (law parameters and the
+    /// VFT offsets where the physics has them).
+    pub fn viscosity_at<D: DualNum<Primitive = f64> + Copy>(&self, t: D, rate: D, p: &[D]) -> D {
+        let lp = &p[self.params.law()];
+        let sp = &p[self.params.strengths()];
+        viscosity_shifted(
+            &self.law,
+            &self.zero,
+            self.vft_shift(sp),
+            self.scaling.de,
+            t,
+            rate,
+            lp,
+        )
+    }
+
+    /// The VFT shift of the strength parameters `sp` (`None` without VFT offsets).
+    #[inline]
+    fn vft_shift<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> VftShift<D> {
+        self.physics
+            .vft_shift_planned(&self.plan, sp, self.scaling.reference.temperature)
     }
 
     /// Values of all named terms at `s̃ = x` for `y` and full parameters `p`:
@@ -618,8 +645,15 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
         let q = st.q;
         let f_n = st.rate * q - c * force;
         let f_t = c * heat / (st.cp * q);
-        let (mu, mu_t, mu_r) =
-            viscosity_with_partials(&self.law, &self.zero, self.scaling.de, st.t, st.rate, lp);
+        let (mu, mu_t, mu_r) = viscosity_with_partials_shifted(
+            &self.law,
+            &self.zero,
+            self.vft_shift(sp),
+            self.scaling.de,
+            st.t,
+            st.rate,
+            lp,
+        );
         let re_over_q = if self.has_mass_flow_scale() {
             self.re_c(c) / q
         } else {
@@ -636,7 +670,6 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
 
     fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
         let c = p[ParamLayout::CONTINUATION];
-        let lp = &p[self.params.law()];
         let sp = &p[self.params.strengths()];
         // process conditions: u(0) and T(0) off their nominal values, mass flow scaled
         let (u_in, t_in, pf) = self.inlet_conditions(sp);
@@ -663,6 +696,6 @@ impl<L: ViscosityLaw, H: NusseltLaw> Bvp for FiberModel<L, H> {
         } else {
             self.re_c(c) / self.co.q
         };
-        r[3] = re_over_q * (ya[1] * (u_in * rho_in)) - ya[3] * self.viscosity(t_in, ya[3], lp);
+        r[3] = re_over_q * (ya[1] * (u_in * rho_in)) - ya[3] * self.viscosity_at(t_in, ya[3], p);
     }
 }

@@ -163,8 +163,6 @@ impl FiberSolution {
         } = co.si;
         let mu_o = model.scaling.reference.viscosity;
         let p = &self.solution.params;
-        let law = model.param_layout().law();
-        let lp = &p[law.start..law.end.min(p.len())];
         let mut out = Profiles::default();
         let mut y = [0.0; 4];
         let mut yp = [0.0; 4];
@@ -178,7 +176,7 @@ impl FiberSolution {
             out.temperature.push(y[2] * t_o);
             out.strain_rate.push(y[3] * rate_o);
             out.diameter.push(model.diameter(y[0], rho) * d_o);
-            out.viscosity.push(model.viscosity(y[2], y[3], lp) * mu_o);
+            out.viscosity.push(model.viscosity_at(y[2], y[3], p) * mu_o);
             for (k, (name, balance, v)) in model.terms_at(x, &y, p).into_iter().enumerate() {
                 let scale = match balance {
                     Balance::Momentum => co.force_per_length,

@@ -27,7 +27,8 @@ pub struct CompareArgs {
     /// takes the strength from --fit), shape parameters after colons
     /// ("air_coflow=40:decay_length=0.2"): radiation, air_coflow, air_coflow_line,
     /// air_temperature_profile, nusselt_scale, inlet_diameter, inlet_velocity,
-    /// die_temperature_offset, mass_flow_scale, gauge_scale, gauge_offset. Effects in the fit
+    /// die_temperature_offset, mass_flow_scale, gauge_scale, gauge_offset, vft_b_offset,
+    /// vft_t_vf_offset. Effects in the fit
     /// file are included automatically (with their fitted shapes).
     #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,

@@ -23,7 +23,8 @@ pub struct FitArgs {
     /// parameters fixed after colons ("air_coflow=40:decay_length=0.2"); repeatable.
     /// Physics: strain_thinning, radiation, air_coflow, air_coflow_line,
     /// air_temperature_profile, nusselt_scale; process: inlet_diameter, inlet_velocity,
-    /// die_temperature_offset, mass_flow_scale; instrument: gauge_scale, gauge_offset.
+    /// die_temperature_offset, mass_flow_scale; instrument: gauge_scale, gauge_offset;
+    /// material data: vft_b_offset, vft_t_vf_offset (K, viscosity at T_o held).
     #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,
     /// The loss of the fit: linear (least squares), or a robust loss that down-weights
