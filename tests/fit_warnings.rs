@@ -114,11 +114,14 @@ fn shipped_data_fit_has_no_warning() {
     let (dir, toml, data) = probe::shipped_copy("fw_control");
     // process conditions and gauge known well enough that the error budget (issue 11) stays
     // below the statistical errors; with the default uncertainties (2 % inlet diameter, 1 %
-    // gauge scale) the budget warns, see tests/error_budget.rs
+    // gauge scale, 3 K of the VFT temperature T_VF) the budget warns, see tests/error_budget.rs
     let text = std::fs::read_to_string(&toml).unwrap();
     std::fs::write(
         &toml,
-        format!("{text}\n[uncertainty]\ninlet_diameter_rel = 0.005\ngauge_scale_rel = 0.005\n"),
+        format!(
+            "{text}\n[uncertainty]\ninlet_diameter_rel = 0.005\ngauge_scale_rel = 0.005\n\
+             vft_T_VF_K = 1.0\n"
+        ),
     )
     .unwrap();
     let (p, v) = fit_cli(&toml, &data, &dir);
