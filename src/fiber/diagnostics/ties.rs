@@ -448,6 +448,41 @@ mod tests {
     }
 
     #[test]
+    fn the_report_says_what_decides_and_whether_the_material_result_is_robust() {
+        use StrengthStatus::*;
+        let named = cand("inlet_diameter", Physical, -41.2, 0.797, 11.79);
+        let g = cand("gauge_scale", Physical, -39.1, 0.802, 11.74);
+        let a = Alternative::new(&named, &g, Category::Process, Category::Instrument, 0.986);
+        assert_eq!(
+            or_alternatives(std::slice::from_ref(&a)),
+            " — or, about as consistent with these data, gauge_scale (delta BIC gap 2.1, \
+             signatures cos +0.986)"
+        );
+        let t = ties_paragraph(&named, std::slice::from_ref(&a));
+        assert!(t.contains("between inlet_diameter and gauge_scale"), "{t}");
+        assert!(t.contains("ROBUST to the choice"), "{t}");
+        assert!(t.contains("n +0.5, kappa -0.5 standard errors"), "{t}");
+        assert!(
+            t.contains("gauge_scale: calibrate the diameter gauge"),
+            "{t}"
+        );
+        assert!(t.contains("inlet_diameter: measure the die swell"), "{t}");
+        assert!(!t.contains("mixes missing physics"), "{t}");
+        // physics tied with an instrument error, material result moved by 3 se
+        let rad = cand("radiation", Physical, -38.0, 0.83, 11.79);
+        let b = Alternative::new(&named, &rad, Category::Process, Category::Physics, -0.9);
+        let t = ties_paragraph(&named, &[b]);
+        assert!(t.contains("DEPENDS ON THE CHOICE: with radiation"), "{t}");
+        assert!(
+            t.contains("mixes missing physics with process conditions"),
+            "{t}"
+        );
+        assert!(t.contains("(inlet_diameter: measure the die swell"), "{t}");
+        assert!(ties_paragraph(&named, &[]).is_empty());
+        assert!(or_alternatives(&[]).is_empty());
+    }
+
+    #[test]
     fn process_and_instrument_effects_have_an_independent_check() {
         for e in crate::fiber::effects::Effect::all() {
             assert_eq!(
