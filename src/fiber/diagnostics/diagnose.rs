@@ -803,25 +803,23 @@ pub fn diagnose(
         .copied()
         .find(|&i| earns_its_place(&results[i], options.earn_threshold));
     let most_likely = best_i.map(|i| cands[i].name().to_string());
+    let candidates: Vec<CandidateResult> = ranked.iter().map(|&i| results[i].clone()).collect();
+    // other candidates about as consistent with the data as the named one
     let alternatives: Vec<Alternative> = match best_i {
-        Some(b) => {
-            let ranked_results: Vec<CandidateResult> =
-                ranked.iter().map(|&i| results[i].clone()).collect();
-            alternatives(
-                &results[b],
-                &ranked_results,
-                options.earn_threshold,
-                options.tie_margin,
-                cands[b].category(),
-                |name| match cands.iter().position(|e| e.name() == name) {
-                    Some(i) => (
-                        cands[i].category(),
-                        cosine(&lin[b].signature, &lin[i].signature),
-                    ),
-                    None => (Category::Physics, f64::NAN),
-                },
-            )
-        }
+        Some(b) => alternatives(
+            &results[b],
+            &candidates,
+            options.earn_threshold,
+            options.tie_margin,
+            cands[b].category(),
+            |name| match cands.iter().position(|e| e.name() == name) {
+                Some(i) => (
+                    cands[i].category(),
+                    cosine(&lin[b].signature, &lin[i].signature),
+                ),
+                None => (Category::Physics, f64::NAN),
+            },
+        ),
         None => Vec::new(),
     };
     // a physical effect that explains part of the residuals significantly shows they are
@@ -834,7 +832,6 @@ pub fn diagnose(
         },
         None => (None, None),
     };
-    let candidates: Vec<CandidateResult> = ranked.iter().map(|&i| results[i].clone()).collect();
     Ok(DiagnosisRun {
         diagnosis: Diagnosis {
             model: spec.law,
