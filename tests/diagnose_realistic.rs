@@ -359,6 +359,8 @@ fn low_mass_flow_is_found() {
     assert_found(&sc, &run(&sc));
 }
 
+/// Its premise, the truth ranked first, is out of reach of these data (a tie with
+/// `inlet_diameter`); `gauge_scale_is_named_or_tied` tests the tie.
 #[test]
 #[ignore = "issue 11: not separable by these data: inlet_diameter (0.034 ± 0.005) is named, gauge_scale (0.033 ± 0.005) second by dBIC 2.1; noise-free the truth wins by only lambda = 1.22 chi2 (first with p = 0.71 at 1.5 % noise; 95 % needs |g| >= 8.9 %), see tests/diagnose_separability.rs"]
 fn gauge_scale_is_found() {
