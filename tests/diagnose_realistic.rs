@@ -59,6 +59,32 @@ fn run(sc: &Scenario) -> DiagnosisRun {
         t_gen,
         t_diag
     );
+    println!(
+        "ALTERNATIVES | {} | named {:?} | {}",
+        sc.name,
+        d.most_likely_missing,
+        if d.alternatives.is_empty() {
+            "none".to_string()
+        } else {
+            d.alternatives
+                .iter()
+                .map(|a| {
+                    format!(
+                        "{} (gap {:.1}, cos {:+.3}, n {:.4} κ {:.4}, shifts {:+.2}/{:+.2} se, robust {})",
+                        a.effect,
+                        a.delta_bic_gap,
+                        a.signature_cosine,
+                        a.n,
+                        a.kappa,
+                        a.n_shift_se,
+                        a.kappa_shift_se,
+                        a.material_robust
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join("; ")
+        }
+    );
     r
 }
 
@@ -151,6 +177,76 @@ fn truth_in_ci(sc: &Scenario, r: &DiagnosisRun) -> bool {
     c.ci95_n[0] <= n && n <= c.ci95_n[1] && c.ci95_kappa[0] <= k && k <= c.ci95_kappa[1]
 }
 
+/// The acceptance criteria where the data cannot separate the truth from another cause: the
+/// truth (the scenario's expected candidate) is named, or listed among the alternatives (a tie
+/// with the named one, `ΔBIC` gap below the tie margin); its own refit then meets the criteria
+/// of [`assert_found`]: strength within 3 standard errors of the truth, RMS after within 20 %
+/// of the noise, the true (n, κ) inside its 95 % CIs.
+fn assert_named_or_tied(sc: &Scenario, r: &DiagnosisRun) {
+    let d = &r.diagnosis;
+    assert_named_is_credible(r);
+    let (truth, strength) = sc.expected.expect("the scenario has an expected candidate");
+    let named = d.most_likely_missing.as_deref();
+    let tied = d.alternatives.iter().find(|a| a.effect == truth);
+    assert!(
+        named == Some(truth) || tied.is_some(),
+        "{}: {truth} neither named ({named:?}) nor an alternative ({:?})",
+        sc.name,
+        d.alternatives.iter().map(|a| &a.effect).collect::<Vec<_>>()
+    );
+    let c = d
+        .candidates
+        .iter()
+        .find(|c| c.effect == truth)
+        .expect("the truth is a candidate");
+    if let (Some(a), Some(n)) = (tied, named) {
+        let best = &d.candidates[0];
+        assert_eq!(best.effect, n, "named is not ranked first");
+        let margin = DiagnoseOptions::default().tie_margin;
+        assert!(
+            c.delta_bic - best.delta_bic < margin,
+            "{}: {truth} listed with a gap {} ≥ {margin}",
+            sc.name,
+            c.delta_bic - best.delta_bic
+        );
+        assert_eq!(
+            (a.n, a.kappa),
+            (c.n, c.kappa),
+            "the alternative is its refit"
+        );
+    }
+    let expected = strength
+        .in_unit(&c.unit, c.strength)
+        .expect("the truth's unit");
+    assert!(
+        (c.strength - expected).abs() <= 3.0 * c.stderr_strength,
+        "{}: {truth} = {} ± {} {}, truth {expected}",
+        sc.name,
+        c.strength,
+        c.stderr_strength,
+        c.unit
+    );
+    let ratio = c.rms_relative_residual_after / NOISE_SD;
+    assert!(
+        (ratio - 1.0).abs() <= 0.2,
+        "{}: RMS after / noise = {ratio}",
+        sc.name
+    );
+    let (n, k) = (sc.law.n, sc.law.kappa);
+    assert!(
+        c.ci95_n[0] <= n && n <= c.ci95_n[1],
+        "{}: n = {n} outside {:?} with {truth}",
+        sc.name,
+        c.ci95_n
+    );
+    assert!(
+        c.ci95_kappa[0] <= k && k <= c.ci95_kappa[1],
+        "{}: κ = {k} outside {:?} with {truth}",
+        sc.name,
+        c.ci95_kappa
+    );
+}
+
 /// The criteria without a physical cause: nothing named, the base fit covers the truth, the
 /// noise is estimated within 20 %.
 fn assert_nothing_missing(sc: &Scenario, r: &DiagnosisRun) {
@@ -161,6 +257,12 @@ fn assert_nothing_missing(sc: &Scenario, r: &DiagnosisRun) {
         "{}: named {:?}",
         sc.name,
         d.most_likely_missing
+    );
+    assert!(
+        d.alternatives.is_empty(),
+        "{}: alternatives {:?}",
+        sc.name,
+        d.alternatives
     );
     let b = &d.base_fit;
     let (n, k) = (sc.law.n, sc.law.kappa);
@@ -257,11 +359,32 @@ fn low_mass_flow_is_found() {
     assert_found(&sc, &run(&sc));
 }
 
+/// Its premise, the truth ranked first, is out of reach of these data (a tie with
+/// `inlet_diameter`); `gauge_scale_is_named_or_tied` tests the tie.
 #[test]
 #[ignore = "issue 11: not separable by these data: inlet_diameter (0.034 ± 0.005) is named, gauge_scale (0.033 ± 0.005) second by dBIC 2.1; noise-free the truth wins by only lambda = 1.22 chi2 (first with p = 0.71 at 1.5 % noise; 95 % needs |g| >= 8.9 %), see tests/diagnose_separability.rs"]
 fn gauge_scale_is_found() {
     let sc = scenarios::gauge_scale();
     assert_found(&sc, &run(&sc));
+}
+
+/// The gauge reading 3 % high, judged as the tie it is: `gauge_scale` named or listed as an
+/// alternative to the named cause (here `inlet_diameter`, signatures cos ≈ +0.99), and its own
+/// refit recovering the truth.
+#[test]
+fn gauge_scale_is_named_or_tied() {
+    let sc = scenarios::gauge_scale();
+    let r = run(&sc);
+    assert_named_or_tied(&sc, &r);
+    // the report says so in words
+    let text = r.diagnosis.to_text();
+    if r.diagnosis.most_likely_missing.as_deref() != Some("gauge_scale") {
+        assert!(
+            text.contains("or, about as consistent with these data, gauge_scale"),
+            "{text}"
+        );
+        assert!(text.contains("calibrate the diameter gauge"), "{text}");
+    }
 }
 
 #[test]

@@ -30,13 +30,20 @@
 //!    search bound or outside the physical range is reported as such and never named.
 //! 5. **Indistinguishable** candidates: cosine of their orthogonalised signatures above
 //!    [`DiagnoseOptions::indistinguishable_cosine`] (0.9) in absolute value.
+//! 6. **Ties** ([`ties`](super::ties)): other candidates that earn their place with a `ΔBIC`
+//!    less than [`DiagnoseOptions::tie_margin`] (6) above the named one's are listed as
+//!    [`Diagnosis::alternatives`], with their refits' `(n, κ)` and the shifts from the named
+//!    refit's in its standard errors (the named cause stays the best by `ΔBIC`).
 
 use super::scan::{
     physical, refine, scan_profile, search_range, shape_variants, GridStart, Profile, ProfileScan,
     Refit, ScanOptions, ShapeParameter,
 };
 use super::scores::{cosine, linear_scores};
-use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use super::ties::{alternatives, Alternative, DEFAULT_TIE_MARGIN};
+use crate::fiber::effects::{
+    Category, Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+};
 use crate::fiber::noise_model::Outlier;
 use crate::fiber::rheometer::estimator::RelativeResidual;
 use crate::fiber::rheometer::report::bound_side;
@@ -69,6 +76,11 @@ pub struct DiagnoseOptions {
     pub indistinguishable_cosine: f64,
     /// `ΔBIC` a candidate must beat to earn its place (default −10).
     pub earn_threshold: f64,
+    /// `ΔBIC` gap to the named cause below which another candidate that earns its place is
+    /// listed as an alternative (default 6: `ΔBIC ≈ −2 ln B`, and a Bayes factor below
+    /// `e³ ≈ 20` is less than "strong" evidence on the Kass–Raftery scale, so the data do not
+    /// clearly prefer the named cause; see [`ties`](super::ties)).
+    pub tie_margin: f64,
     /// Start `(n, κ)` of the user's Carreau fit (default: the paper's start heuristic).
     pub start: Option<[f64; 2]>,
 }
@@ -82,6 +94,7 @@ impl Default for DiagnoseOptions {
             scan: ScanOptions::default(),
             indistinguishable_cosine: 0.9,
             earn_threshold: -10.0,
+            tie_margin: DEFAULT_TIE_MARGIN,
             start: None,
         }
     }
@@ -280,8 +293,14 @@ pub struct Diagnosis {
     pub candidates: Vec<CandidateResult>,
     /// Pairs of candidates with nearly parallel signatures.
     pub indistinguishable: Vec<Indistinguishable>,
-    /// The most likely missing effect, if one earns its place.
+    /// The most likely missing effect, if one earns its place (the best by `ΔBIC`).
     pub most_likely_missing: Option<String>,
+    /// Other candidates about as consistent with the data as the named one: they earn their
+    /// place too, with a `ΔBIC` less than [`DiagnoseOptions::tie_margin`] above the named
+    /// one's (best first; empty when nothing is named or nothing ties; see
+    /// [`ties`](super::ties)).
+    #[serde(default)]
+    pub alternatives: Vec<Alternative>,
     /// Wall time \[s\].
     pub wall_time_s: f64,
 }
@@ -784,6 +803,25 @@ pub fn diagnose(
         .copied()
         .find(|&i| earns_its_place(&results[i], options.earn_threshold));
     let most_likely = best_i.map(|i| cands[i].name().to_string());
+    let candidates: Vec<CandidateResult> = ranked.iter().map(|&i| results[i].clone()).collect();
+    // other candidates about as consistent with the data as the named one
+    let alternatives: Vec<Alternative> = match best_i {
+        Some(b) => alternatives(
+            &results[b],
+            &candidates,
+            options.earn_threshold,
+            options.tie_margin,
+            cands[b].category(),
+            |name| match cands.iter().position(|e| e.name() == name) {
+                Some(i) => (
+                    cands[i].category(),
+                    cosine(&lin[b].signature, &lin[i].signature),
+                ),
+                None => (Category::Physics, f64::NAN),
+            },
+        ),
+        None => Vec::new(),
+    };
     // a physical effect that explains part of the residuals significantly shows they are
     // systematic, even where the noise level is too uncertain for the RMS test
     systematic |= most_likely.is_some();
@@ -794,7 +832,6 @@ pub fn diagnose(
         },
         None => (None, None),
     };
-    let candidates: Vec<CandidateResult> = ranked.iter().map(|&i| results[i].clone()).collect();
     Ok(DiagnosisRun {
         diagnosis: Diagnosis {
             model: spec.law,
@@ -808,6 +845,7 @@ pub fn diagnose(
             candidates,
             indistinguishable: indist,
             most_likely_missing: most_likely,
+            alternatives,
             wall_time_s: t0.elapsed().as_secs_f64(),
         },
         residuals_before: before,

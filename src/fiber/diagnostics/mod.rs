@@ -10,10 +10,12 @@
 //! * [`diagnose`]: ranking the candidates by the excess misfit they explain (linearised scores,
 //!   global search and refits, information criteria) and the report in words;
 //! * [`scan`]: the global search of one candidate's strength (and shape): the profile of `J`
-//!   and the refits of its best points.
+//!   and the refits of its best points;
+//! * [`ties`]: candidates about as consistent with the data as the named one (alternatives).
 
 pub mod compare;
 pub mod diagnose;
 pub mod report;
 pub mod scan;
 pub mod scores;
+pub mod ties;

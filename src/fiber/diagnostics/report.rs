@@ -64,9 +64,10 @@ impl Diagnosis {
         match (&self.most_likely_missing, self.candidates.first()) {
             (Some(name), Some(c)) => {
                 s.push_str(&format!(
-                    "Most likely missing: {name}. Its signature lies along s = {} (strongest at {:.2} m). \
+                    "Most likely missing: {name}{}. Its signature lies along s = {} (strongest at {:.2} m). \
                      Adding it removes {:.1} % of the misfit (J {:.4e} -> {:.4e}), RMS {:.3} % -> {:.3} %, \
                      delta BIC = {:.1}, delta AIC = {:.1}; fitted strength {:.4} +/- {:.4} {}.\n",
+                    super::ties::or_alternatives(&self.alternatives),
                     fmt_range(c.signature_range_m),
                     c.signature_peak_m,
                     100.0 * (1.0 - c.cost_after / c.cost_before),
@@ -97,6 +98,7 @@ impl Diagnosis {
                         estimate_with_ci(c, "kappa", c.kappa, c.ci95_kappa)
                     ));
                 }
+                s.push_str(&super::ties::ties_paragraph(c, &self.alternatives));
             }
             _ => s.push_str(
                 "No candidate earns its place: no effect lowers BIC by more than the threshold; \

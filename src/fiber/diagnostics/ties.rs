@@ -1,0 +1,496 @@
+//! Ties: candidates the data cannot tell apart from the named one.
+//!
+//! The named cause ([`Diagnosis::most_likely_missing`](super::diagnose::Diagnosis)) is the
+//! credible candidate with the lowest `ΔBIC`. Another candidate that also earns its place
+//! (refitted, its strength physical and away from the search bounds, `ΔBIC` below the earn
+//! threshold) and whose `ΔBIC` is within
+//! [`DiagnoseOptions::tie_margin`](super::diagnose::DiagnoseOptions::tie_margin) of the best is
+//! an **alternative**: the data do not prefer the named one strongly. `ΔBIC ≈ −2 ln B` (B the
+//! Bayes factor), so a gap below 6 is less than "strong" evidence on the Kass–Raftery scale
+//! (gap 0–2: not worth more than a bare mention, 2–6: positive, 6–10: strong, > 10: very
+//! strong). For each alternative the diagnosis lists its gap, the cosine of its orthogonalised
+//! signature with the named one's, its refit's `(n, κ)` with 95% CIs, and how far `n` and `κ`
+//! move from the named refit's, in units of the named refit's standard errors: whether the
+//! material result is robust to the choice. A process condition or an instrument error in a tie
+//! can be checked independently of these data ([`independent_check`]).
+
+use super::diagnose::{earns_its_place, CandidateResult};
+use crate::fiber::effects::Category;
+use serde::{Deserialize, Serialize};
+
+/// Default [`DiagnoseOptions::tie_margin`](super::diagnose::DiagnoseOptions::tie_margin): a
+/// `ΔBIC` gap below 6 is less than "strong" evidence (Kass–Raftery) for the named cause.
+pub const DEFAULT_TIE_MARGIN: f64 = 6.0;
+
+/// Half-width of a 95% CI in standard errors (the fit report's symmetric intervals).
+const Z95: f64 = 1.96;
+
+/// Shifts of `n` and `κ` (in the named refit's standard errors) below which the material
+/// result is robust to the choice between tied causes.
+pub const ROBUST_SHIFT_SE: f64 = 1.0;
+
+/// A candidate about as consistent with the data as the named one (JSON: an entry of
+/// `alternatives`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Alternative {
+    /// Canonical name of the alternative.
+    pub effect: String,
+    /// Its category (physics, process, instrument).
+    pub category: Category,
+    /// Category of the named cause it ties with.
+    pub named_category: Category,
+    /// `ΔBIC(alternative) − ΔBIC(named)` (≥ 0, below the tie margin).
+    pub delta_bic_gap: f64,
+    /// Cosine of its orthogonalised (linearised) signature with the named one's (`NaN` when
+    /// not available).
+    pub signature_cosine: f64,
+    /// Its fitted strength (unit [`unit`](Self::unit)).
+    pub strength: f64,
+    /// Standard error of the strength.
+    pub stderr_strength: f64,
+    /// Unit of the strength.
+    pub unit: String,
+    /// `n` \[-\] of its refit.
+    pub n: f64,
+    /// `κ = ln(K / 1 Pa)` \[-\] of its refit.
+    pub kappa: f64,
+    /// 95% CI of `n` in its refit.
+    pub ci95_n: [f64; 2],
+    /// 95% CI of `κ` in its refit.
+    pub ci95_kappa: [f64; 2],
+    /// `(n_alt − n_named) / se(n_named)` (`NaN` where the named refit has no valid CI).
+    pub n_shift_se: f64,
+    /// `(κ_alt − κ_named) / se(κ_named)`.
+    pub kappa_shift_se: f64,
+    /// Whether `|n_shift_se|` and `|kappa_shift_se|` are both below [`ROBUST_SHIFT_SE`]: the
+    /// material result does not depend on which of the two causes is chosen.
+    pub material_robust: bool,
+}
+
+/// Whether `c` ties with the `named` cause: a different candidate that earns its place
+/// ([`earns_its_place`] with `earn_threshold`) with a `ΔBIC` less than `tie_margin` above the
+/// named one's. At-bound, unphysical and unrefitted candidates never tie.
+pub fn ties_with(
+    named: &CandidateResult,
+    c: &CandidateResult,
+    earn_threshold: f64,
+    tie_margin: f64,
+) -> bool {
+    c.effect != named.effect
+        && earns_its_place(c, earn_threshold)
+        && c.delta_bic - named.delta_bic < tie_margin
+}
+
+/// Standard error from a symmetric 95% CI (`NaN` if the CI is not valid).
+fn stderr_of(ci: [f64; 2]) -> f64 {
+    if ci.iter().all(|v| v.is_finite()) {
+        (ci[1] - ci[0]) / (2.0 * Z95)
+    } else {
+        f64::NAN
+    }
+}
+
+/// `(alt − named) / se`, `NaN` unless `se` is positive and finite.
+fn shift(alt: f64, named: f64, se: f64) -> f64 {
+    if se.is_finite() && se > 0.0 {
+        (alt - named) / se
+    } else {
+        f64::NAN
+    }
+}
+
+impl Alternative {
+    /// The record of `alt` tying with `named`, with the categories and the signature cosine
+    /// supplied by the caller (the candidate results do not carry them).
+    pub fn new(
+        named: &CandidateResult,
+        alt: &CandidateResult,
+        named_category: Category,
+        category: Category,
+        signature_cosine: f64,
+    ) -> Self {
+        let n_shift_se = shift(alt.n, named.n, stderr_of(named.ci95_n));
+        let kappa_shift_se = shift(alt.kappa, named.kappa, stderr_of(named.ci95_kappa));
+        Alternative {
+            effect: alt.effect.clone(),
+            category,
+            named_category,
+            delta_bic_gap: alt.delta_bic - named.delta_bic,
+            signature_cosine,
+            strength: alt.strength,
+            stderr_strength: alt.stderr_strength,
+            unit: alt.unit.clone(),
+            n: alt.n,
+            kappa: alt.kappa,
+            ci95_n: alt.ci95_n,
+            ci95_kappa: alt.ci95_kappa,
+            n_shift_se,
+            kappa_shift_se,
+            // NaN shifts (no valid interval) compare false: not robust
+            material_robust: n_shift_se.abs() < ROBUST_SHIFT_SE
+                && kappa_shift_se.abs() < ROBUST_SHIFT_SE,
+        }
+    }
+
+    /// Whether the tie mixes missing physics with a process condition or an instrument error.
+    pub fn mixes_physics_and_conditions(&self) -> bool {
+        (self.category == Category::Physics) != (self.named_category == Category::Physics)
+    }
+}
+
+/// The alternatives to `named` among `candidates` (in their order, best first), each built by
+/// [`Alternative::new`] with `info(effect) = (category, signature cosine with the named one)`.
+pub fn alternatives(
+    named: &CandidateResult,
+    candidates: &[CandidateResult],
+    earn_threshold: f64,
+    tie_margin: f64,
+    named_category: Category,
+    info: impl Fn(&str) -> (Category, f64),
+) -> Vec<Alternative> {
+    candidates
+        .iter()
+        .filter(|c| ties_with(named, c, earn_threshold, tie_margin))
+        .map(|c| {
+            let (cat, cos) = info(&c.effect);
+            Alternative::new(named, c, named_category, cat, cos)
+        })
+        .collect()
+}
+
+/// An independent check (outside these diameter data) that decides whether a process condition
+/// or the instrument is off, for the built-in process and instrument effects (`None` for
+/// physics and unknown names).
+pub fn independent_check(effect: &str) -> Option<&'static str> {
+    match effect {
+        "gauge_scale" => Some("calibrate the diameter gauge on a wire or fiber of known diameter"),
+        "gauge_offset" => Some("check the diameter gauge's zero on a reference wire"),
+        "inlet_diameter" | "inlet_velocity" => {
+            Some("measure the die swell (the diameter just below the die, e.g. on a photograph)")
+        }
+        "die_temperature_offset" => {
+            Some("measure the melt temperature at the die exit (a thermocouple in the melt)")
+        }
+        "mass_flow_scale" => Some("weigh the extrudate collected over a timed interval"),
+        _ => None,
+    }
+}
+
+/// The category in words (`"missing physics"`, `"a process condition"`, `"an instrument
+/// error"`).
+fn category_words(c: Category) -> &'static str {
+    match c {
+        Category::Physics => "missing physics",
+        Category::Process => "a process condition",
+        Category::Instrument => "an instrument error",
+    }
+}
+
+/// `"0.8020 (95% CI [0.7865, 0.8175])"`, or the value without an interval.
+fn value_with_ci(v: f64, ci: [f64; 2]) -> String {
+    if ci.iter().all(|x| x.is_finite()) {
+        format!("{v:.4} (95% CI [{:.4}, {:.4}])", ci[0], ci[1])
+    } else {
+        format!("{v:.4} (no valid 95% CI)")
+    }
+}
+
+/// The words after the named cause in the report: `" — or, about as consistent with these
+/// data, gauge_scale (delta BIC gap 2.1, signatures cos +0.986)"` (empty without
+/// alternatives).
+pub(super) fn or_alternatives(alts: &[Alternative]) -> String {
+    if alts.is_empty() {
+        return String::new();
+    }
+    let each: Vec<String> = alts
+        .iter()
+        .map(|a| {
+            format!(
+                "{} (delta BIC gap {:.1}, signatures cos {:+.3})",
+                a.effect, a.delta_bic_gap, a.signature_cosine
+            )
+        })
+        .collect();
+    format!(
+        " — or, about as consistent with these data, {}",
+        each.join("; or ")
+    )
+}
+
+/// The report's paragraph on a tie (empty without alternatives): each alternative's strength
+/// and `(n, κ)`, whether the material result is robust to the choice, and what decides.
+pub(super) fn ties_paragraph(named: &CandidateResult, alts: &[Alternative]) -> String {
+    let c = named;
+    let named = c.effect.as_str();
+    let Some(first) = alts.first() else {
+        return String::new();
+    };
+    let mut s = format!(
+        "TIE: the data cannot choose between {named} and {} (a delta BIC gap below the tie \
+         margin is less than strong evidence). The material estimate with either:\n",
+        alts.iter()
+            .map(|a| a.effect.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    s.push_str(&format!(
+        "    with {named} ({:.4} +/- {:.4} {}): n = {}, kappa = {}\n",
+        c.strength,
+        c.stderr_strength,
+        c.unit,
+        value_with_ci(c.n, c.ci95_n),
+        value_with_ci(c.kappa, c.ci95_kappa)
+    ));
+    for a in alts {
+        s.push_str(&format!(
+            "    with {} ({:.4} +/- {:.4} {}): n = {}, kappa = {}; shifts from {named}'s: \
+             n {:+.1}, kappa {:+.1} standard errors\n",
+            a.effect,
+            a.strength,
+            a.stderr_strength,
+            a.unit,
+            value_with_ci(a.n, a.ci95_n),
+            value_with_ci(a.kappa, a.ci95_kappa),
+            a.n_shift_se,
+            a.kappa_shift_se
+        ));
+    }
+    let fragile: Vec<&Alternative> = alts.iter().filter(|a| !a.material_robust).collect();
+    if fragile.is_empty() {
+        s.push_str(&format!(
+            "The material result is ROBUST to the choice: n and kappa move by less than \
+             {ROBUST_SHIFT_SE} standard error between them.\n"
+        ));
+    } else {
+        s.push_str(&format!(
+            "The material result DEPENDS ON THE CHOICE: with {} n or kappa moves by \
+             {ROBUST_SHIFT_SE} standard error or more (or has no valid interval); decide the \
+             cause before trusting (n, kappa).\n",
+            fragile
+                .iter()
+                .map(|a| a.effect.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    // what decides: an independent check of each process condition / instrument in the tie
+    let members: Vec<(&str, Category)> = std::iter::once((named, first.named_category))
+        .chain(alts.iter().map(|a| (a.effect.as_str(), a.category)))
+        .collect();
+    let checks: Vec<String> = members
+        .iter()
+        .filter_map(|(e, _)| independent_check(e).map(|c| format!("{e}: {c}")))
+        .collect();
+    let words = |(e, c): &(&str, Category)| format!("{e} is {}", category_words(*c));
+    if alts.iter().any(Alternative::mixes_physics_and_conditions) {
+        s.push_str(&format!(
+            "The tie mixes missing physics with process conditions or the instrument ({}): an \
+             independent check of the process condition or instrument decides",
+            members.iter().map(words).collect::<Vec<_>>().join(", ")
+        ));
+    } else if members.iter().all(|m| m.1 == Category::Physics) {
+        s.push_str(
+            "All are missing physics: data at other conditions (another take-up speed, air \
+             condition or mass flow), which change their signatures differently, can tell them \
+             apart.\n",
+        );
+    } else {
+        s.push_str(&format!(
+            "{}: an independent check decides",
+            members.iter().map(words).collect::<Vec<_>>().join(", ")
+        ));
+    }
+    if !checks.is_empty() {
+        s.push_str(&format!(" ({}).\n", checks.join("; ")));
+    } else if !s.ends_with('\n') {
+        s.push_str(".\n");
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fiber::diagnostics::diagnose::StrengthStatus;
+
+    fn cand(
+        effect: &str,
+        status: StrengthStatus,
+        dbic: f64,
+        n: f64,
+        kappa: f64,
+    ) -> CandidateResult {
+        CandidateResult {
+            effect: effect.into(),
+            unit: "-".into(),
+            refitted: status != StrengthStatus::NotRefitted,
+            linear_score: 1.0,
+            linear_strength: 0.0,
+            strength: 0.03,
+            stderr_strength: 0.005,
+            cost_before: 1.0,
+            cost_after: 0.8,
+            rms_relative_residual_after: 0.015,
+            extra_parameters: 1,
+            delta_bic: dbic,
+            delta_aic: dbic,
+            signature_peak_m: 0.0,
+            signature_range_m: [0.0, 0.04],
+            n,
+            kappa,
+            // se(n) = 0.01, se(κ) = 0.1
+            ci95_n: [n - Z95 * 0.01, n + Z95 * 0.01],
+            ci95_kappa: [kappa - Z95 * 0.1, kappa + Z95 * 0.1],
+            at_bound: Vec::new(),
+            status,
+            status_note: None,
+            physical_range: [-0.1, 0.1],
+            search_range: [-0.2, 0.2],
+            shape: Vec::new(),
+            profiles: Vec::new(),
+            scan_errors: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn only_credible_earning_candidates_within_the_margin_tie() {
+        use StrengthStatus::*;
+        let named = cand("a", Physical, -41.0, 0.80, 11.8);
+        let (earn, margin) = (-10.0, DEFAULT_TIE_MARGIN);
+        // just inside and just outside the margin
+        assert!(ties_with(
+            &named,
+            &cand("b", Physical, -35.01, 0.8, 11.8),
+            earn,
+            margin
+        ));
+        assert!(!ties_with(
+            &named,
+            &cand("b", Physical, -34.99, 0.8, 11.8),
+            earn,
+            margin
+        ));
+        assert!(!ties_with(
+            &named,
+            &cand("b", Physical, -35.0, 0.8, 11.8),
+            earn,
+            margin
+        ));
+        // the named one never ties with itself
+        assert!(!ties_with(&named, &named, earn, margin));
+        // better ΔBIC but at a bound, unphysical, or not refitted: never an alternative
+        for s in [AtBound, Unphysical, NotRefitted] {
+            assert!(
+                !ties_with(&named, &cand("c", s, -42.0, 0.8, 11.8), earn, margin),
+                "{s:?}"
+            );
+        }
+        // within the margin of a weak named cause but not earning its place
+        let weak = cand("a", Physical, -12.0, 0.8, 11.8);
+        assert!(!ties_with(
+            &weak,
+            &cand("d", Physical, -9.0, 0.8, 11.8),
+            earn,
+            margin
+        ));
+        assert!(ties_with(
+            &weak,
+            &cand("d", Physical, -10.5, 0.8, 11.8),
+            earn,
+            margin
+        ));
+    }
+
+    #[test]
+    fn shifts_are_in_the_named_refits_standard_errors() {
+        use StrengthStatus::*;
+        let named = cand("inlet_diameter", Physical, -41.2, 0.797, 11.79);
+        let list = [
+            named.clone(),
+            cand("gauge_scale", Physical, -39.1, 0.802, 11.74),
+            cand("radiation", Unphysical, -45.0, 0.7, 12.0),
+            cand("die_temperature_offset", Physical, -36.0, 0.83, 11.5),
+            cand("nusselt_scale", Physical, -20.0, 0.8, 11.8),
+        ];
+        let alts = alternatives(
+            &named,
+            &list,
+            -10.0,
+            DEFAULT_TIE_MARGIN,
+            Category::Process,
+            |e| match e {
+                "gauge_scale" => (Category::Instrument, 0.986),
+                _ => (Category::Process, 0.5),
+            },
+        );
+        let names: Vec<&str> = alts.iter().map(|a| a.effect.as_str()).collect();
+        assert_eq!(names, ["gauge_scale", "die_temperature_offset"]);
+        let g = &alts[0];
+        assert!((g.delta_bic_gap - 2.1).abs() < 1e-12);
+        assert!((g.n_shift_se - 0.5).abs() < 1e-9, "{}", g.n_shift_se);
+        assert!(
+            (g.kappa_shift_se + 0.5).abs() < 1e-9,
+            "{}",
+            g.kappa_shift_se
+        );
+        assert!(g.material_robust);
+        assert_eq!(g.signature_cosine, 0.986);
+        assert!(!g.mixes_physics_and_conditions());
+        let d = &alts[1];
+        assert!((d.n_shift_se - 3.3).abs() < 1e-9);
+        assert!(!d.material_robust);
+        // without a valid CI of the named refit the shift is unknown: not robust
+        let mut no_ci = named.clone();
+        no_ci.ci95_n = [f64::NAN; 2];
+        let a = Alternative::new(&no_ci, &list[1], Category::Process, Category::Physics, 0.9);
+        assert!(a.n_shift_se.is_nan() && !a.material_robust);
+        assert!(a.mixes_physics_and_conditions());
+    }
+
+    #[test]
+    fn the_report_says_what_decides_and_whether_the_material_result_is_robust() {
+        use StrengthStatus::*;
+        let named = cand("inlet_diameter", Physical, -41.2, 0.797, 11.79);
+        let g = cand("gauge_scale", Physical, -39.1, 0.802, 11.74);
+        let a = Alternative::new(&named, &g, Category::Process, Category::Instrument, 0.986);
+        assert_eq!(
+            or_alternatives(std::slice::from_ref(&a)),
+            " — or, about as consistent with these data, gauge_scale (delta BIC gap 2.1, \
+             signatures cos +0.986)"
+        );
+        let t = ties_paragraph(&named, std::slice::from_ref(&a));
+        assert!(t.contains("between inlet_diameter and gauge_scale"), "{t}");
+        assert!(t.contains("ROBUST to the choice"), "{t}");
+        assert!(t.contains("n +0.5, kappa -0.5 standard errors"), "{t}");
+        assert!(
+            t.contains("gauge_scale: calibrate the diameter gauge"),
+            "{t}"
+        );
+        assert!(t.contains("inlet_diameter: measure the die swell"), "{t}");
+        assert!(!t.contains("mixes missing physics"), "{t}");
+        // physics tied with an instrument error, material result moved by 3 se
+        let rad = cand("radiation", Physical, -38.0, 0.83, 11.79);
+        let b = Alternative::new(&named, &rad, Category::Process, Category::Physics, -0.9);
+        let t = ties_paragraph(&named, &[b]);
+        assert!(t.contains("DEPENDS ON THE CHOICE: with radiation"), "{t}");
+        assert!(
+            t.contains("mixes missing physics with process conditions"),
+            "{t}"
+        );
+        assert!(t.contains("(inlet_diameter: measure the die swell"), "{t}");
+        assert!(ties_paragraph(&named, &[]).is_empty());
+        assert!(or_alternatives(&[]).is_empty());
+    }
+
+    #[test]
+    fn process_and_instrument_effects_have_an_independent_check() {
+        for e in crate::fiber::effects::Effect::all() {
+            assert_eq!(
+                independent_check(e.name()).is_some(),
+                e.category() != Category::Physics,
+                "{}",
+                e.name()
+            );
+        }
+    }
+}
