@@ -172,17 +172,21 @@ pub fn independent_check(effect: &str) -> Option<&'static str> {
             Some("measure the melt temperature at the die exit (a thermocouple in the melt)")
         }
         "mass_flow_scale" => Some("weigh the extrudate collected over a timed interval"),
+        "vft_b_offset" | "vft_t_vf_offset" => Some(
+            "measure the zero-shear viscosity down to the take-up temperatures (shear rheometry)",
+        ),
         _ => None,
     }
 }
 
 /// The category in words (`"missing physics"`, `"a process condition"`, `"an instrument
-/// error"`).
+/// error"`, `"material data"`).
 fn category_words(c: Category) -> &'static str {
     match c {
         Category::Physics => "missing physics",
         Category::Process => "a process condition",
         Category::Instrument => "an instrument error",
+        Category::Material => "material data",
     }
 }
 
