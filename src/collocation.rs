@@ -168,6 +168,18 @@ impl Collocation {
             |i| self.x[i] + 0.5 * self.h[i],
             "right-hand side",
         )?;
+        self.finish_residual(problem, y, p)
+    }
+
+    /// The residual vector from the node and midpoint values of `f` in place, and the boundary
+    /// residuals.
+    fn finish_residual<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+    ) -> Result<(), BvpError> {
+        let (n, m) = (self.n, self.m());
         for i in 0..m - 1 {
             let h = self.h[i];
             for c in 0..n {
@@ -192,6 +204,20 @@ impl Collocation {
         Ok(())
     }
 
+    /// [`residual`](Self::residual) and [`jacobians`](Self::jacobians) at `y` in one pass over
+    /// the nodes and midpoints: the values of `f` are the real parts of the dual-number
+    /// evaluations (no separate `f64` evaluation). For an iterate whose Jacobian will be needed.
+    pub(crate) fn residual_and_jacobians<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        seeded: usize,
+    ) -> Result<(), BvpError> {
+        self.dual_pass(problem, y, p, seeded, true)?;
+        self.finish_residual(problem, y, p)
+    }
+
     /// Evaluates the node, midpoint and boundary Jacobians with respect to `y` and the first
     /// `seeded` parameters. Requires a preceding [`residual`](Self::residual) at the same `y`
     /// (the midpoint states are reused).
@@ -201,6 +227,20 @@ impl Collocation {
         y: &[f64],
         p: &[f64],
         seeded: usize,
+    ) -> Result<(), BvpError> {
+        self.dual_pass(problem, y, p, seeded, false)
+    }
+
+    /// The dual-number pass of [`jacobians`](Self::jacobians); with `values`, the real parts
+    /// also set the node slopes `f`, the midpoint states and `f_mid` (checked finite, as
+    /// [`residual`](Self::residual) checks them).
+    fn dual_pass<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        seeded: usize,
+        values: bool,
     ) -> Result<(), BvpError> {
         let (n, m) = (self.n, self.m());
         let w = n + seeded;
@@ -220,13 +260,20 @@ impl Collocation {
                 x: self.x[i],
                 n,
             };
-            self.engine.jacobian(
-                &rf,
-                &self.input,
-                w,
-                &mut fbuf[..n],
-                &mut self.jn[i * n * w..(i + 1) * n * w],
-            );
+            let out = if values {
+                &mut self.f[i * n..(i + 1) * n]
+            } else {
+                &mut fbuf[..n]
+            };
+            self.engine
+                .jacobian(&rf, &self.input, w, out, &mut self.jn[i * n * w..(i + 1) * n * w]);
+        }
+        if values {
+            if let Err(e) = check_finite(&self.f, n, 1, |i| self.x[i], "right-hand side") {
+                self.fbuf = fbuf;
+                return Err(e);
+            }
+            self.midpoint_states(y);
         }
         for i in 0..m - 1 {
             self.input.clear();
@@ -238,15 +285,27 @@ impl Collocation {
                 x: self.x[i] + 0.5 * self.h[i],
                 n,
             };
-            self.engine.jacobian(
-                &rf,
-                &self.input,
-                w,
-                &mut fbuf[..n],
-                &mut self.jm[i * n * w..(i + 1) * n * w],
-            );
+            let out = if values {
+                &mut self.f_mid[i * n..(i + 1) * n]
+            } else {
+                &mut fbuf[..n]
+            };
+            self.engine
+                .jacobian(&rf, &self.input, w, out, &mut self.jm[i * n * w..(i + 1) * n * w]);
         }
         self.jac_evals += (2 * m - 1) * w.div_ceil(8).max(1);
+        if values {
+            if let Err(e) = check_finite(
+                &self.f_mid,
+                n,
+                1,
+                |i| self.x[i] + 0.5 * self.h[i],
+                "right-hand side",
+            ) {
+                self.fbuf = fbuf;
+                return Err(e);
+            }
+        }
         check_finite(&self.jn, n * w, w, |i| self.x[i], "Jacobian")?;
         check_finite(
             &self.jm,
