@@ -109,12 +109,19 @@ impl Collocation {
     /// the node values `y` and the node slopes in `f`.
     fn midpoint_states(&mut self, y: &[f64]) {
         let (n, m) = (self.n, self.m());
-        for i in 0..m - 1 {
-            let h = self.h[i];
+        let len = (m - 1) * n;
+        let ys = y[..len].chunks_exact(n).zip(y[n..len + n].chunks_exact(n));
+        let fs = self.f[..len]
+            .chunks_exact(n)
+            .zip(self.f[n..len + n].chunks_exact(n));
+        for (((ym, &h), (yi, yj)), (fi, fj)) in self.y_mid[..len]
+            .chunks_exact_mut(n)
+            .zip(&self.h)
+            .zip(ys)
+            .zip(fs)
+        {
             for c in 0..n {
-                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
-                let (fi, fj) = (self.f[i * n + c], self.f[(i + 1) * n + c]);
-                self.y_mid[i * n + c] = 0.5 * (yi + yj) - 0.125 * h * (fj - fi);
+                ym[c] = 0.5 * (yi[c] + yj[c]) - 0.125 * h * (fj[c] - fi[c]);
             }
         }
     }
@@ -180,15 +187,23 @@ impl Collocation {
         p: &[f64],
     ) -> Result<(), BvpError> {
         let (n, m) = (self.n, self.m());
-        for i in 0..m - 1 {
-            let h = self.h[i];
+        let len = (m - 1) * n;
+        let ys = y[..len].chunks_exact(n).zip(y[n..len + n].chunks_exact(n));
+        let fs = self.f[..len]
+            .chunks_exact(n)
+            .zip(self.f[n..len + n].chunks_exact(n));
+        for ((((r, &h), fm), (yi, yj)), (fi, fj)) in self.res[..len]
+            .chunks_exact_mut(n)
+            .zip(&self.h)
+            .zip(self.f_mid[..len].chunks_exact(n))
+            .zip(ys)
+            .zip(fs)
+        {
             for c in 0..n {
-                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
-                let (fi, fj) = (self.f[i * n + c], self.f[(i + 1) * n + c]);
-                self.res[i * n + c] = yj - yi - h / 6.0 * (fi + 4.0 * self.f_mid[i * n + c] + fj);
+                r[c] = yj[c] - yi[c] - h / 6.0 * (fi[c] + 4.0 * fm[c] + fj[c]);
             }
         }
-        let off = (m - 1) * n;
+        let off = len;
         let (res_col, res_bc) = self.res.split_at_mut(off);
         let _ = res_col;
         problem.bc(&y[..n], &y[(m - 1) * n..], p, res_bc);

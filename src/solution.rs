@@ -257,8 +257,18 @@ pub(crate) fn hermite(
 pub(crate) fn resample(xs: &[f64], ys: &[f64], fs: &[f64], n: usize, new_x: &[f64]) -> Vec<f64> {
     let mut out = vec![0.0; new_x.len() * n];
     let mut yp = vec![0.0; n];
+    // sorted new nodes: the interval search continues from the previous one (what
+    // `interval_of` finds, without a binary search per node)
+    let last = xs.len().saturating_sub(2);
+    let mut i = 0;
     for (j, &x) in new_x.iter().enumerate() {
-        let i = interval_of(xs, x);
+        if xs.len() < 2 || !(x >= xs[i]) {
+            i = interval_of(xs, x);
+        } else {
+            while i < last && x >= xs[i + 1] {
+                i += 1;
+            }
+        }
         hermite(xs, ys, fs, n, i, x, &mut out[j * n..(j + 1) * n], &mut yp);
     }
     out
