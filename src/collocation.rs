@@ -357,6 +357,52 @@ impl Collocation {
     /// The `n × n` blocks `A_i = ∂r_i/∂y_i` and `B_i = ∂r_i/∂y_{i+1}` side by side: row `r`
     /// of `[A_i B_i]` is written to `out[r ld..r ld + 2n]` (`ld >= 2n`).
     pub(crate) fn interval_rows(&self, i: usize, out: &mut [f64], ld: usize) {
+        // small systems with the sizes known at compile time (the same operations in the same
+        // order: bit-identical to the general loop)
+        match self.n {
+            1 => self.interval_rows_fixed::<1>(i, out, ld),
+            2 => self.interval_rows_fixed::<2>(i, out, ld),
+            3 => self.interval_rows_fixed::<3>(i, out, ld),
+            4 => self.interval_rows_fixed::<4>(i, out, ld),
+            5 => self.interval_rows_fixed::<5>(i, out, ld),
+            6 => self.interval_rows_fixed::<6>(i, out, ld),
+            _ => self.interval_rows_general(i, out, ld),
+        }
+    }
+
+    /// [`interval_rows`](Self::interval_rows) for `n = N`.
+    fn interval_rows_fixed<const N: usize>(&self, i: usize, out: &mut [f64], ld: usize) {
+        let w = N + self.seeded_params;
+        let h = self.h[i];
+        let block = |j: &[f64]| -> [[f64; N]; N] {
+            std::array::from_fn(|r| std::array::from_fn(|c| j[r * w + c]))
+        };
+        let ji = block(&self.jn[i * N * w..(i + 1) * N * w]);
+        let jj = block(&self.jn[(i + 1) * N * w..(i + 2) * N * w]);
+        let jm = block(&self.jm[i * N * w..(i + 1) * N * w]);
+        for r in 0..N {
+            let mut sa = [0.0; N];
+            let mut sb = [0.0; N];
+            for l in 0..N {
+                let jml = jm[r][l];
+                for c in 0..N {
+                    sa[c] += jml * ji[l][c];
+                    sb[c] += jml * jj[l][c];
+                }
+            }
+            let (oa, ob) = out[r * ld..r * ld + 2 * N].split_at_mut(N);
+            for c in 0..N {
+                let d = if r == c { 1.0 } else { 0.0 };
+                let m_a = 2.0 * jm[r][c] + 0.5 * h * sa[c];
+                let m_b = 2.0 * jm[r][c] - 0.5 * h * sb[c];
+                oa[c] = -d - h / 6.0 * (ji[r][c] + m_a);
+                ob[c] = d - h / 6.0 * (jj[r][c] + m_b);
+            }
+        }
+    }
+
+    /// [`interval_rows`](Self::interval_rows) for any `n`.
+    fn interval_rows_general(&self, i: usize, out: &mut [f64], ld: usize) {
         let n = self.n;
         let w = n + self.seeded_params;
         let h = self.h[i];

@@ -123,8 +123,70 @@ fn swap_rows(a: &mut [f64], w: usize, r1: usize, r2: usize) {
 }
 
 /// Partial-pivoting elimination of columns `0..ncols` of the `rows × w` row-major block `a`.
-/// Returns the first column without a nonzero pivot as `Err(column)`.
+/// Returns the first column without a nonzero pivot as `Err(column)`. Small widths run with
+/// the width known at compile time (the same operations in the same order).
 fn eliminate(
+    a: &mut [f64],
+    rows: usize,
+    w: usize,
+    ncols: usize,
+    piv: &mut [usize],
+) -> Result<(), usize> {
+    match w {
+        2 => eliminate_fixed::<2>(a, rows, ncols, piv),
+        3 => eliminate_fixed::<3>(a, rows, ncols, piv),
+        4 => eliminate_fixed::<4>(a, rows, ncols, piv),
+        5 => eliminate_fixed::<5>(a, rows, ncols, piv),
+        6 => eliminate_fixed::<6>(a, rows, ncols, piv),
+        7 => eliminate_fixed::<7>(a, rows, ncols, piv),
+        8 => eliminate_fixed::<8>(a, rows, ncols, piv),
+        9 => eliminate_fixed::<9>(a, rows, ncols, piv),
+        10 => eliminate_fixed::<10>(a, rows, ncols, piv),
+        _ => eliminate_general(a, rows, w, ncols, piv),
+    }
+}
+
+/// [`eliminate`] for `w = W`.
+fn eliminate_fixed<const W: usize>(
+    a: &mut [f64],
+    rows: usize,
+    ncols: usize,
+    piv: &mut [usize],
+) -> Result<(), usize> {
+    for j in 0..ncols {
+        let mut p = j;
+        let mut best = a[j * W + j].abs();
+        for r in j + 1..rows {
+            let v = a[r * W + j].abs();
+            if v > best {
+                best = v;
+                p = r;
+            }
+        }
+        if best.is_nan() || best <= 0.0 {
+            return Err(j);
+        }
+        piv[j] = p;
+        swap_rows(a, W, j, p);
+        let (top, below) = a.split_at_mut((j + 1) * W);
+        let mut prow = [0.0; W];
+        prow.copy_from_slice(&top[j * W..(j + 1) * W]);
+        let inv = 1.0 / prow[j];
+        for row in below.chunks_exact_mut(W).take(rows - j - 1) {
+            let l = row[j] * inv;
+            row[j] = l;
+            if l != 0.0 {
+                for c in j + 1..W {
+                    row[c] -= l * prow[c];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// [`eliminate`] for any width.
+fn eliminate_general(
     a: &mut [f64],
     rows: usize,
     w: usize,
