@@ -133,66 +133,28 @@ fn eliminate(
     piv: &mut [usize],
 ) -> Result<(), usize> {
     match w {
-        2 => eliminate_fixed::<2>(a, rows, ncols, piv),
-        3 => eliminate_fixed::<3>(a, rows, ncols, piv),
-        4 => eliminate_fixed::<4>(a, rows, ncols, piv),
-        5 => eliminate_fixed::<5>(a, rows, ncols, piv),
-        6 => eliminate_fixed::<6>(a, rows, ncols, piv),
-        7 => eliminate_fixed::<7>(a, rows, ncols, piv),
-        8 => eliminate_fixed::<8>(a, rows, ncols, piv),
-        9 => eliminate_fixed::<9>(a, rows, ncols, piv),
-        10 => eliminate_fixed::<10>(a, rows, ncols, piv),
-        _ => eliminate_general(a, rows, w, ncols, piv),
+        2 => eliminate_w::<2>(a, rows, w, ncols, piv),
+        3 => eliminate_w::<3>(a, rows, w, ncols, piv),
+        4 => eliminate_w::<4>(a, rows, w, ncols, piv),
+        5 => eliminate_w::<5>(a, rows, w, ncols, piv),
+        6 => eliminate_w::<6>(a, rows, w, ncols, piv),
+        7 => eliminate_w::<7>(a, rows, w, ncols, piv),
+        8 => eliminate_w::<8>(a, rows, w, ncols, piv),
+        9 => eliminate_w::<9>(a, rows, w, ncols, piv),
+        10 => eliminate_w::<10>(a, rows, w, ncols, piv),
+        _ => eliminate_w::<0>(a, rows, w, ncols, piv),
     }
 }
 
-/// [`eliminate`] for `w = W`.
-fn eliminate_fixed<const W: usize>(
+/// [`eliminate`] with the width `W` fixed at compile time (`W = 0`: the run-time `w_rt`).
+fn eliminate_w<const W: usize>(
     a: &mut [f64],
     rows: usize,
+    w_rt: usize,
     ncols: usize,
     piv: &mut [usize],
 ) -> Result<(), usize> {
-    for j in 0..ncols {
-        let mut p = j;
-        let mut best = a[j * W + j].abs();
-        for r in j + 1..rows {
-            let v = a[r * W + j].abs();
-            if v > best {
-                best = v;
-                p = r;
-            }
-        }
-        if best.is_nan() || best <= 0.0 {
-            return Err(j);
-        }
-        piv[j] = p;
-        swap_rows(a, W, j, p);
-        let (top, below) = a.split_at_mut((j + 1) * W);
-        let mut prow = [0.0; W];
-        prow.copy_from_slice(&top[j * W..(j + 1) * W]);
-        let inv = 1.0 / prow[j];
-        for row in below.chunks_exact_mut(W).take(rows - j - 1) {
-            let l = row[j] * inv;
-            row[j] = l;
-            if l != 0.0 {
-                for c in j + 1..W {
-                    row[c] -= l * prow[c];
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// [`eliminate`] for any width.
-fn eliminate_general(
-    a: &mut [f64],
-    rows: usize,
-    w: usize,
-    ncols: usize,
-    piv: &mut [usize],
-) -> Result<(), usize> {
+    let w = if W > 0 { W } else { w_rt };
     for j in 0..ncols {
         let mut p = j;
         let mut best = a[j * w + j].abs();
@@ -209,13 +171,13 @@ fn eliminate_general(
         piv[j] = p;
         swap_rows(a, w, j, p);
         let (top, below) = a.split_at_mut((j + 1) * w);
-        let prow = &top[j * w..];
+        let prow = &top[j * w..(j + 1) * w];
         let inv = 1.0 / prow[j];
         for row in below.chunks_exact_mut(w).take(rows - j - 1) {
             let l = row[j] * inv;
             row[j] = l;
             if l != 0.0 {
-                for (x, u) in row[j + 1..].iter_mut().zip(&prow[j + 1..w]) {
+                for (x, u) in row[j + 1..].iter_mut().zip(&prow[j + 1..]) {
                     *x -= l * u;
                 }
             }
@@ -352,16 +314,35 @@ impl BlockLu {
             if transpose {
                 self.solve_transpose_one(d, col, scratch);
             } else {
-                self.solve_one(d, col, scratch);
+                // small systems with the sizes known at compile time (the same operations)
+                match (d.n, 2 * d.n + d.k) {
+                    (1, 2) => self.solve_one::<1, 2>(d, col, scratch),
+                    (1, 3) => self.solve_one::<1, 3>(d, col, scratch),
+                    (2, 4) => self.solve_one::<2, 4>(d, col, scratch),
+                    (2, 5) => self.solve_one::<2, 5>(d, col, scratch),
+                    (3, 6) => self.solve_one::<3, 6>(d, col, scratch),
+                    (3, 7) => self.solve_one::<3, 7>(d, col, scratch),
+                    (4, 8) => self.solve_one::<4, 8>(d, col, scratch),
+                    (4, 9) => self.solve_one::<4, 9>(d, col, scratch),
+                    _ => self.solve_one::<0, 0>(d, col, scratch),
+                }
             }
         }
     }
 
-    fn solve_one(&self, d: Dims, x: &mut [f64], scratch: &mut [f64]) {
+    /// One solve `J x = b`; `N`, `W` are `n` and `2n + k` fixed at compile time (`0`: those of
+    /// `d` at run time).
+    fn solve_one<const N: usize, const W: usize>(
+        &self,
+        d: Dims,
+        x: &mut [f64],
+        scratch: &mut [f64],
+    ) {
         let Dims { n, k, m } = d;
+        let n = if N > 0 { N } else { n };
         let nl = self.left.len();
         let nb = n + k;
-        let w = 2 * n + k;
+        let w = if W > 0 { W } else { 2 * n + k };
         let rows = nl + n;
         let bsize = rows * w;
         let off = (m - 1) * n;
