@@ -280,8 +280,13 @@ impl Collocation {
             } else {
                 &mut fbuf[..n]
             };
-            self.engine
-                .jacobian(&rf, &self.input, w, out, &mut self.jn[i * n * w..(i + 1) * n * w]);
+            self.engine.jacobian(
+                &rf,
+                &self.input,
+                w,
+                out,
+                &mut self.jn[i * n * w..(i + 1) * n * w],
+            );
         }
         if values {
             if let Err(e) = check_finite(&self.f, n, 1, |i| self.x[i], "right-hand side") {
@@ -305,8 +310,13 @@ impl Collocation {
             } else {
                 &mut fbuf[..n]
             };
-            self.engine
-                .jacobian(&rf, &self.input, w, out, &mut self.jm[i * n * w..(i + 1) * n * w]);
+            self.engine.jacobian(
+                &rf,
+                &self.input,
+                w,
+                out,
+                &mut self.jm[i * n * w..(i + 1) * n * w],
+            );
         }
         self.jac_evals += (2 * m - 1) * w.div_ceil(8).max(1);
         if values {
