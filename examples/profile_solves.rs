@@ -9,7 +9,6 @@ use diffbvp::{solve, Guess, Solution, SolveOptions};
 use std::hint::black_box;
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 use common::{Bratu, CoupledTroesch, Shock};
 

@@ -261,7 +261,7 @@ pub(crate) fn resample(xs: &[f64], ys: &[f64], fs: &[f64], n: usize, new_x: &[f6
     let last = xs.len().saturating_sub(2);
     let mut i = 0;
     for (j, &x) in new_x.iter().enumerate() {
-        if xs.len() < 2 || !(x >= xs[i]) {
+        if xs.len() < 2 || x.is_nan() || x < xs[i] {
             i = interval_of(xs, x);
         } else {
             while i < last && x >= xs[i + 1] {
