@@ -109,12 +109,19 @@ impl Collocation {
     /// the node values `y` and the node slopes in `f`.
     fn midpoint_states(&mut self, y: &[f64]) {
         let (n, m) = (self.n, self.m());
-        for i in 0..m - 1 {
-            let h = self.h[i];
+        let len = (m - 1) * n;
+        let ys = y[..len].chunks_exact(n).zip(y[n..len + n].chunks_exact(n));
+        let fs = self.f[..len]
+            .chunks_exact(n)
+            .zip(self.f[n..len + n].chunks_exact(n));
+        for (((ym, &h), (yi, yj)), (fi, fj)) in self.y_mid[..len]
+            .chunks_exact_mut(n)
+            .zip(&self.h)
+            .zip(ys)
+            .zip(fs)
+        {
             for c in 0..n {
-                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
-                let (fi, fj) = (self.f[i * n + c], self.f[(i + 1) * n + c]);
-                self.y_mid[i * n + c] = 0.5 * (yi + yj) - 0.125 * h * (fj - fi);
+                ym[c] = 0.5 * (yi[c] + yj[c]) - 0.125 * h * (fj[c] - fi[c]);
             }
         }
     }
@@ -168,15 +175,35 @@ impl Collocation {
             |i| self.x[i] + 0.5 * self.h[i],
             "right-hand side",
         )?;
-        for i in 0..m - 1 {
-            let h = self.h[i];
+        self.finish_residual(problem, y, p)
+    }
+
+    /// The residual vector from the node and midpoint values of `f` in place, and the boundary
+    /// residuals.
+    fn finish_residual<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+    ) -> Result<(), BvpError> {
+        let (n, m) = (self.n, self.m());
+        let len = (m - 1) * n;
+        let ys = y[..len].chunks_exact(n).zip(y[n..len + n].chunks_exact(n));
+        let fs = self.f[..len]
+            .chunks_exact(n)
+            .zip(self.f[n..len + n].chunks_exact(n));
+        for ((((r, &h), fm), (yi, yj)), (fi, fj)) in self.res[..len]
+            .chunks_exact_mut(n)
+            .zip(&self.h)
+            .zip(self.f_mid[..len].chunks_exact(n))
+            .zip(ys)
+            .zip(fs)
+        {
             for c in 0..n {
-                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
-                let (fi, fj) = (self.f[i * n + c], self.f[(i + 1) * n + c]);
-                self.res[i * n + c] = yj - yi - h / 6.0 * (fi + 4.0 * self.f_mid[i * n + c] + fj);
+                r[c] = yj[c] - yi[c] - h / 6.0 * (fi[c] + 4.0 * fm[c] + fj[c]);
             }
         }
-        let off = (m - 1) * n;
+        let off = len;
         let (res_col, res_bc) = self.res.split_at_mut(off);
         let _ = res_col;
         problem.bc(&y[..n], &y[(m - 1) * n..], p, res_bc);
@@ -192,6 +219,20 @@ impl Collocation {
         Ok(())
     }
 
+    /// [`residual`](Self::residual) and [`jacobians`](Self::jacobians) at `y` in one pass over
+    /// the nodes and midpoints: the values of `f` are the real parts of the dual-number
+    /// evaluations (no separate `f64` evaluation). For an iterate whose Jacobian will be needed.
+    pub(crate) fn residual_and_jacobians<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        seeded: usize,
+    ) -> Result<(), BvpError> {
+        self.dual_pass(problem, y, p, seeded, true)?;
+        self.finish_residual(problem, y, p)
+    }
+
     /// Evaluates the node, midpoint and boundary Jacobians with respect to `y` and the first
     /// `seeded` parameters. Requires a preceding [`residual`](Self::residual) at the same `y`
     /// (the midpoint states are reused).
@@ -201,6 +242,20 @@ impl Collocation {
         y: &[f64],
         p: &[f64],
         seeded: usize,
+    ) -> Result<(), BvpError> {
+        self.dual_pass(problem, y, p, seeded, false)
+    }
+
+    /// The dual-number pass of [`jacobians`](Self::jacobians); with `values`, the real parts
+    /// also set the node slopes `f`, the midpoint states and `f_mid` (checked finite, as
+    /// [`residual`](Self::residual) checks them).
+    fn dual_pass<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        seeded: usize,
+        values: bool,
     ) -> Result<(), BvpError> {
         let (n, m) = (self.n, self.m());
         let w = n + seeded;
@@ -220,13 +275,25 @@ impl Collocation {
                 x: self.x[i],
                 n,
             };
+            let out = if values {
+                &mut self.f[i * n..(i + 1) * n]
+            } else {
+                &mut fbuf[..n]
+            };
             self.engine.jacobian(
                 &rf,
                 &self.input,
                 w,
-                &mut fbuf[..n],
+                out,
                 &mut self.jn[i * n * w..(i + 1) * n * w],
             );
+        }
+        if values {
+            if let Err(e) = check_finite(&self.f, n, 1, |i| self.x[i], "right-hand side") {
+                self.fbuf = fbuf;
+                return Err(e);
+            }
+            self.midpoint_states(y);
         }
         for i in 0..m - 1 {
             self.input.clear();
@@ -238,15 +305,32 @@ impl Collocation {
                 x: self.x[i] + 0.5 * self.h[i],
                 n,
             };
+            let out = if values {
+                &mut self.f_mid[i * n..(i + 1) * n]
+            } else {
+                &mut fbuf[..n]
+            };
             self.engine.jacobian(
                 &rf,
                 &self.input,
                 w,
-                &mut fbuf[..n],
+                out,
                 &mut self.jm[i * n * w..(i + 1) * n * w],
             );
         }
         self.jac_evals += (2 * m - 1) * w.div_ceil(8).max(1);
+        if values {
+            if let Err(e) = check_finite(
+                &self.f_mid,
+                n,
+                1,
+                |i| self.x[i] + 0.5 * self.h[i],
+                "right-hand side",
+            ) {
+                self.fbuf = fbuf;
+                return Err(e);
+            }
+        }
         check_finite(&self.jn, n * w, w, |i| self.x[i], "Jacobian")?;
         check_finite(
             &self.jm,
@@ -283,6 +367,52 @@ impl Collocation {
     /// The `n × n` blocks `A_i = ∂r_i/∂y_i` and `B_i = ∂r_i/∂y_{i+1}` side by side: row `r`
     /// of `[A_i B_i]` is written to `out[r ld..r ld + 2n]` (`ld >= 2n`).
     pub(crate) fn interval_rows(&self, i: usize, out: &mut [f64], ld: usize) {
+        // small systems with the sizes known at compile time (the same operations in the same
+        // order: bit-identical to the general loop)
+        match self.n {
+            1 => self.interval_rows_fixed::<1>(i, out, ld),
+            2 => self.interval_rows_fixed::<2>(i, out, ld),
+            3 => self.interval_rows_fixed::<3>(i, out, ld),
+            4 => self.interval_rows_fixed::<4>(i, out, ld),
+            5 => self.interval_rows_fixed::<5>(i, out, ld),
+            6 => self.interval_rows_fixed::<6>(i, out, ld),
+            _ => self.interval_rows_general(i, out, ld),
+        }
+    }
+
+    /// [`interval_rows`](Self::interval_rows) for `n = N`.
+    fn interval_rows_fixed<const N: usize>(&self, i: usize, out: &mut [f64], ld: usize) {
+        let w = N + self.seeded_params;
+        let h = self.h[i];
+        let block = |j: &[f64]| -> [[f64; N]; N] {
+            std::array::from_fn(|r| std::array::from_fn(|c| j[r * w + c]))
+        };
+        let ji = block(&self.jn[i * N * w..(i + 1) * N * w]);
+        let jj = block(&self.jn[(i + 1) * N * w..(i + 2) * N * w]);
+        let jm = block(&self.jm[i * N * w..(i + 1) * N * w]);
+        for r in 0..N {
+            let mut sa = [0.0; N];
+            let mut sb = [0.0; N];
+            for l in 0..N {
+                let jml = jm[r][l];
+                for c in 0..N {
+                    sa[c] += jml * ji[l][c];
+                    sb[c] += jml * jj[l][c];
+                }
+            }
+            let (oa, ob) = out[r * ld..r * ld + 2 * N].split_at_mut(N);
+            for c in 0..N {
+                let d = if r == c { 1.0 } else { 0.0 };
+                let m_a = 2.0 * jm[r][c] + 0.5 * h * sa[c];
+                let m_b = 2.0 * jm[r][c] - 0.5 * h * sb[c];
+                oa[c] = -d - h / 6.0 * (ji[r][c] + m_a);
+                ob[c] = d - h / 6.0 * (jj[r][c] + m_b);
+            }
+        }
+    }
+
+    /// [`interval_rows`](Self::interval_rows) for any `n`.
+    fn interval_rows_general(&self, i: usize, out: &mut [f64], ld: usize) {
         let n = self.n;
         let w = n + self.seeded_params;
         let h = self.h[i];

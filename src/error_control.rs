@@ -29,6 +29,9 @@ pub(crate) fn rms_residuals<P: Bvp>(
     let (d1, rest) = rest.split_at_mut(n);
     let (f1, _) = rest.split_at_mut(n);
     let off = 0.5 * (3.0f64 / 7.0).sqrt();
+    // the Hermite weights at the two quadrature points for h = 1 (those of `hermite_weights`,
+    // which scales them by h and 1/h the same way)
+    let weights = [0.5 - off, 0.5 + off].map(|t| (t, hermite_weights(t, 1.0)));
     for i in 0..m - 1 {
         let h = col.h[i];
         let mut r_mid = 0.0;
@@ -38,14 +41,15 @@ pub(crate) fn rms_residuals<P: Bvp>(
             let s = 1.5 * r / h / (sc + fm.abs());
             r_mid += s * s;
         }
+        let (yi, yj) = (&y[i * n..(i + 1) * n], &y[(i + 1) * n..(i + 2) * n]);
+        let (fi, fj) = (&col.f[i * n..(i + 1) * n], &col.f[(i + 1) * n..(i + 2) * n]);
         let mut r_12 = 0.0;
-        for t in [0.5 - off, 0.5 + off] {
-            let (v, d) = hermite_weights(t, h);
+        for &(t, (v1, d1w)) in &weights {
+            let v = [v1[0], h * v1[1], v1[2], h * v1[3]];
+            let d = [d1w[0] / h, d1w[1], d1w[2] / h, d1w[3]];
             for c in 0..n {
-                let (yi, yj) = (y[i * n + c], y[(i + 1) * n + c]);
-                let (fi, fj) = (col.f[i * n + c], col.f[(i + 1) * n + c]);
-                s1[c] = v[0] * yi + v[1] * fi + v[2] * yj + v[3] * fj;
-                d1[c] = d[0] * yi + d[1] * fi + d[2] * yj + d[3] * fj;
+                s1[c] = v[0] * yi[c] + v[1] * fi[c] + v[2] * yj[c] + v[3] * fj[c];
+                d1[c] = d[0] * yi[c] + d[1] * fi[c] + d[2] * yj[c] + d[3] * fj[c];
             }
             problem.rhs(col.x[i] + t * h, s1, p, f1);
             for ((d, f), sc) in d1.iter().zip(f1.iter()).zip(scale) {

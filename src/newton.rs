@@ -27,6 +27,17 @@ pub(crate) struct NewtonSettings {
     pub verbose: u8,
 }
 
+/// How the start of a Newton run is evaluated.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Start {
+    /// The residual alone: a start that may already pass the termination test (a warm start,
+    /// a coarsened mesh) costs no Jacobian.
+    Lazy,
+    /// The residual with the Jacobian in one dual-number pass: for a start that is unlikely to
+    /// pass (values interpolated onto a refined mesh), whose Jacobian the first step needs.
+    WithJacobian,
+}
+
 /// What a Newton run achieved.
 pub(crate) struct NewtonReport {
     pub iterations: usize,
@@ -52,6 +63,7 @@ pub(crate) fn newton<P: Bvp>(
     settings: &NewtonSettings,
     work: &mut NewtonWork,
     initial: Option<&Factorization>,
+    start: Start,
 ) -> Result<NewtonReport, BvpError> {
     let (n, k, m) = (col.n, col.k, col.m());
     let size = m * n + k;
@@ -63,7 +75,13 @@ pub(crate) fn newton<P: Bvp>(
     work.y_new.resize(m * n, 0.0);
     work.p_new.resize(p.len(), 0.0);
 
-    col.residual(problem, y, p)?;
+    // the Jacobian of the start is only evaluated with it when it will be factored
+    let mut fresh_jacobian = start == Start::WithJacobian && borrowed.is_none();
+    if fresh_jacobian {
+        col.residual_and_jacobians(problem, y, p, k)?;
+    } else {
+        col.residual(problem, y, p)?;
+    }
     // A start that already passes the termination test (a warm start at the parameters it was
     // solved for, or values interpolated onto a refined mesh that already satisfy the
     // collocation equations this well) needs no Newton step: no Jacobian, no factorisation. Not
@@ -95,7 +113,10 @@ pub(crate) fn newton<P: Bvp>(
             }
         }
         if recompute {
-            col.jacobians(problem, y, p, k)?;
+            if !fresh_jacobian {
+                col.jacobians(problem, y, p, k)?;
+            }
+            fresh_jacobian = false;
             lin.factor(col)?;
             njev += 1;
             work.step.copy_from_slice(&col.res);

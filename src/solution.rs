@@ -256,10 +256,26 @@ pub(crate) fn hermite(
 /// Interpolates node values `ys` (with slopes `fs`) on mesh `xs` onto `new_x`.
 pub(crate) fn resample(xs: &[f64], ys: &[f64], fs: &[f64], n: usize, new_x: &[f64]) -> Vec<f64> {
     let mut out = vec![0.0; new_x.len() * n];
-    let mut yp = vec![0.0; n];
+    // sorted new nodes: the interval search continues from the previous one (what
+    // `interval_of` finds, without a binary search per node)
+    let last = xs.len().saturating_sub(2);
+    let mut i = 0;
     for (j, &x) in new_x.iter().enumerate() {
-        let i = interval_of(xs, x);
-        hermite(xs, ys, fs, n, i, x, &mut out[j * n..(j + 1) * n], &mut yp);
+        if xs.len() < 2 || x.is_nan() || x < xs[i] {
+            i = interval_of(xs, x);
+        } else {
+            while i < last && x >= xs[i + 1] {
+                i += 1;
+            }
+        }
+        // the values of `hermite` (its slopes are not needed here)
+        let h = xs[i + 1] - xs[i];
+        let (v, _) = hermite_weights((x - xs[i]) / h, h);
+        let (yi, yj) = (&ys[i * n..(i + 1) * n], &ys[(i + 1) * n..(i + 2) * n]);
+        let (fi, fj) = (&fs[i * n..(i + 1) * n], &fs[(i + 1) * n..(i + 2) * n]);
+        for (c, o) in out[j * n..(j + 1) * n].iter_mut().enumerate() {
+            *o = v[0] * yi[c] + v[1] * fi[c] + v[2] * yj[c] + v[3] * fj[c];
+        }
     }
     out
 }

@@ -8,7 +8,7 @@ use crate::error_control::rms_residuals;
 use crate::linear::{Factorization, LinearSolverKind, LinearSystem, Pattern};
 use crate::linearization::Linearization;
 use crate::mesh;
-use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork};
+use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork, Start};
 use crate::problem::Bvp;
 use crate::solution::{resample, Solution, SolveStats};
 use std::cell::RefCell;
@@ -529,6 +529,9 @@ impl<'a, P: Bvp> Solver<'a, P> {
         let mesh_opts = &opts.mesh;
         let mut coarsenings_left = if opts.coarsen && opts.adapt { 3 } else { 0 };
         let mut iteration = 0;
+        // values interpolated onto a refined mesh rarely pass the termination test as they
+        // are: their Jacobian is evaluated with their residual (one pass instead of two)
+        let mut start = Start::Lazy;
         loop {
             iteration += 1;
             let m = x.len();
@@ -546,6 +549,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 &settings,
                 &mut self.ws.newton_work,
                 initial.take(),
+                start,
             );
             let report = match report {
                 Ok(r) => r,
@@ -621,6 +625,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 y = resample(&x, &y, &self.ws.col.f, n, &new_x);
                 x = new_x;
                 stats.mesh_refinements += 1;
+                start = Start::WithJacobian;
             } else if max_bc_res <= bc_tol {
                 // coarsen only if the coarser mesh can still be solved and checked: the solution
                 // returned must belong to the mesh it was computed on
@@ -633,6 +638,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                         x = new_x;
                         stats.mesh_refinements += 1;
                         stats.mesh_coarsenings += 1;
+                        start = Start::Lazy;
                         continue;
                     }
                 }

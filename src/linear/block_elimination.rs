@@ -123,7 +123,8 @@ fn swap_rows(a: &mut [f64], w: usize, r1: usize, r2: usize) {
 }
 
 /// Partial-pivoting elimination of columns `0..ncols` of the `rows × w` row-major block `a`.
-/// Returns the first column without a nonzero pivot as `Err(column)`.
+/// Returns the first column without a nonzero pivot as `Err(column)`. Small widths run with
+/// the width known at compile time (the same operations in the same order).
 fn eliminate(
     a: &mut [f64],
     rows: usize,
@@ -131,6 +132,29 @@ fn eliminate(
     ncols: usize,
     piv: &mut [usize],
 ) -> Result<(), usize> {
+    match w {
+        2 => eliminate_w::<2>(a, rows, w, ncols, piv),
+        3 => eliminate_w::<3>(a, rows, w, ncols, piv),
+        4 => eliminate_w::<4>(a, rows, w, ncols, piv),
+        5 => eliminate_w::<5>(a, rows, w, ncols, piv),
+        6 => eliminate_w::<6>(a, rows, w, ncols, piv),
+        7 => eliminate_w::<7>(a, rows, w, ncols, piv),
+        8 => eliminate_w::<8>(a, rows, w, ncols, piv),
+        9 => eliminate_w::<9>(a, rows, w, ncols, piv),
+        10 => eliminate_w::<10>(a, rows, w, ncols, piv),
+        _ => eliminate_w::<0>(a, rows, w, ncols, piv),
+    }
+}
+
+/// [`eliminate`] with the width `W` fixed at compile time (`W = 0`: the run-time `w_rt`).
+fn eliminate_w<const W: usize>(
+    a: &mut [f64],
+    rows: usize,
+    w_rt: usize,
+    ncols: usize,
+    piv: &mut [usize],
+) -> Result<(), usize> {
+    let w = if W > 0 { W } else { w_rt };
     for j in 0..ncols {
         let mut p = j;
         let mut best = a[j * w + j].abs();
@@ -147,13 +171,13 @@ fn eliminate(
         piv[j] = p;
         swap_rows(a, w, j, p);
         let (top, below) = a.split_at_mut((j + 1) * w);
-        let prow = &top[j * w..];
+        let prow = &top[j * w..(j + 1) * w];
         let inv = 1.0 / prow[j];
         for row in below.chunks_exact_mut(w).take(rows - j - 1) {
             let l = row[j] * inv;
             row[j] = l;
             if l != 0.0 {
-                for (x, u) in row[j + 1..].iter_mut().zip(&prow[j + 1..w]) {
+                for (x, u) in row[j + 1..].iter_mut().zip(&prow[j + 1..]) {
                     *x -= l * u;
                 }
             }
@@ -290,16 +314,35 @@ impl BlockLu {
             if transpose {
                 self.solve_transpose_one(d, col, scratch);
             } else {
-                self.solve_one(d, col, scratch);
+                // small systems with the sizes known at compile time (the same operations)
+                match (d.n, 2 * d.n + d.k) {
+                    (1, 2) => self.solve_one::<1, 2>(d, col, scratch),
+                    (1, 3) => self.solve_one::<1, 3>(d, col, scratch),
+                    (2, 4) => self.solve_one::<2, 4>(d, col, scratch),
+                    (2, 5) => self.solve_one::<2, 5>(d, col, scratch),
+                    (3, 6) => self.solve_one::<3, 6>(d, col, scratch),
+                    (3, 7) => self.solve_one::<3, 7>(d, col, scratch),
+                    (4, 8) => self.solve_one::<4, 8>(d, col, scratch),
+                    (4, 9) => self.solve_one::<4, 9>(d, col, scratch),
+                    _ => self.solve_one::<0, 0>(d, col, scratch),
+                }
             }
         }
     }
 
-    fn solve_one(&self, d: Dims, x: &mut [f64], scratch: &mut [f64]) {
+    /// One solve `J x = b`; `N`, `W` are `n` and `2n + k` fixed at compile time (`0`: those of
+    /// `d` at run time).
+    fn solve_one<const N: usize, const W: usize>(
+        &self,
+        d: Dims,
+        x: &mut [f64],
+        scratch: &mut [f64],
+    ) {
         let Dims { n, k, m } = d;
+        let n = if N > 0 { N } else { n };
         let nl = self.left.len();
         let nb = n + k;
-        let w = 2 * n + k;
+        let w = if W > 0 { W } else { 2 * n + k };
         let rows = nl + n;
         let bsize = rows * w;
         let off = (m - 1) * n;

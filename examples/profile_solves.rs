@@ -1,0 +1,96 @@
+//! Repeats one benchmark solve for instruction counting (`perf stat -e instructions` or
+//! callgrind): `cargo run --release --example profile_solves -- shock|troesch|bratu|fiber [reps]`.
+//! Prints the nodes, meshes, Newton iterations and factorisations of one solve.
+
+use diffbvp::fiber::setup::{Air, Experiment, Material};
+use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+use diffbvp::mesh::linspace;
+use diffbvp::{solve, Guess, Solution, SolveOptions};
+use std::hint::black_box;
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::{Bratu, CoupledTroesch, Shock};
+
+fn stats(name: &str, s: &Solution) {
+    let st = &s.stats;
+    // a fingerprint of the values (changes with any bit of the solution)
+    let bits = s.y.iter().fold(0u64, |a, v| a.rotate_left(5) ^ v.to_bits());
+    println!("{name}: fingerprint {bits:016x}");
+    println!(
+        "{name}: {} nodes, {} meshes, {} Newton iterations, {} factorisations, {} rhs + {} dual evaluations",
+        s.nodes(),
+        st.mesh_refinements + 1,
+        st.newton_iterations,
+        st.jacobian_factorizations,
+        st.rhs_evaluations,
+        st.rhs_dual_evaluations
+    );
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let which = args.get(1).map_or("shock", String::as_str);
+    let reps: usize = args.get(2).map_or(Ok(1), |s| s.parse())?;
+    let mut opts = SolveOptions::with_tol(1e-6);
+    // PROFILE_VERBOSE=1 or 2: the solver's progress lines (stderr)
+    // PROFILE_MESH="max_pieces,max_growth,smooth,target": other mesh options (experiments)
+    if let Ok(v) = std::env::var("PROFILE_MESH") {
+        let f: Vec<&str> = v.split(',').collect();
+        if f.len() == 4 {
+            opts.mesh.max_pieces = f[0].parse()?;
+            opts.mesh.max_growth = f[1].parse()?;
+            opts.mesh.smooth = f[2] == "1";
+            opts.mesh.target = f[3].parse()?;
+        }
+    }
+    opts.verbose = std::env::var("PROFILE_VERBOSE").map_or(Ok(0), |v| v.parse())?;
+    match which {
+        "shock" => {
+            let g = Guess::constant(linspace(-1.0, 1.0, 5), &[0.0, 0.0]);
+            let p = Shock { eps: 1e-3 };
+            stats(which, &solve(&p, &[], &g, &opts)?);
+            for _ in 0..reps {
+                black_box(solve(&p, &[], black_box(&g), &opts)?);
+            }
+        }
+        "troesch" => {
+            let g = Guess::from_fn(linspace(0.0, 1.0, 11), 4, |x, y| {
+                y[0] = x;
+                y[1] = 1.0;
+                y[2] = 0.0;
+                y[3] = 0.0;
+            });
+            stats(which, &solve(&CoupledTroesch, &[5.0, 1.0], &g, &opts)?);
+            for _ in 0..reps {
+                black_box(solve(&CoupledTroesch, &[5.0, 1.0], black_box(&g), &opts)?);
+            }
+        }
+        "bratu" => {
+            let g = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
+            let p = Bratu { k: 1.0 };
+            stats(which, &solve(&p, &[], &g, &opts)?);
+            for _ in 0..reps {
+                black_box(solve(&p, &[], black_box(&g), &opts)?);
+            }
+        }
+        "fiber" => {
+            let exp = Experiment::pmma7n_v0p53_p2();
+            let m = FiberModel::new(
+                &Material::pmma7n(),
+                &Air::paper(),
+                &exp,
+                CarreauLike::new(),
+                Physics::paper(),
+            )?;
+            let fopts = SimulateOptions::with_tol(1e-6);
+            let s = simulate(&m, &[0.8, 11.71], &fopts)?;
+            stats(which, &s.solution);
+            for _ in 0..reps {
+                black_box(simulate(&m, black_box(&[0.8, 11.71]), &fopts)?);
+            }
+        }
+        other => return Err(format!("unknown problem {other}").into()),
+    }
+    Ok(())
+}
