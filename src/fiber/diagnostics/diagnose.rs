@@ -31,6 +31,7 @@
 //! 5. **Indistinguishable** candidates: cosine of their orthogonalised signatures above
 //!    [`DiagnoseOptions::indistinguishable_cosine`] (0.9) in absolute value.
 
+use super::detection::{detection_limits, DetectionContext, DetectionLimits};
 use super::scan::{
     physical, refine, scan_profile, search_range, shape_variants, GridStart, Profile, ProfileScan,
     Refit, ScanOptions, ShapeParameter,
@@ -41,8 +42,8 @@ use crate::fiber::noise_model::Outlier;
 use crate::fiber::rheometer::estimator::RelativeResidual;
 use crate::fiber::rheometer::report::bound_side;
 use crate::fiber::rheometer::{
-    AtBound, Estimator, FitReport, FitStart, Identification, IdentifyOptions, Layout, Rheometer,
-    RheometerError,
+    AtBound, Estimator, FitReport, FitStart, Identification, IdentifyOptions, Layout,
+    ParameterShift, Rheometer, RheometerError,
 };
 use crate::fiber::setup::ExperimentSet;
 use crate::fiber::FiberError;
@@ -282,6 +283,12 @@ pub struct Diagnosis {
     pub indistinguishable: Vec<Indistinguishable>,
     /// The most likely missing effect, if one earns its place.
     pub most_likely_missing: Option<String>,
+    /// What these data could have missed: per candidate, the strength named with 50 % and
+    /// 95 % probability (linearised at strength 0) and the shift of `(n, κ)` an undetected
+    /// effect of the 95 % strength would cause ([`detection`](super::detection)). Empty in
+    /// diagnoses written before it existed.
+    #[serde(default)]
+    pub detection: DetectionLimits,
     /// Wall time \[s\].
     pub wall_time_s: f64,
 }
@@ -565,6 +572,38 @@ pub fn diagnose(
             }
         })
         .collect();
+    // detection limits (linearised at strength 0) and the bias an undetected effect causes
+    let detection = {
+        let shift = ParameterShift::new(&x, n_res, q)?;
+        let dtheta: Vec<Vec<f64>> = cols
+            .iter()
+            .map(|c| {
+                shift
+                    .derivative(&nalgebra::DVector::from_column_slice(c))
+                    .iter()
+                    .copied()
+                    .collect()
+            })
+            .collect();
+        let col = |name: &str| layout.names.iter().position(|s| s == name);
+        let extra: Vec<usize> = results.iter().map(|c| c.extra_parameters).collect();
+        detection_limits(
+            &cands,
+            &extra,
+            &lin,
+            &dtheta,
+            (col("n"), col("kappa")),
+            &DetectionContext {
+                sigma: noise_level / sigma,
+                noise_level,
+                cost_before,
+                measurements: n_res,
+                threshold: options.earn_threshold,
+                stderr_n: base_report.stderr_n,
+                stderr_kappa: base_report.stderr_kappa,
+            },
+        )
+    };
     let mut order: Vec<usize> = (0..cands.len()).collect();
     order.sort_by(|&a, &b| lin[b].score.total_cmp(&lin[a].score));
 
@@ -808,6 +847,7 @@ pub fn diagnose(
             candidates,
             indistinguishable: indist,
             most_likely_missing: most_likely,
+            detection,
             wall_time_s: t0.elapsed().as_secs_f64(),
         },
         residuals_before: before,
