@@ -302,7 +302,13 @@ impl DetectionLimits {
             })
             .collect();
         if !parts.is_empty() {
-            s.push_str(&format!(" {}.", parts.join("; ")));
+            let joined = parts.join("; ");
+            let mut chars = joined.chars();
+            let capital: String = chars
+                .next()
+                .map(|c| c.to_uppercase().chain(chars).collect())
+                .unwrap_or_default();
+            s.push_str(&format!(" {capital}."));
         }
         Some(s)
     }
