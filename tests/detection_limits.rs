@@ -263,15 +263,17 @@ fn the_predicted_bias_of_an_undetected_fault_is_the_fits() {
     }
 }
 
-/// The 95 % claim over five seeds: a fault at exactly the control's `s95` is named in at
-/// least four (probability 0.977 if the claim holds).
+/// The 95 % claim over five seeds: a fault at exactly the control's `s95` is detected (its own
+/// refit earns its place) in at least four (probability 0.977 if the claim holds). How often it
+/// is also named first (it may lose to a rival listed as indistinguishable) is printed.
 #[test]
 #[ignore = "slow: ten diagnoses (about 3 min on 2 cores)"]
-fn faults_at_s95_are_named_over_seeds() {
+fn faults_at_s95_are_detected_over_seeds() {
     let c = control();
     let mf = limit(c, "mass_flow_scale").s95;
     let go = limit(c, "gauge_offset").s95;
     let seeds = [301u64, 302, 303, 304, 305];
+    let threshold = DiagnoseOptions::default().earn_threshold;
     for (label, make) in [
         (
             "mass_flow_scale",
@@ -282,14 +284,17 @@ fn faults_at_s95_are_named_over_seeds() {
             Box::new(|seed| gauge_offset(go * 1e-6, seed)),
         ),
     ] {
-        let named = seeds
-            .iter()
-            .filter(|&&seed| run(&make(seed)).most_likely_missing.as_deref() == Some(label))
-            .count();
+        let (mut detected, mut first) = (0, 0);
+        for &seed in &seeds {
+            let d = run(&make(seed));
+            let c = d.candidates.iter().find(|c| c.effect == label).unwrap();
+            detected += usize::from(earns_its_place(c, threshold));
+            first += usize::from(d.most_likely_missing.as_deref() == Some(label));
+        }
         println!(
-            "SEEDS | {label} at s95: named in {named} of {}",
+            "SEEDS | {label} at s95: detected in {detected} of {}, named first in {first}",
             seeds.len()
         );
-        assert!(named >= 4, "{label} at s95 named in {named} of 5");
+        assert!(detected >= 4, "{label} at s95 detected in {detected} of 5");
     }
 }

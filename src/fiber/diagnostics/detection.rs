@@ -1,4 +1,4 @@
-//! Detection limits: how strong each candidate would have to be for `diagnose` to name it, and
+//! Detection limits: how strong each candidate would have to be for `diagnose` to detect it, and
 //! how far an effect just below that limit would move the fitted `(n, κ)`. A clean bill of
 //! health must be earned: where the data cannot identify a process condition or an instrument
 //! error, the report says how much it could shift the result.
@@ -14,16 +14,20 @@
 //! λ(s) = s² ‖c⊥‖² / σ².
 //! ```
 //!
-//! `diagnose` names it when `ΔBIC = N ln(J_after/J_before) + Δk ln N` falls below the earn
-//! threshold `t` (−10), i.e. when the removed cost exceeds
+//! The candidate earns its place (is *detected*) when `ΔBIC = N ln(J_after/J_before) + Δk ln N`
+//! falls below the earn threshold `t` (−10), i.e. when the removed cost exceeds
 //! `ΔJ* = J_before (1 − e^{(t − Δk ln N)/N})`. In χ² units `λ* = ΔJ*/σ²`, which for residuals
 //! that are noise (`J_before ≈ N σ²`) and large `N` is `|t| + Δk ln N`. The candidate is then
-//! named
+//! detected
 //!
 //! * **on average** (probability ≈ 50 %) when `λ = λ*`: `s50 = √λ* σ/‖c⊥‖`;
 //! * **with 95 % probability** when `√λ ≥ √λ* + 1.645`: `s95 = (√λ* + 1.645) σ/‖c⊥‖`. This is
 //!   an approximation: `χ²₁(λ) = (√λ + Z)²` with `Z ~ N(0, 1)` exceeds `λ*` when
 //!   `Z > √λ* − √λ` (probability 95 % at the limit) or `Z < −√λ* − √λ` (negligible here).
+//!
+//! Being *named* as the most likely missing effect also needs the candidate to beat its rivals:
+//! one whose signature is nearly parallel to another's (listed as indistinguishable) may be
+//! detected and still lose the ranking to it.
 //!
 //! Both signs of `s` are symmetric in the linearisation. The limits are a guide for the process
 //! and instrument candidates (whose effect on the diameters is close to linear over their
@@ -55,13 +59,13 @@ pub struct DetectionLimit {
     pub category: String,
     /// Extra parameters `Δk` the candidate costs in `ΔBIC`.
     pub extra_parameters: usize,
-    /// `λ*`: the non-centrality (χ² units) at which the candidate is named on average.
+    /// `λ*`: the non-centrality (χ² units) at which the candidate is detected on average.
     pub required_chi2: f64,
     /// `‖c⊥‖/σ`: the square root of `λ` per unit strength \[1/unit\].
     pub chi_per_unit: f64,
-    /// Strength named with probability ≈ 50 % (magnitude; either sign) \[unit\].
+    /// Strength detected with probability ≈ 50 % (magnitude; either sign) \[unit\].
     pub s50: f64,
-    /// Strength named with probability ≈ 95 % (magnitude; either sign) \[unit\].
+    /// Strength detected with probability ≈ 95 % (magnitude; either sign) \[unit\].
     pub s95: f64,
     /// Bias of the fitted `n` when the data carry strength `+1 unit` the model leaves out
     /// \[1/unit\] (`null` where `n` is not fitted).
@@ -126,7 +130,7 @@ pub fn required_reduction(cost_before: f64, n: usize, threshold: f64, extra: usi
 }
 
 /// `(s50, s95)` for a signature `‖c⊥‖ = norm` per unit strength, noise `sigma` (both in the
-/// residuals' units) and the non-centrality `lambda_star` at which the candidate is named on
+/// residuals' units) and the non-centrality `lambda_star` at which the candidate is detected on
 /// average (infinite where the signature vanishes).
 pub fn strength_limits(norm: f64, sigma: f64, lambda_star: f64) -> (f64, f64) {
     if !(norm > 0.0 && norm.is_finite()) {
@@ -220,7 +224,7 @@ impl DetectionLimits {
             return String::new();
         }
         let mut s = format!(
-            "[[What these data could have missed: detection limits (noise {:.3} %, N = {}, named \
+            "[[What these data could have missed: detection limits (noise {:.3} %, N = {}, detected \
              when delta BIC < {}; linearised at strength 0, both signs alike; a guide for the \
              process and instrument candidates, cruder for co-flow)]]\n",
             100.0 * self.noise_level,
@@ -228,8 +232,13 @@ impl DetectionLimits {
             self.earn_threshold
         );
         s.push_str(&format!(
-            "    {:<24} {:<10} {:>12} {:>12}   {:<26} {}\n",
-            "effect", "category", "named 50 %", "named 95 %", "undetected s95 shifts n", "kappa"
+            "    {:<24} {:<10} {:>13} {:>13}   {:<26} {}\n",
+            "effect",
+            "category",
+            "detected 50 %",
+            "detected 95 %",
+            "undetected s95 shifts n",
+            "kappa"
         ));
         let shift = |v: Option<f64>, se: Option<f64>| match (v, se) {
             (Some(v), Some(se)) => format!("{:+.4} ({se:.1} se)", v),
@@ -238,7 +247,7 @@ impl DetectionLimits {
         };
         for l in &self.limits {
             s.push_str(&format!(
-                "    {:<24} {:<10} {:>12} {:>12}   {:<26} {}\n",
+                "    {:<24} {:<10} {:>13} {:>13}   {:<26} {}\n",
                 l.effect,
                 l.category,
                 l.strength_words(l.s50),
@@ -254,10 +263,11 @@ impl DetectionLimits {
             ));
         }
         s.push_str(
-            "(named 50 %/95 %: the strength diagnose names with that probability, \
-             sqrt(lambda) >= sqrt(lambda*) + 1.645 for 95 %; shifts: the bias of the fit that \
-             leaves out an effect of +s95, in units of the statistical standard error; a \
-             negative strength reverses the sign.)\n",
+            "(detected 50 %/95 %: the strength at which the candidate's own refit earns its \
+             place with that probability, sqrt(lambda) >= sqrt(lambda*) + 1.645 for 95 %; \
+             being named first also needs it to beat the rivals the data cannot tell apart \
+             from it; shifts: the bias of the fit that leaves out an effect of +s95, in units \
+             of the statistical standard error; a negative strength reverses the sign.)\n",
         );
         s
     }
@@ -380,7 +390,7 @@ mod tests {
     }
 
     #[test]
-    fn s95_is_named_with_probability_near_95_percent() {
+    fn s95_is_detected_with_probability_near_95_percent() {
         for lambda_star in [10.0, 15.45, 30.0] {
             let (s50, s95) = strength_limits(1.0, 1.0, lambda_star);
             let p95 = detection_probability(s95 * s95, lambda_star);
