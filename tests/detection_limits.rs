@@ -5,11 +5,12 @@
 //! * the control's limits say the faults the diagnosis cannot see (−4 % mass flow, a 3 µm gauge
 //!   offset: the ignored tests of `tests/diagnose_realistic.rs`) could be missed, and place the
 //!   10 K cold die between the 50 % and 95 % limits (it is named on one seed of three);
-//! * a fault generated at 1.5 × the control's `s95` is named, ranked first, its strength within
-//!   3 standard errors of the truth;
+//! * a fault generated at 1.5 × the control's `s95` is detected with its strength within 3
+//!   standard errors of the truth, and named first (the mass flow: or tied with `nusselt_scale`,
+//!   whose signature is nearly parallel);
 //! * the bias the limits predict for an undetected fault (the error budget's exact propagation)
 //!   is the bias of the user's fit on the same noise realisation;
-//! * (slow, ignored) over five seeds, a fault at `s95` is named in at least four.
+//! * (slow, ignored) over five seeds, a fault at `s95` is detected in at least four.
 //!
 //! Each run prints one `DETECTION` line (run with `--nocapture`).
 

@@ -15,10 +15,12 @@
 //! ```
 //!
 //! The candidate earns its place (is *detected*) when `ΔBIC = N ln(J_after/J_before) + Δk ln N`
-//! falls below the earn threshold `t` (−10), i.e. when the removed cost exceeds
-//! `ΔJ* = J_before (1 − e^{(t − Δk ln N)/N})`. In χ² units `λ* = ΔJ*/σ²`, which for residuals
-//! that are noise (`J_before ≈ N σ²`) and large `N` is `|t| + Δk ln N`. The candidate is then
-//! detected
+//! falls below the earn threshold `t` (−10). The effect itself raises `J_before`: with
+//! `J_before = J_rest + ΔJ` (`ΔJ` the cost along `c⊥`, which the candidate removes; `J_rest` the
+//! rest, `J_before − score` on the data at hand) the condition is
+//! `ΔJ > ΔJ* = J_rest (e^{(Δk ln N − t)/N} − 1)`, and in χ² units `λ* = ΔJ*/σ²`, which for
+//! residuals that are noise (`J_rest ≈ N σ²`) and large `N` is `|t| + Δk ln N`. The candidate is
+//! then detected
 //!
 //! * **on average** (probability ≈ 50 %) when `λ = λ*`: `s50 = √λ* σ/‖c⊥‖`;
 //! * **with 95 % probability** when `√λ ≥ √λ* + 1.645`: `s95 = (√λ* + 1.645) σ/‖c⊥‖`. This is
@@ -121,12 +123,13 @@ pub struct DetectionContext {
     pub stderr_kappa: f64,
 }
 
-/// `ΔJ*`: the cost reduction that brings `ΔBIC = N ln(J_after/J_before) + Δk ln N` down to
-/// `threshold`.
-pub fn required_reduction(cost_before: f64, n: usize, threshold: f64, extra: usize) -> f64 {
+/// `ΔJ*`: the cost a candidate must remove to bring `ΔBIC = N ln(J_after/J_before) + Δk ln N`
+/// down to `threshold`, where `J_before = cost_rest + ΔJ` (`cost_rest`: the cost the candidate
+/// does not carry).
+pub fn required_reduction(cost_rest: f64, n: usize, threshold: f64, extra: usize) -> f64 {
     let nf = n.max(1) as f64;
     let penalty = extra as f64 * nf.ln();
-    cost_before * (-((threshold - penalty) / nf).exp_m1())
+    cost_rest * ((penalty - threshold) / nf).exp_m1()
 }
 
 /// `(s50, s95)` for a signature `‖c⊥‖ = norm` per unit strength, noise `sigma` (both in the
@@ -161,8 +164,9 @@ pub fn detection_limits(
         let (Some(l), Some(&k)) = (scores.get(i), extra.get(i)) else {
             continue;
         };
-        let lambda_star = required_reduction(ctx.cost_before, ctx.measurements, ctx.threshold, k)
-            / (ctx.sigma * ctx.sigma);
+        let rest = (ctx.cost_before - l.score).max(0.0);
+        let lambda_star =
+            required_reduction(rest, ctx.measurements, ctx.threshold, k) / (ctx.sigma * ctx.sigma);
         let (s50, s95) = strength_limits(l.norm, ctx.sigma, lambda_star);
         if !s95.is_finite() || !(ctx.sigma > 0.0) {
             out.invisible.push(e.name().to_string());
@@ -375,11 +379,12 @@ mod tests {
 
     #[test]
     fn required_reduction_inverts_delta_bic() {
-        let (j, n, t) = (250.0, 234usize, -10.0);
+        let (rest, n, t) = (250.0, 234usize, -10.0);
         for k in [1usize, 2, 3] {
-            let dj = required_reduction(j, n, t, k);
+            let dj = required_reduction(rest, n, t, k);
             let nf = n as f64;
-            let bic = nf * ((j - dj) / j).ln() + k as f64 * nf.ln();
+            // J_before = rest + ΔJ*, J_after = rest
+            let bic = nf * (rest / (rest + dj)).ln() + k as f64 * nf.ln();
             assert!((bic - t).abs() < 1e-9, "ΔBIC at the limit {bic}");
             // residuals that are noise (J = N σ², σ = 1) and large N: |t| + Δk ln N
             let big = 1_000_000usize;
@@ -407,13 +412,13 @@ mod tests {
             Effect::MassFlowScale,
             Effect::StrainThinning,
         ];
-        let score = |norm: f64| LinearScore {
-            score: 0.0,
+        let score = |norm: f64, score: f64| LinearScore {
+            score,
             strength: 0.0,
             norm,
             signature: Vec::new(),
         };
-        let scores = [score(4.0), score(100.0), score(0.0)];
+        let scores = [score(4.0, 40.0), score(100.0, 40.0), score(0.0, 0.0)];
         // θ = (n, κ, take-up): dθ/ds
         let dtheta = vec![
             vec![0.001, -0.05, 0.0],
@@ -440,7 +445,8 @@ mod tests {
         assert_eq!(d.invisible, ["strain_thinning"]);
         assert_eq!(d.limits.len(), 2);
         let die = &d.limits[0];
-        let lam = required_reduction(400.0, 100, -10.0, 1) / 4.0;
+        // J_rest = J_before − the candidate's score
+        let lam = required_reduction(360.0, 100, -10.0, 1) / 4.0;
         assert!((die.required_chi2 - lam).abs() < 1e-12);
         assert!((die.s95 - (lam.sqrt() + Z95) * 2.0 / 4.0).abs() < 1e-12);
         assert_eq!(die.dkappa_per_unit, Some(0.05));

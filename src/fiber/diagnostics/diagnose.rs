@@ -574,17 +574,20 @@ pub fn diagnose(
         .collect();
     // detection limits (linearised at strength 0) and the bias an undetected effect causes
     let detection = {
-        let shift = ParameterShift::new(&x, n_res, q)?;
-        let dtheta: Vec<Vec<f64>> = cols
-            .iter()
-            .map(|c| {
-                shift
-                    .derivative(&nalgebra::DVector::from_column_slice(c))
-                    .iter()
-                    .copied()
-                    .collect()
-            })
-            .collect();
+        // without a determined fit (singular JᵀJ) the limits come without the shifts
+        let dtheta: Vec<Vec<f64>> = match ParameterShift::new(&x, n_res, q) {
+            Ok(shift) => cols
+                .iter()
+                .map(|c| {
+                    shift
+                        .derivative(&nalgebra::DVector::from_column_slice(c))
+                        .iter()
+                        .copied()
+                        .collect()
+                })
+                .collect(),
+            Err(_) => Vec::new(),
+        };
         let col = |name: &str| layout.names.iter().position(|s| s == name);
         let extra: Vec<usize> = results.iter().map(|c| c.extra_parameters).collect();
         detection_limits(
