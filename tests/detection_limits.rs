@@ -196,7 +196,7 @@ fn the_control_says_which_faults_it_could_miss() {
     assert_eq!(back.detection.limits.len(), d.detection.limits.len());
 }
 
-/// A mass-flow error of 1.5 × `s95` (−14 %) is detected; `nusselt_scale`, whose signature is
+/// A mass-flow error of 1.5 × `s95` (−14.5 %) is detected; `nusselt_scale`, whose signature is
 /// nearly parallel (cosine −0.997, listed as indistinguishable), may tie with it.
 #[test]
 fn a_mass_flow_error_of_one_and_a_half_s95_is_detected() {
@@ -206,7 +206,7 @@ fn a_mass_flow_error_of_one_and_a_half_s95_is_detected() {
 }
 
 #[test]
-#[ignore = "issue 11: detected but not separable: at 1.5 s95 (-14 % mass flow, seed 209) mass_flow_scale earns its place (dBIC -63.7) but nusselt_scale ranks first by 0.8 (signature cosine -0.997)"]
+#[ignore = "issue 11: detected but not separable: at 1.5 s95 (-14.5 % mass flow, seed 209) mass_flow_scale earns its place (dBIC -67.2) but nusselt_scale ranks first by 0.8 (signature cosine -0.997)"]
 fn a_mass_flow_error_of_one_and_a_half_s95_is_ranked_first() {
     let s95 = limit(control(), "mass_flow_scale").s95;
     let sc = mass_flow(1.0 - 1.5 * s95, 209);
@@ -268,7 +268,7 @@ fn the_predicted_bias_of_an_undetected_fault_is_the_fits() {
 /// refit earns its place) in at least four (probability 0.977 if the claim holds). How often it
 /// is also named first (it may lose to a rival listed as indistinguishable) is printed.
 #[test]
-#[ignore = "slow: ten diagnoses (about 3 min on 2 cores)"]
+#[ignore = "slow (ten diagnoses, about 2 min on 2 cores); issue 11 open: mass flow at s95 (9.6 %) detected in 5 of 5 seeds (named first in 2: radiation, nusselt_scale, die_temperature_offset win the others), gauge offset (13.4 um) in 3 of 5 (fitted 8.7 and 7.6 um on the two misses): the linearised 95 % limit is optimistic for gauge_offset, whose undetected shift of n is 8 se"]
 fn faults_at_s95_are_detected_over_seeds() {
     let c = control();
     let mf = limit(c, "mass_flow_scale").s95;
