@@ -334,7 +334,7 @@ fn cold_die_is_found() {
 /// the three. With the 95 % CIs' measured joint miss rate (2 of 40 seeds, tests/ci_coverage.rs),
 /// two misses of three happen by chance with probability 3 p² − 2 p³ ≈ 0.7 % at p = 0.05.
 #[test]
-#[ignore = "issue 11 open: detection of a 10 K cold die is itself marginal: seed 2108 names nothing (mass_flow_scale first, dBIC -8.5 > -10), so 1 of 3 seeds passes (108 misses n's CI by chance, 1108 passes)"]
+#[ignore = "issue 11 open: detection of a 10 K cold die is itself marginal: it lies between the control's detection limits s50 = 9.1 K and s95 = 13.1 K (tests/detection_limits.rs), so it is named on average, not with 95 %: seed 2108 names nothing (mass_flow_scale first, dBIC -8.5 > -10), so 1 of 3 seeds passes (108 misses n's CI by chance, 1108 passes)"]
 fn cold_die_is_found_over_seeds() {
     let base = scenarios::die_colder();
     let held = [0u64, 1000, 2000]
@@ -353,7 +353,7 @@ fn cold_die_is_found_over_seeds() {
 }
 
 #[test]
-#[ignore = "issue 11 open: a 4 % low mass flow is below the detection limit (RMS 1.33 % < noise, nothing named; the error budget covers it)"]
+#[ignore = "issue 11 open: a 4 % low mass flow is below the detection limit: the control reports s50 = 6.7 %, s95 = 9.6 % (tests/detection_limits.rs; RMS 1.33 % < noise, nothing named; the report says a mass-flow error below 9.6 % could be missed and the error budget covers it)"]
 fn low_mass_flow_is_found() {
     let sc = scenarios::mass_flow_low();
     assert_found(&sc, &run(&sc));
@@ -388,7 +388,7 @@ fn gauge_scale_is_named_or_tied() {
 }
 
 #[test]
-#[ignore = "issue 11 open: a 3 um gauge offset is below the detection limit (gauge_offset 5.3 ± 2.4 um, dBIC +0.4)"]
+#[ignore = "issue 11 open: a 3 um gauge offset is below the detection limit: the control reports s50 = 9.3 um, s95 = 13.4 um (tests/detection_limits.rs; gauge_offset 5.3 ± 2.4 um, dBIC +0.4); 1.5 s95 is named"]
 fn gauge_offset_is_found() {
     let sc = scenarios::gauge_offset();
     assert_found(&sc, &run(&sc));

@@ -35,6 +35,7 @@
 //!    [`Diagnosis::alternatives`], with their refits' `(n, κ)` and the shifts from the named
 //!    refit's in its standard errors (the named cause stays the best by `ΔBIC`).
 
+use super::detection::{detection_limits, DetectionContext, DetectionLimits};
 use super::scan::{
     physical, refine, scan_profile, search_range, shape_variants, GridStart, Profile, ProfileScan,
     Refit, ScanOptions, ShapeParameter,
@@ -48,8 +49,8 @@ use crate::fiber::noise_model::Outlier;
 use crate::fiber::rheometer::estimator::RelativeResidual;
 use crate::fiber::rheometer::report::bound_side;
 use crate::fiber::rheometer::{
-    AtBound, Estimator, FitReport, FitStart, Identification, IdentifyOptions, Layout, Rheometer,
-    RheometerError,
+    AtBound, Estimator, FitReport, FitStart, Identification, IdentifyOptions, Layout,
+    ParameterShift, Rheometer, RheometerError,
 };
 use crate::fiber::setup::ExperimentSet;
 use crate::fiber::FiberError;
@@ -301,6 +302,12 @@ pub struct Diagnosis {
     /// [`ties`](super::ties)).
     #[serde(default)]
     pub alternatives: Vec<Alternative>,
+    /// What these data could have missed: per candidate, the strength named with 50 % and
+    /// 95 % probability (linearised at strength 0) and the shift of `(n, κ)` an undetected
+    /// effect of the 95 % strength would cause ([`detection`](super::detection)). Empty in
+    /// diagnoses written before it existed.
+    #[serde(default)]
+    pub detection: DetectionLimits,
     /// Wall time \[s\].
     pub wall_time_s: f64,
 }
@@ -584,6 +591,41 @@ pub fn diagnose(
             }
         })
         .collect();
+    // detection limits (linearised at strength 0) and the bias an undetected effect causes
+    let detection = {
+        // without a determined fit (singular JᵀJ) the limits come without the shifts
+        let dtheta: Vec<Vec<f64>> = match ParameterShift::new(&x, n_res, q) {
+            Ok(shift) => cols
+                .iter()
+                .map(|c| {
+                    shift
+                        .derivative(&nalgebra::DVector::from_column_slice(c))
+                        .iter()
+                        .copied()
+                        .collect()
+                })
+                .collect(),
+            Err(_) => Vec::new(),
+        };
+        let col = |name: &str| layout.names.iter().position(|s| s == name);
+        let extra: Vec<usize> = results.iter().map(|c| c.extra_parameters).collect();
+        detection_limits(
+            &cands,
+            &extra,
+            &lin,
+            &dtheta,
+            (col("n"), col("kappa")),
+            &DetectionContext {
+                sigma: noise_level / sigma,
+                noise_level,
+                cost_before,
+                measurements: n_res,
+                threshold: options.earn_threshold,
+                stderr_n: base_report.stderr_n,
+                stderr_kappa: base_report.stderr_kappa,
+            },
+        )
+    };
     let mut order: Vec<usize> = (0..cands.len()).collect();
     order.sort_by(|&a, &b| lin[b].score.total_cmp(&lin[a].score));
 
@@ -846,6 +888,7 @@ pub fn diagnose(
             indistinguishable: indist,
             most_likely_missing: most_likely,
             alternatives,
+            detection,
             wall_time_s: t0.elapsed().as_secs_f64(),
         },
         residuals_before: before,

@@ -9,11 +9,14 @@
 //!   [`effects`](crate::fiber::effects);
 //! * [`diagnose`]: ranking the candidates by the excess misfit they explain (linearised scores,
 //!   global search and refits, information criteria) and the report in words;
+//! * [`detection`]: the detection limit of each candidate (the strength the data would reveal)
+//!   and the shift of `(n, κ)` an effect just below it would cause;
 //! * [`scan`]: the global search of one candidate's strength (and shape): the profile of `J`
 //!   and the refits of its best points;
 //! * [`ties`]: candidates about as consistent with the data as the named one (alternatives).
 
 pub mod compare;
+pub mod detection;
 pub mod diagnose;
 pub mod report;
 pub mod scan;

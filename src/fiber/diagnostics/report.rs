@@ -100,10 +100,15 @@ impl Diagnosis {
                 }
                 s.push_str(&super::ties::ties_paragraph(c, &self.alternatives));
             }
-            _ => s.push_str(
-                "No candidate earns its place: no effect lowers BIC by more than the threshold; \
-                 the model is adequate for these data (or the missing effect is not among the candidates).\n",
-            ),
+            _ => {
+                s.push_str(
+                    "No candidate earns its place: no effect lowers BIC by more than the threshold; \
+                     the model is adequate for these data (or the missing effect is not among the candidates).\n",
+                );
+                if let Some(w) = self.detection.words() {
+                    s.push_str(&format!("{w}\n"));
+                }
+            }
         }
         for c in self
             .candidates
@@ -178,6 +183,7 @@ impl Diagnosis {
                 ));
             }
         }
+        s.push_str(&self.detection.to_text());
         s.push_str(&format!("wall time {:.2} s\n", self.wall_time_s));
         s
     }

@@ -31,7 +31,7 @@ pub mod options;
 pub mod report;
 
 pub use data::Rheometer;
-pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
+pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, ParameterShift, SourceStatus};
 pub use estimator::Estimator;
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
