@@ -5,7 +5,8 @@
 //! model parameters too, fitted together with the strength unless fixed.
 //!
 //! Each effect has a [`Category`]: missing **physics**, a **process** condition that differs
-//! from the nominal one, or an **instrument** (diameter gauge) error. Each has a *physical range*
+//! from the nominal one, an **instrument** (diameter gauge) error, or **material** data (the VFT
+//! law) off. Each has a *physical range*
 //! ([`Effect::physical_range`], what real spinning lines do) and a wider *search range*
 //! ([`Effect::bounds`]) so that a best fit outside physics can be seen and reported
 //! ([`Effect::judge`]).
@@ -455,7 +456,7 @@ impl Effect {
         }
     }
 
-    /// Physics missing, process condition off, or instrument error.
+    /// Physics missing, process condition off, instrument error, or material data off.
     pub fn category(&self) -> Category {
         match self {
             Effect::InletVelocity
