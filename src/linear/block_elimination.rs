@@ -106,6 +106,9 @@ pub(crate) struct BlockLu {
     blocks: Vec<f64>,
     /// Per interval: the pivot row (within the block) chosen for each of the `n` columns.
     piv: Vec<usize>,
+    /// Per interval: the reciprocals of the `n` pivots `U11[r][r]` (back substitution
+    /// multiplies instead of dividing: off the solve's serial dependency chain).
+    dinv: Vec<f64>,
     /// The final `(n+k) × (n+k)` block's LU (row-major).
     last: Vec<f64>,
     /// Its pivot rows.
@@ -311,6 +314,9 @@ impl BlockLu {
         if self.piv.len() < (m - 1) * n {
             self.piv.resize((m - 1) * n, 0);
         }
+        if self.dinv.len() < (m - 1) * n {
+            self.dinv.resize((m - 1) * n, 0.0);
+        }
         for i in 0..m - 1 {
             let (done, rest) = self.blocks.split_at_mut(i * bsize);
             let blk = &mut rest[..bsize];
@@ -340,6 +346,9 @@ impl BlockLu {
                     ),
                 }
             })?;
+            for (r, d) in self.dinv[i * n..(i + 1) * n].iter_mut().enumerate() {
+                *d = 1.0 / blk[r * w + r];
+            }
         }
         self.last.resize(nb * nb, 0.0);
         self.last_piv.resize(nb, 0);
@@ -465,19 +474,27 @@ impl BlockLu {
             let (xi_all, xnext_all) = head.split_at_mut((i + 1) * n);
             let xi = &mut xi_all[i * n..];
             let xnext = &xnext_all[..n];
-            for r in (0..n).rev() {
+            let dinv = &self.dinv[i * n..(i + 1) * n];
+            // the parts in (x_{i+1}, p) first: independent of each other, so only the
+            // triangular part within the block is a serial chain
+            for (r, xr) in xi.iter_mut().enumerate() {
                 let row = &blk[r * w..(r + 1) * w];
-                let mut s = xi[r];
-                for c in r + 1..n {
-                    s -= row[c] * xi[c];
-                }
+                let mut s = *xr;
                 for (u, xv) in row[n..2 * n].iter().zip(xnext) {
                     s -= u * xv;
                 }
                 for (u, pv) in row[2 * n..].iter().zip(p_part.iter()) {
                     s -= u * pv;
                 }
-                xi[r] = s / row[r];
+                *xr = s;
+            }
+            for r in (0..n).rev() {
+                let row = &blk[r * w..(r + 1) * w];
+                let mut s = xi[r];
+                for c in r + 1..n {
+                    s -= row[c] * xi[c];
+                }
+                xi[r] = s * dinv[r];
             }
         }
     }
