@@ -106,6 +106,9 @@ pub(crate) struct BlockLu {
     blocks: Vec<f64>,
     /// Per interval: the pivot row (within the block) chosen for each of the `n` columns.
     piv: Vec<usize>,
+    /// Per interval: the reciprocals of the `n` pivots `U11[r][r]` (back substitution
+    /// multiplies instead of dividing: off the solve's serial dependency chain).
+    dinv: Vec<f64>,
     /// The final `(n+k) × (n+k)` block's LU (row-major).
     last: Vec<f64>,
     /// Its pivot rows.
@@ -132,6 +135,19 @@ fn eliminate(
     ncols: usize,
     piv: &mut [usize],
 ) -> Result<(), usize> {
+    // the interval steps (`ncols = n`, `w = 2n + k`) of small systems with both known at
+    // compile time: the column loop unrolls
+    match (ncols, w) {
+        (1, 2) => return eliminate_nw::<1, 2>(a, rows, piv),
+        (1, 3) => return eliminate_nw::<1, 3>(a, rows, piv),
+        (2, 4) => return eliminate_nw::<2, 4>(a, rows, piv),
+        (2, 5) => return eliminate_nw::<2, 5>(a, rows, piv),
+        (3, 6) => return eliminate_nw::<3, 6>(a, rows, piv),
+        (3, 7) => return eliminate_nw::<3, 7>(a, rows, piv),
+        (4, 8) => return eliminate_nw::<4, 8>(a, rows, piv),
+        (4, 9) => return eliminate_nw::<4, 9>(a, rows, piv),
+        _ => {}
+    }
     match w {
         2 => eliminate_w::<2>(a, rows, w, ncols, piv),
         3 => eliminate_w::<3>(a, rows, w, ncols, piv),
@@ -144,6 +160,73 @@ fn eliminate(
         10 => eliminate_w::<10>(a, rows, w, ncols, piv),
         _ => eliminate_w::<0>(a, rows, w, ncols, piv),
     }
+}
+
+/// [`eliminate`] with `ncols = N` and the width `W` fixed at compile time (the same operations
+/// in the same order as [`eliminate_w`]: bit-identical).
+fn eliminate_nw<const N: usize, const W: usize>(
+    a: &mut [f64],
+    rows: usize,
+    piv: &mut [usize],
+) -> Result<(), usize> {
+    let a = &mut a[..rows * W];
+    // each column step inlined with its index a constant (N <= 4 here)
+    for j in 0..N.min(4) {
+        match j {
+            0 => eliminate_column::<W>(a, rows, 0, piv)?,
+            1 => eliminate_column::<W>(a, rows, 1, piv)?,
+            2 => eliminate_column::<W>(a, rows, 2, piv)?,
+            _ => eliminate_column::<W>(a, rows, 3, piv)?,
+        }
+    }
+    for j in 4..N {
+        eliminate_column::<W>(a, rows, j, piv)?;
+    }
+    Ok(())
+}
+
+/// Step `j` of [`eliminate_nw`]: pivot search, row swap and update of the rows below.
+#[inline(always)]
+fn eliminate_column<const W: usize>(
+    a: &mut [f64],
+    rows: usize,
+    j: usize,
+    piv: &mut [usize],
+) -> Result<(), usize> {
+    let mut p = j;
+    let mut best = a[j * W + j].abs();
+    for r in j + 1..rows {
+        let v = a[r * W + j].abs();
+        if v > best {
+            best = v;
+            p = r;
+        }
+    }
+    if best.is_nan() || best <= 0.0 {
+        return Err(j);
+    }
+    piv[j] = p;
+    swap_rows(a, W, j, p);
+    let (top, below) = a.split_at_mut((j + 1) * W);
+    let prow: &[f64; W] = match top[j * W..].try_into() {
+        Ok(r) => r,
+        Err(_) => return Err(j),
+    };
+    let inv = 1.0 / prow[j];
+    for row in below.chunks_exact_mut(W) {
+        let row: &mut [f64; W] = match row.try_into() {
+            Ok(r) => r,
+            Err(_) => return Err(j),
+        };
+        let l = row[j] * inv;
+        row[j] = l;
+        if l != 0.0 {
+            for (x, u) in row[j + 1..].iter_mut().zip(&prow[j + 1..]) {
+                *x -= l * u;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// [`eliminate`] with the width `W` fixed at compile time (`W = 0`: the run-time `w_rt`).
@@ -231,6 +314,9 @@ impl BlockLu {
         if self.piv.len() < (m - 1) * n {
             self.piv.resize((m - 1) * n, 0);
         }
+        if self.dinv.len() < (m - 1) * n {
+            self.dinv.resize((m - 1) * n, 0.0);
+        }
         for i in 0..m - 1 {
             let (done, rest) = self.blocks.split_at_mut(i * bsize);
             let blk = &mut rest[..bsize];
@@ -260,6 +346,9 @@ impl BlockLu {
                     ),
                 }
             })?;
+            for (r, d) in self.dinv[i * n..(i + 1) * n].iter_mut().enumerate() {
+                *d = 1.0 / blk[r * w + r];
+            }
         }
         self.last.resize(nb * nb, 0.0);
         self.last_piv.resize(nb, 0);
@@ -385,19 +474,27 @@ impl BlockLu {
             let (xi_all, xnext_all) = head.split_at_mut((i + 1) * n);
             let xi = &mut xi_all[i * n..];
             let xnext = &xnext_all[..n];
-            for r in (0..n).rev() {
+            let dinv = &self.dinv[i * n..(i + 1) * n];
+            // the parts in (x_{i+1}, p) first: independent of each other, so only the
+            // triangular part within the block is a serial chain
+            for (r, xr) in xi.iter_mut().enumerate() {
                 let row = &blk[r * w..(r + 1) * w];
-                let mut s = xi[r];
-                for c in r + 1..n {
-                    s -= row[c] * xi[c];
-                }
+                let mut s = *xr;
                 for (u, xv) in row[n..2 * n].iter().zip(xnext) {
                     s -= u * xv;
                 }
                 for (u, pv) in row[2 * n..].iter().zip(p_part.iter()) {
                     s -= u * pv;
                 }
-                xi[r] = s / row[r];
+                *xr = s;
+            }
+            for r in (0..n).rev() {
+                let row = &blk[r * w..(r + 1) * w];
+                let mut s = xi[r];
+                for c in r + 1..n {
+                    s -= row[c] * xi[c];
+                }
+                xi[r] = s * dinv[r];
             }
         }
     }
