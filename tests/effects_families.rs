@@ -3,7 +3,9 @@
 //! stays physical, the gauge enters the residuals as `(1 + g) d + o`, settings parse and
 //! round-trip, unphysical strengths are named, and fits recover a die-temperature offset and a
 //! gauge scale from data made *without* the candidate code paths (the experiment's inlet
-//! temperature changed, the measured diameters scaled).
+//! temperature changed, the measured diameters scaled). The material-data effects
+//! `vft_b_offset` and `vft_t_vf_offset` are the model built from changed VFT data (with `μ_c`
+//! rescaled so that the zero-rate viscosity at `T_o` stays), with exact derivatives.
 
 use diffbvp::fiber::effects::{
     Category, Effect, EffectSetting, ModelSpec, ALL_NAMES, BUILTIN_NAMES,
@@ -24,14 +26,11 @@ fn experiment(i: usize) -> Experiment {
 }
 
 fn model_for(e: &Experiment, physics: Physics) -> FiberModel<CarreauLike> {
-    FiberModel::new(
-        &Material::pmma7n(),
-        &Air::paper(),
-        e,
-        CarreauLike::new(),
-        physics,
-    )
-    .unwrap()
+    model_with(&Material::pmma7n(), e, physics)
+}
+
+fn model_with(material: &Material, e: &Experiment, physics: Physics) -> FiberModel<CarreauLike> {
+    FiberModel::new(material, &Air::paper(), e, CarreauLike::new(), physics).unwrap()
 }
 
 fn opts() -> SimulateOptions {
@@ -524,6 +523,105 @@ fn fit_recovers_a_gauge_scale_made_by_scaling_the_measurements() {
                 );
                 assert!(rep.ci95_kappa[0] <= TRUTH[1] && TRUTH[1] <= rep.ci95_kappa[1]);
             }
+        }
+    }
+}
+
+#[test]
+fn vft_offsets_are_the_model_of_changed_material_data() {
+    let nominal = Material::pmma7n();
+    let e = experiment(3);
+    let t_o = model_for(&e, Physics::paper())
+        .scaling
+        .reference
+        .temperature;
+    let nominal_model = model_for(&e, Physics::paper());
+    let base = diameters_m(
+        &nominal_model,
+        &nominal_model.parameters(1.0, &TRUTH).unwrap(),
+    );
+    // far from neutral: B + 250 K, T_VF − 12 K; μ_c rescaled so that μ_s0(T_o) stays
+    for (effect, strength) in [(Effect::VftBOffset, 250.0), (Effect::VftTvfOffset, -12.0)] {
+        assert_eq!(effect.category(), Category::Material);
+        let mut changed = nominal.clone();
+        match effect {
+            Effect::VftBOffset => changed.vft_b += strength,
+            _ => changed.vft_t_vf += strength,
+        }
+        changed.vft_mu_c *= (nominal.vft_b / (t_o - nominal.vft_t_vf)
+            - changed.vft_b / (t_o - changed.vft_t_vf))
+            .exp();
+        let level = |m: &Material| m.vft_mu_c * (m.vft_b / (t_o - m.vft_t_vf)).exp();
+        assert!((level(&changed) / level(&nominal) - 1.0).abs() < 1e-12);
+
+        let m = model_for(&e, effect.apply(Physics::paper()).unwrap());
+        let neutral = diameters_m(&m, &m.parameters(1.0, &TRUTH).unwrap());
+        let mut p = m.parameters(1.0, &TRUTH).unwrap();
+        p[m.param_index(effect.model_param()).unwrap()] = strength;
+        let with_param = diameters_m(&m, &p);
+        let direct_model = model_with(&changed, &e, Physics::paper());
+        let direct = diameters_m(
+            &direct_model,
+            &direct_model.parameters(1.0, &TRUTH).unwrap(),
+        );
+        let diff = max_rel_diff(&with_param, &direct);
+        let change = max_rel_diff(&direct, &base);
+        println!(
+            "{}: parameter vs changed material data {diff:.2e}, change {change:.2e}, neutral vs \
+             nominal {:.2e}",
+            effect.name(),
+            max_rel_diff(&neutral, &base)
+        );
+        // the same function by two code paths, both solved to tol 1e-8
+        assert!(diff < 1e-8, "{}: {diff:e}", effect.name());
+        assert!(
+            change > 1e-3,
+            "{}: no visible change ({change:e})",
+            effect.name()
+        );
+        assert!(max_rel_diff(&neutral, &base) < 1e-9, "{}", effect.name());
+    }
+}
+
+#[test]
+fn vft_offset_derivatives_match_finite_differences() {
+    let physics = [Effect::VftBOffset, Effect::VftTvfOffset]
+        .iter()
+        .try_fold(Physics::paper(), |p, e| e.apply(p))
+        .unwrap();
+    let m = model_for(&experiment(3), physics);
+    let mut p = m.parameters(1.0, &TRUTH).unwrap();
+    p[m.param_index("vft_b_offset").unwrap()] = 120.0;
+    p[m.param_index("vft_t_vf_offset").unwrap()] = -7.0;
+    let s = simulate_params(&m, &p, None, &opts()).unwrap().solution;
+    let sens = Sensitivities::compute(&m, &s).unwrap();
+    let q = sens.num_params();
+    let xs: Vec<f64> = (1..=10).map(|i| m.length() * i as f64 / 10.0).collect();
+    // fixed mesh: only the FD truncation error remains (as for the shape parameters above)
+    const TOL: f64 = 1e-7;
+    for (name, h) in [("vft_b_offset", 0.05), ("vft_t_vf_offset", 0.005)] {
+        let j = m.param_index(name).unwrap();
+        let solve_at = |dv: f64| {
+            let mut pp = p.clone();
+            pp[j] += dv;
+            let sol = Solver::new(&m, SolveOptions::fixed_mesh())
+                .solve(&pp, &Guess::from(&s))
+                .unwrap();
+            xs.iter().map(|&x| sol.eval(x)).collect::<Vec<Vec<f64>>>()
+        };
+        let (up, dn) = (solve_at(h), solve_at(-h));
+        // velocity (state 0) and temperature (state 2)
+        for state in [0usize, 2] {
+            let col = |x: f64| sens.at(x)[state * q + j];
+            let scale = xs.iter().map(|&x| col(x).abs()).fold(0.0, f64::max);
+            assert!(scale > 0.0, "{name}: zero sensitivity of state {state}");
+            let worst = xs
+                .iter()
+                .enumerate()
+                .map(|(i, &x)| (col(x) - (up[i][state] - dn[i][state]) / (2.0 * h)).abs() / scale)
+                .fold(0.0, f64::max);
+            println!("{name}, state {state}: max |dual - FD| / max |dual| = {worst:.2e}");
+            assert!(worst <= TOL, "{name}, state {state}: {worst:.2e}");
         }
     }
 }
