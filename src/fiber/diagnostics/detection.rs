@@ -60,7 +60,7 @@ pub struct DetectionLimit {
     pub effect: String,
     /// Unit of the strengths `s50`, `s95` (the candidate's unit; `"-"`: relative).
     pub unit: String,
-    /// `"physics"`, `"process"` or `"instrument"`.
+    /// `"physics"`, `"process"`, `"instrument"` or `"material"`.
     pub category: String,
     /// Extra parameters `Δk` the candidate costs in `ΔBIC`.
     pub extra_parameters: usize,

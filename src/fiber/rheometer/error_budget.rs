@@ -28,10 +28,11 @@ use super::estimator::Estimator;
 use super::identify::Identification;
 use super::layout::FitStart;
 use super::options::{FitWarning, IdentifyOptions, RheometerError, WarningCode};
+use super::parameter_shift::ParameterShift;
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
 use crate::fiber::uncertainty::{GaugeColumn, Origin, Scope, Source, Uncertainties, SOURCES};
 use crate::least_squares::LeastSquaresProblem;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -369,43 +370,6 @@ pub fn error_budget(
         total_kappa: both(stat_k, systematic_kappa),
         wall_time_s: t0.elapsed().as_secs_f64(),
     })
-}
-
-/// The linear map from a residual column `∂r/∂q` to the fitted parameters' derivative
-/// `dθ/dq = −(JᵀJ)⁻¹ Jᵀ ∂r/∂q` (one Cholesky factorisation of `JᵀJ`, reused for every column):
-/// how the estimate moves when the model's `q` changes by one unit with the data fixed. A fit
-/// that leaves out an effect present in the data with strength `s` is therefore biased by
-/// `−s dθ/dq` (first order).
-#[derive(Debug, Clone)]
-pub struct ParameterShift {
-    xt: DMatrix<f64>,
-    chol: nalgebra::Cholesky<f64, nalgebra::Dyn>,
-}
-
-impl ParameterShift {
-    /// From the residual Jacobian `x` (`n_res × q`, row-major) at the fit. Errors if `JᵀJ` is
-    /// singular (the fit's parameters are not determined) or the sizes do not match.
-    pub fn new(x: &[f64], n_res: usize, q: usize) -> Result<Self, RheometerError> {
-        if x.len() != n_res * q {
-            return Err(RheometerError::Data(format!(
-                "parameter shift: a Jacobian of {} entries is not {n_res} × {q}",
-                x.len()
-            )));
-        }
-        let xm = DMatrix::from_row_slice(n_res, q, x);
-        let xt = xm.transpose();
-        let chol = (&xt * &xm).cholesky().ok_or_else(|| {
-            RheometerError::Data(
-                "error budget: JᵀJ is singular (the fit's parameters are not determined)".into(),
-            )
-        })?;
-        Ok(ParameterShift { xt, chol })
-    }
-
-    /// `dθ/dq` (length `q`) for the residual column `c = ∂r/∂q` (length `n_res`).
-    pub fn derivative(&self, c: &DVector<f64>) -> DVector<f64> {
-        -self.chol.solve(&(&self.xt * c))
-    }
 }
 
 /// Row `i` (row `j` of experiment `k`) of a source's column, before its per-unit factor.

@@ -28,15 +28,17 @@ pub mod landscape;
 pub mod layout;
 pub mod objective;
 pub mod options;
+pub mod parameter_shift;
 pub mod report;
 
 pub use data::Rheometer;
-pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, ParameterShift, SourceStatus};
+pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
 pub use estimator::Estimator;
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
 pub use options::{CarreauFiber, IdentifyOptions, RheometerError};
+pub use parameter_shift::ParameterShift;
 pub use report::{
     AtBound, BoundSide, EffectReport, FitReport, FitWarning, ShapeReport, WarningCode,
 };
