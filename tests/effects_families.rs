@@ -120,6 +120,7 @@ fn profiled_model() -> (FiberModel<CarreauLike>, Vec<f64>) {
     let effects = [
         Effect::AirCoflow {
             decay_length: Some(0.08),
+            tail: None,
         },
         Effect::AirCoflowLine {
             onset: Some(0.3),
@@ -143,6 +144,8 @@ fn profiled_model() -> (FiberModel<CarreauLike>, Vec<f64>) {
         p[m.param_index(name).unwrap()] = v;
     }
     assert_eq!(p[m.param_index("air_coflow.decay_length").unwrap()], 0.08);
+    // the exponential tail r = 0, where the decay is evaluated by its series
+    assert_eq!(p[m.param_index("air_coflow.tail").unwrap()], 0.0);
     assert_eq!(p[m.param_index("air_coflow_line.onset").unwrap()], 0.3);
     (m, p)
 }
@@ -158,6 +161,7 @@ fn shape_parameter_derivatives_match_finite_differences() {
     const TOL: f64 = 1e-7;
     for name in [
         "air_coflow.decay_length",
+        "air_coflow.tail",
         "air_coflow_line.onset",
         "air_coflow_line.ramp_width",
         "air_temperature_profile.decay_length",
@@ -165,7 +169,7 @@ fn shape_parameter_derivatives_match_finite_differences() {
         "air_coflow_line",
     ] {
         let j = m.param_index(name).unwrap();
-        let h = 1e-4 * p[j].abs();
+        let h = 1e-4 * p[j].abs().max(0.1);
         let solve_at = |dv: f64| {
             let mut q = p.clone();
             q[j] += dv;
@@ -193,6 +197,7 @@ fn coflow_faster_than_the_fiber_pulls_it_forward() {
     // ℓ = 0.03 m: at the nozzle the air is still slower than the fiber (300 m/s e^(-10))
     let effect = Effect::AirCoflow {
         decay_length: Some(0.05),
+        tail: None,
     };
     let m = model_for(&e, effect.apply(Physics::paper()).unwrap());
     let mut p = m.parameters(1.0, &TRUTH).unwrap();
@@ -382,7 +387,10 @@ fn judge_and_categories() {
     assert!(msg.contains("not physical"), "{msg}");
     assert!(Effect::Radiation.judge(0.9).is_none());
     assert!(Effect::Radiation.judge(-0.1).unwrap().contains("< 0"));
-    let coflow = Effect::AirCoflow { decay_length: None };
+    let coflow = Effect::AirCoflow {
+        decay_length: None,
+        tail: None,
+    };
     assert!(coflow.judge(250.0).is_none());
     assert!(coflow.judge(500.0).unwrap().contains("m/s"));
     let die = Effect::DieTemperatureOffset.judge(-40.0).unwrap();

@@ -280,7 +280,10 @@ impl Term {
 pub enum AirSpeed {
     /// Still air, `v_air = 0`.
     Still,
-    /// Aspirator co-flow `v_air(s) = strength · V exp(−(L − s)/ℓ)`.
+    /// Aspirator co-flow `v_air(s) = strength · V φ_r((L − s)/ℓ)` with the decay
+    /// `φ_r(u) = (1 + r u)^(−1/r)`: `φ_0(u) = exp(−u)`, an algebraic tail `u^(−1/r)` for
+    /// `r > 0` (`r = 1/2`: inverse square, as the entrainment towards a sink; `r = 1`: inverse,
+    /// as a jet).
     CoFlow {
         /// `V` \[m/s\].
         speed: f64,
@@ -289,6 +292,9 @@ pub enum AirSpeed {
         length: Strength,
         /// Factor on `V` (`Parameter` makes it a model parameter named `"air_coflow"`).
         strength: Strength,
+        /// Tail `r` \[-\], `0 <= r <= 1` (`Parameter` makes it a model parameter named
+        /// `"air_coflow.tail"`).
+        tail: Strength,
     },
 }
 
@@ -330,7 +336,7 @@ pub enum LineCoflow {
 }
 
 /// Number of parameter slots after the terms' strengths ([`Physics::strength_parameters`]).
-const SLOTS: usize = 15;
+const SLOTS: usize = 16;
 const S_COFLOW: usize = 0;
 const S_COFLOW_LEN: usize = 1;
 const S_LINE: usize = 2;
@@ -346,6 +352,7 @@ const S_GAUGE_SCALE: usize = 11;
 const S_GAUGE_OFFSET: usize = 12;
 const S_VFT_B: usize = 13;
 const S_VFT_T_VF: usize = 14;
+const S_COFLOW_TAIL: usize = 15;
 
 /// Names of the parameter slots after the terms, in `p` order.
 const SLOT_NAMES: [&str; SLOTS] = [
@@ -364,6 +371,7 @@ const SLOT_NAMES: [&str; SLOTS] = [
     "gauge_offset",
     "vft_b_offset",
     "vft_t_vf_offset",
+    "air_coflow.tail",
 ];
 
 /// Process and instrument factors of a model evaluation (dual numbers, so that derivatives with
@@ -506,6 +514,7 @@ impl<H: NusseltLaw> Physics<H> {
             speed,
             length: Strength::Fixed(length),
             strength: Strength::Fixed(1.0),
+            tail: Strength::Fixed(0.0),
         };
         self
     }
@@ -531,11 +540,15 @@ impl<H: NusseltLaw> Physics<H> {
     fn slots(&self) -> [Strength; SLOTS] {
         let mut v = [Strength::Off; SLOTS];
         if let AirSpeed::CoFlow {
-            length, strength, ..
+            length,
+            strength,
+            tail,
+            ..
         } = self.air_speed
         {
             v[S_COFLOW] = strength;
             v[S_COFLOW_LEN] = length;
+            v[S_COFLOW_TAIL] = tail;
         }
         if let LineCoflow::On {
             onset,
@@ -606,20 +619,21 @@ impl<H: NusseltLaw> Physics<H> {
             )))
         };
         match name {
-            "air_coflow" | "air_coflow.decay_length" => match &mut self.air_speed {
-                AirSpeed::CoFlow {
-                    length,
-                    strength: s,
-                    ..
-                } => {
-                    if name == "air_coflow" {
-                        *s = strength
-                    } else {
-                        *length = strength
-                    }
+            "air_coflow" | "air_coflow.decay_length" | "air_coflow.tail" => {
+                match &mut self.air_speed {
+                    AirSpeed::CoFlow {
+                        length,
+                        strength: s,
+                        tail,
+                        ..
+                    } => match name {
+                        "air_coflow" => *s = strength,
+                        "air_coflow.decay_length" => *length = strength,
+                        _ => *tail = strength,
+                    },
+                    AirSpeed::Still => return missing("air co-flow", "with_coflow"),
                 }
-                AirSpeed::Still => return missing("air co-flow", "with_coflow"),
-            },
+            }
             "air_coflow_line" | "air_coflow_line.onset" | "air_coflow_line.ramp_width" => {
                 match &mut self.line_coflow {
                     LineCoflow::On {
@@ -1080,7 +1094,12 @@ impl<H: NusseltLaw> Physics<H> {
         let l_o = co.si.length;
         let mut v = match (&self.air_speed, val(S_COFLOW), val(S_COFLOW_LEN)) {
             (AirSpeed::CoFlow { speed, .. }, Some(f), Some(ell)) => {
-                f * (D::from(-(co.length - s) * l_o) / ell).exp() * (speed / co.si.velocity)
+                let u = D::from((co.length - s) * l_o) / ell;
+                let decay = match val(S_COFLOW_TAIL) {
+                    Some(r) => coflow_decay(u, r),
+                    None => (-u).exp(),
+                };
+                f * decay * (speed / co.si.velocity)
             }
             _ => D::zero(),
         };
@@ -1235,9 +1254,77 @@ impl<H: NusseltLaw> Physics<H> {
     }
 }
 
+/// The co-flow's decay `φ_r(u) = (1 + r u)^(−1/r)` at `u = (L − s)/ℓ >= 0`, tail `r >= 0`:
+/// `exp(−ln(1 + r u)/r)`, with `ln(1 + x)/r = u (1 − x/2 + x²/3 − …)` for `|x| = |r u| < 10⁻²`
+/// (relative error below 10⁻¹⁵), so that `r = 0` gives `exp(−u)` with the right derivative
+/// `∂φ/∂r = u² e^(−u)/2` as well.
+fn coflow_decay<D: DualNum<Primitive = f64> + Copy>(u: D, r: D) -> D {
+    let x = r * u;
+    let log = if x.re().abs() < 1e-2 {
+        let mut q = x * (1.0 / 7.0) - 1.0 / 6.0;
+        q = q * x + 0.2;
+        q = q * x - 0.25;
+        q = q * x + 1.0 / 3.0;
+        q = q * x - 0.5;
+        q = q * x + 1.0;
+        u * q
+    } else {
+        x.ln_1p() / r
+    };
+    (-log).exp()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn coflow_decay_spans_exponential_and_algebraic_tails() {
+        use num_dual::Dual64;
+        // the closed form, accurate for small r u too
+        let direct = |u: f64, r: f64| (-(r * u).ln_1p() / r).exp();
+        for u in [0.0, 0.3, 1.0, 4.0, 25.0] {
+            // r = 0: the exponential
+            let e: f64 = coflow_decay(u, 0.0);
+            assert!(
+                (e - (-u).exp()).abs() <= 1e-15 * (-u).exp().max(1e-300),
+                "{u}: {e}"
+            );
+            // both branches against the closed form, on either side of the switch |r u| = 1e-2
+            for r in [
+                1e-7,
+                1e-4,
+                0.9e-2 / u.max(1.0),
+                1.1e-2 / u.max(1.0),
+                0.3,
+                0.5,
+                1.0,
+            ] {
+                let v: f64 = coflow_decay(u, r);
+                let w = direct(u, r);
+                assert!((v - w).abs() <= 1e-12 * w, "u {u} r {r}: {v} vs {w}");
+            }
+            // the derivative in r at r = 0 (the series branch): u² e^(−u) / 2, and against a
+            // central difference of the closed form at r = 0.3 (the logarithm branch)
+            let d0 = coflow_decay(Dual64::from_re(u), Dual64::from_re(0.0).derivative()).eps;
+            let exact = 0.5 * u * u * (-u).exp();
+            assert!(
+                (d0 - exact).abs() <= 1e-14 * exact.max(1e-300),
+                "{u}: {d0} vs {exact}"
+            );
+            let d3 = coflow_decay(Dual64::from_re(u), Dual64::from_re(0.3).derivative()).eps;
+            let h = 1e-6;
+            let fd = (direct(u, 0.3 + h) - direct(u, 0.3 - h)) / (2.0 * h);
+            assert!(
+                (d3 - fd).abs() <= 1e-7 * fd.abs().max(1e-12),
+                "{u}: {d3} vs {fd}"
+            );
+        }
+        // the tails: inverse square at r = 1/2, inverse at r = 1
+        let far: f64 = 1e4;
+        assert!((coflow_decay(far, 0.5_f64) * (far / 2.0).powi(2) - 1.0).abs() < 1e-3);
+        assert!((coflow_decay(far, 1.0_f64) * far - 1.0).abs() < 1e-3);
+    }
 
     #[test]
     fn still_air_nusselt_is_half_churchill_bernstein() {

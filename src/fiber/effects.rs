@@ -15,7 +15,7 @@
 //! |---|---|---|---|---|---|---|
 //! | `strain_thinning` | `1 − n` (-) | Carreau-type law with power index `n = 1 − s` | – | physics | [0, 1] | 0 (Newtonian) |
 //! | `radiation` | emissivity `ε` (-) | heat loss `π d ε σ (T⁴ − T_air⁴)` | – | physics | [0, 1] | 0 |
-//! | `air_coflow` | amplitude `V` (m/s) | air speed `v_air = V exp(−(L − s)/ℓ)` (aspirator near the take-up) | `decay_length` ℓ (m, 0.1, [0.01, min(1.5, 1.5 L)]) | physics | [−50, 400] | 0 |
+//! | `air_coflow` | amplitude `V` (m/s) | air speed `v_air = V (1 + r (L − s)/ℓ)^(−1/r)` (aspirator near the take-up; `r = 0`: `V exp(−(L − s)/ℓ)`) | `decay_length` ℓ (m, 0.1, [0.01, min(1.5, 1.5 L)]), `tail` r (-, 0, [0, 1]; not fitted: `diagnose` scans 0 and 0.5) | physics | [−50, 400] | 0 |
 //! | `air_coflow_line` | speed `V` (m/s) | air speed `v_air = V / (1 + exp(−(s − s₀)/w))` (co-flow along the line after `s₀`) | `onset` s₀ (m, 0.2, [0, L]), `ramp_width` w (m, 0.02, [0.002, min(0.5, L)]) | physics | [−50, 400] | 0 |
 //! | `air_temperature_profile` | excess `ΔT` (K) | `T_air(s) = T_air + ΔT exp(−s/ℓ)` | `decay_length` ℓ (m, 0.05, [0.005, min(1, L)]) | physics | [−50, 400] | 0 |
 //! | `nusselt_scale` | `s` (-) | Nusselt law `𝒩 → (1 + s) 𝒩` | – | physics | [−0.5, 1] | 0 |
@@ -55,6 +55,14 @@
 //! shape parameters fixed at a value: `air_coflow:decay_length=0.2` (strength fitted, ℓ fixed),
 //! `air_coflow=40:decay_length=0.2` (both fixed), `air_coflow_line:onset=0.3:ramp_width=0.05`.
 //! A shape parameter `name.shape` is a model parameter, e.g. `air_coflow.decay_length` \[m\].
+//!
+//! **The co-flow's tail.** Air drawn towards an aspirator slows with the distance `z = L − s`
+//! from it algebraically, not exponentially (as the flow towards a sink, `∝ z⁻²`, or along a
+//! jet, `∝ z⁻¹`), and a slow co-flow far upstream still pulls on the slow fiber there. The tail
+//! `r` spans these: `(1 + r z/ℓ)^(−1/r)` decays like `z^(−1/r)` far away and is the exponential at
+//! `r = 0`. It is a discrete choice of `diagnose` (both 0 and 0.5 are scanned and the better
+//! variant refined with `r` held), not a fitted parameter; `fit --with air_coflow:tail=0.5`
+//! fixes it.
 
 use crate::fiber::contributions::{Balance, FiberTerm, Physics, Strength};
 use crate::fiber::error::FiberError;
@@ -161,6 +169,19 @@ const COFLOW_DECAY: ShapeParameter = ShapeParameter {
     describe: "decay length of the co-flow away from the take-up",
 };
 
+const COFLOW_TAIL: ShapeParameter = ShapeParameter {
+    name: "tail",
+    model_param: "air_coflow.tail",
+    unit: "-",
+    default: 0.0,
+    bounds: (0.0, 1.0),
+    max_per_length: None,
+    fitted_with_strength: false,
+    scanned: true,
+    describe: "tail r of the co-flow's decay away from the take-up, (1 + r z/l)^(-1/r): \
+               0 exponential, 0.5 inverse square (entrainment towards a sink), 1 inverse (a jet)",
+};
+
 const COFLOW_LINE_ONSET: ShapeParameter = ShapeParameter {
     name: "onset",
     model_param: "air_coflow_line.onset",
@@ -254,6 +275,9 @@ pub enum Effect {
     AirCoflow {
         /// Decay length `ℓ` \[m\] fixed, or `None` (fitted, start [`DEFAULT_COFLOW_DECAY_LENGTH`]).
         decay_length: Option<f64>,
+        /// Tail `r` \[-\] of the decay `(1 + r z/ℓ)^(−1/r)` fixed, or `None` (0, the
+        /// exponential; not fitted: `diagnose` scans 0 and 0.5, the fit keeps the better).
+        tail: Option<f64>,
     },
     /// `air_coflow_line`: co-flow along the line after an onset, strength = speed `V` \[m/s\].
     AirCoflowLine {
@@ -337,7 +361,10 @@ impl Effect {
         vec![
             Effect::StrainThinning,
             Effect::Radiation,
-            Effect::AirCoflow { decay_length: None },
+            Effect::AirCoflow {
+                decay_length: None,
+                tail: None,
+            },
             Effect::AirCoflowLine {
                 onset: None,
                 ramp_width: None,
@@ -546,7 +573,7 @@ impl Effect {
     /// The effect's shape parameters (empty for most).
     pub fn shape_parameters(&self) -> Vec<ShapeParameter> {
         match self {
-            Effect::AirCoflow { .. } => vec![COFLOW_DECAY],
+            Effect::AirCoflow { .. } => vec![COFLOW_DECAY, COFLOW_TAIL],
             Effect::AirCoflowLine { .. } => vec![COFLOW_LINE_ONSET, COFLOW_LINE_RAMP],
             Effect::AirTemperatureProfile { .. } => vec![WARM_AIR_DECAY],
             _ => Vec::new(),
@@ -557,7 +584,9 @@ impl Effect {
     /// [`shape_parameters`](Self::shape_parameters) order.
     pub fn shape_settings(&self) -> Vec<(ShapeParameter, Option<f64>)> {
         match self {
-            Effect::AirCoflow { decay_length } => vec![(COFLOW_DECAY, *decay_length)],
+            Effect::AirCoflow { decay_length, tail } => {
+                vec![(COFLOW_DECAY, *decay_length), (COFLOW_TAIL, *tail)]
+            }
             Effect::AirCoflowLine { onset, ramp_width } => {
                 vec![(COFLOW_LINE_ONSET, *onset), (COFLOW_LINE_RAMP, *ramp_width)]
             }
@@ -610,7 +639,8 @@ impl Effect {
             ));
         }
         match (&mut self, name) {
-            (Effect::AirCoflow { decay_length }, "decay_length") => *decay_length = Some(value),
+            (Effect::AirCoflow { decay_length, .. }, "decay_length") => *decay_length = Some(value),
+            (Effect::AirCoflow { tail, .. }, "tail") => *tail = Some(value),
             (Effect::AirTemperatureProfile { decay_length }, "decay_length") => {
                 *decay_length = Some(value)
             }
@@ -1024,7 +1054,11 @@ mod tests {
             .parse()
             .unwrap();
         assert!(both.effect.free_shapes().is_empty());
-        let free = Effect::AirCoflow { decay_length: None }.free_shapes();
+        let free = Effect::AirCoflow {
+            decay_length: None,
+            tail: None,
+        }
+        .free_shapes();
         assert_eq!(free.len(), 1);
         assert_eq!(free[0].model_param, "air_coflow.decay_length");
     }

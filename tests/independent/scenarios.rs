@@ -264,3 +264,63 @@ pub fn other_material() -> Scenario {
         ..base("other_material", 114)
     }
 }
+
+/// An aspirator jet of `speed` m/s at the take-up and Lorentzian decay length `length` m
+/// (issue 11's range: 30–300 m/s, 0.03–0.3 m).
+pub fn aspirator(speed: f64, length: f64, seed: u64) -> Scenario {
+    Scenario {
+        air_flow: AirFlow::Aspirator { speed, length },
+        acceptable: vec!["air_coflow"],
+        ..base("aspirator_range", seed)
+    }
+}
+
+/// Warm air near the nozzle with the profile `heat`.
+pub fn warm_air(heat: AirHeat, seed: u64) -> Scenario {
+    Scenario {
+        air_heat: heat,
+        acceptable: vec!["air_temperature_profile"],
+        ..base("warm_air_range", seed)
+    }
+}
+
+/// Grey-body radiation with emissivity `emissivity`.
+pub fn radiating(emissivity: f64, seed: u64) -> Scenario {
+    Scenario {
+        emissivity,
+        acceptable: vec!["radiation"],
+        expected: Some(("radiation", Expected::Emissivity(emissivity))),
+        ..base("radiation_range", seed)
+    }
+}
+
+/// One process or instrument fault (the first that is set of: die offset, mass flow, gauge
+/// scale, gauge offset), or outliers alone (nothing to name).
+pub fn with_faults(faults: Faults, seed: u64) -> Scenario {
+    let expected = if faults.die_offset_k != 0.0 {
+        Some((
+            "die_temperature_offset",
+            Expected::DieOffsetK(faults.die_offset_k),
+        ))
+    } else if faults.mass_flow_factor != 1.0 {
+        Some((
+            "mass_flow_scale",
+            Expected::MassFlowFactor(faults.mass_flow_factor),
+        ))
+    } else if faults.gauge_factor != 1.0 {
+        Some(("gauge_scale", Expected::GaugeFactor(faults.gauge_factor)))
+    } else if faults.gauge_offset_m != 0.0 {
+        Some((
+            "gauge_offset",
+            Expected::GaugeOffsetM(faults.gauge_offset_m),
+        ))
+    } else {
+        None
+    };
+    Scenario {
+        faults,
+        acceptable: expected.iter().map(|e| e.0).collect(),
+        expected,
+        ..base("fault_range", seed)
+    }
+}

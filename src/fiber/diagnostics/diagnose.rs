@@ -163,12 +163,40 @@ pub struct CandidateResult {
     /// without a shape).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub shape: Vec<ShapeParameter>,
+    /// The best refit with another discrete shape (the co-flow's tail) where the data cannot
+    /// choose between them (`ΔBIC` gap below the tie margin): its shape and material estimate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_alternative: Option<ShapeAlternative>,
     /// Profiles of `J` against the strength, one per scanned shape.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub profiles: Vec<Profile>,
     /// Scans that could not start (one per variant, in words).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub scan_errors: Vec<String>,
+}
+
+/// A candidate's refit with another value of a discrete shape (the co-flow's tail `r`: 0 the
+/// exponential, 0.5 the inverse-square decay) that the data cannot tell from the one reported:
+/// `ΔBIC` within the tie margin. The reported refit keeps the default shape unless the other
+/// is better by more than the margin.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShapeAlternative {
+    /// Its shape parameters.
+    pub shape: Vec<ShapeParameter>,
+    /// Its `ΔBIC` minus the reported refit's (positive: worse).
+    pub delta_bic_gap: f64,
+    /// Its strength (the effect's unit) and standard error.
+    pub strength: f64,
+    /// Standard error of `strength`.
+    pub stderr_strength: f64,
+    /// `n` of its refit.
+    pub n: f64,
+    /// `κ` of its refit.
+    pub kappa: f64,
+    /// 95% CI of `n`.
+    pub ci95_n: [f64; 2],
+    /// 95% CI of `κ`.
+    pub ci95_kappa: [f64; 2],
 }
 
 /// Whether a candidate's refitted strength may be named as found.
@@ -198,12 +226,21 @@ impl StrengthStatus {
     }
 }
 
-/// The status of a refitted `strength` of `effect` with the fit's estimates at a bound: at a
-/// search bound (listed in `at_bound`, or within the report's tolerance of the range) comes
-/// first, then outside the physical range.
+/// How many standard errors a strength may lie beyond its physical range and still count as
+/// consistent with it (the two-sided 95 % normal quantile): an emissivity estimated as
+/// 1.02 ± 0.09 is consistent with ε ≤ 1, one of 2.0 ± 0.1 is not.
+pub const PHYSICAL_RANGE_SE: f64 = 1.96;
+
+/// The status of a refitted `strength` (standard error `stderr`) of `effect` with the fit's
+/// estimates at a bound: at a search bound (listed in `at_bound`, or within the report's
+/// tolerance of the range) comes first, then outside the physical range by more than
+/// [`PHYSICAL_RANGE_SE`] standard errors. A strength beyond the physical range by less is
+/// [`StrengthStatus::Physical`] with a note saying so (noise alone puts a true value at the
+/// limit that far beyond it).
 pub fn strength_status(
     effect: &Effect,
     strength: f64,
+    stderr: f64,
     at_bound: &[AtBound],
 ) -> (StrengthStatus, Option<String>) {
     let (lo, hi) = search_range(effect);
@@ -230,8 +267,45 @@ pub fn strength_status(
     }
     match physical(effect, strength) {
         Ok(()) => (StrengthStatus::Physical, None),
-        Err(why) => (StrengthStatus::Unphysical, Some(why)),
+        Err(why) => {
+            let (plo, phi) = effect.physical_range();
+            let (limit, beyond) = if strength > phi {
+                (phi, strength - phi)
+            } else {
+                (plo, plo - strength)
+            };
+            let se_ok = stderr.is_finite() && stderr > 0.0;
+            let u = if unit == "-" {
+                String::new()
+            } else {
+                format!(" {unit}")
+            };
+            if se_ok && strength.is_finite() && beyond <= PHYSICAL_RANGE_SE * stderr {
+                (
+                    StrengthStatus::Physical,
+                    Some(format!(
+                        "{} = {strength:.4} +/- {stderr:.4}{u} lies beyond its physical limit \
+                         {limit}{u} by {:.2} standard errors: consistent with it (the data do not \
+                         tell it from a value at the limit)",
+                        effect.name(),
+                        beyond / stderr
+                    )),
+                )
+            } else {
+                (StrengthStatus::Unphysical, Some(why))
+            }
+        }
     }
+}
+
+/// Whether every discrete shape of `variant` (scanned, not fitted: the co-flow's tail) is at
+/// its default.
+fn discrete_shapes_at_defaults(variant: &Effect) -> bool {
+    variant
+        .shape_values()
+        .iter()
+        .filter(|(sp, _)| sp.scanned && !sp.fitted_with_strength)
+        .all(|(sp, v)| *v == sp.default)
 }
 
 /// Whether a candidate may be named as the missing effect: refitted, `ΔBIC` below `threshold`,
@@ -586,6 +660,7 @@ pub fn diagnose(
                     [r.0, r.1]
                 },
                 shape: Vec::new(),
+                shape_alternative: None,
                 profiles: Vec::new(),
                 scan_errors: Vec::new(),
             }
@@ -678,11 +753,13 @@ pub fn diagnose(
     }
     // refine each candidate's best grid points over all its shapes, in parallel
     let mut refine_jobs: Vec<(usize, usize, usize)> = Vec::new(); // (candidate, scan, start)
-    for &i in &scanned {
+                                                                  // (the variants with the discrete shapes at their defaults and those with other values
+                                                                  // are refined apart: the choice between them needs the best refit of each)
+    for (i, kind) in scanned.iter().flat_map(|&i| [(i, false), (i, true)]) {
         let mut starts: Vec<(usize, usize, f64)> = ok_scans
             .iter()
             .enumerate()
-            .filter(|(_, (c, _))| *c == i)
+            .filter(|(_, (c, sc))| *c == i && discrete_shapes_at_defaults(&sc.effect) != kind)
             .flat_map(|(j, (_, sc))| {
                 sc.starts
                     .iter()
@@ -748,11 +825,43 @@ pub fn diagnose(
             refine(sc, start, &opts).ok().map(|r| (i, j, r))
         })
         .collect();
-    let mut best_refit: Vec<Option<(Effect, Refit)>> = vec![None; cands.len()];
+    // per candidate, the best refit with the discrete shapes (scanned, not fitted: the
+    // co-flow's tail) at their defaults and the best with other values; the other is reported
+    // only where it is better by more than the tie margin, else listed as the shape alternative
+    // if within it
+    let mut best_by_kind: Vec<[Option<(Effect, Refit)>; 2]> = vec![[None, None]; cands.len()];
     for (i, j, r) in refined {
-        if best_refit[i].as_ref().is_none_or(|(_, b)| r.cost < b.cost) {
-            best_refit[i] = Some((ok_scans[j].1.effect.clone(), r));
+        let variant = &ok_scans[j].1.effect;
+        let kind = usize::from(!discrete_shapes_at_defaults(variant));
+        if best_by_kind[i][kind]
+            .as_ref()
+            .is_none_or(|(_, b)| r.cost < b.cost)
+        {
+            best_by_kind[i][kind] = Some((variant.clone(), r));
         }
+    }
+    let mut best_refit: Vec<Option<(Effect, Refit)>> = Vec::with_capacity(cands.len());
+    let mut other_shape: Vec<Option<(Effect, Refit)>> = Vec::with_capacity(cands.len());
+    for (i, [dflt, alt]) in best_by_kind.into_iter().enumerate() {
+        let k = results[i].extra_parameters;
+        let (chosen, other) = match (dflt, alt) {
+            (Some(d), Some(a)) => {
+                let gap = ic(a.1.cost, k).0 - ic(d.1.cost, k).0;
+                if gap < -options.tie_margin {
+                    (Some(a), Some(d))
+                } else {
+                    (Some(d), Some(a))
+                }
+            }
+            (d, a) => (d.or(a), None),
+        };
+        let other = other.filter(|o| {
+            chosen
+                .as_ref()
+                .is_some_and(|c| (ic(o.1.cost, k).0 - ic(c.1.cost, k).0).abs() < options.tie_margin)
+        });
+        best_refit.push(chosen);
+        other_shape.push(other);
     }
     let mut refits: Vec<(usize, Identification)> = Vec::new();
     for (i, br) in best_refit.into_iter().enumerate() {
@@ -786,7 +895,8 @@ pub fn diagnose(
         res.at_bound = rep.at_bound.clone();
         res.delta_bic = bic;
         res.delta_aic = aic;
-        let (mut status, mut note) = strength_status(&variant, res.strength, &res.at_bound);
+        let (mut status, mut note) =
+            strength_status(&variant, res.strength, res.stderr_strength, &res.at_bound);
         // a shape parameter at a bound of its range is no credible estimate either
         if status == StrengthStatus::Physical {
             let prefix = format!("{}.", e.name());
@@ -822,6 +932,29 @@ pub fn diagnose(
         let (peak, range) = signature_location(&positions, &change);
         res.signature_peak_m = peak;
         res.signature_range_m = range;
+        if let Some((_, o)) = other_shape[i].take() {
+            let orep = &o.report;
+            if let Some(oe) = orep.effects.iter().find(|x| x.effect == e.name()) {
+                res.shape_alternative = Some(ShapeAlternative {
+                    shape: oe
+                        .shapes
+                        .iter()
+                        .map(|sh| ShapeParameter {
+                            name: sh.name.clone(),
+                            value: sh.value,
+                            unit: sh.unit.clone(),
+                        })
+                        .collect(),
+                    delta_bic_gap: ic(o.cost, res.extra_parameters).0 - bic,
+                    strength: oe.strength,
+                    stderr_strength: oe.stderr_strength,
+                    n: orep.n,
+                    kappa: orep.kappa,
+                    ci95_n: orep.ci95_n,
+                    ci95_kappa: orep.ci95_kappa,
+                });
+            }
+        }
         refits.push((i, id));
     }
     // best first: credible refits by ΔBIC, then refits not credible (at a bound or not
@@ -936,6 +1069,7 @@ mod tests {
             physical_range: [0.0, 1.0],
             search_range: [0.0, 1.0],
             shape: Vec::new(),
+            shape_alternative: None,
             profiles: Vec::new(),
             scan_errors: Vec::new(),
         }
@@ -963,18 +1097,38 @@ mod tests {
     #[test]
     fn a_strength_at_a_bound_or_beyond_the_physical_range_is_not_credible() {
         let rad = Effect::Radiation;
-        let (s, note) = strength_status(&rad, 0.9, &[]);
+        let (s, note) = strength_status(&rad, 0.9, 0.1, &[]);
         assert_eq!((s, note), (StrengthStatus::Physical, None));
-        let (s, note) = strength_status(&rad, 1.6, &[]);
+        let (s, note) = strength_status(&rad, 1.6, 0.1, &[]);
         assert_eq!(s, StrengthStatus::Unphysical);
         assert!(note.unwrap().contains("> 1: not physical"));
+        // beyond the limit by less than 1.96 standard errors: consistent with it, said so
+        let (s, note) = strength_status(&rad, 1.02, 0.09, &[]);
+        assert_eq!(s, StrengthStatus::Physical);
+        let note = note.unwrap();
+        assert!(
+            note.contains("radiation = 1.0200 +/- 0.0900 lies beyond its physical limit 1 by 0.22 standard errors"),
+            "{note}"
+        );
+        let (s, _) = strength_status(&rad, -0.19, 0.1, &[]);
+        assert_eq!(s, StrengthStatus::Physical);
+        // by more, or without a valid standard error: not physical
+        assert_eq!(
+            strength_status(&rad, 1.2, 0.1, &[]).0,
+            StrengthStatus::Unphysical
+        );
+        assert_eq!(
+            strength_status(&rad, 1.02, f64::NAN, &[]).0,
+            StrengthStatus::Unphysical
+        );
         // at the search bound 2 (found by value, without an at_bound entry)
-        let (s, note) = strength_status(&rad, 2.0, &[]);
+        let (s, note) = strength_status(&rad, 2.0, 0.5, &[]);
         assert_eq!(s, StrengthStatus::AtBound);
         assert!(note.unwrap().contains("upper bound 2"));
         // listed by the fit report
         let c = Effect::AirCoflow {
             decay_length: Some(0.25),
+            tail: None,
         };
         let ab = AtBound {
             parameter: "air_coflow".into(),
@@ -982,7 +1136,7 @@ mod tests {
             bound: -5.0,
             value: -5.0,
         };
-        let (s, note) = strength_status(&c, -5.0, &[ab]);
+        let (s, note) = strength_status(&c, -5.0, 1.0, &[ab]);
         assert_eq!(s, StrengthStatus::AtBound);
         let note = note.unwrap();
         assert!(
@@ -997,7 +1151,7 @@ mod tests {
             value: 20.0,
         };
         assert_eq!(
-            strength_status(&c, 3.0, &[other]).0,
+            strength_status(&c, 3.0, 1.0, &[other]).0,
             StrengthStatus::Physical
         );
     }

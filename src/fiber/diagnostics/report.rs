@@ -1,6 +1,8 @@
 //! The diagnosis in words, and the before/after residual figure.
 
-use super::diagnose::{CandidateResult, Diagnosis, DiagnosisRun, ResidualProfiles, StrengthStatus};
+use super::diagnose::{
+    CandidateResult, Diagnosis, DiagnosisRun, ResidualProfiles, ShapeAlternative, StrengthStatus,
+};
 use super::scan::Profile;
 use crate::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
@@ -91,12 +93,18 @@ impl Diagnosis {
                         c.unit
                     ));
                 }
+                if let (StrengthStatus::Physical, Some(note)) = (c.status, &c.status_note) {
+                    s.push_str(&format!("NOTE: {note}.\n"));
+                }
                 if c.n.is_finite() {
                     s.push_str(&format!(
                         "With it: n = {}, kappa = {}.\n",
                         estimate_with_ci(c, "n", c.n, c.ci95_n),
                         estimate_with_ci(c, "kappa", c.kappa, c.ci95_kappa)
                     ));
+                }
+                if let Some(a) = &c.shape_alternative {
+                    s.push_str(&shape_alternative_line(c, a));
                 }
                 s.push_str(&super::ties::ties_paragraph(c, &self.alternatives));
             }
@@ -368,4 +376,40 @@ impl DiagnosisRun {
             self.residuals_after.as_ref().map(|a| (name.as_str(), a)),
         )
     }
+}
+
+/// The sentence on a shape the data cannot choose (see [`ShapeAlternative`]): the other
+/// shape's strength and material estimate, and how far the latter lies from the reported one
+/// in its standard errors.
+fn shape_alternative_line(c: &CandidateResult, a: &ShapeAlternative) -> String {
+    let shape = a
+        .shape
+        .iter()
+        .map(|p| match p.unit.as_str() {
+            "-" | "" => format!("{} {}", p.name, p.value),
+            u => format!("{} {:.4} {u}", p.name, p.value),
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let se = |ci: [f64; 2]| (ci[1] - ci[0]) / (2.0 * 1.959964);
+    let shift = |x: f64, x0: f64, ci: [f64; 2]| (x - x0) / se(ci);
+    format!(
+        "SHAPE: these data cannot choose the shape of {}: with {shape} (delta BIC {:+.1}) its \
+         strength is {:.4} +/- {:.4} {}, n = {:.4} (95% CI [{:.4}, {:.4}]), kappa = {:.4} \
+         (95% CI [{:.4}, {:.4}]): n {:+.1}, kappa {:+.1} standard errors from the estimate \
+         above, a systematic uncertainty of the shape.\n",
+        c.effect,
+        a.delta_bic_gap,
+        a.strength,
+        a.stderr_strength,
+        c.unit,
+        a.n,
+        a.ci95_n[0],
+        a.ci95_n[1],
+        a.kappa,
+        a.ci95_kappa[0],
+        a.ci95_kappa[1],
+        shift(a.n, c.n, c.ci95_n),
+        shift(a.kappa, c.kappa, c.ci95_kappa)
+    )
 }

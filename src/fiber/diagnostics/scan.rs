@@ -246,18 +246,29 @@ pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
 /// its range (lengths `0.4 ×`, `1 ×` and `2.5 ×` the default, an onset at 30 %, 50 % and 70 % of
 /// the spin line of length `length` \[m\]), clamped to its bounds; the other free shapes (the
 /// line co-flow's ramp width) are held at their defaults; shapes fixed by the user stay fixed.
-/// Without `scan_shapes`, one variant with the free shapes at their defaults. The refinement
-/// frees every free shape again ([`refine`]).
+/// A scanned shape the fit does not free (the co-flow's tail) takes the values 0 and 0.5 of
+/// its discrete choice. Without `scan_shapes`, one variant with the free shapes at their
+/// defaults. The refinement frees every free shape again and holds the discrete ones at the
+/// variant's values ([`refine`]).
 pub fn shape_variants(
     effect: &Effect,
     scan_shapes: bool,
     length: f64,
 ) -> Vec<(Effect, Vec<ShapeParameter>)> {
     let mut variants = vec![effect.clone()];
-    for sp in effect.free_shapes() {
+    let shapes: Vec<_> = effect
+        .shape_settings()
+        .into_iter()
+        .filter(|(sp, v)| v.is_none() && (sp.fitted_with_strength || (scan_shapes && sp.scanned)))
+        .map(|(sp, _)| sp)
+        .collect();
+    for sp in shapes {
         let (lo, hi) = sp.bounds_for_length(length);
         let values: Vec<f64> = if !scan_shapes || !sp.scanned {
             vec![sp.default]
+        } else if !sp.fitted_with_strength {
+            // a discrete choice (the co-flow's tail: exponential or inverse square)
+            vec![sp.default, 0.5]
         } else if sp.name == "onset" {
             [0.3, 0.5, 0.7].iter().map(|f| f * length).collect()
         } else {
@@ -503,9 +514,23 @@ pub fn refine(
     start: &GridStart,
     options: &IdentifyOptions,
 ) -> Result<Refit, RheometerError> {
-    // the shapes the scan fixed are fitted again, started at the variant's values
+    // the shapes the scan fixed are fitted again, started at the variant's values; the
+    // discrete ones (scanned, not fitted) keep the variant's values
     let mut strengths = vec![(scan.effect.name().to_string(), start.strength)];
-    let free = scan.candidate.free_shapes();
+    let mut candidate = scan.candidate.clone();
+    for (sp, v) in scan.effect.shape_values() {
+        let open = scan
+            .candidate
+            .shape_settings()
+            .iter()
+            .any(|(c, set)| c.name == sp.name && set.is_none());
+        if open && sp.scanned && !sp.fitted_with_strength {
+            candidate = candidate
+                .with_shape(sp.name, v)
+                .map_err(RheometerError::Data)?;
+        }
+    }
+    let free = candidate.free_shapes();
     let fixed_by_scan: Vec<(&'static str, f64)> = scan
         .effect
         .shape_values()
@@ -520,7 +545,7 @@ pub fn refine(
     } else {
         let mut spec = scan.rheometer.spec.clone();
         if let Some(last) = spec.effects.last_mut() {
-            last.effect = scan.candidate.clone();
+            last.effect = candidate.clone();
         }
         freed = rheometer_for(&scan.rheometer, spec)?;
         &freed
@@ -601,6 +626,7 @@ mod tests {
     fn grid_spans_small_and_large_magnitudes_on_both_sides() {
         let e = Effect::AirCoflow {
             decay_length: Some(DEFAULT_COFLOW_DECAY_LENGTH),
+            tail: None,
         };
         let (lo, hi) = e.physical_range();
         let o = ScanOptions::default();
@@ -668,7 +694,10 @@ mod tests {
         assert!(e.contains("radiation") && e.contains("> 1") && e.contains("not physical"));
         assert!(physical(&Effect::Radiation, -0.2).is_err());
         assert!(physical(&Effect::Radiation, f64::NAN).is_err());
-        let c = Effect::AirCoflow { decay_length: None };
+        let c = Effect::AirCoflow {
+            decay_length: None,
+            tail: None,
+        };
         assert!(physical(&c, 5.0).is_ok());
         assert!(physical(&c, 150.0).is_ok(), "aspirator speeds are physical");
         assert!(physical(&c, 1e3).unwrap_err().contains("m/s"));
@@ -687,26 +716,42 @@ mod tests {
 
     #[test]
     fn shapes_are_scanned_as_variants() {
-        let v = shape_variants(&Effect::AirCoflow { decay_length: None }, true, 0.5);
-        assert_eq!(v.len(), 3);
+        let free = Effect::AirCoflow {
+            decay_length: None,
+            tail: None,
+        };
+        let v = shape_variants(&free, true, 0.5);
+        // three decay lengths, each with the exponential and the inverse-square tail
+        assert_eq!(v.len(), 6);
         assert!(v.iter().any(|(_, s)| s[0].value <= 0.041));
         assert!(v.iter().any(|(_, s)| s[0].value >= 0.25));
+        for tail in [0.0, 0.5] {
+            assert_eq!(v.iter().filter(|(_, s)| s[1].value == tail).count(), 3);
+        }
         for (e, s) in &v {
             match e {
-                Effect::AirCoflow { decay_length } => assert_eq!(*decay_length, Some(s[0].value)),
+                Effect::AirCoflow { decay_length, tail } => {
+                    assert_eq!(*decay_length, Some(s[0].value));
+                    assert_eq!(*tail, Some(s[1].value));
+                }
                 _ => panic!("not a co-flow"),
             }
         }
+        // without the shape scan: one variant, the tail at its default (exponential)
+        let plain = shape_variants(&free, false, 0.5);
+        assert_eq!(plain.len(), 1);
+        assert_eq!(plain[0].1[1].value, 0.0);
         // a shape fixed by the user is not scanned
         let fixed = shape_variants(
             &Effect::AirCoflow {
                 decay_length: Some(0.2),
+                tail: Some(0.5),
             },
             true,
             0.5,
         );
         assert_eq!(fixed.len(), 1);
-        assert_eq!(fixed[0].1[0].value, 0.2);
+        assert_eq!((fixed[0].1[0].value, fixed[0].1[1].value), (0.2, 0.5));
         assert_eq!(shape_variants(&Effect::Radiation, true, 0.5).len(), 1);
         // the onset of the line co-flow across the line (its ramp width held at its default:
         // fitted by the refinement only)

@@ -351,6 +351,7 @@ mod tests {
             physical_range: [-0.1, 0.1],
             search_range: [-0.2, 0.2],
             shape: Vec::new(),
+            shape_alternative: None,
             profiles: Vec::new(),
             scan_errors: Vec::new(),
         }
