@@ -934,7 +934,18 @@ pub fn diagnose(
         res.signature_range_m = range;
         if let Some((_, o)) = other_shape[i].take() {
             let orep = &o.report;
-            if let Some(oe) = orep.effects.iter().find(|x| x.effect == e.name()) {
+            // only a credible other shape (its strength and shape inside their ranges) is an
+            // alternative
+            let prefix = format!("{}.", e.name());
+            let credible = !orep
+                .at_bound
+                .iter()
+                .any(|b| b.parameter == e.name() || b.parameter.starts_with(&prefix));
+            if let Some(oe) = orep
+                .effects
+                .iter()
+                .find(|x| credible && x.effect == e.name())
+            {
                 res.shape_alternative = Some(ShapeAlternative {
                     shape: oe
                         .shapes
