@@ -752,9 +752,9 @@ pub fn diagnose(
         }
     }
     // refine each candidate's best grid points over all its shapes, in parallel
+    // (the variants with the discrete shapes at their defaults and those with other values are
+    // refined apart: the choice between them needs the best refit of each)
     let mut refine_jobs: Vec<(usize, usize, usize)> = Vec::new(); // (candidate, scan, start)
-                                                                  // (the variants with the discrete shapes at their defaults and those with other values
-                                                                  // are refined apart: the choice between them needs the best refit of each)
     for (i, kind) in scanned.iter().flat_map(|&i| [(i, false), (i, true)]) {
         let mut starts: Vec<(usize, usize, f64)> = ok_scans
             .iter()
