@@ -632,10 +632,13 @@ impl Effect {
         };
         let (lo, hi) = sp.bounds;
         if !(value.is_finite() && value >= lo && value <= hi) {
+            let unit = match sp.unit {
+                "-" => String::new(),
+                u => format!(" {u}"),
+            };
             return Err(format!(
-                "{}:{name} = {value} is outside its admissible range [{lo}, {hi}] {}",
-                self.name(),
-                sp.unit
+                "{}:{name} = {value} is outside its admissible range [{lo}, {hi}]{unit}",
+                self.name()
             ));
         }
         match (&mut self, name) {
