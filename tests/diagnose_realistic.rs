@@ -450,7 +450,6 @@ fn aspirator_30_m_s_short_is_found() {
 }
 
 #[test]
-#[ignore = "issue 11: a 300 m/s jet within 3 cm of the take-up: air_coflow is named (tail 0.5, 5.6 ± 0.95 m/s, l 0.22 m, dBIC -412) but RMS after 3.09 % (noise 1.5 %), n 0.700: a local optimum; the refit from the grid point 86 m/s, l 0.04 m, tail 0.5 ends worse (J 0.34 vs 0.224), while V 100 m/s, l 0.03 m, tail 0.5 held gives RMS 1.9 %: the 3-point grid of decay lengths (0.04, 0.1, 0.25 m) is too coarse for a 3 cm jet"]
 fn aspirator_300_m_s_short_is_found() {
     let sc = scenarios::aspirator(300.0, 0.03, 123);
     assert_found(&sc, &run(&sc));

@@ -242,8 +242,10 @@ pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
 
 /// The variants of `effect` whose shapes are scanned, each with its shape parameters: every
 /// shape parameter the effect fits with its strength ([`Effect::free_shapes`]) and marks
-/// [`scanned`](crate::fiber::effects::ShapeParameter::scanned) is fixed at three values across
-/// its range (lengths `0.4 ×`, `1 ×` and `2.5 ×` the default, an onset at 30 %, 50 % and 70 % of
+/// [`scanned`](crate::fiber::effects::ShapeParameter::scanned) is fixed at values across its
+/// range (lengths `0.4 ×`, `1 ×` and `2.5 ×` the default, for the co-flow also `0.15 ×`: a jet
+/// within a few centimetres of the take-up is found only from a short decay length; an onset at
+/// 30 %, 50 % and 70 % of
 /// the spin line of length `length` \[m\]), clamped to its bounds; the other free shapes (the
 /// line co-flow's ramp width) are held at their defaults; shapes fixed by the user stay fixed.
 /// A scanned shape the fit does not free (the co-flow's tail) takes the values 0 and 0.5 of
@@ -272,7 +274,12 @@ pub fn shape_variants(
         } else if sp.name == "onset" {
             [0.3, 0.5, 0.7].iter().map(|f| f * length).collect()
         } else {
-            [0.4 * sp.default, sp.default, 2.5 * sp.default].to_vec()
+            let mut v = vec![0.4 * sp.default, sp.default, 2.5 * sp.default];
+            if sp.model_param == "air_coflow.decay_length" {
+                // an aspirator jet within a few centimetres of the take-up
+                v.insert(0, 0.15 * sp.default);
+            }
+            v
         };
         let mut values: Vec<f64> = values.into_iter().map(|v| v.clamp(lo, hi)).collect();
         values.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-300));
@@ -721,12 +728,12 @@ mod tests {
             tail: None,
         };
         let v = shape_variants(&free, true, 0.5);
-        // three decay lengths, each with the exponential and the inverse-square tail
-        assert_eq!(v.len(), 6);
+        // four decay lengths, each with the exponential and the inverse-square tail
+        assert_eq!(v.len(), 8);
         assert!(v.iter().any(|(_, s)| s[0].value <= 0.041));
         assert!(v.iter().any(|(_, s)| s[0].value >= 0.25));
         for tail in [0.0, 0.5] {
-            assert_eq!(v.iter().filter(|(_, s)| s[1].value == tail).count(), 3);
+            assert_eq!(v.iter().filter(|(_, s)| s[1].value == tail).count(), 4);
         }
         for (e, s) in &v {
             match e {
