@@ -103,6 +103,18 @@ impl ZeroRateViscosity {
 /// [`ZeroRateViscosity::eval_shifted`]); `None`: the nominal VFT law.
 pub type VftShift<D> = Option<[D; 2]>;
 
+impl ZeroRateViscosity {
+    /// `μ̃_e0(T̃)`, with the VFT parameters shifted when `shift` is given
+    /// ([`eval`](Self::eval) or [`eval_shifted`](Self::eval_shifted)).
+    #[inline]
+    pub fn eval_with<D: DualNum<Primitive = f64> + Copy>(&self, t: D, shift: VftShift<D>) -> D {
+        match shift {
+            None => self.eval(t),
+            Some([db, dt_vf]) => self.eval_shifted(t, db, dt_vf),
+        }
+    }
+}
+
 /// Newtonian law `μ_e = μ_e0(T)` (no parameters).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Newtonian;
@@ -251,10 +263,7 @@ pub fn viscosity_with_partials_shifted<L: ViscosityLaw, D: DualNum<Primitive = f
     }
     let pl = &pl[..k];
     let tt = DualSVec::<D, 2>::from_re(t).derivative(0);
-    let mu0 = match shift {
-        None => zero.eval(tt),
-        Some([db, dt_vf]) => zero.eval_shifted(tt, DualSVec::from_re(db), DualSVec::from_re(dt_vf)),
-    };
+    let mu0 = zero.eval_with(tt, shift.map(|d| d.map(DualSVec::from_re)));
     let x = LawInputs {
         t: tt,
         mu0,
@@ -290,10 +299,7 @@ pub fn viscosity_shifted<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
     rate: D,
     p: &[D],
 ) -> D {
-    let mu0 = match shift {
-        None => zero.eval(t),
-        Some([db, dt_vf]) => zero.eval_shifted(t, db, dt_vf),
-    };
+    let mu0 = zero.eval_with(t, shift);
     law.mu_e(&LawInputs { t, mu0, rate, de }, p)
 }
 
