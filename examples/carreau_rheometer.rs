@@ -9,9 +9,7 @@
 
 use diffbvp::fiber::figures::{identification_figures, landscape_map};
 use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{
-    Estimator, FitReport, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS,
-};
+use diffbvp::fiber::rheometer::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
 use diffbvp::mesh::linspace;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -51,15 +49,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         heuristic.trace.len() + 1
     );
     let id = rheometer.identify(start, &principled)?;
-    let report = FitReport::new(&id);
+    let report = id.summary.clone();
     println!("\n{}", report.to_text());
     // ANCHOR_END: identify
     let paper = IdentifyOptions::with_estimator(Estimator::Paper);
     let id_paper = rheometer.identify(start, &paper)?;
-    println!("{}", FitReport::new(&id_paper).to_text());
+    println!("{}", id_paper.summary.clone().to_text());
     println!(
         "truth (0.8, 11.71): principled estimator lands at ({:.4}, {:.4}), paper's at ({:.4}, {:.4}) (bias of the smoothing step)",
-        id.n, id.kappa, id_paper.n, id_paper.kappa
+        id.law()[0], id.law()[1], id_paper.law()[0], id_paper.law()[1]
     );
 
     println!("\nPaper Table 3: identification from 11 starting points");
@@ -82,7 +80,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let cell = |r: &Result<diffbvp::fiber::rheometer::Identification, _>| match r {
             Ok(i) => format!(
                 "{:>8.4} {:>8.4} {:>5} {:>8.3}",
-                i.n, i.kappa, i.fit.iterations, i.wall_time_s
+                i.law()[0],
+                i.law()[1],
+                i.fit.iterations,
+                i.summary.solver.wall_time_s
             ),
             Err(e) => format!("failed: {e}"),
         };
@@ -92,7 +93,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Figures: paper Fig. 2, 3, 5 for the principled fit, and Fig. 4, the cost landscape.
     std::fs::create_dir_all(&out)?;
-    let newtonian = rheometer.newtonian_solutions(id.kappa, &principled)?;
+    let newtonian = rheometer.newtonian_solutions(id.law()[1], &principled)?;
     for path in identification_figures(&rheometer, &id, &newtonian, &out, "png", &inputs)? {
         println!("wrote {}", path.display());
     }
@@ -114,8 +115,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|&[n, k]| (n, k, "Table 3 start".to_string()))
         .collect();
     markers.push((
-        id_paper.n,
-        id_paper.kappa,
+        id_paper.law()[0],
+        id_paper.law()[1],
         "identified (paper J)".to_string(),
     ));
     let path = out.join("fig4_landscape.png");

@@ -46,30 +46,37 @@
 //! ## Layers
 //!
 //! Each module imports only from its own layer's peers without cycles and from the layers below
-//! it. The toolkit, bottom to top:
+//! it (checked by `python3 .ci/import-graph.py`, which reads this list). The toolkit, bottom to
+//! top:
 //!
 //! 1. [`error`], [`problem`], [`mesh`], [`dyn_dual`];
-//! 2. dual Jacobians, collocation, [`linear`] (sparse LU), error control, Newton, [`solution`];
+//! 2. `dual_jacobian`, `collocation`, [`linear`] (sparse LU and block elimination),
+//!    `error_control`, `newton`, `linearization`, [`solution`];
 //! 3. [`solve`](mod@solve) (the adaptive loop);
 //! 4. [`continuation`], [`sensitivity`], [`inspect`];
 //! 5. [`least_squares`] (the bounded driver; its [`BvpResiduals`](least_squares::BvpResiduals)
 //!    adaptor solves BVPs and takes their sensitivities).
 //!
-//! `plot` (with the atomic file writing it shares with `fiber`) stands apart: no solver imports.
+//! `plot` and `atomic_write` stand apart: no solver imports (`atomic_write` is the
+//! temporary-then-rename writing that the figures share with the rheometer's outputs).
 //!
 //! The toolkit never imports `fiber`. The fiber model and rheometer (`fiber`, feature
 //! `rheometer`), bottom to top:
 //!
-//! 1. `setup`, `error`, `scaling`, `material_law`;
+//! 1. `setup`, `error`, `scaling`, `material_law`, `format` (numbers for people), `serde_nan`;
 //! 2. `contributions` (force and heat terms) and `effects` (the candidate effects vocabulary);
 //! 3. `model` (the BVP);
 //! 4. `cold_start`, `simulate`;
-//! 5. `smoothing`, `synthetic`, `input`, `output`, `statistics`, `take_up`;
+//! 5. `smoothing`, `synthetic`, `input`, `output`, `statistics`, `noise_model`,
+//!    `noise_summary` (the one noise level), `take_up`, `uncertainty`;
 //! 6. `rheometer` (inside: `options`, `estimator` → `data` → `layout` → `objective` →
-//!    `identify` → `report`, `landscape`);
+//!    `identify` → `summary_build`, `error_budget`, `landscape`; the values `summary`,
+//!    `budget` below them);
 //! 7. `figures`;
-//! 8. `diagnostics` (`compare`, `diagnose`, `report`);
-//! 9. `failure_hints`.
+//! 8. `diagnostics` (`compare`, `candidate` → `ties`, `diagnose` (its stages), `diagnosis`,
+//!    `report`);
+//! 9. `failure_hints`;
+//! 10. `workflow` (what each `rheometer` subcommand does, as library calls).
 //!
 //! ## Cargo features
 //!

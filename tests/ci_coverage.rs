@@ -63,9 +63,9 @@ fn coverage(sc: &Scenario, effect: Effect, base: bool) {
         let c = &d.candidates[0];
         let (n, kappa, ci_n, ci_k) = if base {
             let b = &d.base_fit;
-            (b.n, b.kappa, b.ci95_n, b.ci95_kappa)
+            (b.n.value, b.kappa.value, b.n.ci95, b.kappa.ci95)
         } else {
-            (c.n, c.kappa, c.ci95_n, c.ci95_kappa)
+            (c.n(), c.kappa(), c.ci95_n(), c.ci95_kappa())
         };
         let row = Row {
             n,
@@ -89,11 +89,11 @@ fn coverage(sc: &Scenario, effect: Effect, base: bool) {
             (row.kappa - sc.law.kappa) / row.se_kappa,
             if row.kappa_in { "in" } else { "OUT" },
             c.effect,
-            c.strength,
-            c.stderr_strength,
+            c.strength(),
+            c.stderr_strength(),
             c.unit,
-            c.shape.iter().map(|sh| (sh.name.clone(), sh.value)).collect::<Vec<_>>(),
-            100.0 * c.rms_relative_residual_after,
+            c.shape().iter().map(|sh| (sh.name.clone(), sh.value)).collect::<Vec<_>>(),
+            100.0 * c.rms_relative_residual_after(),
             t1.elapsed().as_secs_f64()
         );
         rows.push(row);

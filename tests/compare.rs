@@ -108,7 +108,7 @@ fn noise_free_simulated_data_give_zero_residuals_and_no_segment() {
     );
     // data at tol 1e-8, model at 1e-6 (measured: max |r| 1.2e-8, chi2/dof 2e-14)
     assert!(max < 1e-6, "max |r| = {max}");
-    assert_eq!(cmp.sigma_source, NoiseSource::Given);
+    assert_eq!(cmp.noise.source, NoiseSource::Declared);
     assert!(cmp.chi2_per_dof < 1e-8, "chi2/dof = {}", cmp.chi2_per_dof);
     assert!(cmp.segments.is_empty(), "{:?}", cmp.segments);
     assert!(cmp.experiments.iter().all(|e| e.segments.is_empty()));
@@ -123,12 +123,12 @@ fn white_noise_is_white_and_has_no_segment() {
         let cmp = compare(&synthetic(|_| 0.0, 0.015, seed), None, &estimated()).unwrap();
         eprintln!(
             "seed {seed}: sigma_est = {:.4}, chi2/dof = {:.3}, runs z = {:.2}, lag1 z = {:.2}, segments {}",
-            cmp.sigma, cmp.chi2_per_dof, cmp.runs.z, cmp.lag1_z, cmp.segments.len()
+            cmp.noise.level, cmp.chi2_per_dof, cmp.runs.z, cmp.lag1_z, cmp.segments.len()
         );
         assert!(
-            (cmp.sigma / 0.015 - 1.0).abs() < 0.15,
+            (cmp.noise.level / 0.015 - 1.0).abs() < 0.15,
             "estimated sigma {}",
-            cmp.sigma
+            cmp.noise.level
         );
         assert!((cmp.chi2_per_dof - 1.0).abs() < 0.3, "{}", cmp.chi2_per_dof);
         assert!(cmp.segments.is_empty(), "seed {seed}: {:?}", cmp.segments);
@@ -144,12 +144,16 @@ fn runs_test_flags_a_smooth_residual() {
     let cmp = compare(&synthetic(wave, 0.01, 7), None, &estimated()).unwrap();
     eprintln!(
         "smooth: runs z = {:.2}, lag1 = {:.2} (z {:.1}), sigma_est = {:.4}",
-        cmp.runs.z, cmp.lag1, cmp.lag1_z, cmp.sigma
+        cmp.runs.z, cmp.lag1, cmp.lag1_z, cmp.noise.level
     );
     assert!(cmp.runs.z < -4.0, "runs z = {}", cmp.runs.z);
     assert!(cmp.lag1_z > 4.0, "lag-1 z = {}", cmp.lag1_z);
     // the noise estimate is not inflated by the smooth part
-    assert!((cmp.sigma / 0.01 - 1.0).abs() < 0.2, "sigma {}", cmp.sigma);
+    assert!(
+        (cmp.noise.level / 0.01 - 1.0).abs() < 0.2,
+        "sigma {}",
+        cmp.noise.level
+    );
     assert!(cmp.to_text().contains("NOT white"));
     // the basic statistic on a plain sequence
     let t = RunsTest::of(&[1.0, 1.0, 1.0, 1.0, 1.0, -1.0, -1.0, -1.0, -1.0, -1.0]);
@@ -189,8 +193,8 @@ fn injected_bias_is_located_with_sign_and_size() {
 fn given_uncertainty_is_used_and_chi2_scales() {
     let runs = synthetic(|_| 0.0, 0.015, 3);
     let cmp = compare(&runs, Some(0.03), &estimated()).unwrap();
-    assert_eq!(cmp.sigma_source, NoiseSource::Given);
-    assert_eq!(cmp.sigma, 0.03);
+    assert_eq!(cmp.noise.source, NoiseSource::Declared);
+    assert_eq!(cmp.noise.level, 0.03);
     assert!(
         (cmp.chi2_per_dof - 0.25).abs() < 0.08,
         "{}",
@@ -222,7 +226,7 @@ fn summary(cmp: &Comparison) -> String {
     format!(
         "chi2/dof = {:.2}, sigma = {:.4}, runs z = {:.1}, lag1 z = {:.1}, segments: [{}]",
         cmp.chi2_per_dof,
-        cmp.sigma,
+        cmp.noise.level,
         cmp.runs.z,
         cmp.lag1_z,
         segs.join("; ")

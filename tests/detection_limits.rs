@@ -44,12 +44,12 @@ fn run(sc: &Scenario) -> Diagnosis {
         "DETECTION | {} seed {} | base n {:.4} κ {:.4} | named {:?} | top {} = {:.4} ± {:.4} {} ΔBIC {:.1}",
         sc.name,
         sc.seed,
-        d.base_fit.n,
-        d.base_fit.kappa,
+        d.base_fit.n.value,
+        d.base_fit.kappa.value,
         d.most_likely_missing,
         top.effect,
-        top.strength,
-        top.stderr_strength,
+        top.strength(),
+        top.stderr_strength(),
         top.unit,
         top.delta_bic
     );
@@ -135,14 +135,14 @@ fn assert_detected(sc: &Scenario, d: &Diagnosis, allow_tie: bool) {
         "{}: {name} does not earn its place: {ranking:?}",
         sc.name
     );
-    let t = truth.in_unit(&c.unit, c.strength).unwrap();
+    let t = truth.in_unit(&c.unit, c.strength()).unwrap();
     assert!(
-        (c.strength - t).abs() <= 3.0 * c.stderr_strength,
+        (c.strength() - t).abs() <= 3.0 * c.stderr_strength(),
         "{}: {} = {} ± {} {}, truth {t}",
         sc.name,
         c.effect,
-        c.strength,
-        c.stderr_strength,
+        c.strength(),
+        c.stderr_strength(),
         c.unit
     );
     if pos == 0 {
@@ -245,8 +245,8 @@ fn the_predicted_bias_of_an_undetected_fault_is_the_fits() {
     ] {
         let d = run(&sc);
         let l = limit(c, effect);
-        let dk = d.base_fit.kappa - c.base_fit.kappa;
-        let dn = d.base_fit.n - c.base_fit.n;
+        let dk = d.base_fit.kappa.value - c.base_fit.kappa.value;
+        let dn = d.base_fit.n.value - c.base_fit.n.value;
         let pk = l.dkappa_per_unit.unwrap() * strength;
         let pn = l.dn_per_unit.unwrap() * strength;
         println!(
@@ -254,7 +254,7 @@ fn the_predicted_bias_of_an_undetected_fault_is_the_fits() {
         );
         // first order: the misprediction is second order in the strength, small against the
         // statistical standard error
-        let (sk, sn) = (c.base_fit.stderr_kappa, c.base_fit.stderr_n);
+        let (sk, sn) = (c.base_fit.kappa.stderr, c.base_fit.n.stderr);
         assert!(
             (dk - pk).abs() < 0.5 * sk,
             "{effect}: Δκ {dk} vs {pk} (se {sk})"
@@ -319,7 +319,7 @@ fn an_unnamed_cold_die_is_covered_by_the_reported_limits() {
     let truth_k = 10.0;
     if d.most_likely_missing.as_deref() == Some("die_temperature_offset") {
         let c = &d.candidates[0];
-        assert!((c.strength + truth_k).abs() <= 3.0 * c.stderr_strength);
+        assert!((c.strength() + truth_k).abs() <= 3.0 * c.stderr_strength());
         return;
     }
     let l = limit(&d, "die_temperature_offset");
@@ -331,9 +331,12 @@ fn an_unnamed_cold_die_is_covered_by_the_reported_limits() {
         "{text}"
     );
     let b = &d.base_fit;
-    let (err_k, err_n) = ((b.kappa - sc.law.kappa).abs(), (b.n - sc.law.n).abs());
-    let cover_k = l.shift_kappa_at_s95.unwrap().abs() + 2.0 * b.stderr_kappa;
-    let cover_n = l.shift_n_at_s95.unwrap().abs() + 2.0 * b.stderr_n;
+    let (err_k, err_n) = (
+        (b.kappa.value - sc.law.kappa).abs(),
+        (b.n.value - sc.law.n).abs(),
+    );
+    let cover_k = l.shift_kappa_at_s95.unwrap().abs() + 2.0 * b.kappa.stderr;
+    let cover_n = l.shift_n_at_s95.unwrap().abs() + 2.0 * b.n.stderr;
     println!(
         "COLD DIE UNNAMED | s50 {:.1} K s95 {:.1} K | κ error {err_k:.4} covered by {cover_k:.4} | n error {err_n:.4} covered by {cover_n:.4}",
         l.s50, l.s95

@@ -131,25 +131,25 @@ fn assert_found(r: &DiagnosisRun, hidden: &str, truth: Option<[f64; 2]>) {
     );
     assert_eq!(d.most_likely_missing.as_deref(), Some(hidden));
     let c = &d.candidates[0];
-    let ratio = c.rms_relative_residual_after / noise_level();
+    let ratio = c.rms_relative_residual_after() / noise_level();
     println!(
         "{hidden}: RMS after {:.4} % vs noise {:.4} % (ratio {ratio:.3}); strength {:.4} +/- {:.4}",
-        100.0 * c.rms_relative_residual_after,
+        100.0 * c.rms_relative_residual_after(),
         100.0 * noise_level(),
-        c.strength,
-        c.stderr_strength
+        c.strength(),
+        c.stderr_strength()
     );
     assert!((ratio - 1.0).abs() <= 0.2, "RMS/noise after = {ratio}");
     if let Some([n, k]) = truth {
         assert!(
-            c.ci95_n[0] <= n && n <= c.ci95_n[1],
+            c.ci95_n()[0] <= n && n <= c.ci95_n()[1],
             "n = {n} outside {:?}",
-            c.ci95_n
+            c.ci95_n()
         );
         assert!(
-            c.ci95_kappa[0] <= k && k <= c.ci95_kappa[1],
+            c.ci95_kappa()[0] <= k && k <= c.ci95_kappa()[1],
             "κ = {k} outside {:?}",
-            c.ci95_kappa
+            c.ci95_kappa()
         );
     }
 }
@@ -161,7 +161,7 @@ fn hidden_radiation_is_found() {
     let r = run(&set, LawChoice::Carreau, None);
     assert_found(&r, "radiation", Some(truth));
     let c = &r.diagnosis.candidates[0];
-    assert!((c.strength - 0.9).abs() <= 3.0 * c.stderr_strength);
+    assert!((c.strength() - 0.9).abs() <= 3.0 * c.stderr_strength());
 }
 
 #[test]
@@ -221,6 +221,7 @@ fn without_a_hidden_effect_no_candidate_earns_its_place() {
     assert!(
         !d.systematic,
         "RMS/noise {} ρ1 {}",
-        d.rms_over_noise, d.lag1_autocorrelation
+        d.rms_over_noise(),
+        d.lag1_autocorrelation()
     );
 }

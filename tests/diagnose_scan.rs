@@ -87,10 +87,14 @@ fn radiation_needing_emissivity_above_one_is_reported_and_not_named() {
         .iter()
         .find(|c| c.effect == "radiation")
         .unwrap();
-    assert!(rad.refitted);
+    assert!(rad.refitted());
     // the data need a strong radiation: the refit strength lies beyond ε = 1 (or at the
     // search bound), which is reported
-    assert!(rad.strength > 1.0, "radiation strength {}", rad.strength);
+    assert!(
+        rad.strength() > 1.0,
+        "radiation strength {}",
+        rad.strength()
+    );
     assert_ne!(rad.status, StrengthStatus::Physical);
     let note = rad.status_note.as_deref().unwrap();
     assert!(note.contains("radiation"), "{note}");
@@ -112,7 +116,7 @@ fn radiation_needing_emissivity_above_one_is_reported_and_not_named() {
         best.strength
     );
     assert!(best.cost < prof.cost_base);
-    assert!(rad.strength > 1.0, "refined ε = {}", rad.strength);
+    assert!(rad.strength() > 1.0, "refined ε = {}", rad.strength());
     // JSON carries the status and the profile
     let js = serde_json::to_string(d).unwrap();
     assert!(js.contains("\"status\":\"unphysical\"") || js.contains("\"status\":\"at_bound\""));

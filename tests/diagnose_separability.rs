@@ -46,8 +46,8 @@ fn refit(d: &Diagnosis, name: &str) -> (f64, f64) {
         .iter()
         .find(|c| c.effect == name)
         .expect("candidate listed");
-    assert!(c.refitted, "{name} not refitted");
-    (c.cost_after, c.strength)
+    assert!(c.refitted(), "{name} not refitted");
+    (c.cost_after, c.strength())
 }
 
 /// Standard normal CDF (Abramowitz–Stegun 7.1.26 for erf, |error| < 1.5e-7).

@@ -11,7 +11,7 @@ use diffbvp::fiber::effects::{
     Category, Effect, EffectSetting, ModelSpec, ALL_NAMES, BUILTIN_NAMES,
 };
 use diffbvp::fiber::rheometer::estimator::RelativeResidual;
-use diffbvp::fiber::rheometer::{FitReport, FitStart, IdentifyOptions, Layout, Rheometer};
+use diffbvp::fiber::rheometer::{FitStart, FitSummary, IdentifyOptions, Layout, Rheometer};
 use diffbvp::fiber::setup::{Air, Experiment, ExperimentSet, Inlet, Material, Measurements};
 use diffbvp::fiber::simulate::simulate_params;
 use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
@@ -455,11 +455,11 @@ const WHITE: NoiseModel = NoiseModel {
     disturbance_amplitude: 0.0,
 };
 
-fn fit_with(set: &ExperimentSet, setting: &str) -> FitReport {
+fn fit_with(set: &ExperimentSet, setting: &str) -> FitSummary {
     let spec = ModelSpec::default().with(setting.parse().unwrap());
     let rh = Rheometer::with_spec(set, spec).unwrap();
     let id = rh.identify(TRUTH, &IdentifyOptions::default()).unwrap();
-    let rep = FitReport::new(&id);
+    let rep = id.summary.clone();
     println!("{}", rep.to_text());
     rep
 }
@@ -484,19 +484,23 @@ fn fit_recovers_a_die_temperature_offset_made_through_the_inlet_temperature() {
         let e = &rep.effects[0];
         println!(
             "die_temperature_offset = {:.4} +/- {:.4} K (truth +10 K)",
-            e.strength, e.stderr_strength
+            e.strength.value, e.strength.stderr
         );
         match noise {
             // noise-free: the truth is the exact minimum
-            None => assert!((e.strength - 10.0).abs() < 0.05, "{}", e.strength),
+            None => assert!(
+                (e.strength.value - 10.0).abs() < 0.05,
+                "{}",
+                e.strength.value
+            ),
             Some(_) => {
                 assert!(
-                    (e.strength - 10.0).abs() < 3.0 * e.stderr_strength,
+                    (e.strength.value - 10.0).abs() < 3.0 * e.strength.stderr,
                     "{} +/- {}",
-                    e.strength,
-                    e.stderr_strength
+                    e.strength.value,
+                    e.strength.stderr
                 );
-                assert!(rep.ci95_kappa[0] <= TRUTH[1] && TRUTH[1] <= rep.ci95_kappa[1]);
+                assert!(rep.kappa.ci95[0] <= TRUTH[1] && TRUTH[1] <= rep.kappa.ci95[1]);
             }
         }
     }
@@ -518,18 +522,22 @@ fn fit_recovers_a_gauge_scale_made_by_scaling_the_measurements() {
         let e = &rep.effects[0];
         println!(
             "gauge_scale = {:.5} +/- {:.5} (truth 0.03)",
-            e.strength, e.stderr_strength
+            e.strength.value, e.strength.stderr
         );
         match noise {
-            None => assert!((e.strength - 0.03).abs() < 1e-4, "{}", e.strength),
+            None => assert!(
+                (e.strength.value - 0.03).abs() < 1e-4,
+                "{}",
+                e.strength.value
+            ),
             Some(_) => {
                 assert!(
-                    (e.strength - 0.03).abs() < 3.0 * e.stderr_strength,
+                    (e.strength.value - 0.03).abs() < 3.0 * e.strength.stderr,
                     "{} +/- {}",
-                    e.strength,
-                    e.stderr_strength
+                    e.strength.value,
+                    e.strength.stderr
                 );
-                assert!(rep.ci95_kappa[0] <= TRUTH[1] && TRUTH[1] <= rep.ci95_kappa[1]);
+                assert!(rep.kappa.ci95[0] <= TRUTH[1] && TRUTH[1] <= rep.kappa.ci95[1]);
             }
         }
     }

@@ -17,7 +17,7 @@ mod probe;
 use diffbvp::fiber::effects::{Effect, EffectSetting, ModelSpec};
 use diffbvp::fiber::input::{load_experiments_with, parse_experiments, LoadedExperiments};
 use diffbvp::fiber::rheometer::{
-    error_budget, ErrorBudget, FitReport, Identification, IdentifyOptions, Rheometer, SourceStatus,
+    error_budget, ErrorBudget, Identification, IdentifyOptions, Rheometer, SourceStatus,
     WarningCode,
 };
 use diffbvp::fiber::setup::{ExperimentSet, Inlet};
@@ -242,14 +242,14 @@ fn sensitivities_agree_with_central_differences_of_refits() {
     let (rh, id) = fit(&loaded.set, [0.8, 11.7]);
     let opts = IdentifyOptions::default();
     let b = error_budget(&rh, &id, &Uncertainties::defaults(), &opts).unwrap();
-    let start = [id.n, id.kappa];
+    let start = [id.law()[0], id.law()[1]];
     // central difference of a refit with the input changed by `change(set, ±h)`
     let refit_slope = |h: f64, change: &dyn Fn(&mut ExperimentSet, f64)| {
         let est = |x: f64| {
             let mut set = loaded.set.clone();
             change(&mut set, x);
             let (_, id) = fit(&set, start);
-            [id.n, id.kappa]
+            [id.law()[0], id.law()[1]]
         };
         let (p, m) = (est(h), est(-h));
         [(p[0] - m[0]) / (2.0 * h), (p[1] - m[1]) / (2.0 * h)]
@@ -370,9 +370,9 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
         }
     }
     // the statistical error is the fit report's
-    let rep = FitReport::new(&id);
-    assert_eq!(stat_k, rep.stderr_kappa);
-    assert_eq!(b.statistical_n.unwrap(), rep.stderr_n);
+    let rep = id.summary.clone();
+    assert_eq!(stat_k, rep.kappa.stderr);
+    assert_eq!(b.statistical_n.unwrap(), rep.n.stderr);
 
     // a warning iff the shift exceeds the statistical standard error: declare the inlet
     // diameter's uncertainty at 0.9 and 1.1 times the one that shifts κ by one SE
@@ -398,7 +398,7 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
         let e = entry(&b, "inlet_diameter_rel");
         assert_eq!(e.origin, Origin::Declared);
         assert!((e.shift_kappa.unwrap() - f * stat_k).abs() < 1e-9 * stat_k);
-        let rep = FitReport::new(&id).with_error_budget(b.clone());
+        let rep = id.summary.clone().with_error_budget(b.clone());
         let w: Vec<_> = rep
             .warnings
             .iter()

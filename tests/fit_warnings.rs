@@ -10,10 +10,9 @@
 
 mod probe;
 
-use diffbvp::fiber::diagnostics::compare::FitParameters;
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::rheometer::{
-    BoundSide, Estimator, FitReport, IdentifyOptions, Rheometer, WarningCode,
+    BoundSide, Estimator, FitSummary, IdentifyOptions, Rheometer, WarningCode,
 };
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -134,20 +133,21 @@ fn shipped_data_fit_has_no_warning() {
     assert_eq!(v["fitted"], serde_json::json!(["n", "kappa"]));
     assert_eq!(v["experiments"].as_array().unwrap().len(), 9);
     // the misfit check runs against a finite noise level, and the fit is within it
-    let noise = v["noise_level"].as_f64().unwrap();
+    let noise = v["noise"]["level"].as_f64().unwrap();
     let rms = v["rms_relative_residual"].as_f64().unwrap();
     assert!(noise > 0.005 && noise < 0.03, "noise level {noise}");
     assert!(rms < 3.0 * noise, "RMS {rms} vs noise {noise}");
     // intervals are valid numbers and contain the estimates
-    for (x, ci) in [("n", "ci95_n"), ("kappa", "ci95_kappa")] {
-        let (a, b) = (v[ci][0].as_f64().unwrap(), v[ci][1].as_f64().unwrap());
-        let x = v[x].as_f64().unwrap();
-        assert!(a < x && x < b, "{ci} = [{a}, {b}] around {x}");
+    for x in ["n", "kappa"] {
+        let ci = &v[x]["ci95"];
+        let (a, b) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+        let x = v[x]["value"].as_f64().unwrap();
+        assert!(a < x && x < b, "ci95 = [{a}, {b}] around {x}");
     }
     assert!(line(&p.stdout, "n:").contains("95% CI ["));
     // the written report reads back as a fit file for `compare`
     let text = std::fs::read_to_string(dir.join("fit.json")).unwrap();
-    let fp = FitParameters::from_json(&text, "fit.json").unwrap();
+    let fp = FitSummary::from_json(&text, "fit.json").unwrap();
     assert_eq!(fp.experiments.len(), 9);
 }
 
@@ -160,15 +160,15 @@ fn a_kappa_at_its_lower_bound_is_marked_and_gets_no_interval() {
     });
     let (p, v) = fit_cli(&toml, &data, &dir);
     println!("{}", p.stdout);
-    let kappa = v["kappa"].as_f64().unwrap();
+    let kappa = v["kappa"]["value"].as_f64().unwrap();
     assert!((kappa - 7.0).abs() < 1e-3, "kappa = {kappa}");
     assert_eq!(at_bound(&v, "kappa"), Some(("lower".to_string(), 7.0)));
     // no symmetric interval: null in JSON, none in the text
     assert!(
-        v["ci95_kappa"][0].is_null() && v["ci95_kappa"][1].is_null(),
+        v["kappa"]["ci95"][0].is_null() && v["kappa"]["ci95"][1].is_null(),
         "{v}"
     );
-    assert!(v["ci95_K_Pa"][0].is_null(), "{v}");
+    assert!(v["K_Pa"]["ci95"][0].is_null(), "{v}");
     let kl = line(&p.stdout, "kappa:");
     assert!(kl.contains("AT LOWER BOUND 7"), "{kl}");
     assert!(!kl.contains("95% CI ["), "{kl}");
@@ -261,7 +261,7 @@ fn increasing_diameters_are_named_and_undetermined_parameters_warned_about() {
         .iter()
         .any(|c| c == "large_uncertainty" || c == "singular_covariance");
     assert!(undetermined, "{v}");
-    if v["n"].as_f64().unwrap() > 0.999 {
+    if v["n"]["value"].as_f64().unwrap() > 0.999 {
         assert!(warning_with(&v, "at_bound", "Newtonian limit"), "{v}");
     }
     assert!(p
@@ -291,7 +291,7 @@ fn air_hotter_than_the_melt_is_not_relabelled_newtonian() {
         warning_with(&v, "misfit", "misfit far above the noise"),
         "{v}"
     );
-    if v["n"].as_f64().unwrap() > 0.999 {
+    if v["n"]["value"].as_f64().unwrap() > 0.999 {
         assert_eq!(at_bound(&v, "n").map(|b| b.0), Some("upper".to_string()));
         assert!(line(&p.stdout, "n:").contains("AT UPPER BOUND 1"));
     }
@@ -348,7 +348,7 @@ fn library_bounds_that_exclude_the_optimum_are_marked() {
             ..IdentifyOptions::with_estimator(Estimator::Principled)
         };
         let id = rh.identify([0.6, 14.0], &opts).unwrap();
-        let rep = FitReport::new(&id);
+        let rep = id.summary.clone();
         let text = rep.to_text();
         println!("{text}");
         let hits: Vec<(&str, BoundSide, f64)> = rep
@@ -358,12 +358,12 @@ fn library_bounds_that_exclude_the_optimum_are_marked() {
             .collect();
         assert_eq!(hits, vec![(name, side, bound)], "{text}");
         let ci = if name == "n" {
-            rep.ci95_n
+            rep.n.ci95
         } else {
-            rep.ci95_kappa
+            rep.kappa.ci95
         };
         assert!(ci.iter().all(|v| v.is_nan()), "{ci:?}");
-        assert!(!rep.covers(rep.n, rep.kappa));
+        assert!(!rep.covers(rep.n.value, rep.kappa.value));
         let l = line(&text, label);
         let mark = format!("AT {} BOUND {bound}", side.name().to_uppercase());
         assert!(l.contains(&mark) && !l.contains("95% CI ["), "{l}");
@@ -377,14 +377,15 @@ fn library_bounds_that_exclude_the_optimum_are_marked() {
         assert!(at[0].message.starts_with(&format!("{name} = ")), "{at:?}");
         // the JSON carries the mark, and the invalid interval is written as null
         let v: Value = serde_json::to_value(&rep).unwrap();
-        assert!(v[if name == "n" { "ci95_n" } else { "ci95_kappa" }][0].is_null());
+        assert!(v[name]["ci95"][0].is_null());
         assert_eq!(at_bound(&v, name), Some((side.name().to_string(), bound)));
         // and the written report reads back, nulls as NaN, marks and warnings kept
-        let back: FitReport = serde_json::from_value(v).unwrap();
+        let back: FitSummary = serde_json::from_value(v).unwrap();
         assert!(back
-            .ci95_n
+            .n
+            .ci95
             .iter()
-            .chain(&back.ci95_kappa)
+            .chain(&back.kappa.ci95)
             .any(|x| x.is_nan()));
         assert_eq!(back.at_bound, rep.at_bound);
         assert_eq!(back.warnings, rep.warnings);
@@ -403,11 +404,11 @@ fn reports_without_the_new_fields_still_read() {
       "take_up_factors": [1.0, 1.0], "residuals": 52, "iterations": 9,
       "failed_evaluations": 0, "wall_time_s": 0.5, "termination": "cost change below ftol"
     }"#;
-    let rep: FitReport = serde_json::from_str(old).unwrap();
-    assert!(rep.law.is_none() && rep.warnings.is_empty() && rep.at_bound.is_empty());
+    let rep = FitSummary::from_json(old, "old.json").unwrap();
+    assert!(rep.warnings.is_empty() && rep.at_bound.is_empty());
     let text = rep.to_text();
     assert!(line(&text, "n:").contains("95% CI ["), "{text}");
-    let fp = FitParameters::from_json(old, "old.json").unwrap();
+    let fp = FitSummary::from_json(old, "old.json").unwrap();
     assert_eq!(fp.take_up_factors.len(), 2);
     assert!(fp.experiments.is_empty());
 }
@@ -472,7 +473,7 @@ fn bad_fit_files() -> Vec<(&'static str, String, Vec<&'static str>)> {
         (
             "n_as_string",
             with(&|v| v["n"] = Value::from("NaN")),
-            vec!["field \"n\"", "expected a number"],
+            vec!["field \"n\"", "expected a number or an estimate"],
         ),
         (
             "huge_n",
@@ -575,7 +576,7 @@ fn fit_files_are_checked_by_the_library_too() {
         if name == "too_few_take_up_factors" || name == "other_experiments" {
             continue; // need the data set: checked by `apply` / `check_experiments`
         }
-        let err = FitParameters::from_json(&text, "f.json")
+        let err = FitSummary::from_json(&text, "f.json")
             .unwrap_err()
             .to_string();
         assert!(err.starts_with("f.json"), "{name}: {err}");
@@ -583,7 +584,7 @@ fn fit_files_are_checked_by_the_library_too() {
             assert!(err.contains(n), "{name}: {err} lacks {n:?}");
         }
     }
-    let fp = FitParameters::from_json(&good_fit().to_string(), "f.json").unwrap();
+    let fp = FitSummary::from_json(&good_fit().to_string(), "f.json").unwrap();
     let mut names: Vec<String> = fp.experiments.clone();
     assert!(fp.check_experiments(&names, "f.json").is_ok());
     names.swap(0, 1);
@@ -645,7 +646,11 @@ fn diagnose_marks_a_candidate_refit_at_its_bound() {
         .parse::<diffbvp::fiber::effects::Effect>()
         .unwrap()
         .bounds();
-    let s = coflow["strength"].as_f64().unwrap();
+    let s = coflow["refit"]["effects"]
+        .as_array()
+        .and_then(|a| a.iter().find(|e| e["effect"] == "air_coflow"))
+        .map(|e| e["strength"]["value"].as_f64().unwrap())
+        .unwrap();
     assert!(lo < s && s < hi, "co-flow strength {s}");
     let coflow_line = p
         .stdout

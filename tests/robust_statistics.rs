@@ -8,7 +8,7 @@
 use diffbvp::fiber::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
-use diffbvp::fiber::rheometer::{FitReport, IdentifyOptions, Rheometer};
+use diffbvp::fiber::rheometer::{FitSummary, IdentifyOptions, Rheometer};
 use diffbvp::fiber::setup::{ExperimentSet, TakeUp};
 use diffbvp::fiber::synthetic::{NoiseModel as SyntheticNoise, SplitMix64};
 use diffbvp::fiber::Physics;
@@ -340,29 +340,29 @@ fn with_outliers(mut set: ExperimentSet) -> ExperimentSet {
     set
 }
 
-fn report(set: &ExperimentSet, loss: Loss) -> FitReport {
+fn report(set: &ExperimentSet, loss: Loss) -> FitSummary {
     let rh = Rheometer::new(set).unwrap();
     let opts = IdentifyOptions {
         loss,
         ..IdentifyOptions::default()
     };
     let id = rh.identify([0.5, 11.51], &opts).unwrap();
-    FitReport::new(&id)
+    id.summary.clone()
 }
 
-fn line(name: &str, r: &FitReport) -> String {
+fn line(name: &str, r: &FitSummary) -> String {
     format!(
         "{name} {}: n = {:.4} ± {:.4} [{:.4}, {:.4}], kappa = {:.4} ± {:.4} [{:.4}, {:.4}], \
          f_scale {:.4}, down-weighted {}, RMS {:.4} %",
         r.loss,
-        r.n,
-        r.stderr_n,
-        r.ci95_n[0],
-        r.ci95_n[1],
-        r.kappa,
-        r.stderr_kappa,
-        r.ci95_kappa[0],
-        r.ci95_kappa[1],
+        r.n.value,
+        r.n.stderr,
+        r.n.ci95[0],
+        r.n.ci95[1],
+        r.kappa.value,
+        r.kappa.stderr,
+        r.kappa.ci95[0],
+        r.kappa.ci95[1],
         r.f_scale,
         r.down_weighted,
         100.0 * r.rms_relative_residual
@@ -376,7 +376,7 @@ fn robust_fits_of_data_with_outliers_cover_the_truth() {
     let dirty = with_outliers(shipped());
     let lin = report(&dirty, Loss::Linear);
     eprintln!("{}", line("outliers", &lin));
-    let width = |r: &FitReport| r.ci95_kappa[1] - r.ci95_kappa[0];
+    let width = |r: &FitSummary| r.kappa.ci95[1] - r.kappa.ci95[0];
     for loss in [Loss::Huber, Loss::SoftL1, Loss::Cauchy] {
         let r = report(&dirty, loss);
         eprintln!("{}", line("outliers", &r));
@@ -444,7 +444,7 @@ fn the_correct_model_stays_consistent_with_noise_and_outliers_are_reported() {
         "{}",
         cmp.noise.rms_over_noise
     );
-    assert!(cmp.noise.outliers.len() <= 1);
+    assert!(cmp.noise.model.as_ref().unwrap().outliers.len() <= 1);
     // with the injected outliers: all flagged by experiment and position, still noise
     let cmp = compare_set(
         &with_true_take_up(with_outliers(shipped())),
@@ -487,7 +487,7 @@ fn the_noise_model_of_a_fit_names_the_outliers_with_their_diameters() {
     // the call the diagnosis makes on an identification's residuals
     let rh = Rheometer::new(&with_outliers(shipped())).unwrap();
     let id = rh.identify(TRUTH, &IdentifyOptions::default()).unwrap();
-    let nm = rh.noise_model(&id.residual_profiles).unwrap();
+    let nm = id.summary.noise.model.clone().unwrap();
     eprintln!(
         "linear fit with outliers: sigma {:.4}, RMS/noise {:.3}, robust {:.3}, lag1 z {:.2}, flagged {:?}",
         nm.sigma,
@@ -506,7 +506,7 @@ fn the_noise_model_of_a_fit_names_the_outliers_with_their_diameters() {
     let m = &rh.measurements[o.experiment_index];
     assert_eq!(o.d_meas_m, m.diameters[o.point_index]);
     assert!(nm.sigma < 0.02 && nm.rms_over_noise < 1.2, "{nm:?}");
-    assert!(rh.noise_model(&id.residual_profiles[1..]).is_err());
+    assert!(rh.residual_series(&id.residual_profiles[1..]).is_err());
 }
 
 #[test]

@@ -46,8 +46,8 @@ fn compare(rh: &Rheometer, label: &str) {
         fixed.fit.iterations,
         scheduled.fit.iterations,
         scheduled.fit.loose_iterations,
-        scheduled.n,
-        scheduled.kappa
+        scheduled.law()[0],
+        scheduled.law()[1]
     );
 }
 

@@ -654,6 +654,15 @@ impl Effect {
         Ok(self)
     }
 
+    /// Parameters a refit with the effect adds: its strength and the shapes fitted with it
+    /// (`strain_thinning`: `n` and `κ`, the stress scale a Newtonian model leaves free).
+    pub fn extra_parameters(&self) -> usize {
+        match self {
+            Effect::StrainThinning => 2,
+            _ => 1 + self.free_shapes().len(),
+        }
+    }
+
     /// Name of the model parameter (in [`FiberModel::param_names`](crate::fiber::FiberModel::param_names))
     /// that carries the strength.
     pub fn model_param(&self) -> &'static str {
@@ -863,12 +872,13 @@ impl FromStr for EffectSetting {
 }
 
 /// The viscosity law of a user's model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LawChoice {
     /// Newtonian (`n = 1`); strain thinning is a candidate.
     Newtonian,
     /// The paper's Carreau-type law with `(n, κ)` fitted.
+    #[default]
     Carreau,
 }
 

@@ -6,7 +6,8 @@
 //! error stays its [`source`](std::error::Error::source)), and [`hints`] translates it into
 //! likely causes in the experiment's own terms: a melt or air temperature close to the VFT
 //! law's divergence, air hotter than the melt, strong strain thinning, a very thin take-up,
-//! a mesh limit to raise with `--max-nodes`. The hints name the `rheometer` program's flags.
+//! a mesh limit to raise. A hint names the library's option and, after it, the `rheometer`
+//! program's flag (a Python or Rust caller sets the option, a shell user the flag).
 
 use super::diagnostics::compare::CompareError;
 use super::error::FiberError;
@@ -125,9 +126,10 @@ pub fn hints(
     );
     if let Some(m) = max_nodes {
         out.push(format!(
-            "the mesh needed more than {m} nodes: raise the limit with --max-nodes (default \
-             20000; the landscape uses at most 1000), or check this experiment's inputs (a very \
-             thin take-up or strong strain thinning makes the profiles steep)"
+            "the mesh needed more than {m} nodes: raise the node limit (the option max_nodes; \
+             --max-nodes of the rheometer program; default 20000, the landscape uses at most \
+             1000), or check this experiment's inputs (a very thin take-up or strong strain \
+             thinning makes the profiles steep)"
         ));
     }
     if solver.is_some() && t_in.min(t_air) - t_vf < VFT_MARGIN_K {

@@ -307,7 +307,7 @@ pub fn identification_figures(
     };
     let identified = profiles(&id.solutions);
     let newtonian = profiles(newtonian);
-    let label = format!("identified n = {:.3}, κ = {:.2}", id.n, id.kappa);
+    let label = format!("identified n = {:.3}, κ = {:.2}", id.law()[0], id.law()[1]);
     let fitted = ModelCurves {
         label: &label,
         profiles: &identified,

@@ -21,7 +21,8 @@
 //! * [`take_up`]: the take-up condition a model uses (the data set's, a given diameter, or
 //!   `d_fit(L)` of the smoothed data);
 //! * [`synthetic`]: reproducible measurement noise for synthetic data sets;
-//! * [`diagnostics`]: model vs measurement comparison (where and how the model misses the data).
+//! * [`diagnostics`]: model vs measurement comparison (where and how the model misses the data);
+//! * [`workflow`]: what each `rheometer` subcommand does, as library calls returning values.
 
 pub mod cold_start;
 pub mod contributions;
@@ -30,13 +31,16 @@ pub mod effects;
 pub mod error;
 pub mod failure_hints;
 pub mod figures;
+pub mod format;
 pub mod input;
 pub mod material_law;
 pub mod model;
 pub mod noise_model;
+pub mod noise_summary;
 pub mod output;
 pub mod rheometer;
 pub mod scaling;
+pub(crate) mod serde_nan;
 pub mod setup;
 pub mod simulate;
 pub mod smoothing;
@@ -44,6 +48,7 @@ pub mod statistics;
 pub mod synthetic;
 pub mod take_up;
 pub mod uncertainty;
+pub mod workflow;
 
 pub use contributions::{
     Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength,

@@ -20,8 +20,6 @@
 
 use serde::{Deserialize, Serialize};
 
-pub use crate::fiber::noise_model::{NoiseModel, NoiseOptions, Outlier, ResidualSeries};
-
 /// `1/Φ⁻¹(3/4)`: turns a median absolute deviation into a normal standard deviation.
 const MAD_TO_SD: f64 = 1.482_602_218_505_602;
 

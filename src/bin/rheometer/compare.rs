@@ -36,6 +36,9 @@ pub struct CompareArgs {
     /// the TOML's, else estimated from the data; in (0, 1)).
     #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_fraction)]
     pub relative_uncertainty: Option<f64>,
+    /// BVP tolerance of the simulations (1e-12 to 0.1; default 1e-6).
+    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_tol)]
+    pub tol: Option<f64>,
     /// Output directory (created; input files are never overwritten).
     #[arg(long)]
     pub out: PathBuf,
@@ -52,75 +55,65 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         take_up_from_data,
         relative_uncertainty,
         with,
+        tol,
         out,
     } = args;
     let loaded = load_experiments_with(&experiments, 4)?;
     let inputs = inputs_of(&experiments, &loaded);
-    let set = &loaded.set;
-    let fit_params = fit.as_ref().map(|p| read_fit(p)).transpose()?;
-    let effects = compare_effects(fit_params.as_ref(), &with)?;
-    // validated once here; the closure rebuilds the same physics per experiment
-    physics_with(&effects)?;
-    let physics = || physics_with(&effects).unwrap_or_else(|_| Physics::paper());
-    for (e, v) in &effects {
+    let mut request = match &fit {
+        Some(path) => {
+            let rep = read_fit(path)?;
+            for w in &rep.warnings {
+                g.warn(format!(
+                    "the fit in {} carries a warning: [{}] {}",
+                    path.display(),
+                    w.code.name(),
+                    w.message
+                ));
+            }
+            g.say(format!(
+                "model from {}: n = {}, kappa = {} ({} estimator)",
+                path.display(),
+                rep.n.value,
+                rep.kappa.value,
+                rep.estimator.name()
+            ));
+            CompareRequest::of_fit(rep, &path.display().to_string())
+        }
+        None => {
+            let kappa = kappa.ok_or(
+                "give the parameters: --fit FIT.json (from `rheometer fit --json`) or --kappa K \
+                 with --n N or --newtonian",
+            )?;
+            let n = if newtonian {
+                1.0
+            } else {
+                n.ok_or("give --n N (or --newtonian) together with --kappa")?
+            };
+            let mut r = CompareRequest::at([n, kappa]);
+            if take_up_from_data {
+                r.missing_take_up = MissingTakeUp::FromData;
+            }
+            r
+        }
+    };
+    request.with = with;
+    request.relative_uncertainty = relative_uncertainty;
+    request.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
+    if let Some(t) = tol {
+        request.simulate.tol = t;
+    }
+    for (e, v) in request.effects()? {
         g.say(format!("model includes {} = {v} {}", e.name(), e.unit()));
     }
-    let mut setup = ModelSetup::carreau([0.8, 11.71], &physics);
-    setup.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
-    let mut fitted = 0;
-    if let (Some(path), Some(rep)) = (&fit, fit_params) {
-        let names: Vec<String> = set.experiments.iter().map(|e| e.name.clone()).collect();
-        rep.check_experiments(&names, &path.display().to_string())?;
-        rep.apply(
-            &mut setup,
-            set.experiments.len(),
-            &path.display().to_string(),
-        )?;
-        fitted = rep.fitted_parameters();
-        for w in &rep.warnings {
-            g.warn(format!(
-                "the fit in {} carries a warning: [{}] {}",
-                path.display(),
-                w.code.name(),
-                w.message
-            ));
-        }
-        g.say(format!(
-            "model from {}: n = {}, kappa = {} ({} estimator)",
-            path.display(),
-            rep.n,
-            rep.kappa,
-            rep.estimator.name()
-        ));
-    } else {
-        let kappa = kappa.ok_or(
-            "give the parameters: --fit FIT.json (from `rheometer fit --json`) or --kappa K \
-             with --n N or --newtonian",
-        )?;
-        let n = if newtonian {
-            1.0
-        } else {
-            n.ok_or("give --n N (or --newtonian) together with --kappa")?
-        };
-        setup.law_params = [n, kappa];
-        if take_up_from_data {
-            setup.missing_take_up = MissingTakeUp::FromData;
-        }
-    }
-    let options = CompareOptions {
-        relative_uncertainty,
-        fitted_parameters: fitted,
-        ..Default::default()
-    };
     let t0 = std::time::Instant::now();
-    let runs = simulate_experiments(set, &setup)
-        .map_err(|e| checks::name_experiment(Box::new(e), &experiments, Some(setup.law_params)))?;
-    let cmp = compare(&runs, set.relative_uncertainty, &options)?;
+    let cmp = workflow::compare(&loaded, &request)
+        .map_err(|e| checks::name_experiment(Box::new(e), &experiments, Some(request.law)))?;
     let written = cmp.write(&out, g.format.format(), &inputs)?;
     outln!("{}", cmp.to_text());
     g.say(format!(
         "compared {} experiments in {:.1} s; wrote {} files to {}",
-        set.experiments.len(),
+        loaded.set.experiments.len(),
         t0.elapsed().as_secs_f64(),
         written.len(),
         out.display()

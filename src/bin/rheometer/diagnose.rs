@@ -18,12 +18,16 @@ pub struct DiagnoseArgs {
     /// (default: all).
     #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_refit_top)]
     pub refit_top: Option<usize>,
+    /// BVP tolerance of the fits (1e-12 to 0.1; default 1e-4, matched to the noise).
+    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_tol)]
+    pub tol: Option<f64>,
     /// Write the diagnosis as JSON to FILE.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Output directory (report and before/after residual figure).
+    /// Output directory (report, JSON, before/after residual figure and J profiles; without
+    /// it only the report is printed).
     #[arg(long)]
-    pub out: PathBuf,
+    pub out: Option<PathBuf>,
 }
 
 /// Runs `rheometer diagnose`.
@@ -33,6 +37,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         model,
         with,
         refit_top,
+        tol,
         json,
         out,
     } = args;
@@ -44,11 +49,40 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         candidates: Vec::new(),
     };
     spec.validate()?;
+    // every output is checked before the work starts
+    let ext = g.format.ext();
+    let names = [
+        "diagnosis.txt".to_string(),
+        "diagnosis.json".to_string(),
+        format!("residuals_before_after.{ext}"),
+        format!("j_profiles.{ext}"),
+    ];
+    if let Some(dir) = &out {
+        check_output_dir(dir, &names, &inputs)?;
+        if let Some(path) = &json {
+            if let Some(name) = names.iter().find(|n| dir.join(n) == *path) {
+                return Err(format!(
+                    "--json {} is also the {name} of --out {}: one would replace the other; \
+                     choose another file",
+                    path.display(),
+                    dir.display()
+                )
+                .into());
+            }
+        }
+    }
+    if let Some(path) = &json {
+        ensure_not_input(path, &inputs)?;
+    }
     let mut opts = DiagnoseOptions::default();
     if let Some(k) = refit_top {
         opts.refit_top = k;
     }
     opts.identify.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
+    if let Some(t) = tol {
+        opts.identify.simulate.tol = t;
+        opts.identify.max_discretisation_shift = Some(f64::INFINITY);
+    }
     // a spinner on a terminal (indicatif draws nothing when stderr is not a terminal)
     let spinner = if g.quiet {
         ProgressBar::hidden()
@@ -58,24 +92,26 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         b.enable_steady_tick(std::time::Duration::from_millis(120));
         b
     };
-    let run = diagnose(&loaded.set, &spec, &opts);
+    let run = workflow::diagnose(&loaded, &spec, &opts);
     spinner.finish_and_clear();
     let run = run?;
     let text = run.diagnosis.to_text();
     outln!("{text}");
-    create_dir(&out)?;
-    write_text(&out.join("diagnosis.txt"), &text, &inputs)?;
     let js = serde_json::to_string_pretty(&run.diagnosis)?;
-    write_text(&out.join("diagnosis.json"), &js, &inputs)?;
     if let Some(path) = json {
         write_json(&path, &js, &inputs)?;
         g.say(format!("wrote {}", path.display()));
     }
-    let fig = out.join(format!("residuals_before_after.{}", g.format.ext()));
-    ensure_not_input(&fig, &inputs)?;
+    let Some(out) = out else {
+        g.say("no --out: the report and figures were not written to files".into());
+        return Ok(());
+    };
+    create_dir(&out)?;
+    write_text(&out.join("diagnosis.txt"), &text, &inputs)?;
+    write_text(&out.join("diagnosis.json"), &js, &inputs)?;
+    let fig = out.join(&names[2]);
     run.save_figure(&fig)?;
-    let prof = out.join(format!("j_profiles.{}", g.format.ext()));
-    ensure_not_input(&prof, &inputs)?;
+    let prof = out.join(&names[3]);
     run.save_profile_figure(&prof)?;
     g.say(format!(
         "wrote the report, {} and {} to {}",

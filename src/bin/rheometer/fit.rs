@@ -13,12 +13,12 @@ pub struct FitArgs {
     /// The estimator.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Principled)]
     pub estimator: EstimatorArg,
-    /// Evaluate the Newtonian model (n = 1) instead of fitting.
-    #[arg(long)]
+    /// Fit the Newtonian model (n = 1; the same as --model newtonian).
+    #[arg(long, conflicts_with = "model")]
     pub newtonian: bool,
-    /// The viscosity law of the model: carreau (n, kappa fitted) or newtonian.
-    #[arg(long, default_value = "carreau")]
-    pub model: LawChoice,
+    /// The viscosity law of the model: carreau (n, kappa fitted; the default) or newtonian.
+    #[arg(long)]
+    pub model: Option<LawChoice>,
     /// Add an effect, its strength fitted ("radiation") or fixed ("radiation=0.9"), shape
     /// parameters fixed after colons ("air_coflow=40:decay_length=0.2"); repeatable.
     /// Physics: strain_thinning, radiation, air_coflow, air_coflow_line,
@@ -36,6 +36,11 @@ pub struct FitArgs {
     /// robust noise scale of the data).
     #[arg(long = "f-scale", value_parser = checks::parse_f_scale, allow_hyphen_values = true)]
     pub f_scale: Option<f64>,
+    /// BVP tolerance of the fit (1e-12 to 0.1; default: 1e-4, refined until the
+    /// discretisation moves no estimate by more than 0.01 standard errors). Given, it is kept
+    /// and the shift only reported.
+    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_tol)]
+    pub tol: Option<f64>,
     /// Write the result as JSON to FILE.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -56,10 +61,15 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         with,
         loss,
         f_scale,
+        tol,
         json,
         out,
     } = args;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
+    if let Some(t) = tol {
+        opts.simulate.tol = t;
+        opts.max_discretisation_shift = Some(f64::INFINITY);
+    }
     opts.loss = loss;
     opts.f_scale = f_scale;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
@@ -77,106 +87,107 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             ensure_not_input(&dir.join(name), &inputs)?;
         }
     }
+    let law = match (newtonian, model) {
+        (true, _) => LawChoice::Newtonian,
+        (false, m) => m.unwrap_or_default(),
+    };
+    if law == LawChoice::Newtonian && start.is_some() {
+        return Err(
+            "--start: the Newtonian model (n = 1) has no (n, kappa) to start from; \
+                    drop --start or fit the Carreau-type law (--model carreau)"
+                .into(),
+        );
+    }
     let spec = ModelSpec {
-        law: model,
+        law,
         effects: with.clone(),
         candidates: Vec::new(),
     };
-    let rh = Rheometer::with_spec(&loaded.set, spec)?;
-    let law_fitted = model == LawChoice::Carreau
-        || with
-            .iter()
-            .any(|w| w.effect.name() == "strain_thinning" && w.value.is_none());
-    if newtonian {
-        let mut obj = rh.objective([1.0, 20.0], &opts)?;
-        let j = obj.cost_at(1.0, 20.0)?;
-        outln!(
-            "Newtonian model (n = 1): cost J = {j:.6e} ({} estimator)",
-            opts.estimator.name()
-        );
-        return Ok(());
+    let request = FitRequest {
+        model: spec,
+        identify: opts,
+        start: start.map(|(n, k)| [n, k]),
+        baseline: out.is_some(),
+        newtonian_reference: out.is_some(),
+    };
+    let run = workflow::fit(&loaded, &request)?;
+    if let Some(sp) = &run.start_heuristic {
+        g.say(format!(
+            "start heuristic: (n, kappa) = ({}, {})",
+            sp.start[0], sp.start[1]
+        ));
     }
-    let start = match start {
-        Some((n, k)) => [n, k],
-        None if !law_fitted => [1.0, STRAIN_THINNING_REFERENCE_KAPPA],
-        None => {
-            let sp = rh.start_heuristic(&opts)?;
-            g.say(format!(
-                "start heuristic: (n, kappa) = ({}, {})",
-                sp.start[0], sp.start[1]
-            ));
-            sp.start
-        }
-    };
-    let id = rh.identify(start, &opts)?;
-    // the systematic uncertainty of what the data cannot identify (declared or default
-    // uncertainties); a budget that cannot be computed does not fail the fit
-    let rep = match error_budget(&rh, &id, &loaded.uncertainty, &opts) {
-        Ok(budget) => FitReport::new(&id).with_error_budget(budget),
-        Err(e) => {
-            g.say(format!("warning: error budget not computed: {e}"));
-            FitReport::new(&id)
-        }
-    };
+    if let Some(e) = &run.budget_error {
+        g.say(format!("warning: error budget not computed: {e}"));
+    }
+    let rep = run.summary();
     outln!("{}", rep.to_text());
     for w in &rep.warnings {
         g.say(format!("warning: {w}"));
     }
-    let text = serde_json::to_string_pretty(&rep)?;
+    let text = serde_json::to_string_pretty(rep)?;
     if let Some(path) = json {
         write_json(&path, &text, &inputs)?;
         g.say(format!("wrote {}", path.display()));
     }
     if let Some(dir) = out {
-        create_dir(&dir)?;
-        if !with.is_empty() {
-            // the same fit without the effects, for the before/after comparison
-            let rh0 = Rheometer::with_spec(&loaded.set, ModelSpec::new(model))?;
-            let s0 = if model == LawChoice::Carreau {
-                [id.n, id.kappa]
-            } else {
-                [1.0, STRAIN_THINNING_REFERENCE_KAPPA]
-            };
-            let id0 = rh0.identify(s0, &opts)?;
-            let names: Vec<String> = with.iter().map(|w| w.effect.name().to_string()).collect();
-            let label = names.join(" + ");
-            let before = profiles_of(&rh0, &id0.solutions);
-            let after = profiles_of(&rh, &id.solutions);
-            let fig = dir.join("residuals_before_after.png");
-            save_residual_figure(&fig, &before, Some((&label, &after)))?;
-            outln!(
-                "RMS relative residual: {:.4} % without {label}, {:.4} % with it ({})",
-                100.0 * id0.rms_relative_residual,
-                100.0 * id.rms_relative_residual,
-                fig.display()
-            );
-        }
-        write_text(&dir.join("fit_report.txt"), &rep.to_text(), &inputs)?;
-        write_text(&dir.join("fit.json"), &text, &inputs)?;
-        for (k, sol) in id.solutions.iter().enumerate() {
-            let model = &rh.models[k];
-            let fs = FiberSolution {
-                solution: sol.clone(),
-            };
-            let prof = fs.uniform_profiles(model, 101);
-            write_text(
-                &dir.join(format!("{}_fitted_profile.csv", rh.experiments[k].name)),
-                &profiles_csv(&prof),
-                &inputs,
-            )?;
-        }
-        let newtonian = rh
-            .newtonian_solutions(id.kappa, &opts)
-            .map_err(figures::FigureError::Model)?;
-        let written =
-            figures::identification_figures(&rh, &id, &newtonian, &dir, g.format.ext(), &inputs)?;
-        for w in written {
-            g.say(format!("wrote {}", w.display()));
-        }
-        g.say(format!(
-            "wrote the report and fitted profiles to {}",
-            dir.display()
-        ));
+        write_fit_outputs(&run, &dir, &text, &with, &inputs, g)?;
     }
+    Ok(())
+}
+
+/// The report, JSON, fitted profiles and figures of a fit into `dir`.
+fn write_fit_outputs(
+    run: &FitRun,
+    dir: &Path,
+    json: &str,
+    with: &[EffectSetting],
+    inputs: &[PathBuf],
+    g: &Global,
+) -> Result<(), Box<dyn Error>> {
+    let (rh, id) = (&run.rheometer, &run.identification);
+    create_dir(dir)?;
+    if let Some(id0) = &run.baseline {
+        let names: Vec<String> = with.iter().map(|w| w.effect.name().to_string()).collect();
+        let label = names.join(" + ");
+        let before = profiles_of(rh, &id0.solutions);
+        let after = profiles_of(rh, &id.solutions);
+        let fig = dir.join(format!("residuals_before_after.{}", g.format.ext()));
+        ensure_not_input(&fig, inputs)?;
+        save_residual_figure(&fig, &before, Some((&label, &after)))?;
+        outln!(
+            "RMS relative residual: {:.4} % without {label}, {:.4} % with it ({})",
+            100.0 * id0.rms(),
+            100.0 * id.rms(),
+            fig.display()
+        );
+    }
+    write_text(
+        &dir.join("fit_report.txt"),
+        &run.summary().to_text(),
+        inputs,
+    )?;
+    write_text(&dir.join("fit.json"), json, inputs)?;
+    for (k, sol) in id.solutions.iter().enumerate() {
+        let model = &rh.models[k];
+        let fs = FiberSolution {
+            solution: sol.clone(),
+        };
+        let prof = fs.uniform_profiles(model, 101);
+        write_text(
+            &dir.join(format!("{}_fitted_profile.csv", rh.experiments[k].name)),
+            &profiles_csv(&prof),
+            inputs,
+        )?;
+    }
+    let newtonian = run.newtonian.as_deref().unwrap_or_default();
+    let written = figures::identification_figures(rh, id, newtonian, dir, g.format.ext(), inputs)?;
+    for w in written {
+        g.say(format!("wrote {}", w.display()));
+    }
+    g.say(format!(
+        "wrote the report and fitted profiles to {}",
+        dir.display()
+    ));
     Ok(())
 }

@@ -16,7 +16,7 @@ pub struct LandscapeArgs {
     /// Range of kappa "MIN,MAX" (within the fit's bounds [7, 20]).
     #[arg(long, default_value = "9,16", value_parser = checks::parse_pair, allow_hyphen_values = true)]
     pub kappa_range: (f64, f64),
-    /// The estimator whose cost is mapped.
+    /// The estimator whose cost is mapped (default: the paper's, as in its Fig. 4).
     #[arg(long, value_enum, default_value_t = EstimatorArg::Paper)]
     pub estimator: EstimatorArg,
     /// BVP tolerance of the landscape solves (1e-12 to 0.1; a picture: fits use 1e-6).

@@ -2,15 +2,10 @@
 //! from your own TOML + CSV measurements.
 
 use clap::{Parser, Subcommand, ValueEnum};
-use diffbvp::fiber::diagnostics::compare::{
-    compare, simulate_experiments, CompareOptions, FigureFormat, FitParameters, MissingTakeUp,
-    ModelSetup,
-};
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, ResidualProfiles};
+use diffbvp::fiber::diagnostics::compare::{FigureFormat, MissingTakeUp};
+use diffbvp::fiber::diagnostics::diagnose::{DiagnoseOptions, ResidualProfiles};
 use diffbvp::fiber::diagnostics::report::save_residual_figure;
-use diffbvp::fiber::effects::{
-    physics_with, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
-};
+use diffbvp::fiber::effects::{EffectSetting, LawChoice, ModelSpec};
 use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
@@ -19,9 +14,10 @@ use diffbvp::fiber::output::{
     write_text,
 };
 use diffbvp::fiber::rheometer::{
-    error_budget, Estimator, FitReport, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
+    Estimator, FitSummary, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
 };
-use diffbvp::fiber::{CarreauLike, FiberModel, FiberSolution, Physics, SimulateOptions};
+use diffbvp::fiber::workflow::{self, CompareRequest, FitRequest, FitRun};
+use diffbvp::fiber::{FiberSolution, SimulateOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -157,7 +153,7 @@ struct Cli {
 
 #[derive(Clone, Copy, ValueEnum)]
 pub enum EstimatorArg {
-    /// Relative least squares against the raw data, take-up diameters fitted (default).
+    /// Relative least squares against the raw data, take-up diameters fitted.
     Principled,
     /// The paper's strain-rate-weighted cost against the smoothed data.
     Paper,
@@ -298,43 +294,10 @@ fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
     diffbvp::mesh::linspace(a, b, m)
 }
 
-/// The effects of a compared model: those of the fit file, overridden or extended by `--with`.
-fn compare_effects(
-    fit: Option<&FitParameters>,
-    with: &[EffectSetting],
-) -> Result<Vec<(Effect, f64)>, Box<dyn Error>> {
-    let mut out: Vec<(Effect, f64)> = Vec::new();
-    if let Some(f) = fit {
-        for e in &f.effects {
-            let effect: Effect = e.to_effect()?;
-            out.push((effect, e.strength));
-        }
-    }
-    for w in with {
-        let name = w.effect.name();
-        let value = match (w.value, out.iter().find(|(e, _)| e.name() == name)) {
-            (Some(v), _) => v,
-            (None, Some((_, v))) => *v,
-            (None, None) => {
-                return Err(format!(
-                "--with {name}: give its strength as --with {name}=VALUE (the fit file has none)"
-            )
-                .into())
-            }
-        };
-        out.retain(|(e, _)| e.name() != name);
-        out.push((w.effect.clone(), value));
-    }
-    Ok(out)
-}
-
-fn read_fit(path: &Path) -> Result<FitParameters, Box<dyn Error>> {
+fn read_fit(path: &Path) -> Result<FitSummary, Box<dyn Error>> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("cannot read the fit file {}: {e}", path.display()))?;
-    Ok(FitParameters::from_json(
-        &text,
-        &path.display().to_string(),
-    )?)
+    Ok(FitSummary::from_json(&text, &path.display().to_string())?)
 }
 
 fn run(cli: Cli) -> Result<(), Box<dyn Error>> {

@@ -1,9 +1,9 @@
 //! `rheometer simulate`.
 
 use crate::*;
-use diffbvp::fiber::input::Location;
-use diffbvp::fiber::simulate;
-use diffbvp::fiber::take_up::{resolve_take_up, TakeUpError};
+use diffbvp::fiber::simulate::Profiles;
+use diffbvp::fiber::workflow::{SimulateError, SimulateRequest};
+use std::ops::ControlFlow;
 
 /// Arguments of `rheometer simulate`.
 #[derive(clap::Args)]
@@ -64,103 +64,70 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let mut complete: Vec<&str> = Vec::with_capacity(names.len());
     write_partial(&out, &names, &complete, &inputs)?;
     let law = if newtonian { [1.0, kappa] } else { [n, kappa] };
-    let options = SimulateOptions {
-        max_nodes: g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES),
-        ..SimulateOptions::default()
-    };
-    let mut all_profiles = Vec::with_capacity(set.experiments.len());
-    for (k, e) in set.experiments.iter().enumerate() {
-        if interrupted() {
-            return Err(Interrupted(format!(
-                "simulated {} of {} experiments; {} lists the profiles written and the missing ones",
-                complete.len(),
-                names.len(),
-                out.join(PARTIAL).display()
-            ))
-            .into());
-        }
-        let mut e = e.clone();
-        let rule = if let Some(d) = take_up_diameter {
+    let request = SimulateRequest {
+        law,
+        missing_take_up: if let Some(d) = take_up_diameter {
             MissingTakeUp::Diameter(d)
         } else if take_up_from_data {
             MissingTakeUp::FromData
         } else {
             MissingTakeUp::Error
-        };
-        let resolved = resolve_take_up(&e, set.measurements[k].as_ref(), rule, None).map_err(
-            |err| -> Box<dyn std::error::Error> {
-                match err {
-                    TakeUpError::NoMeasurements => format!(
-                        "experiment {}: --take-up-from-data needs measurements",
-                        e.name
-                    ),
-                    TakeUpError::Smoothing(err) => format!(
-                        "experiment {} ({}): --take-up-from-data: smoothing the measurements \
-                         failed: {err}",
-                        e.name,
-                        Location {
-                            path: experiments.clone(),
-                            line: loaded.details[k].line,
-                        }
-                    ),
-                    TakeUpError::Missing => format!(
-                        "experiment {} has no take-up condition: give take_up_diameter_m or take_up_velocity_m_s \
-                         in {}, or use --take-up-diameter M or --take-up-from-data",
-                        e.name,
-                        experiments.display()
-                    ),
-                }
-                .into()
-            },
-        )?;
-        let from_data = resolved.from_data;
-        e.take_up = Some(resolved.take_up);
-        // a failure names the experiment, its TOML line and likely causes
-        let failed = |source: diffbvp::fiber::FiberError| {
-            let mut f = ExperimentFailure::new(
-                &e,
-                &set.material,
-                Location {
-                    path: experiments.clone(),
-                    line: loaded.details[k].line,
-                },
-                Some(law),
-                Box::new(source),
-            );
-            if let Some(d) = from_data {
-                f.hints.push(format!(
-                    "the take-up diameter {d:.4e} m is d_fit(L) of the smoothed measurements \
-                     (--take-up-from-data)"
-                ));
-            }
-            f
-        };
-        let model = FiberModel::new(
-            &set.material,
-            &set.air,
-            &e,
-            CarreauLike::new(),
-            Physics::paper(),
-        )
-        .map_err(failed)?;
-        let sol = simulate(&model, &law, &options).map_err(failed)?;
-        let prof = sol.uniform_profiles(&model, points);
-        let path = out.join(format!("{}_profile.csv", e.name));
-        write_profiles(&path, &prof, &inputs)?;
-        complete.push(names[k]);
-        write_partial(&out, &names, &complete, &inputs)?;
+        },
+        points,
+        simulate: SimulateOptions {
+            max_nodes: g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES),
+            ..SimulateOptions::default()
+        },
+        source: experiments.clone(),
+    };
+    // each profile written (and the manifest updated) as soon as it is finished
+    let mut write_error: Option<Box<dyn Error>> = None;
+    let result = workflow::simulate_experiments(&loaded, &request, |k, p| {
+        let path = out.join(format!("{}_profile.csv", p.name));
+        let written = write_profiles(&path, &p.profiles, &inputs)
+            .map_err(Box::<dyn Error>::from)
+            .and_then(|()| {
+                complete.push(names[k]);
+                write_partial(&out, &names, &complete, &inputs)
+            });
+        if let Err(e) = written {
+            write_error = Some(e);
+            return ControlFlow::Break(());
+        }
         if g.verbose {
+            let pr = &p.profiles;
             g.say(format!(
                 "{}: {} nodes, T(L) = {:.2} K, d(L) = {:.3} µm -> {}",
-                e.name,
-                sol.nodes(),
-                prof.temperature[prof.temperature.len() - 1],
-                1e6 * prof.diameter[prof.diameter.len() - 1],
+                p.name,
+                p.nodes,
+                pr.temperature.last().copied().unwrap_or(f64::NAN),
+                1e6 * pr.diameter.last().copied().unwrap_or(f64::NAN),
                 path.display()
             ));
         }
-        all_profiles.push(prof);
+        if interrupted() {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    if let Some(e) = write_error {
+        return Err(e);
     }
+    let all_profiles: Vec<Profiles> = match result {
+        Ok(v) => v.into_iter().map(|p| p.profiles).collect(),
+        Err(SimulateError::Stopped { done }) => {
+            return Err(Interrupted(format!(
+                "simulated {done} of {} experiments; {} lists the profiles written and the \
+                 missing ones",
+                names.len(),
+                out.join(PARTIAL).display()
+            ))
+            .into())
+        }
+        Err(SimulateError::Experiment(f)) => return Err(Box::new(f)),
+        Err(e) => return Err(e.to_string().into()),
+    };
     // every profile is written: the figures cannot lose data any more
     remove_partial(&out, &inputs)?;
     let fig = out.join(format!("profiles.{ext}"));

@@ -20,8 +20,10 @@
 //! * the *noise model* ([`NoiseModel`], the project's one estimator): a robust noise scale
 //!   from second differences along `s`, the noise scale along the line `σ(s/L)`, gross
 //!   outliers by experiment and position, the lag-1 autocorrelation and `RMS/noise`;
-//! * *noise level* `σ`: the data set's `relative_uncertainty` if given (or
-//!   [`CompareOptions::relative_uncertainty`]), else the noise model's robust scale;
+//! * *noise level* `σ`: the one noise level of the model on these data
+//!   ([`NoiseSummary`]): the fit's when a fit is compared ([`CompareOptions::fit_noise`]),
+//!   else the data set's `relative_uncertainty` if given (or
+//!   [`CompareOptions::relative_uncertainty`]), else the noise model's estimate;
 //! * `χ² = Σ r²/σᵢ²` over the points that are not outliers, with `σᵢ = σ` if given, else the
 //!   local `σ(sᵢ/L)` (so a noisier take-up region does not pass for a misfit), and
 //!   `dof = N − outliers − p` (`p` fitted parameters);
@@ -37,11 +39,12 @@ pub mod segments;
 pub mod summary_text;
 
 pub use crate::fiber::statistics::RunsTest;
-pub use model_runs::{compare_set, simulate_experiments, FitParameters, MissingTakeUp, ModelSetup};
+pub use model_runs::{compare_set, simulate_experiments, MissingTakeUp, ModelSetup};
 pub use segments::{Segment, SegmentOptions, Station};
 
 use crate::fiber::error::FiberError;
 pub use crate::fiber::noise_model::{NoiseModel, NoiseOptions, Outlier, ResidualSeries};
+pub use crate::fiber::noise_summary::{NoiseSource, NoiseSummary};
 use crate::fiber::output::{create_output_dir, write_text, OutputError};
 use crate::fiber::simulate::Profiles;
 use crate::fiber::smoothing::SmoothingError;
@@ -115,6 +118,10 @@ pub struct CompareOptions {
     /// Settings of the noise model.
     #[serde(default)]
     pub noise: NoiseOptions,
+    /// The noise summary of the fit being compared (same model and data): used as this
+    /// comparison's noise, so that a fit and its comparison report one noise level.
+    #[serde(skip)]
+    pub fit_noise: Option<NoiseSummary>,
 }
 
 /// One measurement point.
@@ -171,16 +178,6 @@ pub struct ComparedExperiment {
     pub segments: Vec<Segment>,
 }
 
-/// Where the noise level came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum NoiseSource {
-    /// Given (TOML `relative_uncertainty` or the options).
-    Given,
-    /// Estimated from the residuals.
-    Estimated,
-}
-
 /// Rank correlation of the residual with a local model quantity.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Trend {
@@ -195,14 +192,10 @@ pub struct Trend {
 pub struct Comparison {
     /// Per experiment.
     pub experiments: Vec<ComparedExperiment>,
-    /// The noise level `σ` used \[-\].
-    pub sigma: f64,
-    /// Where `σ` came from.
-    pub sigma_source: NoiseSource,
-    /// The data-based estimate of `σ` (the noise model's robust scale, always computed) \[-\].
-    pub sigma_estimated: f64,
-    /// The noise model of the residuals: scale along the line, outliers, lag-1, RMS/noise.
-    pub noise: NoiseModel,
+    /// The noise level `σ` used and the noise model of the residuals (scale along the line,
+    /// outliers, lag-1, RMS/noise): the fit's when the comparison is of a fit
+    /// ([`CompareOptions::fit_noise`]), else from these residuals.
+    pub noise: NoiseSummary,
     /// Number of measurement points `N`.
     pub points: usize,
     /// Number of fitted parameters `p`.
@@ -265,24 +258,20 @@ pub fn compare(
             length_m: run.curve.position.last().copied().filter(|l| *l > 0.0),
         })
         .collect();
-    let noise = NoiseModel::estimate(&input, &options.noise).map_err(CompareError::Data)?;
-    let sigma_estimated = noise.sigma;
-    let given = options.relative_uncertainty.or(set_uncertainty);
-    if let Some(s) = given {
-        if !(s > 0.0 && s.is_finite()) {
-            return Err(CompareError::Data(format!(
-                "relative uncertainty must be positive and finite, got {s}"
-            )));
-        }
-    }
-    let (sigma, sigma_source) = match given {
-        Some(s) => (s, NoiseSource::Given),
-        None => (sigma_estimated, NoiseSource::Estimated),
+    let noise = match &options.fit_noise {
+        Some(n) => n.clone(),
+        None => NoiseSummary::of(
+            &input,
+            options.relative_uncertainty.or(set_uncertainty),
+            &options.noise,
+        )
+        .map_err(CompareError::Data)?,
     };
+    let sigma = noise.level;
     if !(sigma > 0.0 && sigma.is_finite()) {
         return Err(CompareError::Data(format!(
-            "cannot estimate the noise level from the data (estimate {sigma_estimated}); \
-             give relative_uncertainty in the experiments TOML"
+            "cannot estimate the noise level from the data (estimate {sigma}); give \
+             relative_uncertainty in the experiments TOML"
         )));
     }
     let n_points: usize = experiments.iter().map(|e| e.points.len()).sum();
@@ -294,26 +283,27 @@ pub fn compare(
             if p.outlier {
                 continue;
             }
-            let sd = match sigma_source {
-                NoiseSource::Given => sigma,
-                NoiseSource::Estimated => noise.local_sigma_at(k, p.position_m),
-            };
+            let sd = noise.sigma_at(k, p.position_m);
             e.chi2 += (p.residual / sd).powi(2);
         }
         chi2 += e.chi2;
         sum2 += r.iter().map(|v| v * v).sum::<f64>();
         e.lag1 = noise
-            .lag1_per_experiment
-            .get(k)
-            .copied()
+            .model
+            .as_ref()
+            .and_then(|m| m.lag1_per_experiment.get(k).copied())
             .unwrap_or(f64::NAN);
         e.segments = segments::find_segments(&[(s.clone(), r.clone())], sigma, &options.segments);
     }
+    let n_outliers = noise.model.as_ref().map_or(0, |m| m.outliers.len());
     let dof = n_points
-        .saturating_sub(noise.outliers.len())
+        .saturating_sub(n_outliers)
         .saturating_sub(options.fitted_parameters);
     let runs_each: Vec<RunsTest> = experiments.iter().map(|e| e.runs).collect();
-    let (lag1, lag1_z) = (noise.lag1, noise.lag1_z);
+    let (lag1, lag1_z) = noise
+        .model
+        .as_ref()
+        .map_or((f64::NAN, f64::NAN), |m| (m.lag1, m.lag1_z));
     let all = |f: fn(&ComparedPoint) -> f64| -> Vec<f64> {
         experiments
             .iter()
@@ -333,9 +323,6 @@ pub fn compare(
     })
     .collect();
     Ok(Comparison {
-        sigma,
-        sigma_source,
-        sigma_estimated,
         points: n_points,
         fitted_parameters: options.fitted_parameters,
         chi2,

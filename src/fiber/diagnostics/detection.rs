@@ -51,7 +51,7 @@ use crate::fiber::effects::Effect;
 use serde::{Deserialize, Serialize};
 
 /// The one-sided 95 % quantile of the standard normal distribution.
-pub const Z95: f64 = 1.644_853_626_951_472_2;
+pub const Z95_ONE_SIDED: f64 = 1.644_853_626_951_472_2;
 
 /// One candidate's detection limit (JSON: an entry of `detection.limits`).
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -143,7 +143,7 @@ pub fn strength_limits(norm: f64, sigma: f64, lambda_star: f64) -> (f64, f64) {
         return (f64::INFINITY, f64::INFINITY);
     }
     let root = lambda_star.max(0.0).sqrt();
-    (root * sigma / norm, (root + Z95) * sigma / norm)
+    (root * sigma / norm, (root + Z95_ONE_SIDED) * sigma / norm)
 }
 
 /// The detection limits of `effects` (with their `extra` parameters, linearised `scores` and
@@ -371,7 +371,7 @@ mod tests {
         let (s50, s95) = strength_limits(2.0, 0.5, 16.0);
         // hand numbers: √16 · 0.5 / 2 = 1, (4 + 1.645) · 0.5 / 2
         assert!((s50 - 1.0).abs() < 1e-15);
-        assert!((s95 - (4.0 + Z95) * 0.25).abs() < 1e-15);
+        assert!((s95 - (4.0 + Z95_ONE_SIDED) * 0.25).abs() < 1e-15);
         for f in [0.1, 3.0, 17.0] {
             let (a50, a95) = strength_limits(2.0, 0.5 * f, 16.0);
             assert!((a50 / s50 - f).abs() < 1e-12 && (a95 / s95 - f).abs() < 1e-12);
@@ -452,7 +452,7 @@ mod tests {
         // J_rest = J_before − the candidate's score
         let lam = required_reduction(360.0, 100, -10.0, 1) / 4.0;
         assert!((die.required_chi2 - lam).abs() < 1e-12);
-        assert!((die.s95 - (lam.sqrt() + Z95) * 2.0 / 4.0).abs() < 1e-12);
+        assert!((die.s95 - (lam.sqrt() + Z95_ONE_SIDED) * 2.0 / 4.0).abs() < 1e-12);
         assert_eq!(die.dkappa_per_unit, Some(0.05));
         assert!((die.shift_kappa_at_s95.unwrap() - 0.05 * die.s95).abs() < 1e-15);
         assert!((die.shift_kappa_se.unwrap() - 0.5 * die.s95).abs() < 1e-12);

@@ -7,17 +7,23 @@
 //! * the candidate effects themselves (canonical names, strength parameters, neutral values,
 //!   the model specification a rheometer fit uses) live below the model, in
 //!   [`effects`](crate::fiber::effects);
-//! * [`diagnose`]: ranking the candidates by the excess misfit they explain (linearised scores,
-//!   global search and refits, information criteria) and the report in words;
+//! * [`diagnose`]: the stages of a diagnosis (fit the base, linearise, test the noise,
+//!   search, choose shapes, judge, rank, ties), ranking the candidates by the excess misfit
+//!   they explain;
+//! * [`candidate`]: the record of one candidate and how candidates are judged and ranked;
+//! * [`diagnosis`]: the result of a diagnosis (JSON) and what figures need besides;
+//! * [`report`]: the diagnosis in words and its figures;
 //! * [`detection`]: the detection limit of each candidate (the strength the data would reveal)
 //!   and the shift of `(n, κ)` an effect just below it would cause;
 //! * [`scan`]: the global search of one candidate's strength (and shape): the profile of `J`
 //!   and the refits of its best points;
 //! * [`ties`]: candidates about as consistent with the data as the named one (alternatives).
 
+pub mod candidate;
 pub mod compare;
 pub mod detection;
 pub mod diagnose;
+pub mod diagnosis;
 pub mod report;
 pub mod scan;
 pub mod scores;

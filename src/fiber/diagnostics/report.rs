@@ -1,8 +1,7 @@
 //! The diagnosis in words, and the before/after residual figure.
 
-use super::diagnose::{
-    CandidateResult, Diagnosis, DiagnosisRun, ResidualProfiles, ShapeAlternative, StrengthStatus,
-};
+use super::candidate::{Candidate, ShapeAlternative, StrengthStatus};
+use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::scan::Profile;
 use crate::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
@@ -25,12 +24,11 @@ impl Diagnosis {
         ));
         s.push_str(&format!(
             "Your model fitted with the principled estimator: J = {:.4e}, RMS relative residual {:.3} % \
-             over {} measurements; noise level {:.3} % ({}).\n",
+             over {} measurements; noise level {}.\n",
             b.cost,
             100.0 * b.rms_relative_residual,
             b.residuals,
-            100.0 * self.noise_level,
-            self.noise_source
+            b.noise.describe()
         ));
         for w in &b.warnings {
             s.push_str(&format!("WARNING about your model's fit: {w}\n"));
@@ -42,16 +40,16 @@ impl Diagnosis {
             } else {
                 "consistent with noise"
             },
-            self.rms_over_noise,
-            self.lag1_autocorrelation
+            self.rms_over_noise(),
+            self.lag1_autocorrelation()
         ));
-        if !self.outliers.is_empty() {
+        if !self.outliers().is_empty() {
             s.push_str(&format!(
                 "OUTLIERS ({}; left out of the noise level, the RMS and the autocorrelation; \
                  `fit --loss huber` down-weights them):\n",
-                self.outliers.len()
+                self.outliers().len()
             ));
-            for o in &self.outliers {
+            for o in self.outliers() {
                 s.push_str(&format!(
                     "    {} at s = {:.3} m: measured {:.2} um, model {:.2} um, residual {:+.1} % ({:.1} robust sd)\n",
                     o.experiment,
@@ -76,14 +74,14 @@ impl Diagnosis {
                     c.cost_before,
                     c.cost_after,
                     100.0 * b.rms_relative_residual,
-                    100.0 * c.rms_relative_residual_after,
+                    100.0 * c.rms_relative_residual_after(),
                     c.delta_bic,
                     c.delta_aic,
-                    c.strength,
-                    c.stderr_strength,
+                    c.strength(),
+                    c.stderr_strength(),
                     c.unit
                 ));
-                if let Some(b) = c.at_bound.iter().find(|b| b.parameter == c.effect) {
+                if let Some(b) = c.at_bound().iter().find(|b| b.parameter == c.effect) {
                     s.push_str(&format!(
                         "WARNING: its strength ends AT ITS {} BOUND {} {}: the data push it beyond its \
                          search range, so this is not a credible estimate of the effect (a different \
@@ -96,17 +94,21 @@ impl Diagnosis {
                 if let (StrengthStatus::Physical, Some(note)) = (c.status, &c.status_note) {
                     s.push_str(&format!("NOTE: {note}.\n"));
                 }
-                if c.n.is_finite() {
+                if c.n().is_finite() {
                     s.push_str(&format!(
                         "With it: n = {}, kappa = {}.\n",
-                        estimate_with_ci(c, "n", c.n, c.ci95_n),
-                        estimate_with_ci(c, "kappa", c.kappa, c.ci95_kappa)
+                        estimate_with_ci(c, "n", c.n(), c.ci95_n()),
+                        estimate_with_ci(c, "kappa", c.kappa(), c.ci95_kappa())
                     ));
                 }
                 if let Some(a) = &c.shape_alternative {
                     s.push_str(&shape_alternative_line(c, a));
                 }
-                s.push_str(&super::ties::ties_paragraph(c, &self.alternatives));
+                s.push_str(&super::ties::ties_paragraph(
+                    c,
+                    &self.alternatives,
+                    &self.candidates,
+                ));
             }
             _ => {
                 s.push_str(
@@ -121,7 +123,7 @@ impl Diagnosis {
         for c in self
             .candidates
             .iter()
-            .filter(|c| c.refitted && c.status != StrengthStatus::Physical && c.delta_bic < 0.0)
+            .filter(|c| c.refitted() && c.status != StrengthStatus::Physical && c.delta_bic < 0.0)
         {
             if let Some(note) = &c.status_note {
                 s.push_str(&format!(
@@ -136,20 +138,20 @@ impl Diagnosis {
         s.push_str("    effect                   refit  strength +/- stderr        J after      RMS after  dBIC     lin.dJ/J  status       signature\n");
         for c in &self.candidates {
             let shape: String = c
-                .shape
+                .shape()
                 .iter()
                 .map(|p| format!("  [{} {:.4} {}]", p.name, p.value, p.unit))
                 .collect();
             s.push_str(&format!(
                 "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {:>8.4}  {:<11}  {} (peak {:.2} m){shape}\n",
                 c.effect,
-                if c.refitted { "yes" } else { "lin" },
-                c.strength,
-                c.stderr_strength,
+                if c.refitted() { "yes" } else { "lin" },
+                c.strength(),
+                c.stderr_strength(),
                 c.unit,
                 c.cost_after,
-                if c.rms_relative_residual_after.is_finite() {
-                    format!("{:.3} %", 100.0 * c.rms_relative_residual_after)
+                if c.rms_relative_residual_after().is_finite() {
+                    format!("{:.3} %", 100.0 * c.rms_relative_residual_after())
                 } else {
                     "-".into()
                 },
@@ -168,7 +170,7 @@ impl Diagnosis {
             "(lin.dJ/J: the first-order (linearised) share of J the effect would remove at strength 0; \
              a refit far better than it means the finite effect differs from its first-order signature.)\n",
         );
-        let with_profiles: Vec<&CandidateResult> = self
+        let with_profiles: Vec<&Candidate> = self
             .candidates
             .iter()
             .filter(|c| !c.profiles.is_empty())
@@ -299,9 +301,9 @@ pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), Plo
                     }
                 }
             }
-            if c.refitted && c.strength.is_finite() && c.cost_before > 0.0 {
+            if c.refitted() && c.strength().is_finite() && c.cost_before > 0.0 {
                 p = p.with_series(
-                    Series::markers("refit", vec![(c.strength, c.cost_after / c.cost_before)])
+                    Series::markers("refit", vec![(c.strength(), c.cost_after / c.cost_before)])
                         .with_color(3),
                 );
             }
@@ -314,8 +316,8 @@ pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), Plo
 }
 
 /// `"0.8040 (95% CI [0.79, 0.82])"`, or the estimate marked at its bound without an interval.
-fn estimate_with_ci(c: &CandidateResult, name: &str, value: f64, ci: [f64; 2]) -> String {
-    match c.at_bound.iter().find(|b| b.parameter == name) {
+fn estimate_with_ci(c: &Candidate, name: &str, value: f64, ci: [f64; 2]) -> String {
+    match c.at_bound().iter().find(|b| b.parameter == name) {
         Some(b) => format!(
             "{value:.4} (AT ITS {} BOUND: no valid 95% CI)",
             b.side.name().to_uppercase()
@@ -381,9 +383,13 @@ impl DiagnosisRun {
 /// The sentence on a shape the data cannot choose (see [`ShapeAlternative`]): the other
 /// shape's strength and material estimate, and how far the latter lies from the reported one
 /// in its standard errors.
-fn shape_alternative_line(c: &CandidateResult, a: &ShapeAlternative) -> String {
-    let shape = a
-        .shape
+fn shape_alternative_line(c: &Candidate, a: &ShapeAlternative) -> String {
+    let r = &a.refit;
+    let Some(e) = r.effect(&c.effect) else {
+        return String::new();
+    };
+    let shape = e
+        .shapes
         .iter()
         .map(|p| match p.unit.as_str() {
             "-" | "" => format!("{} {}", p.name, p.value),
@@ -391,8 +397,8 @@ fn shape_alternative_line(c: &CandidateResult, a: &ShapeAlternative) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ");
-    let se = |ci: [f64; 2]| (ci[1] - ci[0]) / (2.0 * 1.959964);
-    let shift = |x: f64, x0: f64, ci: [f64; 2]| (x - x0) / se(ci);
+    let shift = |x: f64, x0: f64, se: f64| (x - x0) / se;
+    let se_of = |ci: [f64; 2]| (ci[1] - ci[0]) / (2.0 * crate::fiber::rheometer::summary::Z95);
     format!(
         "SHAPE: these data cannot choose the shape of {}: with {shape} (delta BIC {:+.1}) its \
          strength is {:.4} +/- {:.4} {}, n = {:.4} (95% CI [{:.4}, {:.4}]), kappa = {:.4} \
@@ -400,16 +406,16 @@ fn shape_alternative_line(c: &CandidateResult, a: &ShapeAlternative) -> String {
          above, a systematic uncertainty of the shape.\n",
         c.effect,
         a.delta_bic_gap,
-        a.strength,
-        a.stderr_strength,
+        e.strength.value,
+        e.strength.stderr,
         c.unit,
-        a.n,
-        a.ci95_n[0],
-        a.ci95_n[1],
-        a.kappa,
-        a.ci95_kappa[0],
-        a.ci95_kappa[1],
-        shift(a.n, c.n, c.ci95_n),
-        shift(a.kappa, c.kappa, c.ci95_kappa)
+        r.n.value,
+        r.n.ci95[0],
+        r.n.ci95[1],
+        r.kappa.value,
+        r.kappa.ci95[0],
+        r.kappa.ci95[1],
+        shift(r.n.value, c.n(), se_of(c.ci95_n())),
+        shift(r.kappa.value, c.kappa(), se_of(c.ci95_kappa()))
     )
 }

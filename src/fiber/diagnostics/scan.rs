@@ -22,7 +22,7 @@
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
 use crate::fiber::rheometer::identify::WarmFit;
 use crate::fiber::rheometer::{
-    FitReport, FitStart, Identification, IdentifyOptions, Rheometer, RheometerError,
+    FitStart, Identification, IdentifyOptions, Rheometer, RheometerError,
 };
 use crate::least_squares::Loss;
 use crate::solution::Solution;
@@ -146,10 +146,8 @@ impl Profile {
 pub struct Refit {
     /// Strength of the grid point it started from.
     pub start_strength: f64,
-    /// The fit.
+    /// The fit (with its summary).
     pub identification: Identification,
-    /// Its report.
-    pub report: FitReport,
     /// `J = Σ r²` (dimensionless).
     pub cost: f64,
 }
@@ -423,11 +421,11 @@ pub fn scan_profile(
     inner.simulate.tol = scan.grid_tol.max(options.simulate.tol);
     let base_point = GridStart {
         strength: grid.neutral,
-        law: [base.n, base.kappa],
-        take_up: base.take_up_factors.clone(),
+        law: base.law(),
+        take_up: base.take_up_factors().to_vec(),
         solutions: base.solutions.clone(),
         cost: cost_base,
-        rms: base.rms_relative_residual,
+        rms: base.rms(),
     };
     let mut stopped = Vec::new();
     let mut sides: Vec<Vec<(f64, GridStart)>> = Vec::new();
@@ -450,10 +448,10 @@ pub fn scan_profile(
             };
             fit_warm(&vrh, &start, &prev.take_up, &inner, true).map(|id| GridStart {
                 strength: v,
-                law: [id.n, id.kappa],
-                take_up: id.take_up_factors,
+                law: id.law(),
+                take_up: id.take_up_factors().to_vec(),
                 cost: 2.0 * id.fit.cost,
-                rms: id.rms_relative_residual,
+                rms: id.rms(),
                 solutions: id.solutions,
             })
         });
@@ -564,12 +562,10 @@ pub fn refine(
         warm: Some(start.solutions.clone()),
     };
     let id = fit_warm(rh, &fs, &start.take_up, options, false)?;
-    let report = FitReport::new(&id);
     Ok(Refit {
         start_strength: start.strength,
         cost: 2.0 * id.fit.cost,
         identification: id,
-        report,
     })
 }
 

@@ -1,6 +1,6 @@
 //! Ties: candidates the data cannot tell apart from the named one.
 //!
-//! The named cause ([`Diagnosis::most_likely_missing`](super::diagnose::Diagnosis)) is the
+//! The named cause ([`Diagnosis::most_likely_missing`](super::diagnosis::Diagnosis)) is the
 //! credible candidate with the lowest `ΔBIC`. Another candidate that also earns its place
 //! (refitted, its strength physical and away from the search bounds, `ΔBIC` below the earn
 //! threshold) and whose `ΔBIC` is within
@@ -14,7 +14,7 @@
 //! material result is robust to the choice. A process condition or an instrument error in a tie
 //! can be checked independently of these data ([`independent_check`]).
 
-use super::diagnose::{earns_its_place, CandidateResult};
+use super::candidate::{earns_its_place, Candidate};
 use crate::fiber::effects::Category;
 use serde::{Deserialize, Serialize};
 
@@ -22,15 +22,16 @@ use serde::{Deserialize, Serialize};
 /// `ΔBIC` gap below 6 is less than "strong" evidence (Kass–Raftery) for the named cause.
 pub const DEFAULT_TIE_MARGIN: f64 = 6.0;
 
-/// Half-width of a 95% CI in standard errors (the fit report's symmetric intervals).
-const Z95: f64 = 1.96;
+use crate::fiber::rheometer::summary::Z95;
 
 /// Shifts of `n` and `κ` (in the named refit's standard errors) below which the material
 /// result is robust to the choice between tied causes.
 pub const ROBUST_SHIFT_SE: f64 = 1.0;
 
 /// A candidate about as consistent with the data as the named one (JSON: an entry of
-/// `alternatives`).
+/// `alternatives`). Its refit (strength, `(n, κ)` with intervals) is the candidate's own
+/// ([`Diagnosis::candidate`](super::diagnosis::Diagnosis::candidate)); the record says how it
+/// compares with the named one.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Alternative {
     /// Canonical name of the alternative.
@@ -44,20 +45,6 @@ pub struct Alternative {
     /// Cosine of its orthogonalised (linearised) signature with the named one's (`NaN` when
     /// not available).
     pub signature_cosine: f64,
-    /// Its fitted strength (unit [`unit`](Self::unit)).
-    pub strength: f64,
-    /// Standard error of the strength.
-    pub stderr_strength: f64,
-    /// Unit of the strength.
-    pub unit: String,
-    /// `n` \[-\] of its refit.
-    pub n: f64,
-    /// `κ = ln(K / 1 Pa)` \[-\] of its refit.
-    pub kappa: f64,
-    /// 95% CI of `n` in its refit.
-    pub ci95_n: [f64; 2],
-    /// 95% CI of `κ` in its refit.
-    pub ci95_kappa: [f64; 2],
     /// `(n_alt − n_named) / se(n_named)` (`NaN` where the named refit has no valid CI).
     pub n_shift_se: f64,
     /// `(κ_alt − κ_named) / se(κ_named)`.
@@ -70,18 +57,13 @@ pub struct Alternative {
 /// Whether `c` ties with the `named` cause: a different candidate that earns its place
 /// ([`earns_its_place`] with `earn_threshold`) with a `ΔBIC` less than `tie_margin` above the
 /// named one's. At-bound, unphysical and unrefitted candidates never tie.
-pub fn ties_with(
-    named: &CandidateResult,
-    c: &CandidateResult,
-    earn_threshold: f64,
-    tie_margin: f64,
-) -> bool {
+pub fn ties_with(named: &Candidate, c: &Candidate, earn_threshold: f64, tie_margin: f64) -> bool {
     c.effect != named.effect
         && earns_its_place(c, earn_threshold)
         && c.delta_bic - named.delta_bic < tie_margin
 }
 
-/// Standard error from a symmetric 95% CI (`NaN` if the CI is not valid).
+/// Standard error of a refit's law parameter where its interval is valid (`NaN` else).
 fn stderr_of(ci: [f64; 2]) -> f64 {
     if ci.iter().all(|v| v.is_finite()) {
         (ci[1] - ci[0]) / (2.0 * Z95)
@@ -103,27 +85,20 @@ impl Alternative {
     /// The record of `alt` tying with `named`, with the categories and the signature cosine
     /// supplied by the caller (the candidate results do not carry them).
     pub fn new(
-        named: &CandidateResult,
-        alt: &CandidateResult,
+        named: &Candidate,
+        alt: &Candidate,
         named_category: Category,
         category: Category,
         signature_cosine: f64,
     ) -> Self {
-        let n_shift_se = shift(alt.n, named.n, stderr_of(named.ci95_n));
-        let kappa_shift_se = shift(alt.kappa, named.kappa, stderr_of(named.ci95_kappa));
+        let n_shift_se = shift(alt.n(), named.n(), stderr_of(named.ci95_n()));
+        let kappa_shift_se = shift(alt.kappa(), named.kappa(), stderr_of(named.ci95_kappa()));
         Alternative {
             effect: alt.effect.clone(),
             category,
             named_category,
             delta_bic_gap: alt.delta_bic - named.delta_bic,
             signature_cosine,
-            strength: alt.strength,
-            stderr_strength: alt.stderr_strength,
-            unit: alt.unit.clone(),
-            n: alt.n,
-            kappa: alt.kappa,
-            ci95_n: alt.ci95_n,
-            ci95_kappa: alt.ci95_kappa,
             n_shift_se,
             kappa_shift_se,
             // NaN shifts (no valid interval) compare false: not robust
@@ -141,8 +116,8 @@ impl Alternative {
 /// The alternatives to `named` among `candidates` (in their order, best first), each built by
 /// [`Alternative::new`] with `info(effect) = (category, signature cosine with the named one)`.
 pub fn alternatives(
-    named: &CandidateResult,
-    candidates: &[CandidateResult],
+    named: &Candidate,
+    candidates: &[Candidate],
     earn_threshold: f64,
     tie_margin: f64,
     named_category: Category,
@@ -223,7 +198,11 @@ pub(super) fn or_alternatives(alts: &[Alternative]) -> String {
 
 /// The report's paragraph on a tie (empty without alternatives): each alternative's strength
 /// and `(n, κ)`, whether the material result is robust to the choice, and what decides.
-pub(super) fn ties_paragraph(named: &CandidateResult, alts: &[Alternative]) -> String {
+pub(super) fn ties_paragraph(
+    named: &Candidate,
+    alts: &[Alternative],
+    candidates: &[Candidate],
+) -> String {
     let c = named;
     let named = c.effect.as_str();
     let Some(first) = alts.first() else {
@@ -239,22 +218,25 @@ pub(super) fn ties_paragraph(named: &CandidateResult, alts: &[Alternative]) -> S
     );
     s.push_str(&format!(
         "    with {named} ({:.4} +/- {:.4} {}): n = {}, kappa = {}\n",
-        c.strength,
-        c.stderr_strength,
+        c.strength(),
+        c.stderr_strength(),
         c.unit,
-        value_with_ci(c.n, c.ci95_n),
-        value_with_ci(c.kappa, c.ci95_kappa)
+        value_with_ci(c.n(), c.ci95_n()),
+        value_with_ci(c.kappa(), c.ci95_kappa())
     ));
     for a in alts {
+        let Some(r) = candidates.iter().find(|x| x.effect == a.effect) else {
+            continue;
+        };
         s.push_str(&format!(
             "    with {} ({:.4} +/- {:.4} {}): n = {}, kappa = {}; shifts from {named}'s: \
              n {:+.1}, kappa {:+.1} standard errors\n",
             a.effect,
-            a.strength,
-            a.stderr_strength,
-            a.unit,
-            value_with_ci(a.n, a.ci95_n),
-            value_with_ci(a.kappa, a.ci95_kappa),
+            r.strength(),
+            r.stderr_strength(),
+            r.unit,
+            value_with_ci(r.n(), r.ci95_n()),
+            value_with_ci(r.kappa(), r.ci95_kappa()),
             a.n_shift_se,
             a.kappa_shift_se
         ));
@@ -315,42 +297,30 @@ pub(super) fn ties_paragraph(named: &CandidateResult, alts: &[Alternative]) -> S
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fiber::diagnostics::diagnose::StrengthStatus;
+    use crate::fiber::diagnostics::candidate::StrengthStatus;
+    use crate::fiber::rheometer::summary::tests::refit_summary;
 
-    fn cand(
-        effect: &str,
-        status: StrengthStatus,
-        dbic: f64,
-        n: f64,
-        kappa: f64,
-    ) -> CandidateResult {
-        CandidateResult {
+    fn cand(effect: &str, status: StrengthStatus, dbic: f64, n: f64, kappa: f64) -> Candidate {
+        Candidate {
             effect: effect.into(),
             unit: "-".into(),
-            refitted: status != StrengthStatus::NotRefitted,
             linear_score: 1.0,
             linear_strength: 0.0,
-            strength: 0.03,
-            stderr_strength: 0.005,
+            linear_stderr: 0.005,
             cost_before: 1.0,
             cost_after: 0.8,
-            rms_relative_residual_after: 0.015,
             extra_parameters: 1,
             delta_bic: dbic,
             delta_aic: dbic,
             signature_peak_m: 0.0,
             signature_range_m: [0.0, 0.04],
-            n,
-            kappa,
-            // se(n) = 0.01, se(κ) = 0.1
-            ci95_n: [n - Z95 * 0.01, n + Z95 * 0.01],
-            ci95_kappa: [kappa - Z95 * 0.1, kappa + Z95 * 0.1],
-            at_bound: Vec::new(),
             status,
             status_note: None,
             physical_range: [-0.1, 0.1],
             search_range: [-0.2, 0.2],
-            shape: Vec::new(),
+            // se(n) = 0.01, se(κ) = 0.1
+            refit: (status != StrengthStatus::NotRefitted)
+                .then(|| refit_summary(effect, (0.03, 0.005), (n, 0.01), (kappa, 0.1))),
             shape_alternative: None,
             profiles: Vec::new(),
             scan_errors: Vec::new(),
@@ -446,7 +416,9 @@ mod tests {
         assert!(!d.material_robust);
         // without a valid CI of the named refit the shift is unknown: not robust
         let mut no_ci = named.clone();
-        no_ci.ci95_n = [f64::NAN; 2];
+        if let Some(r) = no_ci.refit.as_mut() {
+            r.n.ci95 = [f64::NAN; 2];
+        }
         let a = Alternative::new(&no_ci, &list[1], Category::Process, Category::Physics, 0.9);
         assert!(a.n_shift_se.is_nan() && !a.material_robust);
         assert!(a.mixes_physics_and_conditions());
@@ -463,7 +435,8 @@ mod tests {
             " — or, about as consistent with these data, gauge_scale (delta BIC gap 2.1, \
              signatures cos +0.986)"
         );
-        let t = ties_paragraph(&named, std::slice::from_ref(&a));
+        let all = [named.clone(), g.clone()];
+        let t = ties_paragraph(&named, std::slice::from_ref(&a), &all);
         assert!(t.contains("between inlet_diameter and gauge_scale"), "{t}");
         assert!(t.contains("ROBUST to the choice"), "{t}");
         assert!(t.contains("n +0.5, kappa -0.5 standard errors"), "{t}");
@@ -476,14 +449,14 @@ mod tests {
         // physics tied with an instrument error, material result moved by 3 se
         let rad = cand("radiation", Physical, -38.0, 0.83, 11.79);
         let b = Alternative::new(&named, &rad, Category::Process, Category::Physics, -0.9);
-        let t = ties_paragraph(&named, &[b]);
+        let t = ties_paragraph(&named, &[b], &[named.clone(), rad.clone()]);
         assert!(t.contains("DEPENDS ON THE CHOICE: with radiation"), "{t}");
         assert!(
             t.contains("mixes missing physics with process conditions"),
             "{t}"
         );
         assert!(t.contains("(inlet_diameter: measure the die swell"), "{t}");
-        assert!(ties_paragraph(&named, &[]).is_empty());
+        assert!(ties_paragraph(&named, &[], &[]).is_empty());
         assert!(or_alternatives(&[]).is_empty());
     }
 

@@ -6,6 +6,7 @@ use crate::fiber::effects::ModelSpec;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
+use crate::fiber::noise_summary::NoiseSummary;
 use crate::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
 use crate::fiber::smoothing::{smooth, SmoothFit};
 use crate::fiber::statistics::median;
@@ -210,14 +211,13 @@ impl Rheometer {
         }
     }
 
-    /// The [`NoiseModel`] of a fit's residuals (`residual_profiles` of an
-    /// [`Identification`](super::Identification), one per experiment in order): experiment
-    /// names, measured diameters and spin-line lengths from the data, default options. The
-    /// call for the diagnosis: `rh.noise_model(&id.residual_profiles)?`.
-    pub fn noise_model(
+    /// The residual profiles of a fit (`(positions [m], relative residuals [-])`, one per
+    /// experiment in order) as the noise model's series: experiment names, measured diameters
+    /// and spin-line lengths from the data.
+    pub fn residual_series(
         &self,
         residual_profiles: &[(Vec<f64>, Vec<f64>)],
-    ) -> Result<NoiseModel, RheometerError> {
+    ) -> Result<Vec<ResidualSeries>, RheometerError> {
         if residual_profiles.len() != self.len() {
             return Err(RheometerError::Data(format!(
                 "{} residual profiles for {} experiments",
@@ -225,7 +225,7 @@ impl Rheometer {
                 self.len()
             )));
         }
-        let series: Vec<ResidualSeries> = residual_profiles
+        Ok(residual_profiles
             .iter()
             .enumerate()
             .map(|(k, (s, r))| ResidualSeries {
@@ -235,8 +235,24 @@ impl Rheometer {
                 measured_m: self.measurements[k].diameters.clone(),
                 length_m: Some(self.experiments[k].spinline_length),
             })
-            .collect();
-        NoiseModel::estimate(&series, &NoiseOptions::default()).map_err(RheometerError::Data)
+            .collect())
+    }
+
+    /// The one noise summary of a fit's residual profiles (see
+    /// [`noise_summary`](crate::fiber::noise_summary)): the declared relative uncertainty
+    /// (`declared`, else the data set's), else the noise model's estimate.
+    pub fn noise_summary(
+        &self,
+        residual_profiles: &[(Vec<f64>, Vec<f64>)],
+        declared: Option<f64>,
+    ) -> Result<NoiseSummary, RheometerError> {
+        let series = self.residual_series(residual_profiles)?;
+        NoiseSummary::of(
+            &series,
+            declared.or(self.relative_uncertainty),
+            &NoiseOptions::default(),
+        )
+        .map_err(RheometerError::Data)
     }
 
     /// `(d_model − d_meas)/d_meas` at the measurement positions of experiment `k`; `d_model` is

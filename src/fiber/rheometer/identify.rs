@@ -10,9 +10,10 @@
 use super::data::Rheometer;
 use super::estimator::Estimator;
 use super::layout::{EffectSlot, FitStart};
-use super::options::{FitWarning, IdentifyOptions, RheometerError};
-use crate::fiber::effects::LawChoice;
-use crate::least_squares::{fit, Accuracy, FitOptions, FitResult, Loss};
+use super::options::{IdentifyOptions, RheometerError};
+use super::summary::FitSummary;
+use super::summary_build::SummaryInput;
+use crate::least_squares::{fit, Accuracy, FitOptions, FitResult};
 use crate::solution::Solution;
 use std::time::Instant;
 
@@ -59,6 +60,22 @@ impl Rheometer {
         options: &IdentifyOptions,
         warm: &WarmFit,
     ) -> Result<Identification, RheometerError> {
+        let id = self.identify_unchecked(start, options, warm)?;
+        if warm.stop_tolerance.is_some() {
+            // a grid point of a scan: no estimate of its own to report
+            return Ok(id);
+        }
+        super::accuracy::matched(self, start, options, id)
+    }
+
+    /// [`identify_warm`](Self::identify_warm) without the discretisation check (see
+    /// [`accuracy`](super::accuracy)).
+    pub(crate) fn identify_unchecked(
+        &self,
+        start: &FitStart,
+        options: &IdentifyOptions,
+        warm: &WarmFit,
+    ) -> Result<Identification, RheometerError> {
         let t0 = Instant::now();
         let mut obj = self.objective_from(start, options)?;
         let mut p0 = obj.initial_parameters();
@@ -98,8 +115,7 @@ impl Rheometer {
         }
         let fit_result = fit(&mut obj, &p0, &fo)?;
         let solutions: Vec<Solution> = obj.solutions();
-        let rms = self.rms_relative_residual(&solutions);
-        let residual_profiles = solutions
+        let residual_profiles: Vec<(Vec<f64>, Vec<f64>)> = solutions
             .iter()
             .enumerate()
             .map(|(k, sol)| {
@@ -112,35 +128,48 @@ impl Rheometer {
         let local = obj
             .layout
             .local(&fit_result.p[..ns], 1.0, obj.layout.params.take_up_factor());
-        let [n, kappa] = obj.layout.law_of(&local);
-        Ok(Identification {
+        let declared = options.relative_uncertainty.or(self.relative_uncertainty);
+        let noise = self.noise_summary(&residual_profiles, declared)?;
+        let summary = FitSummary::new(SummaryInput {
             estimator: options.estimator,
+            law: self.spec.law,
             start: start.law,
-            n,
-            kappa,
+            experiments: self.experiments.iter().map(|e| e.name.clone()).collect(),
+            names: &obj.layout.names,
+            effects: &obj.layout.effects,
+            local_params: &local,
+            law_params: obj.layout.law_of(&local),
+            fit: &fit_result,
+            lower: &lower,
+            upper: &upper,
             take_up_factors: if options.estimator == Estimator::Principled {
                 fit_result.p[ns..].to_vec()
             } else {
                 vec![1.0; self.len()]
             },
+            rms: rms_of(residual_profiles.iter().flat_map(|(_, r)| r)),
+            rms_by_experiment: residual_profiles
+                .iter()
+                .map(|(_, r)| rms_of(r.iter()))
+                .collect(),
+            noise,
+            data_warnings: self.data_warnings(),
+            f_scale,
+            f_scale_source,
+            bvp_tolerance: options.simulate.tol,
+            nodes: solutions.iter().map(|s| s.x.len()).collect(),
+            wall_time_s: t0.elapsed().as_secs_f64(),
+        });
+        Ok(Identification {
+            summary,
             names: obj.layout.names.clone(),
             effects: obj.layout.effects.clone(),
             local_params: local,
-            rms_relative_residual: rms,
-            law: self.spec.law,
-            experiment_names: self.experiments.iter().map(|e| e.name.clone()).collect(),
             lower,
             upper,
             residual_profiles,
-            relative_uncertainty: options.relative_uncertainty.or(self.relative_uncertainty),
-            data_warnings: self.data_warnings(),
-            loss: options.loss,
-            f_scale,
-            f_scale_source,
-            down_weighted: fit_result.down_weighted(),
             solutions,
             fit: fit_result,
-            wall_time_s: t0.elapsed().as_secs_f64(),
         })
     }
 
@@ -228,19 +257,12 @@ pub struct StartPoint {
     pub trace: Vec<(f64, f64)>,
 }
 
-/// Result of an identification.
+/// Result of an identification: its [`FitSummary`] (the outcome, as reported) and what the
+/// next computation needs (the solutions, the least-squares result, the model layout).
 #[derive(Debug, Clone)]
 pub struct Identification {
-    /// The estimator used.
-    pub estimator: Estimator,
-    /// Start point `(n, κ)`.
-    pub start: [f64; 2],
-    /// Identified power index `n` \[-\].
-    pub n: f64,
-    /// Identified `κ = ln(K / 1 Pa)` \[-\].
-    pub kappa: f64,
-    /// Take-up factors `φ_k = d_out,k / d_fit,k(L)` (all 1 for the paper's estimator).
-    pub take_up_factors: Vec<f64>,
+    /// The outcome: named estimates with uncertainties, noise level, warnings.
+    pub summary: FitSummary,
     /// Names of the shared fitted parameters (the first entries of `fit.p`; the take-up factors
     /// follow).
     pub names: Vec<String>,
@@ -248,18 +270,10 @@ pub struct Identification {
     pub effects: Vec<EffectSlot>,
     /// The fitted local model parameters `[c, n, κ, strengths..., φ = 1]`.
     pub local_params: Vec<f64>,
-    /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements \[-\].
-    pub rms_relative_residual: f64,
     /// Final fiber solutions, one per experiment.
     pub solutions: Vec<Solution>,
     /// The least-squares result (cost, Jacobian, iterations, termination).
     pub fit: FitResult,
-    /// Wall time \[s\], including the cold starts.
-    pub wall_time_s: f64,
-    /// The viscosity law of the model (what was fitted; never inferred from the values).
-    pub law: LawChoice,
-    /// Experiment names, in the order of `take_up_factors` and `solutions`.
-    pub experiment_names: Vec<String>,
     /// Lower bounds of `fit.p` (shared parameters in model units, then take-up factors).
     pub lower: Vec<f64>,
     /// Upper bounds of `fit.p`.
@@ -267,16 +281,31 @@ pub struct Identification {
     /// Per experiment: measurement positions \[m\] and relative residuals
     /// `(d_model − d_meas)/d_meas` \[-\] at the optimum.
     pub residual_profiles: Vec<(Vec<f64>, Vec<f64>)>,
-    /// Declared relative measurement uncertainty (options, else the data set), if any.
-    pub relative_uncertainty: Option<f64>,
-    /// Warnings about the data found before fitting ([`Rheometer::data_warnings`]).
-    pub data_warnings: Vec<FitWarning>,
-    /// The loss of the fit.
-    pub loss: Loss,
-    /// Its soft margin `C` \[-\] in relative-residual units (`NaN` for the linear loss).
-    pub f_scale: f64,
-    /// Where `f_scale` came from (`"given"` or the data's robust noise scale; empty for linear).
-    pub f_scale_source: String,
-    /// Residuals beyond the soft margin (down-weighted by the robust loss; 0 for linear).
-    pub down_weighted: usize,
+}
+
+impl Identification {
+    /// `(n, κ)` of the fitted model.
+    pub fn law(&self) -> [f64; 2] {
+        self.summary.law_params()
+    }
+
+    /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements \[-\].
+    pub fn rms(&self) -> f64 {
+        self.summary.rms_relative_residual
+    }
+
+    /// Take-up factors `φ_k = d_out,k / d_fit,k(L)` (all 1 for the paper's estimator).
+    pub fn take_up_factors(&self) -> &[f64] {
+        &self.summary.take_up_factors
+    }
+}
+
+/// RMS of `values` (0 for none).
+fn rms_of<'a>(values: impl Iterator<Item = &'a f64>) -> f64 {
+    let (mut s2, mut n) = (0.0, 0usize);
+    for v in values {
+        s2 += v * v;
+        n += 1;
+    }
+    (s2 / n.max(1) as f64).sqrt()
 }

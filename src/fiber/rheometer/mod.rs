@@ -16,10 +16,14 @@
 //! * [`landscape`]: the cost on a grid (paper Fig. 4);
 //! * [`error_budget()`]: what the data cannot identify (process conditions, instrument,
 //!   material data) propagated through exact sensitivities into a systematic uncertainty;
-//! * [`report`]: uncertainty (standard errors, 95% confidence intervals, correlation), the checks
-//!   of a fit (estimates at bounds, misfit, huge errors, data the model cannot describe) and the
-//!   text and JSON reports.
+//! * [`summary`]: the outcome of a fit as one value, [`FitSummary`] (named estimates with
+//!   standard errors and 95% confidence intervals, covariance, the one noise level, warnings),
+//!   rendered as text and JSON and read back by the next step;
+//! * [`summary_checks`]: the checks of a fit (estimates at bounds, misfit, huge errors, data
+//!   the model cannot describe).
 
+pub mod accuracy;
+pub mod budget;
 pub mod data;
 pub mod error_budget;
 pub mod estimator;
@@ -29,7 +33,11 @@ pub mod layout;
 pub mod objective;
 pub mod options;
 pub mod parameter_shift;
-pub mod report;
+pub mod summary;
+mod summary_build;
+pub mod summary_checks;
+mod summary_read;
+mod summary_text;
 
 pub use data::Rheometer;
 pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
@@ -39,6 +47,8 @@ pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
 pub use options::{CarreauFiber, IdentifyOptions, RheometerError};
 pub use parameter_shift::ParameterShift;
-pub use report::{
-    AtBound, BoundSide, EffectReport, FitReport, FitWarning, ShapeReport, WarningCode,
+pub use summary::{
+    AtBound, BoundSide, Covariance, EffectEstimate, Estimate, FitSummary, FitWarning, SolverRecord,
+    WarningCode,
 };
+pub use summary_read::{FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE, FIT_FILE_TAKE_UP_RANGE};

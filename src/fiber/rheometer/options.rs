@@ -56,7 +56,8 @@ pub struct IdentifyOptions {
     pub estimator: Estimator,
     /// Regular optimisation points per experiment for the paper's cost (`n_o`, default 20).
     pub n_opt_points: usize,
-    /// BVP settings (tolerance 1e-6 by default).
+    /// BVP settings (tolerance 1e-4 by default: matched to the noise and checked, see
+    /// [`max_discretisation_shift`](Self::max_discretisation_shift)).
     pub simulate: SimulateOptions,
     /// Lower bounds of `(n, κ)` (default `(0, 7)`, the paper's Ω).
     pub lower: [f64; 2],
@@ -81,12 +82,18 @@ pub struct IdentifyOptions {
     /// the noise or of the step's effect on the residuals), the final iterations, the estimate
     /// and its covariance at `simulate.tol`. `None`: every solve at `simulate.tol`.
     pub loose_tolerance: Option<f64>,
+    /// The largest shift of an estimate \[standard errors\] the BVPs' discretisation may cause
+    /// (default `Some(0.01)`): the fit is checked with every BVP solved 100 times more
+    /// accurately at the optimum and refined at tighter tolerances until it holds (see
+    /// [`accuracy`](super::accuracy)). `None`: no check, `simulate.tol` as given.
+    pub max_discretisation_shift: Option<f64>,
 }
 
 impl Default for IdentifyOptions {
     fn default() -> Self {
         let simulate = SimulateOptions {
             factor_at_solution: true,
+            tol: 1e-4,
             ..SimulateOptions::default()
         };
         IdentifyOptions {
@@ -101,6 +108,7 @@ impl Default for IdentifyOptions {
             loss: Loss::Linear,
             f_scale: None,
             loose_tolerance: Some(1e-3),
+            max_discretisation_shift: Some(0.01),
         }
     }
 }
@@ -135,6 +143,10 @@ pub enum WarningCode {
     /// conditions, instrument, material data) shifts an estimate by more than its statistical
     /// standard error (see [`error_budget`](super::error_budget())).
     Systematic,
+    /// A material law outside what polymer melts do (`n` near 0, an interval reaching beyond
+    /// the law's range, a jump from the plain fit that the gain in fit does not pay for): the
+    /// fit compensates a model error with the viscosity law; not a result.
+    Implausible,
 }
 
 impl WarningCode {
@@ -148,6 +160,7 @@ impl WarningCode {
             WarningCode::IllConditioned => "ill_conditioned",
             WarningCode::DataTrend => "data_trend",
             WarningCode::Systematic => "systematic",
+            WarningCode::Implausible => "implausible",
         }
     }
 }

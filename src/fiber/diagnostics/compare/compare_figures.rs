@@ -23,7 +23,12 @@ const TREND_BINS: usize = 12;
 fn pooled_trend(cmp: &Comparison, length: f64) -> Vec<(f64, f64)> {
     let mut bins: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); TREND_BINS];
     for (k, e) in cmp.experiments.iter().enumerate() {
-        let l = cmp.noise.lengths_m.get(k).copied().unwrap_or(length);
+        let l = cmp
+            .noise
+            .model
+            .as_ref()
+            .and_then(|m| m.lengths_m.get(k).copied())
+            .unwrap_or(length);
         for p in e.points.iter().filter(|p| !p.outlier) {
             let x = p.position_m / l;
             let b = ((x * TREND_BINS as f64).floor().max(0.0) as usize).min(TREND_BINS - 1);
@@ -127,19 +132,29 @@ pub fn write_figures(
             .with_color(k),
         );
     }
-    let length = cmp.noise.lengths_m.iter().copied().fold(0.0, f64::max);
-    let band: Vec<(f64, f64)> = (0..=60)
-        .map(|i| {
-            let s = s_lo + (s_hi - s_lo) * f64::from(i) / 60.0;
-            (s, 200.0 * cmp.noise.local_sigma(s / length))
-        })
-        .collect();
-    let lower: Vec<(f64, f64)> = band.iter().map(|(s, v)| (*s, -v)).collect();
-    each = each
-        .with_series(Series::dashed("±2σ(s) noise model", band).with_color(9))
-        .with_series(Series::dashed("", lower).with_color(9));
-    if cmp.sigma_source == super::NoiseSource::Given {
-        let two_sigma = 200.0 * cmp.sigma;
+    let length = cmp.noise.model.as_ref().map_or_else(
+        || {
+            cmp.experiments
+                .iter()
+                .filter_map(|e| e.curve_position_m.last().copied())
+                .fold(0.0, f64::max)
+        },
+        |m| m.lengths_m.iter().copied().fold(0.0, f64::max),
+    );
+    if let Some(nm) = &cmp.noise.model {
+        let band: Vec<(f64, f64)> = (0..=60)
+            .map(|i| {
+                let s = s_lo + (s_hi - s_lo) * f64::from(i) / 60.0;
+                (s, 200.0 * nm.local_sigma(s / length))
+            })
+            .collect();
+        let lower: Vec<(f64, f64)> = band.iter().map(|(s, v)| (*s, -v)).collect();
+        each = each
+            .with_series(Series::dashed("±2σ(s) noise model", band).with_color(9))
+            .with_series(Series::dashed("", lower).with_color(9));
+    }
+    if cmp.noise.declared() {
+        let two_sigma = 200.0 * cmp.noise.level;
         each = each
             .with_series(
                 Series::dashed("±2σ given", vec![(s_lo, two_sigma), (s_hi, two_sigma)])

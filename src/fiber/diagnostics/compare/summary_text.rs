@@ -1,6 +1,6 @@
 //! The comparison in words: noise level, χ²/dof, whiteness, where the misfit is systematic.
 
-use super::{Comparison, NoiseSource, Segment};
+use super::{Comparison, NoiseModel, Segment};
 use std::fmt::Write;
 
 fn pct(v: f64) -> f64 {
@@ -51,8 +51,7 @@ const MAX_LISTED_OUTLIERS: usize = 30;
 
 impl Comparison {
     /// The noise model in words: scale along the line, RMS/noise, outliers.
-    fn noise_lines(&self, s: &mut String) {
-        let nm = &self.noise;
+    fn noise_lines(nm: &NoiseModel, s: &mut String) {
         let bins: Vec<String> = nm
             .bins
             .iter()
@@ -69,12 +68,7 @@ impl Comparison {
                 nm.variation_ratio, nm.variation_z
             )
         };
-        let _ = writeln!(
-            s,
-            "noise model: robust scale {:.2} %; along the line {}: {along}",
-            pct(nm.sigma),
-            bins.join(", ")
-        );
+        let _ = writeln!(s, "noise along the line {}: {along}", bins.join(", "));
         let _ = writeln!(
             s,
             "RMS/noise = {:.2} (RMS {:.2} % vs local noise RMS {:.2} % over the same {} points, outliers left out); robust RMS/noise = {:.2}",
@@ -133,25 +127,10 @@ impl Comparison {
             "RMS relative residual (d_model - d_meas)/d_meas = {:.2} %",
             pct(self.rms)
         );
-        match self.sigma_source {
-            NoiseSource::Given => {
-                let _ = writeln!(
-                    s,
-                    "noise level sigma = {:.2} % (given); estimated from the data: {:.2} %",
-                    pct(self.sigma),
-                    pct(self.sigma_estimated)
-                );
-            }
-            NoiseSource::Estimated => {
-                let _ = writeln!(
-                    s,
-                    "noise level sigma = {:.2} % (estimated from the data: robust scatter of \
-                     second differences of the residuals along s; none given in the TOML)",
-                    pct(self.sigma)
-                );
-            }
+        let _ = writeln!(s, "noise level sigma = {}", self.noise.describe());
+        if let Some(nm) = &self.noise.model {
+            Self::noise_lines(nm, &mut s);
         }
-        self.noise_lines(&mut s);
         let dof = self.dof as f64;
         let excess = (self.chi2 - dof) / (2.0 * dof).sqrt();
         let verdict = if self.dof == 0 {
@@ -172,7 +151,7 @@ impl Comparison {
             self.dof,
             self.chi2_per_dof,
             self.fitted_parameters,
-            match self.noise.outliers.len() {
+            match self.noise.model.as_ref().map_or(0, |m| m.outliers.len()) {
                 0 => String::new(),
                 k => format!(", {k} outliers left out"),
             }

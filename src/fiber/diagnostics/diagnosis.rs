@@ -1,0 +1,104 @@
+//! The result of a diagnosis: what is written as JSON ([`Diagnosis`]) and what figures and
+//! the next step need besides ([`DiagnosisRun`]).
+
+use super::candidate::{Candidate, Indistinguishable};
+use super::detection::DetectionLimits;
+use super::ties::Alternative;
+use crate::fiber::effects::LawChoice;
+use crate::fiber::rheometer::{FitSummary, Identification};
+use serde::{Deserialize, Serialize};
+
+/// Relative residuals along the spin line, per experiment: `(name, [(s in m, residual)])`.
+pub type ResidualProfiles = Vec<(String, Vec<(f64, f64)>)>;
+
+/// The diagnosis (what is written as JSON).
+///
+/// The noise level, the outliers and the residual statistics the judgement uses are those of
+/// the user's fit, [`base_fit`](Self::base_fit)`.noise`: the same numbers `rheometer fit`
+/// prints for the same data and model.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Diagnosis {
+    /// The user's law.
+    pub model: LawChoice,
+    /// The user's fit (principled estimator), with its one noise level.
+    pub base_fit: FitSummary,
+    /// Whether the residuals are systematic: `rms_over_noise > 1.2`, or `ρ₁ √N > 3`, or a
+    /// candidate earns its place (its refit lowers BIC below the threshold).
+    pub systematic: bool,
+    /// The candidates, best first.
+    pub candidates: Vec<Candidate>,
+    /// Pairs of candidates with nearly parallel signatures.
+    pub indistinguishable: Vec<Indistinguishable>,
+    /// The most likely missing effect, if one earns its place (the best by `ΔBIC`).
+    pub most_likely_missing: Option<String>,
+    /// Other candidates about as consistent with the data as the named one: they earn their
+    /// place too, with a `ΔBIC` less than the tie margin above the named one's (best first;
+    /// empty when nothing is named or nothing ties; see [`ties`](super::ties)).
+    #[serde(default)]
+    pub alternatives: Vec<Alternative>,
+    /// What these data could have missed: per candidate, the strength named with 50 % and
+    /// 95 % probability (linearised at strength 0) and the shift of `(n, κ)` an undetected
+    /// effect of the 95 % strength would cause ([`detection`](super::detection)).
+    #[serde(default)]
+    pub detection: DetectionLimits,
+    /// Wall time \[s\].
+    pub wall_time_s: f64,
+}
+
+impl Diagnosis {
+    /// The candidate named `effect`, if it was a candidate.
+    pub fn candidate(&self, effect: &str) -> Option<&Candidate> {
+        self.candidates.iter().find(|c| c.effect == effect)
+    }
+
+    /// The named cause's record, if one earns its place.
+    pub fn named(&self) -> Option<&Candidate> {
+        self.most_likely_missing
+            .as_deref()
+            .and_then(|n| self.candidate(n))
+    }
+
+    /// The noise level the judgement used \[-\] (the base fit's).
+    pub fn noise_level(&self) -> f64 {
+        self.base_fit.noise.level
+    }
+
+    /// RMS relative residual of the user's fit (outliers excluded) over the noise level \[-\].
+    pub fn rms_over_noise(&self) -> f64 {
+        self.base_fit.noise.rms_over_noise
+    }
+
+    /// Pooled lag-1 autocorrelation of the noise-normalised residuals of the user's fit
+    /// (about zero, outliers excluded; `NaN` without a noise model) \[-\].
+    pub fn lag1_autocorrelation(&self) -> f64 {
+        self.base_fit
+            .noise
+            .model
+            .as_ref()
+            .map_or(f64::NAN, |m| m.lag1)
+    }
+
+    /// Gross outliers of the user's fit, by experiment and position.
+    pub fn outliers(&self) -> &[crate::fiber::noise_model::Outlier] {
+        self.base_fit
+            .noise
+            .model
+            .as_ref()
+            .map_or(&[], |m| &m.outliers)
+    }
+}
+
+/// A diagnosis with the data for figures.
+#[derive(Debug, Clone)]
+pub struct DiagnosisRun {
+    /// The numbers.
+    pub diagnosis: Diagnosis,
+    /// Residuals of the user's fit.
+    pub residuals_before: ResidualProfiles,
+    /// Residuals after adding the named candidate.
+    pub residuals_after: Option<ResidualProfiles>,
+    /// The user's fit.
+    pub base: Identification,
+    /// The refit with the named candidate.
+    pub best: Option<Identification>,
+}

@@ -1,0 +1,129 @@
+//! Accuracy matched to the noise: a fit solves its boundary-value problems only as accurately
+//! as the data need, and proves it.
+//!
+//! The measurement noise (≈ 1–2 % of the diameter) makes every estimate uncertain by its
+//! standard error; a discretisation error of the BVPs moves the estimate too. The fit runs at
+//! [`IdentifyOptions::simulate`](super::IdentifyOptions::simulate)`.tol` (default 1e-4) and
+//! then checks the shift: the residuals at the optimum are recomputed with every experiment
+//! re-solved [`CHECK_FACTOR`] times more accurately (warm-started from the fit's solutions),
+//! and the optimum's first-order move `Δθ = −(JᵀJ)⁻¹ Jᵀ (r_fine − r)` is compared with the
+//! standard errors. Above [`IdentifyOptions::max_discretisation_shift`](super::IdentifyOptions::max_discretisation_shift)
+//! (default 0.01 standard errors) the fit is refined at a tolerance ten times tighter and
+//! checked again. The measured shift and the tolerances are in the fit's
+//! [`SolverRecord`](super::SolverRecord).
+
+use super::data::Rheometer;
+use super::identify::{Identification, WarmFit};
+use super::layout::FitStart;
+use super::options::{IdentifyOptions, RheometerError};
+use super::parameter_shift::ParameterShift;
+use crate::least_squares::LeastSquaresProblem;
+use nalgebra::DVector;
+
+/// The check re-solves this many times more accurately than the fit.
+pub const CHECK_FACTOR: f64 = 100.0;
+
+/// The tightest tolerance the refinement goes to \[-\].
+pub const TIGHTEST_TOLERANCE: f64 = 1e-9;
+
+/// The largest shift \[standard errors\] of a fitted shared parameter (`n`, `κ`, strengths,
+/// shapes) when the BVPs are solved [`CHECK_FACTOR`] times more accurately at the optimum, and
+/// the tolerance of that check.
+pub(crate) fn discretisation_shift(
+    rh: &Rheometer,
+    start: &FitStart,
+    options: &IdentifyOptions,
+    id: &Identification,
+) -> Result<(f64, f64), RheometerError> {
+    let check_tol = options.simulate.tol / CHECK_FACTOR;
+    let mut fine = options.clone();
+    fine.simulate.tol = check_tol;
+    fine.loose_tolerance = None;
+    let fs = FitStart {
+        warm: Some(id.solutions.clone()),
+        ..start.clone()
+    };
+    let mut obj = rh.objective_from(&fs, &fine)?;
+    let (r_fine, _) = obj.evaluate(&id.fit.p)?;
+    let r = &id.fit.residuals;
+    if r_fine.len() != r.len() {
+        return Err(RheometerError::Data(format!(
+            "discretisation check: {} residuals at the fine tolerance, {} in the fit",
+            r_fine.len(),
+            r.len()
+        )));
+    }
+    let dr = DVector::from_iterator(r.len(), r_fine.iter().zip(r).map(|(a, b)| a - b));
+    let q = id.fit.p.len();
+    let shift = ParameterShift::new(&id.fit.jacobian, r.len(), q)?.derivative(&dr);
+    let se = id
+        .fit
+        .standard_errors()
+        .unwrap_or_else(|| vec![f64::NAN; q]);
+    let worst = (0..id.names.len())
+        .map(|c| (shift[c] / se[c]).abs())
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    Ok((worst, check_tol))
+}
+
+/// The fit `id` (started from `start`) checked and, where the discretisation moves an estimate
+/// by more than the options allow, refined at tighter tolerances until it does not.
+pub(crate) fn matched(
+    rh: &Rheometer,
+    start: &FitStart,
+    options: &IdentifyOptions,
+    mut id: Identification,
+) -> Result<Identification, RheometerError> {
+    let Some(limit) = options.max_discretisation_shift else {
+        return Ok(id);
+    };
+    let mut opts = options.clone();
+    loop {
+        let (shift, check_tol) = discretisation_shift(rh, start, &opts, &id)?;
+        id.summary.solver.discretisation_shift_se = shift;
+        id.summary.solver.check_tolerance = check_tol;
+        if shift <= limit || opts.simulate.tol <= TIGHTEST_TOLERANCE {
+            return Ok(id);
+        }
+        // refine: a tighter tolerance, warm from this fit
+        opts.simulate.tol = (opts.simulate.tol / 10.0).max(TIGHTEST_TOLERANCE);
+        let next = FitStart {
+            law: id.law(),
+            strengths: fitted_strengths(&id),
+            warm: Some(id.solutions.clone()),
+            ..start.clone()
+        };
+        let warm = WarmFit {
+            take_up: id.take_up_factors().to_vec(),
+            stop_tolerance: None,
+        };
+        let wall = id.summary.solver.wall_time_s;
+        let mut refined = rh.identify_unchecked(&next, &opts, &warm)?;
+        refined.summary.start = id.summary.start;
+        refined.summary.solver.wall_time_s += wall;
+        id = refined;
+    }
+}
+
+/// The fitted strengths and shapes of `id` by model-parameter name, in the effects' units.
+fn fitted_strengths(id: &Identification) -> Vec<(String, f64)> {
+    let mut out = Vec::new();
+    for slot in &id.effects {
+        if slot.column.is_some() {
+            out.push((
+                slot.effect.name().to_string(),
+                slot.effect.strength_of(id.local_params[slot.local]),
+            ));
+        }
+        for sh in &slot.shapes {
+            if sh.column.is_some() {
+                out.push((
+                    sh.parameter.model_param.to_string(),
+                    id.local_params[sh.local],
+                ));
+            }
+        }
+    }
+    out
+}

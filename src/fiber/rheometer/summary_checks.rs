@@ -1,0 +1,369 @@
+//! The checks of a fit: a bad fit is never printed as a good one.
+//!
+//! * **Estimates at a bound.** An estimate within [`AT_BOUND_TOLERANCE`] of the width of its
+//!   search range from a bound is listed in [`FitSummary::at_bound`] and marked `AT LOWER
+//!   BOUND` / `AT UPPER BOUND` in the text. The optimum then lies at or beyond the search
+//!   range, and the normal-approximation interval is not valid: its `ci95` is `NaN` (`null` in
+//!   JSON) and the text prints no interval for it.
+//! * **Misfit far above the noise.** The RMS relative residual is compared with the fit's one
+//!   noise level ([`NoiseSummary`](crate::fiber::noise_summary::NoiseSummary): declared, else
+//!   estimated by the noise model). Above [`MISFIT_RATIO`] times the noise the report warns and
+//!   names the worst experiments.
+//! * **Huge standard errors**: `SE(n) >` [`LARGE_STDERR_N`], `SE(κ) >` [`LARGE_STDERR_KAPPA`],
+//!   a fitted strength with a standard error above [`LARGE_STDERR_STRENGTH_FRACTION`] of its
+//!   search range, or a `K` interval reaching `0` or `∞`.
+//! * **A singular or ill-conditioned covariance** (no standard errors, or a correlation matrix
+//!   with reciprocal condition number below [`ILL_CONDITIONED_RCOND`]).
+//! * **Data the model cannot describe**: measured diameters that do not decrease along the spin
+//!   line ([`Rheometer::data_warnings`](super::Rheometer::data_warnings)).
+//!
+//! Each finding is a [`FitWarning`] (a [`WarningCode`] and a message naming the parameter or
+//! experiment) in [`FitSummary::warnings`].
+
+use super::estimator::Estimator;
+use super::layout::EffectSlot;
+use super::options::{FitWarning, WarningCode};
+use super::summary::{BoundSide, FitSummary};
+use crate::fiber::format::fmt_g;
+use nalgebra::{DMatrix, SymmetricEigen};
+
+/// An estimate counts as at a bound when it is within this fraction of the width of its search
+/// range from the bound (e.g. `0.001` for `n ∈ [0, 1]`, `0.013` for `κ ∈ [7, 20]`).
+pub const AT_BOUND_TOLERANCE: f64 = 1e-3;
+/// The report warns when the RMS relative residual exceeds this multiple of the noise level.
+pub const MISFIT_RATIO: f64 = 3.0;
+/// Without any noise level (too few points to estimate it), the report warns when the RMS
+/// relative residual exceeds this \[-\].
+pub const MISFIT_WITHOUT_NOISE: f64 = 0.1;
+/// A standard error of `n` above this \[-\] is reported as huge.
+pub const LARGE_STDERR_N: f64 = 0.2;
+/// A standard error of `κ` above this \[-\] (a factor `e` in `K`) is reported as huge.
+pub const LARGE_STDERR_KAPPA: f64 = 1.0;
+/// A fitted strength whose standard error exceeds this fraction of its search range is
+/// reported as undetermined.
+pub const LARGE_STDERR_STRENGTH_FRACTION: f64 = 0.25;
+/// A correlation matrix whose smallest/largest eigenvalue ratio is below this is reported as
+/// ill-conditioned.
+pub const ILL_CONDITIONED_RCOND: f64 = 1e-10;
+
+/// The power index `n` \[-\] polymer melts show in elongation: below 0.2 a fitted `n` is
+/// compensating a model error, not describing a melt.
+pub const PLAUSIBLE_N: [f64; 2] = [0.2, 1.0];
+
+/// A law that moved by more than this many of the plain fit's standard errors is checked
+/// against the gain in fit it bought ([`law_jump`]).
+pub const JUMP_SE: f64 = 5.0;
+
+/// Which bound `value` is at (within [`AT_BOUND_TOLERANCE`] of the range width), if any.
+pub fn bound_side(value: f64, lower: f64, upper: f64) -> Option<BoundSide> {
+    let width = upper - lower;
+    let tol = if width.is_finite() && width > 0.0 {
+        AT_BOUND_TOLERANCE * width
+    } else {
+        AT_BOUND_TOLERANCE * value.abs().max(1.0)
+    };
+    if lower.is_finite() && value - lower <= tol {
+        Some(BoundSide::Lower)
+    } else if upper.is_finite() && upper - value <= tol {
+        Some(BoundSide::Upper)
+    } else {
+        None
+    }
+}
+
+/// One warning per estimate at a bound, with what it means for `n`, `κ` and take-up factors.
+pub(crate) fn check_bounds(s: &FitSummary, w: &mut Vec<FitWarning>) {
+    for b in &s.at_bound {
+        let mut m = format!(
+            "{} = {} is AT ITS {} BOUND {}: the optimum lies at or beyond the search range, \
+             so its standard error and 95% interval are not valid",
+            b.parameter,
+            fmt_g(b.value),
+            b.side.name().to_uppercase(),
+            fmt_g(b.bound)
+        );
+        if b.parameter == "n" && b.side == BoundSide::Upper && b.bound >= 1.0 && s.law_fitted() {
+            m.push_str(
+                "; n = 1 is the Newtonian limit of the Carreau-type law, where kappa (K) no \
+                 longer enters: the data show no strain thinning, or the model misses \
+                 something (is the air hotter than the melt, are the data right?)",
+            );
+        } else if b.parameter == "kappa" {
+            m.push_str(&format!(
+                "; K = e^kappa = {:.4e} Pa sits at its {} limit: the data ask for K outside \
+                 the search range",
+                b.value.exp(),
+                b.side.name()
+            ));
+        } else if b.parameter.starts_with("take_up_factor[") {
+            m.push_str(
+                "; the fitted take-up diameter is that far from d_fit(L) (or from the TOML's \
+                 take_up_* value): check this experiment's take-up condition and data",
+            );
+        }
+        w.push(FitWarning::new(WarningCode::AtBound, m));
+    }
+}
+
+/// Singular or ill-conditioned covariance, huge standard errors, unbounded `K` intervals,
+/// undetermined strengths.
+pub(crate) fn check_uncertainty(
+    s: &FitSummary,
+    slots: &[EffectSlot],
+    have_se: bool,
+    corr: Option<&[f64]>,
+    np: usize,
+    w: &mut Vec<FitWarning>,
+) {
+    check_covariance(s, have_se, corr, np, w);
+    let at = |name: &str| s.bound_of(name).is_some();
+    if s.n.fitted && s.n.stderr > LARGE_STDERR_N {
+        w.push(FitWarning::new(
+            WarningCode::LargeUncertainty,
+            format!(
+                "the standard error of n is {} (> {LARGE_STDERR_N}): the data do not \
+                 determine n",
+                fmt_g(s.n.stderr)
+            ),
+        ));
+    }
+    if s.kappa.fitted {
+        if s.kappa.stderr > LARGE_STDERR_KAPPA {
+            w.push(FitWarning::new(
+                WarningCode::LargeUncertainty,
+                format!(
+                    "the standard error of kappa is {} (> {LARGE_STDERR_KAPPA}, a factor \
+                     {:.3} in K): the data do not determine kappa or K",
+                    fmt_g(s.kappa.stderr),
+                    LARGE_STDERR_KAPPA.exp()
+                ),
+            ));
+        }
+        let [a, b] = s.k_pa.ci95;
+        if !at("kappa") && s.kappa.stderr.is_finite() && (a <= 0.0 || b.is_infinite()) {
+            w.push(FitWarning::new(
+                WarningCode::LargeUncertainty,
+                format!(
+                    "the 95% interval of K is [{a:.4e}, {b:.4e}] Pa: unbounded, K is not \
+                     determined"
+                ),
+            ));
+        }
+    }
+    for (slot, e) in slots.iter().zip(&s.effects) {
+        let st = &e.strength;
+        if !st.fitted || st.at_bound.is_some() {
+            continue;
+        }
+        let (lo, hi) = slot.effect.bounds();
+        let limit = LARGE_STDERR_STRENGTH_FRACTION * (hi - lo).abs();
+        if st.stderr > limit && !(slot.column == Some(0) && at("n")) {
+            w.push(FitWarning::new(
+                WarningCode::LargeUncertainty,
+                format!(
+                    "the standard error of the {} strength is {} {} (more than {}% of its \
+                     search range [{lo}, {hi}]): the data do not determine it",
+                    e.effect,
+                    fmt_g(st.stderr),
+                    st.unit,
+                    100.0 * LARGE_STDERR_STRENGTH_FRACTION
+                ),
+            ));
+        }
+    }
+}
+
+fn check_covariance(
+    s: &FitSummary,
+    have_se: bool,
+    corr: Option<&[f64]>,
+    np: usize,
+    w: &mut Vec<FitWarning>,
+) {
+    if !have_se && np > 0 {
+        w.push(FitWarning::new(
+            WarningCode::SingularCovariance,
+            format!(
+                "the covariance is singular (J^T J cannot be inverted): the data do not \
+                 determine all of the fitted parameters ({}{}); no standard errors or \
+                 confidence intervals",
+                s.fitted.join(", "),
+                if s.estimator == Estimator::Principled {
+                    ", take-up factors"
+                } else {
+                    ""
+                }
+            ),
+        ));
+        return;
+    }
+    let Some(c) = corr else { return };
+    let m = DMatrix::from_row_slice(np, np, c);
+    if m.iter().all(|v| v.is_finite()) {
+        let ev = SymmetricEigen::new(m).eigenvalues;
+        let max = ev.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let min = ev.iter().fold(f64::INFINITY, |a, v| a.min(v.abs()));
+        if max > 0.0 && min / max < ILL_CONDITIONED_RCOND {
+            w.push(FitWarning::new(
+                WarningCode::IllConditioned,
+                format!(
+                    "the covariance is ill-conditioned (reciprocal condition number {:.1e} of \
+                     the correlation matrix): some combination of the fitted parameters is not \
+                     determined by the data; standard errors are unreliable",
+                    min / max
+                ),
+            ));
+        }
+    } else {
+        w.push(FitWarning::new(
+            WarningCode::IllConditioned,
+            "the correlation matrix of the fitted parameters is not finite: standard errors \
+             are unreliable"
+                .to_string(),
+        ));
+    }
+}
+
+/// An implausible material law: `n` below [`PLAUSIBLE_N`], or a 95 % interval of `n` reaching
+/// beyond `[0, 1]` (the law's own range: the data do not determine it).
+pub(crate) fn check_law(s: &FitSummary, w: &mut Vec<FitWarning>) {
+    let n = &s.n;
+    if !n.fitted || s.bound_of("n").is_some() {
+        return;
+    }
+    if n.value < PLAUSIBLE_N[0] {
+        w.push(FitWarning::new(
+            WarningCode::Implausible,
+            format!(
+                "n = {} is implausible for a polymer melt (expected {} to {}): the fit \
+                 compensates a model error with the viscosity law; this is not a material \
+                 result",
+                fmt_g(n.value),
+                PLAUSIBLE_N[0],
+                PLAUSIBLE_N[1]
+            ),
+        ));
+    } else if n.has_interval() && (n.ci95[0] < 0.0 || n.ci95[1] > 1.0) {
+        w.push(FitWarning::new(
+            WarningCode::Implausible,
+            format!(
+                "the 95% interval of n, [{}, {}], reaches beyond the law's range [0, 1]: the \
+                 data do not determine n well enough for a linearised interval",
+                fmt_g(n.ci95[0]),
+                fmt_g(n.ci95[1])
+            ),
+        ));
+    }
+}
+
+/// A law that jumped from the plain fit `base` by more than [`JUMP_SE`] of its standard errors
+/// while the fit improved by less than that jump is worth (`z²` in units of the noise
+/// variance: moving a parameter `z` standard errors costs `z²`): the added effect buys a
+/// different law instead of explaining the data. Returns the jump in standard errors.
+pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarning)> {
+    let z = |a: &super::summary::Estimate, b: &super::summary::Estimate| {
+        if a.fitted && b.fitted && a.stderr > 0.0 && a.stderr.is_finite() {
+            ((b.value - a.value) / a.stderr).abs()
+        } else {
+            0.0
+        }
+    };
+    let jump = z(&base.n, &refit.n).max(z(&base.kappa, &refit.kappa));
+    let dof = refit
+        .residuals
+        .saturating_sub(refit.fitted_parameters())
+        .max(1) as f64;
+    let s2 = refit.cost / dof;
+    let gain = (base.cost - refit.cost) / s2;
+    if jump > JUMP_SE && gain < jump * jump {
+        Some((
+            jump,
+            FitWarning::new(
+                WarningCode::Implausible,
+                format!(
+                    "the law moved by {:.1} standard errors from the plain fit (n {} -> {}, \
+                     kappa {} -> {}) while the fit improved by only {:.1} (in units of the \
+                     noise variance; such a move is worth {:.1}): the added effect buys a \
+                     different law rather than explaining the data",
+                    jump,
+                    fmt_g(base.n.value),
+                    fmt_g(refit.n.value),
+                    fmt_g(base.kappa.value),
+                    fmt_g(refit.kappa.value),
+                    gain,
+                    jump * jump
+                ),
+            ),
+        ))
+    } else {
+        None
+    }
+}
+
+/// The misfit against the fit's one noise level, naming the worst experiments.
+pub(crate) fn check_misfit(s: &FitSummary, w: &mut Vec<FitWarning>) {
+    let rms = s.rms_relative_residual;
+    let noise = s.noise.level;
+    let (bad, limit) = if noise.is_finite() && noise > 0.0 {
+        (rms > MISFIT_RATIO * noise, MISFIT_RATIO * noise)
+    } else {
+        (rms > MISFIT_WITHOUT_NOISE, MISFIT_WITHOUT_NOISE)
+    };
+    if !(bad || rms.is_nan()) {
+        return;
+    }
+    let mut worst: Vec<(usize, f64)> = s
+        .rms_relative_residual_by_experiment
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(_, r)| r.is_nan() || *r > limit)
+        .collect();
+    worst.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let names: Vec<String> = worst
+        .iter()
+        .take(5)
+        .map(|(k, r)| {
+            let name = s
+                .experiments
+                .get(*k)
+                .cloned()
+                .unwrap_or_else(|| format!("#{}", k + 1));
+            format!("{name} ({:.3} %)", 100.0 * r)
+        })
+        .collect();
+    let noise_text = if noise.is_finite() && noise > 0.0 {
+        format!(
+            "{:.1} times the noise level {}",
+            rms / noise,
+            s.noise.describe()
+        )
+    } else {
+        format!(
+            "above {:.0} % (no noise level: too few points to estimate it)",
+            100.0 * MISFIT_WITHOUT_NOISE
+        )
+    };
+    let mut m = format!(
+        "misfit far above the noise: the RMS relative residual {:.3} % is {noise_text}; the \
+         model does not describe these data",
+        100.0 * rms
+    );
+    if !names.is_empty() {
+        m.push_str(&format!(
+            "; experiments with RMS above {:.3} %: {}{}",
+            100.0 * limit,
+            names.join(", "),
+            if worst.len() > names.len() {
+                format!(" and {} more", worst.len() - names.len())
+            } else {
+                String::new()
+            }
+        ));
+    }
+    if s.noise.declared() {
+        m.push_str(" (or the declared relative_uncertainty is too small)");
+    }
+    m.push_str(": check their data, TOML entries (temperatures, take-up) and the model");
+    w.push(FitWarning::new(WarningCode::Misfit, m));
+}

@@ -1,0 +1,123 @@
+//! The `fit` workflow: start point, identification, error budget, and what the figures need
+//! (the Newtonian reference and, for a model with added effects, the same fit without them).
+
+use crate::fiber::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::fiber::input::LoadedExperiments;
+use crate::fiber::rheometer::{
+    error_budget, FitSummary, Identification, IdentifyOptions, Rheometer, RheometerError,
+    StartPoint,
+};
+use crate::solution::Solution;
+
+/// What to fit.
+#[derive(Debug, Clone)]
+pub struct FitRequest {
+    /// The model: law and effects (fitted or fixed); no candidates.
+    pub model: ModelSpec,
+    /// Estimator, loss, bounds, BVP settings.
+    pub identify: IdentifyOptions,
+    /// Start `(n, κ)`; `None`: the paper's start heuristic for a fitted law, `(1, 13.5)` for a
+    /// Newtonian one.
+    pub start: Option<[f64; 2]>,
+    /// Also fit the model without its added effects (the before/after residuals of a model
+    /// with effects; nothing for the paper's model).
+    pub baseline: bool,
+    /// Also solve the Newtonian model at the fitted `κ` (paper Fig. 3's reference curves).
+    pub newtonian_reference: bool,
+}
+
+impl FitRequest {
+    /// The paper's model (Carreau-type law, no effects) with `identify`'s settings.
+    pub fn new(identify: IdentifyOptions) -> Self {
+        FitRequest {
+            model: ModelSpec::default(),
+            identify,
+            start: None,
+            baseline: false,
+            newtonian_reference: false,
+        }
+    }
+
+    /// Whether `n` (or strain thinning) is fitted: the start heuristic applies.
+    pub fn law_fitted(&self) -> bool {
+        self.model.law == LawChoice::Carreau
+            || self
+                .model
+                .effects
+                .iter()
+                .any(|w| w.effect.name() == "strain_thinning" && w.value.is_none())
+    }
+}
+
+/// The outcome of the `fit` workflow.
+#[derive(Debug)]
+pub struct FitRun {
+    /// The prepared data and models.
+    pub rheometer: Rheometer,
+    /// The identification; its summary carries the error budget when it could be computed.
+    pub identification: Identification,
+    /// The start heuristic's trace, when it chose the start.
+    pub start_heuristic: Option<StartPoint>,
+    /// Why the error budget is missing, if it is.
+    pub budget_error: Option<String>,
+    /// The same fit without the model's added effects ([`FitRequest::baseline`]).
+    pub baseline: Option<Identification>,
+    /// The Newtonian model at the fitted `κ` ([`FitRequest::newtonian_reference`]).
+    pub newtonian: Option<Vec<Solution>>,
+}
+
+impl FitRun {
+    /// The outcome as reported.
+    pub fn summary(&self) -> &FitSummary {
+        &self.identification.summary
+    }
+}
+
+/// Fits `request`'s model to `data`: the start (given, heuristic or Newtonian), the
+/// identification, its error budget (declared or default uncertainties of what the data cannot
+/// identify; a budget that cannot be computed does not fail the fit) and the optional
+/// reference computations.
+pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, RheometerError> {
+    request.model.validate().map_err(RheometerError::Data)?;
+    let opts = &request.identify;
+    let rh = Rheometer::with_spec(&data.set, request.model.clone())?;
+    let (start, start_heuristic) = match request.start {
+        Some(s) => (s, None),
+        None if !request.law_fitted() => ([1.0, STRAIN_THINNING_REFERENCE_KAPPA], None),
+        None => {
+            let sp = rh.start_heuristic(opts)?;
+            (sp.start, Some(sp))
+        }
+    };
+    let mut id = rh.identify(start, opts)?;
+    let budget_error = match error_budget(&rh, &id, &data.uncertainty, opts) {
+        Ok(budget) => {
+            id.summary = id.summary.clone().with_error_budget(budget);
+            None
+        }
+        Err(e) => Some(e.to_string()),
+    };
+    let baseline = if request.baseline && !request.model.effects.is_empty() {
+        let rh0 = Rheometer::with_spec(&data.set, ModelSpec::new(request.model.law))?;
+        let s0 = match request.model.law {
+            LawChoice::Carreau => id.law(),
+            LawChoice::Newtonian => [1.0, STRAIN_THINNING_REFERENCE_KAPPA],
+        };
+        Some(rh0.identify(s0, opts)?)
+    } else {
+        None
+    };
+    let newtonian = if request.newtonian_reference {
+        Some(rh.newtonian_solutions(id.law()[1], opts)?)
+    } else {
+        None
+    };
+    Ok(FitRun {
+        rheometer: rh,
+        identification: id,
+        start_heuristic,
+        budget_error,
+        baseline,
+        newtonian,
+    })
+}

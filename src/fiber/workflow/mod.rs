@@ -1,0 +1,78 @@
+//! Workflows as library calls: what each `rheometer` subcommand does, on a loaded data set,
+//! returning values. The program parses its arguments, calls one of these, and renders the
+//! result; a Rust or Python user gets exactly what the command line gets.
+//!
+//! | subcommand | call | result |
+//! |---|---|---|
+//! | `simulate` | [`simulate_experiments`] | profiles per experiment |
+//! | `fit` | [`fit()`] | [`FitRun`] (its [`FitSummary`](crate::fiber::rheometer::FitSummary)) |
+//! | `compare` | [`compare()`] | [`Comparison`](crate::fiber::diagnostics::compare::Comparison) |
+//! | `diagnose` | [`diagnose()`] | [`DiagnosisRun`] |
+//! | `landscape` | [`landscape()`] | [`LandscapeRun`] |
+//!
+//! ```no_run
+//! use diffbvp::fiber::input::load_experiments_with;
+//! use diffbvp::fiber::rheometer::IdentifyOptions;
+//! use diffbvp::fiber::workflow::{fit, FitRequest};
+//! use std::path::Path;
+//! let data = load_experiments_with(Path::new("data/pmma7n_synthetic/experiments.toml"), 4)?;
+//! let run = fit(&data, &FitRequest::new(IdentifyOptions::default()))?;
+//! println!("{}", run.summary().to_text());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod compare;
+mod fit;
+mod simulate;
+
+pub use compare::{compare, CompareRequest};
+pub use fit::{fit, FitRequest, FitRun};
+pub use simulate::{simulate_experiments, SimulateError, SimulateRequest, SimulatedProfile};
+
+use crate::fiber::diagnostics::diagnose::{diagnose as run_diagnosis, DiagnoseOptions};
+use crate::fiber::diagnostics::diagnosis::DiagnosisRun;
+use crate::fiber::effects::ModelSpec;
+use crate::fiber::input::LoadedExperiments;
+use crate::fiber::rheometer::{IdentifyOptions, LandscapeRun, Rheometer, RheometerError};
+use std::sync::atomic::AtomicBool;
+
+/// Diagnoses which candidate effect is missing from `model` on `data` (see
+/// [`diagnose`](crate::fiber::diagnostics::diagnose)).
+pub fn diagnose(
+    data: &LoadedExperiments,
+    model: &ModelSpec,
+    options: &DiagnoseOptions,
+) -> Result<DiagnosisRun, RheometerError> {
+    model.validate().map_err(RheometerError::Data)?;
+    run_diagnosis(&data.set, model, options)
+}
+
+/// A cost landscape: the grid and the cost's settings.
+#[derive(Debug, Clone)]
+pub struct LandscapeRequest {
+    /// `n` values of the grid \[-\].
+    pub n: Vec<f64>,
+    /// `κ` values of the grid \[-\].
+    pub kappa: Vec<f64>,
+    /// The estimator whose cost is mapped, and the BVP settings.
+    pub identify: IdentifyOptions,
+}
+
+/// The cost `J(n, κ)` of the paper's model on `request`'s grid; `progress(points done)` is
+/// called as points finish, and `cancel` stops the run between points (the points not
+/// reached are marked).
+pub fn landscape(
+    data: &LoadedExperiments,
+    request: &LandscapeRequest,
+    progress: impl FnMut(usize) + Send,
+    cancel: &AtomicBool,
+) -> Result<LandscapeRun, RheometerError> {
+    let rh = Rheometer::new(&data.set)?;
+    rh.landscape_with(
+        &request.n,
+        &request.kappa,
+        &request.identify,
+        progress,
+        cancel,
+    )
+}
