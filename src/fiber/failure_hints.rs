@@ -126,10 +126,10 @@ pub fn hints(
     );
     if let Some(m) = max_nodes {
         out.push(format!(
-            "the mesh needed more than {m} nodes: raise the node limit (the option max_nodes; \
-             --max-nodes of the rheometer program; default 20000, the landscape uses at most \
-             1000), or check this experiment's inputs (a very thin take-up or strong strain \
-             thinning makes the profiles steep)"
+            "the mesh needed more than {m} nodes: raise the limit with --max-nodes (in the \
+             library the option max_nodes; default 20000, the landscape uses at most 1000), or \
+             check this experiment's inputs (a very thin take-up or strong strain thinning makes \
+             the profiles steep)"
         ));
     }
     if solver.is_some() && t_in.min(t_air) - t_vf < VFT_MARGIN_K {

@@ -124,6 +124,10 @@ pub struct Scenario {
     pub faults: Faults,
     /// Relative Gaussian noise σ [-].
     pub noise_sd: f64,
+    /// Noise near the take-up: σ times this factor for `s > 0.8 L` (1: uniform noise).
+    pub take_up_noise: f64,
+    /// Strain hardening β of the melt [-] (see [`Line::hardening`]; 0: none).
+    pub hardening: f64,
     /// Seed of the noise.
     pub seed: u64,
     /// Candidate names accepted as the cause ranked first (empty: nothing may be named).
@@ -160,6 +164,7 @@ impl Scenario {
             air_flow: self.air_flow,
             air_heat: self.air_heat,
             emissivity: self.emissivity,
+            hardening: self.hardening,
         }
     }
 
@@ -181,11 +186,17 @@ impl Scenario {
         let f = &self.faults;
         let mut measured: Vec<Vec<f64>> = clean
             .iter()
-            .map(|d| {
+            .enumerate()
+            .map(|(k, d)| {
                 d.iter()
-                    .map(|&di| {
-                        (di * f.gauge_factor + f.gauge_offset_m)
-                            * (1.0 + self.noise_sd * rng.normal())
+                    .zip(&self.experiments[k].positions)
+                    .map(|(&di, &s)| {
+                        let sd = if s > 0.8 * self.length {
+                            self.noise_sd * self.take_up_noise
+                        } else {
+                            self.noise_sd
+                        };
+                        (di * f.gauge_factor + f.gauge_offset_m) * (1.0 + sd * rng.normal())
                     })
                     .collect()
             })

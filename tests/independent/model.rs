@@ -204,6 +204,10 @@ pub struct Line {
     pub air_heat: AirHeat,
     /// Grey-body emissivity [-] (0: no radiation).
     pub emissivity: f64,
+    /// Strain hardening β [-] (0: none): the melt's zero-rate viscosity grows as
+    /// `exp(β ε_H)` with the Hencky strain `ε_H = ln(u/u_in)` — an effect outside the
+    /// project's candidates.
+    pub hardening: f64,
 }
 
 impl Line {
@@ -295,7 +299,9 @@ impl Bvp for Line {
         let cp = t * m.cp_slope + m.cp_intercept;
         let area = (rho * u).recip() * q;
         let d = (area * (4.0 / PI)).sqrt();
-        let mu0 = ((t - m.vft_t_vf).recip() * m.vft_b).exp() * (3.0 * m.mu_c);
+        let mu0 = ((t - m.vft_t_vf).recip() * m.vft_b).exp()
+            * (3.0 * m.mu_c)
+            * (y[0] * self.hardening).exp();
         // constitutive law: σ/K = Φ(a), a = μ0 ε̇/K
         let k = self.law.kappa.exp();
         let ratio = tension / area / k;

@@ -56,6 +56,8 @@ fn base(name: &'static str, seed: u64) -> Scenario {
         emissivity: 0.0,
         faults: Faults::none(),
         noise_sd: NOISE_SD,
+        take_up_noise: 1.0,
+        hardening: 0.0,
         seed,
         acceptable: vec![],
         expected: None,

@@ -111,6 +111,26 @@ pub struct Candidate {
     /// Scans that could not start (one per variant, in words).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub scan_errors: Vec<String>,
+    /// Refinements of this candidate that ran (from grid points and from other material
+    /// laws) and how many of them reached its best cost (global search; `[0, 0]` without
+    /// refit).
+    #[serde(default)]
+    pub refit_starts: [usize; 2],
+    /// The probability that the search over all candidates and shapes finds an effect at
+    /// least this convincing (`ΔBIC` at or below this one's) on effect-free data like these
+    /// (see [`calibrate`](super::diagnose::calibrate); `NaN` where not computed).
+    #[serde(
+        default = "crate::fiber::serde_nan::nan",
+        deserialize_with = "crate::fiber::serde_nan::f64"
+    )]
+    pub false_alarm: f64,
+    /// Share of the excess misfit (the cost above what the noise alone leaves) the effect
+    /// removes \[-\] (`NaN` where not computed).
+    #[serde(
+        default = "crate::fiber::serde_nan::nan",
+        deserialize_with = "crate::fiber::serde_nan::f64"
+    )]
+    pub share_of_excess: f64,
 }
 
 impl Candidate {
@@ -336,6 +356,9 @@ mod tests {
             shape_alternative: None,
             profiles: Vec::new(),
             scan_errors: Vec::new(),
+            refit_starts: [0, 0],
+            false_alarm: f64::NAN,
+            share_of_excess: f64::NAN,
         }
     }
 

@@ -3,6 +3,8 @@
 
 use super::candidate::{Candidate, Indistinguishable};
 use super::detection::DetectionLimits;
+use super::diagnose::calibrate::Calibration;
+use super::diagnose::verdict::Verdict;
 use super::ties::Alternative;
 use crate::fiber::effects::LawChoice;
 use crate::fiber::rheometer::{FitSummary, Identification};
@@ -41,8 +43,37 @@ pub struct Diagnosis {
     /// effect of the 95 % strength would cause ([`detection`](super::detection)).
     #[serde(default)]
     pub detection: DetectionLimits,
+    /// The look-elsewhere calibration of the first step: the null distribution of the best
+    /// `ΔBIC` over all candidates and shapes on effect-free data like these.
+    #[serde(default)]
+    pub calibration: Calibration,
+    /// The steps after the first: each with the effects found before in the model.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub further_steps: Vec<ForwardStep>,
+    /// The effects found, in order (the first is `most_likely_missing`).
+    #[serde(default)]
+    pub found: Vec<String>,
+    /// The fit with all found effects (fitted jointly), if any was found.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub final_fit: Option<FitSummary>,
+    /// What the diagnosis concludes.
+    pub verdict: Verdict,
     /// Wall time \[s\].
     pub wall_time_s: f64,
+}
+
+/// A step of the forward search after the first: the model with the effects found so far,
+/// its fit, the remaining candidates ranked, and the one named.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ForwardStep {
+    /// The effects in the model at this step (found before, fitted).
+    pub model_effects: Vec<String>,
+    /// The step's fit.
+    pub base_fit: FitSummary,
+    /// Its candidates, best first.
+    pub candidates: Vec<Candidate>,
+    /// The candidate named at this step.
+    pub named: Option<String>,
 }
 
 impl Diagnosis {
@@ -78,9 +109,13 @@ impl Diagnosis {
             .map_or(f64::NAN, |m| m.lag1)
     }
 
-    /// Gross outliers of the user's fit, by experiment and position.
+    /// Gross outliers by experiment and position, of the final fit (with the found effects)
+    /// where there is one, else of the user's fit: a point that only looks wrong to a model
+    /// missing an effect is no outlier.
     pub fn outliers(&self) -> &[crate::fiber::noise_model::Outlier] {
-        self.base_fit
+        self.final_fit
+            .as_ref()
+            .unwrap_or(&self.base_fit)
             .noise
             .model
             .as_ref()

@@ -1,6 +1,7 @@
 //! The diagnosis in words, and the before/after residual figure.
 
 use super::candidate::{Candidate, ShapeAlternative, StrengthStatus};
+use super::diagnose::verdict::Verdict;
 use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::scan::Profile;
 use crate::plot::{save_panels, Panel, PlotError, Series};
@@ -61,16 +62,36 @@ impl Diagnosis {
                 ));
             }
         }
-        match (&self.most_likely_missing, self.candidates.first()) {
+        s.push_str(&self.verdict_text());
+        match (&self.most_likely_missing, self.named()) {
             (Some(name), Some(c)) => {
+                let exact: Vec<&str> = self
+                    .alternatives
+                    .iter()
+                    .filter(|a| a.delta_bic_gap < EXACT_TIE)
+                    .map(|a| a.effect.as_str())
+                    .collect();
+                let lead = if exact.is_empty() {
+                    "Most likely missing:".to_string()
+                } else {
+                    format!(
+                        "TIE: {name} and {} explain these data equally well (delta BIC gap below \
+                         {EXACT_TIE}); the data cannot choose, and the one listed first is not \
+                         preferred. Taking",
+                        exact.join(", ")
+                    )
+                };
                 s.push_str(&format!(
-                    "Most likely missing: {name}{}. Its signature lies along s = {} (strongest at {:.2} m). \
-                     Adding it removes {:.1} % of the misfit (J {:.4e} -> {:.4e}), RMS {:.3} % -> {:.3} %, \
+                    "{lead} {name}{}. Its signature lies along s = {} (strongest at {:.2} m). \
+                     Adding it removes {:.1} % of the misfit ({:.0} % of the excess over the noise; \
+                     false-alarm probability of the search {}) (J {:.4e} -> {:.4e}), RMS {:.3} % -> {:.3} %, \
                      delta BIC = {:.1}, delta AIC = {:.1}; fitted strength {:.4} +/- {:.4} {}.\n",
                     super::ties::or_alternatives(&self.alternatives),
                     fmt_range(c.signature_range_m),
                     c.signature_peak_m,
                     100.0 * (1.0 - c.cost_after / c.cost_before),
+                    100.0 * c.share_of_excess,
+                    probability(c.false_alarm),
                     c.cost_before,
                     c.cost_after,
                     100.0 * b.rms_relative_residual,
@@ -120,6 +141,39 @@ impl Diagnosis {
                 }
             }
         }
+        for (k, st) in self.further_steps.iter().enumerate() {
+            s.push_str(&format!(
+                "Step {} (with {} in the model, fitted jointly): {}.\n",
+                k + 2,
+                st.model_effects.join(" + "),
+                match st
+                    .named
+                    .as_deref()
+                    .and_then(|n| st.candidates.iter().find(|c| c.effect == n))
+                {
+                    Some(c) => format!(
+                        "{} named too (delta BIC {:.1}, {:.0} % of the remaining excess, \
+                         false-alarm probability {})",
+                        c.effect,
+                        c.delta_bic,
+                        100.0 * c.share_of_excess,
+                        probability(c.false_alarm)
+                    ),
+                    None => "no further candidate earns its place".into(),
+                }
+            ));
+        }
+        if let Some(f) = &self.final_fit {
+            if self.found.len() > 1 {
+                s.push_str(&format!(
+                    "With {}: n = {:.4}, kappa = {:.4}, RMS {:.3} %.\n",
+                    self.found.join(" + "),
+                    f.n.value,
+                    f.kappa.value,
+                    100.0 * f.rms_relative_residual
+                ));
+            }
+        }
         for c in self
             .candidates
             .iter()
@@ -135,7 +189,7 @@ impl Diagnosis {
             }
         }
         s.push_str("[[Candidates, best first (credible refits by delta BIC, then refits at a bound or not physical)]]\n");
-        s.push_str("    effect                   refit  strength +/- stderr        J after      RMS after  dBIC     lin.dJ/J  status       signature\n");
+        s.push_str("    effect                   refit  strength +/- stderr        J after      RMS after  dBIC     lin.dJ/J  false-al.  excess  status       signature\n");
         for c in &self.candidates {
             let shape: String = c
                 .shape()
@@ -143,7 +197,7 @@ impl Diagnosis {
                 .map(|p| format!("  [{} {:.4} {}]", p.name, p.value, p.unit))
                 .collect();
             s.push_str(&format!(
-                "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {:>8.4}  {:<11}  {} (peak {:.2} m){shape}\n",
+                "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {:>8.4}  {:>9}  {:>6}  {:<11}  {} (peak {:.2} m){shape}\n",
                 c.effect,
                 if c.refitted() { "yes" } else { "lin" },
                 c.strength(),
@@ -160,6 +214,12 @@ impl Diagnosis {
                     c.linear_score / c.cost_before
                 } else {
                     f64::NAN
+                },
+                probability(c.false_alarm),
+                if c.share_of_excess.is_finite() {
+                    format!("{:.0} %", 100.0 * c.share_of_excess)
+                } else {
+                    "-".into()
                 },
                 c.status.name(),
                 fmt_range(c.signature_range_m),
@@ -196,6 +256,87 @@ impl Diagnosis {
         s.push_str(&self.detection.to_text());
         s.push_str(&format!("wall time {:.2} s\n", self.wall_time_s));
         s
+    }
+}
+
+/// `ΔBIC` gap below which two causes are an exact tie: no first, no second.
+const EXACT_TIE: f64 = 1.0;
+
+/// A probability in words: `"0.3 %"`, `"< 0.05 %"` (below the bootstrap's resolution), `"-"`.
+fn probability(p: f64) -> String {
+    if !p.is_finite() {
+        "-".into()
+    } else if p < 5e-4 {
+        "< 0.05 %".into()
+    } else {
+        format!("{:.1} %", 100.0 * p)
+    }
+}
+
+impl Diagnosis {
+    /// The verdict in words (see [`Verdict`]).
+    fn verdict_text(&self) -> String {
+        match &self.verdict {
+            Verdict::Adequate => "VERDICT: the model is adequate for these data: the residuals \
+                 are consistent with the noise and no candidate earns its place.\n"
+                .into(),
+            Verdict::Explained {
+                effects,
+                rms_over_noise,
+            } => format!(
+                "VERDICT: explained by {}: with {} the residuals are at the noise (RMS/noise \
+                 {rms_over_noise:.2}, no structure left along the line).\n",
+                effects.join(" + "),
+                if effects.len() > 1 { "them" } else { "it" }
+            ),
+            Verdict::NoneOfTheCandidates {
+                helps,
+                unexplained,
+                rms_over_noise,
+            } => {
+                let mut t = String::from(
+                    "VERDICT: NONE OF THE CANDIDATES explains the misfit: something else is missing",
+                );
+                if helps.is_empty() {
+                    t.push_str("; no candidate helps");
+                } else {
+                    let h: Vec<String> = helps
+                        .iter()
+                        .take(4)
+                        .map(|h| format!("{} removes {:.0} %", h.effect, 100.0 * h.share_of_excess))
+                        .collect();
+                    t.push_str(&format!(
+                        " ({} of the excess misfit over the noise)",
+                        h.join(", ")
+                    ));
+                }
+                t.push_str(&format!(
+                    "; with the best of them RMS/noise is {rms_over_noise:.2}.\n"
+                ));
+                for u in unexplained.iter().take(4) {
+                    t.push_str(&format!(
+                        "    unexplained: s = {:.3}-{:.3} m, the model too {} by {:.1} % ({:.1} \
+                         standard errors) in {}\n",
+                        u.start_m,
+                        u.end_m,
+                        if u.mean > 0.0 { "thick" } else { "thin" },
+                        100.0 * u.mean.abs(),
+                        u.z.abs(),
+                        if u.experiments.is_empty() {
+                            "the pooled residual".to_string()
+                        } else {
+                            u.experiments.join(", ")
+                        }
+                    ));
+                }
+                t.push_str(
+                    "    Next step: describe the missing effect as an effect of your own (a term \
+                     and a descriptor; see the book's chapter \"When the model fails\") and \
+                     diagnose again with it as a candidate.\n",
+                );
+                t
+            }
+        }
     }
 }
 

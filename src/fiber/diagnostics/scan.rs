@@ -54,6 +54,10 @@ pub struct ScanOptions {
     /// A side's walk ends once a point's `J` exceeds this multiple of the user's `J`
     /// (default 20: far from any useful fit, and the fits there are the expensive ones).
     pub stop_above: f64,
+    /// Rounds of bracketing after the walk (default 2): the lowest grid point's interval on
+    /// each side is halved (geometrically for magnitudes of one sign), so that a basin between
+    /// two coarse grid points is found and the refinement starts inside it.
+    pub bracket_rounds: usize,
 }
 
 impl Default for ScanOptions {
@@ -67,6 +71,7 @@ impl Default for ScanOptions {
             stop_above: 20.0,
             grid_tol: 1e-4,
             refine_within: 0.05,
+            bracket_rounds: 2,
         }
     }
 }
@@ -464,7 +469,6 @@ pub fn scan_profile(
         }
         sides.push(done);
     }
-    vrh.spec.effects[slot].value = None;
     // all points by increasing strength, the neutral one included
     let mut pts: Vec<GridStart> = Vec::new();
     let mut above = Vec::new();
@@ -476,9 +480,35 @@ pub fn scan_profile(
             above.extend(it);
         }
     }
-    let neutral = pts.len();
     pts.push(base_point);
     pts.extend(above);
+    for _ in 0..scan.bracket_rounds {
+        let added = bracket_minimum(&mut pts, grid.neutral, |v, near| {
+            vrh.spec.effects[slot].value = Some(v);
+            let start = FitStart {
+                law: near.law,
+                free_candidates: Vec::new(),
+                strengths: Vec::new(),
+                warm: Some(near.solutions.clone()),
+            };
+            fit_warm(&vrh, &start, &near.take_up, &inner, true).map(|id| GridStart {
+                strength: v,
+                law: id.law(),
+                take_up: id.take_up_factors().to_vec(),
+                cost: 2.0 * id.fit.cost,
+                rms: id.rms(),
+                solutions: id.solutions,
+            })
+        });
+        if added == 0 {
+            break;
+        }
+    }
+    vrh.spec.effects[slot].value = None;
+    let neutral = pts
+        .iter()
+        .position(|p| p.strength == grid.neutral)
+        .unwrap_or(0);
     let (lo, hi) = search_range(effect);
     let (plo, phi) = physical_range(effect);
     let profile = Profile {
@@ -510,6 +540,51 @@ pub fn scan_profile(
         rheometer: vrh,
         candidate: candidate.clone(),
     })
+}
+
+/// The midpoint of strengths `a` and `b` about the neutral value `neutral`: geometric in the
+/// distance from it where both lie on one side (the grid is geometric there), else arithmetic.
+fn midpoint(a: f64, b: f64, neutral: f64) -> f64 {
+    let (da, db) = (a - neutral, b - neutral);
+    if da * db > 0.0 {
+        neutral + da.signum() * (da.abs() * db.abs()).sqrt()
+    } else {
+        0.5 * (a + b)
+    }
+}
+
+/// One round of bracketing: the grid point of lowest `J` gets a new point halfway to each
+/// neighbour (`fit(strength, nearest point)` warm-started from the lowest point); points stay
+/// sorted by strength. Returns how many points were added (failed fits add none).
+fn bracket_minimum<E>(
+    pts: &mut Vec<GridStart>,
+    neutral: f64,
+    mut fit: impl FnMut(f64, &GridStart) -> Result<GridStart, E>,
+) -> usize {
+    let Some(i) = pts
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.cost.total_cmp(&b.1.cost))
+        .map(|(i, _)| i)
+    else {
+        return 0;
+    };
+    let mut new = Vec::new();
+    for j in [i.wrapping_sub(1), i + 1] {
+        let Some(other) = pts.get(j) else { continue };
+        let m = midpoint(pts[i].strength, other.strength, neutral);
+        let span = (pts[i].strength - other.strength).abs();
+        if !(m.is_finite() && (m - pts[i].strength).abs() > 1e-6 * span.max(1e-300)) {
+            continue;
+        }
+        if let Ok(p) = fit(m, &pts[i]) {
+            new.push(p);
+        }
+    }
+    let added = new.len();
+    pts.extend(new);
+    pts.sort_by(|a, b| a.strength.total_cmp(&b.strength));
+    added
 }
 
 /// Refines a grid point of [`scan_profile`]: the bounded least-squares fit with the strength

@@ -324,6 +324,9 @@ mod tests {
             shape_alternative: None,
             profiles: Vec::new(),
             scan_errors: Vec::new(),
+            refit_starts: [0, 0],
+            false_alarm: f64::NAN,
+            share_of_excess: f64::NAN,
         }
     }
 

@@ -54,21 +54,22 @@ impl<L: ViscosityLaw, H: NusseltLaw> PointFunction for PaperResidual<'_, L, H> {
     }
 }
 
-/// The relative residual `(d(s_j) − d_meas,j)/(σ d_meas,j)`, `d` the gauge's reading
+/// The relative residual `(d(s_j) − d_meas,j)/(σ_j d_meas,j)`, `d` the gauge's reading
 /// ([`FiberModel::observed_diameter`]: `(1 + g) d + o` with the instrument parameters).
 pub struct RelativeResidual<'a, L: ViscosityLaw, H: NusseltLaw> {
     /// The fiber model.
     pub model: &'a FiberModel<L, H>,
     /// Measured diameters (dimensionless).
     pub d_meas: &'a [f64],
-    /// Relative uncertainty `σ` (1 for plain relative residuals).
-    pub sigma: f64,
+    /// Relative uncertainty `σ_j` of each measurement \[-\] (all 1 for plain relative
+    /// residuals; a noise that varies along the line weights the points by it).
+    pub sigma: &'a [f64],
 }
 
 impl<L: ViscosityLaw, H: NusseltLaw> PointFunction for RelativeResidual<'_, L, H> {
     fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], p: &[D]) -> D {
         // the gauge's reading (instrument parameters, if any, enter here)
         let d = self.model.observed_diameter(y, p);
-        (d / self.d_meas[j] - 1.0) / self.sigma
+        (d / self.d_meas[j] - 1.0) / self.sigma[j]
     }
 }

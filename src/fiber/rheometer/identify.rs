@@ -298,6 +298,29 @@ impl Identification {
     pub fn take_up_factors(&self) -> &[f64] {
         &self.summary.take_up_factors
     }
+
+    /// The fitted strengths (the effects' units) and shapes by model-parameter name: the start
+    /// of a fit that continues from this one ([`FitStart::strengths`]).
+    pub fn fitted_strengths(&self) -> Vec<(String, f64)> {
+        let mut out = Vec::new();
+        for slot in &self.effects {
+            if slot.column.is_some() {
+                out.push((
+                    slot.effect.name().to_string(),
+                    slot.effect.strength_of(self.local_params[slot.local]),
+                ));
+            }
+            for sh in &slot.shapes {
+                if sh.column.is_some() {
+                    out.push((
+                        sh.parameter.model_param.to_string(),
+                        self.local_params[sh.local],
+                    ));
+                }
+            }
+        }
+        out
+    }
 }
 
 /// RMS of `values` (0 for none).

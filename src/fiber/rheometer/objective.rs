@@ -26,11 +26,11 @@ pub(super) enum FiberResidual<'a> {
         sqrt_delta: Vec<f64>,
         d_fit: Vec<f64>,
     },
-    /// [`RelativeResidual`]: measured diameters (dimensionless) and `σ`.
+    /// [`RelativeResidual`]: measured diameters (dimensionless) and each point's `σ_j`.
     Relative {
         model: &'a CarreauFiber,
         d_meas: Vec<f64>,
-        sigma: f64,
+        sigma: Vec<f64>,
     },
 }
 
@@ -55,7 +55,7 @@ impl PointFunction for FiberResidual<'_> {
             } => RelativeResidual {
                 model: *model,
                 d_meas,
-                sigma: *sigma,
+                sigma,
             }
             .eval(j, x, y, p),
         }
@@ -185,7 +185,7 @@ impl<'a> Objective<'a> {
                             FiberResidual::Relative {
                                 model,
                                 d_meas: m.diameters.iter().map(|v| v / dd).collect(),
-                                sigma,
+                                sigma: options.point_sigmas(k, m.diameters.len(), sigma),
                             },
                         )
                     }

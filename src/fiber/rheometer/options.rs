@@ -87,6 +87,10 @@ pub struct IdentifyOptions {
     /// accurately at the optimum and refined at tighter tolerances until it holds (see
     /// [`accuracy`](super::accuracy)). `None`: no check, `simulate.tol` as given.
     pub max_discretisation_shift: Option<f64>,
+    /// Relative noise factor of each measurement, per experiment (`σ_j / σ`, ≈ 1 on average;
+    /// principled estimator): a noise that varies along the line (the take-up region noisier)
+    /// weights the points by it. `None`: all points alike.
+    pub noise_factors: Option<std::sync::Arc<Vec<Vec<f64>>>>,
 }
 
 impl Default for IdentifyOptions {
@@ -109,11 +113,22 @@ impl Default for IdentifyOptions {
             f_scale: None,
             loose_tolerance: Some(1e-3),
             max_discretisation_shift: Some(0.01),
+            noise_factors: None,
         }
     }
 }
 
 impl IdentifyOptions {
+    /// Each of experiment `k`'s `n` measurements' relative uncertainty: `sigma` times its
+    /// noise factor ([`noise_factors`](Self::noise_factors); 1 where not given or not
+    /// matching).
+    pub fn point_sigmas(&self, k: usize, n: usize, sigma: f64) -> Vec<f64> {
+        match self.noise_factors.as_ref().and_then(|f| f.get(k)) {
+            Some(f) if f.len() == n => f.iter().map(|w| sigma * w).collect(),
+            _ => vec![sigma; n],
+        }
+    }
+
     /// Default options with the given estimator.
     pub fn with_estimator(estimator: Estimator) -> Self {
         IdentifyOptions {

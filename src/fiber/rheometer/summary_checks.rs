@@ -52,7 +52,7 @@ pub const PLAUSIBLE_N: [f64; 2] = [0.2, 1.0];
 
 /// A law that moved by more than this many of the plain fit's standard errors is checked
 /// against the gain in fit it bought ([`law_jump`]).
-pub const JUMP_SE: f64 = 5.0;
+pub const JUMP_SE: f64 = 20.0;
 
 /// Which bound `value` is at (within [`AT_BOUND_TOLERANCE`] of the range width), if any.
 pub fn bound_side(value: f64, lower: f64, upper: f64) -> Option<BoundSide> {
@@ -258,8 +258,10 @@ pub(crate) fn check_law(s: &FitSummary, w: &mut Vec<FitWarning>) {
 
 /// A law that jumped from the plain fit `base` by more than [`JUMP_SE`] of its standard errors
 /// while the fit improved by less than that jump is worth (`z²` in units of the noise
-/// variance: moving a parameter `z` standard errors costs `z²`): the added effect buys a
-/// different law instead of explaining the data. Returns the jump in standard errors.
+/// variance: moving a parameter `z` standard errors costs `z²`): worth a note (the added
+/// effect may buy a different law rather than explain the data; a plain fit biased by a
+/// missing effect moves by many of its standard errors too). Returns the jump in standard
+/// errors.
 pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarning)> {
     let z = |a: &super::summary::Estimate, b: &super::summary::Estimate| {
         if a.fitted && b.fitted && a.stderr > 0.0 && a.stderr.is_finite() {
@@ -283,8 +285,8 @@ pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarnin
                 format!(
                     "the law moved by {:.1} standard errors from the plain fit (n {} -> {}, \
                      kappa {} -> {}) while the fit improved by only {:.1} (in units of the \
-                     noise variance; such a move is worth {:.1}): the added effect buys a \
-                     different law rather than explaining the data",
+                     noise variance; such a move is worth {:.1}): the added effect may buy a \
+                     different law rather than explain the data",
                     jump,
                     fmt_g(base.n.value),
                     fmt_g(refit.n.value),

@@ -136,6 +136,20 @@ fn upgrade_legacy(mut v: Value) -> Value {
             .as_ref()
             .is_none_or(|l| l.iter().any(|x| x == k))
     };
+    if fitted_list.is_none() && obj.get("n").is_some_and(Value::is_number) {
+        // before the list existed every fit fitted (n, κ) and the effects marked fitted
+        let mut names = vec![Value::from("n"), Value::from("kappa")];
+        if let Some(Value::Array(effects)) = obj.get("effects") {
+            for e in effects {
+                if e.get("fitted").and_then(Value::as_bool) == Some(true) {
+                    if let Some(n) = e.get("effect") {
+                        names.push(n.clone());
+                    }
+                }
+            }
+        }
+        obj.insert("fitted".into(), Value::Array(names));
+    }
     for key in ["n", "kappa"] {
         if let Some(x) = obj.get(key).filter(|x| x.is_number()).cloned() {
             let e = estimate_object(

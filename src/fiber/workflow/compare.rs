@@ -101,7 +101,8 @@ pub fn compare(
             .map_err(CompareError::Data)?;
         setup.apply_fit(fit, set.experiments.len(), source)?;
         options.fitted_parameters = fit.fitted_parameters();
-        if request.with.is_empty() && request.relative_uncertainty.is_none() {
+        let known = fit.noise.level > 0.0 && fit.noise.level.is_finite();
+        if known && request.with.is_empty() && request.relative_uncertainty.is_none() {
             options.fit_noise = Some(fit.noise.clone());
         }
     }

@@ -148,7 +148,8 @@ fn simulate_one(
         );
         if let Some(d) = from_data {
             f.hints.push(format!(
-                "the take-up diameter {d:.4e} m is d_fit(L) of the smoothed measurements"
+                "the take-up diameter {d:.4e} m is d_fit(L) of the smoothed measurements \
+                 (--take-up-from-data; in the library MissingTakeUp::FromData)"
             ));
         }
         SimulateError::Experiment(f)

@@ -2,10 +2,15 @@
 
 use super::DiagnoseOptions;
 use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::fiber::rheometer::identify::WarmFit;
 use crate::fiber::rheometer::{
     Estimator, FitStart, Identification, IdentifyOptions, Layout, Rheometer, RheometerError,
 };
 use crate::fiber::setup::ExperimentSet;
+use std::sync::Arc;
+
+/// Weight factor of a gross outlier in the diagnosis' fits (its residual counts 1/1000).
+pub const OUTLIER_FACTOR: f64 = 1000.0;
 
 /// What every stage reads: the user's model with the candidates at neutral strength, the fit
 /// settings, the start law and the candidates.
@@ -73,9 +78,83 @@ impl<'a> Context<'a> {
     }
 
     /// Stage 1: the user's model fitted with the principled estimator (the candidates at
-    /// neutral strength reproduce it exactly).
-    pub fn fit_base(&self) -> Result<Identification, RheometerError> {
-        self.rh.identify(self.law0, &self.opts)
+    /// neutral strength reproduce it exactly), started from `warm` (a previous step's refit
+    /// with the effects of this model) where given.
+    pub fn fit_base(
+        &self,
+        warm: Option<&Identification>,
+    ) -> Result<Identification, RheometerError> {
+        let Some(w) = warm else {
+            return self.rh.identify(self.law0, &self.opts);
+        };
+        let start = FitStart {
+            strengths: w.fitted_strengths(),
+            warm: Some(w.solutions.clone()),
+            ..FitStart::at(w.law())
+        };
+        let fit = WarmFit {
+            take_up: w.take_up_factors().to_vec(),
+            stop_tolerance: None,
+        };
+        self.rh.identify_warm(&start, &self.opts, &fit)
+    }
+
+    /// Stage 1 (cont.): the user's fit again with each point weighted by its local noise level
+    /// where the noise varies along the line (the take-up region noisier), and with the gross
+    /// outliers of its noise model left out (weighted by [`OUTLIER_FACTOR`]); every later fit
+    /// of the diagnosis uses the same weights, so that neither the noisier points nor the
+    /// outliers dominate the cost and a flexible candidate cannot earn its place by fitting
+    /// them. Unchanged when the noise is declared, or even and without outliers.
+    pub fn weighted_base(
+        &mut self,
+        base: Identification,
+    ) -> Result<Identification, RheometerError> {
+        let noise = &base.summary.noise;
+        let Some(m) = noise.model.as_ref() else {
+            return Ok(base);
+        };
+        let varies = m.varies_along_line && !noise.declared() && noise.level > 0.0;
+        if !varies && m.outliers.is_empty() {
+            return Ok(base);
+        }
+        let factors: Vec<Vec<f64>> = self
+            .rh
+            .measurements
+            .iter()
+            .enumerate()
+            .map(|(k, meas)| {
+                meas.positions
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &s)| {
+                        let f = if varies {
+                            m.local_sigma_at(k, s) / noise.level
+                        } else {
+                            1.0
+                        };
+                        if m.is_outlier(k, i) {
+                            f * OUTLIER_FACTOR
+                        } else {
+                            f
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        self.opts.noise_factors = Some(Arc::new(factors));
+        let start = FitStart {
+            warm: Some(base.solutions.clone()),
+            strengths: base.fitted_strengths(),
+            ..FitStart::at(base.law())
+        };
+        let warm = WarmFit {
+            take_up: base.take_up_factors().to_vec(),
+            stop_tolerance: None,
+        };
+        let mut weighted = self.rh.identify_warm(&start, &self.opts, &warm)?;
+        // the one noise level of these data and this model is the plain fit's
+        weighted.summary.noise = base.summary.noise.clone();
+        Ok(weighted)
     }
 
     /// The column of the shared parameter `name` in the user's fit.

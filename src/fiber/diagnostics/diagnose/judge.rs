@@ -2,7 +2,6 @@
 //! strength (and shape) is credible, where along the line it changes the residuals, and the
 //! other shape the data cannot rule out.
 
-use super::base::Context;
 use super::linearise::Linearisation;
 use super::shapes::Choice;
 use super::signature::{named_residuals, signature_location};
@@ -17,7 +16,6 @@ use crate::fiber::rheometer::{FitSummary, Identification, WarningCode};
 /// Fills `record` from its chosen refit (`variant` the shape variant it belongs to) and the
 /// other shape's refit; returns the refit's identification.
 pub(crate) fn judge(
-    ctx: &Context<'_>,
     lin: &Linearisation,
     base: &FitSummary,
     before: &ResidualProfiles,
@@ -41,7 +39,7 @@ pub(crate) fn judge(
     };
     record.status = status;
     record.status_note = note;
-    let after = named_residuals(&ctx.rh, &id);
+    let after = named_residuals(&id);
     let change: Vec<f64> = after
         .iter()
         .zip(before)

@@ -5,10 +5,10 @@
 use super::base::Context;
 use super::signature::signature_location;
 use crate::fiber::diagnostics::candidate::{Candidate, StrengthStatus};
-use crate::fiber::diagnostics::scan::{physical_range, search_range};
+use crate::fiber::diagnostics::scan::{physical_range, search_range, shape_variants};
 use crate::fiber::diagnostics::scores::{linear_scores, LinearScore};
 use crate::fiber::rheometer::estimator::RelativeResidual;
-use crate::fiber::rheometer::{Identification, Rheometer, RheometerError};
+use crate::fiber::rheometer::{Identification, IdentifyOptions, Rheometer, RheometerError};
 use crate::fiber::FiberError;
 use crate::sensitivity::{residual_jacobian, Sensitivities};
 use rayon::prelude::*;
@@ -88,7 +88,7 @@ pub(crate) fn linearise(
         .collect::<Result<_, _>>()?;
     let parts: Vec<Part> = (0..m)
         .into_par_iter()
-        .map(|k| experiment_part(rh, base, k, ctx.sigma))
+        .map(|k| experiment_part(rh, base, k, &ctx.opts, ctx.sigma))
         .collect::<Result<_, RheometerError>>()?;
     let mut r = Vec::new();
     let mut x = Vec::new();
@@ -131,10 +131,23 @@ fn experiment_part(
     rh: &Rheometer,
     base: &Identification,
     k: usize,
+    opts: &IdentifyOptions,
     sigma: f64,
 ) -> Result<Part, RheometerError> {
+    let (r, jl) = experiment_part_at(rh, &base.solutions[k], k, opts, sigma)?;
+    Ok((r, jl, rh.models[k].param_layout().take_up_factor()))
+}
+
+/// Experiment `k`'s residuals and their Jacobian (row-major, all model parameters) at the
+/// solution `sol`.
+fn experiment_part_at(
+    rh: &Rheometer,
+    sol: &crate::solution::Solution,
+    k: usize,
+    opts: &IdentifyOptions,
+    sigma: f64,
+) -> Result<(Vec<f64>, Vec<f64>), RheometerError> {
     let model = &rh.models[k];
-    let sol = &base.solutions[k];
     let lo = model.scaling.reference.length;
     let dd = model.scaling.diameter();
     let meas = &rh.measurements[k];
@@ -142,14 +155,13 @@ fn experiment_part(
     let d: Vec<f64> = meas.diameters.iter().map(|v| v / dd).collect();
     let sens =
         Sensitivities::compute(model, sol).map_err(|e| sim_err(rh, k, FiberError::from(e)))?;
+    let sigmas = opts.point_sigmas(k, d.len(), sigma);
     let g = RelativeResidual {
         model,
         d_meas: &d,
-        sigma,
+        sigma: &sigmas,
     };
-    let (r, jl) = residual_jacobian(model, sol, &sens, &xs, &g)
-        .map_err(|e| sim_err(rh, k, FiberError::from(e)))?;
-    Ok((r, jl, model.param_layout().take_up_factor()))
+    residual_jacobian(model, sol, &sens, &xs, &g).map_err(|e| sim_err(rh, k, FiberError::from(e)))
 }
 
 /// The candidates' records from the linearisation alone (refits fill them in later).
@@ -191,7 +203,76 @@ pub(crate) fn linear_candidates(ctx: &Context<'_>, lin: &Linearisation) -> Vec<C
                 shape_alternative: None,
                 profiles: Vec::new(),
                 scan_errors: Vec::new(),
+                refit_starts: [0, 0],
+                false_alarm: f64::NAN,
+                share_of_excess: f64::NAN,
             }
+        })
+        .collect()
+}
+
+/// The candidates' columns at the other shapes the global search scans (each shaped candidate
+/// at each of its shape variants, except the default one, which is in `lin.cols`): at strength
+/// 0 the solution does not depend on the shape, only the residuals' derivative with respect to
+/// the strength does, so one sensitivity solve per variant and experiment at the user's fit
+/// gives each column. For the look-elsewhere calibration.
+pub(crate) fn shape_columns(
+    ctx: &Context<'_>,
+    base: &Identification,
+    lin: &Linearisation,
+) -> Result<Vec<(usize, Vec<f64>)>, RheometerError> {
+    let mut jobs: Vec<(usize, Vec<(usize, f64)>)> = Vec::new();
+    for (i, e) in ctx.cands.iter().enumerate() {
+        if e.free_shapes().is_empty() {
+            continue;
+        }
+        for (variant, _) in shape_variants(e, ctx.options.scan.scan_shapes, ctx.length) {
+            let values: Vec<(usize, f64)> = variant
+                .shape_values()
+                .iter()
+                .filter_map(|(sp, v)| {
+                    ctx.rh.models[0]
+                        .param_index(sp.model_param)
+                        .map(|p| (p, *v))
+                })
+                .collect();
+            let default = variant
+                .shape_values()
+                .iter()
+                .all(|(sp, v)| *v == sp.default);
+            if !default && !values.is_empty() {
+                jobs.push((i, values));
+            }
+        }
+    }
+    let cand_idx: Vec<Option<(usize, f64)>> = ctx
+        .cands
+        .iter()
+        .map(|e| {
+            ctx.rh.models[0]
+                .param_index(e.model_param())
+                .map(|p| (p, e.param_per_strength()))
+        })
+        .collect();
+    jobs.into_par_iter()
+        .filter_map(|(i, values)| {
+            let (pi, per) = cand_idx[i]?;
+            let mut col = Vec::with_capacity(lin.residuals());
+            for k in 0..ctx.rh.len() {
+                let mut sol = base.solutions[k].clone();
+                for &(p, v) in &values {
+                    if let Some(x) = sol.params.get_mut(p) {
+                        *x = v;
+                    }
+                }
+                let (r, jl) = match experiment_part_at(&ctx.rh, &sol, k, &ctx.opts, ctx.sigma) {
+                    Ok(part) => part,
+                    Err(e) => return Some(Err(e)),
+                };
+                let ql = jl.len() / r.len().max(1);
+                col.extend((0..r.len()).map(|row| jl[row * ql + pi] * per));
+            }
+            Some(Ok((ctx.cands[i].extra_parameters(), col)))
         })
         .collect()
 }

@@ -1,5 +1,5 @@
-//! `diagnose`: which physical effect is missing from a user's model — a chain of stages, each
-//! in its own file, passing one record per candidate ([`Candidate`]) along.
+//! `diagnose`: which physical effects are missing from a user's model — a chain of stages,
+//! each in its own file, passing one record per candidate ([`Candidate`]) along.
 //!
 //! 1. **Fit the user's model** ([`base`]) with the principled estimator (raw relative residuals,
 //!    take-up diameters fitted): the paper's smoothed-data estimator leaves residuals ~1.4× the
@@ -31,36 +31,46 @@
 //! 7. **Rank** ([`rank_order`]): credible refits by `ΔBIC`, then the others. A candidate earns
 //!    its place when `ΔBIC` is below [`DiagnoseOptions::earn_threshold`] (−10: "very strong"
 //!    evidence on the Kass–Raftery scale) and its strength is credible.
+//!    The false-alarm probability of each refit ([`calibrate`]: how often the search over all
+//!    candidates and shapes finds an effect at least that convincing on effect-free data like
+//!    the user's) must be at most [`DiagnoseOptions::max_false_alarm`] (5 %), and the effect
+//!    must remove at least half the excess misfit ([`verdict`]).
 //! 8. **Ties** ([`ties`](super::ties)): other candidates that earn their place with a `ΔBIC`
 //!    less than [`DiagnoseOptions::tie_margin`] (6) above the named one's, and pairs whose
 //!    orthogonalised signatures have `|cos|` above
 //!    [`DiagnoseOptions::indistinguishable_cosine`] (0.9).
+//! 9. **Several effects** ([`step`]): while a named effect does not bring the residuals to the
+//!    noise, it is added to the model (strength and shapes fitted jointly with the law) and the
+//!    search runs again over the remaining candidates, at most
+//!    [`DiagnoseOptions::max_effects`] effects in all.
+//! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, or none of the
+//!    candidates (which help and how much, where the unexplained residual lies).
 
 mod base;
+pub mod calibrate;
 mod judge;
 mod linearise;
 mod search;
 mod shapes;
 mod signature;
+mod step;
+pub mod verdict;
 
-use super::detection::{detection_limits, DetectionContext, DetectionLimits};
 use super::scan::ScanOptions;
-use super::scores::cosine;
-use super::ties::{alternatives, Alternative, DEFAULT_TIE_MARGIN};
-use crate::fiber::effects::{Category, Effect, ModelSpec};
-use crate::fiber::rheometer::{
-    Estimator, Identification, IdentifyOptions, ParameterShift, RheometerError,
-};
+use super::ties::DEFAULT_TIE_MARGIN;
+use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
+use crate::fiber::noise_summary::NoiseSummary;
+use crate::fiber::rheometer::{Estimator, Identification, IdentifyOptions, RheometerError};
 use crate::fiber::setup::ExperimentSet;
-use base::Context;
-use linearise::Linearisation;
 use std::time::Instant;
+use verdict::{Help, Verdict};
 
 pub use super::candidate::{
     earns_its_place, rank_order, strength_status, Candidate, Indistinguishable, ShapeAlternative,
     StrengthStatus, PHYSICAL_RANGE_SE,
 };
-pub use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
+pub use super::diagnosis::{Diagnosis, DiagnosisRun, ForwardStep, ResidualProfiles};
+pub use step::MAX_FALSE_ALARM;
 
 /// Options of [`diagnose`].
 #[derive(Debug, Clone)]
@@ -86,6 +96,13 @@ pub struct DiagnoseOptions {
     pub tie_margin: f64,
     /// Start `(n, κ)` of the user's Carreau fit (default: the paper's start heuristic).
     pub start: Option<[f64; 2]>,
+    /// Largest false-alarm probability of the search at which an effect is named (default
+    /// 0.05; see [`calibrate`]).
+    pub max_false_alarm: f64,
+    /// Replicates of the look-elsewhere calibration (default 2000).
+    pub calibration_replicates: usize,
+    /// Most effects the forward search adds (default 2).
+    pub max_effects: usize,
 }
 
 impl Default for DiagnoseOptions {
@@ -99,186 +116,144 @@ impl Default for DiagnoseOptions {
             earn_threshold: -10.0,
             tie_margin: DEFAULT_TIE_MARGIN,
             start: None,
+            max_false_alarm: MAX_FALSE_ALARM,
+            calibration_replicates: calibrate::DEFAULT_REPLICATES,
+            max_effects: 2,
         }
     }
 }
 
-/// Diagnoses which candidate effect is missing from the model `base_spec` on the data `set`
-/// (the stages of the module documentation).
+/// Diagnoses which candidate effects are missing from the model `base_spec` on the data `set`:
+/// the stages of the module documentation on the user's model, then — while an effect is
+/// named but does not bring the residuals to the noise — the same with the effects found so
+/// far added to the model and refitted jointly (at most [`DiagnoseOptions::max_effects`]), and
+/// the verdict.
 pub fn diagnose(
     set: &ExperimentSet,
     base_spec: &ModelSpec,
     options: &DiagnoseOptions,
 ) -> Result<DiagnosisRun, RheometerError> {
     let t0 = Instant::now();
-    let ctx = Context::new(set, base_spec, options)?;
-    let base = ctx.fit_base()?;
-    let lin = linearise::linearise(&ctx, &base)?;
-    let noise_systematic = residuals_systematic(&base);
-    let mut records = linearise::linear_candidates(&ctx, &lin);
-    let detection = limits(&ctx, &lin, &base, &records);
-    let refits = search_and_judge(&ctx, &lin, &base, &mut records);
-    let mut ranked: Vec<usize> = (0..records.len()).collect();
-    ranked.sort_by(|&a, &b| rank_order(&records[a], &records[b]));
-    let named = ranked
+    let first = step::run(set, base_spec, options, None)?;
+    let mut steps = vec![first];
+    while steps.len() < options.max_effects.max(1) {
+        let Some(last) = steps.last() else { break };
+        let Some((variant, refit)) = &last.named_refit else {
+            break;
+        };
+        if verdict::explained(&refit.summary, &steps[0].base.summary.noise) {
+            break;
+        }
+        let spec = last
+            .spec
+            .clone()
+            .with(EffectSetting::fitted(variant.clone()));
+        let mut opts = options.clone();
+        opts.candidates
+            .retain(|c| !spec.effects.iter().any(|e| e.effect.name() == c.name()));
+        if opts.candidates.is_empty() {
+            break;
+        }
+        opts.start = Some(refit.law());
+        let next = step::run(set, &spec, &opts, Some(refit))?;
+        steps.push(next);
+    }
+    Ok(assemble(steps, t0))
+}
+
+/// The diagnosis of the steps: the first step's records, the further steps', the effects
+/// found, the final fit and the verdict.
+fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
+    let noise = steps[0].base.summary.noise.clone();
+    let found: Vec<String> = steps
         .iter()
-        .copied()
-        .find(|&i| earns_its_place(&records[i], options.earn_threshold));
-    let alternatives = ties(&ctx, &lin, &records, named);
-    let candidates: Vec<Candidate> = ranked.iter().map(|&i| records[i].clone()).collect();
-    let best = named.and_then(|i| refits.into_iter().find(|(j, _)| *j == i).map(|(_, id)| id));
-    let residuals_before = signature::named_residuals(&ctx.rh, &base);
-    Ok(DiagnosisRun {
+        .filter_map(|s| s.named_candidate().map(|c| c.effect.clone()))
+        .collect();
+    // the final model: the last named refit (all found effects, fitted jointly)
+    let final_id: Option<Identification> = steps
+        .iter()
+        .rev()
+        .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id.clone()));
+    let first = steps.remove(0);
+    let verdict = verdict_of(&first, &found, final_id.as_ref(), &noise);
+    let further: Vec<ForwardStep> = steps
+        .iter()
+        .map(|s| ForwardStep {
+            model_effects: s
+                .spec
+                .effects
+                .iter()
+                .map(|e| e.effect.name().to_string())
+                .collect(),
+            base_fit: s.base.summary.clone(),
+            candidates: s.candidates.clone(),
+            named: s.named_candidate().map(|c| c.effect.clone()),
+        })
+        .collect();
+    let residuals_before = signature::named_residuals(&first.base);
+    let residuals_after = final_id.as_ref().map(|id| signature::named_residuals(id));
+    DiagnosisRun {
         diagnosis: Diagnosis {
-            model: ctx.spec.law,
-            base_fit: base.summary.clone(),
+            model: first.spec.law,
+            base_fit: first.base.summary.clone(),
             // a physical effect that explains part of the residuals significantly shows they
             // are systematic, even where the noise level is too uncertain for the RMS test
-            systematic: noise_systematic || named.is_some(),
-            candidates,
-            indistinguishable: indistinguishable(&ctx, &lin),
-            most_likely_missing: named.map(|i| ctx.cands[i].name().to_string()),
-            alternatives,
-            detection,
+            systematic: first.systematic || first.named.is_some(),
+            most_likely_missing: first.named_candidate().map(|c| c.effect.clone()),
+            candidates: first.candidates,
+            indistinguishable: first.indistinguishable,
+            alternatives: first.alternatives,
+            detection: first.detection,
+            calibration: first.calibration,
+            further_steps: further,
+            found,
+            final_fit: final_id.as_ref().map(|id| id.summary.clone()),
+            verdict,
             wall_time_s: t0.elapsed().as_secs_f64(),
         },
         residuals_before,
-        residuals_after: best
-            .as_ref()
-            .map(|id| signature::named_residuals(&ctx.rh, id)),
-        base,
-        best,
-    })
-}
-
-/// Stage 3: whether the user's residuals are systematic by the noise test (RMS over the noise
-/// level above 1.2, or the lag-1 autocorrelation `ρ₁ √pairs` above 3).
-fn residuals_systematic(base: &Identification) -> bool {
-    let noise = &base.summary.noise;
-    let lag1_z = noise.model.as_ref().map_or(0.0, |m| m.lag1_z);
-    noise.rms_over_noise > 1.2 || lag1_z > 3.0
-}
-
-/// Stage 3 (cont.): detection limits linearised at strength 0 and the bias an undetected
-/// effect causes (without a determined fit — singular `JᵀJ` — the limits come without the
-/// shifts).
-fn limits(
-    ctx: &Context<'_>,
-    lin: &Linearisation,
-    base: &Identification,
-    records: &[Candidate],
-) -> DetectionLimits {
-    let dtheta: Vec<Vec<f64>> = match ParameterShift::new(&lin.x, lin.residuals(), lin.q) {
-        Ok(shift) => lin
-            .cols
-            .iter()
-            .map(|c| {
-                shift
-                    .derivative(&nalgebra::DVector::from_column_slice(c))
-                    .iter()
-                    .copied()
-                    .collect()
-            })
-            .collect(),
-        Err(_) => Vec::new(),
-    };
-    let extra: Vec<usize> = records.iter().map(|c| c.extra_parameters).collect();
-    let s = &base.summary;
-    let se = |e: &crate::fiber::rheometer::Estimate| if e.fitted { e.stderr } else { f64::NAN };
-    detection_limits(
-        &ctx.cands,
-        &extra,
-        &lin.scores,
-        &dtheta,
-        (ctx.column("n"), ctx.column("kappa")),
-        &DetectionContext {
-            sigma: s.noise.level / ctx.sigma,
-            noise_level: s.noise.level,
-            cost_before: lin.cost_before,
-            measurements: lin.residuals(),
-            threshold: ctx.options.earn_threshold,
-            stderr_n: se(&s.n),
-            stderr_kappa: se(&s.kappa),
-        },
-    )
-}
-
-/// Stages 4–6: search (scan and refine), choose shapes, judge; the refits' identifications
-/// by candidate.
-fn search_and_judge(
-    ctx: &Context<'_>,
-    lin: &Linearisation,
-    base: &Identification,
-    records: &mut [Candidate],
-) -> Vec<(usize, Identification)> {
-    let searched = search::searched(ctx, lin);
-    let scans = search::scan_all(ctx, base, lin, &searched, records);
-    let refined = search::refine_all(ctx, lin, &scans, &searched, records);
-    let extra: Vec<usize> = records.iter().map(|c| c.extra_parameters).collect();
-    let choices = shapes::choose_shapes(ctx, lin, &scans, refined, &extra);
-    let before = signature::named_residuals(&ctx.rh, base);
-    let mut refits = Vec::new();
-    for (i, (chosen, other)) in choices.into_iter().enumerate() {
-        if let Some(choice) = chosen {
-            let id = judge::judge(
-                ctx,
-                lin,
-                &base.summary,
-                &before,
-                &mut records[i],
-                choice,
-                other,
-            );
-            refits.push((i, id));
-        }
+        residuals_after,
+        base: first.base,
+        best: final_id,
     }
-    refits
 }
 
-/// Stage 8: the candidates tied with the named one.
-fn ties(
-    ctx: &Context<'_>,
-    lin: &Linearisation,
-    records: &[Candidate],
-    named: Option<usize>,
-) -> Vec<Alternative> {
-    let Some(b) = named else {
-        return Vec::new();
-    };
-    let mut ranked: Vec<Candidate> = records.to_vec();
-    ranked.sort_by(rank_order);
-    alternatives(
-        &records[b],
-        &ranked,
-        ctx.options.earn_threshold,
-        ctx.options.tie_margin,
-        ctx.cands[b].category(),
-        |name| match ctx.cands.iter().position(|e| e.name() == name) {
-            Some(i) => (
-                ctx.cands[i].category(),
-                cosine(&lin.scores[b].signature, &lin.scores[i].signature),
-            ),
-            None => (Category::Physics, f64::NAN),
-        },
-    )
-}
-
-/// Stage 8 (cont.): pairs of candidates with nearly parallel orthogonalised signatures.
-fn indistinguishable(ctx: &Context<'_>, lin: &Linearisation) -> Vec<Indistinguishable> {
-    let mut out = Vec::new();
-    for a in 0..ctx.cands.len() {
-        for b in a + 1..ctx.cands.len() {
-            let c = cosine(&lin.scores[a].signature, &lin.scores[b].signature);
-            if c.abs() > ctx.options.indistinguishable_cosine {
-                out.push(Indistinguishable {
-                    effects: [
-                        ctx.cands[a].name().to_string(),
-                        ctx.cands[b].name().to_string(),
-                    ],
-                    cosine: c,
-                });
-            }
-        }
+/// The verdict of the steps (see [`verdict`]).
+fn verdict_of(
+    first: &step::Step,
+    found: &[String],
+    final_id: Option<&Identification>,
+    noise: &NoiseSummary,
+) -> Verdict {
+    let fit = final_id.unwrap_or(&first.base);
+    let (ratio, _) = verdict::at_noise(&fit.summary, noise);
+    if !found.is_empty() && verdict::explained(&fit.summary, noise) {
+        return Verdict::Explained {
+            effects: found.to_vec(),
+            rms_over_noise: ratio,
+        };
     }
-    out
+    if found.is_empty() && !first.systematic {
+        return Verdict::Adequate;
+    }
+    let mut helps: Vec<Help> = first
+        .candidates
+        .iter()
+        .filter(|c| c.refitted() && c.delta_bic < 0.0 && c.share_of_excess > 0.05)
+        .map(|c| Help {
+            effect: c.effect.clone(),
+            share_of_excess: c.share_of_excess,
+            delta_bic: c.delta_bic,
+        })
+        .collect();
+    helps.sort_by(|a, b| b.share_of_excess.total_cmp(&a.share_of_excess));
+    Verdict::NoneOfTheCandidates {
+        helps,
+        unexplained: verdict::unexplained(
+            &fit.residual_profiles,
+            &fit.summary.experiments,
+            noise.level,
+        ),
+        rms_over_noise: ratio,
+    }
 }

@@ -147,29 +147,49 @@ fn refine_starts(
         .collect()
 }
 
+/// A refinement job: candidate, scan, grid point, and the `(n, κ)` to start from instead of
+/// the grid point's.
+type Job = (usize, usize, usize, Option<[f64; 2]>);
+
 /// Refines the best grid points of every searched candidate in parallel (refits that fail
-/// are left out).
+/// are left out). The lowest grid point of each candidate is refined from several material
+/// laws besides its own — the user's fit's and the diagnosis' start law — since a refit from
+/// the grid point's law alone can end in a local minimum far from the truth (a co-flow that
+/// drives `n` to 0); the best of all starts is kept and [`Candidate::refit_starts`] says how
+/// many reached it.
 pub(crate) fn refine_all(
     ctx: &Context<'_>,
+    base: &Identification,
     lin: &Linearisation,
     scans: &Scans,
     searched: &[usize],
     records: &[Candidate],
 ) -> Vec<Refined> {
-    let jobs: Vec<(usize, usize, usize)> = searched
+    let laws = [base.law(), ctx.law0];
+    let jobs: Vec<Job> = searched
         .iter()
         .flat_map(|&i| [(i, false), (i, true)])
         .flat_map(|(i, kind)| {
-            refine_starts(ctx, lin, scans, i, kind, records[i].extra_parameters)
-                .into_iter()
-                .map(move |(j, k)| (i, j, k))
+            let starts = refine_starts(ctx, lin, scans, i, kind, records[i].extra_parameters);
+            let first = starts.first().copied();
+            let mut jobs: Vec<Job> = starts.into_iter().map(|(j, k)| (i, j, k, None)).collect();
+            if let Some((j, k)) = first {
+                let own = scans.ok[j].1.starts[k].law;
+                for law in laws {
+                    let differs = (law[0] - own[0]).abs() > 0.02 || (law[1] - own[1]).abs() > 0.1;
+                    if differs && !jobs.iter().any(|x| x.3 == Some(law)) {
+                        jobs.push((i, j, k, Some(law)));
+                    }
+                }
+            }
+            jobs
         })
         .collect();
     let n_bounds = ctx
         .column("n")
         .map(|c| (ctx.layout.lower[c], ctx.layout.upper[c]));
     jobs.into_par_iter()
-        .filter_map(|(i, j, k)| {
+        .filter_map(|(i, j, k, law)| {
             let sc = &scans.ok[j].1;
             // a grid point whose n sits at a bound of its range (the Newtonian limit n = 1,
             // where κ has no effect: the fit cannot leave it) is refined from the diagnosis'
@@ -177,15 +197,21 @@ pub(crate) fn refine_all(
             let start = &sc.starts[k];
             let at_n_bound = n_bounds
                 .is_some_and(|(lo, hi)| start.law[0] <= lo + 1e-6 || start.law[0] >= hi - 1e-6);
+            let law = match law {
+                Some(l) if ctx.spec.law == LawChoice::Carreau => Some(l),
+                None if at_n_bound && ctx.spec.law == LawChoice::Carreau => Some(ctx.law0),
+                _ => None,
+            };
             let moved;
-            let start = if at_n_bound && ctx.spec.law == LawChoice::Carreau {
-                moved = GridStart {
-                    law: ctx.law0,
-                    ..start.clone()
-                };
-                &moved
-            } else {
-                start
+            let start = match law {
+                Some(law) => {
+                    moved = GridStart {
+                        law,
+                        ..start.clone()
+                    };
+                    &moved
+                }
+                None => start,
             };
             refine(sc, start, &ctx.opts).ok().map(|refit| Refined {
                 candidate: i,

@@ -1,7 +1,7 @@
 //! Where along the spin line a change of the residuals lies, and residual profiles by name.
 
 use super::super::diagnosis::ResidualProfiles;
-use crate::fiber::rheometer::{Identification, Rheometer};
+use crate::fiber::rheometer::Identification;
 
 /// Where along `s` a residual change lies: the position \[m\] of the largest pooled change and
 /// the 10%–90% range \[m\] of its cumulative weight.
@@ -43,13 +43,17 @@ pub(crate) fn signature_location(positions: &[f64], change: &[f64]) -> (f64, [f6
 
 /// The residuals of a fit on its own model (a refit's parameter vector belongs to the
 /// candidate's model, not to the diagnosis' one), named by experiment.
-pub(crate) fn named_residuals(rh: &Rheometer, id: &Identification) -> ResidualProfiles {
+pub(crate) fn named_residuals(id: &Identification) -> ResidualProfiles {
     id.residual_profiles
         .iter()
         .enumerate()
         .map(|(k, (s, r))| {
             (
-                rh.experiments[k].name.clone(),
+                id.summary
+                    .experiments
+                    .get(k)
+                    .cloned()
+                    .unwrap_or_else(|| format!("#{}", k + 1)),
                 s.iter().copied().zip(r.iter().copied()).collect(),
             )
         })

@@ -10,7 +10,7 @@ use diffbvp::{
     solve, Bvp, BvpError, DualNum, Guess, LinearSolverKind, Solution, SolveOptions, Solver,
 };
 
-mod common;
+use crate::common;
 use common::{Bratu, CoupledTroesch, Oscillator, Shock};
 
 const AGREE: f64 = 1e-12;

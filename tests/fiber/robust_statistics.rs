@@ -468,7 +468,7 @@ fn the_correct_model_stays_consistent_with_noise_and_outliers_are_reported() {
         assert!(text.contains(&needle), "{needle} not in\n{text}");
     }
     let json: serde_json::Value = serde_json::from_str(&cmp.to_json().unwrap()).unwrap();
-    assert!(json["noise"]["outliers"].as_array().unwrap().len() >= OUTLIERS.len());
+    assert!(json["noise"]["model"]["outliers"].as_array().unwrap().len() >= OUTLIERS.len());
     assert_eq!(json["experiments"][0]["points"][5]["outlier"], true);
     // the figures are written (noise band, pooled trend, outlier rings)
     let dir = std::env::temp_dir().join(format!("diffbvp-robust-{}", std::process::id()));

@@ -12,7 +12,7 @@
 //! * the JSON has the `error_budget` object, and without declarations the CLI prints the
 //!   sensitivities in words.
 
-mod probe;
+use crate::probe;
 
 use diffbvp::fiber::effects::{Effect, EffectSetting, ModelSpec};
 use diffbvp::fiber::input::{load_experiments_with, parse_experiments, LoadedExperiments};

@@ -10,7 +10,7 @@
 //! Tests the project cannot pass yet are `#[ignore]`d with the reason; each prints one
 //! `BASELINE` line (run with `--nocapture`).
 
-mod independent;
+use crate::independent;
 
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, Candidate, DiagnoseOptions, DiagnosisRun};
 use diffbvp::fiber::effects::{LawChoice, ModelSpec};

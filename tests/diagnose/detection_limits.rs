@@ -16,7 +16,7 @@
 //!
 //! Each run prints one `DETECTION` line (run with `--nocapture`).
 
-mod independent;
+use crate::independent;
 
 use diffbvp::fiber::diagnostics::detection::DetectionLimit;
 use diffbvp::fiber::diagnostics::diagnose::{

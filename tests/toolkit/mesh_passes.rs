@@ -4,7 +4,7 @@
 //! 239) and in at most half the meshes scipy's refinement rule needs from the same guess
 //! (Bratu 4 meshes, shock 10, Troesch 7; `diffbvp::mesh::RefineRule::Scipy`).
 
-mod common;
+use crate::common;
 use common::{shock_exact, Bratu, CoupledTroesch, Shock};
 use diffbvp::mesh::linspace;
 use diffbvp::{solve, Guess, Solution, SolveOptions};

@@ -12,7 +12,7 @@
 //! asserts what honest unbiased intervals give but for a < 1 % chance: no more misses than the
 //! binomial tail allows, and a mean standardised error within ±3.3/√N.
 
-mod independent;
+use crate::independent;
 
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
 use diffbvp::fiber::effects::{Effect, LawChoice, ModelSpec};

@@ -2,7 +2,7 @@
 //! Accuracy of the collocation solver: convergence order, exact Jacobians, singularly perturbed
 //! problems, per-component residual scaling.
 
-mod common;
+use crate::common;
 use common::*;
 use diffbvp::inspect::discrete_system;
 use diffbvp::mesh::linspace;

@@ -8,7 +8,7 @@
 //! pinned at 0.5 (a take-up diameter 10× too large in the TOML), (c) a CSV with increasing
 //! diameters, (d) air hotter than the melt. The shipped data are the control (no warning).
 
-mod probe;
+use crate::probe;
 
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::rheometer::{

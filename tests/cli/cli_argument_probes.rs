@@ -3,7 +3,7 @@
 //! and value (or the experiment and its TOML line) and unchanged inputs; values refused up
 //! front must be refused quickly.
 
-mod probe;
+use crate::probe;
 
 use probe::{s, variant, Probe};
 use std::path::{Path, PathBuf};

@@ -275,10 +275,11 @@ fn gauge_parameters_enter_the_residuals_exactly() {
     let mut sol_g = sol.clone();
     sol_g.params = pg.clone();
     let sens = Sensitivities::compute(&m, &sol_g).unwrap();
+    let sigmas = vec![sigma; d_meas.len()];
     let res = RelativeResidual {
         model: &m,
         d_meas: &d_meas,
-        sigma,
+        sigma: &sigmas,
     };
     let (r, jac) = residual_jacobian(&m, &sol_g, &sens, &xs, &res).unwrap();
     let q = pg.len();

@@ -2,7 +2,7 @@
 //! the independent scipy implementation (`tests/data/reference_profiles/`) for all nine
 //! experiments, Carreau truth (n, κ) = (0.8, 11.71) and Newtonian.
 
-mod independent;
+use crate::independent;
 
 use independent::model::{AirFlow, AirHeat, Law, Line, Material};
 use independent::solve::{profile, solve_line};
@@ -52,6 +52,7 @@ fn line(q: f64, d_out: f64, law: Law) -> Line {
         air_flow: AirFlow::Still,
         air_heat: AirHeat::Uniform,
         emissivity: 0.0,
+        hardening: 0.0,
     }
 }
 

@@ -2,7 +2,7 @@
 //! scipy's own `solve_bvp` test problems (test_bvp.py), written out in
 //! shared/docs/bvp-test-problems.md, plus Bratu's two branches.
 
-mod common;
+use crate::common;
 use common::*;
 use diffbvp::mesh::linspace;
 use diffbvp::{solve, Bvp, BvpError, DualNum, Guess, SolveOptions};

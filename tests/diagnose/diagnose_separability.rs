@@ -18,7 +18,7 @@
 //!
 //! Run: `cargo test --release --test diagnose_separability -- --ignored --nocapture`.
 
-mod independent;
+use crate::independent;
 
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use diffbvp::fiber::effects::{Effect, LawChoice, ModelSpec};

@@ -2,7 +2,7 @@
 //! each must fail cleanly (exit code 1, no panic) before any work, with a message naming the
 //! file, the line, the experiment and the key, and leave every input file unchanged.
 
-mod probe;
+use crate::probe;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

@@ -6,7 +6,7 @@ use diffbvp::mesh::linspace;
 use diffbvp::sensitivity::{adjoint_gradient, residual_jacobian, PointFunction, Sensitivities};
 use diffbvp::{solve, Bvp, DualNum, Guess, Solution, SolveOptions};
 
-mod common;
+use crate::common;
 use common::Oscillator;
 
 /// y'' = p² y, y(0) = 1, y(1) = 0: y = sinh(p(1-x))/sinh(p).

@@ -5,7 +5,7 @@
 //! and very many experiments. Every probe checksums the inputs before and after.
 #![cfg(unix)]
 
-mod probe;
+use crate::probe;
 
 use probe::{checksums_below, rheometer, run_with, s, shipped_copy, Probe};
 use std::fs;

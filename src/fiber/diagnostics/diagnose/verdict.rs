@@ -1,0 +1,148 @@
+//! Stage 9: the verdict — what the diagnosis may say.
+//!
+//! * An effect is named as missing only when it earns its place (credible strength and law,
+//!   `ΔBIC` below the threshold), is unlikely to be a false alarm of the search over all
+//!   candidates ([`calibrate`](super::calibrate)), and removes at least
+//!   [`MIN_SHARE_OF_EXCESS`] of the excess misfit (the cost above what the noise alone
+//!   leaves).
+//! * It is *the* explanation only when, with the named effects, the residuals are at the noise:
+//!   RMS within [`EXPLAINED_RMS_OVER_NOISE`] of the noise level and no structure along the line
+//!   (lag-1 autocorrelation `ρ₁ √pairs` below 3). Otherwise the verdict is "none of the
+//!   candidates": which ones help and how much, and where along the line (and in which
+//!   experiments) the unexplained residual lies — a user-written effect is the next step.
+
+use crate::fiber::diagnostics::compare::segments::{find_segments, SegmentOptions};
+use crate::fiber::noise_summary::NoiseSummary;
+use crate::fiber::rheometer::FitSummary;
+use serde::{Deserialize, Serialize};
+
+/// Share of the excess misfit an effect must remove to be named \[-\].
+pub const MIN_SHARE_OF_EXCESS: f64 = 0.5;
+
+/// RMS over the noise level at or below which the residuals are at the noise \[-\].
+pub const EXPLAINED_RMS_OVER_NOISE: f64 = 1.2;
+
+/// `ρ₁ √pairs` at or above which the residuals keep a structure along the line.
+pub const STRUCTURE_Z: f64 = 3.0;
+
+/// A candidate that helps: how much of the excess misfit it removes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Help {
+    /// The effect.
+    pub effect: String,
+    /// Share of the excess misfit it removes \[-\] (1: all of it).
+    pub share_of_excess: f64,
+    /// Its `ΔBIC`.
+    pub delta_bic: f64,
+}
+
+/// A stretch of the spin line where the residual stays systematic after the best candidates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Unexplained {
+    /// Start \[m\].
+    pub start_m: f64,
+    /// End \[m\].
+    pub end_m: f64,
+    /// Mean relative residual there \[-\] (positive: the model too thick).
+    pub mean: f64,
+    /// Its size in standard errors.
+    pub z: f64,
+    /// The experiments with a residual of that sign there.
+    pub experiments: Vec<String>,
+}
+
+/// What the diagnosis concludes (JSON: `{"kind": "explained", ...}`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Verdict {
+    /// The residuals are consistent with the noise and no candidate earns its place.
+    Adequate,
+    /// The named effects bring the residuals to the noise.
+    Explained {
+        /// The effects, in the order they were found.
+        effects: Vec<String>,
+        /// RMS (outliers excluded) over the noise level with them \[-\].
+        rms_over_noise: f64,
+    },
+    /// Something is missing that none of the candidates describes (or describes only in part).
+    NoneOfTheCandidates {
+        /// The candidates that help, most first (named ones included).
+        helps: Vec<Help>,
+        /// Where the residual stays systematic with the best of them.
+        unexplained: Vec<Unexplained>,
+        /// RMS (outliers excluded) over the noise level with the best of them \[-\].
+        rms_over_noise: f64,
+    },
+}
+
+/// `J` the noise alone leaves after fitting `q` parameters to `n` residuals of noise level
+/// `sd` each (the fit's residual units).
+pub(crate) fn noise_cost(sd: &[f64], q: usize) -> f64 {
+    let n = sd.len().max(1) as f64;
+    let s2: f64 = sd.iter().map(|v| v * v).sum();
+    s2 * (n - q as f64).max(1.0) / n
+}
+
+/// The share of the excess misfit `J_before − J_noise` a refit to `J_after` removes (0 when
+/// there is no excess).
+pub(crate) fn share_of_excess(before: f64, after: f64, j_noise: f64) -> f64 {
+    let excess = before - j_noise;
+    if excess > 0.0 {
+        ((before - after) / excess).clamp(0.0, f64::INFINITY)
+    } else {
+        0.0
+    }
+}
+
+/// RMS (outliers excluded) of `fit`'s residuals over the data's noise level `noise` and the
+/// lag-1 structure statistic of its residuals.
+pub(crate) fn at_noise(fit: &FitSummary, noise: &NoiseSummary) -> (f64, f64) {
+    let m = fit.noise.model.as_ref();
+    let rms = m.map_or(fit.rms_relative_residual, |m| m.rms);
+    let lag1_z = m.map_or(0.0, |m| m.lag1_z);
+    (rms / noise.level, lag1_z)
+}
+
+/// Whether `fit` leaves residuals at the noise (see the module documentation).
+pub(crate) fn explained(fit: &FitSummary, noise: &NoiseSummary) -> bool {
+    let (ratio, z) = at_noise(fit, noise);
+    ratio <= EXPLAINED_RMS_OVER_NOISE && z < STRUCTURE_Z
+}
+
+/// Where `fit`'s residuals (`(positions, residuals)` per experiment, names `names`) stay
+/// systematic, at the noise level `sigma`.
+pub(crate) fn unexplained(
+    profiles: &[(Vec<f64>, Vec<f64>)],
+    names: &[String],
+    sigma: f64,
+) -> Vec<Unexplained> {
+    find_segments(profiles, sigma, &SegmentOptions::default())
+        .into_iter()
+        .map(|seg| Unexplained {
+            start_m: seg.start_m,
+            end_m: seg.end_m,
+            mean: seg.mean,
+            z: seg.z,
+            experiments: seg
+                .per_experiment
+                .iter()
+                .filter(|(_, v)| (*v > 0.0) == (seg.mean > 0.0))
+                .filter_map(|(k, _)| names.get(*k).cloned())
+                .collect(),
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shares_of_the_excess() {
+        // J 300 with noise cost 100: a refit to 150 removes 3/4 of the excess
+        assert!((share_of_excess(300.0, 150.0, 100.0) - 0.75).abs() < 1e-15);
+        assert_eq!(share_of_excess(90.0, 80.0, 100.0), 0.0);
+        let sd = vec![0.5; 100];
+        assert!((noise_cost(&sd, 10) - 0.25 * 90.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,11 @@
+//! The cli tests in one binary (one link instead of 5): each file is a module
+//! named after its former test binary; run one with `cargo test --release --test cli NAME::`.
+
+#[path = "../probe/mod.rs"]
+mod probe;
+
+mod cli_argument_probes;
+mod cli_output_safety;
+mod input_loading;
+mod input_plausibility;
+mod reader_fuzz;

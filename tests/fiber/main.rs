@@ -1,0 +1,23 @@
+//! The fiber tests in one binary (one link instead of 15): each file is a module
+//! named after its former test binary; run one with `cargo test --release --test fiber NAME::`.
+
+#[path = "../independent/mod.rs"]
+mod independent;
+#[path = "../probe/mod.rs"]
+mod probe;
+
+mod cold_start;
+mod compare;
+mod effects_families;
+mod error_budget;
+mod fiber_physics;
+mod fiber_reference;
+mod fiber_terms;
+mod fit_warnings;
+mod independent_model;
+mod landscape;
+mod rheometer;
+mod robust_statistics;
+mod smoothing;
+mod tolerance_schedule;
+mod workflows;

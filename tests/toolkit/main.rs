@@ -1,0 +1,15 @@
+//! The toolkit tests in one binary (one link instead of 9): each file is a module
+//! named after its former test binary; run one with `cargo test --release --test toolkit NAME::`.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod continuation;
+mod core_accuracy;
+mod least_squares;
+mod library_edges;
+mod linear_solvers;
+mod mesh_passes;
+mod plot;
+mod scipy_problems;
+mod sensitivities;
