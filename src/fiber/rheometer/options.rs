@@ -81,6 +81,12 @@ pub struct IdentifyOptions {
     /// the noise or of the step's effect on the residuals), the final iterations, the estimate
     /// and its covariance at `simulate.tol`. `None`: every solve at `simulate.tol`.
     pub loose_tolerance: Option<f64>,
+    /// A cancellation flag (default `None`), handed to the least-squares driver
+    /// ([`FitOptions::cancel`](crate::least_squares::FitOptions::cancel)): once set, a running
+    /// identification stops before its next model evaluation with
+    /// [`FitError::Cancelled`](crate::least_squares::FitError::Cancelled) (the Python bindings
+    /// set it on Ctrl-C).
+    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Default for IdentifyOptions {
@@ -101,6 +107,7 @@ impl Default for IdentifyOptions {
             loss: Loss::Linear,
             f_scale: None,
             loose_tolerance: Some(1e-3),
+            cancel: None,
         }
     }
 }
