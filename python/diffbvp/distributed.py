@@ -65,7 +65,7 @@ def replicate_dataset(dataset: Dataset, base: FitResult, index: int, seed: int =
         if name not in measured:
             continue
         pos, d = measured[name]
-        r = base.residuals[name]["relative_residual"]
+        r = base.residual_profiles[name]["relative_residual"]
         model = d * (1.0 + r)  # relative residual = (d_model - d_meas) / d_meas
         new[name] = (pos, model * (1.0 + sigma * rng.standard_normal(len(pos))))
     return dataset.with_measurements(new)

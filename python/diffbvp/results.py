@@ -145,8 +145,8 @@ class FitResult(Result):
     intervals, correlation, warnings, error budget, take-up factors, per-experiment RMS); its
     keys also read as attributes (``fit.n``, ``fit.kappa``, ``fit.K_Pa`` [Pa],
     ``fit.rms_relative_residual`` [-], ...). Arrays: ``parameter_names``, ``parameters`` and
-    ``covariance`` of the fit vector (n, κ, fitted strengths, take-up factors), ``residuals``
-    (name → ``position_m`` [m], ``relative_residual`` [-]) and ``profiles`` (name → fitted
+    ``covariance`` of the fit vector (n, κ, fitted strengths, take-up factors),
+    ``residual_profiles`` (name → ``position_m`` [m], ``relative_residual`` [-]) and ``profiles`` (name → fitted
     profiles on uniform positions, SI units in the keys).
     """
 
@@ -228,6 +228,17 @@ class FitResult(Result):
         return np.asarray(self._data["take_up_factors"], dtype=float)
 
     @property
+    def residual_profiles(self) -> Dict[str, Dict[str, np.ndarray]]:
+        """name → ``position_m`` [m] and ``relative_residual`` [-] = (d_model − d_meas)/d_meas
+        at the measurement positions."""
+        return self._arrays["residual_profiles"]
+
+    @property
+    def profiles(self) -> Dict[str, Dict[str, Any]]:
+        """name → fitted profiles on uniform positions (SI units in the keys)."""
+        return self._arrays.get("profiles", {})
+
+    @property
     def covariance(self) -> Optional[np.ndarray]:
         """Covariance of the fit vector (``parameter_names``), None if singular."""
         return self._arrays.get("covariance")
@@ -242,7 +253,7 @@ class FitResult(Result):
     def residuals_table(self) -> Dict[str, np.ndarray]:
         """Columns ``experiment``, ``position_m`` [m], ``relative_residual`` [-]
         (``pandas.DataFrame(fit.residuals_table())``)."""
-        return _long_table(self._arrays["residuals"], ["position_m", "relative_residual"])
+        return _long_table(self._arrays["residual_profiles"], ["position_m", "relative_residual"])
 
     def profiles_table(self) -> Dict[str, np.ndarray]:
         """The fitted profiles of every experiment as one long table (SI units in the keys)."""

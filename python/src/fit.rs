@@ -133,7 +133,7 @@ pub fn identification_arrays<'py>(
         e.set_item("relative_residual", array1(py, r))?;
         res.set_item(name, e)?;
     }
-    d.set_item("residuals", res)?;
+    d.set_item("residual_profiles", res)?;
     if let Some(profiles) = profiles {
         let pd = PyDict::new(py);
         for (name, p) in id.experiment_names.iter().zip(profiles) {
