@@ -94,8 +94,8 @@ pub fn compare<'py>(
         }
     }
     let max_nodes = options::max_nodes(max_nodes)?;
-    let mut law = [0.8, 11.71];
-    let mut take_up_factors = None;
+    let law: [f64; 2];
+    let take_up_factors: Option<Vec<f64>> = None;
     let mut missing = MissingTakeUp::Error;
     let mut fitted = 0;
     let mut warnings = Vec::new();
@@ -130,7 +130,6 @@ pub fn compare<'py>(
         if take_up_from_data {
             missing = MissingTakeUp::FromData;
         }
-        take_up_factors = None;
     }
     let opts = CompareOptions {
         relative_uncertainty,

@@ -5,7 +5,7 @@
 use crate::convert::{array1, from_py, vec_f64};
 use crate::errors::{input_error, to_py_err};
 use diffbvp::fiber::input::{
-    load_experiments_with, parse_experiments, parse_measurements, LoadedExperiments,
+    load_experiments_with, parse_experiments, parse_measurements, InputError, LoadedExperiments,
 };
 use diffbvp::fiber::setup::{Inlet, TakeUp};
 use pyo3::prelude::*;
@@ -158,15 +158,15 @@ impl Dataset {
     /// value checked, errors name file, line, table and key).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        let result = py.detach(|| {
-            let loaded = load_experiments_with(&path, MIN_POINTS)?;
+        let result = py.detach(|| -> Result<DatasetInner, Box<InputError>> {
+            let loaded = load_experiments_with(&path, MIN_POINTS).map_err(Box::new)?;
             let toml = std::fs::read_to_string(&path).map_err(|e| {
-                diffbvp::fiber::input::InputError::Io {
+                Box::new(InputError::Io {
                     path: path.clone(),
                     source: e,
-                }
+                })
             })?;
-            Ok::<_, diffbvp::fiber::input::InputError>(DatasetInner {
+            Ok(DatasetInner {
                 loaded,
                 path: path.clone(),
                 toml,
@@ -176,7 +176,7 @@ impl Dataset {
             Ok(inner) => Ok(Dataset {
                 inner: Arc::new(inner),
             }),
-            Err(e) => Err(to_py_err(py, Box::new(e), None, None)),
+            Err(e) => Err(to_py_err(py, e, None, None)),
         }
     }
 

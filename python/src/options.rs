@@ -115,7 +115,7 @@ pub fn check_range(
     (lo, hi): (f64, f64),
     [min, max]: [f64; 2],
 ) -> PyResult<()> {
-    if !(lo < hi) {
+    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
         return Err(input_error(format!(
             "{arg} = ({lo}, {hi}): give (MIN, MAX) with MIN < MAX"
         )));

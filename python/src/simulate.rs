@@ -85,7 +85,7 @@ fn sensitivities(
         ("strain_rate_1_s", 3, si.strain_rate),
     ];
     let mut blocks = vec![("diameter_m", diameter)];
-    let mut states: Vec<Vec<f64>> = vec![Vec::with_capacity(xs.len() * m); n];
+    let mut states: Vec<Vec<f64>> = (0..n).map(|_| Vec::with_capacity(xs.len() * m)).collect();
     let mut dy = vec![0.0; n * q];
     let mut dyp = vec![0.0; n * q];
     for &x in &xs {
