@@ -80,6 +80,7 @@ pub fn diagnose<'py>(
     }
     opts.identify.simulate.max_nodes = options::max_nodes(max_nodes)?;
     let set = &dataset.inner.loaded.set;
+    // TODO(restructure): call the library's diagnose workflow (options, spec and run in one)
     let out = interruptible(py, |cancel| -> Result<_, BoxError> {
         let mut opts = opts;
         opts.identify.cancel = Some(cancel);
@@ -89,6 +90,8 @@ pub fn diagnose<'py>(
     let d = PyDict::new(py);
     d.set_item("diagnosis", serde_to_py(py, &run.diagnosis)?)?;
     d.set_item("text", run.diagnosis.to_text())?;
+    // TODO(restructure): the diagnosis will hold FitSummary values; serialise those instead of
+    // building FitReports from the identifications here
     let fit_dict =
         |id: &diffbvp::fiber::rheometer::Identification| -> PyResult<Bound<'py, PyDict>> {
             let rep = FitReport::new(id);

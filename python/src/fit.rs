@@ -145,6 +145,7 @@ pub fn identification_arrays<'py>(
 }
 
 /// A fit outcome as `{"report": dict, "arrays": dict, "notes": [str]}`.
+// TODO(restructure): serialise the FitSummary (report, covariance, flow curve) instead.
 pub fn outcome_to_py<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("report", serde_to_py(py, &o.report)?)?;

@@ -74,6 +74,7 @@ pub fn landscape<'py>(
     let ns = linspace(n_range.0, n_range.1, a);
     let ks = linspace(kappa_range.0, kappa_range.1, b);
     let set = &dataset.inner.loaded.set;
+    // TODO(restructure): call the library's landscape workflow (range checks, mesh cap).
     let out = interruptible(py, |cancel| -> Result<_, BoxError> {
         let rh = Rheometer::new(set)?;
         Ok(rh.landscape_with(&ns, &ks, &opts, |_| {}, &cancel)?)

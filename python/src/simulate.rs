@@ -189,6 +189,7 @@ impl SimError {
 
 /// Simulates every experiment in order (as `rheometer simulate` does), stopping between
 /// experiments once `cancel` is set.
+// TODO(restructure): call the library's simulate workflow (take-up rules, failure naming).
 pub fn simulate_all(
     dataset: &Dataset,
     s: &SimulateSettings,
