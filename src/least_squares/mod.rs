@@ -51,6 +51,8 @@ pub use loss::Loss;
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// A least-squares problem with exact Jacobians.
@@ -150,6 +152,10 @@ pub struct FitOptions {
     pub f_scale: f64,
     /// How accurately the model is evaluated (default [`Accuracy::Fixed`]).
     pub accuracy: Accuracy,
+    /// A cancellation flag (default `None`): once set (by another thread, e.g. a signal
+    /// handler or an interactive front end), the fit stops before its next model evaluation
+    /// with [`FitError::Cancelled`].
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 impl FitOptions {
@@ -167,7 +173,15 @@ impl FitOptions {
             loss: Loss::Linear,
             f_scale: 1.0,
             accuracy: Accuracy::Fixed,
+            cancel: None,
         }
+    }
+
+    /// Whether [`cancel`](Self::cancel) is set.
+    pub fn cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
     }
 }
 
@@ -306,6 +320,12 @@ pub enum FitError {
         p: Vec<f64>,
         /// Cause.
         cause: String,
+    },
+    /// [`FitOptions::cancel`] was set: the fit stopped before its next model evaluation.
+    #[error("the fit was cancelled (interrupted) after {iterations} iterations")]
+    Cancelled {
+        /// Trial steps done before the cancellation.
+        iterations: usize,
     },
 }
 
@@ -542,6 +562,9 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
     let mut p = p0.to_vec();
     // the start point at the loosest accuracy the problem offers (no residuals yet to scale
     // the allowed error by), at full accuracy if that fails or without a schedule
+    if options.cancelled() {
+        return Err(FitError::Cancelled { iterations: 0 });
+    }
     let loose_start = schedule.is_some() && problem.set_accuracy(Some(f64::INFINITY));
     if !loose_start {
         problem.set_accuracy(None);
@@ -584,6 +607,9 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
     let mut stop: Option<Termination> = None;
     let termination;
     loop {
+        if options.cancelled() {
+            return Err(FitError::Cancelled { iterations });
+        }
         if let Some(t) = stop.take() {
             if !loose {
                 termination = t;

@@ -7,7 +7,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::{Duration, Instant};
 
 use diffbvp::continuation::{continuation, sweep, ContinuationOptions};
-use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem};
+use diffbvp::least_squares::{fit, FitError, FitOptions, LeastSquaresProblem};
 use diffbvp::mesh::{coarsen, linspace, refine, validate};
 use diffbvp::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
 use diffbvp::{solve, Bvp, BvpError, DualNum, Guess, Solution, SolveOptions, Solver};
@@ -484,4 +484,70 @@ fn fiber_model_refuses_an_overflowing_inlet_velocity() {
     };
     assert!(m.contains("inlet velocity") && m.contains("inf"), "{m}");
     assert!(!m.contains("inlet diameter 0 m"), "{m}");
+}
+
+/// A slowly converging problem that sets its fit's cancellation flag at its `after`-th
+/// evaluation and counts its evaluations.
+struct CancelAfter {
+    flag: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    after: usize,
+    evaluations: usize,
+}
+
+impl LeastSquaresProblem for CancelAfter {
+    type Error = String;
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
+        self.evaluations += 1;
+        if self.evaluations == self.after {
+            self.flag.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+        // Rosenbrock: many iterations from (-1.2, 1)
+        let (x, y) = (p[0], p[1]);
+        Ok((
+            vec![10.0 * (y - x * x), 1.0 - x],
+            vec![-20.0 * x, 10.0, -1.0, 0.0],
+        ))
+    }
+}
+
+#[test]
+fn a_set_cancel_flag_stops_the_fit_before_its_next_evaluation() {
+    let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let opts = FitOptions {
+        cancel: Some(flag.clone()),
+        ..FitOptions::with_bounds(vec![-5.0, -5.0], vec![5.0, 5.0])
+    };
+    // not set: the fit runs to its optimum
+    let mut free = CancelAfter {
+        flag: std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false)),
+        after: usize::MAX,
+        evaluations: 0,
+    };
+    let done = fit(&mut free, &[-1.2, 1.0], &opts).unwrap();
+    assert!((done.p[0] - 1.0).abs() < 1e-6 && free.evaluations > 5);
+    // set during the fit: stops after that evaluation, no further one
+    let mut p = CancelAfter {
+        flag: flag.clone(),
+        after: 3,
+        evaluations: 0,
+    };
+    match fit(&mut p, &[-1.2, 1.0], &opts) {
+        Err(FitError::Cancelled { iterations }) => assert!(iterations >= 1),
+        other => panic!("expected a cancelled fit, got {other:?}"),
+    }
+    assert_eq!(p.evaluations, 3);
+    // set before the start: no evaluation at all
+    let mut q = CancelAfter {
+        flag: flag.clone(),
+        after: usize::MAX,
+        evaluations: 0,
+    };
+    assert!(matches!(
+        fit(&mut q, &[-1.2, 1.0], &opts),
+        Err(FitError::Cancelled { iterations: 0 })
+    ));
+    assert_eq!(q.evaluations, 0);
 }

@@ -108,6 +108,7 @@ impl Rheometer {
             } else {
                 Accuracy::Fixed
             },
+            cancel: options.cancel.clone(),
             ..FitOptions::with_bounds(lower.clone(), upper.clone())
         };
         if let Some(t) = warm.stop_tolerance {

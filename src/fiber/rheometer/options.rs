@@ -91,6 +91,12 @@ pub struct IdentifyOptions {
     /// principled estimator): a noise that varies along the line (the take-up region noisier)
     /// weights the points by it. `None`: all points alike.
     pub noise_factors: Option<std::sync::Arc<Vec<Vec<f64>>>>,
+    /// A cancellation flag (default `None`), handed to the least-squares driver
+    /// ([`FitOptions::cancel`](crate::least_squares::FitOptions::cancel)): once set, a running
+    /// identification stops before its next model evaluation with
+    /// [`FitError::Cancelled`](crate::least_squares::FitError::Cancelled) (the Python bindings
+    /// set it on Ctrl-C).
+    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Default for IdentifyOptions {
@@ -114,6 +120,7 @@ impl Default for IdentifyOptions {
             loose_tolerance: Some(1e-3),
             max_discretisation_shift: Some(0.01),
             noise_factors: None,
+            cancel: None,
         }
     }
 }

@@ -1,0 +1,308 @@
+"""diffbvp from Python: the simulation-based elongational rheometer with numpy in and out.
+
+    >>> import diffbvp
+    >>> ds = diffbvp.load("data/pmma7n_synthetic/experiments.toml")
+    >>> fit = diffbvp.fit(ds)
+    >>> fit
+    FitResult(n=0.804±0.007, kappa=11.63±0.09, rms=1.6 %)
+
+The functions mirror the ``rheometer`` program: :func:`load` (or :meth:`Dataset.from_arrays`),
+:func:`simulate`, :func:`fit`, :func:`compare`, :func:`diagnose`, :func:`landscape`. Results are
+plain data (see :mod:`diffbvp.results`); errors are :mod:`diffbvp.errors` exceptions with the
+command-line program's messages. Long calls release the GIL and stop on Ctrl-C
+(``KeyboardInterrupt``). :mod:`diffbvp.distributed` spreads many fits over a Dask cluster.
+
+Units: SI throughout, with the unit in every key (``diameter_m``, ``temperature_K``, ...);
+``kappa`` = ln(K / 1 Pa); relative quantities are fractions (0.01 = 1 %).
+"""
+
+from __future__ import annotations
+
+import os
+import warnings as _warnings
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _native
+from .errors import DiffbvpError, FitError, InputError, SimulationError
+from .results import Comparison, Diagnosis, FitResult, Landscape, Result, SimulationResult
+
+__all__ = [
+    "Dataset",
+    "load",
+    "simulate",
+    "fit",
+    "compare",
+    "diagnose",
+    "landscape",
+    "DiffbvpError",
+    "InputError",
+    "SimulationError",
+    "FitError",
+    "FitResult",
+    "SimulationResult",
+    "Comparison",
+    "Diagnosis",
+    "Landscape",
+    "Result",
+]
+
+__version__ = _native.library_version()
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class Dataset:
+    """A set of spinning experiments: material, air, per-experiment conditions and measured
+    diameters. Immutable; picklable (the TOML text and the measurement arrays travel, no file
+    is needed on the other side)."""
+
+    __slots__ = ("_native",)
+
+    def __init__(self, native: "_native.Dataset"):
+        self._native = native
+
+    @classmethod
+    def load(cls, path: PathLike) -> "Dataset":
+        """Reads a TOML experiments file and the CSV files (``position_m,diameter_m``) it
+        names. Raises :class:`InputError` naming file, line, table and key."""
+        return cls(_native.Dataset.load(os.fspath(path)))
+
+    @classmethod
+    def from_toml(cls, text: str, path: PathLike = "<text>",
+                  measurements: Optional[Mapping[str, Tuple[Sequence[float], Sequence[float]]]] = None) -> "Dataset":
+        """A data set from TOML text. ``path`` labels it in messages and resolves relative
+        ``data`` files; ``measurements`` (name → (positions [m], diameters [m])) replaces
+        them."""
+        m = {k: (np.asarray(p, dtype=float), np.asarray(d, dtype=float))
+             for k, (p, d) in (measurements or {}).items()}
+        return cls(_native.Dataset.from_toml(text, os.fspath(path), m))
+
+    @classmethod
+    def from_arrays(cls, material: Mapping[str, float], experiments: Sequence[Mapping[str, Any]], *,
+                    defaults: Optional[Mapping[str, float]] = None,
+                    relative_uncertainty: Optional[float] = None,
+                    uncertainty: Optional[Mapping[str, float]] = None) -> "Dataset":
+        """A data set from dicts in the TOML file's layout and numpy arrays.
+
+        ``material``: the ``[material]`` keys (``density_slope_kg_m3_K``, ...,
+        ``air_heat_conductivity_W_m_K``); ``experiments``: one dict per experiment with its
+        keys (``name``, ``mass_flow_kg_s``, ``inlet_diameter_m`` or ``inlet_velocity_m_s``,
+        optional ``spinline_length_m``, ``inlet_temperature_K``, ``air_temperature_K``,
+        ``take_up_diameter_m``, ...) and the measurements as ``positions_m`` and
+        ``diameters_m`` (1-D arrays, metres); ``defaults``: keys shared by all experiments;
+        ``relative_uncertainty``: the diameters' relative measurement uncertainty [-];
+        ``uncertainty``: the ``[uncertainty]`` table of the error budget.
+
+        Every value is checked as in a TOML file; messages name ``<conditions>`` with the
+        line of the generated TOML (:attr:`toml`), or ``<arrays of experiment "NAME">`` with
+        the line of a virtual CSV file (row ``i`` is line ``i + 2``).
+        """
+        exps: List[Dict[str, Any]] = []
+        meas: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
+        for e in experiments:
+            e = dict(e)
+            pos = e.pop("positions_m", None)
+            dia = e.pop("diameters_m", None)
+            if (pos is None) != (dia is None):
+                raise InputError(
+                    f"experiment {e.get('name')!r}: give both positions_m and diameters_m, or neither")
+            if pos is not None:
+                meas[str(e.get("name"))] = (np.asarray(pos, dtype=float), np.asarray(dia, dtype=float))
+            exps.append(e)
+        cond: Dict[str, Any] = {}
+        if relative_uncertainty is not None:
+            cond["relative_uncertainty"] = relative_uncertainty
+        if uncertainty is not None:
+            cond["uncertainty"] = dict(uncertainty)
+        cond["material"] = dict(material)
+        if defaults is not None:
+            cond["defaults"] = dict(defaults)
+        cond["experiment"] = exps
+        return cls(_native.Dataset.from_conditions(cond, meas))
+
+    @classmethod
+    def _from_state(cls, toml: str, path: str, measurements: Dict[str, Tuple[np.ndarray, np.ndarray]]) -> "Dataset":
+        return cls(_native.Dataset.from_toml(toml, path, measurements))
+
+    def __reduce__(self):
+        return (Dataset._from_state, (self.toml, self.path, self.measurements()))
+
+    def with_measurements(self, measurements: Mapping[str, Tuple[Sequence[float], Sequence[float]]]) -> "Dataset":
+        """The same experiments with other measured diameters (name → (positions [m],
+        diameters [m]); experiments not named keep theirs), e.g. a bootstrap replicate."""
+        m = self.measurements()
+        for k, (p, d) in measurements.items():
+            m[k] = (np.asarray(p, dtype=float), np.asarray(d, dtype=float))
+        return Dataset._from_state(self.toml, self.path, m)
+
+    @property
+    def path(self) -> str:
+        """The experiments file (or ``<conditions>``, ``<text>``)."""
+        return self._native.path
+
+    @property
+    def toml(self) -> str:
+        """The TOML text of the data set."""
+        return self._native.toml
+
+    @property
+    def names(self) -> List[str]:
+        """Experiment names, in file order."""
+        return self._native.names
+
+    @property
+    def relative_uncertainty(self) -> Optional[float]:
+        """Declared relative measurement uncertainty of the diameters [-], if any."""
+        return self._native.relative_uncertainty
+
+    def measurements(self) -> Dict[str, Tuple[np.ndarray, np.ndarray]]:
+        """name → (positions [m], diameters [m])."""
+        return self._native.measurements()
+
+    def conditions(self) -> List[Dict[str, Any]]:
+        """Per experiment: its conditions (SI units in the keys), TOML ``line`` and ``data``
+        file."""
+        return self._native.conditions()
+
+    def measurements_table(self) -> Dict[str, np.ndarray]:
+        """All measurements as columns ``experiment``, ``position_m``, ``diameter_m``."""
+        exp: List[str] = []
+        pos: List[np.ndarray] = []
+        dia: List[np.ndarray] = []
+        for k, (p, d) in self.measurements().items():
+            exp.extend([k] * len(p))
+            pos.append(p)
+            dia.append(d)
+        return {"experiment": np.asarray(exp),
+                "position_m": np.concatenate(pos) if pos else np.zeros(0),
+                "diameter_m": np.concatenate(dia) if dia else np.zeros(0)}
+
+    def __len__(self) -> int:
+        return len(self._native)
+
+    def __repr__(self) -> str:
+        return f"Dataset({self.path!r}, {len(self)} experiments)"
+
+
+def load(path: PathLike) -> Dataset:
+    """Reads a TOML experiments file and its CSV files (see :meth:`Dataset.load`)."""
+    return Dataset.load(path)
+
+
+def _ds(dataset: Union[Dataset, PathLike]) -> "_native.Dataset":
+    if isinstance(dataset, Dataset):
+        return dataset._native
+    if isinstance(dataset, (str, os.PathLike)):
+        return Dataset.load(dataset)._native
+    raise TypeError(f"expected a diffbvp.Dataset or a path, got {type(dataset).__name__}")
+
+
+def _effects(effects: Union[None, str, Iterable[str]]) -> List[str]:
+    if effects is None:
+        return []
+    if isinstance(effects, str):
+        return [effects]
+    return [str(e) for e in effects]
+
+
+def simulate(dataset: Union[Dataset, PathLike], n: float = 0.8, kappa: float = 11.71, *,
+             effects: Union[None, str, Iterable[str]] = None,
+             take_up_diameter: Optional[float] = None, take_up_from_data: bool = False,
+             points: int = 101, positions: Optional[Sequence[float]] = None,
+             sensitivities: bool = False, tol: Optional[float] = None,
+             max_nodes: Optional[int] = None) -> SimulationResult:
+    """Simulates every experiment with the Carreau-type law (n [-], kappa = ln(K / 1 Pa)).
+
+    ``effects``: fixed effects, ``"radiation=0.9"``; ``take_up_diameter`` [m] or
+    ``take_up_from_data`` for experiments without a take-up condition; ``points`` uniform
+    positions from 0 to L, or ``positions`` [m]; ``sensitivities``: exact d(profile)/d(n, κ,
+    strengths) from forward sensitivities; ``tol``: BVP tolerance (default 1e-6);
+    ``max_nodes``: mesh limit (default 20000). Raises :class:`SimulationError` naming the
+    experiment and its TOML line.
+    """
+    pos = None if positions is None else [float(x) for x in np.asarray(positions, dtype=float).ravel()]
+    d = _native.simulate(_ds(dataset), float(n), float(kappa), effects=_effects(effects),
+                         take_up_diameter=take_up_diameter, take_up_from_data=take_up_from_data,
+                         points=points, positions=pos, sensitivities=sensitivities, tol=tol,
+                         max_nodes=max_nodes)
+    return SimulationResult(d)
+
+
+def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float]] = None,
+        estimator: str = "principled", model: str = "carreau",
+        effects: Union[None, str, Iterable[str]] = None, loss: str = "linear",
+        f_scale: Optional[float] = None, relative_uncertainty: Optional[float] = None,
+        error_budget: bool = True, max_nodes: Optional[int] = None,
+        profile_points: int = 101) -> FitResult:
+    """Identifies (n, κ) and the strengths of fitted effects, as ``rheometer fit``.
+
+    ``start``: (n, κ) (default: the paper's start heuristic); ``estimator``: ``"principled"``
+    (relative least squares against the raw data, take-up diameters fitted) or ``"paper"``;
+    ``model``: ``"carreau"`` or ``"newtonian"``; ``effects``: ``"radiation"`` (strength
+    fitted), ``"radiation=0.9"`` (fixed), ``"air_coflow=40:decay_length=0.2"`` (shape fixed);
+    ``loss``: ``"linear"``, ``"soft_l1"``, ``"huber"``, ``"cauchy"``; ``f_scale``: soft
+    margin of a robust loss as a relative residual [-]; ``relative_uncertainty``: the
+    diameters' noise [-] (default: the data set's); ``error_budget``: propagate the declared
+    uncertainties of process conditions, instrument and material data; ``profile_points``:
+    positions of the fitted profiles. Warnings of the fit are in ``FitResult.warnings``;
+    a budget that could not be computed is in ``FitResult.notes`` and warned about.
+    """
+    d = _native.fit(_ds(dataset), start=None if start is None else (float(start[0]), float(start[1])),
+                    estimator=estimator, model=model, effects=_effects(effects), loss=loss,
+                    f_scale=f_scale, relative_uncertainty=relative_uncertainty,
+                    error_budget=error_budget, max_nodes=max_nodes, profile_points=profile_points)
+    result = FitResult._from_native(d)
+    for note in result.notes:
+        _warnings.warn(note, RuntimeWarning, stacklevel=2)
+    return result
+
+
+def compare(dataset: Union[Dataset, PathLike], fit: Optional[FitResult] = None, *,
+            n: Optional[float] = None, kappa: Optional[float] = None, newtonian: bool = False,
+            take_up_from_data: bool = False, effects: Union[None, str, Iterable[str]] = None,
+            relative_uncertainty: Optional[float] = None,
+            max_nodes: Optional[int] = None) -> Comparison:
+    """Compares the model with the measurements, as ``rheometer compare``: with a
+    :class:`FitResult` (its parameters, take-up factors and effects) or with ``n``/``kappa``
+    (or ``newtonian=True``). ``effects`` add or override effects (``"radiation=0.9"``);
+    ``relative_uncertainty`` overrides the noise level [-]."""
+    report = None
+    if fit is not None:
+        report = fit.report if isinstance(fit, FitResult) else dict(fit)
+    d = _native.compare(_ds(dataset), report, n=n, kappa=kappa, newtonian=newtonian,
+                        take_up_from_data=take_up_from_data, effects=_effects(effects),
+                        relative_uncertainty=relative_uncertainty, max_nodes=max_nodes)
+    for w in d["warnings"]:
+        _warnings.warn(w, RuntimeWarning, stacklevel=2)
+    return Comparison(d["comparison"], d["text"], d["warnings"])
+
+
+def diagnose(dataset: Union[Dataset, PathLike], *, model: str = "carreau",
+             effects: Union[None, str, Iterable[str]] = None,
+             candidates: Optional[Iterable[str]] = None, refit_top: Optional[int] = None,
+             start: Optional[Tuple[float, float]] = None,
+             max_nodes: Optional[int] = None) -> Diagnosis:
+    """Which physical effect is missing? As ``rheometer diagnose``: fits your model
+    (``model``, ``effects``), scores every candidate effect (default: all built-in ones, or
+    ``candidates`` by name), scans and refits them, ranks them by ΔBIC and names the most
+    likely missing one, ties and outliers. Takes seconds (5 s on the shipped data, 2 cores)."""
+    d = _native.diagnose(_ds(dataset), model=model, effects=_effects(effects),
+                         candidates=None if candidates is None else [str(c) for c in candidates],
+                         refit_top=refit_top, start=start, max_nodes=max_nodes)
+    return Diagnosis._from_native(d)
+
+
+def landscape(dataset: Union[Dataset, PathLike], *, grid: Tuple[int, int] = (41, 41),
+              n_range: Tuple[float, float] = (0.0, 1.0),
+              kappa_range: Tuple[float, float] = (9.0, 16.0), estimator: str = "paper",
+              tol: float = 1e-4, max_nodes: Optional[int] = None) -> Landscape:
+    """The cost J(n, κ) on a grid (paper Fig. 4), as ``rheometer landscape``: ``grid`` =
+    (number of n values, number of κ values); ``tol``: BVP tolerance (a picture; fits use
+    1e-6). Ctrl-C stops it between grid points (``KeyboardInterrupt``)."""
+    d = _native.landscape(_ds(dataset), grid=(int(grid[0]), int(grid[1])),
+                          n_range=(float(n_range[0]), float(n_range[1])),
+                          kappa_range=(float(kappa_range[0]), float(kappa_range[1])),
+                          estimator=estimator, tol=tol, max_nodes=max_nodes)
+    return Landscape(d)

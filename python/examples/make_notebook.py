@@ -1,0 +1,84 @@
+"""Writes rheometer.ipynb (kept as a script so that the notebook's source is reviewable)."""
+import nbformat as nbf
+
+cells = [
+    ("md", """# The rheometer from Python
+
+Load the shipped synthetic PMMA-like data (truth (n, κ) = (0.8, 11.71)), identify the
+Carreau-type elongational viscosity, plot the profiles and the flow curve, then find what is
+missing from the model on a data set with a hidden effect and add it."""),
+    ("code", """from pathlib import Path
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+import diffbvp
+
+# the repository root (this notebook lives in python/examples/)
+root = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "data" / "pmma7n_synthetic").exists())
+out = root / "target" / "notebook"
+out.mkdir(parents=True, exist_ok=True)
+ds = diffbvp.load(root / "data" / "pmma7n_synthetic" / "experiments.toml")
+ds"""),
+    ("code", """fit = diffbvp.fit(ds)
+fit"""),
+    ("code", """print(fit)            # the same report as `rheometer fit`"""),
+    ("code", """pd.DataFrame({k: [v, se] for k, (v, se) in fit.estimates().items()}, index=["estimate", "standard error"])"""),
+    ("md", """## Fitted diameter profiles against the measurements"""),
+    ("code", """meas = ds.measurements()
+fig, axes = plt.subplots(3, 3, figsize=(11, 8), sharex=True)
+for ax, name in zip(axes.flat, ds.names):
+    p = fit.profiles[name]
+    s, d = meas[name]
+    ax.plot(s, 1e6 * d, ".", ms=3, label="measured")
+    ax.plot(p["position_m"], 1e6 * p["diameter_m"], "-", label="fitted")
+    ax.set_yscale("log"); ax.set_title(name, fontsize=9)
+for ax in axes[-1]:
+    ax.set_xlabel("position s [m]")
+for ax in axes[:, 0]:
+    ax.set_ylabel("diameter [µm]")
+axes[0, 0].legend()
+fig.tight_layout(); fig.savefig(out / "profiles.png", dpi=80)"""),
+    ("md", """## Flow curve
+
+The identified law as the experiments see it: elongational viscosity against strain rate along
+every fitted spin line (the temperature falls along the line, hence one branch per
+experiment)."""),
+    ("code", """fc = pd.DataFrame(fit.flow_curve())
+fig, ax = plt.subplots(figsize=(6, 4))
+for name, g in fc.groupby("experiment"):
+    g = g[g.strain_rate_1_s > 1e-2]  # leave out the frozen tail (glass, strain rate → 0)
+    ax.loglog(g.strain_rate_1_s, g.viscosity_Pa_s, lw=1, label=name)
+ax.set_xlabel("strain rate [1/s]"); ax.set_ylabel("elongational viscosity [Pa s]")
+ax.legend(fontsize=6, ncol=2); fig.tight_layout(); fig.savefig(out / "flow_curve.png", dpi=80)"""),
+    ("md", """## Residuals as a table"""),
+    ("code", """res = pd.DataFrame(fit.residuals_table())
+res.groupby("experiment").relative_residual.agg(lambda r: 100 * np.sqrt(np.mean(r**2))).rename("RMS [%]")"""),
+    ("md", """## When the model fails: a data set with a hidden effect
+
+`diagnose` scans every candidate effect, refits the promising ones and ranks them by ΔBIC."""),
+    ("code", """hidden = diffbvp.load(root / "data" / "hidden_radiation" / "experiments.toml")
+diag = diffbvp.diagnose(hidden)
+diag"""),
+    ("code", """pd.DataFrame(diag.candidates_table()).head(8)"""),
+    ("code", """missing = diag.most_likely_missing
+assert missing == "radiation", missing
+refit = diffbvp.fit(hidden, effects=[missing])
+base = diag.base_fit
+print("paper's model:", base)
+print("with", missing + ":", refit)
+assert refit.rms < base.rms"""),
+    ("code", """fig, ax = plt.subplots(figsize=(7, 3.5))
+for label, f in [("paper's model", base), ("with " + missing, refit)]:
+    t = pd.DataFrame(f.residuals_table())
+    ax.plot(t.position_m, 100 * t.relative_residual, ".", ms=2, label=f"{label}: RMS {100 * f.rms:.2f} %")
+ax.set_xlabel("position s [m]"); ax.set_ylabel("relative residual [%]"); ax.legend()
+fig.tight_layout(); fig.savefig(out / "residuals_before_after.png", dpi=80)"""),
+]
+
+nb = nbf.v4.new_notebook()
+nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+nb.cells = [nbf.v4.new_markdown_cell(src) if kind == "md" else nbf.v4.new_code_cell(src) for kind, src in cells]
+from pathlib import Path
+nbf.write(nb, Path(__file__).resolve().parent / "rheometer.ipynb")

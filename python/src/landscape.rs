@@ -1,0 +1,106 @@
+//! `landscape`: the cost `J(n, κ)` on a grid (paper Fig. 4), as `rheometer landscape` without
+//! files; Ctrl-C stops it between grid points.
+
+use crate::convert::{array1, array2};
+use crate::dataset::Dataset;
+use crate::errors::{input_error, to_py_err, BoxError};
+use crate::options;
+use crate::run::interruptible;
+use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;
+use diffbvp::fiber::rheometer::{IdentifyOptions, PointStatus, Rheometer};
+use diffbvp::mesh::linspace;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Largest number of values per direction.
+const MAX_GRID_SIDE: usize = 1000;
+/// Largest number of grid points.
+const MAX_GRID_POINTS: usize = 100_000;
+
+/// Computes `J(n, κ)` on a `grid = (number of n values, number of κ values)` grid. Returns
+/// `{"n", "kappa", "cost": (κ × n) array, "status": (κ × n) array of 0 ok / 1 failed / 2 not
+/// computed, "estimator", "minimum": (n, κ, J) | None}`.
+#[pyfunction]
+#[pyo3(signature = (dataset, *, grid=(41, 41), n_range=(0.0, 1.0), kappa_range=(9.0, 16.0),
+    estimator="paper", tol=1e-4, max_nodes=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn landscape<'py>(
+    py: Python<'py>,
+    dataset: &Dataset,
+    grid: (usize, usize),
+    n_range: (f64, f64),
+    kappa_range: (f64, f64),
+    estimator: &str,
+    tol: f64,
+    max_nodes: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut opts = IdentifyOptions::with_estimator(options::estimator(estimator)?);
+    options::check_range("n_range", "n", n_range, [opts.lower[0], opts.upper[0]])?;
+    options::check_range(
+        "kappa_range",
+        "kappa",
+        kappa_range,
+        [opts.lower[1], opts.upper[1]],
+    )?;
+    let (a, b) = grid;
+    if a < 2 || b < 2 {
+        return Err(input_error(
+            "grid: the grid needs at least 2 points per direction".into(),
+        ));
+    }
+    if a > MAX_GRID_SIDE || b > MAX_GRID_SIDE || a.saturating_mul(b) > MAX_GRID_POINTS {
+        return Err(input_error(format!(
+            "grid = ({a}, {b}) is too large: at most {MAX_GRID_SIDE} values per direction and \
+             {MAX_GRID_POINTS} points (zoom in with n_range and kappa_range instead)"
+        )));
+    }
+    if !(1e-12..=0.1).contains(&tol) {
+        return Err(input_error(format!(
+            "tol: the tolerance must lie in [1e-12, 0.1] (got {tol})"
+        )));
+    }
+    opts.simulate.tol = tol;
+    opts.simulate.max_nodes = match max_nodes {
+        None => LANDSCAPE_MAX_NODES,
+        Some(m) if (options::MIN_MAX_NODES..=LANDSCAPE_MAX_NODES).contains(&m) => m,
+        Some(m) => {
+            return Err(input_error(format!(
+                "max_nodes = {m}: the landscape caps its meshes at {LANDSCAPE_MAX_NODES} nodes; \
+                 give {} to {LANDSCAPE_MAX_NODES}",
+                options::MIN_MAX_NODES
+            )))
+        }
+    };
+    let ns = linspace(n_range.0, n_range.1, a);
+    let ks = linspace(kappa_range.0, kappa_range.1, b);
+    let set = &dataset.inner.loaded.set;
+    // TODO(restructure): call the library's landscape workflow (range checks, mesh cap).
+    let out = interruptible(py, |cancel| -> Result<_, BoxError> {
+        let rh = Rheometer::new(set)?;
+        Ok(rh.landscape_with(&ns, &ks, &opts, |_| {}, &cancel)?)
+    })?;
+    let run = out.map_err(|e| to_py_err(py, e, Some(dataset.data()), None))?;
+    let l = &run.landscape;
+    let status: Vec<f64> = run
+        .status
+        .iter()
+        .map(|s| match s {
+            PointStatus::Computed => 0.0,
+            PointStatus::Failed => 1.0,
+            PointStatus::NotReached => 2.0,
+        })
+        .collect();
+    let d = PyDict::new(py);
+    d.set_item("n", array1(py, &l.n))?;
+    d.set_item("kappa", array1(py, &l.kappa))?;
+    d.set_item("cost", array2(py, &l.cost, l.kappa.len(), l.n.len())?)?;
+    d.set_item(
+        "status",
+        array2(py, &status, l.kappa.len(), l.n.len())?.call_method1("astype", ("int8",))?,
+    )?;
+    d.set_item("estimator", estimator)?;
+    d.set_item("tol", tol)?;
+    d.set_item("minimum", l.minimum())?;
+    d.set_item("cancelled", run.cancelled)?;
+    Ok(d)
+}

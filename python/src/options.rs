@@ -1,0 +1,129 @@
+//! Arguments shared by the bindings, checked as the CLI checks its flags (same ranges, same
+//! words in the messages).
+
+use crate::errors::input_error;
+use diffbvp::fiber::effects::{EffectSetting, LawChoice};
+use diffbvp::fiber::rheometer::{Estimator, IdentifyOptions};
+use diffbvp::least_squares::Loss;
+use pyo3::prelude::*;
+
+/// Smallest `max_nodes` (the cold start begins on a mesh of 21 nodes).
+pub const MIN_MAX_NODES: usize = 50;
+/// Largest `max_nodes`.
+pub const MAX_MAX_NODES: usize = 1_000_000;
+/// Default mesh limit of the solves of `simulate`, `fit`, `diagnose` and `compare`.
+pub const DEFAULT_MAX_NODES: usize = 20_000;
+/// Largest |κ| (K = e^κ Pa stays a finite positive number).
+pub const MAX_ABS_KAPPA: f64 = 700.0;
+
+/// `max_nodes`: `MIN_MAX_NODES..=MAX_MAX_NODES`, default [`DEFAULT_MAX_NODES`].
+pub fn max_nodes(v: Option<usize>) -> PyResult<usize> {
+    match v {
+        None => Ok(DEFAULT_MAX_NODES),
+        Some(v) if (MIN_MAX_NODES..=MAX_MAX_NODES).contains(&v) => Ok(v),
+        Some(v) => Err(input_error(format!(
+            "max_nodes: the mesh limit must lie in {MIN_MAX_NODES}..={MAX_MAX_NODES} nodes \
+             (got {v}; default {DEFAULT_MAX_NODES})"
+        ))),
+    }
+}
+
+/// The estimator by name: `"principled"` or `"paper"`.
+pub fn estimator(name: &str) -> PyResult<Estimator> {
+    match name.trim() {
+        "principled" => Ok(Estimator::Principled),
+        "paper" => Ok(Estimator::Paper),
+        other => Err(input_error(format!(
+            "estimator: \"{other}\" is not an estimator; use \"principled\" (relative least \
+             squares against the raw data) or \"paper\" (the paper's weighted cost)"
+        ))),
+    }
+}
+
+/// The viscosity law by name: `"carreau"` or `"newtonian"`.
+pub fn law(name: &str) -> PyResult<LawChoice> {
+    name.parse::<LawChoice>()
+        .map_err(|e| input_error(format!("model: {e}")))
+}
+
+/// Effects in the CLI's `--with` syntax (`"radiation"`, `"radiation=0.9"`,
+/// `"air_coflow=40:decay_length=0.2"`).
+pub fn effects(items: &[String]) -> PyResult<Vec<EffectSetting>> {
+    items
+        .iter()
+        .map(|s| {
+            s.parse::<EffectSetting>()
+                .map_err(|e| input_error(format!("effects: \"{s}\": {e}")))
+        })
+        .collect()
+}
+
+/// The loss by name (`"linear"`, `"soft_l1"`, `"huber"`, `"cauchy"`).
+pub fn loss(name: &str) -> PyResult<Loss> {
+    Loss::parse(name).map_err(|e| input_error(format!("loss: {e}")))
+}
+
+/// `f_scale`: a relative residual in (0, 1).
+pub fn f_scale(v: Option<f64>) -> PyResult<Option<f64>> {
+    match v {
+        Some(v) if !(v > 0.0 && v < 1.0) => Err(input_error(format!(
+            "f_scale is a relative residual in (0, 1) (got {v}; 0.02 is 2 %)"
+        ))),
+        other => Ok(other),
+    }
+}
+
+/// `n`: the Carreau-type law's domain (finite, >= 0).
+pub fn check_n(v: f64) -> PyResult<f64> {
+    if !(v >= 0.0 && v.is_finite()) {
+        return Err(input_error(format!(
+            "the power index n must be >= 0 (the Carreau-type law's domain; 1 is Newtonian), \
+             got {v}"
+        )));
+    }
+    Ok(v)
+}
+
+/// `kappa`: finite with |κ| <= [`MAX_ABS_KAPPA`].
+pub fn check_kappa(v: f64) -> PyResult<f64> {
+    if v.is_nan() || v.abs() > MAX_ABS_KAPPA {
+        return Err(input_error(format!(
+            "kappa = ln(K / 1 Pa) must lie in [-{MAX_ABS_KAPPA}, {MAX_ABS_KAPPA}] (K = e^kappa \
+             overflows beyond; the fit searches [7, 20]), got {v}"
+        )));
+    }
+    Ok(v)
+}
+
+/// `start = (n, κ)` within the fit's bounds.
+pub fn check_start((n, kappa): (f64, f64), opts: &IdentifyOptions) -> PyResult<()> {
+    let inside = |v: f64, i: usize| v >= opts.lower[i] && v <= opts.upper[i];
+    if !inside(n, 0) || !inside(kappa, 1) {
+        return Err(input_error(format!(
+            "start = ({n}, {kappa}): the start must lie within the fit's bounds n in [{}, {}] \
+             and kappa in [{}, {}]",
+            opts.lower[0], opts.upper[0], opts.lower[1], opts.upper[1]
+        )));
+    }
+    Ok(())
+}
+
+/// `(lo, hi)` increasing and within `[min, max]` (the fit's bounds of `name`).
+pub fn check_range(
+    arg: &str,
+    name: &str,
+    (lo, hi): (f64, f64),
+    [min, max]: [f64; 2],
+) -> PyResult<()> {
+    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
+        return Err(input_error(format!(
+            "{arg} = ({lo}, {hi}): give (MIN, MAX) with MIN < MAX"
+        )));
+    }
+    if lo < min || hi > max {
+        return Err(input_error(format!(
+            "{arg} = ({lo}, {hi}): {name} must lie within the fit's bounds [{min}, {max}]"
+        )));
+    }
+    Ok(())
+}

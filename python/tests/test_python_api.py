@@ -1,0 +1,82 @@
+"""Arrays in, arrays out; pickling; sensitivities against finite differences."""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+import pytest
+
+import diffbvp
+from conftest import PMMA, assert_same
+from test_errors import _material
+
+
+def _from_arrays(ds: diffbvp.Dataset) -> diffbvp.Dataset:
+    meas = ds.measurements()
+    exps = []
+    for c in ds.conditions():
+        e = {k: v for k, v in c.items() if k not in ("line", "data")}
+        e["positions_m"], e["diameters_m"] = meas[c["name"]]
+        exps.append(e)
+    return diffbvp.Dataset.from_arrays(_material(), exps)
+
+
+def test_dataset_from_arrays_fits_as_the_file(pmma, pmma_fit):
+    ds = _from_arrays(pmma)
+    assert ds.names == pmma.names and ds.path == "<conditions>"
+    for k, (p, d) in pmma.measurements().items():
+        p2, d2 = ds.measurements()[k]
+        assert np.array_equal(p, p2) and np.array_equal(d, d2)
+    assert_same(pmma_fit.report, diffbvp.fit(ds).report)
+
+
+def test_pickle_round_trips(pmma, pmma_fit, radiation_diagnosis):
+    for obj in (pmma_fit, radiation_diagnosis, diffbvp.simulate(pmma, 0.8, 11.7, points=5, take_up_from_data=True)):
+        back = pickle.loads(pickle.dumps(obj))
+        assert type(back) is type(obj) and back == obj and repr(back) == repr(obj)
+    ds = pickle.loads(pickle.dumps(pmma))
+    assert ds.toml == pmma.toml and ds.names == pmma.names
+    for k, (p, d) in pmma.measurements().items():
+        assert np.array_equal(ds.measurements()[k][1], d)
+    assert pickle.loads(pickle.dumps(radiation_diagnosis)).best_fit == radiation_diagnosis.best_fit
+
+
+def test_repr_and_to_dict(pmma_fit, radiation_diagnosis):
+    r = repr(pmma_fit)
+    assert r.startswith("FitResult(n=0.804±0.007, kappa=11.63±0.09, rms=1.7 %")
+    d = pmma_fit.to_dict()
+    assert d["n"] == pmma_fit.n and isinstance(d["covariance"], list)
+    import json
+    json.dumps(d)  # plain data
+    assert "radiation" in repr(radiation_diagnosis)
+    pd = pytest.importorskip("pandas")
+    df = pd.DataFrame(pmma_fit.residuals_table())
+    assert len(df) == pmma_fit.report["residuals"]
+
+
+def test_sensitivities_match_finite_differences(pmma):
+    n, k = 0.8, 11.7
+    pos = np.linspace(0.0, 0.51, 7)
+    sim = diffbvp.simulate(pmma, n, k, take_up_from_data=True, positions=pos, sensitivities=True)
+    name = pmma.names[4]
+    s = sim.sensitivities[name]
+    assert s["parameters"] == ["n", "kappa"]
+    assert np.allclose(sim.profiles[name]["position_m"], pos)
+    for j, (dn, dk) in enumerate([(1e-6, 0.0), (0.0, 1e-6)]):
+        hi = diffbvp.simulate(pmma, n + dn, k + dk, take_up_from_data=True, positions=pos, tol=1e-10)
+        lo = diffbvp.simulate(pmma, n - dn, k - dk, take_up_from_data=True, positions=pos, tol=1e-10)
+        h = 2 * (dn + dk)
+        for key in ("diameter_m", "temperature_K", "velocity_m_s"):
+            fd = (hi.profiles[name][key] - lo.profiles[name][key]) / h
+            ex = s[key][:, j]
+            scale = np.max(np.abs(ex)) + 1e-300
+            assert np.max(np.abs(fd - ex)) / scale < 1e-4, (key, j, fd, ex)
+
+
+def test_take_up_rules(pmma):
+    with pytest.raises(diffbvp.InputError, match="no take-up condition"):
+        diffbvp.simulate(pmma, 0.8, 11.7)
+    sim = diffbvp.simulate(pmma, 0.8, 11.7, take_up_diameter=1e-4, points=3)
+    for e in sim:
+        assert e["profiles"]["diameter_m"][-1] == pytest.approx(1e-4, rel=1e-6)
