@@ -11,3 +11,4 @@ mod diagnose_hidden_effects;
 mod diagnose_realistic;
 mod diagnose_scan;
 mod diagnose_separability;
+mod global;

@@ -101,8 +101,8 @@ fn accuracy_matched_to_the_noise_moves_no_estimate_by_a_hundredth_of_a_standard_
         let reference = rh.identify([0.7, 11.51], &tight).unwrap();
         let se = reference.fit.standard_errors().unwrap();
         let mut worst: f64 = 0.0;
-        for i in 0..reference.names.len() {
-            let d = (matched.fit.p[i] - reference.fit.p[i]).abs() / se[i];
+        for (i, se_i) in se.iter().enumerate().take(reference.names.len()) {
+            let d = (matched.fit.p[i] - reference.fit.p[i]).abs() / se_i;
             worst = worst.max(d);
             assert!(
                 d <= 0.01,

@@ -32,6 +32,8 @@ pub enum StrengthStatus {
     /// The strength is credible but the refit's material law is not (`n` near 0, an interval
     /// beyond the law's range, a jump from the plain fit the gain does not pay for).
     ImplausibleLaw,
+    /// The refit does not determine the strength (no standard error: a singular covariance).
+    Undetermined,
 }
 
 impl StrengthStatus {
@@ -43,6 +45,7 @@ impl StrengthStatus {
             StrengthStatus::AtBound => "at_bound",
             StrengthStatus::Unphysical => "unphysical",
             StrengthStatus::ImplausibleLaw => "implausible_law",
+            StrengthStatus::Undetermined => "undetermined",
         }
     }
 }

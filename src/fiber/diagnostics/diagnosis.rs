@@ -7,7 +7,7 @@ use super::diagnose::calibrate::Calibration;
 use super::diagnose::verdict::Verdict;
 use super::ties::Alternative;
 use crate::fiber::effects::LawChoice;
-use crate::fiber::rheometer::{FitSummary, Identification};
+use crate::fiber::rheometer::{FitSummary, Identification, IdentifyOptions};
 use serde::{Deserialize, Serialize};
 
 /// Relative residuals along the spin line, per experiment: `(name, [(s in m, residual)])`.
@@ -134,6 +134,9 @@ pub struct DiagnosisRun {
     pub residuals_after: Option<ResidualProfiles>,
     /// The user's fit.
     pub base: Identification,
-    /// The refit with the named candidate.
+    /// The fit with all found effects (fitted jointly; the final fit).
     pub best: Option<Identification>,
+    /// The fit settings the diagnosis used (principled estimator, the noise weights of its
+    /// last step): a fit that continues from the diagnosis uses them.
+    pub fit_options: IdentifyOptions,
 }

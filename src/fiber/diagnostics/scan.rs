@@ -58,6 +58,9 @@ pub struct ScanOptions {
     /// each side is halved (geometrically for magnitudes of one sign), so that a basin between
     /// two coarse grid points is found and the refinement starts inside it.
     pub bracket_rounds: usize,
+    /// Bracketing runs only where the walk's lowest `J` lies this fraction below the user's
+    /// `J` (default 0.02): elsewhere there is no basin to localise.
+    pub bracket_below: f64,
 }
 
 impl Default for ScanOptions {
@@ -72,6 +75,7 @@ impl Default for ScanOptions {
             grid_tol: 1e-4,
             refine_within: 0.05,
             bracket_rounds: 2,
+            bracket_below: 0.02,
         }
     }
 }
@@ -482,7 +486,14 @@ pub fn scan_profile(
     }
     pts.push(base_point);
     pts.extend(above);
-    for _ in 0..scan.bracket_rounds {
+    // bracketing where the walk found the effect lowering J at all (a basin to localise)
+    let lowest = pts.iter().map(|p| p.cost).fold(f64::INFINITY, f64::min);
+    let rounds = if lowest < (1.0 - scan.bracket_below) * cost_base {
+        scan.bracket_rounds
+    } else {
+        0
+    };
+    for _ in 0..rounds {
         let added = bracket_minimum(&mut pts, grid.neutral, |v, near| {
             vrh.spec.effects[slot].value = Some(v);
             let start = FitStart {

@@ -224,8 +224,9 @@ fn check_covariance(
     }
 }
 
-/// An implausible material law: `n` below [`PLAUSIBLE_N`], or a 95 % interval of `n` reaching
-/// beyond `[0, 1]` (the law's own range: the data do not determine it).
+/// An implausible material law (`n` below [`PLAUSIBLE_N`]: not a result), or a 95 % interval
+/// of `n` reaching beyond `[0, 1]` (the law's own range: the linearised interval is not
+/// reliable there; a large-uncertainty warning).
 pub(crate) fn check_law(s: &FitSummary, w: &mut Vec<FitWarning>) {
     let n = &s.n;
     if !n.fitted || s.bound_of("n").is_some() {
@@ -245,7 +246,7 @@ pub(crate) fn check_law(s: &FitSummary, w: &mut Vec<FitWarning>) {
         ));
     } else if n.has_interval() && (n.ci95[0] < 0.0 || n.ci95[1] > 1.0) {
         w.push(FitWarning::new(
-            WarningCode::Implausible,
+            WarningCode::LargeUncertainty,
             format!(
                 "the 95% interval of n, [{}, {}], reaches beyond the law's range [0, 1]: the \
                  data do not determine n well enough for a linearised interval",

@@ -17,8 +17,11 @@ pub const OUTLIER_FACTOR: f64 = 1000.0;
 pub(crate) struct Context<'a> {
     /// The diagnosis' options.
     pub options: &'a DiagnoseOptions,
-    /// Fit settings (principled estimator, factorisation kept at the solution).
+    /// Fit settings (principled estimator, factorisation kept at the solution, no
+    /// discretisation check).
     pub opts: IdentifyOptions,
+    /// The discretisation check of the user's fit ([`IdentifyOptions::max_discretisation_shift`]).
+    pub check: Option<f64>,
     /// The user's model with the candidates carried at neutral strength.
     pub spec: ModelSpec,
     /// The data and models.
@@ -45,6 +48,9 @@ impl<'a> Context<'a> {
         let mut opts = options.identify.clone();
         opts.estimator = Estimator::Principled;
         opts.simulate.factor_at_solution = true;
+        // the diagnosis' many fits run at the matched tolerance without each checking it; the
+        // user's fit is checked (fit_base)
+        let check = opts.max_discretisation_shift.take();
         let spec = base_spec.clone().with_candidates(&options.candidates);
         let rh = Rheometer::with_spec(set, spec.clone())?;
         let sigma = opts
@@ -66,6 +72,7 @@ impl<'a> Context<'a> {
             .fold(f64::INFINITY, f64::min);
         Ok(Context {
             options,
+            check,
             opts,
             cands: spec.candidates.clone(),
             spec,
@@ -84,8 +91,12 @@ impl<'a> Context<'a> {
         &self,
         warm: Option<&Identification>,
     ) -> Result<Identification, RheometerError> {
+        let checked = IdentifyOptions {
+            max_discretisation_shift: self.check,
+            ..self.opts.clone()
+        };
         let Some(w) = warm else {
-            return self.rh.identify(self.law0, &self.opts);
+            return self.rh.identify(self.law0, &checked);
         };
         let start = FitStart {
             strengths: w.fitted_strengths(),
@@ -96,7 +107,7 @@ impl<'a> Context<'a> {
             take_up: w.take_up_factors().to_vec(),
             stop_tolerance: None,
         };
-        self.rh.identify_warm(&start, &self.opts, &fit)
+        self.rh.identify_warm(&start, &checked, &fit)
     }
 
     /// Stage 1 (cont.): the user's fit again with each point weighted by its local noise level

@@ -49,7 +49,7 @@ pub(crate) fn judge(
         signature_location(&lin.positions, &change);
     record.shape_alternative = other.and_then(|(_, o)| {
         let gap = lin.ic(o.cost, record.extra_parameters).0 - record.delta_bic;
-        credible_shape(&record.effect, &o.identification.summary).then(|| ShapeAlternative {
+        credible_shape(&record.effect, &o.identification.summary).then_some(ShapeAlternative {
             delta_bic_gap: gap,
             refit: o.identification.summary,
         })
@@ -70,6 +70,15 @@ fn credibility(
     let (status, note) = strength_status(variant, strength, stderr, &summary.at_bound);
     if status != StrengthStatus::Physical {
         return (status, note);
+    }
+    if !(stderr.is_finite() && stderr > 0.0) {
+        return (
+            StrengthStatus::Undetermined,
+            Some(format!(
+                "the refit does not determine {effect} (no standard error: its covariance is \
+                 singular)"
+            )),
+        );
     }
     let prefix = format!("{effect}.");
     match summary

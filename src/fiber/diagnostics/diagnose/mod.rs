@@ -44,7 +44,7 @@
 //!    search runs again over the remaining candidates, at most
 //!    [`DiagnoseOptions::max_effects`] effects in all.
 //! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, or none of the
-//!    candidates (which help and how much, where the unexplained residual lies).
+//!     candidates (which help and how much, where the unexplained residual lies).
 
 mod base;
 pub mod calibrate;
@@ -144,10 +144,9 @@ pub fn diagnose(
         if verdict::explained(&refit.summary, &steps[0].base.summary.noise) {
             break;
         }
-        let spec = last
-            .spec
-            .clone()
-            .with(EffectSetting::fitted(variant.clone()));
+        let mut spec = last.spec.clone();
+        spec.candidates.clear();
+        let spec = spec.with(EffectSetting::fitted(variant.clone()));
         let mut opts = options.clone();
         opts.candidates
             .retain(|c| !spec.effects.iter().any(|e| e.effect.name() == c.name()));
@@ -174,6 +173,7 @@ fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
         .iter()
         .rev()
         .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id.clone()));
+    let fit_options = steps.last().map(|s| s.opts.clone()).unwrap_or_default();
     let first = steps.remove(0);
     let verdict = verdict_of(&first, &found, final_id.as_ref(), &noise);
     let further: Vec<ForwardStep> = steps
@@ -191,7 +191,7 @@ fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
         })
         .collect();
     let residuals_before = signature::named_residuals(&first.base);
-    let residuals_after = final_id.as_ref().map(|id| signature::named_residuals(id));
+    let residuals_after = final_id.as_ref().map(signature::named_residuals);
     DiagnosisRun {
         diagnosis: Diagnosis {
             model: first.spec.law,
@@ -215,6 +215,7 @@ fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
         residuals_after,
         base: first.base,
         best: final_id,
+        fit_options,
     }
 }
 

@@ -170,8 +170,13 @@ pub(crate) fn refine_all(
         .iter()
         .flat_map(|&i| [(i, false), (i, true)])
         .flat_map(|(i, kind)| {
-            let starts = refine_starts(ctx, lin, scans, i, kind, records[i].extra_parameters);
-            let first = starts.first().copied();
+            let extra = records[i].extra_parameters;
+            let starts = refine_starts(ctx, lin, scans, i, kind, extra);
+            // other material laws for the refit of a grid point that already earns its place
+            // there (its refit can only be better): the candidates that may be named
+            let first = starts.first().copied().filter(|&(j, k)| {
+                lin.ic(scans.ok[j].1.starts[k].cost, extra).0 < ctx.options.earn_threshold
+            });
             let mut jobs: Vec<Job> = starts.into_iter().map(|(j, k)| (i, j, k, None)).collect();
             if let Some((j, k)) = first {
                 let own = scans.ok[j].1.starts[k].law;

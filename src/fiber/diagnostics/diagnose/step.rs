@@ -16,7 +16,9 @@ use crate::fiber::diagnostics::detection::{detection_limits, DetectionContext, D
 use crate::fiber::diagnostics::scores::cosine;
 use crate::fiber::diagnostics::ties::{alternatives, Alternative};
 use crate::fiber::effects::{Category, Effect, ModelSpec};
-use crate::fiber::rheometer::{Estimate, Identification, ParameterShift, RheometerError};
+use crate::fiber::rheometer::{
+    Estimate, Identification, IdentifyOptions, ParameterShift, RheometerError,
+};
 use crate::fiber::setup::ExperimentSet;
 
 /// Largest false-alarm probability of the search at which an effect may be named.
@@ -44,6 +46,8 @@ pub(crate) struct Step {
     pub calibration: Calibration,
     /// Whether the noise test finds the residuals systematic.
     pub systematic: bool,
+    /// The fit settings of this step (the noise weights included).
+    pub opts: IdentifyOptions,
 }
 
 impl Step {
@@ -118,6 +122,7 @@ pub(crate) fn run(
         detection,
         calibration,
         systematic,
+        opts: ctx.opts.clone(),
     })
 }
 
@@ -128,7 +133,7 @@ pub(crate) fn run(
 /// the share is noise over noise).
 fn names(c: &Candidate, options: &DiagnoseOptions, excess: bool) -> bool {
     earns_its_place(c, options.earn_threshold)
-        && !(c.false_alarm > options.max_false_alarm)
+        && c.false_alarm.partial_cmp(&options.max_false_alarm) != Some(std::cmp::Ordering::Greater)
         && (!excess || c.share_of_excess >= MIN_SHARE_OF_EXCESS)
 }
 
