@@ -32,6 +32,6 @@ for _ in range(0, runs, block):
     out = subprocess.run([str(exe), str(block + 1), str(data)], cwd=root, capture_output=True, text=True, check=True)
     rs_times += [float(l.split(":")[1].split()[0]) for l in out.stdout.splitlines() if l.startswith("run")][1:]
 mp, mr = statistics.median(py_times), statistics.median(rs_times)
-print(f"python: median {mp:.4f} s over {len(py_times)} fits (n={f.n:.6f}, kappa={f.kappa:.6f})")
+print(f"python: median {mp:.4f} s over {len(py_times)} fits (n={f.n.value:.6f}, kappa={f.kappa.value:.6f})")
 print(f"rust:   median {mr:.4f} s over {len(rs_times)} fits")
 print(f"python / rust = {mp / mr:.3f}")

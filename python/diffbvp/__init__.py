@@ -4,13 +4,17 @@
     >>> ds = diffbvp.load("data/pmma7n_synthetic/experiments.toml")
     >>> fit = diffbvp.fit(ds)
     >>> fit
-    FitResult(n=0.804±0.007, kappa=11.63±0.09, rms=1.6 %)
+    FitResult(n=0.804±0.007, kappa=11.63±0.09, rms=1.7 %, noise=1.5 %)
+    >>> fit.n.value, fit.n.stderr, fit.n.ci95
 
-The functions mirror the ``rheometer`` program: :func:`load` (or :meth:`Dataset.from_arrays`),
-:func:`simulate`, :func:`fit`, :func:`compare`, :func:`diagnose`, :func:`landscape`. Results are
-plain data (see :mod:`diffbvp.results`); errors are :mod:`diffbvp.errors` exceptions with the
-command-line program's messages. Long calls release the GIL and stop on Ctrl-C
-(``KeyboardInterrupt``). :mod:`diffbvp.distributed` spreads many fits over a Dask cluster.
+The functions are the library's workflows, as the ``rheometer`` program runs them: :func:`load`
+(or :meth:`Dataset.from_arrays`), :func:`simulate`, :func:`fit`, :func:`compare`,
+:func:`diagnose`, :func:`landscape`. Results are the library's values as plain data (see
+:mod:`diffbvp.results`): a fit is its ``FitSummary``, a diagnosis its ``Diagnosis``, exactly the
+JSON the program writes. Errors are :mod:`diffbvp.errors` exceptions with the program's
+messages. Long calls release the GIL and stop on Ctrl-C (``KeyboardInterrupt``);
+:func:`set_threads` chooses how many cores a call uses. :mod:`diffbvp.distributed` spreads many
+fits over a Dask cluster.
 
 Units: SI throughout, with the unit in every key (``diameter_m``, ``temperature_K``, ...);
 ``kappa`` = ln(K / 1 Pa); relative quantities are fractions (0.01 = 1 %).
@@ -26,7 +30,8 @@ import numpy as np
 
 from . import _native
 from .errors import DiffbvpError, FitError, InputError, SimulationError
-from .results import Comparison, Diagnosis, FitResult, Landscape, Result, SimulationResult
+from .results import (Candidate, Comparison, Diagnosis, Estimate, FitResult, Landscape, Result,
+                      SimulationResult)
 
 __all__ = [
     "Dataset",
@@ -40,7 +45,11 @@ __all__ = [
     "InputError",
     "SimulationError",
     "FitError",
+    "set_threads",
+    "threads",
     "FitResult",
+    "Estimate",
+    "Candidate",
     "SimulationResult",
     "Comparison",
     "Diagnosis",
@@ -186,6 +195,20 @@ class Dataset:
         return f"Dataset({self.path!r}, {len(self)} experiments)"
 
 
+def set_threads(n: Optional[int] = None) -> None:
+    """Sets how many threads (cores) every later call of this process uses: a fit solves its
+    experiments in parallel, a landscape its rows, a diagnosis its candidates. ``None``: the
+    default (``RAYON_NUM_THREADS``, else one per core). Several processes on one machine (Dask
+    workers) should share the cores: ``cores // processes`` each (see
+    :mod:`diffbvp.distributed`)."""
+    _native.set_threads(None if n is None else int(n))
+
+
+def threads() -> int:
+    """The number of threads a call of this process uses now (see :func:`set_threads`)."""
+    return _native.threads()
+
+
 def load(path: PathLike) -> Dataset:
     """Reads a TOML experiments file and its CSV files (see :meth:`Dataset.load`)."""
     return Dataset.load(path)
@@ -234,9 +257,10 @@ def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float
         estimator: str = "principled", model: str = "carreau",
         effects: Union[None, str, Iterable[str]] = None, loss: str = "linear",
         f_scale: Optional[float] = None, relative_uncertainty: Optional[float] = None,
-        error_budget: bool = True, max_nodes: Optional[int] = None,
+        error_budget: bool = True, tol: Optional[float] = None, max_nodes: Optional[int] = None,
         profile_points: int = 101) -> FitResult:
-    """Identifies (n, κ) and the strengths of fitted effects, as ``rheometer fit``.
+    """Identifies (n, κ) and the strengths of fitted effects: the library's fit workflow, as
+    ``rheometer fit``. Returns the fit's ``FitSummary`` (:class:`FitResult`).
 
     ``start``: (n, κ) (default: the paper's start heuristic); ``estimator``: ``"principled"``
     (relative least squares against the raw data, take-up diameters fitted) or ``"paper"``;
@@ -245,14 +269,18 @@ def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float
     ``loss``: ``"linear"``, ``"soft_l1"``, ``"huber"``, ``"cauchy"``; ``f_scale``: soft
     margin of a robust loss as a relative residual [-]; ``relative_uncertainty``: the
     diameters' noise [-] (default: the data set's); ``error_budget``: propagate the declared
-    uncertainties of process conditions, instrument and material data; ``profile_points``:
-    positions of the fitted profiles. Warnings of the fit are in ``FitResult.warnings``;
-    a budget that could not be computed is in ``FitResult.notes`` and warned about.
+    uncertainties of process conditions, instrument and material data (about half the fit's
+    time; a bootstrap replicate can do without); ``tol``: BVP tolerance [-] kept as given
+    (default: 1e-4, refined until the discretisation moves no estimate by more than 0.01
+    standard errors); ``max_nodes``: mesh limit (default 20000); ``profile_points``:
+    positions of the fitted profiles. Warnings of the fit are in ``FitResult.warnings``; a
+    budget that could not be computed is in ``FitResult.notes`` and warned about.
     """
     d = _native.fit(_ds(dataset), start=None if start is None else (float(start[0]), float(start[1])),
                     estimator=estimator, model=model, effects=_effects(effects), loss=loss,
                     f_scale=f_scale, relative_uncertainty=relative_uncertainty,
-                    error_budget=error_budget, max_nodes=max_nodes, profile_points=profile_points)
+                    error_budget=error_budget, tol=tol, max_nodes=max_nodes,
+                    profile_points=profile_points)
     result = FitResult._from_native(d)
     for note in result.notes:
         _warnings.warn(note, RuntimeWarning, stacklevel=2)
@@ -262,35 +290,45 @@ def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float
 def compare(dataset: Union[Dataset, PathLike], fit: Optional[FitResult] = None, *,
             n: Optional[float] = None, kappa: Optional[float] = None, newtonian: bool = False,
             take_up_from_data: bool = False, effects: Union[None, str, Iterable[str]] = None,
-            relative_uncertainty: Optional[float] = None,
+            relative_uncertainty: Optional[float] = None, tol: Optional[float] = None,
             max_nodes: Optional[int] = None) -> Comparison:
-    """Compares the model with the measurements, as ``rheometer compare``: with a
-    :class:`FitResult` (its parameters, take-up factors and effects) or with ``n``/``kappa``
-    (or ``newtonian=True``). ``effects`` add or override effects (``"radiation=0.9"``);
-    ``relative_uncertainty`` overrides the noise level [-]."""
-    report = None
+    """Compares the model with the measurements: the library's compare workflow, as
+    ``rheometer compare``. The model is a fit's (a :class:`FitResult`, or the dict of a
+    ``FitSummary`` such as the JSON of ``rheometer fit --json``: its law, effects, take-up
+    factors and, compared as it is, its noise level) or given by ``n``/``kappa`` (or
+    ``newtonian=True``). ``effects`` add or override effects (``"radiation=0.9"``);
+    ``relative_uncertainty`` overrides the noise level [-]; ``tol``: BVP tolerance (default
+    1e-6). A fit that carries warnings is compared with a ``RuntimeWarning`` for each."""
+    summary = None
+    notes: List[str] = []
     if fit is not None:
-        report = fit.report if isinstance(fit, FitResult) else dict(fit)
-    d = _native.compare(_ds(dataset), report, n=n, kappa=kappa, newtonian=newtonian,
+        summary = fit.summary if isinstance(fit, FitResult) else dict(fit)
+        for w in summary.get("warnings", []):
+            notes.append(f"the fit carries a warning: [{w.get('code')}] {w.get('message')}")
+    d = _native.compare(_ds(dataset), summary, n=n, kappa=kappa, newtonian=newtonian,
                         take_up_from_data=take_up_from_data, effects=_effects(effects),
-                        relative_uncertainty=relative_uncertainty, max_nodes=max_nodes)
-    for w in d["warnings"]:
+                        relative_uncertainty=relative_uncertainty, tol=tol, max_nodes=max_nodes)
+    for w in notes:
         _warnings.warn(w, RuntimeWarning, stacklevel=2)
-    return Comparison(d["comparison"], d["text"], d["warnings"])
+    return Comparison(d["comparison"], d["text"], notes)
 
 
 def diagnose(dataset: Union[Dataset, PathLike], *, model: str = "carreau",
              effects: Union[None, str, Iterable[str]] = None,
              candidates: Optional[Iterable[str]] = None, refit_top: Optional[int] = None,
-             start: Optional[Tuple[float, float]] = None,
+             start: Optional[Tuple[float, float]] = None, tol: Optional[float] = None,
              max_nodes: Optional[int] = None) -> Diagnosis:
-    """Which physical effect is missing? As ``rheometer diagnose``: fits your model
-    (``model``, ``effects``), scores every candidate effect (default: all built-in ones, or
-    ``candidates`` by name), scans and refits them, ranks them by ΔBIC and names the most
-    likely missing one, ties and outliers. Takes seconds (5 s on the shipped data, 2 cores)."""
+    """Which physical effects are missing? The library's diagnose workflow, as ``rheometer
+    diagnose``: fits your model (``model``, ``effects``), scores every candidate effect
+    (default: all built-in ones, or ``candidates`` by name), searches and refits them, ranks
+    them by ΔBIC with a look-elsewhere calibration (false-alarm probability), adds the found
+    effect and searches again, and gives a verdict (explained, adequate, none of the
+    candidates). ``refit_top``: how many candidates get the search and refits; ``start``:
+    (n, κ) of your fit; ``tol``: BVP tolerance (default 1e-4). Takes tens of seconds on the
+    shipped data (2 cores)."""
     d = _native.diagnose(_ds(dataset), model=model, effects=_effects(effects),
                          candidates=None if candidates is None else [str(c) for c in candidates],
-                         refit_top=refit_top, start=start, max_nodes=max_nodes)
+                         refit_top=refit_top, start=start, tol=tol, max_nodes=max_nodes)
     return Diagnosis._from_native(d)
 
 

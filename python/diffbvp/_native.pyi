@@ -29,8 +29,10 @@ class Dataset:
 def fit(dataset: Dataset, *, start: Optional[Tuple[float, float]] = None, estimator: str = "principled",
         model: str = "carreau", effects: Sequence[str] = ..., loss: str = "linear",
         f_scale: Optional[float] = None, relative_uncertainty: Optional[float] = None,
-        error_budget: bool = True, max_nodes: Optional[int] = None,
-        profile_points: int = 101) -> Dict[str, Any]: ...
+        error_budget: bool = True, tol: Optional[float] = None, max_nodes: Optional[int] = None,
+        profile_points: int = 101) -> Dict[str, Any]:
+    """{"summary": FitSummary dict, "text": str, "arrays": {"residual_profiles", "profiles"},
+    "notes": [str]}"""
 def simulate(dataset: Dataset, n: float = 0.8, kappa: float = 11.71, *, effects: Sequence[str] = ...,
              take_up_diameter: Optional[float] = None, take_up_from_data: bool = False,
              points: int = 101, positions: Optional[Sequence[float]] = None,
@@ -39,13 +41,18 @@ def simulate(dataset: Dataset, n: float = 0.8, kappa: float = 11.71, *, effects:
 def compare(dataset: Dataset, fit: Optional[Mapping[str, Any]] = None, *, n: Optional[float] = None,
             kappa: Optional[float] = None, newtonian: bool = False, take_up_from_data: bool = False,
             effects: Sequence[str] = ..., relative_uncertainty: Optional[float] = None,
-            max_nodes: Optional[int] = None) -> Dict[str, Any]: ...
+            tol: Optional[float] = None, max_nodes: Optional[int] = None) -> Dict[str, Any]:
+    """{"comparison": Comparison dict, "text": str}"""
 def diagnose(dataset: Dataset, *, model: str = "carreau", effects: Sequence[str] = ...,
              candidates: Optional[Sequence[str]] = None, refit_top: Optional[int] = None,
-             start: Optional[Tuple[float, float]] = None,
-             max_nodes: Optional[int] = None) -> Dict[str, Any]: ...
+             start: Optional[Tuple[float, float]] = None, tol: Optional[float] = None,
+             max_nodes: Optional[int] = None) -> Dict[str, Any]:
+    """{"diagnosis": Diagnosis dict, "text": str, "base_arrays": {"residual_profiles"},
+    "final_arrays": {"residual_profiles"} | None}"""
 def landscape(dataset: Dataset, *, grid: Tuple[int, int] = (41, 41),
               n_range: Tuple[float, float] = (0.0, 1.0), kappa_range: Tuple[float, float] = (9.0, 16.0),
               estimator: str = "paper", tol: float = 1e-4,
               max_nodes: Optional[int] = None) -> Dict[str, Any]: ...
 def library_version() -> str: ...
+def set_threads(n: Optional[int] = None) -> None: ...
+def threads() -> int: ...

@@ -16,7 +16,9 @@ import numpy as np
 
 __all__ = [
     "Result",
+    "Estimate",
     "FitResult",
+    "Candidate",
     "SimulationResult",
     "Comparison",
     "Diagnosis",
@@ -138,28 +140,110 @@ _PROFILE_KEYS = [
 ]
 
 
-class FitResult(Result):
-    """The outcome of :func:`diffbvp.fit`.
+class Estimate:
+    """A named parameter of a fit with its uncertainty: the library's ``Estimate``.
 
-    ``report`` is the dict ``rheometer fit --json`` writes (estimates, standard errors, 95 %
-    intervals, correlation, warnings, error budget, take-up factors, per-experiment RMS); its
-    keys also read as attributes (``fit.n``, ``fit.kappa``, ``fit.K_Pa`` [Pa],
-    ``fit.rms_relative_residual`` [-], ...). Arrays: ``parameter_names``, ``parameters`` and
-    ``covariance`` of the fit vector (n, κ, fitted strengths, take-up factors),
-    ``residual_profiles`` (name → ``position_m`` [m], ``relative_residual`` [-]) and ``profiles`` (name → fitted
-    profiles on uniform positions, SI units in the keys).
+    ``value`` in ``unit`` (``"-"`` dimensionless, ``"Pa"``, ``"m/s"``, ``"K"``, ...);
+    ``stderr`` its standard error (0 for a fixed parameter, nan where none exists, e.g. a
+    singular covariance); ``ci95`` the 95 % confidence interval (nan where not valid: an
+    estimate at a bound of its search range, no standard error); ``fitted``; ``at_bound``
+    (``"lower"``, ``"upper"`` or None). ``float(estimate)`` is its value.
+    """
+
+    __slots__ = ("name", "value", "unit", "stderr", "ci95", "fitted", "at_bound")
+
+    def __init__(self, name: str, value: float, unit: str = "-", stderr: float = math.nan,
+                 ci95: Tuple[float, float] = (math.nan, math.nan), fitted: bool = False,
+                 at_bound: Optional[str] = None):
+        self.name = name
+        self.value = value
+        self.unit = unit
+        self.stderr = stderr
+        self.ci95 = ci95
+        self.fitted = fitted
+        self.at_bound = at_bound
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], name: str = "") -> "Estimate":
+        """From the library's JSON form (``{"name", "value", "unit", "stderr", "ci95",
+        "fitted", "at_bound"}``; a null number is nan)."""
+        if not isinstance(d, Mapping):  # a bare number (reports of earlier versions)
+            return cls(name, _num(d), "-", 0.0, (_num(d), _num(d)))
+        ci = d.get("ci95") or (None, None)
+        return cls(d.get("name") or name, _num(d.get("value")), d.get("unit", "-"),
+                   _num(d.get("stderr")), (_num(ci[0]), _num(ci[1])), bool(d.get("fitted", False)),
+                   d.get("at_bound"))
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The library's JSON form (nan as None, as serde writes it)."""
+        def j(x: float) -> Optional[float]:
+            return None if math.isnan(x) else x
+        d: Dict[str, Any] = {"name": self.name, "value": j(self.value), "unit": self.unit,
+                             "stderr": j(self.stderr), "ci95": [j(self.ci95[0]), j(self.ci95[1])],
+                             "fitted": self.fitted}
+        if self.at_bound is not None:
+            d["at_bound"] = self.at_bound
+        return d
+
+    def __float__(self) -> float:
+        return float(self.value)
+
+    def __format__(self, spec: str) -> str:
+        """``f"{fit.n:.3f}"`` formats the value; ``f"{fit.n}"`` is ``str``."""
+        return format(self.value, spec) if spec else str(self)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Estimate):
+            return NotImplemented
+        return _same(self.to_dict(), other.to_dict())
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __getstate__(self) -> Dict[str, Any]:
+        return {k: getattr(self, k) for k in self.__slots__}
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        for k, v in state.items():
+            setattr(self, k, v)
+
+    def __str__(self) -> str:
+        unit = "" if self.unit in ("", "-") else f" {self.unit}"
+        bound = f" (at its {self.at_bound} bound)" if self.at_bound else ""
+        return f"{_pm(self.value, self.stderr)}{unit}{bound}"
+
+    def __repr__(self) -> str:
+        return f"Estimate({self.name}={self})"
+
+
+class FitResult(Result):
+    """The outcome of :func:`diffbvp.fit`: the library's ``FitSummary`` as a dict (exactly the
+    JSON ``rheometer fit --json`` writes) plus arrays.
+
+    Estimates (:class:`Estimate`: ``value``, ``stderr``, ``ci95``, ``unit``): ``fit.n`` [-],
+    ``fit.kappa`` = ln(K / 1 Pa) [-], ``fit.K`` [Pa], the effects' strengths and shapes in
+    :meth:`estimates`. ``fit.noise_level`` [-] is the one noise level the misfit is judged
+    against (``fit.noise``: where it comes from, the noise model); ``fit.rms`` [-] the RMS
+    relative residual; ``fit.warnings`` everything that makes the fit doubtful;
+    ``fit.covariance`` the covariance of the fitted shared parameters
+    (``fit.covariance_names``) in their reported units; ``fit.error_budget`` the systematic
+    uncertainty from what the data cannot identify. Every other key of the summary reads as an
+    attribute (``fit.solver``, ``fit.take_up_factors``, ``fit.at_bound``, ...).
+
+    Arrays: ``residual_profiles`` (name → ``position_m`` [m], ``relative_residual`` [-]) and
+    ``profiles`` (name → fitted profiles on uniform positions, SI units in the keys).
     """
 
     __slots__ = ("text", "notes")
 
-    def __init__(self, report: Dict[str, Any], arrays: Dict[str, Any], text: str = "", notes: Optional[List[str]] = None):
-        super().__init__(report, arrays)
+    def __init__(self, summary: Dict[str, Any], arrays: Optional[Dict[str, Any]] = None, text: str = "",
+                 notes: Optional[List[str]] = None):
+        super().__init__(summary, arrays)
         object.__setattr__(self, "text", text)
         object.__setattr__(self, "notes", list(notes or []))
 
     @classmethod
     def _from_native(cls, d: Dict[str, Any]) -> "FitResult":
-        return cls(d["report"], d["arrays"], d.get("text", ""), d.get("notes", []))
+        return cls(d["summary"], d["arrays"], d.get("text", ""), d.get("notes", []))
 
     def __getstate__(self):  # type: ignore[override]
         return (self._data, self._arrays, self.text, self.notes)
@@ -171,41 +255,31 @@ class FitResult(Result):
         object.__setattr__(self, "notes", state[3])
 
     @property
-    def report(self) -> Dict[str, Any]:
-        """The fit report as ``rheometer fit --json`` writes it (NaN written as ``None``)."""
+    def summary(self) -> Dict[str, Any]:
+        """The library's ``FitSummary`` as a dict, as ``rheometer fit --json`` writes it (a
+        nan written as ``None``); ``diffbvp.compare`` reads it back."""
         return self._data
 
     @property
-    def n(self) -> float:
-        """Power index n [-]."""
-        return _num(self._data["n"])
+    def n(self) -> Estimate:
+        """Power index n [-] of the Carreau-type law."""
+        return Estimate.from_dict(self._data["n"], "n")
 
     @property
-    def kappa(self) -> float:
+    def kappa(self) -> Estimate:
         """κ = ln(K / 1 Pa) [-]."""
-        return _num(self._data["kappa"])
+        return Estimate.from_dict(self._data["kappa"], "kappa")
 
     @property
-    def stderr_n(self) -> float:
-        """Standard error of n [-] (nan if it does not exist)."""
-        return _num(self._data.get("stderr_n"))
+    def K(self) -> Estimate:  # noqa: N802 (the law's symbol)
+        """K = e^κ [Pa] (its interval is the image of κ's)."""
+        return Estimate.from_dict(self._data.get("K_Pa", {"value": None}), "K")
 
     @property
-    def stderr_kappa(self) -> float:
-        """Standard error of κ [-] (nan if it does not exist)."""
-        return _num(self._data.get("stderr_kappa"))
-
-    @property
-    def ci95_n(self) -> Tuple[float, float]:
-        """95 % confidence interval of n [-] (nan at a bound)."""
-        a, b = self._data["ci95_n"]
-        return (_num(a), _num(b))
-
-    @property
-    def ci95_kappa(self) -> Tuple[float, float]:
-        """95 % confidence interval of κ [-] (nan at a bound)."""
-        a, b = self._data["ci95_kappa"]
-        return (_num(a), _num(b))
+    def noise_level(self) -> float:
+        """The one relative noise level σ [-] of these data and this model (declared, else
+        estimated; nan if neither)."""
+        return _num(self._data.get("noise", {}).get("level"))
 
     @property
     def rms(self) -> float:
@@ -219,69 +293,130 @@ class FitResult(Result):
 
     @property
     def effects(self) -> List[Dict[str, Any]]:
-        """The model's extra effects with strength, unit and standard error."""
+        """The model's extra effects: ``{"effect", "category", "strength", "shapes"}`` (the
+        strength and shapes as estimate dicts; see :meth:`estimates`)."""
         return list(self._data.get("effects", []))
 
     @property
+    def error_budget(self) -> Optional[Dict[str, Any]]:
+        """The error budget (systematic shifts of the estimates from the declared
+        uncertainties of process conditions, instrument and material data), None if not
+        computed."""
+        return self._data.get("error_budget")
+
+    @property
     def take_up_factors(self) -> np.ndarray:
-        """Take-up factors φ_k = d_out,k / d_fit,k(L) [-], in experiment order."""
+        """Take-up factors φ_k = d_out,k / d_fit,k(L) [-], in the order of ``experiments``."""
         return np.asarray(self._data["take_up_factors"], dtype=float)
+
+    @property
+    def covariance_names(self) -> List[str]:
+        """The parameters of :attr:`covariance`, in order (``"n"``, ``"kappa"``, effects,
+        ``"effect.shape"``); empty without a covariance."""
+        c = self._data.get("covariance")
+        return list(c["names"]) if c else []
+
+    @property
+    def covariance(self) -> Optional[np.ndarray]:
+        """Covariance of the fitted shared parameters (:attr:`covariance_names`) in their
+        reported units (strengths in the effects' units), None where singular or nothing is
+        fitted."""
+        c = self._data.get("covariance")
+        if not c:
+            return None
+        k = len(c["names"])
+        return np.asarray([_num(v) for v in c["matrix"]], dtype=float).reshape(k, k)
 
     @property
     def residual_profiles(self) -> Dict[str, Dict[str, np.ndarray]]:
         """name → ``position_m`` [m] and ``relative_residual`` [-] = (d_model − d_meas)/d_meas
         at the measurement positions."""
-        return self._arrays["residual_profiles"]
+        return self._arrays.get("residual_profiles", {})
 
     @property
     def profiles(self) -> Dict[str, Dict[str, Any]]:
-        """name → fitted profiles on uniform positions (SI units in the keys)."""
+        """name → fitted profiles on uniform positions (SI units in the keys; empty for the
+        refits of a diagnosis)."""
         return self._arrays.get("profiles", {})
 
-    @property
-    def covariance(self) -> Optional[np.ndarray]:
-        """Covariance of the fit vector (``parameter_names``), None if singular."""
-        return self._arrays.get("covariance")
-
-    def estimates(self) -> Dict[str, Tuple[float, float]]:
-        """name → (estimate, standard error) of n, κ and the effects' strengths."""
-        out = {"n": (self.n, self.stderr_n), "kappa": (self.kappa, self.stderr_kappa)}
+    def estimates(self) -> Dict[str, Estimate]:
+        """Every named estimate: ``n``, ``kappa``, then each effect's strength and shapes
+        (shapes named ``effect.shape``), as the library's ``FitSummary::parameters``."""
+        out = {"n": self.n, "kappa": self.kappa}
         for e in self.effects:
-            out[e["effect"]] = (_num(e.get("strength")), _num(e.get("stderr")))
+            s = Estimate.from_dict(e["strength"], e["effect"])
+            out[s.name or e["effect"]] = s
+            for sh in e.get("shapes", []):
+                x = Estimate.from_dict(sh)
+                x.name = f"{e['effect']}.{x.name}"
+                out[x.name] = x
         return out
+
+    def estimates_table(self) -> Dict[str, np.ndarray]:
+        """One row per estimate: ``name``, ``value``, ``unit``, ``stderr``, ``ci95_low``,
+        ``ci95_high``, ``fitted`` (``pandas.DataFrame(fit.estimates_table())``)."""
+        est = list(self.estimates().values())
+        return {
+            "name": np.asarray([e.name for e in est]),
+            "value": np.asarray([e.value for e in est], dtype=float),
+            "unit": np.asarray([e.unit for e in est]),
+            "stderr": np.asarray([e.stderr for e in est], dtype=float),
+            "ci95_low": np.asarray([e.ci95[0] for e in est], dtype=float),
+            "ci95_high": np.asarray([e.ci95[1] for e in est], dtype=float),
+            "fitted": np.asarray([e.fitted for e in est], dtype=bool),
+        }
 
     def residuals_table(self) -> Dict[str, np.ndarray]:
         """Columns ``experiment``, ``position_m`` [m], ``relative_residual`` [-]
         (``pandas.DataFrame(fit.residuals_table())``)."""
-        return _long_table(self._arrays["residual_profiles"], ["position_m", "relative_residual"])
+        return _long_table(self.residual_profiles, ["position_m", "relative_residual"])
 
     def profiles_table(self) -> Dict[str, np.ndarray]:
         """The fitted profiles of every experiment as one long table (SI units in the keys)."""
-        return _long_table(self._arrays.get("profiles", {}), _PROFILE_KEYS)
+        return _long_table(self.profiles, _PROFILE_KEYS)
 
-    def flow_curve(self) -> Dict[str, np.ndarray]:
-        """The identified law as the experiments see it: strain rate [1/s], temperature [K]
-        and elongational viscosity [Pa s] along every fitted spin line (long table).
+    def flow_curve(self) -> Dict[str, Any]:
+        """The identified law as the experiments see it.
 
-        TODO(restructure): the library's FitSummary will carry the flow curve (μ_e(ε̇) at
-        reference temperatures with its confidence band); read it from there.
+        NOTE (interim): the library's flow curve ``FlowCurve`` (η_E(ε̇) at one temperature
+        with its 95 % bands) is not part of the ``FitSummary`` yet. Until it is, this returns
+        the fitted profiles' own columns — strain rate [1/s], elongational viscosity [Pa s],
+        temperature [K], position [m] along every fitted spin line, as a long table with an
+        ``experiment`` column — not a curve at one temperature and without bands. Once the
+        summary carries ``flow_curve``, that is returned instead (its numeric lists as numpy
+        arrays); nothing is computed here either way.
         """
-        return _long_table(
-            self._arrays.get("profiles", {}),
-            ["strain_rate_1_s", "viscosity_Pa_s", "temperature_K", "position_m"],
-        )
+        curve = self._data.get("flow_curve")
+        if curve is not None:
+            return _arrays_of(curve)
+        return _long_table(self.profiles, ["strain_rate_1_s", "viscosity_Pa_s", "temperature_K", "position_m"])
 
     def __repr__(self) -> str:
-        parts = [f"n={_pm(self.n, self.stderr_n)}", f"kappa={_pm(self.kappa, self.stderr_kappa)}"]
+        n, k = self.n, self.kappa
+        parts = [f"n={_pm(n.value, n.stderr)}", f"kappa={_pm(k.value, k.stderr)}"]
         for e in self.effects:
-            parts.append(f"{e['effect']}={_pm(_num(e.get('strength')), _num(e.get('stderr')))}")
+            s = Estimate.from_dict(e["strength"], e["effect"])
+            parts.append(f"{e['effect']}={_pm(s.value, s.stderr)}")
         parts.append(f"rms={100 * self.rms:.2g} %")
+        if math.isfinite(self.noise_level):
+            parts.append(f"noise={100 * self.noise_level:.2g} %")
         if self.warnings:
             parts.append(f"{len(self.warnings)} warning{'s' if len(self.warnings) > 1 else ''}")
         return f"FitResult({', '.join(parts)})"
 
     def __str__(self) -> str:
         return self.text or repr(self)
+
+
+def _arrays_of(x: Any) -> Any:
+    """Lists of numbers (recursively) as float numpy arrays (``None`` as nan)."""
+    if isinstance(x, Mapping):
+        return {k: _arrays_of(v) for k, v in x.items()}
+    if isinstance(x, list) and x and all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in x):
+        return np.asarray([_num(v) for v in x], dtype=float)
+    if isinstance(x, list):
+        return [_arrays_of(v) for v in x]
+    return x
 
 
 class SimulationResult(Result):
@@ -325,9 +460,10 @@ class SimulationResult(Result):
 
 
 class Comparison(Result):
-    """The outcome of :func:`diffbvp.compare`: the JSON of ``rheometer compare`` (``sigma``
-    [-], ``chi2``, per-experiment ``rms``, runs test, lag-1 autocorrelation, systematic
-    ``segments``, the noise model) plus ``text``."""
+    """The outcome of :func:`diffbvp.compare`: the library's ``Comparison`` as a dict, the JSON
+    of ``rheometer compare`` (``noise``: the one noise level and its model, ``chi2``,
+    ``chi2_per_dof``, per-experiment ``rms``, runs test, lag-1 autocorrelation, systematic
+    ``segments``, ``stations``, ``trends``) plus ``text``."""
 
     __slots__ = ("text", "notes")
 
@@ -356,87 +492,165 @@ class Comparison(Result):
                     rows.setdefault(k, []).append(_num(v) if not isinstance(v, bool) else v)
         return {k: np.asarray(v) for k, v in rows.items()}
 
+    @property
+    def noise_level(self) -> float:
+        """The noise level σ [-] the misfit is judged against (the fit's, when the fit is
+        compared as it is)."""
+        return _num(self._data.get("noise", {}).get("level"))
+
     def __repr__(self) -> str:
         d = self._data
-        dof = max(1, d.get("points", 0) - d.get("fitted_parameters", 0))
         return (
             f"Comparison({len(d['experiments'])} experiments, {d.get('points')} points, "
-            f"sigma={100 * _num(d.get('sigma')):.2g} %, chi2/dof={_num(d.get('chi2')) / dof:.3g})"
+            f"noise={100 * self.noise_level:.2g} %, chi2/dof={_num(d.get('chi2_per_dof')):.3g})"
         )
 
     def __str__(self) -> str:
         return self.text or repr(self)
 
 
+class Candidate(Result):
+    """One candidate effect of a diagnosis: the library's ``Candidate`` as a dict (``effect``,
+    ``unit``, linearised ``linear_score``/``linear_strength``/``linear_stderr``, ``delta_bic``,
+    ``delta_aic``, ``status``, ``false_alarm`` [-], ``share_of_excess`` [-], the search's
+    ``profiles``, ...); ``refit`` is its refit as a :class:`FitResult` (None if not
+    refitted)."""
+
+    __slots__ = ()
+
+    @property
+    def refit(self) -> Optional[FitResult]:
+        """The best refit with the effect (strength and shapes freed), None if not refitted."""
+        r = self._data.get("refit")
+        return FitResult(r) if r is not None else None
+
+    @property
+    def strength(self) -> Optional[Estimate]:
+        """The refitted strength of the effect (its unit), None if not refitted."""
+        r = self.refit
+        if r is None:
+            return None
+        for e in r.effects:
+            if e["effect"] == self._data["effect"]:
+                return Estimate.from_dict(e["strength"], e["effect"])
+        return None
+
+    def __repr__(self) -> str:
+        d = self._data
+        s = self.strength
+        strength = f", strength={s}" if s is not None else ""
+        return (f"Candidate({d['effect']}, ΔBIC={_num(d.get('delta_bic')):.1f}{strength}, "
+                f"status={d.get('status')!r}, false_alarm={_num(d.get('false_alarm')):.3g})")
+
+
 class Diagnosis(Result):
-    """The outcome of :func:`diffbvp.diagnose`: the JSON of ``rheometer diagnose``
-    (``candidates`` best first with ΔBIC, strengths and refits, ``indistinguishable`` pairs,
-    ``most_likely_missing``, ``outliers``, ``rms_over_noise``, ...), the user's fit
-    ``base_fit`` and the refit with the best candidate ``best_fit`` (as :class:`FitResult`),
-    and the residuals before and after (name → ``position_m``, ``relative_residual``)."""
+    """The outcome of :func:`diffbvp.diagnose`: the library's ``Diagnosis`` as a dict (the
+    JSON of ``rheometer diagnose``).
 
-    __slots__ = ("text", "base_fit", "best_fit")
+    ``verdict`` (``{"kind": "explained" | "adequate" | "none_of_the_candidates", ...}``),
+    ``found`` (the effects found, in order), ``most_likely_missing``, ``candidates`` (best
+    first, as :class:`Candidate` with their refits), ``base_fit`` (the user's model) and
+    ``final_fit`` (with all found effects, fitted jointly) as :class:`FitResult`,
+    ``calibration`` (the look-elsewhere calibration), ``further_steps``, ``alternatives``,
+    ``indistinguishable``, ``detection``. Arrays: ``residuals_before`` and
+    ``residuals_after`` (name → ``position_m``, ``relative_residual``) of the base and final
+    fit.
+    """
 
-    def __init__(self, data: Dict[str, Any], arrays: Dict[str, Any], text: str = "",
-                 base_fit: Optional[FitResult] = None, best_fit: Optional[FitResult] = None):
+    __slots__ = ("text",)
+
+    def __init__(self, data: Dict[str, Any], arrays: Optional[Dict[str, Any]] = None, text: str = ""):
         super().__init__(data, arrays)
         object.__setattr__(self, "text", text)
-        object.__setattr__(self, "base_fit", base_fit)
-        object.__setattr__(self, "best_fit", best_fit)
 
     @classmethod
     def _from_native(cls, d: Dict[str, Any]) -> "Diagnosis":
-        best = d.get("best_fit")
-        arrays = {"residuals_before": d["residuals_before"], "residuals_after": d["residuals_after"]}
-        return cls(d["diagnosis"], arrays, d.get("text", ""),
-                   FitResult._from_native(d["base_fit"]),
-                   FitResult._from_native(best) if best is not None else None)
+        final = d.get("final_arrays")
+        arrays = {"residuals_before": d["base_arrays"]["residual_profiles"],
+                  "residuals_after": final["residual_profiles"] if final is not None else None}
+        return cls(d["diagnosis"], arrays, d.get("text", ""))
 
     def __getstate__(self):  # type: ignore[override]
-        return (self._data, self._arrays, self.text, self.base_fit, self.best_fit)
+        return (self._data, self._arrays, self.text)
 
     def __setstate__(self, state):  # type: ignore[override]
-        for k, v in zip(("_data", "_arrays", "text", "base_fit", "best_fit"), state):
+        for k, v in zip(("_data", "_arrays", "text"), state):
             object.__setattr__(self, k, v)
 
-    def to_dict(self) -> Dict[str, Any]:
-        out = super().to_dict()
-        out["base_fit"] = self.base_fit.to_dict() if self.base_fit else None
-        out["best_fit"] = self.best_fit.to_dict() if self.best_fit else None
-        return out
+    @property
+    def diagnosis(self) -> Dict[str, Any]:
+        """The library's ``Diagnosis`` as a dict, as ``rheometer diagnose --json`` writes it."""
+        return self._data
+
+    @property
+    def verdict(self) -> Dict[str, Any]:
+        """What the diagnosis concludes: ``{"kind": "explained", "effects", "rms_over_noise"}``,
+        ``{"kind": "adequate"}`` or ``{"kind": "none_of_the_candidates", "helps",
+        "unexplained", "rms_over_noise"}``."""
+        return self._data["verdict"]
+
+    @property
+    def found(self) -> List[str]:
+        """The effects found, in the order they were found."""
+        return list(self._data.get("found", []))
 
     @property
     def most_likely_missing(self) -> Optional[str]:
-        """The effect that earns its place with the best ΔBIC, or None."""
+        """The first effect found (the best that earns its place), or None."""
         return self._data.get("most_likely_missing")
 
+    @property
+    def candidates(self) -> List[Candidate]:
+        """The candidates of the first step, best first."""
+        return [Candidate(c) for c in self._data.get("candidates", [])]
+
+    def candidate(self, effect: str) -> Optional[Candidate]:
+        """The candidate named ``effect``, if it was one."""
+        return next((c for c in self.candidates if c._data["effect"] == effect), None)
+
+    @property
+    def base_fit(self) -> FitResult:
+        """The user's model fitted (principled estimator), with its one noise level."""
+        return FitResult(self._data["base_fit"], {"residual_profiles": self._arrays.get("residuals_before") or {}})
+
+    @property
+    def final_fit(self) -> Optional[FitResult]:
+        """The fit with all found effects (fitted jointly), None if nothing was found."""
+        f = self._data.get("final_fit")
+        if f is None:
+            return None
+        return FitResult(f, {"residual_profiles": self._arrays.get("residuals_after") or {}})
+
+    @property
+    def noise_level(self) -> float:
+        """The noise level the judgement used [-] (the base fit's)."""
+        return self.base_fit.noise_level
+
     def candidates_table(self) -> Dict[str, np.ndarray]:
-        """One row per candidate: ``effect`` and its scalar results (ΔBIC, strength, ...)."""
+        """One row per candidate: ``effect`` and its scalar results (``delta_bic``,
+        ``false_alarm``, ``share_of_excess``, ``status``, ...) plus the refitted ``strength``
+        and its ``strength_stderr`` (nan where not refitted)."""
         rows: Dict[str, List[Any]] = {}
-        cands = self._data.get("candidates", [])
-        scalar_keys = [k for k, v in (cands[0].items() if cands else [])
+        cands = self.candidates
+        scalar_keys = [k for k, v in (cands[0]._data.items() if cands else [])
                        if v is None or isinstance(v, (int, float, str, bool))]
         for c in cands:
             for k in scalar_keys:
-                v = c.get(k)
+                v = c._data.get(k)
                 rows.setdefault(k, []).append(math.nan if v is None else v)
+            s = c.strength
+            rows.setdefault("strength", []).append(s.value if s is not None else math.nan)
+            rows.setdefault("strength_stderr", []).append(s.stderr if s is not None else math.nan)
         return {k: np.asarray(v) for k, v in rows.items()}
 
     def __repr__(self) -> str:
         d = self._data
-        best = d.get("most_likely_missing")
-        dbic = ""
-        for c in d.get("candidates", []):
-            name = c.get("effect") or c.get("name")
-            if best is not None and name == best:
-                v = c.get("delta_bic")
-                if v is not None:
-                    dbic = f", ΔBIC={v:.0f}"
-        return (
-            f"Diagnosis(most_likely_missing={best!r}{dbic}, "
-            f"rms/noise={_num(d.get('rms_over_noise')):.3g}, "
-            f"{len(d.get('candidates', []))} candidates)"
-        )
+        kind = d.get("verdict", {}).get("kind")
+        named = self.candidate(self.most_likely_missing) if self.most_likely_missing else None
+        dbic = f", ΔBIC={_num(named._data.get('delta_bic')):.0f}" if named is not None else ""
+        return (f"Diagnosis(verdict={kind!r}, found={self.found!r}{dbic}, "
+                f"rms/noise={_num(d['base_fit'].get('noise', {}).get('rms_over_noise')):.3g}, "
+                f"{len(d.get('candidates', []))} candidates)")
 
     def __str__(self) -> str:
         return self.text or repr(self)

@@ -4,9 +4,9 @@
 //! `cargo run --release -p diffbvp-python --example fit_timing -- [RUNS] [EXPERIMENTS.toml]`
 //! prints one wall time per run (s) and the median, then `n kappa` of the last fit.
 
-use diffbvp::fiber::effects::ModelSpec;
 use diffbvp::fiber::input::load_experiments_with;
-use diffbvp::fiber::rheometer::{error_budget, FitReport, IdentifyOptions, Rheometer};
+use diffbvp::fiber::rheometer::IdentifyOptions;
+use diffbvp::fiber::workflow::{fit, FitRequest};
 use diffbvp::fiber::FiberSolution;
 use std::time::Instant;
 
@@ -21,19 +21,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut last = None;
     for _ in 0..runs {
         let t0 = Instant::now();
-        // the steps of python/src/fit.rs::fit_workflow
-        let opts = IdentifyOptions::default();
-        let rh = Rheometer::with_spec(&loaded.set, ModelSpec::default())?;
-        let start = rh.start_heuristic(&opts)?.start;
-        let id = rh.identify(start, &opts)?;
-        let report = match error_budget(&rh, &id, &loaded.uncertainty, &opts) {
-            Ok(b) => FitReport::new(&id).with_error_budget(b),
-            Err(_) => FitReport::new(&id),
-        };
-        let profiles: Vec<_> = id
+        // what `diffbvp.fit(dataset)` runs: the fit workflow, the fitted profiles on 101
+        // positions, the summary as JSON
+        let run = fit(&loaded, &FitRequest::new(IdentifyOptions::default()))?;
+        let profiles: Vec<_> = run
+            .identification
             .solutions
             .iter()
-            .zip(&rh.models)
+            .zip(&run.rheometer.models)
             .map(|(s, m)| {
                 FiberSolution {
                     solution: s.clone(),
@@ -41,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .uniform_profiles(m, 101)
             })
             .collect();
-        let json = serde_json::to_value(&report)?;
+        let json = serde_json::to_value(run.summary())?;
         times.push(t0.elapsed().as_secs_f64());
         println!("run {:>3}: {:.4} s", times.len(), times[times.len() - 1]);
         last = Some((json, profiles.len()));
@@ -54,7 +49,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     println!("median {median:.4} s over {runs} runs");
     if let Some((json, _)) = last {
-        println!("n = {}, kappa = {}", json["n"], json["kappa"]);
+        println!(
+            "n = {}, kappa = {}",
+            json["n"]["value"], json["kappa"]["value"]
+        );
     }
     Ok(())
 }

@@ -3,8 +3,8 @@
 //! (`caused by: ...`) and the hints of a failed simulation (`hint: ...`), each on its own line.
 
 use diffbvp::fiber::diagnostics::compare::CompareError;
-use diffbvp::fiber::failure_hints::{failed_experiment, ExperimentFailure};
-use diffbvp::fiber::input::{InputError, LoadedExperiments, Location};
+use diffbvp::fiber::failure_hints::{failed_experiment, name_experiment, ExperimentFailure};
+use diffbvp::fiber::input::{InputError, LoadedExperiments};
 use diffbvp::fiber::rheometer::RheometerError;
 use diffbvp::least_squares::FitError;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
@@ -12,9 +12,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyType;
 use std::error::Error;
 use std::path::Path;
-
-/// A library error that can leave the worker thread.
-pub type BoxError = Box<dyn Error + Send + Sync + 'static>;
 
 /// An exception of class `kind` (`"InputError"`, `"SimulationError"`, `"FitError"`,
 /// `"DiffbvpError"`) from `diffbvp.errors` with `message`.
@@ -107,9 +104,9 @@ fn kind_of(e: &(dyn Error + 'static)) -> &'static str {
 }
 
 /// A library error as a Python exception; a failed simulation is first named with its
-/// experiment and TOML line (as the CLI does), and the exception gets the attributes
-/// `experiment`, `path`, `line` and `hints` where known. A cancelled fit is a
-/// `KeyboardInterrupt`.
+/// experiment and TOML line (the library's [`name_experiment`], as the CLI does), and the
+/// exception gets the attributes `experiment`, `path`, `line` and `hints` where known. A
+/// cancelled fit is a `KeyboardInterrupt`.
 pub fn to_py_err(
     py: Python<'_>,
     e: Box<dyn Error + 'static>,
@@ -132,45 +129,4 @@ pub fn to_py_err(
         let _ = v.setattr("hints", f.hints.clone());
     }
     err
-}
-
-/// The failure `e` as an [`ExperimentFailure`] naming the experiment and its line in the
-/// experiments file where the chain names an experiment whose simulation failed (the CLI's
-/// `checks::name_experiment`, with the data set already loaded); other errors unchanged.
-// TODO(restructure): call the library's version once the CLI's naming of failures moves there.
-fn name_experiment(
-    e: Box<dyn Error + 'static>,
-    loaded: &LoadedExperiments,
-    path: &Path,
-    law: Option<[f64; 2]>,
-) -> Box<dyn Error + 'static> {
-    if e.downcast_ref::<ExperimentFailure>().is_some() {
-        return e;
-    }
-    let Some((name, stated)) = failed_experiment(e.as_ref()) else {
-        return e;
-    };
-    let law = stated.or(law);
-    match loaded.set.experiments.iter().position(|x| x.name == name) {
-        Some(k) => {
-            let at = Location {
-                path: path.to_path_buf(),
-                line: loaded.details[k].line,
-            };
-            Box::new(ExperimentFailure::new(
-                &loaded.set.experiments[k],
-                &loaded.set.material,
-                at,
-                law,
-                e,
-            ))
-        }
-        None => {
-            let at = Location {
-                path: path.to_path_buf(),
-                line: None,
-            };
-            Box::new(ExperimentFailure::unlocated(&name, at, e))
-        }
-    }
 }

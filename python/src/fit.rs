@@ -1,84 +1,18 @@
-//! `fit`: identify the law (and effect strengths) with uncertainties, the error budget and the
-//! arrays a notebook plots (residuals, fitted profiles, covariance).
+//! `fit`: the library's fit workflow ([`workflow::fit`]); its outcome, the [`FitSummary`]
+//! (`FitRun::summary`), goes to Python through its serde JSON form, with the arrays a notebook
+//! plots besides (residuals at the measurement positions, fitted profiles).
 
-use crate::convert::{array1, array2, serde_to_py};
+use crate::convert::{array1, serde_to_py};
 use crate::dataset::Dataset;
-use crate::errors::{to_py_err, BoxError};
+use crate::errors::{input_error, to_py_err};
 use crate::options;
 use crate::run::interruptible;
-use diffbvp::fiber::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
-use diffbvp::fiber::rheometer::{
-    error_budget, FitReport, Identification, IdentifyOptions, Rheometer,
-};
+use diffbvp::fiber::effects::{LawChoice, ModelSpec};
+use diffbvp::fiber::rheometer::{Identification, IdentifyOptions, Rheometer};
+use diffbvp::fiber::workflow::{self, FitRequest};
 use diffbvp::fiber::{FiberSolution, Profiles};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-
-/// Everything one fit hands back to Python.
-pub struct FitOutcome {
-    /// The report (serialised to the result dict).
-    pub report: FitReport,
-    /// The identification (arrays).
-    pub id: Identification,
-    /// Fitted profiles per experiment on `profile_points` uniform positions.
-    pub profiles: Vec<Profiles>,
-    /// Why the error budget is missing, if it is.
-    pub budget_error: Option<String>,
-}
-
-/// The fit settings of one call.
-pub struct FitSettings {
-    pub start: Option<(f64, f64)>,
-    pub opts: IdentifyOptions,
-    pub spec: ModelSpec,
-    pub with_budget: bool,
-    pub profile_points: usize,
-}
-
-/// What `rheometer fit` does, without its files: start heuristic (unless a start is given),
-/// identification, error budget (a budget that cannot be computed does not fail the fit),
-/// report, and the fitted profiles.
-// TODO(restructure): call the library's fit workflow (returning a FitSummary) instead.
-pub fn fit_workflow(dataset: &Dataset, s: &FitSettings) -> Result<FitOutcome, BoxError> {
-    let loaded = &dataset.inner.loaded;
-    let rh = Rheometer::with_spec(&loaded.set, s.spec.clone())?;
-    let law_fitted = s.spec.law == LawChoice::Carreau
-        || s.spec
-            .effects
-            .iter()
-            .any(|w| w.effect.name() == "strain_thinning" && w.value.is_none());
-    let start = match s.start {
-        Some((n, k)) => [n, k],
-        None if !law_fitted => [1.0, STRAIN_THINNING_REFERENCE_KAPPA],
-        None => rh.start_heuristic(&s.opts)?.start,
-    };
-    let id = rh.identify(start, &s.opts)?;
-    let (report, budget_error) = if s.with_budget {
-        match error_budget(&rh, &id, &loaded.uncertainty, &s.opts) {
-            Ok(budget) => (FitReport::new(&id).with_error_budget(budget), None),
-            Err(e) => (FitReport::new(&id), Some(e.to_string())),
-        }
-    } else {
-        (FitReport::new(&id), None)
-    };
-    let profiles = id
-        .solutions
-        .iter()
-        .zip(&rh.models)
-        .map(|(sol, model)| {
-            FiberSolution {
-                solution: sol.clone(),
-            }
-            .uniform_profiles(model, s.profile_points)
-        })
-        .collect();
-    Ok(FitOutcome {
-        report,
-        id,
-        profiles,
-        budget_error,
-    })
-}
 
 /// Profiles as a dict of numpy arrays (SI units in the key names), the named terms under
 /// `terms`.
@@ -103,71 +37,44 @@ pub fn profiles_dict<'py>(py: Python<'py>, p: &Profiles) -> PyResult<Bound<'py, 
     Ok(d)
 }
 
-/// The arrays of an identification: parameter names and covariance of the fit vector, the
-/// relative residuals at the measurement positions and (if given) the fitted profiles, per
-/// experiment.
+/// An identification's arrays: `residual_profiles` (name → `position_m`, `relative_residual`
+/// at the measurement positions) and, with `profiles = Some((rheometer, points))`, the fitted
+/// `profiles` (name → profiles on `points` uniform positions).
 pub fn identification_arrays<'py>(
     py: Python<'py>,
     id: &Identification,
-    profiles: Option<&[Profiles]>,
+    profiles: Option<(&Rheometer, usize)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let mut names = id.names.clone();
-    let np = id.fit.p.len();
-    for e in &id.experiment_names {
-        if names.len() >= np {
-            break;
-        }
-        names.push(format!("take_up_factor[{e}]"));
-    }
-    d.set_item("parameter_names", names)?;
-    d.set_item("parameters", array1(py, &id.fit.p))?;
-    match id.fit.covariance() {
-        Some(c) => d.set_item("covariance", array2(py, &c, np, np)?)?,
-        None => d.set_item("covariance", py.None())?,
-    }
+    let names = &id.summary.experiments;
     let res = PyDict::new(py);
-    for (name, (pos, r)) in id.experiment_names.iter().zip(&id.residual_profiles) {
+    for (name, (pos, r)) in names.iter().zip(&id.residual_profiles) {
         let e = PyDict::new(py);
         e.set_item("position_m", array1(py, pos))?;
         e.set_item("relative_residual", array1(py, r))?;
         res.set_item(name, e)?;
     }
     d.set_item("residual_profiles", res)?;
-    if let Some(profiles) = profiles {
+    if let Some((rh, points)) = profiles {
         let pd = PyDict::new(py);
-        for (name, p) in id.experiment_names.iter().zip(profiles) {
-            pd.set_item(name, profiles_dict(py, p)?)?;
+        for ((name, sol), model) in names.iter().zip(&id.solutions).zip(&rh.models) {
+            let fs = FiberSolution {
+                solution: sol.clone(),
+            };
+            pd.set_item(name, profiles_dict(py, &fs.uniform_profiles(model, points))?)?;
         }
         d.set_item("profiles", pd)?;
     }
     Ok(d)
 }
 
-/// A fit outcome as `{"report": dict, "arrays": dict, "notes": [str]}`.
-// TODO(restructure): serialise the FitSummary (report, covariance, flow curve) instead.
-pub fn outcome_to_py<'py>(py: Python<'py>, o: &FitOutcome) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("report", serde_to_py(py, &o.report)?)?;
-    d.set_item("text", o.report.to_text())?;
-    d.set_item(
-        "arrays",
-        identification_arrays(py, &o.id, Some(&o.profiles))?,
-    )?;
-    let mut notes = Vec::new();
-    if let Some(e) = &o.budget_error {
-        notes.push(format!("error budget not computed: {e}"));
-    }
-    d.set_item("notes", notes)?;
-    Ok(d)
-}
-
-/// Identifies `(n, κ)` (and the strengths of fitted effects) from the measurements: the
-/// `rheometer fit` workflow. Returns `{"report", "text", "arrays", "notes"}`.
+/// Identifies `(n, κ)` (and the strengths of fitted effects): the library's fit workflow, as
+/// `rheometer fit`. Returns `{"summary": FitSummary as dict, "text": the report, "arrays":
+/// {"residual_profiles", "profiles"}, "notes": [str]}`.
 #[pyfunction]
 #[pyo3(signature = (dataset, *, start=None, estimator="principled", model="carreau",
     effects=Vec::new(), loss="linear", f_scale=None, relative_uncertainty=None,
-    error_budget=true, max_nodes=None, profile_points=101))]
+    error_budget=true, tol=None, max_nodes=None, profile_points=101))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
@@ -180,27 +87,27 @@ pub fn fit<'py>(
     f_scale: Option<f64>,
     relative_uncertainty: Option<f64>,
     error_budget: bool,
+    tol: Option<f64>,
     max_nodes: Option<usize>,
     profile_points: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut opts = IdentifyOptions::with_estimator(options::estimator(estimator)?);
     opts.loss = options::loss(loss)?;
     opts.f_scale = options::f_scale(f_scale)?;
-    opts.relative_uncertainty = match relative_uncertainty {
-        Some(v) if !(v > 0.0 && v < 1.0) => {
-            return Err(crate::errors::input_error(format!(
-                "relative_uncertainty must lie in (0, 1) like the TOML key (got {v}; 0.01 is 1 %)"
-            )))
-        }
-        other => other,
-    };
+    opts.relative_uncertainty = options::fraction("relative_uncertainty", relative_uncertainty)?;
     opts.simulate.max_nodes = options::max_nodes(max_nodes)?;
+    if let Some(t) = options::tol(tol)? {
+        // a given tolerance is kept (the discretisation shift is only reported), as `--tol`
+        opts.simulate.tol = t;
+        opts.max_discretisation_shift = Some(f64::INFINITY);
+    }
     if let Some(s) = start {
         options::check_start(s, &opts)?;
     }
-    if !(2..=100_000).contains(&profile_points) {
-        return Err(crate::errors::input_error(format!(
-            "profile_points: give 2 to 100000 positions per profile (got {profile_points})"
+    if !(2..=options::MAX_POINTS).contains(&profile_points) {
+        return Err(input_error(format!(
+            "profile_points: give 2 to {} positions per profile (got {profile_points})",
+            options::MAX_POINTS
         )));
     }
     let spec = ModelSpec {
@@ -208,20 +115,42 @@ pub fn fit<'py>(
         effects: options::effects(&effects)?,
         candidates: Vec::new(),
     };
-    let settings = FitSettings {
-        start,
-        opts,
-        spec,
-        with_budget: error_budget,
-        profile_points,
-    };
-    let out = interruptible(py, |cancel| {
-        let mut s = settings;
-        s.opts.cancel = Some(cancel);
-        fit_workflow(dataset, &s)
-    })?;
-    match out {
-        Ok(o) => outcome_to_py(py, &o),
-        Err(e) => Err(to_py_err(py, e, Some(dataset.data()), None)),
+    if spec.law == LawChoice::Newtonian && start.is_some() {
+        return Err(input_error(
+            "start: the Newtonian model (n = 1) has no (n, kappa) to start from; drop start or \
+             fit the Carreau-type law (model=\"carreau\")"
+                .into(),
+        ));
     }
+    let request = FitRequest {
+        model: spec,
+        start: start.map(|(n, k)| [n, k]),
+        error_budget,
+        ..FitRequest::new(opts)
+    };
+    let (loaded, path) = dataset.data();
+    let out = interruptible(py, |cancel| {
+        let mut request = request;
+        request.identify.cancel = Some(cancel);
+        workflow::fit(loaded, &request)
+    })?;
+    let run = out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), None))?;
+    let d = PyDict::new(py);
+    d.set_item("summary", serde_to_py(py, run.summary())?)?;
+    d.set_item("text", run.summary().to_text())?;
+    d.set_item(
+        "arrays",
+        identification_arrays(
+            py,
+            &run.identification,
+            Some((&run.rheometer, profile_points)),
+        )?,
+    )?;
+    let notes: Vec<String> = run
+        .budget_error
+        .iter()
+        .map(|e| format!("error budget not computed: {e}"))
+        .collect();
+    d.set_item("notes", notes)?;
+    Ok(d)
 }

@@ -1,13 +1,15 @@
-//! `landscape`: the cost `J(n, κ)` on a grid (paper Fig. 4), as `rheometer landscape` without
-//! files; Ctrl-C stops it between grid points.
+//! `landscape`: the cost `J(n, κ)` on a grid (paper Fig. 4), the library's landscape workflow
+//! ([`workflow::landscape`]) as `rheometer landscape` runs it, without files; Ctrl-C stops it
+//! between grid points.
 
 use crate::convert::{array1, array2};
 use crate::dataset::Dataset;
-use crate::errors::{input_error, to_py_err, BoxError};
+use crate::errors::{input_error, to_py_err};
 use crate::options;
 use crate::run::interruptible;
 use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;
-use diffbvp::fiber::rheometer::{IdentifyOptions, PointStatus, Rheometer};
+use diffbvp::fiber::rheometer::{IdentifyOptions, PointStatus};
+use diffbvp::fiber::workflow::{self, LandscapeRequest};
 use diffbvp::mesh::linspace;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -54,11 +56,7 @@ pub fn landscape<'py>(
              {MAX_GRID_POINTS} points (zoom in with n_range and kappa_range instead)"
         )));
     }
-    if !(1e-12..=0.1).contains(&tol) {
-        return Err(input_error(format!(
-            "tol: the tolerance must lie in [1e-12, 0.1] (got {tol})"
-        )));
-    }
+    options::tol(Some(tol))?;
     opts.simulate.tol = tol;
     opts.simulate.max_nodes = match max_nodes {
         None => LANDSCAPE_MAX_NODES,
@@ -71,15 +69,16 @@ pub fn landscape<'py>(
             )))
         }
     };
-    let ns = linspace(n_range.0, n_range.1, a);
-    let ks = linspace(kappa_range.0, kappa_range.1, b);
-    let set = &dataset.inner.loaded.set;
-    // TODO(restructure): call the library's landscape workflow (range checks, mesh cap).
-    let out = interruptible(py, |cancel| -> Result<_, BoxError> {
-        let rh = Rheometer::new(set)?;
-        Ok(rh.landscape_with(&ns, &ks, &opts, |_| {}, &cancel)?)
+    let request = LandscapeRequest {
+        n: linspace(n_range.0, n_range.1, a),
+        kappa: linspace(kappa_range.0, kappa_range.1, b),
+        identify: opts,
+    };
+    let (loaded, path) = dataset.data();
+    let out = interruptible(py, |cancel| {
+        workflow::landscape(loaded, &request, |_| {}, &cancel)
     })?;
-    let run = out.map_err(|e| to_py_err(py, e, Some(dataset.data()), None))?;
+    let run = out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), None))?;
     let l = &run.landscape;
     let status: Vec<f64> = run
         .status

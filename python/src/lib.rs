@@ -1,8 +1,10 @@
 //! `diffbvp._native`: the thin Rust layer of the Python package `diffbvp`.
 //!
-//! Each function calls the library and hands its result to Python through the result's serde
-//! JSON form (dicts, lists, floats) plus numpy arrays for array-valued data; the Python result
-//! classes in `python/diffbvp/` wrap those dicts. Long calls run with the GIL released and stop
+//! Each function checks its arguments as the `rheometer` program checks its flags, calls the
+//! library's workflow ([`diffbvp::fiber::workflow`]: fit, simulate, compare, diagnose,
+//! landscape) and hands its result to Python through the result's serde JSON form (one path:
+//! [`convert::serde_to_py`]; dicts, lists, floats) plus numpy arrays for array-valued data;
+//! the Python result classes in `python/diffbvp/` wrap those dicts. Long calls run with the GIL released and stop
 //! on Ctrl-C ([`run`]). Errors become `diffbvp.errors` exceptions with the CLI's messages
 //! ([`errors`]).
 
@@ -35,5 +37,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(landscape::landscape, m)?)?;
     m.add_function(wrap_pyfunction!(library_version, m)?)?;
+    m.add_function(wrap_pyfunction!(run::set_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(run::threads, m)?)?;
     Ok(())
 }

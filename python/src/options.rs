@@ -15,6 +15,32 @@ pub const MAX_MAX_NODES: usize = 1_000_000;
 pub const DEFAULT_MAX_NODES: usize = 20_000;
 /// Largest |κ| (K = e^κ Pa stays a finite positive number).
 pub const MAX_ABS_KAPPA: f64 = 700.0;
+/// Largest number of output positions per profile.
+pub const MAX_POINTS: usize = 100_000;
+/// Range of a BVP tolerance \[-\].
+pub const TOL_RANGE: (f64, f64) = (1e-12, 0.1);
+
+/// A BVP tolerance `tol` in [`TOL_RANGE`] (or none).
+pub fn tol(v: Option<f64>) -> PyResult<Option<f64>> {
+    match v {
+        Some(t) if !(TOL_RANGE.0..=TOL_RANGE.1).contains(&t) => Err(input_error(format!(
+            "tol: the tolerance must lie in [{:e}, {}] (got {t})",
+            TOL_RANGE.0, TOL_RANGE.1
+        ))),
+        other => Ok(other),
+    }
+}
+
+/// A relative uncertainty `name` in (0, 1) like the TOML key (or none).
+pub fn fraction(name: &str, v: Option<f64>) -> PyResult<Option<f64>> {
+    match v {
+        Some(v) if !(v > 0.0 && v < 1.0) => Err(input_error(format!(
+            "{name} must lie in (0, 1) like the TOML key relative_uncertainty (got {v}; 0.01 is \
+             1 %)"
+        ))),
+        other => Ok(other),
+    }
+}
 
 /// `max_nodes`: `MIN_MAX_NODES..=MAX_MAX_NODES`, default [`DEFAULT_MAX_NODES`].
 pub fn max_nodes(v: Option<usize>) -> PyResult<usize> {

@@ -80,6 +80,27 @@ def test_bad_arguments_name_the_argument(pmma):
         diffbvp.fit(pmma, effects=["radiaton"])
     with pytest.raises(InputError, match="at least 2 points"):
         diffbvp.landscape(pmma, grid=(1, 5))
+    with pytest.raises(InputError, match=r"tol: the tolerance must lie in"):
+        diffbvp.fit(pmma, tol=0.5)
+    with pytest.raises(InputError, match="relative_uncertainty must lie in"):
+        diffbvp.compare(pmma, n=0.8, kappa=11.7, relative_uncertainty=2.0)
+    with pytest.raises(InputError, match="no \\(n, kappa\\) to start from"):
+        diffbvp.fit(pmma, model="newtonian", start=(0.5, 11.0))
+    with pytest.raises(InputError, match="refit_top"):
+        diffbvp.diagnose(pmma, refit_top=0)
+
+
+def test_a_bad_fit_summary_is_refused_naming_the_field(pmma, pmma_fit):
+    bad = dict(pmma_fit.summary)
+    bad["take_up_factors"] = bad["take_up_factors"][:3]  # not one per experiment
+    with pytest.raises(InputError, match="the fit"):
+        diffbvp.compare(pmma, bad)
+    bad = dict(pmma_fit.summary)
+    bad["n"] = dict(bad["n"], value=7.0)  # outside any law's range
+    with pytest.raises(InputError, match="the fit.*n"):
+        diffbvp.compare(pmma, bad)
+    with pytest.raises(InputError, match="not a fit report"):
+        diffbvp.compare(pmma, {"hello": 1})
 
 
 def test_failed_simulation_names_experiment_line_and_causes(rheometer, pmma):

@@ -28,31 +28,55 @@ def test_dataset_from_arrays_fits_as_the_file(pmma, pmma_fit):
     for k, (p, d) in pmma.measurements().items():
         p2, d2 = ds.measurements()[k]
         assert np.array_equal(p, p2) and np.array_equal(d, d2)
-    assert_same(pmma_fit.report, diffbvp.fit(ds).report)
+    assert_same(pmma_fit.summary, diffbvp.fit(ds).summary)
 
 
 def test_pickle_round_trips(pmma, pmma_fit, radiation_diagnosis):
-    for obj in (pmma_fit, radiation_diagnosis, diffbvp.simulate(pmma, 0.8, 11.7, points=5, take_up_from_data=True)):
+    for obj in (pmma_fit, radiation_diagnosis, diffbvp.simulate(pmma, 0.8, 11.7, points=5, take_up_from_data=True),
+                pmma_fit.n, radiation_diagnosis.candidates[0]):
         back = pickle.loads(pickle.dumps(obj))
         assert type(back) is type(obj) and back == obj and repr(back) == repr(obj)
     ds = pickle.loads(pickle.dumps(pmma))
     assert ds.toml == pmma.toml and ds.names == pmma.names
     for k, (p, d) in pmma.measurements().items():
         assert np.array_equal(ds.measurements()[k][1], d)
-    assert pickle.loads(pickle.dumps(radiation_diagnosis)).best_fit == radiation_diagnosis.best_fit
+    assert pickle.loads(pickle.dumps(radiation_diagnosis)).final_fit == radiation_diagnosis.final_fit
 
 
 def test_repr_and_to_dict(pmma_fit, radiation_diagnosis):
     r = repr(pmma_fit)
     assert r.startswith("FitResult(n=0.804±0.007, kappa=11.63±0.09, rms=1.7 %")
+    assert repr(pmma_fit.n) == "Estimate(n=0.804±0.007)" and float(pmma_fit.n) == pmma_fit.n.value
+    assert str(pmma_fit.K).endswith(" Pa")
     d = pmma_fit.to_dict()
-    assert d["n"] == pmma_fit.n and isinstance(d["covariance"], list)
+    assert d["n"] == pmma_fit.n.to_dict() and isinstance(d["covariance"]["matrix"], list)
     import json
     json.dumps(d)  # plain data
-    assert "radiation" in repr(radiation_diagnosis)
+    json.dumps(radiation_diagnosis.to_dict())
+    r = repr(radiation_diagnosis)
+    assert "radiation" in r and radiation_diagnosis.verdict["kind"] in r
+    assert "radiation" in repr(radiation_diagnosis.candidate("radiation"))
     pd = pytest.importorskip("pandas")
     df = pd.DataFrame(pmma_fit.residuals_table())
-    assert len(df) == pmma_fit.report["residuals"]
+    assert len(df) == pmma_fit.summary["residuals"]
+    est = pd.DataFrame(pmma_fit.estimates_table())
+    assert list(est.name) == ["n", "kappa"] and est.stderr[0] == pmma_fit.n.stderr
+    cands = pd.DataFrame(radiation_diagnosis.candidates_table())
+    assert cands.effect[0] == radiation_diagnosis.candidates[0].effect
+
+
+def test_set_threads(pmma):
+    default = diffbvp.threads()
+    try:
+        diffbvp.set_threads(1)
+        assert diffbvp.threads() == 1
+        with pytest.raises(diffbvp.InputError, match="set_threads"):
+            diffbvp.set_threads(0)
+        one = diffbvp.simulate(pmma, 0.8, 11.7, points=5, take_up_from_data=True)
+    finally:
+        diffbvp.set_threads(None)
+    assert diffbvp.threads() == default
+    assert one == diffbvp.simulate(pmma, 0.8, 11.7, points=5, take_up_from_data=True)
 
 
 def test_sensitivities_match_finite_differences(pmma):

@@ -11,13 +11,14 @@
 
 use super::diagnostics::compare::CompareError;
 use super::error::FiberError;
-use super::input::Location;
+use super::input::{LoadedExperiments, Location};
 use super::rheometer::RheometerError;
 use super::setup::{Experiment, Inlet, Material, TakeUp};
 use crate::error::BvpError;
 use std::error::Error;
 use std::f64::consts::PI;
 use std::fmt;
+use std::path::Path;
 
 /// Below this distance \[K\] between the coldest prescribed temperature (inlet or air) and the
 /// VFT temperature `T_VF`, a non-finite solve is blamed on the VFT law.
@@ -190,6 +191,40 @@ pub fn hints(
         );
     }
     out
+}
+
+/// The failure `e` as an [`ExperimentFailure`] naming the experiment and its line in the
+/// experiments file `path` of `loaded`, with hints, where the error chain names an experiment
+/// whose simulation failed ([`failed_experiment`]); other errors (and failures already named)
+/// unchanged. `law` are the law parameters `(n, κ)` of the solve where the error does not
+/// state them.
+pub fn name_experiment(
+    e: Box<dyn Error + 'static>,
+    loaded: &LoadedExperiments,
+    path: &Path,
+    law: Option<[f64; 2]>,
+) -> Box<dyn Error + 'static> {
+    if e.downcast_ref::<ExperimentFailure>().is_some() {
+        return e;
+    }
+    let Some((name, stated)) = failed_experiment(e.as_ref()) else {
+        return e;
+    };
+    let law = stated.or(law);
+    let at = |line| Location {
+        path: path.to_path_buf(),
+        line,
+    };
+    match loaded.set.experiments.iter().position(|x| x.name == name) {
+        Some(k) => Box::new(ExperimentFailure::new(
+            &loaded.set.experiments[k],
+            &loaded.set.material,
+            at(loaded.details.get(k).and_then(|d| d.line)),
+            law,
+            e,
+        )),
+        None => Box::new(ExperimentFailure::unlocated(&name, at(None), e)),
+    }
 }
 
 /// A failed simulation of one experiment: its name, its place in the TOML file, the law

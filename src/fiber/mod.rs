@@ -13,6 +13,8 @@
 //! * [`cold_start`]: continuation from the stress-free fiber;
 //! * [`failure_hints`]: simulation failures naming their experiment, with likely causes;
 //! * [`mod@simulate`]: the user-facing API with SI profiles;
+//! * [`profile_sensitivities`]: exact derivatives of the SI profiles with respect to the law
+//!   parameters and the effects' strengths;
 //! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
 //! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
 //! * [`figures`]: profile, fit and landscape figures (PNG/SVG);
@@ -38,6 +40,7 @@ pub mod model;
 pub mod noise_model;
 pub mod noise_summary;
 pub mod output;
+pub mod profile_sensitivities;
 pub mod rheometer;
 pub mod scaling;
 pub(crate) mod serde_nan;

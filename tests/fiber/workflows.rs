@@ -145,6 +145,7 @@ fn simulate_reproduces_the_program() {
         points: 11,
         simulate: SimulateOptions::default(),
         source: toml.clone(),
+        ..SimulateRequest::new([0.8, 11.71], PathBuf::new())
     };
     let lib =
         workflow::simulate_experiments(&data, &request, |_, _| std::ops::ControlFlow::Continue(()))

@@ -250,35 +250,21 @@ pub fn name_experiment(e: Box<dyn Error>, toml: &Path, law: Option<[f64; 2]>) ->
     if e.downcast_ref::<ExperimentFailure>().is_some() {
         return e;
     }
-    let Some((name, stated)) = diffbvp::fiber::failure_hints::failed_experiment(e.as_ref()) else {
+    let Some((name, _)) = diffbvp::fiber::failure_hints::failed_experiment(e.as_ref()) else {
         return e;
     };
-    let law = stated.or(law);
     let loaded = std::fs::read_to_string(toml)
         .ok()
         .and_then(|text| parse_experiments(&text, toml).ok());
-    let unlocated = Location {
-        path: toml.to_path_buf(),
-        line: None,
-    };
-    let Some(loaded) = loaded else {
-        return Box::new(ExperimentFailure::unlocated(&name, unlocated, e));
-    };
-    match loaded.set.experiments.iter().position(|x| x.name == name) {
-        Some(k) => {
-            let at = Location {
+    match loaded {
+        Some(loaded) => diffbvp::fiber::failure_hints::name_experiment(e, &loaded, toml, law),
+        None => {
+            let unlocated = Location {
                 path: toml.to_path_buf(),
-                line: loaded.details[k].line,
+                line: None,
             };
-            Box::new(ExperimentFailure::new(
-                &loaded.set.experiments[k],
-                &loaded.set.material,
-                at,
-                law,
-                e,
-            ))
+            Box::new(ExperimentFailure::unlocated(&name, unlocated, e))
         }
-        None => Box::new(ExperimentFailure::unlocated(&name, unlocated, e)),
     }
 }
 

@@ -109,6 +109,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         start: start.map(|(n, k)| [n, k]),
         baseline: out.is_some(),
         newtonian_reference: out.is_some(),
+        ..FitRequest::new(IdentifyOptions::default())
     };
     let run = workflow::fit(&loaded, &request)?;
     if let Some(sp) = &run.start_heuristic {

@@ -79,6 +79,7 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             ..SimulateOptions::default()
         },
         source: experiments.clone(),
+        ..SimulateRequest::new(law, PathBuf::new())
     };
     // each profile written (and the manifest updated) as soon as it is finished
     let mut write_error: Option<Box<dyn Error>> = None;

@@ -24,6 +24,9 @@ pub struct FitRequest {
     pub baseline: bool,
     /// Also solve the Newtonian model at the fitted `κ` (paper Fig. 3's reference curves).
     pub newtonian_reference: bool,
+    /// Compute the error budget (default `true`; a bootstrap replicate or a screening that
+    /// needs only the estimates saves about half the fit's time without it).
+    pub error_budget: bool,
 }
 
 impl FitRequest {
@@ -35,6 +38,7 @@ impl FitRequest {
             start: None,
             baseline: false,
             newtonian_reference: false,
+            error_budget: true,
         }
     }
 
@@ -75,8 +79,8 @@ impl FitRun {
 
 /// Fits `request`'s model to `data`: the start (given, heuristic or Newtonian), the
 /// identification, its error budget (declared or default uncertainties of what the data cannot
-/// identify; a budget that cannot be computed does not fail the fit) and the optional
-/// reference computations.
+/// identify; a budget that cannot be computed does not fail the fit; none unless
+/// [`FitRequest::error_budget`]) and the optional reference computations.
 pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, RheometerError> {
     request.model.validate().map_err(RheometerError::Data)?;
     let opts = &request.identify;
@@ -90,12 +94,16 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
         }
     };
     let mut id = rh.identify(start, opts)?;
-    let budget_error = match error_budget(&rh, &id, &data.uncertainty, opts) {
-        Ok(budget) => {
+    let budget = request
+        .error_budget
+        .then(|| error_budget(&rh, &id, &data.uncertainty, opts));
+    let budget_error = match budget {
+        Some(Ok(budget)) => {
             id.summary = id.summary.clone().with_error_budget(budget);
             None
         }
-        Err(e) => Some(e.to_string()),
+        Some(Err(e)) => Some(e.to_string()),
+        None => None,
     };
     let baseline = if request.baseline && !request.model.effects.is_empty() {
         let rh0 = Rheometer::with_spec(&data.set, ModelSpec::new(request.model.law))?;

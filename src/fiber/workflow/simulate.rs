@@ -1,13 +1,16 @@
-//! The `simulate` workflow: every experiment of a data set at given law parameters, with the
-//! take-up rule for experiments without a take-up condition, each result handed to the caller
-//! as soon as it is finished (so that a long run can be written and stopped experiment by
-//! experiment).
+//! The `simulate` workflow: every experiment of a data set at given law parameters (and fixed
+//! effect strengths), with the take-up rule for experiments without a take-up condition, each
+//! result handed to the caller as soon as it is finished (so that a long run can be written
+//! and stopped experiment by experiment), optionally with the exact sensitivities of the
+//! profiles ([`profile_sensitivities`]).
 
+use crate::fiber::effects::{physics_with, Effect};
 use crate::fiber::failure_hints::ExperimentFailure;
 use crate::fiber::input::{LoadedExperiments, Location};
+use crate::fiber::profile_sensitivities::{profile_sensitivities, ProfileSensitivities};
 use crate::fiber::simulate::{simulate, Profiles, SimulateOptions};
 use crate::fiber::take_up::{resolve_take_up, MissingTakeUp, TakeUpError};
-use crate::fiber::{CarreauLike, FiberModel, Physics};
+use crate::fiber::{CarreauLike, FiberModel};
 use std::fmt;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
@@ -25,6 +28,32 @@ pub struct SimulateRequest {
     pub simulate: SimulateOptions,
     /// The experiments file, for the location of a failed experiment.
     pub source: PathBuf,
+    /// Effects added to the paper's physics with fixed strengths (each in its effect's unit;
+    /// empty: the paper's model).
+    pub effects: Vec<(Effect, f64)>,
+    /// Output positions \[m\] used for every experiment instead of `points` uniform ones.
+    pub positions: Option<Vec<f64>>,
+    /// Also compute the exact sensitivities of the profiles with respect to `n`, `κ` and the
+    /// effects' strengths ([`SimulatedProfile::sensitivities`]).
+    pub sensitivities: bool,
+}
+
+impl SimulateRequest {
+    /// The paper's model at `law = (n, κ)`, 101 uniform positions, default BVP settings, no
+    /// take-up rule (an experiment without a take-up condition is an error); `source` names
+    /// the experiments file in messages.
+    pub fn new(law: [f64; 2], source: PathBuf) -> Self {
+        SimulateRequest {
+            law,
+            missing_take_up: MissingTakeUp::Error,
+            points: 101,
+            simulate: SimulateOptions::default(),
+            source,
+            effects: Vec::new(),
+            positions: None,
+            sensitivities: false,
+        }
+    }
 }
 
 /// One experiment's simulation.
@@ -38,6 +67,9 @@ pub struct SimulatedProfile {
     pub nodes: usize,
     /// The take-up diameter \[m\] taken from the smoothed measurements, if it was.
     pub take_up_from_data: Option<f64>,
+    /// Exact `d(profile)/d(n, κ, strengths)` at the profiles' positions
+    /// ([`SimulateRequest::sensitivities`]).
+    pub sensitivities: Option<ProfileSensitivities>,
 }
 
 /// Why the `simulate` workflow stopped.
@@ -45,6 +77,8 @@ pub struct SimulatedProfile {
 pub enum SimulateError {
     /// An experiment has no usable take-up condition (in words, naming it and what to do).
     TakeUp(String),
+    /// The effects cannot be combined into a model (in words).
+    Effects(String),
     /// An experiment's model failed (named, with its TOML line and likely causes).
     Experiment(Box<ExperimentFailure>),
     /// The caller stopped the run after `done` experiments.
@@ -57,7 +91,7 @@ pub enum SimulateError {
 impl fmt::Display for SimulateError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SimulateError::TakeUp(m) => f.write_str(m),
+            SimulateError::TakeUp(m) | SimulateError::Effects(m) => f.write_str(m),
             SimulateError::Experiment(e) => write!(f, "{e}"),
             SimulateError::Stopped { done } => write!(f, "stopped after {done} experiments"),
         }
@@ -81,6 +115,7 @@ pub fn simulate_experiments(
     mut each: impl FnMut(usize, &SimulatedProfile) -> ControlFlow<()>,
 ) -> Result<Vec<SimulatedProfile>, SimulateError> {
     let set = &data.set;
+    physics_with(&request.effects).map_err(SimulateError::Effects)?;
     let mut out = Vec::with_capacity(set.experiments.len());
     for k in 0..set.experiments.len() {
         let p = simulate_one(data, request, k)?;
@@ -154,19 +189,25 @@ fn simulate_one(
         }
         SimulateError::Experiment(Box::new(f))
     };
-    let model = FiberModel::new(
-        &set.material,
-        &set.air,
-        &e,
-        CarreauLike::new(),
-        Physics::paper(),
-    )
-    .map_err(failed)?;
+    // checked in `simulate_experiments`
+    let physics = physics_with(&request.effects).map_err(SimulateError::Effects)?;
+    let model =
+        FiberModel::new(&set.material, &set.air, &e, CarreauLike::new(), physics).map_err(failed)?;
     let sol = simulate(&model, &request.law, &request.simulate).map_err(failed)?;
+    let profiles = match &request.positions {
+        Some(p) => sol.profiles(&model, p),
+        None => sol.uniform_profiles(&model, request.points),
+    };
+    let sensitivities = if request.sensitivities {
+        Some(profile_sensitivities(&model, &sol, &profiles.position).map_err(failed)?)
+    } else {
+        None
+    };
     Ok(SimulatedProfile {
         name: e.name.clone(),
-        profiles: sol.uniform_profiles(&model, request.points),
+        profiles,
         nodes: sol.nodes(),
         take_up_from_data: from_data,
+        sensitivities,
     })
 }
