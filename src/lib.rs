@@ -49,7 +49,8 @@
 //! it. The toolkit, bottom to top:
 //!
 //! 1. [`error`], [`problem`], [`mesh`], [`dyn_dual`];
-//! 2. dual Jacobians, collocation, [`linear`] (sparse LU), error control, Newton, [`solution`];
+//! 2. dual Jacobians, collocation, [`linear`] (sparse LU), error control, Newton, [`solution`],
+//!    the watch for a mesh that does not settle;
 //! 3. [`solve`](mod@solve) (the adaptive loop);
 //! 4. [`continuation`], [`sensitivity`], [`inspect`];
 //! 5. [`least_squares`] (the bounded driver; its [`BvpResiduals`](least_squares::BvpResiduals)
@@ -99,6 +100,7 @@ pub mod least_squares;
 pub mod linear;
 mod linearization;
 pub mod mesh;
+mod mesh_cycle;
 mod newton;
 #[cfg(feature = "plots")]
 pub mod plot;
