@@ -152,7 +152,7 @@ impl Solution {
     }
 
     /// [`eval_into`](Self::eval_into) with the buffer lengths checked: a
-    /// [`BvpError::InvalidInput`](crate::BvpError::InvalidInput) naming the buffer and both
+    /// [`BvpError::InvalidInput`] naming the buffer and both
     /// lengths when `y` or `yp` is shorter than `n`.
     pub fn try_eval_into(&self, x: f64, y: &mut [f64], yp: &mut [f64]) -> Result<(), BvpError> {
         for (name, len) in [("y", y.len()), ("yp", yp.len())] {
