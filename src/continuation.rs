@@ -7,7 +7,8 @@
 //! * [`follow`]: either step control ([`StepControl`]) with solve options passed per call.
 //! * [`solve_by_continuation`]: a path from a guess at the start value, intermediate points at
 //!   a loose tolerance ([`PathOptions`]), the last point solved again at the caller's options.
-//! * [`secant_guess`]: the warm start extrapolated from the last two solutions of a path.
+//! * [`secant_guess`]: the warm start extrapolated from the last two solutions of a path
+//!   ([`try_secant_guess`]: the same with mismatched solutions reported as an error).
 //! * [`bisect_step`]: a failed step retried in halves, with a stop check before every solve.
 //! * [`sweep`]: one solve per parameter value, each warm-started from the previous one.
 //!
@@ -375,8 +376,8 @@ impl Default for SimpleSteps {
 
 impl SimpleSteps {
     /// Checks the options: `initial_step > 0`, `min_step > 0`, `grow >= 1`, `0 < shrink < 1`
-    /// (NaN fails every check). The error names the option and its value. [`follow`] calls
-    /// this before any solve.
+    /// (NaN fails every check), `max_steps >= 1`. The error names the option and its value.
+    /// [`follow`] calls this before any solve.
     pub fn validate(&self) -> Result<(), BvpError> {
         let owner = "SimpleSteps";
         check_positive(
@@ -389,6 +390,11 @@ impl SimpleSteps {
         )?;
         if self.grow.is_nan() || self.grow < 1.0 {
             return bad_option(owner, "grow", self.grow, "must be at least 1");
+        }
+        if self.max_steps == 0 {
+            return Err(BvpError::InvalidInput(
+                "SimpleSteps::max_steps = 0 must be at least 1".into(),
+            ));
         }
         check_shrink(owner, self.shrink)
     }
@@ -567,6 +573,23 @@ impl Default for PathOptions {
 }
 
 impl PathOptions {
+    /// Checks the options: the step control's ([`StepControl::validate`]) and
+    /// `0 < intermediate_tol < 1` (a relative residual; NaN fails). The error names the option
+    /// and its value. [`solve_by_continuation`] calls this before any solve.
+    pub fn validate(&self) -> Result<(), BvpError> {
+        self.step_control.validate()?;
+        let t = self.intermediate_tol;
+        if !(t > 0.0 && t < 1.0) {
+            return bad_option(
+                "PathOptions",
+                "intermediate_tol",
+                t,
+                "must lie in (0, 1) (it bounds a relative residual, as SolveOptions::tol)",
+            );
+        }
+        Ok(())
+    }
+
     /// The solve options of the start and intermediate points for final options `options`:
     /// `tol` and `bc_tol` at least [`intermediate_tol`](Self::intermediate_tol), no
     /// factorisation at the solution.
@@ -605,7 +628,7 @@ pub fn solve_by_continuation<P: Bvp>(
             params.len()
         )));
     }
-    path.step_control.validate()?;
+    path.validate()?;
     let loose = path.intermediate(options);
     let start = solver.solve_with(params, guess, &loose)?;
     let reached = follow(solver, &start, index, target, &path.step_control, &loose)?;
@@ -620,8 +643,30 @@ pub fn solve_by_continuation<P: Bvp>(
 /// extrapolated alike when `a` and `b` have the same number of them, else those of `a` are
 /// kept. On the fiber model it saves about a third of the Newton iterations of a warm start
 /// from `a` itself.
+///
+/// It never panics: when `b` cannot be extrapolated from (another number of states than `a`,
+/// or a non-finite `t`), the warm start is `a` itself, `Guess::from(a)`.
+/// [`try_secant_guess`] reports those cases as errors instead.
 pub fn secant_guess(a: &Solution, b: &Solution, t: f64) -> Guess {
+    try_secant_guess(a, b, t).unwrap_or_else(|_| Guess::from(a))
+}
+
+/// [`secant_guess`] with checked input: `a` and `b` must have the same number of states and
+/// `t` must be finite, else a [`BvpError::InvalidInput`] naming both dimensions (or `t`).
+pub fn try_secant_guess(a: &Solution, b: &Solution, t: f64) -> Result<Guess, BvpError> {
     let n = a.n;
+    if b.n != n {
+        return Err(BvpError::InvalidInput(format!(
+            "secant_guess: the solutions have different dimensions: a has {n} states, b has {}; \
+             both must be solutions of the same problem",
+            b.n
+        )));
+    }
+    if !t.is_finite() {
+        return Err(BvpError::InvalidInput(format!(
+            "secant_guess: the extrapolation factor t = {t} is not finite"
+        )));
+    }
     let mut y = a.y.clone();
     let (mut yb, mut ypb) = (vec![0.0; n], vec![0.0; n]);
     for (i, &x) in a.x.iter().enumerate() {
@@ -640,11 +685,11 @@ pub fn secant_guess(a: &Solution, b: &Solution, t: f64) -> Guess {
     } else {
         a.unknowns.clone()
     };
-    Guess {
+    Ok(Guess {
         x: a.x.clone(),
         y,
         unknowns,
-    }
+    })
 }
 
 /// Reaches `to` from `from` with a solve at `to` and, if it fails, by recursively halving the

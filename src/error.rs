@@ -68,6 +68,11 @@ pub enum BvpError {
         bc_tol: f64,
     },
 
+    /// The mesh loop ended without meeting the tolerances after its mesh had stopped settling
+    /// (the figures boxed: they would double the size of every `BvpError`).
+    #[error("{0}")]
+    MeshCycling(Box<MeshCycle>),
+
     /// The right-hand side or the boundary residual returned a non-finite value.
     #[error("non-finite value in {what}: component {component} at x = {x:e}")]
     NonFinite {
@@ -93,4 +98,54 @@ pub enum BvpError {
         /// The last solver failure.
         last_error: Box<BvpError>,
     },
+}
+
+/// The figures of a mesh loop that ended without meeting the tolerances after its mesh had
+/// stopped settling ([`BvpError::MeshCycling`]): over several refinement passes the node count
+/// stayed between `low` and `high` while the residual did not fall.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshCycle {
+    /// Mesh iterations done.
+    pub iterations: usize,
+    /// Smallest node count of the passes that showed the cycle.
+    pub low: usize,
+    /// Largest node count of the passes that showed the cycle.
+    pub high: usize,
+    /// The mesh iteration after which the refinement switched to scipy's rule (`None`:
+    /// [`MeshOptions::settle`](crate::mesh::MeshOptions::settle) was off).
+    pub switched_at: Option<usize>,
+    /// Largest RMS collocation residual on the last mesh.
+    pub max_residual: f64,
+    /// Requested tolerance.
+    pub tol: f64,
+    /// Largest boundary residual.
+    pub max_bc_residual: f64,
+    /// Requested boundary tolerance.
+    pub bc_tol: f64,
+    /// Which options to try.
+    pub hint: String,
+}
+
+impl std::fmt::Display for MeshCycle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "tolerance not met after {} mesh iterations: the mesh did not settle, it cycled \
+             between {} and {} nodes",
+            self.iterations, self.low, self.high
+        )?;
+        if let Some(k) = self.switched_at {
+            write!(
+                f,
+                ", and scipy's refinement rule, switched to after mesh iteration {k}, did not \
+                 converge either"
+            )?;
+        }
+        write!(
+            f,
+            " (largest RMS residual {:.3e}, tol {:.1e}; largest boundary residual {:.3e}, bc_tol \
+             {:.1e}); try {}",
+            self.max_residual, self.tol, self.max_bc_residual, self.bc_tol, self.hint
+        )
+    }
 }

@@ -51,7 +51,8 @@
 //!
 //! 1. [`error`], [`problem`], [`mesh`], [`dyn_dual`];
 //! 2. `dual_jacobian`, `collocation`, [`linear`] (sparse LU and block elimination),
-//!    `error_control`, `newton`, `linearization`, [`solution`];
+//!    `error_control`, `newton`, `linearization`, [`solution`],
+//!    `mesh_cycle` (the watch for a mesh that does not settle);
 //! 3. [`solve`](mod@solve) (the adaptive loop);
 //! 4. [`continuation`], [`sensitivity`], [`inspect`];
 //! 5. [`least_squares`] (the bounded driver; its [`BvpResiduals`](least_squares::BvpResiduals)
@@ -106,6 +107,7 @@ pub mod least_squares;
 pub mod linear;
 mod linearization;
 pub mod mesh;
+mod mesh_cycle;
 mod newton;
 #[cfg(feature = "plots")]
 pub mod plot;

@@ -7,19 +7,77 @@ use crate::error::BvpError;
 /// `m` equally spaced nodes on `[a, b]`, the last one exactly `b`. `m = 0` gives an empty
 /// vector and `m = 1` gives `[a]` (as numpy's `linspace`); neither is a valid mesh
 /// ([`validate`] needs two nodes).
+///
+/// Finite ends whose distance `b - a` overflows `f64` (e.g. `-f64::MAX` and `f64::MAX`) still
+/// give finite, equally spaced nodes. A non-finite end (NaN or `±inf`) gives non-finite nodes,
+/// as the arithmetic does (numpy alike); [`try_linspace`] refuses such ends with an error
+/// instead.
+///
+/// # Panics
+///
+/// Panics if `m` nodes cannot be allocated (as `Vec::with_capacity` does); [`try_linspace`]
+/// returns an error instead.
 pub fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
     match m {
         0 => return Vec::new(),
         1 => return vec![a],
         _ => {}
     }
-    let h = (b - a) / (m - 1) as f64;
-    (0..m)
-        .map(|i| if i == m - 1 { b } else { a + h * i as f64 })
-        .collect()
+    let mut out = Vec::with_capacity(m);
+    fill_linspace(a, b, m, &mut out);
+    out
 }
 
-/// Checks that a mesh has at least two finite, strictly increasing nodes.
+/// [`linspace`] with checked input: both ends finite and the `m` nodes allocatable, else a
+/// [`BvpError::InvalidInput`] that names the offending end (or the node count). The nodes are
+/// those of [`linspace`], bit for bit.
+pub fn try_linspace(a: f64, b: f64, m: usize) -> Result<Vec<f64>, BvpError> {
+    for (name, v) in [("start a", a), ("end b", b)] {
+        if !v.is_finite() {
+            return Err(BvpError::InvalidInput(format!(
+                "linspace: the {name} = {v} is not finite; both ends of a mesh must be finite numbers"
+            )));
+        }
+    }
+    let mut out = Vec::new();
+    out.try_reserve_exact(m).map_err(|_| {
+        BvpError::InvalidInput(format!(
+            "linspace: cannot allocate {m} nodes; ask for fewer"
+        ))
+    })?;
+    match m {
+        0 => {}
+        1 => out.push(a),
+        _ => fill_linspace(a, b, m, &mut out),
+    }
+    Ok(out)
+}
+
+/// Pushes the `m >= 2` nodes of [`linspace`] onto `out`.
+fn fill_linspace(a: f64, b: f64, m: usize, out: &mut Vec<f64>) {
+    let den = (m - 1) as f64;
+    let h = (b - a) / den;
+    if h.is_finite() || !a.is_finite() || !b.is_finite() {
+        out.extend((0..m).map(|i| if i == m - 1 { b } else { a + h * i as f64 }));
+    } else {
+        // finite ends whose distance overflows: weights of the ends (no overflow on the way)
+        out.extend((0..m).map(|i| {
+            if i == m - 1 {
+                b
+            } else {
+                let t = i as f64 / den;
+                a * (1.0 - t) + b * t
+            }
+        }));
+    }
+}
+
+/// Checks that a mesh has at least two finite, strictly increasing nodes and is not degenerate:
+/// every interval's width `h = x[i+1] - x[i]` must be finite (not overflowing `f64`), a normal
+/// number whose reciprocal is finite, and wide enough that the collocation and quadrature
+/// points inside it (at `x[i] + h/2` and `x[i] + (1/2 ± √(3/28)) h`) are distinct from its
+/// ends, which needs `h >= 64 ε max(|x[i]|, |x[i+1]|)` (ε = `f64::EPSILON`). The error names
+/// the node or interval and says what to change.
 pub fn validate(x: &[f64]) -> Result<(), BvpError> {
     if x.len() < 2 {
         return Err(BvpError::InvalidInput(format!(
@@ -29,9 +87,10 @@ pub fn validate(x: &[f64]) -> Result<(), BvpError> {
     }
     for (i, w) in x.windows(2).enumerate() {
         if !w[0].is_finite() || !w[1].is_finite() {
+            let j = if w[0].is_finite() { i + 1 } else { i };
             return Err(BvpError::InvalidInput(format!(
-                "mesh node {} is not finite",
-                if w[0].is_finite() { i + 1 } else { i }
+                "mesh node {j} is not finite (x[{j}] = {})",
+                x[j]
             )));
         }
         if w[1] <= w[0] {
@@ -43,6 +102,34 @@ pub fn validate(x: &[f64]) -> Result<(), BvpError> {
                 w[1]
             )));
         }
+        degenerate_interval(i, w[0], w[1])?;
+    }
+    Ok(())
+}
+
+/// The error of [`validate`] for interval `i = [a, b]` (`a < b`, both finite) when it is
+/// degenerate.
+fn degenerate_interval(i: usize, a: f64, b: f64) -> Result<(), BvpError> {
+    let h = b - a;
+    if !h.is_finite() {
+        return Err(BvpError::InvalidInput(format!(
+            "the mesh is degenerate: the width of interval {i}, x[{}] - x[{i}] = {b:e} - ({a:e}), \
+             overflows f64; rescale the independent variable (e.g. x' = x / {:e}) so that the \
+             interval widths stay below about 1e308",
+            i + 1,
+            b.abs().max(a.abs())
+        )));
+    }
+    let resolvable = 64.0 * f64::EPSILON * a.abs().max(b.abs());
+    if !h.is_normal() || !(1.0 / h).is_finite() || h < resolvable {
+        return Err(BvpError::InvalidInput(format!(
+            "the mesh is degenerate: interval {i}, [x[{i}], x[{}]] = [{a:e}, {b:e}], has the width \
+             {h:e}, too small to place the collocation points inside it in f64 (at least \
+             {:e} is needed here); rescale the independent variable or remove node {}",
+            i + 1,
+            resolvable.max(f64::MIN_POSITIVE),
+            i + 1
+        )));
     }
     Ok(())
 }
@@ -53,7 +140,8 @@ pub fn validate(x: &[f64]) -> Result<(), BvpError> {
 ///
 /// # Panics
 ///
-/// Panics if `nodes_per_interval` has fewer than `x.len() - 1` entries.
+/// Panics if `nodes_per_interval` has fewer than `x.len() - 1` entries; [`try_refine`]
+/// returns an error instead.
 pub fn refine(x: &[f64], nodes_per_interval: &[u8]) -> Vec<f64> {
     if x.len() < 2 {
         return x.to_vec();
@@ -75,6 +163,37 @@ pub fn refine(x: &[f64], nodes_per_interval: &[u8]) -> Vec<f64> {
     }
     out.push(x[x.len() - 1]);
     out
+}
+
+/// [`refine`] with the lengths checked: a [`BvpError::InvalidInput`] naming both lengths when
+/// `nodes_per_interval` has fewer than `x.len() - 1` entries.
+pub fn try_refine(x: &[f64], nodes_per_interval: &[u8]) -> Result<Vec<f64>, BvpError> {
+    check_per_interval(
+        "nodes_per_interval",
+        nodes_per_interval.len(),
+        x.len(),
+        false,
+    )?;
+    Ok(refine(x, nodes_per_interval))
+}
+
+/// Checks that a per-interval list `name` of `len` entries fits a mesh of `nodes` nodes: at
+/// least (`exact`: exactly) one entry per interval.
+fn check_per_interval(name: &str, len: usize, nodes: usize, exact: bool) -> Result<(), BvpError> {
+    let intervals = nodes.saturating_sub(1);
+    let fits = if exact {
+        len == intervals || nodes < 2
+    } else {
+        len >= intervals
+    };
+    if fits {
+        Ok(())
+    } else {
+        Err(BvpError::InvalidInput(format!(
+            "{name} has {len} entries, but the mesh of {nodes} nodes has {intervals} intervals \
+             (one entry per interval expected)"
+        )))
+    }
 }
 
 /// Marks intervals for refinement: 1 node where `tol < r < 100 tol`, 2 nodes where `r >= 100 tol`
@@ -144,6 +263,16 @@ pub struct MeshOptions {
     /// residual per old interval was up to 2.2 times the constant prediction, forcing a second
     /// full pass for two intervals.
     pub smooth: bool,
+    /// Switch to scipy's rule ([`RefineRule::Scipy`]) for the rest of a solve when the
+    /// equidistributed mesh does not settle (default `true`): over three refinement passes the
+    /// mesh grew by at most 10 % and the largest residual did not halve, as happens on
+    /// solutions with tens of oscillations, where the mesh follows the phase of the computed
+    /// solution and the phase follows the mesh. scipy's rule only adds nodes, so it cannot
+    /// cycle. The pass of the switch is
+    /// [`SolveStats::mesh_rule_switched_at`](crate::SolveStats::mesh_rule_switched_at); with
+    /// `false` a cycling mesh ends in
+    /// [`BvpError::MeshCycling`] once `max_mesh_iterations` are spent.
+    pub settle: bool,
 }
 
 impl Default for MeshOptions {
@@ -155,6 +284,7 @@ impl Default for MeshOptions {
             max_pieces: 16,
             max_growth: 1.5,
             smooth: false,
+            settle: true,
         }
     }
 }
@@ -216,7 +346,8 @@ pub fn plan(rms: &[f64], tol: f64, opts: &MeshOptions, marks: &mut Vec<u8>) -> u
 ///
 /// # Panics
 ///
-/// Panics if `rms` (or, for the scipy rule, `marks`) has fewer than `x.len() - 1` entries.
+/// Panics if `rms` (or, for the scipy rule, `marks`) has fewer than `x.len() - 1` entries;
+/// [`try_apply`] returns an error instead.
 pub fn apply(
     x: &[f64],
     rms: &[f64],
@@ -239,6 +370,23 @@ pub fn apply(
             equidistribute(x, rms, tol, opts, cap)
         }
     }
+}
+
+/// [`apply`] with the lengths checked: a [`BvpError::InvalidInput`] naming the list and both
+/// lengths when `rms` (or, for the scipy rule, `marks`) has fewer than `x.len() - 1` entries.
+pub fn try_apply(
+    x: &[f64],
+    rms: &[f64],
+    marks: &[u8],
+    tol: f64,
+    opts: &MeshOptions,
+    max_nodes: usize,
+) -> Result<Vec<f64>, BvpError> {
+    check_per_interval("rms", rms.len(), x.len(), false)?;
+    if opts.rule == RefineRule::Scipy {
+        check_per_interval("marks", marks.len(), x.len(), false)?;
+    }
+    Ok(apply(x, rms, marks, tol, opts, max_nodes))
 }
 
 /// Redistributes the nodes of `x` (at least two) so that each new interval holds at most one
@@ -349,7 +497,8 @@ fn distribute(x: &[f64], w: &[f64], max_intervals: usize) -> Vec<f64> {
 ///
 /// # Panics
 ///
-/// Panics if `rms` has more than `x.len() - 1` entries.
+/// Panics if `rms` has more than `x.len() - 1` entries; [`try_coarsen`] returns an error
+/// instead.
 pub fn coarsen(x: &[f64], rms: &[f64], threshold: f64) -> Vec<f64> {
     if x.len() < 2 {
         return x.to_vec();
@@ -369,6 +518,15 @@ pub fn coarsen(x: &[f64], rms: &[f64], threshold: f64) -> Vec<f64> {
         }
     }
     out
+}
+
+/// [`coarsen`] with the lengths checked: a [`BvpError::InvalidInput`] naming both lengths when
+/// `rms` has more than `x.len() - 1` entries.
+pub fn try_coarsen(x: &[f64], rms: &[f64], threshold: f64) -> Result<Vec<f64>, BvpError> {
+    if rms.len() > x.len().saturating_sub(1) {
+        check_per_interval("rms", rms.len(), x.len(), true)?;
+    }
+    Ok(coarsen(x, rms, threshold))
 }
 
 #[cfg(test)]

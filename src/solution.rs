@@ -26,6 +26,10 @@ pub struct SolveStats {
     pub max_residual: f64,
     /// Largest absolute boundary-condition residual.
     pub max_bc_residual: f64,
+    /// The mesh iteration after which the refinement switched to scipy's rule because the
+    /// equidistributed mesh did not settle (see
+    /// [`MeshOptions::settle`](crate::mesh::MeshOptions::settle)); `None`: no switch.
+    pub mesh_rule_switched_at: Option<usize>,
 }
 
 impl SolveStats {
@@ -135,7 +139,8 @@ impl Solution {
     ///
     /// # Panics
     ///
-    /// Panics if `y` or `yp` is shorter than `n`.
+    /// Panics if `y` or `yp` is shorter than `n`; [`try_eval_into`](Self::try_eval_into)
+    /// returns an error instead.
     pub fn eval_into(&self, x: f64, y: &mut [f64], yp: &mut [f64]) {
         if !x.is_finite() {
             y[..self.n].fill(f64::NAN);
@@ -144,6 +149,22 @@ impl Solution {
         }
         let i = self.interval(x);
         hermite(&self.x, &self.y, &self.yp, self.n, i, x, y, yp);
+    }
+
+    /// [`eval_into`](Self::eval_into) with the buffer lengths checked: a
+    /// [`BvpError::InvalidInput`] naming the buffer and both
+    /// lengths when `y` or `yp` is shorter than `n`.
+    pub fn try_eval_into(&self, x: f64, y: &mut [f64], yp: &mut [f64]) -> Result<(), BvpError> {
+        for (name, len) in [("y", y.len()), ("yp", yp.len())] {
+            if len < self.n {
+                return Err(BvpError::InvalidInput(format!(
+                    "Solution::try_eval_into: the buffer {name} has {len} entries, the solution {} states",
+                    self.n
+                )));
+            }
+        }
+        self.eval_into(x, y, yp);
+        Ok(())
     }
 
     /// The interpolated state at `x` (see [`eval_into`](Self::eval_into) for `x` outside

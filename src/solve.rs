@@ -3,12 +3,13 @@
 //! residuals below `bc_tol`.
 
 use crate::collocation::Collocation;
-use crate::error::BvpError;
+use crate::error::{BvpError, MeshCycle};
 use crate::error_control::rms_residuals;
 use crate::linear::{Factorization, LinearSolverKind, LinearSystem, Pattern};
 use crate::linearization::Linearization;
 use crate::mesh;
-use crate::newton::{max_bc, newton, NewtonSettings, NewtonWork, Start};
+use crate::mesh_cycle::MeshControl;
+use crate::newton::{max_bc, newton, NewtonReport, NewtonSettings, NewtonWork, Start};
 use crate::problem::Bvp;
 use crate::solution::{resample, Solution, SolveStats};
 use std::cell::RefCell;
@@ -31,7 +32,8 @@ pub enum ResidualScale {
 /// Options of [`Solver`].
 #[derive(Debug, Clone)]
 pub struct SolveOptions {
-    /// Tolerance on the scaled RMS residual of every interval (default 1e-3, as scipy).
+    /// Tolerance on the scaled RMS residual of every interval (default 1e-3, as scipy; must lie
+    /// in (0, 1): the residual is relative, see [`ResidualScale`]).
     pub tol: f64,
     /// Tolerance on the absolute boundary residuals (default: `tol`).
     pub bc_tol: Option<f64>,
@@ -119,7 +121,8 @@ impl SolveOptions {
     }
 
     /// Checks the options for a problem with `n` states: `tol`, `bc_tol` and `newton_step_tol`
-    /// positive and finite, `max_nodes >= 2`, the iteration and factorisation budgets at least
+    /// positive and finite, `tol` and `newton_step_tol` below 1 (relative measures; `bc_tol` is
+    /// absolute, in the units of the boundary residuals), `max_nodes >= 2`, the iteration and factorisation budgets at least
     /// 1, and a [`ResidualScale::PerComponent`] of `n` positive finite values. The error names
     /// the option and its value. [`Solver::solve`] calls this before any work.
     pub fn validate(&self, n: usize) -> Result<(), BvpError> {
@@ -132,12 +135,25 @@ impl SolveOptions {
                 )))
             }
         };
-        positive("tol", self.tol)?;
+        // relative measures: 1 or more accepts any iterate, the initial guess included
+        let relative = |name: &str, v: f64| {
+            positive(name, v)?;
+            if v < 1.0 {
+                Ok(())
+            } else {
+                Err(BvpError::InvalidInput(format!(
+                    "SolveOptions::{name} must be below 1, got {v:e}: it bounds a relative \
+                     residual, and 1 or more would accept any iterate (the initial guess \
+                     included); typical values are 1e-3 to 1e-8"
+                )))
+            }
+        };
+        relative("tol", self.tol)?;
         if let Some(b) = self.bc_tol {
             positive("bc_tol", b)?;
         }
         if let Some(t) = self.newton_step_tol {
-            positive("newton_step_tol", t)?;
+            relative("newton_step_tol", t)?;
         }
         if self.max_nodes < 2 {
             return Err(BvpError::InvalidInput(format!(
@@ -295,6 +311,98 @@ thread_local! {
 /// (the choice of linear solver belongs here).
 fn new_system(pattern: Arc<Pattern>, opts: &SolveOptions) -> LinearSystem {
     LinearSystem::with_kind(pattern, opts.linear_solver)
+}
+
+/// The progress line of mesh iteration `iteration` (on `m` nodes) on stderr, with the
+/// largest collocation and boundary residuals and the size of the next mesh.
+fn report_mesh(
+    iteration: usize,
+    m: usize,
+    report: &NewtonReport,
+    (max_res, max_bc_res): (f64, f64),
+    above: usize,
+    next: usize,
+) {
+    // a failed write to stderr must not panic
+    use std::io::Write as _;
+    let _ = writeln!(
+        std::io::stderr(),
+        "mesh {iteration:>3}: {m:>6} nodes, Newton {:>2} it ({}), max rms residual {max_res:.2e}, max bc residual {max_bc_res:.2e}, intervals above tol {above}, next mesh {next} nodes",
+        report.iterations,
+        if report.converged { "converged" } else { "not converged" },
+    );
+}
+
+/// Newton's settings for a solve with `opts` (larger budgets on a fixed mesh).
+fn newton_settings(opts: &SolveOptions) -> NewtonSettings {
+    NewtonSettings {
+        tol: opts.tol,
+        bc_tol: opts.bc_tol.unwrap_or(opts.tol),
+        max_jacobians: if opts.adapt {
+            opts.max_jacobians_per_mesh
+        } else {
+            opts.max_jacobians_per_mesh.max(25)
+        },
+        max_iterations: if opts.adapt {
+            opts.max_newton_iterations_per_mesh
+        } else {
+            opts.max_newton_iterations_per_mesh.max(50)
+        },
+        step_tol: opts.newton_step_tol,
+        verbose: opts.verbose,
+    }
+}
+
+/// The error of a mesh loop that spent its `iterations` without meeting the tolerances:
+/// [`BvpError::MeshCycling`] if its mesh stopped settling, else [`BvpError::ToleranceNotMet`].
+fn not_met(
+    control: &MeshControl,
+    opts: &SolveOptions,
+    iterations: usize,
+    max_residual: f64,
+    max_bc_residual: f64,
+) -> BvpError {
+    let bc_tol = opts.bc_tol.unwrap_or(opts.tol);
+    match control.cycle() {
+        Some((low, high)) => BvpError::MeshCycling(Box::new(MeshCycle {
+            iterations,
+            low,
+            high,
+            switched_at: control.switched_at,
+            max_residual,
+            tol: opts.tol,
+            max_bc_residual,
+            bc_tol,
+            hint: cycling_hint(opts, control.switched_at.is_some()),
+        })),
+        None => BvpError::ToleranceNotMet {
+            iterations,
+            max_residual,
+            tol: opts.tol,
+            max_bc_residual,
+            bc_tol,
+        },
+    }
+}
+
+/// The options to try when the mesh cycled ([`BvpError::MeshCycling`]): those of `opts` not
+/// tried yet.
+fn cycling_hint(opts: &SolveOptions, switched: bool) -> String {
+    let mut tries = Vec::new();
+    if !switched && opts.mesh.rule != mesh::RefineRule::Scipy {
+        tries.push(
+            "scipy's refinement rule (SolveOptions::mesh = MeshOptions::scipy(), or MeshOptions::settle = true)"
+                .to_string(),
+        );
+    }
+    if opts.scale != ResidualScale::Auto {
+        tries.push("the residual scale ResidualScale::Auto (SolveOptions::scale)".into());
+    }
+    tries.push(format!(
+        "more mesh iterations (SolveOptions::max_mesh_iterations = {} now)",
+        opts.max_mesh_iterations
+    ));
+    tries.join(", or ")
 }
 
 /// Solves `problem` once: a convenience around [`Solver`].
@@ -504,29 +612,15 @@ impl<'a, P: Bvp> Solver<'a, P> {
         let problem = self.problem;
         let n = self.ws.col.n;
         let bc_tol = opts.bc_tol.unwrap_or(opts.tol);
-        let settings = NewtonSettings {
-            tol: opts.tol,
-            bc_tol,
-            max_jacobians: if opts.adapt {
-                opts.max_jacobians_per_mesh
-            } else {
-                opts.max_jacobians_per_mesh.max(25)
-            },
-            max_iterations: if opts.adapt {
-                opts.max_newton_iterations_per_mesh
-            } else {
-                opts.max_newton_iterations_per_mesh.max(50)
-            },
-            step_tol: opts.newton_step_tol,
-            verbose: opts.verbose,
-        };
+        let settings = newton_settings(opts);
         let mut x = guess.x.clone();
         let mut y = guess.y.clone();
         let mut p: Vec<f64> = guess.unknowns.iter().chain(params).copied().collect();
         let mut stats = SolveStats::default();
         self.ws.col.rhs_evals = 0;
         self.ws.col.jac_evals = 0;
-        let mesh_opts = &opts.mesh;
+        // the mesh options of this solve: the rule switches to scipy's when the mesh cycles
+        let mut control = MeshControl::new(&opts.mesh);
         let mut coarsenings_left = if opts.coarsen && opts.adapt { 3 } else { 0 };
         let mut iteration = 0;
         // values interpolated onto a refined mesh rarely pass the termination test as they
@@ -588,29 +682,30 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 });
             }
 
-            let above = mesh::plan(&self.ws.rms, opts.tol, mesh_opts, &mut self.ws.marks);
+            let pass = (m, max_res, iteration);
+            let above = control.plan(
+                &self.ws.rms,
+                opts.tol,
+                &mut self.ws.marks,
+                pass,
+                opts.verbose,
+            );
+            stats.mesh_rule_switched_at = control.switched_at;
             let refined = if above > 0 {
                 Some(mesh::apply(
                     &x,
                     &self.ws.rms,
                     &self.ws.marks,
                     opts.tol,
-                    mesh_opts,
+                    &control.options,
                     opts.max_nodes,
                 ))
             } else {
                 None
             };
             if opts.verbose >= 1 {
-                // a failed write to stderr must not panic
-                use std::io::Write as _;
-                let _ = writeln!(
-                    std::io::stderr(),
-                    "mesh {iteration:>3}: {m:>6} nodes, Newton {:>2} it ({}), max rms residual {max_res:.2e}, max bc residual {max_bc_res:.2e}, intervals above tol {above}, next mesh {} nodes",
-                    report.iterations,
-                    if report.converged { "converged" } else { "not converged" },
-                    refined.as_ref().map_or(m, Vec::len)
-                );
+                let next = refined.as_ref().map_or(m, Vec::len);
+                report_mesh(iteration, m, &report, (max_res, max_bc_res), above, next);
             }
             if let Some(new_x) = refined {
                 self.keep_system(lin);
@@ -647,13 +742,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 self.keep_system(lin);
             }
             if iteration >= opts.max_mesh_iterations {
-                return Err(BvpError::ToleranceNotMet {
-                    iterations: iteration,
-                    max_residual: max_res,
-                    tol: opts.tol,
-                    max_bc_residual: max_bc_res,
-                    bc_tol,
-                });
+                return Err(not_met(&control, opts, iteration, max_res, max_bc_res));
             }
         }
     }

@@ -44,6 +44,7 @@
 //! tolerance.
 
 mod bvp;
+mod contract;
 pub mod loss;
 
 pub use bvp::{BvpResiduals, BvpRun, ParamLink, ParamMap, RunError};
@@ -62,6 +63,13 @@ pub trait LeastSquaresProblem {
     /// Number of parameters.
     fn num_params(&self) -> usize;
     /// Residuals `r(p)` and Jacobian `∂r/∂p` (row-major, `len × num_params`).
+    ///
+    /// The contract [`fit`] checks on every result: the same number of residuals at every
+    /// point, a Jacobian of exactly `len × num_params` entries (else the fit stops with
+    /// [`FitError::InvalidInput`] naming the lengths), and finite values. A non-finite residual
+    /// or Jacobian entry at a trial point is a failed evaluation (a rejected step, its index
+    /// named in [`FitIteration::failure`]); at the start point it is a
+    /// [`FitError::InvalidInput`] naming the index.
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Self::Error>;
     /// Called when `p` (the last point passed to `evaluate`) becomes the new iterate.
     fn accept(&mut self, _p: &[f64]) {}
@@ -490,6 +498,14 @@ fn trust_region_step(j: &DMatrix<f64>, r: &DVector<f64>, d: &[f64], radius: f64)
 }
 
 /// Runs the bounded trust-region Gauss–Newton iteration from `p0`.
+///
+/// Errors before any evaluation: lengths of `p0` and the bounds other than `num_params()`, a
+/// start outside the bounds, invalid options (non-finite or negative tolerances and radii,
+/// `xtol` or `ftol` of 1 or more, `max_iterations = 0`). Errors at the start point: a failed
+/// evaluation ([`FitError::StartFailed`]), a mis-sized or non-finite result
+/// ([`FitError::InvalidInput`], see [`LeastSquaresProblem::evaluate`]), fewer residuals than
+/// parameters. A mis-sized result at a later point also ends the fit with
+/// [`FitError::InvalidInput`]; nothing panics.
 pub fn fit<L: LeastSquaresProblem>(
     problem: &mut L,
     p0: &[f64],
@@ -508,56 +524,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
 ) -> Result<FitResult, FitError> {
     let t0 = Instant::now();
     let np = problem.num_params();
-    if p0.len() != np || options.lower.len() != np || options.upper.len() != np {
-        return Err(FitError::InvalidInput(format!(
-            "{np} parameters, but start has {}, lower {}, upper {}",
-            p0.len(),
-            options.lower.len(),
-            options.upper.len()
-        )));
-    }
-    for i in 0..np {
-        let (l, u, x) = (options.lower[i], options.upper[i], p0[i]);
-        let valid = l < u && x >= l && x <= u && x.is_finite();
-        if !valid {
-            return Err(FitError::InvalidInput(format!(
-                "parameter {i}: start {x} must lie in [{l}, {u}] with lower < upper"
-            )));
-        }
-    }
-    for (name, v, strictly) in [
-        ("initial_radius", options.initial_radius, true),
-        ("max_radius", options.max_radius, true),
-        ("gtol", options.gtol, false),
-        ("xtol", options.xtol, false),
-        ("ftol", options.ftol, false),
-        ("f_scale", options.f_scale, true),
-    ] {
-        let valid = v.is_finite() && if strictly { v > 0.0 } else { v >= 0.0 };
-        if !valid {
-            let rule = if strictly { "positive" } else { "non-negative" };
-            return Err(FitError::InvalidInput(format!(
-                "FitOptions::{name} must be {rule} and finite, got {v}"
-            )));
-        }
-    }
-    let schedule = match options.accuracy {
-        Accuracy::Fixed => None,
-        Accuracy::Scheduled(s) => {
-            for (name, v) in [
-                ("fraction", s.fraction),
-                ("switch_below", s.switch_below),
-                ("negligible_step", s.negligible_step),
-            ] {
-                if !(v.is_finite() && v >= 0.0) {
-                    return Err(FitError::InvalidInput(format!(
-                        "AccuracySchedule::{name} must be non-negative and finite, got {v}"
-                    )));
-                }
-            }
-            Some(s)
-        }
-    };
+    let schedule = contract::check_options(np, p0, options)?;
     let (lo, hi) = (&options.lower, &options.upper);
     let mut p = p0.to_vec();
     // the start point at the loosest accuracy the problem offers (no residuals yet to scale
@@ -580,6 +547,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         p: p.clone(),
         cause: e.to_string(),
     })?;
+    contract::check_start(&r, &jac, np, &p)?;
     problem.accept(&p);
     let nr = r.len();
     if nr < np {
@@ -618,16 +586,13 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             // re-evaluate the iterate at full accuracy and go on from there
             loose = false;
             problem.set_accuracy(None);
-            let (r_t, j_t) = problem.evaluate(&p).map_err(|e| FitError::RefineFailed {
-                p: p.clone(),
-                cause: e.to_string(),
-            })?;
-            if r_t.len() != nr || !r_t.iter().all(|x| x.is_finite()) {
-                return Err(FitError::RefineFailed {
-                    p: p.clone(),
-                    cause: "non-finite or mis-sized residuals".into(),
-                });
-            }
+            let (r_t, j_t) =
+                contract::check_trial(problem.evaluate(&p), np, nr, &p)?.map_err(|cause| {
+                    FitError::RefineFailed {
+                        p: p.clone(),
+                        cause,
+                    }
+                })?;
             problem.accept(&p);
             let d2: f64 = r_t.iter().zip(&r).map(|(a, b)| (a - b) * (a - b)).sum();
             switch_model_error = Some((d2 / nr as f64).sqrt());
@@ -725,8 +690,8 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         iterations += 1;
         let pnorm = p.iter().map(|x| x * x).sum::<f64>().sqrt();
         let snorm = step_vec.norm();
-        match problem.evaluate(&trial) {
-            Ok((r_new, j_new)) if r_new.len() == nr && r_new.iter().all(|x| x.is_finite()) => {
+        match contract::check_trial(problem.evaluate(&trial), np, nr, &trial)? {
+            Ok((r_new, j_new)) => {
                 let cost_new = loss::robust_cost(loss, f_scale, &r_new);
                 let actual = cost - cost_new;
                 let rho = if pred_trial > 0.0 {
@@ -778,11 +743,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                     }
                 }
             }
-            other => {
-                let failure = match other {
-                    Err(e) => e.to_string(),
-                    Ok(_) => "non-finite or mis-sized residuals".to_string(),
-                };
+            Err(failure) => {
                 failed += 1;
                 radius *= 0.25;
                 record(FitIteration {

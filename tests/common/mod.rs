@@ -170,3 +170,50 @@ impl Bvp for Oscillator {
         r[2] = ya[1] - p[2];
     }
 }
+
+/// Which oscillatory equation [`Oscillatory`] is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OscillatoryKind {
+    /// ε² y'' + y = 0, y(0) = 1, y(1) = 0 (exact: cos(x/ε) − cot(1/ε) sin(x/ε)).
+    Linear,
+    /// ε² y'' + sin y = 0, y(0) = 0.5, y(1) = 0 (a pendulum; nonlinear).
+    Pendulum,
+    /// ε² y'' + (1 + x) y = 0, y(0) = 1, y(1) = 0 (the frequency rises by √2 across [0, 1]).
+    Airy,
+}
+
+/// An oscillatory family on [0, 1] with 1/(2π ε) periods (16 for ε = 0.01); the problems of
+/// benches/peers/scipy_oscillatory.py. State (y, y').
+pub struct Oscillatory {
+    pub kind: OscillatoryKind,
+    pub eps: f64,
+}
+impl Bvp for Oscillatory {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], _p: &[D], f: &mut [D]) {
+        let e2 = self.eps * self.eps;
+        f[0] = y[1];
+        f[1] = match self.kind {
+            OscillatoryKind::Linear => -y[0] / e2,
+            OscillatoryKind::Pendulum => -y[0].sin() / e2,
+            OscillatoryKind::Airy => -y[0] * ((1.0 + x) / e2),
+        };
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        let left = if self.kind == OscillatoryKind::Pendulum {
+            0.5
+        } else {
+            1.0
+        };
+        r[0] = ya[0] - left;
+        r[1] = yb[0];
+    }
+}
+
+/// Exact solution of [`OscillatoryKind::Linear`].
+pub fn oscillatory_linear_exact(eps: f64, x: f64) -> f64 {
+    let w = 1.0 / eps;
+    (w * x).cos() - (w * x).sin() / w.tan()
+}
