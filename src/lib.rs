@@ -102,6 +102,8 @@ pub mod error;
 mod error_control;
 #[cfg(feature = "rheometer")]
 pub mod fiber;
+#[cfg(feature = "plots")]
+pub mod html_page;
 pub mod inspect;
 pub mod least_squares;
 pub mod linear;

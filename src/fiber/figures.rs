@@ -4,14 +4,17 @@
 //! A thin fiber-specific layer over the model-agnostic [`crate::plot`]: it converts units for
 //! display (positions in m, diameters in µm, `1/d²` in 1/mm², temperatures in °C) and lays out
 //! one panel per experiment. Every function refuses to write over one of the `inputs` (see
-//! [`ensure_not_input`]); the format follows the extension (`.png` or `.svg`).
+//! [`ensure_not_input`]); the format follows the extension (`.png` or `.svg`), and a function
+//! given a format writes that format. Residual panels carry the noise band (shaded `±2σ`).
 
 use super::output::{ensure_not_input, OutputError};
 use super::rheometer::{Identification, Landscape, Rheometer, RheometerError};
 use super::simulate::FiberSolution;
 use super::simulate::Profiles;
 use super::smoothing::SmoothFit;
-use crate::plot::{save_heatmap, save_panels, Heatmap, Panel, PlotError, Series};
+use crate::plot::{
+    save_heatmap, save_panels, Band, FigureFormat, Heatmap, Panel, PlotError, Series,
+};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -281,6 +284,12 @@ pub fn identification_figures(
     ext: &str,
     inputs: &[PathBuf],
 ) -> Result<Vec<PathBuf>, FigureError> {
+    // the format asked for, or an error before anything is computed or written
+    let ext = FigureFormat::of_path(Path::new(&format!("figure.{ext}")))
+        .map_err(|_| PlotError::UnsupportedFormat {
+            path: dir.join(format!("fig2_smoothing.{ext}")),
+        })?
+        .extension();
     let views: Vec<ExperimentView> = rh
         .experiments
         .iter()
@@ -350,13 +359,122 @@ pub fn identification_figures(
     Ok(written)
 }
 
+/// The relative residuals of one experiment along the spin line, as drawn by
+/// [`residual_panels`].
+#[derive(Debug, Clone, Copy)]
+pub struct ResidualView<'a> {
+    /// Experiment name (panel title).
+    pub name: &'a str,
+    /// Positions `s` \[m\].
+    pub positions: &'a [f64],
+    /// Relative residuals `(d_model − d_meas)/d_meas` \[-\] (drawn in %), one per position.
+    pub residuals: &'a [f64],
+}
+
+/// One panel per experiment of the relative residual (in %) along the spin line: `before` as
+/// markers, `after` (if given: its label and one view per experiment, same order) as a line,
+/// and the noise band `±2σ` shaded around zero when the relative noise level `noise_sigma`
+/// \[-\] is given. Writes `path`; its extension chooses the format.
+pub fn residual_panels(
+    path: &Path,
+    before: &[ResidualView<'_>],
+    after: Option<(&str, &[ResidualView<'_>])>,
+    noise_sigma: Option<f64>,
+    inputs: &[PathBuf],
+) -> Result<(), FigureError> {
+    check(path, inputs)?;
+    let percent = |v: &ResidualView<'_>| -> Vec<(f64, f64)> {
+        v.positions
+            .iter()
+            .zip(v.residuals)
+            .map(|(&s, &r)| (s, 100.0 * r))
+            .collect()
+    };
+    let mut panels = Vec::with_capacity(before.len());
+    for (k, b) in before.iter().enumerate() {
+        let mut p = Panel::new(b.name, "s / m", "(d_model − d_meas)/d_meas / %");
+        if let Some(sigma) = noise_sigma.filter(|s| s.is_finite() && *s > 0.0) {
+            p = p.with_band(Band::noise(
+                format!("noise ±2σ (σ = {:.2} %)", 100.0 * sigma),
+                200.0 * sigma,
+            ));
+        }
+        let label = if after.is_some() {
+            "without"
+        } else {
+            "residual"
+        };
+        p = p.with_series(Series::markers(label, percent(b)).with_color(0));
+        if let Some((label, views)) = after {
+            if let Some(a) = views.get(k) {
+                p = p.with_series(Series::line(format!("with {label}"), percent(a)).with_color(3));
+            }
+        }
+        panels.push(p);
+    }
+    if panels.is_empty() {
+        return Err(FigureError::Plot(PlotError::InvalidInput {
+            path: path.to_path_buf(),
+            reason: "no experiments to draw residuals of".into(),
+        }));
+    }
+    let cols = columns(panels.len());
+    save_panels(path, &panels, cols, grid_size(panels.len()))?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// A scratch directory under `target/` (tests leave nothing in /tmp).
+    fn scratch(name: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("target")
+            .join("test-figures-unit")
+            .join(name)
+    }
+
+    #[test]
+    fn residual_panels_have_the_noise_band_and_the_requested_format() {
+        let dir = scratch("residuals");
+        let s = [0.0, 0.1, 0.2, 0.3];
+        let r = [0.004, -0.006, 0.002, 0.0];
+        let a = [0.001, -0.001, 0.0, 0.0005];
+        let before = [ResidualView {
+            name: "exp <1> & 2",
+            positions: &s,
+            residuals: &r,
+        }];
+        let after = [ResidualView {
+            residuals: &a,
+            ..before[0]
+        }];
+        for ext in ["svg", "png"] {
+            let path = dir.join(format!("residuals.{ext}"));
+            residual_panels(&path, &before, Some(("drag", &after)), Some(0.005), &[]).unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            match ext {
+                "svg" => {
+                    let svg = String::from_utf8(bytes).unwrap();
+                    assert!(svg.starts_with("<svg"));
+                    assert!(svg.contains("noise ±2σ (σ = 0.50 %)"), "band label");
+                    assert!(svg.contains("exp &lt;1&gt; &amp; 2"), "escaped title");
+                    assert!(svg.contains("with drag"));
+                }
+                _ => assert_eq!(&bytes[..4], b"\x89PNG"),
+            }
+        }
+        let err = residual_panels(&dir.join("r.pdf"), &before, None, None, &[]);
+        assert!(matches!(
+            err,
+            Err(FigureError::Plot(PlotError::UnsupportedFormat { .. }))
+        ));
+    }
+
     #[test]
     fn refuses_to_overwrite_an_input() {
-        let dir = std::env::temp_dir().join("diffbvp-figures-unit");
+        let dir = scratch("inputs");
         std::fs::create_dir_all(&dir).unwrap();
         let input = dir.join("input.png");
         std::fs::write(&input, b"keep me").unwrap();
@@ -373,7 +491,7 @@ mod tests {
 
     #[test]
     fn writes_panels_for_each_view() {
-        let dir = std::env::temp_dir().join("diffbvp-figures-unit");
+        let dir = scratch("views");
         let s = [0.0, 0.5, 1.0];
         let d = [1e-3, 3e-4, 1e-4];
         let e = ExperimentView {
@@ -402,8 +520,7 @@ mod tests {
 
     #[test]
     fn many_panels_are_split_into_pages_of_their_own_experiments() {
-        let dir =
-            std::env::temp_dir().join(format!("diffbvp-figures-pages-{}", std::process::id()));
+        let dir = scratch("pages");
         let _ = std::fs::remove_dir_all(&dir);
         let s = [0.0, 0.5, 1.0];
         let d = [1e-3, 3e-4, 1e-4];

@@ -4,29 +4,65 @@
 /// Magnitude beyond which data are clamped for range computation.
 pub(super) const HUGE: f64 = 1e300;
 
-/// Font sizes and label-area sizes scaled to the space available for one chart.
+/// Font sizes, stroke widths and label-area sizes scaled to the space available for one chart,
+/// in pixels of the canvas being drawn (which is `scale` times the figure's pixels when a PNG is
+/// rendered supersampled).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Metrics {
+    /// Canvas pixels per figure pixel (1 for SVG, 2 or 3 for a supersampled PNG).
+    pub(super) scale: f64,
     pub(super) title: f64,
     pub(super) label: f64,
     pub(super) tick: f64,
     pub(super) margin: u32,
     pub(super) x_area: u32,
     pub(super) y_area: u32,
+    /// Line width of series.
+    pub(super) stroke: u32,
+    /// Marker radius.
+    pub(super) radius: i32,
+}
+
+/// A font size in canvas pixels rounded to an even whole number.
+///
+/// plotters' glyph placement (`ab_glyph` backend) puts each glyph at
+/// `(size / 2.0 + glyph_top) as i32`: with a fractional `size / 2` the truncation toward zero
+/// moves glyphs that reach above the middle line (digits) and glyphs below it (the decimal
+/// point, the comma) one pixel apart, which is what made "0.804" read "0·804". With an even
+/// size `size / 2` is whole and every glyph keeps its baseline.
+pub(super) fn font_px(size: f64) -> f64 {
+    (2.0 * (0.5 * size).round()).max(2.0)
 }
 
 impl Metrics {
-    pub(super) fn for_area(w: u32, h: u32) -> Self {
-        let base = (f64::from(w.min(h)) / 24.0).clamp(9.0, 22.0);
+    /// Metrics for a chart area of `w × h` canvas pixels drawn at `scale` canvas pixels per
+    /// figure pixel.
+    pub(super) fn for_area(w: u32, h: u32, scale: f64) -> Self {
+        let scale = if scale.is_finite() && scale >= 1.0 {
+            scale
+        } else {
+            1.0
+        };
+        let (w, h) = (f64::from(w) / scale, f64::from(h) / scale);
+        let base = (w.min(h) / 24.0).clamp(9.0, 22.0);
         let tick = base * 0.85;
+        let px = |v: f64| (v * scale).round() as u32;
         Self {
-            title: base * 1.25,
-            label: base,
-            tick,
-            margin: (base * 0.6).round() as u32,
-            x_area: (tick * 1.6 + base * 1.7).round() as u32,
-            y_area: (tick * 4.2 + base * 1.7).round() as u32,
+            scale,
+            title: font_px(base * 1.25 * scale),
+            label: font_px(base * scale),
+            tick: font_px(tick * scale),
+            margin: px(base * 0.6),
+            x_area: px(tick * 1.6 + base * 1.7),
+            y_area: px(tick * 4.2 + base * 1.7),
+            stroke: px((base / 7.0).round().clamp(1.0, 3.0)).max(1),
+            radius: px((base / 4.0).round().clamp(2.0, 5.0)).max(1) as i32,
         }
+    }
+
+    /// `v` figure pixels in canvas pixels.
+    pub(super) fn px(&self, v: f64) -> i32 {
+        (v * self.scale).round() as i32
     }
 }
 
@@ -70,98 +106,26 @@ pub(super) fn axis_range(values: impl Iterator<Item = f64>, log: bool, pad: bool
     }
 }
 
-/// `m × 10^e` computed so that the result is the correctly rounded decimal (e.g. exactly `0.3`).
-fn decimal(m: f64, e: i32) -> f64 {
-    if e >= 0 {
-        m * 10f64.powi(e)
-    } else {
-        m / 10f64.powi(-e)
-    }
-}
-
-/// Tick values for a logarithmic axis over `[lo, hi]` (`0 < lo < hi`): decades, or 1-2-5 / 1…9
-/// mantissas when the range spans only about a decade, or plain decimal steps for a narrow range.
-pub(super) fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
-    const MAX_TICKS: usize = 8;
-    let e0 = lo.log10().floor() as i32;
-    let e1 = hi.log10().floor() as i32;
-    let in_range = |v: &f64| *v >= lo * (1.0 - 1e-12) && *v <= hi * (1.0 + 1e-12);
-    let with = |mantissas: &[f64]| -> Vec<f64> {
-        (e0..=e1)
-            .flat_map(|e| mantissas.iter().map(move |&m| decimal(m, e)))
-            .filter(in_range)
-            .collect()
-    };
-    let all: Vec<f64> = (1..=9).map(f64::from).collect();
-    for mantissas in [&all[..], &[1.0, 2.0, 5.0], &[1.0]] {
-        let ticks = with(mantissas);
-        if ticks.len() <= MAX_TICKS && ticks.len() >= 3 {
-            return ticks;
-        }
-        if ticks.len() < 3 {
-            break;
-        }
-    }
-    let decades = with(&[1.0]);
-    if decades.len() > MAX_TICKS {
-        let stride = decades.len().div_ceil(MAX_TICKS);
-        return decades.into_iter().step_by(stride).collect();
-    }
-    // Narrow range: evenly spaced decimal ticks.
-    let raw = (hi - lo) / 4.0;
-    let e = raw.log10().floor() as i32;
-    let m = raw / decimal(1.0, e);
-    let m = if m < 1.5 {
-        1.0
-    } else if m < 3.5 {
-        2.0
-    } else if m < 7.5 {
-        5.0
-    } else {
-        10.0
-    };
-    let step = decimal(m, e);
-    let first = (lo / step).ceil() as i64;
-    let last = (hi / step).floor() as i64;
-    (first - 1..=last + 1)
-        .map(|k| decimal(k as f64 * m, e))
-        .filter(in_range)
-        .collect()
-}
-
-/// Tick label: plain decimals for moderate magnitudes, `1.5e6` style otherwise, no float noise.
-pub(super) fn format_tick(v: &f64) -> String {
-    let v = *v;
-    let a = v.abs();
-    if a == 0.0 || !v.is_finite() {
-        return if v.is_finite() {
-            "0".into()
-        } else {
-            format!("{v}")
-        };
-    }
-    if !(1e-3..1e5).contains(&a) {
-        let s = format!("{v:.3e}");
-        return match s.split_once('e') {
-            Some((mantissa, exp)) if mantissa.contains('.') => {
-                let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
-                format!("{mantissa}e{exp}")
-            }
-            _ => s,
-        };
-    }
-    let s = format!("{v:.6}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".into()
-    } else {
-        s.into()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn font_sizes_are_even_and_scale() {
+        assert_eq!(font_px(11.33), 12.0);
+        assert_eq!(font_px(9.5), 10.0);
+        assert_eq!(font_px(0.3), 2.0);
+        let one = Metrics::for_area(420, 320, 1.0);
+        let three = Metrics::for_area(3 * 420, 3 * 320, 3.0);
+        for m in [one, three] {
+            for size in [m.title, m.label, m.tick] {
+                assert_eq!(size % 2.0, 0.0, "{size}");
+            }
+        }
+        assert!((three.tick / one.tick - 3.0).abs() < 0.2);
+        assert_eq!(three.stroke, 3 * one.stroke);
+        assert_eq!(three.px(2.0), 6);
+    }
 
     #[test]
     fn ranges_are_padded_and_never_degenerate() {
@@ -177,30 +141,5 @@ mod tests {
         assert!(a < 1e-3 && a > 0.0 && b > 1e3);
         let (a, b) = axis_range([f64::MAX, -f64::MAX].into_iter(), false, true);
         assert!(a.is_finite() && b.is_finite() && a < b);
-    }
-
-    #[test]
-    fn log_ticks_are_readable() {
-        assert_eq!(log_ticks(0.2, 1.05), vec![0.2, 0.5, 1.0]);
-        assert_eq!(log_ticks(0.5, 5.0), vec![0.5, 1.0, 2.0, 5.0]);
-        assert_eq!(
-            log_ticks(1e-3, 1e3),
-            vec![1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0, 1e3]
-        );
-        assert!((3..=8).contains(&log_ticks(1e-30, 1e30).len()));
-        assert_eq!(log_ticks(0.96, 1.04), vec![0.96, 0.98, 1.0, 1.02, 1.04]);
-        assert_eq!(log_ticks(2.0, 8.0), vec![2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]);
-    }
-
-    #[test]
-    fn tick_labels_are_short() {
-        assert_eq!(format_tick(&0.30000000000000004), "0.3");
-        assert_eq!(format_tick(&14.0), "14");
-        assert_eq!(format_tick(&-2.5), "-2.5");
-        assert_eq!(format_tick(&0.0), "0");
-        assert_eq!(format_tick(&1e300), "1e300");
-        assert_eq!(format_tick(&1.5e6), "1.5e6");
-        assert_eq!(format_tick(&-2.0e-5), "-2e-5");
-        assert_eq!(format_tick(&1e-3), "0.001");
     }
 }

@@ -21,3 +21,53 @@ pub(super) fn ensure_font() -> bool {
             .all(|name| register_font(name, FontStyle::Normal, DEJAVU_SANS).is_ok())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::axes::font_px;
+    use super::*;
+    use plotters::prelude::*;
+
+    /// The lowest row with ink (coverage above half) of `text` drawn at `(4, 4)` at `size`.
+    fn lowest_ink_row(text: &str, size: f64) -> usize {
+        let (w, h) = (60usize, 60usize);
+        let mut buf = vec![255u8; w * h * 3];
+        {
+            let root =
+                BitMapBackend::with_buffer(&mut buf, (w as u32, h as u32)).into_drawing_area();
+            let style = (FONT, size).into_font().color(&BLACK);
+            root.draw_text(text, &style, (4, 4)).unwrap();
+        }
+        // ink: darker than half-way between white and the glyph's darkest pixel (a small
+        // point may not cover any pixel fully)
+        let darkest = buf.iter().copied().min().unwrap_or(255);
+        let threshold = (255 + u32::from(darkest)) / 2;
+        (0..h)
+            .rev()
+            .find(|&y| (0..w).any(|x| u32::from(buf[(y * w + x) * 3]) < threshold))
+            .unwrap_or(0)
+    }
+
+    #[test]
+    fn decimal_points_sit_on_the_baseline() {
+        assert!(ensure_font());
+        // the flat foot of "1" and the decimal point end on the same pixel row at every
+        // font size the figures use
+        let mut raised = 0;
+        for tenth in 80..=280 {
+            let size = f64::from(tenth) / 10.0;
+            let even = font_px(size);
+            assert_eq!(
+                lowest_ink_row("1", even),
+                lowest_ink_row(".", even),
+                "size {even}"
+            );
+            if lowest_ink_row("1", size) != lowest_ink_row(".", size) {
+                raised += 1;
+            }
+        }
+        // the cause: at a fractional size plotters' truncation of `size / 2 + glyph_top`
+        // puts the point a pixel off the digits' baseline (for a good share of the sizes)
+        assert!(raised > 20, "{raised}");
+    }
+}

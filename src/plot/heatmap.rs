@@ -3,15 +3,16 @@
 
 use std::path::Path;
 
-use plotters::coord::ranged1d::{Ranged, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::axes::{axis_range, format_tick, log_ticks, Metrics};
+use super::axes::{axis_range, Metrics};
 use super::colors::{viridis, ColorScale, MARKER_COLORS, MISSING};
 use super::error::{invalid, PlotError};
 use super::fonts::FONT;
+use super::legend::{draw_legend, legend_size, LegendEntry, PixelRect, Swatch};
+use super::ticks::TickedAxis;
 use super::write::{write_figure, DrawResult, Figure};
 
 /// A scalar field on a rectilinear grid, e.g. a cost landscape `J(x, y)`, with a colour bar.
@@ -149,63 +150,82 @@ fn cell_edges(c: &[f64], log: bool) -> Vec<f64> {
     }
 }
 
-// Builds the main heat-map chart with each axis linear or logarithmic (four coordinate types)
-// and fills it.
-macro_rules! build_heatmap_chart {
-    ($builder:expr, $hm:expr, $m:expr, $scale:expr, $xe:expr, $ye:expr,
-     ($x_lo:expr, $x_hi:expr), ($y_lo:expr, $y_hi:expr)) => {{
-        let log_x = ($x_lo..$x_hi)
-            .log_scale()
-            .with_key_points(log_ticks($x_lo, $x_hi));
-        let log_y = ($y_lo..$y_hi)
-            .log_scale()
-            .with_key_points(log_ticks($y_lo, $y_hi));
-        match ($hm.log_x, $hm.log_y) {
-            (false, false) => {
-                let mut c = $builder.build_cartesian_2d($x_lo..$x_hi, $y_lo..$y_hi)?;
-                fill_heatmap(&mut c, $hm, $m, $scale, $xe, $ye)
-            }
-            (true, false) => {
-                let mut c = $builder.build_cartesian_2d(log_x, $y_lo..$y_hi)?;
-                fill_heatmap(&mut c, $hm, $m, $scale, $xe, $ye)
-            }
-            (false, true) => {
-                let mut c = $builder.build_cartesian_2d($x_lo..$x_hi, log_y)?;
-                fill_heatmap(&mut c, $hm, $m, $scale, $xe, $ye)
-            }
-            (true, true) => {
-                let mut c = $builder.build_cartesian_2d(log_x, log_y)?;
-                fill_heatmap(&mut c, $hm, $m, $scale, $xe, $ye)
-            }
+/// What filling the main chart needs.
+struct HeatContext<'a> {
+    m: &'a Metrics,
+    scale: &'a ColorScale,
+    xe: &'a [f64],
+    ye: &'a [f64],
+    /// Palette index of each marker drawn (`None`: off the grid).
+    marker_colors: &'a [Option<usize>],
+}
+
+/// Palette indices of the markers (shared by markers with the same label), `None` for markers
+/// off the grid's cells `[x_lo, x_hi] × [y_lo, y_hi]`, and the legend entries.
+fn marker_legend(
+    hm: &Heatmap<'_>,
+    (x_lo, x_hi): (f64, f64),
+    (y_lo, y_hi): (f64, f64),
+    missing: bool,
+) -> (Vec<Option<usize>>, Vec<LegendEntry>) {
+    let mut entries = Vec::new();
+    if missing {
+        entries.push(LegendEntry {
+            label: "no value".into(),
+            swatch: Swatch::Fill {
+                color: MISSING,
+                opacity: 1.0,
+            },
+        });
+    }
+    let mut labels: Vec<&str> = Vec::new();
+    let mut colors = Vec::with_capacity(hm.markers.len());
+    for (mx, my, label) in hm.markers {
+        let on_grid = (x_lo..=x_hi).contains(mx) && (y_lo..=y_hi).contains(my);
+        if !on_grid {
+            colors.push(None);
+            continue;
         }
-    }};
+        let k = match labels.iter().position(|l| *l == label.as_str()) {
+            Some(k) if !label.is_empty() => k,
+            _ => {
+                labels.push(label.as_str());
+                let k = labels.len() - 1;
+                if !label.is_empty() {
+                    entries.push(LegendEntry {
+                        label: label.clone(),
+                        swatch: Swatch::Outlined(MARKER_COLORS[k % MARKER_COLORS.len()]),
+                    });
+                }
+                k
+            }
+        };
+        colors.push(Some(k));
+    }
+    (colors, entries)
 }
 
 impl Figure for Heatmap<'_> {
-    fn draw<DB>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    fn draw<DB>(&self, root: &DrawingArea<DB, Shift>, scale: f64) -> DrawResult
     where
         DB: DrawingBackend,
         DB::ErrorType: 'static,
     {
         let (w, h) = root.dim_in_pixel();
-        let m = Metrics::for_area(w, h);
+        let m = Metrics::for_area(w, h, scale);
         let body = if self.title.is_empty() {
             root.clone()
         } else {
-            root.titled(self.title, (FONT, m.title))?
+            root.margin(m.px(6.0).max(0) as u32, 0, 0, 0)
+                .titled(self.title, (FONT, m.title))?
         };
-        let (bw, _) = body.dim_in_pixel();
-        let bar_width = (f64::from(bw) * 0.16).clamp(40.0, 220.0) as u32;
-        let (main, bar) = body.split_horizontally(bw.saturating_sub(bar_width));
-
         let (lo, hi) = axis_range(self.values.iter().copied(), self.log_color, false);
-        let scale = ColorScale {
+        let color_scale = ColorScale {
             lo,
             hi,
             log: self.log_color,
         };
 
-        // Main chart.
         let xe = cell_edges(self.xs, self.log_x);
         let ye = cell_edges(self.ys, self.log_y);
         let span = |e: &[f64]| {
@@ -214,21 +234,48 @@ impl Figure for Heatmap<'_> {
         };
         let (x_lo, x_hi) = span(&xe);
         let (y_lo, y_hi) = span(&ye);
+        let missing = self.values.iter().any(|&v| !color_scale.usable(v));
+        let (marker_colors, entries) = marker_legend(self, (x_lo, x_hi), (y_lo, y_hi), missing);
+
+        // The legend goes below the map (every cell of the map is data), in as many columns
+        // as fit.
+        let (bw, bh) = body.dim_in_pixel();
+        let mut body = body;
+        let mut legend_rect = None;
+        let mut columns = 1;
+        if !entries.is_empty() {
+            let one = legend_size(&body, &entries, &m, 1);
+            columns = ((bw as i32 - 2 * m.margin as i32) / one.0.max(1)).max(1) as usize;
+            let size = legend_size(&body, &entries, &m, columns);
+            let (bx, by) = body.get_base_pixel();
+            let x0 = bx + (bw as i32 - size.0).max(0) / 2;
+            let y0 = by + bh as i32 - size.1 - m.px(2.0);
+            legend_rect = Some(PixelRect::new((x0, y0), (x0 + size.0, y0 + size.1)));
+            let (top, _) = body.split_vertically(bh as i32 - size.1 - m.px(8.0));
+            body = top;
+        }
+        let (bw, _) = body.dim_in_pixel();
+        let bar_width = (f64::from(bw) * 0.16).clamp(40.0 * m.scale, 220.0 * m.scale) as u32;
+        let (main, bar) = body.split_horizontally(bw.saturating_sub(bar_width));
+
+        // Main chart.
+        let ctx = HeatContext {
+            m: &m,
+            scale: &color_scale,
+            xe: &xe,
+            ye: &ye,
+            marker_colors: &marker_colors,
+        };
         let mut builder = ChartBuilder::on(&main);
         builder
             .margin(m.margin)
             .x_label_area_size(m.x_area)
             .y_label_area_size(m.y_area);
-        build_heatmap_chart!(
-            builder,
-            self,
-            &m,
-            &scale,
-            &xe,
-            &ye,
-            (x_lo, x_hi),
-            (y_lo, y_hi)
+        let mut chart = builder.build_cartesian_2d(
+            TickedAxis::new(x_lo, x_hi, self.log_x),
+            TickedAxis::new(y_lo, y_hi, self.log_y),
         )?;
+        fill_heatmap(&mut chart, self, &ctx)?;
 
         // Colour bar, aligned with the main plotting area.
         let mut bar_builder = ChartBuilder::on(&bar);
@@ -237,31 +284,26 @@ impl Figure for Heatmap<'_> {
             .margin_left(0)
             .x_label_area_size(m.x_area)
             .right_y_label_area_size(bar_width.saturating_sub(bar_width / 4 + m.margin));
-        if self.log_color {
-            let bar_axis = (lo..hi).log_scale().with_key_points(log_ticks(lo, hi));
-            let mut cb = bar_builder.build_cartesian_2d(0.0..1.0, bar_axis)?;
-            fill_colorbar(&mut cb, self, &m, &scale)
-        } else {
-            let mut cb = bar_builder.build_cartesian_2d(0.0..1.0, lo..hi)?;
-            fill_colorbar(&mut cb, self, &m, &scale)
+        let mut cb =
+            bar_builder.build_cartesian_2d(0.0..1.0, TickedAxis::new(lo, hi, self.log_color))?;
+        fill_colorbar(&mut cb, self, &m, &color_scale)?;
+        if let Some(rect) = legend_rect {
+            draw_legend(root, &rect, &entries, &m, columns)?;
         }
+        Ok(())
     }
 }
 
-fn fill_heatmap<'a, DB, X, Y>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+fn fill_heatmap<'a, DB>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<TickedAxis, TickedAxis>>,
     hm: &Heatmap<'_>,
-    m: &Metrics,
-    scale: &ColorScale,
-    xe: &[f64],
-    ye: &[f64],
+    ctx: &HeatContext<'_>,
 ) -> DrawResult
 where
     DB: DrawingBackend + 'a,
     DB::ErrorType: 'static,
-    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
-    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
+    let m = ctx.m;
     chart
         .configure_mesh()
         .disable_mesh()
@@ -269,73 +311,33 @@ where
         .y_desc(hm.y_label)
         .label_style((FONT, m.tick))
         .axis_desc_style((FONT, m.label))
-        .x_labels(6)
-        .y_labels(6)
-        .x_label_formatter(&format_tick)
-        .y_label_formatter(&format_tick)
+        .set_all_tick_mark_size(m.px(4.0))
+        .axis_style(RGBColor(60, 60, 60).stroke_width(m.px(1.0).max(1) as u32))
         .draw()?;
     let nx = hm.xs.len();
+    let (xe, ye) = (ctx.xe, ctx.ye);
     let cells = hm.values.iter().enumerate().map(|(k, &v)| {
         let (i, j) = (k % nx, k / nx);
         let corners = [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])];
-        Rectangle::new(corners, scale.color(v).filled())
+        Rectangle::new(corners, ctx.scale.color(v).filled())
     });
     chart.draw_series(cells)?;
 
-    let radius = (m.label / 2.5).round().clamp(3.0, 9.0) as i32;
-    let mut any_legend = false;
-    if hm.values.iter().any(|&v| !scale.usable(v)) {
-        any_legend = true;
-        chart
-            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
-            .label("no value")
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], MISSING.filled()));
-    }
-    let (x_range, y_range) = (chart.x_range(), chart.y_range());
-    // Markers sharing a label share a colour and one legend entry.
-    let mut labels: Vec<&str> = Vec::new();
-    for (mx, my, label) in hm.markers.iter() {
-        // Markers off the grid are not drawn (nor listed in the legend).
-        if !(x_range.contains(mx) || *mx == x_range.end)
-            || !(y_range.contains(my) || *my == y_range.end)
-        {
-            continue;
-        }
-        let (k, first) = match labels.iter().position(|l| *l == label.as_str()) {
-            Some(k) if !label.is_empty() => (k, false),
-            _ => {
-                labels.push(label.as_str());
-                (labels.len() - 1, true)
-            }
-        };
+    let radius = (m.label / 2.5).round().clamp(3.0 * m.scale, 9.0 * m.scale) as i32;
+    let outline = BLACK.stroke_width(m.stroke.max(2));
+    for ((mx, my, _), k) in hm.markers.iter().zip(ctx.marker_colors) {
+        let Some(k) = k else { continue };
         let color = MARKER_COLORS[k % MARKER_COLORS.len()];
         let marker = EmptyElement::at((*mx, *my))
             + Circle::new((0, 0), radius, color.filled())
-            + Circle::new((0, 0), radius, BLACK.stroke_width(2));
-        let series = chart.draw_series(std::iter::once(marker))?;
-        if first && !label.is_empty() {
-            any_legend = true;
-            series.label(label.as_str()).legend(move |(x, y)| {
-                EmptyElement::at((x + 7, y))
-                    + Circle::new((0, 0), radius, color.filled())
-                    + Circle::new((0, 0), radius, BLACK.stroke_width(2))
-            });
-        }
-    }
-    if any_legend {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FONT, m.tick))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .draw()?;
+            + Circle::new((0, 0), radius, outline);
+        chart.draw_series(std::iter::once(marker))?;
     }
     Ok(())
 }
 
-fn fill_colorbar<DB, Y>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
+fn fill_colorbar<DB>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, TickedAxis>>,
     hm: &Heatmap<'_>,
     m: &Metrics,
     scale: &ColorScale,
@@ -343,7 +345,6 @@ fn fill_colorbar<DB, Y>(
 where
     DB: DrawingBackend,
     DB::ErrorType: 'static,
-    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
     const STEPS: usize = 128;
     chart.draw_series((0..STEPS).map(|k| {
@@ -361,8 +362,7 @@ where
         .y_desc(hm.value_label)
         .label_style((FONT, m.tick))
         .axis_desc_style((FONT, m.label))
-        .y_labels(8)
-        .y_label_formatter(&format_tick)
+        .set_all_tick_mark_size(m.px(4.0))
         .draw()?;
     Ok(())
 }

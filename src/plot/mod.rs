@@ -58,13 +58,20 @@
 mod axes;
 mod colors;
 mod error;
+mod flow_curve;
 mod fonts;
 mod heatmap;
+mod legend;
+mod panel_draw;
 mod panels;
+mod ticks;
 mod write;
 
 pub use colors::PALETTE;
 pub use error::PlotError;
+pub use flow_curve::{flow_curve_svg, save_flow_curve, FlowCurvePlot, ReferencePoints};
 pub use heatmap::{save_heatmap, Heatmap};
-pub use panels::{save_panels, Panel, Series, Style};
+pub use panels::{
+    panels_svg, save_panels, Band, BandShape, LegendPlacement, Panel, RefLine, Series, Style,
+};
 pub use write::{FigureFormat, MAX_SIDE};

@@ -1,18 +1,11 @@
-//! Line, dashed-line and marker panels: [`Series`], [`Panel`], and a grid of panels
-//! ([`save_panels`]).
+//! Line, dashed-line, marker and shaded-band panels: [`Series`], [`Band`], [`RefLine`],
+//! [`Panel`], and a grid of panels ([`save_panels`], [`panels_svg`]).
 
 use std::path::Path;
 
-use plotters::coord::ranged1d::{Ranged, ValueFormatter};
-use plotters::coord::types::RangedCoordf64;
-use plotters::coord::Shift;
-use plotters::prelude::*;
-
-use super::axes::{axis_range, format_tick, log_ticks, Metrics, HUGE};
-use super::colors::PALETTE;
 use super::error::{invalid, PlotError};
-use super::fonts::FONT;
-use super::write::{write_figure, DrawResult, Figure};
+use super::panel_draw::PanelGrid;
+use super::write::{render_svg, write_figure};
 
 /// How a [`Series`] is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -38,7 +31,8 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Line, dashed line or markers.
     pub style: Style,
-    /// Index into [`PALETTE`] (taken modulo its length); `None` uses the series' position.
+    /// Index into [`PALETTE`](super::PALETTE) (taken modulo its length); `None` uses the
+    /// series' position.
     pub color: Option<usize>,
 }
 
@@ -80,10 +74,160 @@ impl Series {
     }
 }
 
-/// One set of axes with a title, axis labels, series and a legend.
+/// The region a [`Band`] shades.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BandShape {
+    /// Between two curves: `lower[i]` and `upper[i]` are `(x, y)` points (the two lists may
+    /// have different abscissae); the polygon runs along `lower` and back along `upper`.
+    /// Non-finite points are skipped.
+    Between {
+        /// The lower boundary, `(x, y)` with increasing `x`.
+        lower: Vec<(f64, f64)>,
+        /// The upper boundary, `(x, y)` with increasing `x`.
+        upper: Vec<(f64, f64)>,
+    },
+    /// `lo ≤ y ≤ hi` across the whole horizontal axis (e.g. a constant noise band).
+    Horizontal {
+        /// Lower edge (vertical-axis units).
+        lo: f64,
+        /// Upper edge (vertical-axis units).
+        hi: f64,
+    },
+    /// `lo ≤ x ≤ hi` across the whole vertical axis (e.g. the range covered by data).
+    Vertical {
+        /// Left edge (horizontal-axis units).
+        lo: f64,
+        /// Right edge (horizontal-axis units).
+        hi: f64,
+    },
+}
+
+/// A shaded region behind the series of a [`Panel`]: an uncertainty band, a noise band around
+/// zero, or a range of the horizontal axis.
 ///
-/// Axis ranges are automatic: the finite data plus 5 % padding; a single value or an empty
-/// panel still gets a non-degenerate range.
+/// Bands widen the axis ranges so that they are seen whole (a [`BandShape::Vertical`] band
+/// only the horizontal one, a [`BandShape::Horizontal`] band only the vertical one).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Band {
+    /// Legend text (a filled swatch); empty leaves the band out of the legend.
+    pub label: String,
+    /// The shaded region.
+    pub shape: BandShape,
+    /// Index into [`PALETTE`](super::PALETTE); `None` is a neutral grey.
+    pub color: Option<usize>,
+    /// Opacity of the shading in `(0, 1]`.
+    pub opacity: f64,
+}
+
+impl Band {
+    /// The region between two curves (see [`BandShape::Between`]).
+    pub fn between(
+        label: impl Into<String>,
+        lower: Vec<(f64, f64)>,
+        upper: Vec<(f64, f64)>,
+    ) -> Self {
+        Self::new(label, BandShape::Between { lower, upper })
+    }
+
+    /// A noise band `±sigma` around zero across the panel, for residual panels (`sigma` in the
+    /// units of the vertical axis, e.g. % for residuals in %; its absolute value is used).
+    pub fn noise(label: impl Into<String>, sigma: f64) -> Self {
+        let s = sigma.abs();
+        Self::new(label, BandShape::Horizontal { lo: -s, hi: s })
+    }
+
+    /// A noise band `±sigma(x)` around zero that varies along the horizontal axis, from
+    /// `(x, sigma)` pairs (absolute values used).
+    pub fn noise_profile(label: impl Into<String>, sigma: &[(f64, f64)]) -> Self {
+        let upper: Vec<(f64, f64)> = sigma.iter().map(|&(x, s)| (x, s.abs())).collect();
+        let lower = upper.iter().map(|&(x, s)| (x, -s)).collect();
+        Self::between(label, lower, upper)
+    }
+
+    /// `lo ≤ y ≤ hi` across the panel.
+    pub fn horizontal(label: impl Into<String>, lo: f64, hi: f64) -> Self {
+        Self::new(label, BandShape::Horizontal { lo, hi })
+    }
+
+    /// `lo ≤ x ≤ hi` over the full height of the panel.
+    pub fn vertical(label: impl Into<String>, lo: f64, hi: f64) -> Self {
+        Self::new(label, BandShape::Vertical { lo, hi })
+    }
+
+    fn new(label: impl Into<String>, shape: BandShape) -> Self {
+        Self {
+            label: label.into(),
+            shape,
+            color: None,
+            opacity: 0.18,
+        }
+    }
+
+    /// Sets the palette index.
+    pub fn with_color(mut self, palette_index: usize) -> Self {
+        self.color = Some(palette_index);
+        self
+    }
+
+    /// Sets the opacity (clamped to `[0.02, 1]`).
+    pub fn with_opacity(mut self, opacity: f64) -> Self {
+        self.opacity = if opacity.is_finite() {
+            opacity.clamp(0.02, 1.0)
+        } else {
+            0.18
+        };
+        self
+    }
+}
+
+/// A labelled horizontal reference line across a [`Panel`] (e.g. a plateau, a target value).
+///
+/// The label is written on the line's right end, above it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RefLine {
+    /// Text written on the line (empty: none).
+    pub label: String,
+    /// Height of the line (vertical-axis units).
+    pub y: f64,
+    /// Index into [`PALETTE`](super::PALETTE); `None` is dark grey.
+    pub color: Option<usize>,
+    /// Dashed (`true`) or solid.
+    pub dashed: bool,
+}
+
+impl RefLine {
+    /// A dashed dark-grey reference line at `y`.
+    pub fn new(label: impl Into<String>, y: f64) -> Self {
+        Self {
+            label: label.into(),
+            y,
+            color: None,
+            dashed: true,
+        }
+    }
+}
+
+/// Where a panel's legend goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LegendPlacement {
+    /// In the corner of the plotting area that no data, band edge or reference line crosses
+    /// (upper right, upper left, lower right, lower left, in this order of preference);
+    /// outside the plotting area (to its right, or below it when that leaves the plot too
+    /// narrow) when every corner is taken.
+    #[default]
+    Auto,
+    /// Always outside the plotting area.
+    Outside,
+    /// No legend.
+    Hidden,
+}
+
+/// One set of axes with a title, axis labels, bands, series, reference lines and a legend.
+///
+/// Axis ranges are automatic: the finite data (series, bands, reference lines) plus 5 %
+/// padding; a single value or an empty panel still gets a non-degenerate range. Ticks are
+/// 1-2-5 steps on a linear axis (labelled with the decimals the step needs, zero exactly
+/// `0`) and decades labelled `10ⁿ` on a logarithmic axis that spans them.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Panel {
     /// Title above the axes.
@@ -94,8 +238,16 @@ pub struct Panel {
     pub y_label: String,
     /// The series, drawn in order (later ones on top).
     pub series: Vec<Series>,
+    /// Shaded regions, drawn first (behind the series).
+    pub bands: Vec<Band>,
+    /// Horizontal reference lines, drawn after the bands.
+    pub ref_lines: Vec<RefLine>,
     /// Logarithmic vertical axis; points with `y <= 0` are then skipped.
     pub log_y: bool,
+    /// Logarithmic horizontal axis; points with `x <= 0` are then skipped.
+    pub log_x: bool,
+    /// Where the legend goes.
+    pub legend: LegendPlacement,
 }
 
 impl Panel {
@@ -109,8 +261,7 @@ impl Panel {
             title: title.into(),
             x_label: x_label.into(),
             y_label: y_label.into(),
-            series: Vec::new(),
-            log_y: false,
+            ..Self::default()
         }
     }
 
@@ -120,11 +271,52 @@ impl Panel {
         self
     }
 
+    /// Adds a shaded band (drawn behind the series).
+    pub fn with_band(mut self, band: Band) -> Self {
+        self.bands.push(band);
+        self
+    }
+
+    /// Adds a noise band `±sigma` around zero ([`Band::noise`]), labelled `label`.
+    pub fn with_noise_band(self, label: impl Into<String>, sigma: f64) -> Self {
+        self.with_band(Band::noise(label, sigma))
+    }
+
+    /// Adds a horizontal reference line.
+    pub fn with_ref_line(mut self, line: RefLine) -> Self {
+        self.ref_lines.push(line);
+        self
+    }
+
     /// Sets a logarithmic (`true`) or linear (`false`) vertical axis.
     pub fn with_log_y(mut self, log_y: bool) -> Self {
         self.log_y = log_y;
         self
     }
+
+    /// Sets a logarithmic (`true`) or linear (`false`) horizontal axis.
+    pub fn with_log_x(mut self, log_x: bool) -> Self {
+        self.log_x = log_x;
+        self
+    }
+
+    /// Sets where the legend goes.
+    pub fn with_legend(mut self, placement: LegendPlacement) -> Self {
+        self.legend = placement;
+        self
+    }
+}
+
+/// Checks the request of a panel grid; returns the number of rows and columns.
+fn grid_shape(path: &Path, panels: &[Panel], columns: usize) -> Result<(usize, usize), PlotError> {
+    if panels.is_empty() {
+        return Err(invalid(path, "no panels to draw"));
+    }
+    if columns == 0 {
+        return Err(invalid(path, "the number of columns must be at least 1"));
+    }
+    let columns = columns.min(panels.len());
+    Ok((panels.len().div_ceil(columns), columns))
 }
 
 /// Writes `panels` as a grid with `columns` columns (rows as needed, filled row by row) into a
@@ -138,209 +330,24 @@ pub fn save_panels(
     columns: usize,
     size: (u32, u32),
 ) -> Result<(), PlotError> {
-    if panels.is_empty() {
-        return Err(invalid(path, "no panels to draw"));
-    }
-    if columns == 0 {
-        return Err(invalid(path, "the number of columns must be at least 1"));
-    }
-    let columns = columns.min(panels.len());
-    let rows = panels.len().div_ceil(columns);
-    write_figure(
-        path,
-        size,
-        &PanelGrid {
-            panels,
-            rows,
-            columns,
-        },
-    )
-}
-
-/// Runs of consecutive usable points (finite, and `y > 0` for a log axis).
-fn finite_runs(points: &[(f64, f64)], log_y: bool) -> Vec<Vec<(f64, f64)>> {
-    let mut runs = Vec::new();
-    let mut current = Vec::new();
-    for &(x, y) in points {
-        if x.is_finite() && y.is_finite() && (!log_y || y > 0.0) {
-            // Same clamp as the axis range, so that every point maps inside the axes.
-            current.push((x.clamp(-HUGE, HUGE), y.clamp(-HUGE, HUGE)));
-        } else if !current.is_empty() {
-            runs.push(std::mem::take(&mut current));
-        }
-    }
-    if !current.is_empty() {
-        runs.push(current);
-    }
-    runs
-}
-
-struct PanelGrid<'a> {
-    panels: &'a [Panel],
-    rows: usize,
-    columns: usize,
-}
-
-impl Figure for PanelGrid<'_> {
-    fn draw<DB>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
-    where
-        DB: DrawingBackend,
-        DB::ErrorType: 'static,
-    {
-        let areas = root.split_evenly((self.rows, self.columns));
-        for (panel, area) in self.panels.iter().zip(areas.iter()) {
-            draw_panel(area, panel)?;
-        }
-        Ok(())
-    }
-}
-
-fn draw_panel<DB>(area: &DrawingArea<DB, Shift>, panel: &Panel) -> DrawResult
-where
-    DB: DrawingBackend,
-    DB::ErrorType: 'static,
-{
-    let (w, h) = area.dim_in_pixel();
-    let m = Metrics::for_area(w, h);
-    let usable = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && (!panel.log_y || y > 0.0);
-    let points = || {
-        panel
-            .series
-            .iter()
-            .flat_map(|s| s.points.iter().copied())
-            .filter(usable)
+    let (rows, columns) = grid_shape(path, panels, columns)?;
+    let grid = PanelGrid {
+        panels,
+        rows,
+        columns,
     };
-    let (x_lo, x_hi) = axis_range(points().map(|p| p.0), false, true);
-    let (y_lo, y_hi) = axis_range(points().map(|p| p.1), panel.log_y, true);
-
-    let mut builder = ChartBuilder::on(area);
-    builder
-        .margin(m.margin)
-        .margin_right(m.margin * 2)
-        .x_label_area_size(m.x_area)
-        .y_label_area_size(m.y_area);
-    if !panel.title.is_empty() {
-        builder.caption(&panel.title, (FONT, m.title));
-    }
-    if panel.log_y {
-        let y_axis = (y_lo..y_hi)
-            .log_scale()
-            .with_key_points(log_ticks(y_lo, y_hi));
-        let mut chart = builder.build_cartesian_2d(x_lo..x_hi, y_axis)?;
-        fill_panel(&mut chart, panel, &m)
-    } else {
-        let mut chart = builder.build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)?;
-        fill_panel(&mut chart, panel, &m)
-    }
+    write_figure(path, size, &grid)
 }
 
-fn fill_panel<'a, DB, Y>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
-    panel: &Panel,
-    m: &Metrics,
-) -> DrawResult
-where
-    DB: DrawingBackend + 'a,
-    DB::ErrorType: 'static,
-    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
-{
-    chart
-        .configure_mesh()
-        .x_desc(panel.x_label.as_str())
-        .y_desc(panel.y_label.as_str())
-        .label_style((FONT, m.tick))
-        .axis_desc_style((FONT, m.label))
-        .x_labels(6)
-        .y_labels(6)
-        .x_label_formatter(&format_tick)
-        .y_label_formatter(&format_tick)
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(215, 215, 215))
-        .draw()?;
-
-    let stroke = (m.label / 7.0).round().clamp(1.0, 3.0) as u32;
-    let radius = (m.label / 4.0).round().clamp(2.0, 5.0) as i32;
-    for (k, series) in panel.series.iter().enumerate() {
-        let color = PALETTE[series.color.unwrap_or(k) % PALETTE.len()];
-        let line = color.stroke_width(stroke);
-        for run in finite_runs(&series.points, panel.log_y) {
-            match series.style {
-                Style::Markers => {
-                    chart
-                        .draw_series(run.iter().map(|&p| Circle::new(p, radius, color.filled())))?;
-                }
-                Style::Rings => {
-                    chart.draw_series(
-                        run.iter()
-                            .map(|&p| Circle::new(p, 2 * radius, color.stroke_width(stroke))),
-                    )?;
-                }
-                _ if run.len() == 1 => {
-                    // An isolated point between gaps would be invisible as a line.
-                    chart.draw_series(
-                        run.iter()
-                            .map(|&p| Circle::new(p, stroke + 1, color.filled())),
-                    )?;
-                }
-                Style::Line => {
-                    chart.draw_series(LineSeries::new(run, line))?;
-                }
-                Style::Dashed => {
-                    let dash = (stroke * 4) as i32;
-                    chart.draw_series(DashedLineSeries::new(run, dash, dash * 2 / 3, line))?;
-                }
-            }
-        }
-        if !series.label.is_empty() {
-            let style = series.style;
-            chart
-                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
-                .label(series.label.as_str())
-                .legend(move |(x, y)| {
-                    let (line, dot, gap) = match style {
-                        Style::Line => (color.stroke_width(stroke), TRANSPARENT.filled(), 20),
-                        Style::Dashed => (color.stroke_width(stroke), TRANSPARENT.filled(), 7),
-                        Style::Markers => (TRANSPARENT.stroke_width(0), color.filled(), 20),
-                        Style::Rings => {
-                            (TRANSPARENT.stroke_width(0), color.stroke_width(stroke), 20)
-                        }
-                    };
-                    EmptyElement::at((x, y))
-                        + PathElement::new(vec![(0, 0), (gap, 0)], line)
-                        + PathElement::new(vec![(20 - gap, 0), (20, 0)], line)
-                        + Circle::new((10, 0), radius, dot)
-                });
-        }
-    }
-    if panel.series.iter().any(|s| !s.label.is_empty()) {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FONT, m.tick))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .draw()?;
-    }
-    Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn runs_break_at_non_finite_points() {
-        let pts = [
-            (0.0, 1.0),
-            (1.0, f64::NAN),
-            (2.0, 2.0),
-            (3.0, 3.0),
-            (4.0, -1.0),
-        ];
-        assert_eq!(finite_runs(&pts, false).len(), 2);
-        assert_eq!(
-            finite_runs(&pts, true),
-            vec![vec![(0.0, 1.0)], vec![(2.0, 2.0), (3.0, 3.0)]]
-        );
-    }
+/// The grid of [`save_panels`] as an SVG document in memory (e.g. to embed in an HTML page);
+/// errors name `"<svg>"` as the path.
+pub fn panels_svg(panels: &[Panel], columns: usize, size: (u32, u32)) -> Result<String, PlotError> {
+    let path = Path::new("<svg>");
+    let (rows, columns) = grid_shape(path, panels, columns)?;
+    let grid = PanelGrid {
+        panels,
+        rows,
+        columns,
+    };
+    render_svg(path, size, &grid)
 }
