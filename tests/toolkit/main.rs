@@ -12,6 +12,7 @@ mod library_edges;
 mod linear_solvers;
 mod mesh_passes;
 mod oscillatory_mesh;
+mod html_page;
 mod plot;
 mod scipy_problems;
 mod sensitivities;
