@@ -18,6 +18,7 @@
 //! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
 //! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
 //! * [`figures`]: profile, fit and landscape figures (PNG/SVG);
+//! * [`flow_curve_figure`]: the flow curve `η_E(ε̇)` with its bands (PNG/SVG);
 //! * [`statistics`]: noise estimates, runs test, autocorrelation and rank correlation of
 //!   residuals;
 //! * [`take_up`]: the take-up condition a model uses (the data set's, a given diameter, or
@@ -33,6 +34,7 @@ pub mod effects;
 pub mod error;
 pub mod failure_hints;
 pub mod figures;
+pub mod flow_curve_figure;
 pub mod format;
 pub mod input;
 pub mod material_law;

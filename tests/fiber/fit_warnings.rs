@@ -110,21 +110,13 @@ fn line<'a>(text: &'a str, prefix: &str) -> &'a str {
 
 #[test]
 fn shipped_data_fit_has_no_warning() {
+    // the default uncertainties of the error budget (issue 11): a table beside the estimates,
+    // no warning unless the systematic uncertainty dominates and leaves the law undetermined
+    // (issue 31; see tests/error_budget.rs)
     let (dir, toml, data) = probe::shipped_copy("fw_control");
-    // process conditions and gauge known well enough that the error budget (issue 11) stays
-    // below the statistical errors; with the default uncertainties (2 % inlet diameter, 1 %
-    // gauge scale, 3 K of the VFT temperature T_VF) the budget warns, see tests/error_budget.rs
-    let text = std::fs::read_to_string(&toml).unwrap();
-    std::fs::write(
-        &toml,
-        format!(
-            "{text}\n[uncertainty]\ninlet_diameter_rel = 0.005\ngauge_scale_rel = 0.005\n\
-             vft_T_VF_K = 1.0\n"
-        ),
-    )
-    .unwrap();
     let (p, v) = fit_cli(&toml, &data, &dir);
     assert!(!p.stdout.contains("[[Warnings"), "{}", p.stdout);
+    assert!(p.stdout.contains("    warnings: none\n"), "{}", p.stdout);
     assert!(!p.stdout.contains("AT LOWER") && !p.stdout.contains("AT UPPER"));
     assert!(!p.stderr.contains("warning:"), "{}", p.stderr);
     assert_eq!(v["warnings"].as_array().unwrap().len(), 0, "{v}");
@@ -176,11 +168,16 @@ fn a_kappa_at_its_lower_bound_is_marked_and_gets_no_interval() {
     assert!(p.stdout.contains("[[Warnings"), "{}", p.stdout);
     assert!(warning_with(&v, "at_bound", "kappa"), "{v}");
     assert!(warning_with(&v, "misfit", "v0p53_p2"), "{v}");
+    // the warnings are printed once, in the report's one [[Warnings]] section; stderr only
+    // points to them
     assert!(
-        p.stderr.contains("warning: [at_bound] kappa"),
+        p.stdout.contains("    WARNING [at_bound] kappa"),
         "{}",
-        p.stderr
+        p.stdout
     );
+    assert_eq!(p.stdout.matches("WARNING [at_bound] kappa").count(), 1);
+    assert!(!p.stderr.contains("[at_bound]"), "{}", p.stderr);
+    assert!(p.stderr.contains("warning(s) in the report above"), "{}", p.stderr);
 }
 
 #[test]

@@ -326,3 +326,27 @@ pub fn with_faults(faults: Faults, seed: u64) -> Scenario {
         ..base("fault_range", seed)
     }
 }
+
+/// A melt without strain thinning (issue 31): the Newtonian law, `n = 1` (`κ` then does not
+/// enter; 11.71 kept for the record), the shipped set's conditions, no hidden effect.
+pub fn newtonian() -> Scenario {
+    Scenario {
+        law: Law {
+            n: 1.0,
+            kappa: 11.71,
+        },
+        ..base("newtonian", 115)
+    }
+}
+
+/// A melt with barely any strain thinning (issue 31): `n = 0.95`, `κ = 11.71`, the shipped
+/// set's conditions, no hidden effect.
+pub fn slightly_thinning() -> Scenario {
+    Scenario {
+        law: Law {
+            n: 0.95,
+            kappa: 11.71,
+        },
+        ..base("slightly_thinning", 116)
+    }
+}

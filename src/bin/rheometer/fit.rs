@@ -83,7 +83,12 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         ensure_not_input(path, &inputs)?;
     }
     if let Some(dir) = &out {
-        for name in ["fit.json", "fit_report.txt"] {
+        for name in [
+            "fit.json",
+            "fit_report.txt",
+            "flow_curve.csv",
+            "flow_curve.json",
+        ] {
             ensure_not_input(&dir.join(name), &inputs)?;
         }
     }
@@ -118,13 +123,23 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             sp.start[0], sp.start[1]
         ));
     }
-    if let Some(e) = &run.budget_error {
-        g.say(format!("warning: error budget not computed: {e}"));
+    for (what, e) in [
+        ("error budget", &run.budget_error),
+        ("profile intervals and likelihood-ratio test", &run.profile_error),
+        ("flow curve", &run.flow_curve_error),
+    ] {
+        if let Some(e) = e {
+            g.say(format!("note: {what} not computed: {e}"));
+        }
     }
+    // the report is the one place of the warnings (stdout); stderr only says where they are
     let rep = run.summary();
     outln!("{}", rep.to_text());
-    for w in &rep.warnings {
-        g.say(format!("warning: {w}"));
+    if rep.has_warnings() {
+        g.say(format!(
+            "{} warning(s) in the report above ([[Warnings]])",
+            rep.warnings.len()
+        ));
     }
     let text = serde_json::to_string_pretty(rep)?;
     if let Some(path) = json {
@@ -169,6 +184,18 @@ fn write_fit_outputs(
         inputs,
     )?;
     write_text(&dir.join("fit.json"), json, inputs)?;
+    if let Some(curve) = &run.summary().flow_curve {
+        write_text(&dir.join("flow_curve.csv"), &curve.to_csv(), inputs)?;
+        write_text(
+            &dir.join("flow_curve.json"),
+            &serde_json::to_string_pretty(curve)?,
+            inputs,
+        )?;
+        let fig = dir.join(format!("flow_curve.{}", g.format.ext()));
+        ensure_not_input(&fig, inputs)?;
+        save_flow_curve_figure(&fig, curve)?;
+        g.say(format!("wrote {}", fig.display()));
+    }
     for (k, sol) in id.solutions.iter().enumerate() {
         let model = &rh.models[k];
         let fs = FiberSolution {

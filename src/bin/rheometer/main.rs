@@ -8,6 +8,7 @@ use diffbvp::fiber::diagnostics::report::save_residual_figure;
 use diffbvp::fiber::effects::{EffectSetting, LawChoice, ModelSpec};
 use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
+use diffbvp::fiber::flow_curve_figure::save_flow_curve_figure;
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
 use diffbvp::fiber::output::{
     check_output_dir, create_dir, ensure_not_input, profiles_csv, write_atomically, write_profiles,

@@ -240,13 +240,13 @@ impl DetectionLimits {
             self.earn_threshold
         );
         s.push_str(&format!(
-            "    {:<24} {:<10} {:>13} {:>13}   {:<26} {}\n",
+            "    {:<22} {:<9} {:>13} {:>13}  {:<17} {}\n",
             "effect",
             "category",
             "detected 50 %",
             "detected 95 %",
-            "undetected s95 shifts n",
-            "kappa"
+            "shift n at s95",
+            "shift kappa"
         ));
         let shift = |v: Option<f64>, se: Option<f64>| match (v, se) {
             (Some(v), Some(se)) => format!("{:+.4} ({se:.1} se)", v),
@@ -255,7 +255,7 @@ impl DetectionLimits {
         };
         for l in &self.limits {
             s.push_str(&format!(
-                "    {:<24} {:<10} {:>13} {:>13}   {:<26} {}\n",
+                "    {:<22} {:<9} {:>13} {:>13}  {:<17} {}\n",
                 l.effect,
                 l.category,
                 l.strength_words(l.s50),

@@ -4,11 +4,26 @@ use super::candidate::{Candidate, ShapeAlternative, StrengthStatus};
 use super::diagnose::verdict::Verdict;
 use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::scan::Profile;
+use crate::fiber::format::{fmt_at, fmt_g, fmt_pm, wrap_long_lines};
+use crate::fiber::rheometer::summary::Z95;
 use crate::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
 
 fn fmt_range(r: [f64; 2]) -> String {
     format!("{:.2}–{:.2} m", r[0], r[1])
+}
+
+/// `" unit"`, or nothing for a dimensionless quantity.
+fn unit_suffix(unit: &str) -> String {
+    match unit.trim() {
+        "" | "-" => String::new(),
+        u => format!(" {u}"),
+    }
+}
+
+/// `value ± se unit` rounded to the uncertainty.
+fn pm_unit(value: f64, se: f64, unit: &str) -> String {
+    format!("{}{}", fmt_pm(value, se), unit_suffix(unit))
 }
 
 impl Diagnosis {
@@ -85,7 +100,7 @@ impl Diagnosis {
                     "{lead} {name}{}. Its signature lies along s = {} (strongest at {:.2} m). \
                      Adding it removes {:.1} % of the misfit ({:.0} % of the excess over the noise; \
                      false-alarm probability of the search {}) (J {:.4e} -> {:.4e}), RMS {:.3} % -> {:.3} %, \
-                     delta BIC = {:.1}, delta AIC = {:.1}; fitted strength {:.4} +/- {:.4} {}.\n",
+                     delta BIC = {:.1}, delta AIC = {:.1}; fitted strength {}.\n",
                     super::ties::or_alternatives(&self.alternatives),
                     fmt_range(c.signature_range_m),
                     c.signature_peak_m,
@@ -98,18 +113,16 @@ impl Diagnosis {
                     100.0 * c.rms_relative_residual_after(),
                     c.delta_bic,
                     c.delta_aic,
-                    c.strength(),
-                    c.stderr_strength(),
-                    c.unit
+                    pm_unit(c.strength(), c.stderr_strength(), &c.unit)
                 ));
                 if let Some(b) = c.at_bound().iter().find(|b| b.parameter == c.effect) {
                     s.push_str(&format!(
-                        "WARNING: its strength ends AT ITS {} BOUND {} {}: the data push it beyond its \
+                        "WARNING: its strength ends AT ITS {} BOUND {}{}: the data push it beyond its \
                          search range, so this is not a credible estimate of the effect (a different \
                          effect, or a process or instrument error, may be behind the misfit).\n",
                         b.side.name().to_uppercase(),
-                        b.bound,
-                        c.unit
+                        fmt_g(b.bound),
+                        unit_suffix(&c.unit)
                     ));
                 }
                 if let (StrengthStatus::Physical, Some(note)) = (c.status, &c.status_note) {
@@ -189,32 +202,25 @@ impl Diagnosis {
             }
         }
         s.push_str("[[Candidates, best first (credible refits by delta BIC, then refits at a bound or not physical)]]\n");
-        s.push_str("    effect                   refit  strength +/- stderr        J after      RMS after  dBIC     lin.dJ/J  false-al.  excess  status       signature\n");
+        s.push_str("    effect                   refit  strength ± stderr              RMS after  dBIC     false-al.  excess  status\n");
+        s.push_str("        J after, lin.dJ/J, signature (peak), shape\n");
         for c in &self.candidates {
             let shape: String = c
                 .shape()
                 .iter()
-                .map(|p| format!("  [{} {:.4} {}]", p.name, p.value, p.unit))
+                .map(|p| format!(", {} {}{}", p.name, fmt_g(p.value), unit_suffix(&p.unit)))
                 .collect();
             s.push_str(&format!(
-                "    {:<24} {:<5}  {:>10.4} +/- {:<10.4} {:<4} {:.4e}  {:>8}  {:>7.1}  {:>8.4}  {:>9}  {:>6}  {:<11}  {} (peak {:.2} m){shape}\n",
+                "    {:<24} {:<5}  {:<28} {:>9}  {:>7.1}  {:>9}  {:>6}  {}\n",
                 c.effect,
                 if c.refitted() { "yes" } else { "lin" },
-                c.strength(),
-                c.stderr_strength(),
-                c.unit,
-                c.cost_after,
+                pm_unit(c.strength(), c.stderr_strength(), &c.unit),
                 if c.rms_relative_residual_after().is_finite() {
                     format!("{:.3} %", 100.0 * c.rms_relative_residual_after())
                 } else {
                     "-".into()
                 },
                 c.delta_bic,
-                if c.cost_before > 0.0 {
-                    c.linear_score / c.cost_before
-                } else {
-                    f64::NAN
-                },
                 probability(c.false_alarm),
                 if c.share_of_excess.is_finite() {
                     format!("{:.0} %", 100.0 * c.share_of_excess)
@@ -222,6 +228,15 @@ impl Diagnosis {
                     "-".into()
                 },
                 c.status.name(),
+            ));
+            s.push_str(&format!(
+                "        J after {:.4e}, lin.dJ/J {:.4}, signature {} (peak {:.2} m){shape}\n",
+                c.cost_after,
+                if c.cost_before > 0.0 {
+                    c.linear_score / c.cost_before
+                } else {
+                    f64::NAN
+                },
                 fmt_range(c.signature_range_m),
                 c.signature_peak_m
             ));
@@ -255,7 +270,7 @@ impl Diagnosis {
         }
         s.push_str(&self.detection.to_text());
         s.push_str(&format!("wall time {:.2} s\n", self.wall_time_s));
-        s
+        wrap_long_lines(&s)
     }
 }
 
@@ -379,7 +394,7 @@ fn profile_line(p: &Profile) -> String {
         })
         .collect();
     let mut line = format!(
-        "{:<40} ({unit}{}physical {}..{}) {}",
+        "{} ({unit}{}physical {}..{}): {}",
         p.label(),
         if unit.is_empty() { "" } else { "; " },
         p.physical_range[0],
@@ -456,17 +471,25 @@ pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), Plo
     save_panels(path, &panels, cols, (440 * cols as u32, 340 * rows))
 }
 
-/// `"0.8040 (95% CI [0.79, 0.82])"`, or the estimate marked at its bound without an interval.
+/// `"0.804 ± 0.007 (95% CI [0.790, 0.818])"` (rounded to the standard error behind the
+/// interval), or the estimate marked at its bound without an interval.
 fn estimate_with_ci(c: &Candidate, name: &str, value: f64, ci: [f64; 2]) -> String {
     match c.at_bound().iter().find(|b| b.parameter == name) {
         Some(b) => format!(
-            "{value:.4} (AT ITS {} BOUND: no valid 95% CI)",
+            "{} (AT ITS {} BOUND: no valid 95% CI)",
+            fmt_g(value),
             b.side.name().to_uppercase()
         ),
         None if ci.iter().all(|v| v.is_finite()) => {
-            format!("{value:.4} (95% CI [{:.4}, {:.4}])", ci[0], ci[1])
+            let se = (ci[1] - ci[0]) / (2.0 * Z95);
+            format!(
+                "{} (95% CI [{}, {}])",
+                fmt_pm(value, se),
+                fmt_at(ci[0], se),
+                fmt_at(ci[1], se)
+            )
         }
-        None => format!("{value:.4} (no valid 95% CI)"),
+        None => format!("{} (no valid 95% CI)", fmt_g(value)),
     }
 }
 
@@ -533,8 +556,8 @@ fn shape_alternative_line(c: &Candidate, a: &ShapeAlternative) -> String {
         .shapes
         .iter()
         .map(|p| match p.unit.as_str() {
-            "-" | "" => format!("{} {}", p.name, p.value),
-            u => format!("{} {:.4} {u}", p.name, p.value),
+            "-" | "" => format!("{} {}", p.name, fmt_g(p.value)),
+            u => format!("{} {} {u}", p.name, fmt_g(p.value)),
         })
         .collect::<Vec<_>>()
         .join(", ");
@@ -542,20 +565,18 @@ fn shape_alternative_line(c: &Candidate, a: &ShapeAlternative) -> String {
     let se_of = |ci: [f64; 2]| (ci[1] - ci[0]) / (2.0 * crate::fiber::rheometer::summary::Z95);
     format!(
         "SHAPE: these data cannot choose the shape of {}: with {shape} (delta BIC {:+.1}) its \
-         strength is {:.4} +/- {:.4} {}, n = {:.4} (95% CI [{:.4}, {:.4}]), kappa = {:.4} \
-         (95% CI [{:.4}, {:.4}]): n {:+.1}, kappa {:+.1} standard errors from the estimate \
-         above, a systematic uncertainty of the shape.\n",
+         strength is {}, n = {} (95% CI [{}, {}]), kappa = {} (95% CI [{}, {}]): n {:+.1}, \
+         kappa {:+.1} standard errors from the estimate above, a systematic uncertainty of the \
+         shape.\n",
         c.effect,
         a.delta_bic_gap,
-        e.strength.value,
-        e.strength.stderr,
-        c.unit,
-        r.n.value,
-        r.n.ci95[0],
-        r.n.ci95[1],
-        r.kappa.value,
-        r.kappa.ci95[0],
-        r.kappa.ci95[1],
+        pm_unit(e.strength.value, e.strength.stderr, &c.unit),
+        fmt_at(r.n.value, r.n.stderr),
+        fmt_at(r.n.ci95[0], r.n.stderr),
+        fmt_at(r.n.ci95[1], r.n.stderr),
+        fmt_at(r.kappa.value, r.kappa.stderr),
+        fmt_at(r.kappa.ci95[0], r.kappa.stderr),
+        fmt_at(r.kappa.ci95[1], r.kappa.stderr),
         shift(r.n.value, c.n(), se_of(c.ci95_n())),
         shift(r.kappa.value, c.kappa(), se_of(c.ci95_kappa()))
     )

@@ -1,7 +1,8 @@
-//! The error budget of a fit as a value: its sources with their shifts of `(n, κ, K)`, in
-//! words and as warnings. Computed by [`error_budget`](super::error_budget()).
+//! The error budget of a fit as a value: its sources with their shifts of `(n, κ, K)`, as a
+//! table, in words, and as a warning where the systematic uncertainty dominates. Computed by [`error_budget`](super::error_budget()).
 
 use super::options::{FitWarning, WarningCode};
+use super::summary_checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 use crate::fiber::uncertainty::{Origin, Scope, Source, SOURCES};
 use serde::{Deserialize, Serialize};
 
@@ -126,48 +127,66 @@ impl ErrorBudget {
         self.sources.iter().filter(|e| e.status.has_numbers())
     }
 
-    /// A warning for each source that shifts `κ` or `n` by more than its statistical standard
-    /// error at its (declared or default) standard uncertainty.
+    /// One warning when the systematic standard uncertainty of `κ` or `n` dominates the
+    /// statistical one (is larger) and is itself large by the limits the fit's checks apply to
+    /// statistical errors ([`LARGE_STDERR_KAPPA`], [`LARGE_STDERR_N`]): the law is then not
+    /// determined by these data and this knowledge of the process, instrument and material.
+    /// Below that the budget is a table, and the systematic uncertainty is quoted beside the
+    /// estimates. The warning names the largest sources and the remedy of the largest.
     pub fn warnings(&self) -> Vec<FitWarning> {
-        let mut w = Vec::new();
-        for e in self.available() {
-            let Some(s) = SOURCES.iter().find(|s| s.key == e.key) else {
-                continue;
-            };
-            let mut parts = Vec::new();
-            for (label, shift, stat) in [
-                ("kappa", e.shift_kappa, self.statistical_kappa),
-                ("n", e.shift_n, self.statistical_n),
-            ] {
-                if let (Some(shift), Some(stat)) = (shift, stat) {
-                    if stat > 0.0 && shift > stat {
-                        parts.push(format!(
-                            "shift {label} by {}, {:.1} times its statistical uncertainty",
-                            g3(shift),
-                            shift / stat
-                        ));
-                    }
+        let mut parts = Vec::new();
+        for (label, sys, stat, limit) in [
+            ("kappa", self.systematic_kappa, self.statistical_kappa, LARGE_STDERR_KAPPA),
+            ("n", self.systematic_n, self.statistical_n, LARGE_STDERR_N),
+        ] {
+            if let (Some(sys), Some(stat)) = (sys, stat) {
+                if sys > stat && sys > limit {
+                    parts.push(format!(
+                        "{label} ± {} systematic against ± {} statistical (limit {limit})",
+                        g3(sys),
+                        g3(stat)
+                    ));
                 }
             }
-            if parts.is_empty() {
-                continue;
-            }
-            w.push(FitWarning::new(
-                WarningCode::Systematic,
+        }
+        if parts.is_empty() {
+            return Vec::new();
+        }
+        let weight = |e: &BudgetEntry| {
+            (e.shift_kappa.unwrap_or(0.0) / LARGE_STDERR_KAPPA)
+                .max(e.shift_n.unwrap_or(0.0) / LARGE_STDERR_N)
+        };
+        let mut sources: Vec<(&BudgetEntry, &Source)> = self
+            .available()
+            .filter_map(|e| Some((e, SOURCES.iter().find(|s| s.key == e.key)?)))
+            .collect();
+        sources.sort_by(|a, b| weight(b.0).total_cmp(&weight(a.0)));
+        let named: Vec<String> = sources
+            .iter()
+            .take(3)
+            .map(|(e, s)| {
                 format!(
-                    "a {} uncertainty of the {} ({}) would {}: the data cannot tell; {}",
-                    sigma_words(s, e.sigma),
+                    "the {} ({}, {})",
                     s.what,
+                    sigma_words(s, e.sigma),
                     match e.origin {
                         Origin::Default => "default",
                         _ => "declared",
-                    },
-                    parts.join(" and "),
-                    s.remedy
-                ),
-            ));
-        }
-        w
+                    }
+                )
+            })
+            .collect();
+        let remedy = sources.first().map_or("", |(_, s)| s.remedy);
+        vec![FitWarning::new(
+            WarningCode::Systematic,
+            format!(
+                "the systematic uncertainty dominates and leaves the law undetermined: {}; \
+                 largest sources: {}; the data cannot tell these: {remedy}, or declare the \
+                 uncertainties you know in [uncertainty]",
+                parts.join(", "),
+                named.join(", ")
+            ),
+        )]
     }
 
     /// The sensitivities in words: "κ shifts by … per K of inlet temperature, …".

@@ -131,7 +131,7 @@ impl Rheometer {
             .local(&fit_result.p[..ns], 1.0, obj.layout.params.take_up_factor());
         let declared = options.relative_uncertainty.or(self.relative_uncertainty);
         let noise = self.noise_summary(&residual_profiles, declared)?;
-        let summary = FitSummary::new(SummaryInput {
+        let mut summary = FitSummary::new(SummaryInput {
             estimator: options.estimator,
             law: self.spec.law,
             start: start.law,
@@ -161,6 +161,7 @@ impl Rheometer {
             nodes: solutions.iter().map(|s| s.x.len()).collect(),
             wall_time_s: t0.elapsed().as_secs_f64(),
         });
+        summary.strain_rates = self.strain_rate_coverage(&solutions);
         Ok(Identification {
             summary,
             names: obj.layout.names.clone(),

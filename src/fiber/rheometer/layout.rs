@@ -74,6 +74,15 @@ pub struct ShapeSlot {
     pub column: Option<usize>,
 }
 
+/// The column of a parameter after column `i` was removed (`None` for `i` itself).
+fn drop_column(c: &mut Option<usize>, i: usize) {
+    *c = match *c {
+        Some(x) if x == i => None,
+        Some(x) if x > i => Some(x - 1),
+        other => other,
+    };
+}
+
 /// The parameter layout of one fit.
 #[derive(Debug, Clone)]
 pub struct Layout {
@@ -249,6 +258,25 @@ impl Layout {
         u2.extend(upper);
         for (i, &li) in f2.iter().enumerate() {
             template[li] = template[li].clamp(l2[i], u2[i]);
+        }
+        for (name, v) in &options.hold {
+            let Some(i) = n2.iter().position(|n| n == name) else {
+                return Err(RheometerError::Data(format!(
+                    "cannot hold {name}: not a fitted parameter of this model ({})",
+                    n2.join(", ")
+                )));
+            };
+            template[f2[i]] = *v;
+            f2.remove(i);
+            n2.remove(i);
+            l2.remove(i);
+            u2.remove(i);
+            for slot in &mut effects {
+                drop_column(&mut slot.column, i);
+                for sh in &mut slot.shapes {
+                    drop_column(&mut sh.column, i);
+                }
+            }
         }
         Ok(Layout {
             template,

@@ -19,6 +19,10 @@
 //! * [`summary`]: the outcome of a fit as one value, [`FitSummary`] (named estimates with
 //!   standard errors and 95% confidence intervals, covariance, the one noise level, warnings),
 //!   rendered as text and JSON and read back by the next step;
+//! * [`flow_curve`]: the identified law as `η_E(ε̇)` at a temperature, with its statistical
+//!   and systematic bands and the strain rates the data cover ([`FlowCurve`]);
+//! * [`profile`]: profile-likelihood intervals, one-sided bounds at a bound, and the
+//!   likelihood-ratio test against the nested Newtonian law;
 //! * [`summary_checks`]: the checks of a fit (estimates at bounds, misfit, huge errors, data
 //!   the model cannot describe).
 
@@ -27,14 +31,17 @@ pub mod budget;
 pub mod data;
 pub mod error_budget;
 pub mod estimator;
+pub mod flow_curve;
 pub mod identify;
 pub mod landscape;
 pub mod layout;
 pub mod objective;
 pub mod options;
 pub mod parameter_shift;
+pub mod profile;
 pub mod summary;
 mod summary_build;
+mod summary_finding;
 pub mod summary_checks;
 mod summary_read;
 mod summary_text;
@@ -42,11 +49,15 @@ mod summary_text;
 pub use data::Rheometer;
 pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
 pub use estimator::Estimator;
+pub use flow_curve::{BandMethod, FlowCurve, FlowCurveOptions, FlowPoint, StrainRateCoverage};
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
 pub use options::{CarreauFiber, IdentifyOptions, RheometerError};
 pub use parameter_shift::ParameterShift;
+pub use profile::{
+    NewtonianTest, OneSidedBound, ProfileInterval, ProfileMode, ProfilePoint, ThinningBound,
+};
 pub use summary::{
     AtBound, BoundSide, Covariance, EffectEstimate, Estimate, FitSummary, FitWarning, SolverRecord,
     WarningCode,

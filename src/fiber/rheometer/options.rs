@@ -97,6 +97,10 @@ pub struct IdentifyOptions {
     /// [`FitError::Cancelled`](crate::least_squares::FitError::Cancelled) (the Python bindings
     /// set it on Ctrl-C).
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Shared parameters held at a value instead of fitted, by name (`"n"`, `"kappa"`, an
+    /// effect's name, `"effect.shape"`) with the value in model-parameter units (the profile
+    /// likelihood's refits; default none).
+    pub hold: Vec<(String, f64)>,
 }
 
 impl Default for IdentifyOptions {
@@ -121,6 +125,7 @@ impl Default for IdentifyOptions {
             max_discretisation_shift: Some(0.01),
             noise_factors: None,
             cancel: None,
+            hold: Vec::new(),
         }
     }
 }
@@ -161,9 +166,9 @@ pub enum WarningCode {
     IllConditioned,
     /// Measured data the model cannot describe (e.g. diameters increasing along the spin line).
     DataTrend,
-    /// A declared (or default) uncertainty of what the data cannot identify (process
-    /// conditions, instrument, material data) shifts an estimate by more than its statistical
-    /// standard error (see [`error_budget`](super::error_budget())).
+    /// The systematic uncertainty from what the data cannot identify (process conditions,
+    /// instrument, material data; declared or default) dominates the statistical one and
+    /// leaves the law undetermined (see [`ErrorBudget::warnings`](super::ErrorBudget::warnings)).
     Systematic,
     /// A material law outside what polymer melts do (`n` near 0, an interval reaching beyond
     /// the law's range, a jump from the plain fit that the gain in fit does not pay for): the

@@ -15,6 +15,8 @@
 
 use super::budget::ErrorBudget;
 use super::estimator::Estimator;
+use super::flow_curve::{FlowCurve, StrainRateCoverage};
+use super::profile::{NewtonianTest, ProfileInterval};
 pub use super::options::{FitWarning, WarningCode};
 use crate::fiber::effects::{Category, LawChoice};
 use crate::fiber::noise_summary::NoiseSummary;
@@ -354,6 +356,20 @@ pub struct FitSummary {
     /// instrument, material data), if computed ([`with_error_budget`](Self::with_error_budget)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error_budget: Option<ErrorBudget>,
+    /// The strain rates the data cover (`None` in reports written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub strain_rates: Option<StrainRateCoverage>,
+    /// Profile-likelihood intervals of the fitted law parameters and strengths, with the
+    /// reasons the linearised interval is not trusted where it is not (see
+    /// [`profile`](super::profile)).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub intervals: Vec<ProfileInterval>,
+    /// The likelihood-ratio test against the nested Newtonian law, where `n` is fitted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub newtonian_test: Option<NewtonianTest>,
+    /// The identified law as a flow curve `η_E(ε̇)` with its bands.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flow_curve: Option<FlowCurve>,
 }
 
 impl Default for SolverRecord {
@@ -373,8 +389,8 @@ impl Default for SolverRecord {
 
 impl FitSummary {
     /// The summary with the error budget `budget`: its section in the text, its object in
-    /// JSON, and a [`WarningCode::Systematic`] warning for each source that shifts `κ` or `n`
-    /// by more than the statistical standard error.
+    /// JSON, and a [`WarningCode::Systematic`] warning where the systematic uncertainty
+    /// dominates ([`ErrorBudget::warnings`]).
     pub fn with_error_budget(mut self, budget: ErrorBudget) -> Self {
         self.warnings.extend(budget.warnings());
         self.error_budget = Some(budget);
@@ -505,6 +521,10 @@ pub(crate) mod tests {
             f_scale_source: String::new(),
             down_weighted: 0,
             error_budget: None,
+            strain_rates: None,
+            intervals: Vec::new(),
+            newtonian_test: None,
+            flow_curve: None,
         }
     }
 

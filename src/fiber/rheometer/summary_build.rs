@@ -143,6 +143,10 @@ impl FitSummary {
             f_scale_source: input.f_scale_source,
             down_weighted: fit.down_weighted(),
             error_budget: None,
+            strain_rates: None,
+            intervals: Vec::new(),
+            newtonian_test: None,
+            flow_curve: None,
         };
         let mut w = input.data_warnings;
         summary_checks::check_bounds(&summary, &mut w);

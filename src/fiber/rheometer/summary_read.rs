@@ -3,7 +3,7 @@
 //! step needs is checked, and errors name the file and the field.
 
 use super::estimator::Estimator;
-use super::summary::FitSummary;
+use super::summary::{FitSummary, WarningCode};
 use crate::fiber::effects::Effect;
 use crate::fiber::error::Readable;
 use serde_json::Value;
@@ -223,6 +223,16 @@ fn upgrade_legacy(mut v: Value) -> Value {
 }
 
 impl FitSummary {
+    /// Reports written before the error budget became a table warned for every source that
+    /// shifted an estimate by more than its statistical error; their budget's warnings are
+    /// recomputed by today's rule ([`ErrorBudget::warnings`](super::ErrorBudget::warnings)).
+    fn upgrade_systematic_warnings(&mut self) {
+        let Some(b) = &self.error_budget else { return };
+        let now = b.warnings();
+        self.warnings.retain(|w| w.code != WarningCode::Systematic);
+        self.warnings.extend(now);
+    }
+
     /// Parses the JSON text of a fit summary; `source` names it in errors. Reports written by
     /// earlier versions (bare numbers for `n`, `κ` and strengths) read too.
     pub fn from_json(text: &str, source: &str) -> Result<Self, String> {
@@ -236,8 +246,10 @@ impl FitSummary {
             .ok_or_else(|| not_report("expected a JSON object {...}".into()))?;
         check_fields(obj).map_err(|e| format!("{source}: {e}"))?;
         let value = upgrade_legacy(value);
-        let s: FitSummary = serde_json::from_value(value).map_err(|e| not_report(e.to_string()))?;
+        let mut s: FitSummary =
+            serde_json::from_value(value).map_err(|e| not_report(e.to_string()))?;
         s.validate(source)?;
+        s.upgrade_systematic_warnings();
         Ok(s)
     }
 

@@ -1,59 +1,99 @@
-//! The text report of a [`FitSummary`] (lmfit-style sections).
+//! The text report of a [`FitSummary`]: the result on one screen first (the law with its
+//! intervals, what the data support about strain thinning, the fit against the noise, the
+//! warnings), the details below (how the fit ran, the other fitted parameters, the profile
+//! intervals, the flow curve, correlations, the error budget). Numbers carry the digits their
+//! uncertainty supports ([`fmt_pm`]); lines are at most
+//! [`LINE_WIDTH`](crate::fiber::format::LINE_WIDTH) characters
+//! ([`wrap_long_lines`]).
 
 use super::estimator::Estimator;
 use super::summary::{Estimate, FitSummary};
 use crate::fiber::effects::LawChoice;
-use crate::fiber::format::fmt_g;
+use crate::fiber::format::{fmt_at, fmt_e, fmt_g, fmt_pm, fmt_sig, wrap_long_lines};
+
+/// `" unit"`, or nothing for a dimensionless quantity.
+pub(crate) fn unit_suffix(unit: &str) -> String {
+    match unit.trim() {
+        "" | "-" => String::new(),
+        u => format!(" {u}"),
+    }
+}
+
+/// `[lo, hi]` at the precision of `u`.
+pub(crate) fn fmt_interval(ci: [f64; 2], u: f64) -> String {
+    format!("[{}, {}]", fmt_at(ci[0], u), fmt_at(ci[1], u))
+}
 
 impl FitSummary {
-    /// One `label value +/- se ... 95% CI` line of a fitted law parameter.
-    fn variable_line(&self, label: &str, e: &Estimate) -> String {
-        let (value, se, ci) = (e.value, e.stderr, e.ci95);
-        if let Some(b) = self.bound_of(&e.name) {
+    /// The line of a fitted or fixed estimate: `label value ± se  95% CI [lo, hi]`, or its
+    /// bound, or why it has no interval.
+    fn estimate_line(&self, label: &str, e: &Estimate) -> String {
+        let unit = unit_suffix(&e.unit);
+        let (value, se) = (e.value, e.stderr);
+        if !e.fitted {
+            return format!("    {label} {}{unit} (fixed)\n", fmt_g(value));
+        }
+        let mut s = if let Some(b) = self.bound_of(&e.name) {
             format!(
-                "    {label} {value:.5} AT {} BOUND {} ({}no valid 95% CI: the optimum lies at or \
-                 beyond the search range)\n",
+                "    {label} {}{unit} AT {} BOUND {} (no valid 95% CI: the optimum lies at or \
+                 beyond the search range)",
+                fmt_sig(value, 4),
                 b.side.name().to_uppercase(),
-                fmt_g(b.bound),
-                if se.is_finite() {
-                    format!("+/- {} not valid; ", fmt_g(se))
-                } else {
-                    String::new()
-                }
+                fmt_g(b.bound)
+            )
+        } else if let Some(side) = e.at_bound {
+            format!(
+                "    {label} {}{unit} AT {} BOUND (no valid 95% CI)",
+                fmt_sig(value, 4),
+                side.name().to_uppercase()
             )
         } else if !se.is_finite() {
-            format!("    {label} {value:.5} +/- (no standard error: singular covariance)\n")
-        } else if se >= 1e5 {
             format!(
-                "    {label} {value:.5} +/- {se:.3e}  95% CI [{:.3e}, {:.3e}] (not determined)\n",
-                ci[0], ci[1]
+                "    {label} {}{unit} (no standard error: singular covariance)",
+                fmt_sig(value, 5)
             )
         } else {
+            let undetermined = if se >= 1e5 {
+                " (not determined)"
+            } else {
+                ""
+            };
             format!(
-                "    {label} {value:.5} +/- {se:.5} ({:.2}%)  95% CI [{:.5}, {:.5}]\n",
-                100.0 * se / value.abs(),
-                ci[0],
-                ci[1]
+                "    {label} {}{unit}  95% CI {}{unit}{undetermined}",
+                fmt_pm(value, se),
+                fmt_interval(e.ci95, se)
             )
+        };
+        if let Some(i) = self.interval(&e.name) {
+            if !i.linearised_trusted() {
+                s.push_str(&format!("; profile likelihood: {}", i.words()));
+            }
         }
+        s.push('\n');
+        s
     }
 
-    /// An lmfit-style text report, with a `[[Warnings]]` section when a check found something.
+    /// The text report (see the module doc), a `[[Warnings]]` section when a check found
+    /// something.
     pub fn to_text(&self) -> String {
-        let mut s = self.header_text();
+        let mut s = self.result_text();
         if !self.warnings.is_empty() {
             s.push_str(&format!(
-                "[[Warnings: {} — do not use these estimates without checking]]\n",
+                "[[Warnings: {} — check these before using the estimates]]\n",
                 self.warnings.len()
             ));
             for w in &self.warnings {
                 s.push_str(&format!("    WARNING {w}\n"));
             }
         }
-        s.push_str("[[Variables]]\n");
-        s.push_str(&self.law_text());
-        s.push_str(&self.take_up_text());
-        s.push_str(&self.effects_text());
+        s.push_str(&self.header_text());
+        let details = self.take_up_text() + &self.effects_text();
+        if !details.is_empty() {
+            s.push_str("[[Variables]]\n");
+            s.push_str(&details);
+        }
+        s.push_str(&self.intervals_text());
+        s.push_str(&self.flow_curve_text());
         if self.correlation_n_kappa.is_finite() {
             s.push_str("[[Correlations]]\n");
             s.push_str(&format!(
@@ -64,9 +104,45 @@ impl FitSummary {
         if let Some(b) = &self.error_budget {
             s.push_str(&b.to_text());
         }
+        wrap_long_lines(&s)
+    }
+
+    /// The result on one screen: the law, the finding, the fit against the noise, warnings.
+    fn result_text(&self) -> String {
+        let law = match self.law {
+            LawChoice::Carreau => "Carreau-type law",
+            LawChoice::Newtonian => "Newtonian law",
+        };
+        let mut s = format!(
+            "[[Result: {law}, {} estimator, {} experiments]]\n",
+            self.estimator.name(),
+            self.experiments.len().max(self.take_up_factors.len())
+        );
+        s.push_str(&self.law_text());
+        let finding = self.law_finding();
+        if !finding.is_empty() {
+            s.push_str(&format!("    {finding}\n"));
+        }
+        let rms = 100.0 * self.rms_relative_residual;
+        if self.noise.level.is_finite() && self.noise.level > 0.0 {
+            s.push_str(&format!(
+                "    fit: RMS relative residual {rms:.3} %, {:.2} times the noise level {:.3} %\n",
+                self.rms_relative_residual / self.noise.level,
+                100.0 * self.noise.level
+            ));
+        } else {
+            s.push_str(&format!(
+                "    fit: RMS relative residual {rms:.3} % (no noise level)\n"
+            ));
+        }
+        s.push_str(&match self.warnings.len() {
+            0 => "    warnings: none\n".to_string(),
+            n => format!("    warnings: {n}, listed below\n"),
+        });
         s
     }
 
+    /// How the fit ran.
     fn header_text(&self) -> String {
         let mut s = String::new();
         s.push_str(&format!("[[Fit: {} estimator]]\n", self.estimator.name()));
@@ -84,7 +160,8 @@ impl FitSummary {
         ));
         s.push_str(&format!(
             "    start             = (n, kappa) = ({}, {})\n",
-            self.start[0], self.start[1]
+            fmt_g(self.start[0]),
+            fmt_g(self.start[1])
         ));
         let sv = &self.solver;
         s.push_str(&format!("    termination       = {}\n", sv.termination));
@@ -125,7 +202,7 @@ impl FitSummary {
         s
     }
 
-    /// `BVP accuracy = tol 1e-4, 121–294 nodes per experiment; at 1e-6 the estimates move
+    /// `BVP accuracy = tol 1e-4, 121-294 nodes per experiment; at 1e-6 the estimates move
     /// by at most 0.0004 standard errors`.
     fn discretisation_line(&self) -> Option<String> {
         let sv = &self.solver;
@@ -155,28 +232,50 @@ impl FitSummary {
         ))
     }
 
+    /// `n`, `κ` and `K` (or the Newtonian law).
     fn law_text(&self) -> String {
         let mut s = String::new();
         if !self.n.fitted && !self.kappa.fitted && self.law == LawChoice::Newtonian {
             s.push_str("    law:   Newtonian (n = 1 fixed; kappa and K do not enter)\n");
             return s;
         }
-        if self.n.fitted {
-            s.push_str(&self.variable_line("n:    ", &self.n));
+        s.push_str(&self.estimate_line("n:    ", &self.n));
+        s.push_str(&self.estimate_line("kappa:", &self.kappa));
+        let k = &self.k_pa;
+        if k.has_interval() {
+            // the relative error of K is se(kappa): the digits it supports
+            let digits = (1 - self.kappa.stderr.max(1e-15).log10().floor() as i64).clamp(2, 8);
+            let e = |v: f64| fmt_e(v, digits as usize);
+            s.push_str(&format!(
+                "    K:     {} Pa  95% CI [{}, {}] Pa\n",
+                e(k.value),
+                e(k.ci95[0]),
+                e(k.ci95[1])
+            ));
         } else {
-            s.push_str(&format!("    n:     {:.5} (fixed)\n", self.n.value));
+            s.push_str(&format!(
+                "    K:     {} Pa  (no valid 95% CI)\n",
+                fmt_sig(k.value, 4)
+            ));
         }
-        s.push_str(&self.variable_line("kappa:", &self.kappa));
-        if self.k_pa.has_interval() {
-            s.push_str(&format!(
-                "    K:     {:.5e} Pa  95% CI [{:.5e}, {:.5e}] Pa\n",
-                self.k_pa.value, self.k_pa.ci95[0], self.k_pa.ci95[1]
-            ));
-        } else {
-            s.push_str(&format!(
-                "    K:     {:.5e} Pa  (no valid 95% CI)\n",
-                self.k_pa.value
-            ));
+        if let Some(b) = &self.error_budget {
+            let sys = |label: &str, v: Option<f64>, e: &Estimate| {
+                v.filter(|v| v.is_finite() && *v > 0.0 && e.fitted)
+                    .map(|v| format!("{label} ± {}", fmt_sig(v, 2)))
+            };
+            let parts: Vec<String> = [
+                sys("n", b.systematic_n, &self.n),
+                sys("kappa", b.systematic_kappa, &self.kappa),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            if !parts.is_empty() {
+                s.push_str(&format!(
+                    "    systematic (error budget, one standard uncertainty): {}\n",
+                    parts.join(", ")
+                ));
+            }
         }
         s
     }
@@ -214,43 +313,129 @@ impl FitSummary {
     fn effects_text(&self) -> String {
         let mut s = String::new();
         for e in &self.effects {
-            let st = &e.strength;
-            if !st.fitted {
-                s.push_str(&format!(
-                    "    {}: {:.5} {} (fixed)\n",
-                    e.effect, st.value, st.unit
-                ));
-            } else if let Some(side) = st.at_bound {
-                let bound = self
-                    .bound_of(&e.effect)
-                    .map_or(String::new(), |b| format!(" {}", fmt_g(b.bound)));
-                s.push_str(&format!(
-                    "    {}: {:.5} {} AT {} BOUND{bound} (no valid 95% CI)\n",
-                    e.effect,
-                    st.value,
-                    st.unit,
-                    side.name().to_uppercase(),
-                ));
-            } else {
-                s.push_str(&format!(
-                    "    {}: {:.5} +/- {:.5} {}  95% CI [{:.5}, {:.5}]\n",
-                    e.effect, st.value, st.stderr, st.unit, st.ci95[0], st.ci95[1]
-                ));
-            }
+            let label = format!("{}:", e.effect);
+            s.push_str(&self.estimate_line(&label, &e.strength));
             for sh in &e.shapes {
-                if sh.fitted {
-                    s.push_str(&format!(
-                        "      {}.{}: {:.5} +/- {:.5} {}\n",
-                        e.effect, sh.name, sh.value, sh.stderr, sh.unit
-                    ));
-                } else {
-                    s.push_str(&format!(
-                        "      {}.{}: {:.5} {} (fixed)\n",
-                        e.effect, sh.name, sh.value, sh.unit
-                    ));
-                }
+                let label = format!("  {}.{}:", e.effect, sh.name);
+                s.push_str(&self.estimate_line(&label, sh));
             }
         }
         s
+    }
+
+    /// The profile intervals and the likelihood-ratio test.
+    fn intervals_text(&self) -> String {
+        let mut s = String::new();
+        if !self.intervals.is_empty() {
+            s.push_str("[[Profile-likelihood intervals (95 %: deviance 3.84; one-sided 2.71)]]\n");
+        }
+        for i in &self.intervals {
+            let lin = self
+                .parameters()
+                .into_iter()
+                .find(|e| e.name == i.parameter)
+                .filter(|e| e.has_interval());
+            let compare = match lin {
+                Some(e) if i.ci95.iter().all(|v| v.is_finite()) => {
+                    let wl = e.ci95[1] - e.ci95[0];
+                    let wp = i.ci95[1] - i.ci95[0];
+                    format!(
+                        "; linearised {} ({:+.1} % in width)",
+                        fmt_interval(e.ci95, e.stderr),
+                        100.0 * (wp / wl - 1.0)
+                    )
+                }
+                Some(e) => format!("; linearised {}", fmt_interval(e.ci95, e.stderr)),
+                None => String::new(),
+            };
+            let trust = if i.linearised_trusted() {
+                String::new()
+            } else {
+                format!(" — linearised interval not trusted: {}", i.reasons.join(", "))
+            };
+            s.push_str(&format!(
+                "    {}: profile {}{compare}{trust} ({} refits)\n",
+                i.parameter,
+                i.words(),
+                i.points.len().saturating_sub(1)
+            ));
+        }
+        if let Some(t) = &self.newtonian_test {
+            s.push_str("[[Newtonian law (n = 1) against this fit: likelihood-ratio test]]\n");
+            s.push_str(&format!(
+                "    LR = {}, {} (null distribution ½χ²₀ + ½χ²₁; kappa is not identified \
+                 under n = 1, so p is approximate)\n",
+                fmt_sig(t.statistic, 3),
+                fmt_p(t.p_value)
+            ));
+            s.push_str(&format!(
+                "    RMS relative residual {:.3} % with the Newtonian law, {:.3} % with this fit: \
+                 {}\n",
+                100.0 * t.rms_newtonian,
+                100.0 * self.rms_relative_residual,
+                match t.preferred {
+                    LawChoice::Newtonian => "the Newtonian law fits as well (preferred, simpler)",
+                    LawChoice::Carreau => "the strain thinning is significant",
+                }
+            ));
+        }
+        s
+    }
+
+    /// The flow curve in three lines.
+    fn flow_curve_text(&self) -> String {
+        let Some(c) = &self.flow_curve else {
+            return String::new();
+        };
+        let mut s = format!(
+            "[[Flow curve at {} K (flow_curve.csv, .json and figure with --out)]]\n",
+            fmt_g(c.temperature_k)
+        );
+        s.push_str(&format!(
+            "    Newtonian plateau {} eta0 = {} Pa s (Trouton ratio times the VFT shear \
+             viscosity)\n",
+            fmt_g(c.trouton),
+            fmt_sig(c.plateau_pa_s, 3)
+        ));
+        s.push_str(&format!(
+            "    the data cover strain rates {} to {} 1/s at this temperature (median {} 1/s); \
+             beyond, the law is extrapolated\n",
+            fmt_sig(c.covered_per_s[0], 2),
+            fmt_sig(c.covered_per_s[1], 2),
+            fmt_sig(c.median_per_s, 2)
+        ));
+        if let Some(p) = c.nearest(c.median_per_s) {
+            let band = |b: [f64; 2]| format!("[{}, {}]", fmt_sig(b[0], 3), fmt_sig(b[1], 3));
+            s.push_str(&format!(
+                "    at {} 1/s: eta_E = {} Pa s, 95 % band {} Pa s ({}){}\n",
+                fmt_sig(p.strain_rate_per_s, 2),
+                fmt_sig(p.eta_pa_s, 3),
+                band(p.stat95_pa_s),
+                match c.band {
+                    super::flow_curve::BandMethod::Delta => "delta method",
+                    super::flow_curve::BandMethod::Profile => "along the profile",
+                    super::flow_curve::BandMethod::None => "no fitted law parameter",
+                },
+                if c.systematic {
+                    format!(", with systematic {} Pa s", band(p.total95_pa_s))
+                } else {
+                    String::new()
+                }
+            ));
+        }
+        s
+    }
+}
+
+/// A p-value in words: `p = 0.41`, `p = 2.3e-5`, `p < 1e-15`.
+pub(crate) fn fmt_p(p: f64) -> String {
+    if !p.is_finite() {
+        "p unknown".into()
+    } else if p < 1e-15 {
+        "p < 1e-15".into()
+    } else if p < 1e-3 {
+        format!("p = {p:.1e}")
+    } else {
+        format!("p = {}", fmt_sig(p, 2))
     }
 }

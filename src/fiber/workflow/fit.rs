@@ -1,11 +1,14 @@
-//! The `fit` workflow: start point, identification, error budget, and what the figures need
-//! (the Newtonian reference and, for a model with added effects, the same fit without them).
+//! The `fit` workflow: start point, identification, error budget, profile-likelihood
+//! intervals and the likelihood-ratio test against the Newtonian law, the flow curve, and what
+//! the figures need (the Newtonian reference and, for a model with added effects, the same fit
+//! without them).
 
 use crate::fiber::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::fiber::input::LoadedExperiments;
+use crate::fiber::rheometer::profile::{intervals, ProfileMode};
 use crate::fiber::rheometer::{
-    error_budget, FitSummary, Identification, IdentifyOptions, Rheometer, RheometerError,
-    StartPoint,
+    error_budget, FitSummary, FlowCurve, FlowCurveOptions, Identification, IdentifyOptions,
+    Rheometer, RheometerError, StartPoint,
 };
 use crate::solution::Solution;
 
@@ -27,6 +30,11 @@ pub struct FitRequest {
     /// Compute the error budget (default `true`; a bootstrap replicate or a screening that
     /// needs only the estimates saves about half the fit's time without it).
     pub error_budget: bool,
+    /// Profile-likelihood intervals and the likelihood-ratio test against the Newtonian law
+    /// (default [`ProfileMode::Auto`]).
+    pub profile: ProfileMode,
+    /// The flow curve's temperature, resolution and isotherms.
+    pub flow_curve: FlowCurveOptions,
 }
 
 impl FitRequest {
@@ -39,6 +47,8 @@ impl FitRequest {
             baseline: false,
             newtonian_reference: false,
             error_budget: true,
+            profile: ProfileMode::Auto,
+            flow_curve: FlowCurveOptions::default(),
         }
     }
 
@@ -64,6 +74,10 @@ pub struct FitRun {
     pub start_heuristic: Option<StartPoint>,
     /// Why the error budget is missing, if it is.
     pub budget_error: Option<String>,
+    /// Why the profile intervals or the likelihood-ratio test are missing, if they are.
+    pub profile_error: Option<String>,
+    /// Why the flow curve is missing, if it is.
+    pub flow_curve_error: Option<String>,
     /// The same fit without the model's added effects ([`FitRequest::baseline`]).
     pub baseline: Option<Identification>,
     /// The Newtonian model at the fitted `κ` ([`FitRequest::newtonian_reference`]).
@@ -79,8 +93,10 @@ impl FitRun {
 
 /// Fits `request`'s model to `data`: the start (given, heuristic or Newtonian), the
 /// identification, its error budget (declared or default uncertainties of what the data cannot
-/// identify; a budget that cannot be computed does not fail the fit; none unless
-/// [`FitRequest::error_budget`]) and the optional reference computations.
+/// identify; none unless [`FitRequest::error_budget`]), the profile-likelihood intervals and
+/// the likelihood-ratio test against the Newtonian law, the flow curve (none of these three
+/// fails the fit: what could not be computed is named in the run) and the optional reference
+/// computations.
 pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, RheometerError> {
     request.model.validate().map_err(RheometerError::Data)?;
     let opts = &request.identify;
@@ -105,6 +121,26 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
         Some(Err(e)) => Some(e.to_string()),
         None => None,
     };
+    let profile_error = match intervals(&rh, &id, opts, request.profile) {
+        Ok((found, test)) => {
+            id.summary.intervals = found;
+            id.summary.newtonian_test = test;
+            None
+        }
+        Err(e) => Some(e.to_string()),
+    };
+    let curve = rh
+        .models
+        .first()
+        .ok_or_else(|| "no experiment".to_string())
+        .and_then(|m| FlowCurve::of(m, &id.local_params, &id.summary, &request.flow_curve));
+    let flow_curve_error = match curve {
+        Ok(c) => {
+            id.summary.flow_curve = Some(c);
+            None
+        }
+        Err(e) => Some(e),
+    };
     let baseline = if request.baseline && !request.model.effects.is_empty() {
         let rh0 = Rheometer::with_spec(&data.set, ModelSpec::new(request.model.law))?;
         let s0 = match request.model.law {
@@ -125,6 +161,8 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
         identification: id,
         start_heuristic,
         budget_error,
+        profile_error,
+        flow_curve_error,
         baseline,
         newtonian,
     })
