@@ -14,6 +14,7 @@ mod fiber_physics;
 mod fiber_reference;
 mod fiber_terms;
 mod fit_warnings;
+mod flow_curve_intervals;
 mod independent_model;
 mod landscape;
 mod rheometer;

@@ -6,8 +6,6 @@
 //! report's text (no warnings on the clean shipped data, lines of at most 100 characters,
 //! numbers rounded to their uncertainty).
 
-mod independent;
-mod probe;
 
 use diffbvp::fiber::effects::LawChoice;
 use diffbvp::fiber::flow_curve_figure::save_flow_curve_figure;
@@ -15,14 +13,14 @@ use diffbvp::fiber::format::{fmt_pm, LINE_WIDTH};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
 use diffbvp::fiber::rheometer::{BandMethod, FitSummary, IdentifyOptions};
 use diffbvp::fiber::workflow::{fit, FitRequest, FitRun};
-use independent::rng::Rng;
-use independent::scenarios;
+use crate::independent::rng::Rng;
+use crate::independent::scenarios;
 use std::path::Path;
 use std::time::Duration;
 
 fn shipped() -> LoadedExperiments {
     load_experiments_with(
-        &probe::repo().join("data/pmma7n_synthetic/experiments.toml"),
+        &crate::probe::repo().join("data/pmma7n_synthetic/experiments.toml"),
         4,
     )
     .unwrap()
@@ -203,7 +201,7 @@ fn no_thinning_case(sc: &independent::dataset::Scenario, fig: &Path) -> FitSumma
 
 #[test]
 fn a_newtonian_melt_gets_a_one_sided_bound_and_the_newtonian_law_preferred() {
-    let dir = probe::scratch("fc_newtonian");
+    let dir = crate::probe::scratch("fc_newtonian");
     let s = no_thinning_case(&scenarios::newtonian(), &dir.join("flow_curve_newtonian.png"));
     // the flat curve: within 2 % of the plateau over the covered rates
     let c = s.flow_curve.as_ref().unwrap();
@@ -214,7 +212,7 @@ fn a_newtonian_melt_gets_a_one_sided_bound_and_the_newtonian_law_preferred() {
 
 #[test]
 fn a_barely_thinning_melt_is_reported_as_not_detected_with_its_bound() {
-    let dir = probe::scratch("fc_n095");
+    let dir = crate::probe::scratch("fc_n095");
     no_thinning_case(
         &scenarios::slightly_thinning(),
         &dir.join("flow_curve_n095.png"),
@@ -223,10 +221,10 @@ fn a_barely_thinning_melt_is_reported_as_not_detected_with_its_bound() {
 
 #[test]
 fn the_fit_report_on_the_shipped_data_reads_well_and_writes_the_flow_curve() {
-    let (dir, toml, data) = probe::shipped_copy("fc_cli");
+    let (dir, toml, data) = crate::probe::shipped_copy("fc_cli");
     let out = dir.join("out");
-    let p = probe::rheometer(
-        &["fit", probe::s(&toml), "--out", probe::s(&out)],
+    let p = crate::probe::rheometer(
+        &["fit", crate::probe::s(&toml), "--out", crate::probe::s(&out)],
         &[&data],
         Duration::from_secs(120),
     );
