@@ -41,10 +41,8 @@ use super::scan::{
     Refit, ScanOptions, ShapeParameter,
 };
 use super::scores::{cosine, linear_scores};
-use super::ties::{alternatives, Alternative, DEFAULT_TIE_MARGIN};
-use crate::fiber::effects::{
-    Category, Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
-};
+use super::ties::{alternatives_among, Alternative, DEFAULT_TIE_MARGIN};
+use crate::fiber::effects::{Effect, LawChoice, ModelSpec, NEWTONIAN_LAW};
 use crate::fiber::noise_model::Outlier;
 use crate::fiber::rheometer::estimator::RelativeResidual;
 use crate::fiber::rheometer::report::bound_side;
@@ -574,7 +572,7 @@ pub fn diagnose(
             Some(s) => s,
             None => rh.start_heuristic(&opts)?.start,
         },
-        LawChoice::Newtonian => [1.0, STRAIN_THINNING_REFERENCE_KAPPA],
+        LawChoice::Newtonian => NEWTONIAN_LAW,
     };
     let base = rh.identify(law0, &opts)?;
     let base_report = FitReport::new(&base);
@@ -615,11 +613,7 @@ pub fn diagnose(
         .zip(&lin)
         .map(|(e, l)| {
             // shape parameters fitted with the strength count as extra parameters too
-            let k = if matches!(e, Effect::StrainThinning) {
-                2
-            } else {
-                1 + e.free_shapes().len()
-            };
+            let k = e.extra_parameters();
             let after = (cost_before - l.score).max(0.0);
             let (bic, aic) = ic(after, k);
             let change: Vec<f64> = l.signature.iter().map(|v| v * l.strength).collect();
@@ -992,18 +986,15 @@ pub fn diagnose(
     let candidates: Vec<CandidateResult> = ranked.iter().map(|&i| results[i].clone()).collect();
     // other candidates about as consistent with the data as the named one
     let alternatives: Vec<Alternative> = match best_i {
-        Some(b) => alternatives(
+        Some(b) => alternatives_among(
             &results[b],
             &candidates,
             options.earn_threshold,
             options.tie_margin,
-            cands[b].category(),
+            &cands,
             |name| match cands.iter().position(|e| e.name() == name) {
-                Some(i) => (
-                    cands[i].category(),
-                    cosine(&lin[b].signature, &lin[i].signature),
-                ),
-                None => (Category::Physics, f64::NAN),
+                Some(i) => cosine(&lin[b].signature, &lin[i].signature),
+                None => f64::NAN,
             },
         ),
         None => Vec::new(),

@@ -10,7 +10,8 @@
 //! ```
 //!
 //! with `J` the fit's residual Jacobian and `∂r/∂q` the residuals' derivative with respect to
-//! the strength of the effect that represents `q` ([`SOURCES`]), carried in the model at its
+//! the strength of the effect that represents `q` (its descriptor's budget source: the built-in
+//! [`SOURCES`], then those of user-written effects in the model), carried in the model at its
 //! neutral (or fixed) value — the same dual-number sensitivities as the fit's Jacobian, one
 //! warm-started solve and one sensitivity solve per experiment for all sources together. The
 //! gauge's scale and offset, where no effect represents them, use the exact derivative of the
@@ -107,6 +108,38 @@ pub struct BudgetEntry {
     /// Per experiment (where the source applies).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub by_experiment: Vec<ExperimentSensitivity>,
+    /// The source (its words and remedy for the text; not in JSON, where a built-in source is
+    /// found by its key).
+    #[serde(skip)]
+    pub source: Option<Source>,
+}
+
+impl BudgetEntry {
+    /// Its source: the one it was made from, else the built-in one with its key.
+    fn source(&self) -> Option<Source> {
+        self.source
+            .or_else(|| SOURCES.iter().find(|s| s.key == self.key).copied())
+    }
+}
+
+/// The error-budget sources for a model `spec`: the built-in [`SOURCES`], then the budget
+/// sources of the user-written effects in the model (fitted, fixed or candidates; their
+/// uncertainty is the descriptor's default).
+pub fn budget_sources(spec: &ModelSpec) -> Vec<Source> {
+    let mut out: Vec<Source> = SOURCES.to_vec();
+    let users = spec
+        .effects
+        .iter()
+        .map(|s| &s.effect)
+        .chain(&spec.candidates);
+    for e in users.filter(|e| matches!(e, Effect::Custom(_))) {
+        if let Some(src) = Source::of(e.descriptor()) {
+            if !out.iter().any(|s| s.key == src.key) {
+                out.push(src);
+            }
+        }
+    }
+    out
 }
 
 /// The error budget (JSON: `error_budget`).
@@ -114,7 +147,7 @@ pub struct BudgetEntry {
 pub struct ErrorBudget {
     /// Whether any uncertainty was declared in the data set (else all are defaults).
     pub declared: bool,
-    /// The sources, in the order of [`SOURCES`].
+    /// The sources, in the order of [`SOURCES`], then user-written effects' ([`budget_sources`]).
     pub sources: Vec<BudgetEntry>,
     /// Systematic standard uncertainty of `n`: root-sum-square of the sources' shifts.
     pub systematic_n: Option<f64>,
@@ -183,8 +216,9 @@ pub fn error_budget(
             )
         })
         .collect();
+    let sources = budget_sources(&rh.spec);
     let mut plan: Vec<Result<String, SourceStatus>> = Vec::new();
-    for s in SOURCES {
+    for s in &sources {
         let applies = rh.experiments.iter().any(|e| (s.per_unit)(e).is_some());
         let status = if !applies {
             Err(SourceStatus::NotApplicable)
@@ -243,7 +277,7 @@ pub fn error_budget(
         aug = Some(effect_columns(rh, id, spec, free, strengths, options)?);
     }
     let sigma_r = id.relative_uncertainty.unwrap_or(1.0);
-    let columns: Vec<Column> = SOURCES
+    let columns: Vec<Column> = sources
         .iter()
         .zip(&plan)
         .map(|(s, p)| match (p, &aug) {
@@ -272,7 +306,7 @@ pub fn error_budget(
         offsets[k + 1] = offsets[k] + counts[k];
     }
     let mut entries = Vec::new();
-    for (s, col) in SOURCES.iter().zip(&columns) {
+    for (s, col) in sources.iter().zip(&columns) {
         let (sigma, origin) = unc
             .sigma(s.key, usize::MAX)
             .unwrap_or((s.default, Origin::Default));
@@ -295,6 +329,7 @@ pub fn error_budget(
             shift_n: None,
             shift_kappa: None,
             by_experiment: Vec::new(),
+            source: Some(*s),
         };
         entry.status = match col {
             Column::None(st) => *st,
@@ -461,7 +496,7 @@ impl ErrorBudget {
     pub fn warnings(&self) -> Vec<FitWarning> {
         let mut w = Vec::new();
         for e in self.available() {
-            let Some(s) = SOURCES.iter().find(|s| s.key == e.key) else {
+            let Some(s) = e.source() else {
                 continue;
             };
             let mut parts = Vec::new();
@@ -486,7 +521,7 @@ impl ErrorBudget {
                 WarningCode::Systematic,
                 format!(
                     "a {} uncertainty of the {} ({}) would {}: the data cannot tell; {}",
-                    sigma_words(s, e.sigma),
+                    sigma_words(&s, e.sigma),
                     s.what,
                     match e.origin {
                         Origin::Default => "default",
@@ -513,7 +548,7 @@ impl ErrorBudget {
             let parts: Vec<String> = self
                 .available()
                 .filter_map(|e| {
-                    let s = SOURCES.iter().find(|s| s.key == e.key)?;
+                    let s = e.source()?;
                     let d = get(e)? * s.word_unit.1;
                     Some(format!(
                         "by {} per {} of {}",
@@ -549,7 +584,7 @@ impl ErrorBudget {
         ));
         let abs = |v: Option<f64>| v.map_or("-".to_string(), g3);
         for e in &self.sources {
-            let Some(src) = SOURCES.iter().find(|x| x.key == e.key) else {
+            let Some(src) = e.source() else {
                 continue;
             };
             let origin = match e.origin {
@@ -557,7 +592,7 @@ impl ErrorBudget {
                 Origin::Declared => "declared",
                 Origin::Experiment => "experiment",
             };
-            let sigma = format!("{} ({origin})", sigma_words(src, e.sigma));
+            let sigma = format!("{} ({origin})", sigma_words(&src, e.sigma));
             let per = |v: Option<f64>| {
                 v.map_or("-".to_string(), |v| {
                     format!("{}/{}", sign(v * src.word_unit.1), src.word_unit.0)
