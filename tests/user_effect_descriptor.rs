@@ -29,6 +29,7 @@ const GUIDE_WIDTH: f64 = 0.01;
 /// limit on these data (0.39 mN).
 const TRUE_DRAG_MN: f64 = 1.0;
 
+// ANCHOR: descriptor
 /// The user's descriptor: everything `diagnose`, the ties and the report need to know.
 const GUIDE_DRAG: EffectDescriptor = EffectDescriptor::user("guide_drag")
     .with_unit("mN", "F")
@@ -48,6 +49,7 @@ impl FiberTerm for GuideDrag {
         D::from(-1e-3 * (-0.5 * z * z).exp() / (GUIDE_WIDTH * (2.0 * PI).sqrt()))
     }
 }
+// ANCHOR_END: descriptor
 
 #[test]
 fn a_user_written_candidate_is_found_and_ranked_first() {
@@ -62,11 +64,13 @@ fn a_user_written_candidate_is_found_and_ranked_first() {
     };
     let generated = sc.generate().unwrap();
     let set = load_experiments(&generated.toml).unwrap();
+    // ANCHOR: diagnose
     let mut options = DiagnoseOptions::default();
     options
         .candidates
         .push(Effect::user(GUIDE_DRAG, Balance::Momentum, GuideDrag));
     let run = diagnose(&set, &ModelSpec::new(LawChoice::Carreau), &options).unwrap();
+    // ANCHOR_END: diagnose
     let d = &run.diagnosis;
     let text = d.to_text();
     println!("{text}");
