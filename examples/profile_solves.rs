@@ -1,7 +1,10 @@
 //! Repeats one benchmark solve for instruction counting (`perf stat -e instructions` or
-//! callgrind): `cargo run --release --example profile_solves -- shock|troesch|bratu|fiber [reps]`.
+//! callgrind): `cargo run --release --example profile_solves -- shock|troesch|bratu|fiber|fiber_candidates
+//! [reps]` (`fiber_candidates`: the fiber with every built-in candidate effect carried at neutral
+//! strength, as `diagnose` solves it: air profiles, process and instrument parameters).
 //! Prints the nodes, meshes, Newton iterations and factorisations of one solve.
 
+use diffbvp::fiber::effects::{Effect, ModelSpec};
 use diffbvp::fiber::setup::{Air, Experiment, Material};
 use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use diffbvp::mesh::linspace;
@@ -74,14 +77,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 black_box(solve(&p, &[], black_box(&g), &opts)?);
             }
         }
-        "fiber" => {
+        "fiber" | "fiber_candidates" => {
             let exp = Experiment::pmma7n_v0p53_p2();
+            let physics = match which {
+                "fiber" => Physics::paper(),
+                _ => ModelSpec::default()
+                    .with_candidates(&Effect::builtin())
+                    .physics()?,
+            };
             let m = FiberModel::new(
                 &Material::pmma7n(),
                 &Air::paper(),
                 &exp,
                 CarreauLike::new(),
-                Physics::paper(),
+                physics,
             )?;
             let fopts = SimulateOptions::with_tol(1e-6);
             let s = simulate(&m, &[0.8, 11.71], &fopts)?;

@@ -25,7 +25,18 @@
 //! parameters (gauge scale and offset, [`Physics::gauge_reading`]) only the predicted
 //! measurement.
 //! Users add their own SI terms with [`Physics::with_custom`] (a [`FiberTerm`]).
+//!
+//! The strengths that are candidate effects are named by the effects' descriptors
+//! ([`catalog`](super::catalog)): the radiation term, the convection term's factor
+//! `nusselt_scale`, and the parameter slots of the air profiles, process, instrument and
+//! material parameters; [`Physics::enable`] switches on the part that carries an effect.
 
+use super::catalog::{
+    AIR_COFLOW, AIR_COFLOW_LINE, AIR_TEMPERATURE_PROFILE, COFLOW_DECAY, COFLOW_LINE_ONSET,
+    COFLOW_LINE_RAMP, COFLOW_TAIL, DIE_TEMPERATURE_OFFSET, GAUGE_OFFSET, GAUGE_SCALE,
+    INLET_DIAMETER, INLET_VELOCITY, MASS_FLOW_SCALE, NUSSELT_SCALE, RADIATION, VFT_B_OFFSET,
+    VFT_T_VF_OFFSET, WARM_AIR_DECAY,
+};
 use super::error::FiberError;
 use super::setup::Air;
 use crate::dyn_dual::{eval_dyn, DualScalarFn, DynDualScalarFn};
@@ -265,11 +276,11 @@ pub struct Term {
 
 impl Term {
     /// Name of its strength as a model parameter: the candidate effect's name where the term's
-    /// strength is one (`nusselt_scale` for `convection`, see `fiber::effects`), else the term's
-    /// name.
+    /// strength is one (`nusselt_scale` for `convection`, its descriptor
+    /// [`NUSSELT_SCALE`](super::catalog::NUSSELT_SCALE)), else the term's name.
     pub fn parameter_name(&self) -> &'static str {
         match self.kind {
-            TermKind::Convection => "nusselt_scale",
+            TermKind::Convection => NUSSELT_SCALE.model_param,
             _ => self.name,
         }
     }
@@ -354,24 +365,25 @@ const S_VFT_B: usize = 13;
 const S_VFT_T_VF: usize = 14;
 const S_COFLOW_TAIL: usize = 15;
 
-/// Names of the parameter slots after the terms, in `p` order.
+/// Names of the parameter slots after the terms, in `p` order: each slot carries an effect's
+/// strength or one of its shape parameters, named by the effect's descriptor.
 const SLOT_NAMES: [&str; SLOTS] = [
-    "air_coflow",
-    "air_coflow.decay_length",
-    "air_coflow_line",
-    "air_coflow_line.onset",
-    "air_coflow_line.ramp_width",
-    "air_temperature_profile",
-    "air_temperature_profile.decay_length",
-    "inlet_velocity",
-    "inlet_diameter",
-    "die_temperature_offset",
-    "mass_flow_scale",
-    "gauge_scale",
-    "gauge_offset",
-    "vft_b_offset",
-    "vft_t_vf_offset",
-    "air_coflow.tail",
+    AIR_COFLOW.model_param,
+    COFLOW_DECAY.model_param,
+    AIR_COFLOW_LINE.model_param,
+    COFLOW_LINE_ONSET.model_param,
+    COFLOW_LINE_RAMP.model_param,
+    AIR_TEMPERATURE_PROFILE.model_param,
+    WARM_AIR_DECAY.model_param,
+    INLET_VELOCITY.model_param,
+    INLET_DIAMETER.model_param,
+    DIE_TEMPERATURE_OFFSET.model_param,
+    MASS_FLOW_SCALE.model_param,
+    GAUGE_SCALE.model_param,
+    GAUGE_OFFSET.model_param,
+    VFT_B_OFFSET.model_param,
+    VFT_T_VF_OFFSET.model_param,
+    COFLOW_TAIL.model_param,
 ];
 
 /// Process and instrument factors of a model evaluation (dual numbers, so that derivatives with
@@ -489,7 +501,7 @@ impl<H: NusseltLaw> Physics<H> {
     /// Adds grey-body radiation with emissivity `emissivity` \[-\] (term `"radiation"`).
     pub fn with_radiation(mut self, emissivity: f64) -> Self {
         self.terms.push(Term {
-            name: "radiation",
+            name: RADIATION.model_param,
             balance: Balance::Energy,
             strength: Strength::Fixed(1.0),
             kind: TermKind::Radiation { emissivity },
@@ -596,14 +608,15 @@ impl<H: NusseltLaw> Physics<H> {
     }
 
     /// Sets the strength named `name`: a term's (by its name or [`Term::parameter_name`], e.g.
-    /// `"convection"` or `"nusselt_scale"`), `"air_coflow"` and `"air_coflow.decay_length"`
-    /// (need [`with_coflow`](Self::with_coflow)), `"air_coflow_line"`,
+    /// `"convection"` or `"nusselt_scale"`), `"air_coflow"`, `"air_coflow.decay_length"` and
+    /// `"air_coflow.tail"` (need [`with_coflow`](Self::with_coflow)), `"air_coflow_line"`,
     /// `"air_coflow_line.onset"`, `"air_coflow_line.ramp_width"` (need
     /// [`with_line_coflow`](Self::with_line_coflow)), `"air_temperature_profile"` and
     /// `"air_temperature_profile.decay_length"` (need [`with_warm_air`](Self::with_warm_air)),
     /// a process or instrument parameter (`"inlet_velocity"`, `"inlet_diameter"`,
     /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"`) or a
-    /// material-data offset (`"vft_b_offset"`, `"vft_t_vf_offset"`). An unknown name, or an air profile that is not there, is an error.
+    /// material-data offset (`"vft_b_offset"`, `"vft_t_vf_offset"`): the slots are named by the
+    /// effects' descriptors. An unknown name, or an air profile that is not there, is an error.
     pub fn set_strength(&mut self, name: &str, strength: Strength) -> Result<(), FiberError> {
         if let Some(t) = self
             .terms
@@ -613,78 +626,109 @@ impl<H: NusseltLaw> Physics<H> {
             t.strength = strength;
             return Ok(());
         }
-        let missing = |what: &str, how: &str| {
-            Err(FiberError::InvalidInput(format!(
-                "strength {name}: the physics has no {what} (add it with {how})"
-            )))
+        let Some(slot) = SLOT_NAMES.iter().position(|n| *n == name) else {
+            let mut known: Vec<&str> = self.terms.iter().map(|t| t.parameter_name()).collect();
+            known.extend(SLOT_NAMES);
+            return Err(FiberError::InvalidInput(format!(
+                "unknown strength \"{name}\"; the strengths are {}",
+                known.join(", ")
+            )));
         };
-        match name {
-            "air_coflow" | "air_coflow.decay_length" | "air_coflow.tail" => {
-                match &mut self.air_speed {
-                    AirSpeed::CoFlow {
-                        length,
-                        strength: s,
-                        tail,
-                        ..
-                    } => match name {
-                        "air_coflow" => *s = strength,
-                        "air_coflow.decay_length" => *length = strength,
-                        _ => *tail = strength,
-                    },
-                    AirSpeed::Still => return missing("air co-flow", "with_coflow"),
-                }
-            }
-            "air_coflow_line" | "air_coflow_line.onset" | "air_coflow_line.ramp_width" => {
-                match &mut self.line_coflow {
-                    LineCoflow::On {
-                        onset,
-                        ramp_width,
-                        strength: s,
-                        ..
-                    } => match name {
-                        "air_coflow_line" => *s = strength,
-                        "air_coflow_line.onset" => *onset = strength,
-                        _ => *ramp_width = strength,
-                    },
-                    LineCoflow::Off => {
-                        return missing("air co-flow along the line", "with_line_coflow")
-                    }
-                }
-            }
-            "air_temperature_profile" | "air_temperature_profile.decay_length" => {
-                match &mut self.air_temperature {
-                    AirTemperature::WarmNozzle {
-                        length,
-                        strength: s,
-                        ..
-                    } => {
-                        if name == "air_temperature_profile" {
-                            *s = strength
-                        } else {
-                            *length = strength
-                        }
-                    }
-                    AirTemperature::Uniform => return missing("warm-air profile", "with_warm_air"),
-                }
-            }
-            "inlet_velocity" => self.inlet_velocity = strength,
-            "inlet_diameter" => self.inlet_diameter = strength,
-            "die_temperature_offset" => self.die_temperature_offset = strength,
-            "mass_flow_scale" => self.mass_flow_scale = strength,
-            "gauge_scale" => self.gauge_scale = strength,
-            "gauge_offset" => self.gauge_offset = strength,
-            "vft_b_offset" => self.vft_b_offset = strength,
-            "vft_t_vf_offset" => self.vft_t_vf_offset = strength,
-            _ => {
-                let mut known: Vec<&str> = self.terms.iter().map(|t| t.parameter_name()).collect();
-                known.extend(SLOT_NAMES);
-                return Err(FiberError::InvalidInput(format!(
-                    "unknown strength \"{name}\"; the strengths are {}",
-                    known.join(", ")
-                )));
-            }
-        }
+        *self.slot_mut(slot)? = strength;
         Ok(())
+    }
+
+    /// The strength in parameter slot `slot` (an `S_*` index), or an error naming the air
+    /// profile it needs when that is switched off.
+    fn slot_mut(&mut self, slot: usize) -> Result<&mut Strength, FiberError> {
+        let name = SLOT_NAMES[slot];
+        let missing = |what: &str, how: &str| {
+            FiberError::InvalidInput(format!(
+                "strength {name}: the physics has no {what} (add it with {how})"
+            ))
+        };
+        Ok(match slot {
+            S_COFLOW | S_COFLOW_LEN | S_COFLOW_TAIL => match &mut self.air_speed {
+                AirSpeed::CoFlow {
+                    length,
+                    strength,
+                    tail,
+                    ..
+                } => match slot {
+                    S_COFLOW => strength,
+                    S_COFLOW_LEN => length,
+                    _ => tail,
+                },
+                AirSpeed::Still => return Err(missing("air co-flow", "with_coflow")),
+            },
+            S_LINE | S_LINE_ONSET | S_LINE_RAMP => match &mut self.line_coflow {
+                LineCoflow::On {
+                    onset,
+                    ramp_width,
+                    strength,
+                    ..
+                } => match slot {
+                    S_LINE => strength,
+                    S_LINE_ONSET => onset,
+                    _ => ramp_width,
+                },
+                LineCoflow::Off => {
+                    return Err(missing("air co-flow along the line", "with_line_coflow"))
+                }
+            },
+            S_WARM | S_WARM_LEN => match &mut self.air_temperature {
+                AirTemperature::WarmNozzle {
+                    length, strength, ..
+                } => match slot {
+                    S_WARM => strength,
+                    _ => length,
+                },
+                AirTemperature::Uniform => {
+                    return Err(missing("warm-air profile", "with_warm_air"))
+                }
+            },
+            S_INLET_VELOCITY => &mut self.inlet_velocity,
+            S_INLET_DIAMETER => &mut self.inlet_diameter,
+            S_DIE_TEMPERATURE => &mut self.die_temperature_offset,
+            S_MASS_FLOW => &mut self.mass_flow_scale,
+            S_GAUGE_SCALE => &mut self.gauge_scale,
+            S_GAUGE_OFFSET => &mut self.gauge_offset,
+            S_VFT_B => &mut self.vft_b_offset,
+            _ => &mut self.vft_t_vf_offset,
+        })
+    }
+
+    /// Switches on the built-in part that carries the strength named `name` (an effect's
+    /// [`model_param`](super::catalog::EffectDescriptor::model_param)), at unit amplitude with
+    /// its shapes at their defaults: the radiation term (emissivity 1), the aspirator co-flow,
+    /// the co-flow along the line or the warm-air profile (speed or excess 1). Nothing changes
+    /// where the part is there already or always is (a term's factor such as `nusselt_scale`,
+    /// a process, instrument or material parameter). Set the strength afterwards with
+    /// [`set_strength`](Self::set_strength); an unknown name is an error.
+    pub fn enable(self, name: &str) -> Result<Self, FiberError> {
+        if self.terms.iter().any(|t| t.parameter_name() == name) {
+            return Ok(self);
+        }
+        if name == RADIATION.model_param {
+            return Ok(self.with_radiation(1.0));
+        }
+        Ok(match SLOT_NAMES.iter().position(|n| *n == name) {
+            Some(S_COFLOW) if matches!(self.air_speed, AirSpeed::Still) => {
+                self.with_coflow(1.0, COFLOW_DECAY.default)
+            }
+            Some(S_LINE) if matches!(self.line_coflow, LineCoflow::Off) => {
+                self.with_line_coflow(1.0, COFLOW_LINE_ONSET.default, COFLOW_LINE_RAMP.default)
+            }
+            Some(S_WARM) if matches!(self.air_temperature, AirTemperature::Uniform) => {
+                self.with_warm_air(1.0, WARM_AIR_DECAY.default)
+            }
+            Some(_) => self,
+            None => {
+                return Err(FiberError::InvalidInput(format!(
+                    "no built-in part of the physics carries the strength \"{name}\""
+                )))
+            }
+        })
     }
 
     /// Builder form of [`set_strength`](Self::set_strength).
@@ -694,12 +738,14 @@ impl<H: NusseltLaw> Physics<H> {
     }
 
     /// Names and default values of the strengths that are model parameters, in `p` order:
-    /// terms first (in term order, by [`Term::parameter_name`]), then `"air_coflow"`,
+    /// terms first (in term order, by [`Term::parameter_name`]), then the slots (named by the
+    /// effects' descriptors): `"air_coflow"`,
     /// `"air_coflow.decay_length"`, `"air_coflow_line"`, `"air_coflow_line.onset"`,
     /// `"air_coflow_line.ramp_width"`, `"air_temperature_profile"`,
     /// `"air_temperature_profile.decay_length"`, `"inlet_velocity"`, `"inlet_diameter"`,
     /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"`,
-    /// `"vft_b_offset"`, `"vft_t_vf_offset"` (each where it is a parameter).
+    /// `"vft_b_offset"`, `"vft_t_vf_offset"`, `"air_coflow.tail"` (each where it is a
+    /// parameter).
     pub fn strength_parameters(&self) -> Vec<(&'static str, f64)> {
         let mut v: Vec<(&'static str, f64)> = self
             .terms
@@ -1324,6 +1370,44 @@ mod tests {
         let far: f64 = 1e4;
         assert!((coflow_decay(far, 0.5_f64) * (far / 2.0).powi(2) - 1.0).abs() < 1e-3);
         assert!((coflow_decay(far, 1.0_f64) * far - 1.0).abs() < 1e-3);
+    }
+
+    /// Every strength slot is named by a built-in descriptor (its strength or a shape), each
+    /// descriptor of a part of the physics is switched on by [`Physics::enable`] with its
+    /// strength and shapes settable, and nothing else is named.
+    #[test]
+    fn slots_are_named_by_the_descriptors() {
+        use crate::fiber::catalog::{Install, BUILTIN};
+        let mut named: Vec<&str> = Vec::new();
+        for d in BUILTIN {
+            if d.install != Install::Physics {
+                continue;
+            }
+            let mut p = Physics::paper()
+                .enable(d.model_param)
+                .and_then(|p| p.strength(d.model_param, Strength::Parameter(0.0)))
+                .unwrap_or_else(|e| panic!("{}: {e}", d.name));
+            for s in d.shapes {
+                p.set_strength(s.model_param, Strength::Parameter(s.default))
+                    .unwrap();
+                named.push(s.model_param);
+            }
+            if !p.terms.iter().any(|t| t.parameter_name() == d.model_param) {
+                named.push(d.model_param);
+            }
+            // enabling twice changes nothing
+            let n = p.num_strength_params();
+            assert_eq!(p.enable(d.model_param).unwrap().num_strength_params(), n);
+        }
+        named.sort_unstable();
+        let mut slots = SLOT_NAMES.to_vec();
+        slots.sort_unstable();
+        assert_eq!(named, slots);
+        assert!(Physics::paper().enable("nonsense").is_err());
+        let e = Physics::paper()
+            .strength("air_coflow.tail", Strength::Fixed(0.5))
+            .unwrap_err();
+        assert!(e.to_string().contains("with_coflow"), "{e}");
     }
 
     #[test]

@@ -4,30 +4,18 @@
 //! through the dual numbers). Some have **shape parameters** (decay lengths, an onset position),
 //! model parameters too, fitted together with the strength unless fixed.
 //!
+//! What each effect is — name, unit, category, neutral value, search and physical range,
+//! shapes, how the strength maps to the model parameter, remedy, error-budget source, how it
+//! enters the model — is its **descriptor** ([`EffectDescriptor`]), one per effect, in
+//! [`catalog`](crate::fiber::catalog) (the table of the built-in effects is there). An
+//! [`Effect`] is a descriptor plus the settings of one use (its fixed shape values; for a
+//! user-written effect, its term): every method below reads the descriptor.
+//!
 //! Each effect has a [`Category`]: missing **physics**, a **process** condition that differs
 //! from the nominal one, an **instrument** (diameter gauge) error, or **material** data (the VFT
-//! law) off. Each has a *physical range*
-//! ([`Effect::physical_range`], what real spinning lines do) and a wider *search range*
-//! ([`Effect::bounds`]) so that a best fit outside physics can be seen and reported
-//! ([`Effect::judge`]).
-//!
-//! | name | strength (unit) | enters as | shape parameters (unit, default, bounds) | category | physical range | neutral |
-//! |---|---|---|---|---|---|---|
-//! | `strain_thinning` | `1 − n` (-) | Carreau-type law with power index `n = 1 − s` | – | physics | [0, 1] | 0 (Newtonian) |
-//! | `radiation` | emissivity `ε` (-) | heat loss `π d ε σ (T⁴ − T_air⁴)` | – | physics | [0, 1] | 0 |
-//! | `air_coflow` | amplitude `V` (m/s) | air speed `v_air = V (1 + r (L − s)/ℓ)^(−1/r)` (aspirator near the take-up; `r = 0`: `V exp(−(L − s)/ℓ)`) | `decay_length` ℓ (m, 0.1, [0.01, min(1.5, 1.5 L)]), `tail` r (-, 0, [0, 1]; not fitted: `diagnose` scans 0 and 0.5) | physics | [−50, 400] | 0 |
-//! | `air_coflow_line` | speed `V` (m/s) | air speed `v_air = V / (1 + exp(−(s − s₀)/w))` (co-flow along the line after `s₀`) | `onset` s₀ (m, 0.2, [0, L]), `ramp_width` w (m, 0.02, [0.002, min(0.5, L)]) | physics | [−50, 400] | 0 |
-//! | `air_temperature_profile` | excess `ΔT` (K) | `T_air(s) = T_air + ΔT exp(−s/ℓ)` | `decay_length` ℓ (m, 0.05, [0.005, min(1, L)]) | physics | [−50, 400] | 0 |
-//! | `nusselt_scale` | `s` (-) | Nusselt law `𝒩 → (1 + s) 𝒩` | – | physics | [−0.5, 1] | 0 |
-//! | `inlet_diameter` | die swell `δ` (-) | inlet diameter `(1 + δ) d_in` at the same mass flow: `u(0) = u_in/(1 + δ)²` | – | process | [−0.1, 0.6] | 0 |
-//! | `inlet_velocity` | relative error `δ` (-) | `u(0) = (1 + δ) u_in` (same physics as `inlet_diameter`; not a default candidate) | – | process | [−0.6, 0.25] | 0 |
-//! | `die_temperature_offset` | `ΔT` (K) | `T(0) = T_in + ΔT` (and the melt density there) | – | process | [−30, 30] | 0 |
-//! | `mass_flow_scale` | `δ` (-) | true mass flow `(1 + δ) Q` | – | process | [−0.2, 0.2] | 0 |
-//! | `gauge_scale` | `g` (-) | measured diameter `(1 + g) d + o` | – | instrument | [−0.1, 0.1] | 0 |
-//! | `gauge_offset` | `o` (µm) | measured diameter `(1 + g) d + o` | – | instrument | [−20, 20] | 0 |
-//! | `vft_b_offset` | `ΔB` (K) | VFT `B + ΔB`, zero-rate viscosity at `T_o` held (not a default candidate) | – | material | [−400, 400] | 0 |
-//! | `vft_t_vf_offset` | `ΔT_VF` (K) | VFT `T_VF + ΔT_VF`, level at `T_o` held (not a default candidate) | – | material | [−30, 15] | 0 |
-//! | user term | its own factor (-) | `strength ×` the user's [`FiberTerm`] | – | physics | its bounds | 0 |
+//! law) off. Each has a *physical range* ([`Effect::physical_range`], what real spinning lines
+//! do) and a wider *search range* ([`Effect::bounds`]) so that a best fit outside physics can be
+//! seen and reported ([`Effect::judge`]).
 //!
 //! **Sign conventions.** `die_temperature_offset = +10 K` means the melt leaves the die 10 K
 //! *hotter* than the nominal inlet temperature of the experiment file. `gauge_scale = 0.03`
@@ -43,12 +31,11 @@
 //! diameter instead). **Instrument** effects do not enter the boundary-value problem, only the
 //! predicted measurement.
 //!
-//! **Strain thinning.** The user's Newtonian model is the Carreau-type law at `n = 1` (where
-//! `κ` has no effect). The strength is `s = 1 − n`; its derivative at `s = 0` is
-//! `−∂μ_e/∂n = −½ μ_e0 ln(1 + De² (μ_e0 ε̇/K̃)²)`, which depends on the stress scale `K = e^κ`
-//! left undetermined by the Newtonian fit: the linearised score uses `κ` =
-//! [`STRAIN_THINNING_REFERENCE_KAPPA`]; a refit frees both `n` and `κ` (two parameters in the
-//! information criterion).
+//! **Effects in the law.** The user's Newtonian model is the Carreau-type law at `n = 1` (where
+//! `κ` has no effect). Strain thinning lives in the law ([`Install::Law`]): its strength is
+//! `s = 1 − n`, the linearised score takes its direction at the descriptor's reference `κ`
+//! ([`STRAIN_THINNING_REFERENCE_KAPPA`]), and a refit frees both `n` and `κ`
+//! ([`EffectDescriptor::fit_parameters`] = 2 in the information criterion).
 //!
 //! **Settings on the command line** ([`EffectSetting`]): `name` (strength fitted, shapes fitted
 //! with it), `name=value` (strength fixed, shapes fixed at their defaults) and, after a colon,
@@ -63,190 +50,72 @@
 //! `r = 0`. It is a discrete choice of `diagnose` (both 0 and 0.5 are scanned and the better
 //! variant refined with `r` held), not a fitted parameter; `fit --with air_coflow:tail=0.5`
 //! fixes it.
+//!
+//! **Your own effect** is one descriptor and one term ([`Effect::user`]): the term (a
+//! [`FiberTerm`], SI force or heat per length) is multiplied by the strength, and the descriptor
+//! gives it a name, unit, ranges, category and remedy; `diagnose` then scans, refits, ranks and
+//! reports it like a built-in one.
 
+use crate::fiber::catalog::{self, Install};
 use crate::fiber::contributions::{Balance, FiberTerm, Physics, Strength};
 use crate::fiber::error::FiberError;
-use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 use std::sync::Arc;
 
-/// Default decay length `ℓ` \[m\] of the aspirator co-flow `V exp(−(L − s)/ℓ)`.
-pub const DEFAULT_COFLOW_DECAY_LENGTH: f64 = 0.1;
-
-/// Default decay length `ℓ` \[m\] of the warm-air profile `ΔT exp(−s/ℓ)`.
-pub const DEFAULT_WARM_AIR_DECAY_LENGTH: f64 = 0.05;
-
-/// Default onset position `s₀` \[m\] of the co-flow along the line.
-pub const DEFAULT_COFLOW_LINE_ONSET: f64 = 0.2;
-
-/// Default (start) ramp width `w` \[m\] of the co-flow along the line.
-pub const DEFAULT_COFLOW_LINE_RAMP_WIDTH: f64 = 0.02;
-
-/// `κ = ln(K / 1 Pa)` \[-\] at which the strain-thinning direction of a Newtonian model is taken
-/// (the middle of the default κ range (7, 20)).
-pub const STRAIN_THINNING_REFERENCE_KAPPA: f64 = 13.5;
-
-/// What kind of cause an effect is (JSON: `"physics"`, `"process"`, `"instrument"`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Category {
-    /// Physics missing from the model (a term or an environment profile).
-    Physics,
-    /// A process condition (die temperature, mass flow, inlet diameter) off its nominal value.
-    Process,
-    /// The diameter gauge reads wrong (scale or offset).
-    Instrument,
-    /// Material data of the model (the VFT law of the zero-rate viscosity) off.
-    Material,
-}
-
-impl Category {
-    /// Lower-case name (`"physics"`, `"process"`, `"instrument"`, `"material"`).
-    pub fn name(&self) -> &'static str {
-        match self {
-            Category::Physics => "physics",
-            Category::Process => "process",
-            Category::Instrument => "instrument",
-            Category::Material => "material",
-        }
-    }
-}
-
-impl fmt::Display for Category {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A shape parameter of an effect (decay length, onset position, ...): a model parameter named
-/// [`model_param`](Self::model_param), in SI units.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ShapeParameter {
-    /// Name in settings (`decay_length`, `onset`, `ramp_width`).
-    pub name: &'static str,
-    /// Name of the model parameter (`"<effect>.<name>"`, e.g. `"air_coflow.decay_length"`).
-    pub model_param: &'static str,
-    /// Unit (`"m"`).
-    pub unit: &'static str,
-    /// Default (start) value.
-    pub default: f64,
-    /// Bounds of the value in fits (before [`bounds_for_length`](Self::bounds_for_length)).
-    pub bounds: (f64, f64),
-    /// Upper bound at most this multiple of the spin-line length `L` (`None`: no such limit).
-    pub max_per_length: Option<f64>,
-    /// Whether it is fitted with the strength when not fixed (`false`: fixed at its default
-    /// unless given).
-    pub fitted_with_strength: bool,
-    /// Whether `diagnose`'s global search scans it across its range as variants of the effect
-    /// (`false`: the scan holds it at its default and only the refinement fits it).
-    pub scanned: bool,
-    /// What it is, in words.
-    pub describe: &'static str,
-}
-
-impl ShapeParameter {
-    /// The bounds for a spin line of length `length` \[m\]: the upper bound limited to
-    /// `max_per_length · L` (never below the lower bound).
-    pub fn bounds_for_length(&self, length: f64) -> (f64, f64) {
-        let (lo, hi) = self.bounds;
-        match self.max_per_length {
-            Some(f) if length.is_finite() && length > 0.0 => (lo, hi.min(f * length).max(lo)),
-            _ => (lo, hi),
-        }
-    }
-}
-
-const COFLOW_DECAY: ShapeParameter = ShapeParameter {
-    name: "decay_length",
-    model_param: "air_coflow.decay_length",
-    unit: "m",
-    default: DEFAULT_COFLOW_DECAY_LENGTH,
-    bounds: (0.01, 1.5),
-    max_per_length: Some(1.5),
-    fitted_with_strength: true,
-    scanned: true,
-    describe: "decay length of the co-flow away from the take-up",
+pub use crate::fiber::catalog::{
+    BudgetSource, Category, EffectDescriptor, ShapeParameter, ShapeScan, StrengthMap, ALL_NAMES,
+    BUILTIN_NAMES, DEFAULT_COFLOW_DECAY_LENGTH, DEFAULT_COFLOW_LINE_ONSET,
+    DEFAULT_COFLOW_LINE_RAMP_WIDTH, DEFAULT_WARM_AIR_DECAY_LENGTH, STRAIN_THINNING_REFERENCE_KAPPA,
 };
-
-const COFLOW_TAIL: ShapeParameter = ShapeParameter {
-    name: "tail",
-    model_param: "air_coflow.tail",
-    unit: "-",
-    default: 0.0,
-    bounds: (0.0, 1.0),
-    max_per_length: None,
-    fitted_with_strength: false,
-    scanned: true,
-    describe: "tail r of the co-flow's decay away from the take-up, (1 + r z/l)^(-1/r): \
-               0 exponential, 0.5 inverse square (entrainment towards a sink), 1 inverse (a jet)",
-};
-
-const COFLOW_LINE_ONSET: ShapeParameter = ShapeParameter {
-    name: "onset",
-    model_param: "air_coflow_line.onset",
-    unit: "m",
-    default: DEFAULT_COFLOW_LINE_ONSET,
-    bounds: (0.0, 2.0),
-    max_per_length: Some(1.0),
-    fitted_with_strength: true,
-    scanned: true,
-    describe: "position where the co-flow along the line sets in",
-};
-
-const COFLOW_LINE_RAMP: ShapeParameter = ShapeParameter {
-    name: "ramp_width",
-    model_param: "air_coflow_line.ramp_width",
-    unit: "m",
-    default: DEFAULT_COFLOW_LINE_RAMP_WIDTH,
-    bounds: (0.002, 0.5),
-    max_per_length: Some(1.0),
-    fitted_with_strength: true,
-    scanned: false,
-    describe: "width of the logistic ramp of the co-flow along the line",
-};
-
-const WARM_AIR_DECAY: ShapeParameter = ShapeParameter {
-    name: "decay_length",
-    model_param: "air_temperature_profile.decay_length",
-    unit: "m",
-    default: DEFAULT_WARM_AIR_DECAY_LENGTH,
-    bounds: (0.005, 1.0),
-    max_per_length: Some(1.0),
-    fitted_with_strength: true,
-    scanned: true,
-    describe: "decay length of the warm air below the nozzle",
-};
+#[cfg(test)]
+use crate::fiber::catalog::{COFLOW_DECAY, WARM_AIR_DECAY};
 
 /// A user-written effect: a [`FiberTerm`] (SI force or heat per length, written once generically
-/// over dual numbers) multiplied by its own strength parameter (neutral 0, bounds
-/// `bounds`, default `(−10, 10)`; its physical range is its bounds).
+/// over dual numbers) multiplied by its own strength parameter, described by its
+/// [`EffectDescriptor`] (default [`EffectDescriptor::user`]: dimensionless, neutral 0, search
+/// and physical range `(−10, 10)`).
 #[derive(Clone)]
 pub struct UserEffect {
-    name: &'static str,
+    descriptor: Arc<EffectDescriptor>,
     balance: Balance,
-    bounds: (f64, f64),
     add: Arc<dyn Fn(Physics) -> Physics + Send + Sync>,
 }
 
 impl UserEffect {
-    /// The term `term` in `balance`, named `name` (its strength parameter has the same name).
+    /// The term `term` in `balance`, named `name` (its strength parameter has the same name),
+    /// with the default descriptor [`EffectDescriptor::user`]`(name)`.
     pub fn new<T: FiberTerm + Clone + 'static>(
         name: &'static str,
         balance: Balance,
         term: T,
     ) -> Self {
+        Self::described(EffectDescriptor::user(name), balance, term)
+    }
+
+    /// The term `term` in `balance` described by `descriptor` (its name names the term and the
+    /// strength parameter; [`ModelSpec::validate`] checks the descriptor).
+    pub fn described<T: FiberTerm + Clone + 'static>(
+        descriptor: EffectDescriptor,
+        balance: Balance,
+        term: T,
+    ) -> Self {
+        let name = descriptor.name;
         UserEffect {
-            name,
+            descriptor: Arc::new(EffectDescriptor {
+                install: Install::UserTerm,
+                ..descriptor
+            }),
             balance,
-            bounds: (-10.0, 10.0),
             add: Arc::new(move |p: Physics| p.with_custom(name, balance, term.clone())),
         }
     }
 
-    /// Sets the bounds of the strength in fits.
+    /// Sets the bounds of the strength in fits (its search range; the physical range too).
     pub fn with_bounds(mut self, lower: f64, upper: f64) -> Self {
-        self.bounds = (lower, upper);
+        let d = Arc::make_mut(&mut self.descriptor);
+        d.search_range = (lower, upper);
+        d.physical_range = (lower, upper);
         self
     }
 
@@ -254,16 +123,26 @@ impl UserEffect {
     pub fn balance(&self) -> Balance {
         self.balance
     }
+
+    /// Its descriptor.
+    pub fn descriptor(&self) -> &EffectDescriptor {
+        &self.descriptor
+    }
 }
 
 impl fmt::Debug for UserEffect {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "UserEffect({}, {:?})", self.name, self.balance)
+        write!(
+            f,
+            "UserEffect({}, {:?})",
+            self.descriptor.name, self.balance
+        )
     }
 }
 
-/// A candidate effect. Shape parameters are `Option<f64>`: `None` fits them with the strength
-/// (or keeps the default where the shape is not fitted, see
+/// A candidate effect: a built-in one (its descriptor in [`catalog`](crate::fiber::catalog))
+/// or a user-written one. Shape parameters are `Option<f64>`: `None` fits them with the
+/// strength (or keeps the default where the shape is not fitted, see
 /// [`ShapeParameter::fitted_with_strength`]), `Some(v)` fixes them at `v`.
 #[derive(Debug, Clone)]
 pub enum Effect {
@@ -313,51 +192,14 @@ pub enum Effect {
     /// `vft_t_vf_offset`: VFT temperature `T_VF + ΔT_VF`, the level at `T_o` held, strength
     /// ΔT_VF \[K\] (material data; not a default candidate).
     VftTvfOffset,
-    /// A user-written term with its own strength.
+    /// A user-written term with its own strength and descriptor.
     Custom(UserEffect),
 }
 
-/// Canonical names of the built-in candidates, in [`Effect::builtin`] order.
-pub const BUILTIN_NAMES: [&str; 11] = [
-    "strain_thinning",
-    "radiation",
-    "air_coflow",
-    "air_coflow_line",
-    "air_temperature_profile",
-    "nusselt_scale",
-    "inlet_diameter",
-    "die_temperature_offset",
-    "mass_flow_scale",
-    "gauge_scale",
-    "gauge_offset",
-];
-
-/// Every built-in effect name a setting may use: [`BUILTIN_NAMES`], `inlet_velocity` (the
-/// same physics as `inlet_diameter` in another variable, so not a default candidate) and the
-/// material-data offsets `vft_b_offset`, `vft_t_vf_offset` (for the error budget and `fit
-/// --with`; not default candidates: an error of the temperature dependence of the viscosity is
-/// a question for rheometry, not for the spin line).
-pub const ALL_NAMES: [&str; 14] = [
-    "strain_thinning",
-    "radiation",
-    "air_coflow",
-    "air_coflow_line",
-    "air_temperature_profile",
-    "nusselt_scale",
-    "inlet_diameter",
-    "inlet_velocity",
-    "die_temperature_offset",
-    "mass_flow_scale",
-    "gauge_scale",
-    "gauge_offset",
-    "vft_b_offset",
-    "vft_t_vf_offset",
-];
-
 impl Effect {
-    /// The built-in candidates of `diagnose` (shapes fitted): physics, then process conditions,
-    /// then the instrument ([`BUILTIN_NAMES`]).
-    pub fn builtin() -> Vec<Effect> {
+    /// Every built-in effect ([`ALL_NAMES`], the order of [`catalog::BUILTIN`]), shapes not
+    /// fixed.
+    pub fn all() -> Vec<Effect> {
         vec![
             Effect::StrainThinning,
             Effect::Radiation,
@@ -372,23 +214,27 @@ impl Effect {
             Effect::AirTemperatureProfile { decay_length: None },
             Effect::NusseltScale,
             Effect::InletDiameter,
+            Effect::InletVelocity,
             Effect::DieTemperatureOffset,
             Effect::MassFlowScale,
             Effect::GaugeScale,
             Effect::GaugeOffset,
+            Effect::VftBOffset,
+            Effect::VftTvfOffset,
         ]
     }
 
-    /// Every built-in effect ([`ALL_NAMES`]): [`builtin`](Self::builtin), `inlet_velocity` and
-    /// the VFT offsets.
-    pub fn all() -> Vec<Effect> {
-        let mut v = Self::builtin();
-        v.insert(7, Effect::InletVelocity);
-        v.extend([Effect::VftBOffset, Effect::VftTvfOffset]);
-        v
+    /// The built-in candidates of `diagnose` (shapes fitted): physics, then process conditions,
+    /// then the instrument ([`BUILTIN_NAMES`]: the descriptors'
+    /// [`default_candidate`](EffectDescriptor::default_candidate)).
+    pub fn builtin() -> Vec<Effect> {
+        Self::all()
+            .into_iter()
+            .filter(|e| e.descriptor().default_candidate)
+            .collect()
     }
 
-    /// A user-written effect (see [`UserEffect::new`]).
+    /// A user-written effect with the default descriptor (see [`UserEffect::new`]).
     pub fn custom<T: FiberTerm + Clone + 'static>(
         name: &'static str,
         balance: Balance,
@@ -397,151 +243,94 @@ impl Effect {
         Effect::Custom(UserEffect::new(name, balance, term))
     }
 
+    /// A user-written candidate: one descriptor (name, unit, ranges, category, remedy, ...) and
+    /// one term, multiplied by the strength (see [`UserEffect::described`]).
+    pub fn user<T: FiberTerm + Clone + 'static>(
+        descriptor: EffectDescriptor,
+        balance: Balance,
+        term: T,
+    ) -> Self {
+        Effect::Custom(UserEffect::described(descriptor, balance, term))
+    }
+
+    /// What the effect is: its descriptor.
+    pub fn descriptor(&self) -> &EffectDescriptor {
+        match self {
+            Effect::StrainThinning => &catalog::STRAIN_THINNING,
+            Effect::Radiation => &catalog::RADIATION,
+            Effect::AirCoflow { .. } => &catalog::AIR_COFLOW,
+            Effect::AirCoflowLine { .. } => &catalog::AIR_COFLOW_LINE,
+            Effect::AirTemperatureProfile { .. } => &catalog::AIR_TEMPERATURE_PROFILE,
+            Effect::NusseltScale => &catalog::NUSSELT_SCALE,
+            Effect::InletVelocity => &catalog::INLET_VELOCITY,
+            Effect::InletDiameter => &catalog::INLET_DIAMETER,
+            Effect::DieTemperatureOffset => &catalog::DIE_TEMPERATURE_OFFSET,
+            Effect::MassFlowScale => &catalog::MASS_FLOW_SCALE,
+            Effect::GaugeScale => &catalog::GAUGE_SCALE,
+            Effect::GaugeOffset => &catalog::GAUGE_OFFSET,
+            Effect::VftBOffset => &catalog::VFT_B_OFFSET,
+            Effect::VftTvfOffset => &catalog::VFT_T_VF_OFFSET,
+            Effect::Custom(u) => &u.descriptor,
+        }
+    }
+
     /// Canonical name (CLI, JSON, docs).
     pub fn name(&self) -> &'static str {
-        match self {
-            Effect::StrainThinning => "strain_thinning",
-            Effect::Radiation => "radiation",
-            Effect::AirCoflow { .. } => "air_coflow",
-            Effect::AirCoflowLine { .. } => "air_coflow_line",
-            Effect::AirTemperatureProfile { .. } => "air_temperature_profile",
-            Effect::NusseltScale => "nusselt_scale",
-            Effect::InletVelocity => "inlet_velocity",
-            Effect::InletDiameter => "inlet_diameter",
-            Effect::DieTemperatureOffset => "die_temperature_offset",
-            Effect::MassFlowScale => "mass_flow_scale",
-            Effect::GaugeScale => "gauge_scale",
-            Effect::GaugeOffset => "gauge_offset",
-            Effect::VftBOffset => "vft_b_offset",
-            Effect::VftTvfOffset => "vft_t_vf_offset",
-            Effect::Custom(u) => u.name,
-        }
+        self.descriptor().name
     }
 
     /// Unit of the strength, for reports.
     pub fn unit(&self) -> &'static str {
-        match self {
-            Effect::AirCoflow { .. } | Effect::AirCoflowLine { .. } => "m/s",
-            Effect::AirTemperatureProfile { .. }
-            | Effect::DieTemperatureOffset
-            | Effect::VftBOffset
-            | Effect::VftTvfOffset => "K",
-            Effect::GaugeOffset => "µm",
-            _ => "-",
-        }
+        self.descriptor().unit
     }
 
     /// Symbol of the strength in messages (`ε`, `V`, `ΔT`, ...).
     pub fn symbol(&self) -> &'static str {
-        match self {
-            Effect::StrainThinning => "1 - n",
-            Effect::Radiation => "ε",
-            Effect::AirCoflow { .. } | Effect::AirCoflowLine { .. } => "V",
-            Effect::AirTemperatureProfile { .. } | Effect::DieTemperatureOffset => "ΔT",
-            Effect::NusseltScale => "s",
-            Effect::InletVelocity | Effect::InletDiameter | Effect::MassFlowScale => "δ",
-            Effect::GaugeScale => "g",
-            Effect::GaugeOffset => "o",
-            Effect::VftBOffset => "ΔB",
-            Effect::VftTvfOffset => "ΔT_VF",
-            Effect::Custom(_) => "factor",
-        }
+        self.descriptor().symbol
     }
 
     /// What the strength is, in words.
     pub fn describe(&self) -> &'static str {
-        match self {
-            Effect::StrainThinning => "strain thinning (Carreau-type law), strength 1 - n",
-            Effect::Radiation => "thermal radiation, strength = emissivity",
-            Effect::AirCoflow { .. } => {
-                "aspirator air co-flow near the take-up, strength = air speed amplitude"
-            }
-            Effect::AirCoflowLine { .. } => {
-                "air co-flow along the spin line after an onset position, strength = air speed"
-            }
-            Effect::AirTemperatureProfile { .. } => {
-                "warm air near the nozzle, strength = air temperature excess"
-            }
-            Effect::NusseltScale => "scale on the Nusselt law, strength s in (1 + s) Nu",
-            Effect::InletVelocity => "inlet-velocity error, strength = relative error",
-            Effect::InletDiameter => {
-                "inlet diameter (die swell) off, strength = relative diameter error"
-            }
-            Effect::DieTemperatureOffset => {
-                "melt temperature at the die off the nominal inlet temperature, strength = offset"
-            }
-            Effect::MassFlowScale => "mass flow off its nominal value, strength = relative error",
-            Effect::GaugeScale => "diameter gauge scale error, strength = relative error",
-            Effect::GaugeOffset => "diameter gauge zero offset, strength = offset",
-            Effect::VftBOffset => {
-                "VFT parameter B off (viscosity at T_o held), strength = offset of B"
-            }
-            Effect::VftTvfOffset => {
-                "VFT temperature T_VF off (viscosity at T_o held), strength = offset of T_VF"
-            }
-            Effect::Custom(_) => "user-written contribution, strength = its factor",
-        }
+        self.descriptor().describe
     }
 
     /// Physics missing, process condition off, instrument error, or material data off.
     pub fn category(&self) -> Category {
-        match self {
-            Effect::InletVelocity
-            | Effect::InletDiameter
-            | Effect::DieTemperatureOffset
-            | Effect::MassFlowScale => Category::Process,
-            Effect::GaugeScale | Effect::GaugeOffset => Category::Instrument,
-            Effect::VftBOffset | Effect::VftTvfOffset => Category::Material,
-            _ => Category::Physics,
-        }
+        self.descriptor().category
     }
 
-    /// Neutral strength (the effect is absent): 0 for every effect.
+    /// Neutral strength (the effect is absent): 0 for every built-in effect.
     pub fn neutral(&self) -> f64 {
-        0.0
+        self.descriptor().neutral
     }
 
     /// Search range of the strength in fits (wider than the
     /// [`physical_range`](Self::physical_range), so that a best fit outside physics shows).
     pub fn bounds(&self) -> (f64, f64) {
-        match self {
-            Effect::StrainThinning => (0.0, 1.0),
-            Effect::Radiation => (-0.5, 2.0),
-            Effect::AirCoflow { .. } | Effect::AirCoflowLine { .. } => (-100.0, 600.0),
-            Effect::AirTemperatureProfile { .. } => (-60.0, 600.0),
-            Effect::NusseltScale => (-0.9, 3.0),
-            Effect::InletVelocity => (-0.7, 1.0),
-            Effect::InletDiameter => (-0.3, 1.0),
-            Effect::DieTemperatureOffset => (-60.0, 60.0),
-            Effect::MassFlowScale => (-0.5, 0.5),
-            Effect::GaugeScale => (-0.3, 0.3),
-            Effect::GaugeOffset => (-50.0, 50.0),
-            Effect::VftBOffset => (-1000.0, 1000.0),
-            // the VFT law is singular at T = T_VF, and the fiber cools towards the air (about
-            // 290–300 K against T_VF ≈ 273 K for PMMA): raising T_VF is searched less far
-            Effect::VftTvfOffset => (-60.0, 15.0),
-            Effect::Custom(u) => u.bounds,
-        }
+        self.descriptor().search_range
     }
 
     /// Range of the strength that real spinning lines show (in the strength's unit).
     pub fn physical_range(&self) -> (f64, f64) {
-        match self {
-            Effect::StrainThinning => (0.0, 1.0),
-            Effect::Radiation => (0.0, 1.0),
-            Effect::AirCoflow { .. } | Effect::AirCoflowLine { .. } => (-50.0, 400.0),
-            Effect::AirTemperatureProfile { .. } => (-50.0, 400.0),
-            Effect::NusseltScale => (-0.5, 1.0),
-            Effect::InletVelocity => (-0.6, 0.25),
-            Effect::InletDiameter => (-0.1, 0.6),
-            Effect::DieTemperatureOffset => (-30.0, 30.0),
-            Effect::MassFlowScale => (-0.2, 0.2),
-            Effect::GaugeScale => (-0.1, 0.1),
-            Effect::GaugeOffset => (-20.0, 20.0),
-            Effect::VftBOffset => (-400.0, 400.0),
-            Effect::VftTvfOffset => (-30.0, 15.0),
-            Effect::Custom(u) => u.bounds,
-        }
+        self.descriptor().physical_range
+    }
+
+    /// A measurement outside the diameter data that tells this cause apart from another one
+    /// with the same signature (`None` for physics).
+    pub fn independent_check(&self) -> Option<&'static str> {
+        self.descriptor().independent_check
+    }
+
+    /// Whether the effect lives in the viscosity law (strain thinning), not in the physics.
+    pub fn installs_in_law(&self) -> bool {
+        self.descriptor().installs_in_law()
+    }
+
+    /// Parameters a refit with this effect adds to the model without it: the strength's
+    /// [`fit_parameters`](EffectDescriptor::fit_parameters) (2 for strain thinning: `n` and
+    /// `κ`) plus its free shapes ([`free_shapes`](Self::free_shapes)).
+    pub fn extra_parameters(&self) -> usize {
+        self.descriptor().fit_parameters + self.free_shapes().len()
     }
 
     /// Whether `value` (a strength in the effect's unit) is physical, in words: `None` inside
@@ -572,10 +361,27 @@ impl Effect {
 
     /// The effect's shape parameters (empty for most).
     pub fn shape_parameters(&self) -> Vec<ShapeParameter> {
+        self.descriptor().shapes.to_vec()
+    }
+
+    /// The values the settings fix, in [`shape_parameters`](Self::shape_parameters) order (the
+    /// variant's fields).
+    fn fixed_shapes(&self) -> Vec<Option<f64>> {
         match self {
-            Effect::AirCoflow { .. } => vec![COFLOW_DECAY, COFLOW_TAIL],
-            Effect::AirCoflowLine { .. } => vec![COFLOW_LINE_ONSET, COFLOW_LINE_RAMP],
-            Effect::AirTemperatureProfile { .. } => vec![WARM_AIR_DECAY],
+            Effect::AirCoflow { decay_length, tail } => vec![*decay_length, *tail],
+            Effect::AirCoflowLine { onset, ramp_width } => vec![*onset, *ramp_width],
+            Effect::AirTemperatureProfile { decay_length } => vec![*decay_length],
+            _ => Vec::new(),
+        }
+    }
+
+    /// The variant's fields of the fixed shape values, in
+    /// [`shape_parameters`](Self::shape_parameters) order.
+    fn fixed_shapes_mut(&mut self) -> Vec<&mut Option<f64>> {
+        match self {
+            Effect::AirCoflow { decay_length, tail } => vec![decay_length, tail],
+            Effect::AirCoflowLine { onset, ramp_width } => vec![onset, ramp_width],
+            Effect::AirTemperatureProfile { decay_length } => vec![decay_length],
             _ => Vec::new(),
         }
     }
@@ -583,18 +389,12 @@ impl Effect {
     /// Each shape parameter with its fixed value (`None`: not fixed), in
     /// [`shape_parameters`](Self::shape_parameters) order.
     pub fn shape_settings(&self) -> Vec<(ShapeParameter, Option<f64>)> {
-        match self {
-            Effect::AirCoflow { decay_length, tail } => {
-                vec![(COFLOW_DECAY, *decay_length), (COFLOW_TAIL, *tail)]
-            }
-            Effect::AirCoflowLine { onset, ramp_width } => {
-                vec![(COFLOW_LINE_ONSET, *onset), (COFLOW_LINE_RAMP, *ramp_width)]
-            }
-            Effect::AirTemperatureProfile { decay_length } => {
-                vec![(WARM_AIR_DECAY, *decay_length)]
-            }
-            _ => Vec::new(),
-        }
+        self.descriptor()
+            .shapes
+            .iter()
+            .copied()
+            .zip(self.fixed_shapes())
+            .collect()
     }
 
     /// The shape parameters a fit frees with the strength (not fixed and
@@ -618,8 +418,8 @@ impl Effect {
     /// The effect with shape parameter `name` fixed at `value` (must lie within its bounds);
     /// errors name the shape parameter.
     pub fn with_shape(mut self, name: &str, value: f64) -> Result<Effect, String> {
-        let shapes = self.shape_parameters();
-        let Some(sp) = shapes.iter().find(|s| s.name == name) else {
+        let shapes = self.descriptor().shapes;
+        let Some(i) = shapes.iter().position(|s| s.name == name) else {
             return Err(if shapes.is_empty() {
                 format!("{} has no shape parameters (got \"{name}\")", self.name())
             } else {
@@ -630,6 +430,7 @@ impl Effect {
                 )
             });
         };
+        let sp = shapes[i];
         let (lo, hi) = sp.bounds;
         if !(value.is_finite() && value >= lo && value <= hi) {
             let unit = match sp.unit {
@@ -641,85 +442,49 @@ impl Effect {
                 self.name()
             ));
         }
-        match (&mut self, name) {
-            (Effect::AirCoflow { decay_length, .. }, "decay_length") => *decay_length = Some(value),
-            (Effect::AirCoflow { tail, .. }, "tail") => *tail = Some(value),
-            (Effect::AirTemperatureProfile { decay_length }, "decay_length") => {
-                *decay_length = Some(value)
-            }
-            (Effect::AirCoflowLine { onset, .. }, "onset") => *onset = Some(value),
-            (Effect::AirCoflowLine { ramp_width, .. }, "ramp_width") => *ramp_width = Some(value),
-            _ => return Err(format!("{} has no shape parameter \"{name}\"", self.name())),
+        let name_of = self.name();
+        match self.fixed_shapes_mut().into_iter().nth(i) {
+            Some(slot) => *slot = Some(value),
+            None => return Err(format!("{name_of} has no shape parameter \"{name}\"")),
         }
         Ok(self)
     }
 
-    /// Parameters a refit with the effect adds: its strength and the shapes fitted with it
-    /// (`strain_thinning`: `n` and `κ`, the stress scale a Newtonian model leaves free).
-    pub fn extra_parameters(&self) -> usize {
-        match self {
-            Effect::StrainThinning => 2,
-            _ => 1 + self.free_shapes().len(),
-        }
-    }
 
     /// Name of the model parameter (in [`FiberModel::param_names`](crate::fiber::FiberModel::param_names))
     /// that carries the strength.
     pub fn model_param(&self) -> &'static str {
-        match self {
-            Effect::StrainThinning => "n",
-            // one name per effect: the strength parameter carries the effect's name
-            _ => self.name(),
-        }
+        self.descriptor().model_param
     }
 
     /// Model-parameter value for a strength (`1 − s` for `strain_thinning`, `1 + s` for
-    /// `nusselt_scale`, `s` otherwise).
+    /// `nusselt_scale`, `s` otherwise: the descriptor's [`StrengthMap`]).
     pub fn param_value(&self, strength: f64) -> f64 {
-        match self {
-            Effect::StrainThinning => 1.0 - strength,
-            Effect::NusseltScale => 1.0 + strength,
-            _ => strength,
-        }
+        self.descriptor().param_value(strength)
     }
 
     /// Strength for a model-parameter value (inverse of [`param_value`](Self::param_value)).
     pub fn strength_of(&self, param: f64) -> f64 {
-        match self {
-            Effect::StrainThinning => 1.0 - param,
-            Effect::NusseltScale => param - 1.0,
-            _ => param,
-        }
+        self.descriptor().strength_of(param)
     }
 
     /// `d(model parameter)/d(strength)`: ±1.
     pub fn param_per_strength(&self) -> f64 {
-        match self {
-            Effect::StrainThinning => -1.0,
-            _ => 1.0,
-        }
+        self.descriptor().map.param_per_strength()
     }
 
     /// Adds the effect to `physics` at its neutral strength, as a model parameter (nothing for
-    /// `strain_thinning`, which lives in the law), with its shape parameters as model parameters
-    /// at their fixed or default values. Errors if the strength cannot be named in `physics`
-    /// (a user effect whose term does not carry its name).
+    /// an effect that lives in the law), with its shape parameters as model parameters at their
+    /// fixed or default values: the built-in part switched on by
+    /// [`Physics::enable`](crate::fiber::Physics::enable), or the user's term. Errors if the
+    /// strength cannot be named in `physics` (a user effect whose term does not carry its name).
     pub fn apply(&self, physics: Physics) -> Result<Physics, FiberError> {
+        let d = self.descriptor();
         let par = Strength::Parameter(self.param_value(self.neutral()));
-        let added = match self {
-            Effect::StrainThinning => return Ok(physics),
-            Effect::Radiation => physics.with_radiation(1.0),
-            Effect::AirCoflow { .. } => physics.with_coflow(1.0, DEFAULT_COFLOW_DECAY_LENGTH),
-            Effect::AirCoflowLine { .. } => physics.with_line_coflow(
-                1.0,
-                DEFAULT_COFLOW_LINE_ONSET,
-                DEFAULT_COFLOW_LINE_RAMP_WIDTH,
-            ),
-            Effect::AirTemperatureProfile { .. } => {
-                physics.with_warm_air(1.0, DEFAULT_WARM_AIR_DECAY_LENGTH)
-            }
-            Effect::Custom(u) => (u.add)(physics),
-            _ => physics,
+        let added = match (self, d.install) {
+            (_, Install::Law { .. }) => return Ok(physics),
+            (Effect::Custom(u), _) => (u.add)(physics),
+            (_, _) => physics.enable(d.model_param)?,
         };
         // a user effect whose name is taken by another strength is refused by
         // `ModelSpec::validate`; here a missing strength is an error, not a panic
@@ -744,14 +509,19 @@ fn g(v: f64) -> String {
 impl Effect {
     /// Adds the effect to `physics` at `strength` (in the effect's unit, see
     /// [`unit`](Self::unit)) — e.g. a fitted strength from a fit report — with its shape
-    /// parameters at their fixed or default values. Errors for `strain_thinning`, which is not a
-    /// term of the physics but the law's `n = 1 − strength`, and for a strength outside the
-    /// search range [`bounds`](Self::bounds).
+    /// parameters at their fixed or default values. Errors for an effect that lives in the law
+    /// (`strain_thinning`, the law's `n = 1 − strength`), and for a strength outside the search
+    /// range [`bounds`](Self::bounds).
     pub fn apply_at(&self, physics: Physics, strength: f64) -> Result<Physics, String> {
-        if matches!(self, Effect::StrainThinning) {
-            return Err(
-                "strain_thinning is the viscosity law's n = 1 - strength; set n instead".into(),
-            );
+        let d = self.descriptor();
+        if d.installs_in_law() {
+            return Err(format!(
+                "{} is the viscosity law's {} = {}; set {} instead",
+                d.name,
+                d.model_param,
+                d.map.words(),
+                d.model_param
+            ));
         }
         let (lo, hi) = self.bounds();
         if !(strength.is_finite() && strength >= lo && strength <= hi) {
@@ -871,6 +641,14 @@ impl FromStr for EffectSetting {
     }
 }
 
+/// `(n, κ)` \[-\] of a Newtonian model (the law without strain thinning): `n = 1`, and the `κ`
+/// at which the strain-thinning direction is taken — the reference of the effect that lives in
+/// the law ([`Install::Law`] of [`catalog::STRAIN_THINNING`]).
+pub const NEWTONIAN_LAW: [f64; 2] = match catalog::STRAIN_THINNING.install {
+    Install::Law { reference } => reference,
+    _ => panic!("strain thinning lives in the law"),
+};
+
 /// The viscosity law of a user's model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -940,13 +718,11 @@ impl ModelSpec {
             || self.candidates.iter().any(|e| e.name() == name)
     }
 
-    /// Adds `effects` as neutral candidates, skipping those already present (and
-    /// `strain_thinning` for a Carreau law, which has it).
+    /// Adds `effects` as neutral candidates, skipping those already present (and those that
+    /// live in the law, `strain_thinning`, for a Carreau law, which has it).
     pub fn with_candidates(mut self, effects: &[Effect]) -> Self {
         for e in effects {
-            if self.contains(e.name())
-                || (self.law == LawChoice::Carreau && matches!(e, Effect::StrainThinning))
-            {
+            if self.contains(e.name()) || (self.law == LawChoice::Carreau && e.installs_in_law()) {
                 continue;
             }
             self.candidates.push(e.clone());
@@ -954,7 +730,9 @@ impl ModelSpec {
         self
     }
 
-    /// Checks for duplicate effects and `strain_thinning` in a Carreau model.
+    /// Checks for duplicate effects, an effect of the law (`strain_thinning`) in a Carreau
+    /// model, and user effects: a name not taken by a built-in term, strength or effect, and a
+    /// consistent descriptor ([`EffectDescriptor::validate`]).
     pub fn validate(&self) -> Result<(), String> {
         let mut names: Vec<&str> = Vec::new();
         for e in self
@@ -967,28 +745,26 @@ impl ModelSpec {
                 return Err(format!("effect {} given twice", e.name()));
             }
             if let Effect::Custom(u) = e {
+                let name = u.descriptor.name;
                 let paper = Physics::paper();
-                let taken = ALL_NAMES.contains(&u.name)
-                    || u.name.contains('.')
-                    || paper.terms.iter().any(|t| t.name == u.name)
-                    || paper
-                        .strength_parameters()
-                        .iter()
-                        .any(|(n, _)| *n == u.name)
-                    || ["n", "kappa"].contains(&u.name);
+                let taken = ALL_NAMES.contains(&name)
+                    || name.contains('.')
+                    || paper.terms.iter().any(|t| t.name == name)
+                    || paper.strength_parameters().iter().any(|(n, _)| *n == name)
+                    || ["n", "kappa"].contains(&name);
                 if taken {
                     return Err(format!(
-                        "user effect \"{}\": the name is taken by a built-in term or effect; \
-                         choose another",
-                        u.name
+                        "user effect \"{name}\": the name is taken by a built-in term or effect; \
+                         choose another"
                     ));
                 }
+                u.descriptor.validate()?;
             }
-            if self.law == LawChoice::Carreau && matches!(e, Effect::StrainThinning) {
-                return Err(
-                    "strain_thinning is already part of the Carreau model (use --model newtonian)"
-                        .into(),
-                );
+            if self.law == LawChoice::Carreau && e.installs_in_law() {
+                return Err(format!(
+                    "{} is already part of the Carreau model (use --model newtonian)",
+                    e.name()
+                ));
             }
             names.push(e.name());
         }
@@ -1029,6 +805,91 @@ mod tests {
         assert_eq!(Effect::all().len(), ALL_NAMES.len());
         let names: Vec<&str> = Effect::builtin().iter().map(|e| e.name()).collect();
         assert_eq!(names, BUILTIN_NAMES);
+    }
+
+    /// The built-in effects are the catalog's descriptors, in its order, each with as many
+    /// fixed-shape fields as its descriptor has shapes; the accessors read the descriptor.
+    #[test]
+    fn effects_are_the_catalog() {
+        let all = Effect::all();
+        assert_eq!(all.len(), catalog::BUILTIN.len());
+        for (e, d) in all.iter().zip(catalog::BUILTIN) {
+            assert!(std::ptr::eq(e.descriptor().name, d.name), "{}", d.name);
+            assert_eq!(e.fixed_shapes().len(), d.shapes.len(), "{}", d.name);
+            let mut m = e.clone();
+            assert_eq!(m.fixed_shapes_mut().len(), d.shapes.len(), "{}", d.name);
+            assert_eq!(e.name().parse::<Effect>().map(|x| x.name()), Ok(d.name));
+            assert_eq!(
+                e.extra_parameters(),
+                d.fit_parameters + d.shapes.iter().filter(|s| s.fitted_with_strength).count()
+            );
+        }
+        assert_eq!(Effect::StrainThinning.extra_parameters(), 2);
+        assert_eq!(NEWTONIAN_LAW, [1.0, STRAIN_THINNING_REFERENCE_KAPPA]);
+        assert_eq!(
+            Effect::StrainThinning
+                .apply_at(Physics::paper(), 0.2)
+                .unwrap_err(),
+            "strain_thinning is the viscosity law's n = 1 - strength; set n instead"
+        );
+    }
+
+    /// A user effect is a descriptor and a term: the descriptor's unit, ranges, category and
+    /// check are the effect's; an inconsistent descriptor is refused by the spec.
+    #[test]
+    fn a_user_descriptor_describes_its_effect() {
+        #[derive(Clone)]
+        struct Pull;
+        impl FiberTerm for Pull {
+            fn eval<D: num_dual::DualNum<Primitive = f64> + Copy>(
+                &self,
+                st: &crate::fiber::SiState<D>,
+            ) -> D {
+                st.force * 0.0 + (-(st.s - 0.2) * (st.s - 0.2) / 1e-3).exp() * 1e-3
+            }
+        }
+        let d = EffectDescriptor::user("mid_pull")
+            .with_unit("mN", "F")
+            .with_category(Category::Process)
+            .with_ranges((-5.0, 5.0), (-2.0, 2.0))
+            .with_independent_check("a tensiometer above and below the guide");
+        let e = Effect::user(d, Balance::Momentum, Pull);
+        assert_eq!((e.name(), e.unit(), e.symbol()), ("mid_pull", "mN", "F"));
+        assert_eq!((e.bounds(), e.physical_range()), ((-5.0, 5.0), (-2.0, 2.0)));
+        assert_eq!(e.category(), Category::Process);
+        assert_eq!(
+            e.independent_check(),
+            Some("a tensiometer above and below the guide")
+        );
+        assert_eq!(e.extra_parameters(), 1);
+        assert_eq!(
+            e.judge(3.0).as_deref(),
+            Some("mid_pull would need F = 3 mN > 2 mN: not physical")
+        );
+        let spec = ModelSpec::default().with_candidates(&[e]);
+        spec.validate().unwrap();
+        assert!(spec
+            .physics()
+            .unwrap()
+            .strength_parameters()
+            .contains(&("mid_pull", 0.0)));
+        // a neutral strength outside the physical range, or a factor that does not vanish there
+        for bad in [
+            EffectDescriptor { neutral: 3.0, ..d },
+            EffectDescriptor {
+                map: StrengthMap::OnePlus,
+                ..d
+            },
+            EffectDescriptor {
+                physical_range: (-6.0, 2.0),
+                ..d
+            },
+        ] {
+            let spec =
+                ModelSpec::default().with_candidates(&[Effect::user(bad, Balance::Momentum, Pull)]);
+            let err = spec.validate().unwrap_err();
+            assert!(err.starts_with("effect \"mid_pull\""), "{err}");
+        }
     }
 
     #[test]

@@ -6,9 +6,11 @@
 //! * [`input`]: loading experiments from the project's TOML + CSV format;
 //! * [`scaling`]: non-dimensionalisation (paper Table 2);
 //! * [`material_law`]: elongational viscosity laws (Newtonian, Carreau-type, Carreau–Yasuda);
+//! * [`catalog`]: one descriptor per candidate effect (name, unit, ranges, shapes, category,
+//!   remedy, error-budget source, how it enters the model), data only;
 //! * [`contributions`]: named force and heat terms, air environment, Nusselt law;
-//! * [`effects`]: the candidate effects (canonical names, strength parameters, neutral values)
-//!   and the model specification (law + effects) a rheometer fit uses;
+//! * [`effects`]: the candidate effects (a descriptor plus its settings, or a user's descriptor
+//!   and term) and the model specification (law + effects) a rheometer fit uses;
 //! * [`model`]: the strain-rate formulation as a [`Bvp`](crate::Bvp);
 //! * [`cold_start`]: continuation from the stress-free fiber;
 //! * [`failure_hints`]: simulation failures naming their experiment, with likely causes;
@@ -27,6 +29,7 @@
 //! * [`diagnostics`]: model vs measurement comparison (where and how the model misses the data);
 //! * [`workflow`]: what each `rheometer` subcommand does, as library calls returning values.
 
+pub mod catalog;
 pub mod cold_start;
 pub mod contributions;
 pub mod diagnostics;

@@ -1,6 +1,7 @@
 //! Declared standard uncertainties of process conditions, instrument and material data (the
-//! `[uncertainty]` table of the experiment file), and the **one table** that maps each source to
-//! the model effect whose strength represents it ([`SOURCES`]).
+//! `[uncertainty]` table of the experiment file), and the table of the sources ([`SOURCES`]):
+//! each source is the [`budget`](crate::fiber::catalog::EffectDescriptor::budget) of the effect
+//! whose strength represents it, in that effect's descriptor.
 //!
 //! The data cannot identify these quantities; the
 //! [error budget](crate::fiber::rheometer::error_budget()) propagates their uncertainties through
@@ -43,29 +44,17 @@
 //! derivative of the principled estimator's residual `(d/d_meas − 1)/σ` with respect to a gauge
 //! reading `(1 + a) d + b` (exact, from the residual's definition).
 
-use crate::fiber::setup::{Experiment, Inlet};
+use crate::fiber::catalog::{
+    BudgetSource, EffectDescriptor, DIE_TEMPERATURE_OFFSET, GAUGE_OFFSET, GAUGE_SCALE,
+    INLET_DIAMETER, INLET_VELOCITY, MASS_FLOW_SCALE, VFT_B_OFFSET, VFT_T_VF_OFFSET,
+};
+use crate::fiber::setup::Experiment;
 
-/// Whether a source's error is shared by all experiments or independent per experiment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Scope {
-    /// One error shared by every experiment (contributions add before squaring).
-    Common,
-    /// An independent error per experiment (contributions add in squares).
-    PerExperiment,
-}
-
-/// A derivative that needs no effect: the measurement model of the diameter gauge.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum GaugeColumn {
-    /// The gauge reads `(1 + a) d`: `∂r/∂a = d_model/(σ d_meas)`.
-    Scale,
-    /// The gauge reads `d + b` (`b` in µm): `∂r/∂b = 10⁻⁶/(σ d_meas)` with `d_meas` in m.
-    OffsetMicrometre,
-}
+pub use crate::fiber::catalog::{GaugeColumn, Scope};
 
 /// One source of systematic error: its key in `[uncertainty]`, its unit, its default and the
-/// effect that represents it.
+/// effect that represents it (the effect descriptor's [`budget`](EffectDescriptor::budget) with
+/// the effect's name).
 #[derive(Debug, Clone, Copy)]
 pub struct Source {
     /// Key in the `[uncertainty]` table (the unit is in the name: `_K`, `_rel`, `_um`).
@@ -95,127 +84,55 @@ pub struct Source {
     pub remedy: &'static str,
 }
 
-fn one(_: &Experiment) -> Option<f64> {
-    Some(1.0)
+impl Source {
+    /// The source `budget` represented by the effect named `effect`.
+    pub const fn new(effect: &'static str, budget: &BudgetSource) -> Self {
+        Source {
+            key: budget.key,
+            unit: budget.unit,
+            what: budget.what,
+            word_unit: budget.word_unit,
+            default: budget.default,
+            max: budget.max,
+            scope: budget.scope,
+            effect,
+            per_unit: budget.per_unit,
+            fallback: budget.fallback,
+            remedy: budget.remedy,
+        }
+    }
+
+    /// The source the effect described by `d` represents (`None` if it is not a budget source).
+    pub const fn of(d: &EffectDescriptor) -> Option<Self> {
+        match &d.budget {
+            Some(b) => Some(Source::new(d.name, b)),
+            None => None,
+        }
+    }
+
+    /// [`of`](Self::of) for a descriptor that is a budget source (a compile-time error for the
+    /// built-in table otherwise).
+    const fn builtin(d: &EffectDescriptor) -> Self {
+        match Source::of(d) {
+            Some(s) => s,
+            None => panic!("not a budget source"),
+        }
+    }
 }
 
-/// The effect `inlet_diameter` is the relative error of `d_in` itself (at the same mass flow;
-/// `u_in = 4Q/(πρ d_in²)` follows): it applies where the experiment gives `d_in`.
-fn from_inlet_diameter(e: &Experiment) -> Option<f64> {
-    matches!(e.inlet, Inlet::Diameter(_)).then_some(1.0)
-}
-
-fn from_inlet_velocity(e: &Experiment) -> Option<f64> {
-    matches!(e.inlet, Inlet::Velocity(_)).then_some(1.0)
-}
-
-/// The sources of systematic error and the effects that represent them (see the module
-/// documentation). The integrator of a new effect adds or changes its row here.
+/// The sources of systematic error of the built-in effects, in the order of the budget's
+/// rows: the budget sources of their descriptors (see the module documentation). A new source
+/// is a [`budget`](EffectDescriptor::budget) in its effect's descriptor and its row here (a
+/// unit test checks that every built-in budget source has exactly one row).
 pub const SOURCES: &[Source] = &[
-    Source {
-        key: "inlet_temperature_K",
-        unit: "K",
-        what: "inlet (die) temperature",
-        word_unit: ("K", 1.0),
-        default: 2.0,
-        max: 50.0,
-        scope: Scope::Common,
-        effect: "die_temperature_offset",
-        per_unit: one,
-        fallback: None,
-        remedy: "measure the melt temperature at the die or add die_temperature_offset to the fit",
-    },
-    Source {
-        key: "mass_flow_rel",
-        unit: "-",
-        what: "mass flow",
-        word_unit: ("%", 0.01),
-        default: 0.01,
-        max: 0.5,
-        scope: Scope::PerExperiment,
-        effect: "mass_flow_scale",
-        per_unit: one,
-        fallback: None,
-        remedy: "weigh the throughput of each run or add mass_flow_scale to the fit",
-    },
-    Source {
-        key: "inlet_diameter_rel",
-        unit: "-",
-        what: "inlet diameter",
-        word_unit: ("%", 0.01),
-        default: 0.02,
-        max: 0.5,
-        scope: Scope::Common,
-        effect: "inlet_diameter",
-        per_unit: from_inlet_diameter,
-        fallback: None,
-        remedy: "measure the swollen strand below the die or add inlet_diameter to the fit",
-    },
-    Source {
-        key: "inlet_velocity_rel",
-        unit: "-",
-        what: "inlet velocity",
-        word_unit: ("%", 0.01),
-        default: 0.04,
-        max: 0.5,
-        scope: Scope::Common,
-        effect: "inlet_velocity",
-        per_unit: from_inlet_velocity,
-        fallback: None,
-        remedy: "measure the inlet velocity or add inlet_velocity to the fit",
-    },
-    Source {
-        key: "gauge_scale_rel",
-        unit: "-",
-        what: "diameter gauge scale",
-        word_unit: ("%", 0.01),
-        default: 0.01,
-        max: 0.5,
-        scope: Scope::Common,
-        effect: "gauge_scale",
-        per_unit: one,
-        fallback: Some(GaugeColumn::Scale),
-        remedy: "calibrate the diameter gauge against wire gauges or add gauge_scale to the fit",
-    },
-    Source {
-        key: "gauge_offset_um",
-        unit: "µm",
-        what: "diameter gauge offset",
-        word_unit: ("µm", 1.0),
-        default: 1.0,
-        max: 100.0,
-        scope: Scope::Common,
-        effect: "gauge_offset",
-        per_unit: one,
-        fallback: Some(GaugeColumn::OffsetMicrometre),
-        remedy: "zero the diameter gauge or add gauge_offset to the fit",
-    },
-    Source {
-        key: "vft_B_K",
-        unit: "K",
-        what: "VFT parameter B",
-        word_unit: ("K", 1.0),
-        default: 30.0,
-        max: 2000.0,
-        scope: Scope::Common,
-        effect: "vft_b_offset",
-        per_unit: one,
-        fallback: None,
-        remedy: "measure the zero-shear viscosity over the spinning temperatures",
-    },
-    Source {
-        key: "vft_T_VF_K",
-        unit: "K",
-        what: "VFT temperature T_VF",
-        word_unit: ("K", 1.0),
-        default: 3.0,
-        max: 100.0,
-        scope: Scope::Common,
-        effect: "vft_t_vf_offset",
-        per_unit: one,
-        fallback: None,
-        remedy: "measure the zero-shear viscosity over the spinning temperatures",
-    },
+    Source::builtin(&DIE_TEMPERATURE_OFFSET),
+    Source::builtin(&MASS_FLOW_SCALE),
+    Source::builtin(&INLET_DIAMETER),
+    Source::builtin(&INLET_VELOCITY),
+    Source::builtin(&GAUGE_SCALE),
+    Source::builtin(&GAUGE_OFFSET),
+    Source::builtin(&VFT_B_OFFSET),
+    Source::builtin(&VFT_T_VF_OFFSET),
 ];
 
 /// The keys of [`SOURCES`] (the allowed keys of an `[uncertainty]` table).
@@ -356,5 +273,23 @@ mod tests {
         for s in SOURCES {
             assert!(s.default > 0.0 && s.default <= s.max, "{}", s.key);
         }
+    }
+
+    /// Every built-in budget source has exactly one row, and the keys are unique.
+    #[test]
+    fn sources_are_the_descriptors_budgets() {
+        let mut from_descriptors: Vec<&str> = crate::fiber::catalog::BUILTIN
+            .iter()
+            .filter_map(|d| Source::of(d).map(|s| s.effect))
+            .collect();
+        let mut rows: Vec<&str> = SOURCES.iter().map(|s| s.effect).collect();
+        from_descriptors.sort_unstable();
+        rows.sort_unstable();
+        assert_eq!(rows, from_descriptors);
+        let mut keys = source_keys();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), SOURCES.len());
+        assert_eq!(SOURCES[0].key, "inlet_temperature_K");
     }
 }

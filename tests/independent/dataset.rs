@@ -2,6 +2,7 @@
 //! outliers) and its data set written in the project's input format (TOML + one CSV per
 //! experiment) to a fresh directory under `target/independent-data/`.
 
+use super::line_force::{forced_diameters, ForcedLine, LineForce};
 use super::model::{AirFlow, AirHeat, Law, Line, Material};
 use super::rng::Rng;
 use super::solve::diameters;
@@ -120,6 +121,8 @@ pub struct Scenario {
     pub air_heat: AirHeat,
     /// Hidden grey-body emissivity [-].
     pub emissivity: f64,
+    /// Hidden concentrated line force (still air only).
+    pub line_force: Option<LineForce>,
     /// Process and instrument faults.
     pub faults: Faults,
     /// Relative Gaussian noise σ [-].
@@ -168,14 +171,30 @@ impl Scenario {
         }
     }
 
+    /// Noise-free true diameters [m] of experiment `k` at its positions.
+    fn clean_diameters(&self, k: usize) -> Result<Vec<f64>, String> {
+        let positions = &self.experiments[k].positions;
+        match self.line_force {
+            Some(force) => {
+                if !matches!(self.air_flow, AirFlow::Still) {
+                    return Err("a line force is modelled in still air only".into());
+                }
+                let forced = ForcedLine {
+                    line: self.line(k),
+                    force,
+                };
+                forced_diameters(&forced, positions)
+            }
+            None => diameters(&self.line(k), positions),
+        }
+    }
+
     /// Simulates every experiment, applies the faults, noise and outliers, and writes the data
     /// set to a fresh directory.
     pub fn generate(&self) -> Result<Generated, String> {
         let clean: Vec<Vec<f64>> = std::thread::scope(|scope| {
             let handles: Vec<_> = (0..self.experiments.len())
-                .map(|k| {
-                    scope.spawn(move || diameters(&self.line(k), &self.experiments[k].positions))
-                })
+                .map(|k| scope.spawn(move || self.clean_diameters(k)))
                 .collect();
             handles
                 .into_iter()

@@ -2,10 +2,12 @@
 //! implementation of the paper's stationary fiber-spinning model with hidden effects written
 //! directly into the balances ([`model`]), solved with the crate's generic collocation solver
 //! ([`solve`]), its own noise ([`rng`]) and data sets written in the project's TOML + CSV
-//! input format ([`dataset`], [`scenarios`]). Nothing here calls `diffbvp::fiber`.
+//! input format ([`dataset`], [`scenarios`]); a concentrated line force ([`line_force`]) as a
+//! hidden effect no candidate has. Nothing here calls `diffbvp::fiber`.
 #![allow(dead_code)]
 
 pub mod dataset;
+pub mod line_force;
 pub mod model;
 pub mod rng;
 pub mod scenarios;

@@ -54,6 +54,7 @@ fn base(name: &'static str, seed: u64) -> Scenario {
         air_flow: AirFlow::Still,
         air_heat: AirHeat::Uniform,
         emissivity: 0.0,
+        line_force: None,
         faults: Faults::none(),
         noise_sd: NOISE_SD,
         take_up_noise: 1.0,

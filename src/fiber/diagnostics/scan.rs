@@ -249,14 +249,14 @@ pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
 
 /// The variants of `effect` whose shapes are scanned, each with its shape parameters: every
 /// shape parameter the effect fits with its strength ([`Effect::free_shapes`]) and marks
-/// [`scanned`](crate::fiber::effects::ShapeParameter::scanned) is fixed at values across its
-/// range (lengths `0.4 ×`, `1 ×` and `2.5 ×` the default, for the co-flow also `0.15 ×`: a jet
-/// within a few centimetres of the take-up is found only from a short decay length; an onset at
-/// 30 %, 50 % and 70 % of
-/// the spin line of length `length` \[m\]), clamped to its bounds; the other free shapes (the
-/// line co-flow's ramp width) are held at their defaults; shapes fixed by the user stay fixed.
-/// A scanned shape the fit does not free (the co-flow's tail) takes the values 0 and 0.5 of
-/// its discrete choice. Without `scan_shapes`, one variant with the free shapes at their
+/// [`scanned`](crate::fiber::effects::ShapeParameter::scanned) is fixed at the values of its
+/// descriptor's [`scan`](crate::fiber::effects::ShapeParameter::scan) (lengths `0.4 ×`, `1 ×`
+/// and `2.5 ×` the default, for the co-flow also `0.15 ×`: a jet within a few centimetres of
+/// the take-up is found only from a short decay length; an onset at 30 %, 50 % and 70 % of the
+/// spin line of length `length` \[m\]), clamped to its bounds; the other free shapes (the line
+/// co-flow's ramp width) are held at their defaults; shapes fixed by the user stay fixed. A
+/// scanned shape the fit does not free (the co-flow's tail) takes the values 0 and 0.5 of its
+/// discrete choice. Without `scan_shapes`, one variant with the free shapes at their
 /// defaults. The refinement frees every free shape again and holds the discrete ones at the
 /// variant's values ([`refine`]).
 pub fn shape_variants(
@@ -273,20 +273,12 @@ pub fn shape_variants(
         .collect();
     for sp in shapes {
         let (lo, hi) = sp.bounds_for_length(length);
+        // the descriptor's scan values (a discrete choice such as the co-flow's tail, multiples
+        // of a default length, fractions of the line)
         let values: Vec<f64> = if !scan_shapes || !sp.scanned {
             vec![sp.default]
-        } else if !sp.fitted_with_strength {
-            // a discrete choice (the co-flow's tail: exponential or inverse square)
-            vec![sp.default, 0.5]
-        } else if sp.name == "onset" {
-            [0.3, 0.5, 0.7].iter().map(|f| f * length).collect()
         } else {
-            let mut v = vec![0.4 * sp.default, sp.default, 2.5 * sp.default];
-            if sp.model_param == "air_coflow.decay_length" {
-                // an aspirator jet within a few centimetres of the take-up
-                v.insert(0, 0.15 * sp.default);
-            }
-            v
+            sp.scan.values(sp.default, length)
         };
         let mut values: Vec<f64> = values.into_iter().map(|v| v.clamp(lo, hi)).collect();
         values.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-300));

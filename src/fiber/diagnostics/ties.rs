@@ -12,10 +12,12 @@
 //! signature with the named one's, its refit's `(n, κ)` with 95% CIs, and how far `n` and `κ`
 //! move from the named refit's, in units of the named refit's standard errors: whether the
 //! material result is robust to the choice. A process condition or an instrument error in a tie
-//! can be checked independently of these data ([`independent_check`]).
+//! can be checked independently of these data: the check is its descriptor's
+//! [`independent_check`](crate::fiber::effects::EffectDescriptor::independent_check), a
+//! user-written candidate's included.
 
 use super::candidate::{earns_its_place, Candidate};
-use crate::fiber::effects::Category;
+use crate::fiber::effects::{Category, Effect, EffectDescriptor};
 use serde::{Deserialize, Serialize};
 
 /// Default [`DiagnoseOptions::tie_margin`](super::diagnose::DiagnoseOptions::tie_margin): a
@@ -52,6 +54,13 @@ pub struct Alternative {
     /// Whether `|n_shift_se|` and `|kappa_shift_se|` are both below [`ROBUST_SHIFT_SE`]: the
     /// material result does not depend on which of the two causes is chosen.
     pub material_robust: bool,
+    /// The measurement outside these data that decides whether the alternative is the cause
+    /// (its descriptor's independent check; absent for physics).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub independent_check: Option<String>,
+    /// The same for the named cause.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub named_independent_check: Option<String>,
 }
 
 /// Whether `c` ties with the `named` cause: a different candidate that earns its place
@@ -83,7 +92,9 @@ fn shift(alt: f64, named: f64, se: f64) -> f64 {
 
 impl Alternative {
     /// The record of `alt` tying with `named`, with the categories and the signature cosine
-    /// supplied by the caller (the candidate results do not carry them).
+    /// supplied by the caller (the candidate results do not carry them); the independent checks
+    /// are the built-in effects' of those names ([`with_checks`](Self::with_checks) sets
+    /// others).
     pub fn new(
         named: &Candidate,
         alt: &Candidate,
@@ -104,7 +115,17 @@ impl Alternative {
             // NaN shifts (no valid interval) compare false: not robust
             material_robust: n_shift_se.abs() < ROBUST_SHIFT_SE
                 && kappa_shift_se.abs() < ROBUST_SHIFT_SE,
+            independent_check: independent_check(&alt.effect).map(String::from),
+            named_independent_check: independent_check(&named.effect).map(String::from),
         }
+    }
+
+    /// With the independent checks of the named cause and of the alternative (e.g. from
+    /// user-written descriptors).
+    pub fn with_checks(mut self, named: Option<&str>, alternative: Option<&str>) -> Self {
+        self.named_independent_check = named.map(String::from);
+        self.independent_check = alternative.map(String::from);
+        self
     }
 
     /// Whether the tie mixes missing physics with a process condition or an instrument error.
@@ -133,25 +154,44 @@ pub fn alternatives(
         .collect()
 }
 
+/// The alternatives to `named` among `candidates` (in their order, best first), with each
+/// effect's category and independent check read from its descriptor among `effects` (a name
+/// not among them: physics, no check) and `cosine(effect)` its signature cosine with the named
+/// one.
+pub fn alternatives_among(
+    named: &Candidate,
+    candidates: &[Candidate],
+    earn_threshold: f64,
+    tie_margin: f64,
+    effects: &[Effect],
+    cosine: impl Fn(&str) -> f64,
+) -> Vec<Alternative> {
+    let of = |name: &str| {
+        effects
+            .iter()
+            .find(|e| e.name() == name)
+            .map(Effect::descriptor)
+    };
+    let category = |d: Option<&EffectDescriptor>| d.map_or(Category::Physics, |d| d.category);
+    let check = |d: Option<&EffectDescriptor>| d.and_then(|d| d.independent_check);
+    let named_d = of(&named.effect);
+    candidates
+        .iter()
+        .filter(|c| ties_with(named, c, earn_threshold, tie_margin))
+        .map(|c| {
+            let d = of(&c.effect);
+            Alternative::new(named, c, category(named_d), category(d), cosine(&c.effect))
+                .with_checks(check(named_d), check(d))
+        })
+        .collect()
+}
+
 /// An independent check (outside these diameter data) that decides whether a process condition
-/// or the instrument is off, for the built-in process and instrument effects (`None` for
-/// physics and unknown names).
+/// or the instrument is off, for the built-in effects (their descriptors'
+/// [`independent_check`](EffectDescriptor::independent_check); `None` for physics and unknown
+/// names).
 pub fn independent_check(effect: &str) -> Option<&'static str> {
-    match effect {
-        "gauge_scale" => Some("calibrate the diameter gauge on a wire or fiber of known diameter"),
-        "gauge_offset" => Some("check the diameter gauge's zero on a reference wire"),
-        "inlet_diameter" | "inlet_velocity" => {
-            Some("measure the die swell (the diameter just below the die, e.g. on a photograph)")
-        }
-        "die_temperature_offset" => {
-            Some("measure the melt temperature at the die exit (a thermocouple in the melt)")
-        }
-        "mass_flow_scale" => Some("weigh the extrudate collected over a timed interval"),
-        "vft_b_offset" | "vft_t_vf_offset" => Some(
-            "measure the zero-shear viscosity down to the take-up temperatures (shear rheometry)",
-        ),
-        _ => None,
-    }
+    crate::fiber::catalog::builtin(effect).and_then(|d| d.independent_check)
 }
 
 /// The category in words (`"missing physics"`, `"a process condition"`, `"an instrument
@@ -260,12 +300,19 @@ pub(super) fn ties_paragraph(
         ));
     }
     // what decides: an independent check of each process condition / instrument in the tie
+    // (the records' checks; a record without them, e.g. read from older JSON, the built-in's)
     let members: Vec<(&str, Category)> = std::iter::once((named, first.named_category))
         .chain(alts.iter().map(|a| (a.effect.as_str(), a.category)))
         .collect();
+    let recorded = std::iter::once(first.named_independent_check.as_deref())
+        .chain(alts.iter().map(|a| a.independent_check.as_deref()));
     let checks: Vec<String> = members
         .iter()
-        .filter_map(|(e, _)| independent_check(e).map(|c| format!("{e}: {c}")))
+        .zip(recorded)
+        .filter_map(|((e, _), c)| {
+            c.or_else(|| independent_check(e))
+                .map(|c| format!("{e}: {c}"))
+        })
         .collect();
     let words = |(e, c): &(&str, Category)| format!("{e} is {}", category_words(*c));
     if alts.iter().any(Alternative::mixes_physics_and_conditions) {

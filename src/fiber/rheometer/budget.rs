@@ -77,6 +77,18 @@ pub struct BudgetEntry {
     /// Per experiment (where the source applies).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub by_experiment: Vec<ExperimentSensitivity>,
+    /// The source (its words and remedy for the text; not in JSON, where a built-in source is
+    /// found by its key).
+    #[serde(skip)]
+    pub source: Option<Source>,
+}
+
+impl BudgetEntry {
+    /// Its source: the one it was made from, else the built-in one with its key.
+    fn source(&self) -> Option<Source> {
+        self.source
+            .or_else(|| SOURCES.iter().find(|s| s.key == self.key).copied())
+    }
 }
 
 /// The error budget (JSON: `error_budget`).
@@ -84,7 +96,8 @@ pub struct BudgetEntry {
 pub struct ErrorBudget {
     /// Whether any uncertainty was declared in the data set (else all are defaults).
     pub declared: bool,
-    /// The sources, in the order of [`SOURCES`].
+    /// The sources, in the order of [`SOURCES`], then user-written effects'
+    /// ([`budget_sources`](super::error_budget::budget_sources)).
     pub sources: Vec<BudgetEntry>,
     /// Systematic standard uncertainty of `n`: root-sum-square of the sources' shifts.
     pub systematic_n: Option<f64>,
@@ -158,7 +171,7 @@ impl ErrorBudget {
         };
         let mut sources: Vec<(&BudgetEntry, &Source)> = self
             .available()
-            .filter_map(|e| Some((e, SOURCES.iter().find(|s| s.key == e.key)?)))
+            .filter_map(|e| Some((e, e.source()?)))
             .collect();
         sources.sort_by(|a, b| weight(b.0).total_cmp(&weight(a.0)));
         let named: Vec<String> = sources
@@ -168,7 +181,7 @@ impl ErrorBudget {
                 format!(
                     "the {} ({}, {})",
                     s.what,
-                    sigma_words(s, e.sigma),
+                    sigma_words(&s, e.sigma),
                     match e.origin {
                         Origin::Default => "default",
                         _ => "declared",
@@ -202,7 +215,7 @@ impl ErrorBudget {
             let parts: Vec<String> = self
                 .available()
                 .filter_map(|e| {
-                    let s = SOURCES.iter().find(|s| s.key == e.key)?;
+                    let s = e.source()?;
                     let d = get(e)? * s.word_unit.1;
                     Some(format!(
                         "by {} per {} of {}",
@@ -238,7 +251,7 @@ impl ErrorBudget {
         ));
         let abs = |v: Option<f64>| v.map_or("-".to_string(), g3);
         for e in &self.sources {
-            let Some(src) = SOURCES.iter().find(|x| x.key == e.key) else {
+            let Some(src) = e.source() else {
                 continue;
             };
             let origin = match e.origin {
@@ -246,7 +259,7 @@ impl ErrorBudget {
                 Origin::Declared => "declared",
                 Origin::Experiment => "experiment",
             };
-            let sigma = format!("{} ({origin})", sigma_words(src, e.sigma));
+            let sigma = format!("{} ({origin})", sigma_words(&src, e.sigma));
             let per = |v: Option<f64>| {
                 v.map_or("-".to_string(), |v| {
                     format!("{}/{}", sign(v * src.word_unit.1), src.word_unit.0)

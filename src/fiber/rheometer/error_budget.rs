@@ -10,7 +10,8 @@
 //! ```
 //!
 //! with `J` the fit's residual Jacobian and `∂r/∂q` the residuals' derivative with respect to
-//! the strength of the effect that represents `q` ([`SOURCES`]), carried in the model at its
+//! the strength of the effect that represents `q` (its descriptor's budget source: the built-in
+//! [`SOURCES`], then those of user-written effects in the model), carried in the model at its
 //! neutral (or fixed) value — the same dual-number sensitivities as the fit's Jacobian, one
 //! warm-started solve and one sensitivity solve per experiment for all sources together. The
 //! gauge's scale and offset, where no effect represents them, use the exact derivative of the
@@ -30,12 +31,32 @@ use super::layout::FitStart;
 use super::options::{IdentifyOptions, RheometerError};
 use super::parameter_shift::ParameterShift;
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
-use crate::fiber::uncertainty::{GaugeColumn, Origin, Scope, Uncertainties, SOURCES};
+use crate::fiber::uncertainty::{GaugeColumn, Origin, Scope, Source, Uncertainties, SOURCES};
 use crate::least_squares::LeastSquaresProblem;
 use nalgebra::DVector;
 use std::time::Instant;
 
 pub use super::budget::{BudgetEntry, ErrorBudget, ExperimentSensitivity, SourceStatus};
+
+/// The error-budget sources for a model `spec`: the built-in [`SOURCES`], then the budget
+/// sources of the user-written effects in the model (fitted, fixed or candidates; their
+/// uncertainty is the descriptor's default).
+pub fn budget_sources(spec: &ModelSpec) -> Vec<Source> {
+    let mut out: Vec<Source> = SOURCES.to_vec();
+    let users = spec
+        .effects
+        .iter()
+        .map(|s| &s.effect)
+        .chain(&spec.candidates);
+    for e in users.filter(|e| matches!(e, Effect::Custom(_))) {
+        if let Some(src) = Source::of(e.descriptor()) {
+            if !out.iter().any(|s| s.key == src.key) {
+                out.push(src);
+            }
+        }
+    }
+    out
+}
 
 /// How a source's column is obtained.
 enum Column {
@@ -68,8 +89,9 @@ pub fn error_budget(
             )
         })
         .collect();
+    let sources = budget_sources(&rh.spec);
     let mut plan: Vec<Result<String, SourceStatus>> = Vec::new();
-    for s in SOURCES {
+    for s in &sources {
         let applies = rh.experiments.iter().any(|e| (s.per_unit)(e).is_some());
         let status = if !applies {
             Err(SourceStatus::NotApplicable)
@@ -128,7 +150,7 @@ pub fn error_budget(
         aug = Some(effect_columns(rh, id, spec, free, strengths, options)?);
     }
     let sigma_r = id.summary.noise.declared_level().unwrap_or(1.0);
-    let columns: Vec<Column> = SOURCES
+    let columns: Vec<Column> = sources
         .iter()
         .zip(&plan)
         .map(|(s, p)| match (p, &aug) {
@@ -157,7 +179,7 @@ pub fn error_budget(
         offsets[k + 1] = offsets[k] + counts[k];
     }
     let mut entries = Vec::new();
-    for (s, col) in SOURCES.iter().zip(&columns) {
+    for (s, col) in sources.iter().zip(&columns) {
         let (sigma, origin) = unc
             .sigma(s.key, usize::MAX)
             .unwrap_or((s.default, Origin::Default));
@@ -180,6 +202,7 @@ pub fn error_budget(
             shift_n: None,
             shift_kappa: None,
             by_experiment: Vec::new(),
+            source: Some(*s),
         };
         entry.status = match col {
             Column::None(st) => *st,

@@ -9,9 +9,7 @@
 //! `nusselt_scale`).
 
 use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
-use crate::fiber::effects::{
-    Effect, LawChoice, ModelSpec, ShapeParameter, STRAIN_THINNING_REFERENCE_KAPPA,
-};
+use crate::fiber::effects::{Effect, LawChoice, ModelSpec, ShapeParameter, NEWTONIAN_LAW};
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::ParamLayout;
 use crate::solution::Solution;
@@ -127,8 +125,7 @@ impl Layout {
         );
         let (mut n_free, mut k_free) = (spec.law == LawChoice::Carreau, false);
         if spec.law == LawChoice::Newtonian {
-            template[ni] = 1.0;
-            template[ki] = STRAIN_THINNING_REFERENCE_KAPPA;
+            [template[ni], template[ki]] = NEWTONIAN_LAW;
         }
         let mut free = Vec::new();
         let mut names = Vec::new();
@@ -145,13 +142,15 @@ impl Layout {
                 .map(|c| (c, None)),
         );
         for (e, value) in settings {
-            if let Effect::StrainThinning = e {
+            if e.installs_in_law() {
                 match value {
                     Some(v) => template[ni] = e.param_value(v),
                     None => {
                         n_free = true;
                         st_free = true;
-                        let s = start.strength(e.name()).unwrap_or(1.0 - start.law[0]);
+                        let s = start
+                            .strength(e.name())
+                            .unwrap_or(e.strength_of(start.law[0]));
                         template[ni] = e.param_value(s).clamp(options.lower[0], options.upper[0]);
                         template[ki] = start.law[1];
                     }
@@ -244,7 +243,7 @@ impl Layout {
                     *c += shift;
                 }
             }
-            if st_free && matches!(slot.effect, Effect::StrainThinning) {
+            if st_free && slot.effect.installs_in_law() {
                 slot.column = Some(0);
             }
         }

@@ -14,7 +14,7 @@ use crate::fiber::diagnostics::candidate::{
 };
 use crate::fiber::diagnostics::detection::{detection_limits, DetectionContext, DetectionLimits};
 use crate::fiber::diagnostics::scores::cosine;
-use crate::fiber::diagnostics::ties::{alternatives, Alternative};
+use crate::fiber::diagnostics::ties::{alternatives_among, Alternative};
 use crate::fiber::effects::{Category, Effect, ModelSpec};
 use crate::fiber::rheometer::{
     Estimate, Identification, IdentifyOptions, ParameterShift, RheometerError,
@@ -256,18 +256,15 @@ fn ties(
     };
     let mut ranked: Vec<Candidate> = records.to_vec();
     ranked.sort_by(rank_order);
-    alternatives(
+    alternatives_among(
         &records[b],
         &ranked,
         ctx.options.earn_threshold,
         ctx.options.tie_margin,
-        ctx.cands[b].category(),
+        &ctx.cands,
         |name| match ctx.cands.iter().position(|e| e.name() == name) {
-            Some(i) => (
-                ctx.cands[i].category(),
-                cosine(&lin.scores[b].signature, &lin.scores[i].signature),
-            ),
-            None => (Category::Physics, f64::NAN),
+            Some(i) => cosine(&lin.scores[b].signature, &lin.scores[i].signature),
+            None => f64::NAN,
         },
     )
 }
