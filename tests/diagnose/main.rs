@@ -12,3 +12,4 @@ mod diagnose_realistic;
 mod diagnose_scan;
 mod diagnose_separability;
 mod global;
+mod user_effect_descriptor;

@@ -10,15 +10,14 @@
 //! [`GUIDE_DRAG`] (unit mN, process category, ranges, independent check) and the term
 //! [`GuideDrag`] (1 mN against the motion per unit strength).
 
-mod independent;
 
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
 use diffbvp::fiber::effects::{Category, Effect, EffectDescriptor, LawChoice, ModelSpec};
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::{Balance, FiberTerm, SiState};
 use diffbvp::DualNum;
-use independent::line_force::LineForce;
-use independent::scenarios::{self, NOISE_SD};
+use crate::independent::line_force::LineForce;
+use crate::independent::scenarios::{self, NOISE_SD};
 use std::f64::consts::PI;
 
 /// Where the guide sits \[m\] and the width of its contact \[m\].
@@ -53,7 +52,7 @@ impl FiberTerm for GuideDrag {
 
 #[test]
 fn a_user_written_candidate_is_found_and_ranked_first() {
-    let sc = independent::dataset::Scenario {
+    let sc = crate::independent::dataset::Scenario {
         name: "guide_drag",
         line_force: Some(LineForce {
             force: -TRUE_DRAG_MN * 1e-3,
