@@ -10,7 +10,9 @@ use super::layout::{FitStart, Layout};
 use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
 use crate::fiber::error::FiberError;
 use crate::fiber::simulate::{simulate_params, Simulator};
-use crate::least_squares::{BvpResiduals, BvpRun, LeastSquaresProblem, ParamMap, RunError};
+use crate::least_squares::{
+    BvpResiduals, BvpRun, Jacobian, LeastSquaresProblem, ParamMap, RunError,
+};
 use crate::sensitivity::PointFunction;
 use crate::solution::Solution;
 use crate::solve::{Guess, Solver};
@@ -213,6 +215,12 @@ impl<'a> Objective<'a> {
         fit.set_loose_tolerance(options.loose_tolerance);
         for run in runs? {
             fit.push(run)
+                .map_err(|e| RheometerError::Data(format!("parameter layout: {e}")))?;
+        }
+        if estimator == Estimator::Principled {
+            // the take-up factors are the experiments' own parameters: block-arrow normal
+            // equations, solved through the Schur complement (linear in the experiments)
+            fit.declare_blocks(Some(ns))
                 .map_err(|e| RheometerError::Data(format!("parameter layout: {e}")))?;
         }
         Ok(Objective {
@@ -427,6 +435,11 @@ impl LeastSquaresProblem for Objective<'_> {
     }
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), RheometerError> {
         self.eval(p, true)
+    }
+    fn evaluate_jacobian(&mut self, p: &[f64]) -> Result<(Vec<f64>, Jacobian), RheometerError> {
+        self.runs
+            .evaluate_jacobian_from(p, None)
+            .map_err(|e| self.run_error(p, e))
     }
     fn accept(&mut self, _p: &[f64]) {
         self.runs.accept_pending();
