@@ -488,6 +488,7 @@ pub struct BvpResiduals<'a, P: Bvp, G> {
     tol: Option<f64>,
     // the declared block-arrow structure (`declare_blocks`)
     blocks: Option<Arc<BlockStructure>>,
+    thread_workspaces: bool,
 }
 
 impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
@@ -502,6 +503,7 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
             error_per_tol: None,
             tol: None,
             blocks: None,
+            thread_workspaces: false,
         }
     }
 
@@ -512,8 +514,11 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
     }
 
     /// Adds a run; its parameter map must refer to fit parameters `< num_params`.
-    pub fn push(&mut self, run: BvpRun<'a, P, G>) -> Result<(), BvpError> {
+    pub fn push(&mut self, mut run: BvpRun<'a, P, G>) -> Result<(), BvpError> {
         run.map.validate(run.q.len(), self.num_params)?;
+        if self.thread_workspaces {
+            run.solver.use_thread_workspace(true);
+        }
         self.runs.push(run);
         if let Some(ns) = self.blocks.as_ref().map(|b| b.num_shared()) {
             match self.structure_for(ns, false) {
@@ -587,6 +592,17 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
             )));
         }
         Ok(BlockStructure::new(ns, shape))
+    }
+
+    /// Whether the runs' solvers borrow their thread's workspace for every solve instead of
+    /// keeping one each ([`Solver::use_thread_workspace`]): for fits of many runs, whose
+    /// Newton-matrix workspaces would otherwise dominate the memory (default off; results are
+    /// the same). Applies to the runs present and those pushed later.
+    pub fn set_thread_workspaces(&mut self, on: bool) {
+        self.thread_workspaces = on;
+        for run in &mut self.runs {
+            run.solver.use_thread_workspace(on);
+        }
     }
 
     /// Solves the runs in parallel (default) or one after the other. Without the `parallel`

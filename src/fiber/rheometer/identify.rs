@@ -10,9 +10,9 @@
 use super::data::Rheometer;
 use super::estimator::Estimator;
 use super::layout::{EffectSlot, FitStart};
-use super::options::{FitWarning, IdentifyOptions, RheometerError};
+use super::options::{FitProgress, FitWarning, IdentifyOptions, RheometerError};
 use crate::fiber::effects::LawChoice;
-use crate::least_squares::{fit, Accuracy, FitOptions, FitResult, Loss};
+use crate::least_squares::{fit_observed, Accuracy, FitIteration, FitOptions, FitResult, Loss};
 use crate::solution::Solution;
 use std::time::Instant;
 
@@ -96,7 +96,12 @@ impl Rheometer {
         if let Some(t) = warm.stop_tolerance {
             (fo.gtol, fo.xtol, fo.ftol) = (t, t, t);
         }
-        let fit_result = fit(&mut obj, &p0, &fo)?;
+        let mut observer = |it: &FitIteration| {
+            if let Some(hook) = &options.progress {
+                hook.report(&FitProgress::Iteration(it));
+            }
+        };
+        let fit_result = fit_observed(&mut obj, &p0, &fo, &mut observer)?;
         let solutions: Vec<Solution> = obj.solutions();
         let rms = self.rms_relative_residual(&solutions);
         let residual_profiles = solutions

@@ -13,6 +13,7 @@
 //! * [`objective`]: the least-squares objective over all experiments (solved in parallel,
 //!   warm-started, exact Jacobians from forward sensitivities);
 //! * [`layout`]: which parameters are fitted (law, effect strengths, take-up factors);
+//! * [`plan`]: the time and memory a fit will take, measured on one experiment before it starts;
 //! * [`landscape`]: the cost on a grid (paper Fig. 4);
 //! * [`error_budget()`]: what the data cannot identify (process conditions, instrument,
 //!   material data) propagated through exact sensitivities into a systematic uncertainty;
@@ -29,6 +30,7 @@ pub mod layout;
 pub mod objective;
 pub mod options;
 pub mod parameter_shift;
+pub mod plan;
 pub mod report;
 
 pub use data::Rheometer;
@@ -37,7 +39,10 @@ pub use estimator::Estimator;
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
-pub use options::{CarreauFiber, IdentifyOptions, RheometerError};
+pub use options::{
+    CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError,
+};
+pub use plan::FitPlan;
 pub use parameter_shift::ParameterShift;
 pub use report::{
     AtBound, BoundSide, EffectReport, FitReport, FitWarning, ShapeReport, WarningCode,
