@@ -98,7 +98,10 @@ fn main() -> Result<(), Box<dyn Error>> {
         let every = (m / 10).max(1);
         opts.progress = Some(ProgressHook::new(move |event| match event {
             FitProgress::Simulated { done, total } if done % every == 0 || done == total => {
-                eprintln!("[{:6.1} s] simulated {done}/{total}", t1.elapsed().as_secs_f64())
+                eprintln!(
+                    "[{:6.1} s] simulated {done}/{total}",
+                    t1.elapsed().as_secs_f64()
+                )
             }
             FitProgress::Iteration(it) => eprintln!(
                 "[{:6.1} s] step {}: cost {:.6e} {}",

@@ -1,10 +1,15 @@
 //! Repeats one benchmark solve for instruction counting (`perf stat -e instructions` or
-//! callgrind): `cargo run --release --example profile_solves -- shock|troesch|bratu|fiber [reps]`.
-//! Prints the nodes, meshes, Newton iterations and factorisations of one solve.
+//! callgrind): `cargo run --release --example profile_solves --
+//! shock|troesch|bratu|fiber|fiber_warm [reps]`. Prints the nodes, meshes, Newton iterations and
+//! factorisations of one solve. `fiber` is the cold start of `benches/fiber.rs`
+//! (`fiber_cold_v0p53_p2_tol1e-6`), `fiber_warm` its warm re-solve from the tangent predictor
+//! of a nearby linearised solution (`fiber_warm_tangent_v0p53_p2_tol1e-6`, what a fit does).
 
 use diffbvp::fiber::setup::{Air, Experiment, Material};
+use diffbvp::fiber::simulate::simulate_from;
 use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use diffbvp::mesh::linspace;
+use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{solve, Guess, Solution, SolveOptions};
 use std::hint::black_box;
 
@@ -74,7 +79,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 black_box(solve(&p, &[], black_box(&g), &opts)?);
             }
         }
-        "fiber" => {
+        "fiber" | "fiber_warm" => {
             let exp = Experiment::pmma7n_v0p53_p2();
             let m = FiberModel::new(
                 &Material::pmma7n(),
@@ -84,6 +89,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 Physics::paper(),
             )?;
             let fopts = SimulateOptions::with_tol(1e-6);
+            if which == "fiber_warm" {
+                let near = simulate(&m, &[0.79, 11.70], &fopts)?;
+                Sensitivities::compute(&m, &near.solution)?;
+                let s = simulate_from(&m, &[0.8, 11.71], &near, &fopts)?;
+                stats(which, &s.solution);
+                for _ in 0..reps {
+                    black_box(simulate_from(&m, black_box(&[0.8, 11.71]), &near, &fopts)?);
+                }
+                return Ok(());
+            }
             let s = simulate(&m, &[0.8, 11.71], &fopts)?;
             stats(which, &s.solution);
             for _ in 0..reps {

@@ -131,7 +131,11 @@ fn block_fit_is_the_dense_fit_for_every_loss() {
         assert_eq!(block.dense_jacobian().len(), dense.jacobian.len());
         assert_eq!(block.termination, dense.termination, "{loss}");
         // the offset stops at its upper bound in both
-        assert!(block.p[1] > 0.189 && block.p[1] <= 0.19, "{loss}: {:?}", block.p);
+        assert!(
+            block.p[1] > 0.189 && block.p[1] <= 0.19,
+            "{loss}: {:?}",
+            block.p
+        );
         assert_same(&block, &dense);
         // the compact covariance's shared block and local variances
         let bc = block.block_covariance().unwrap();
@@ -204,7 +208,10 @@ fn bvp_runs_declare_their_blocks() {
     let opts = FitOptions::with_bounds(vec![0.0; 1 + m], vec![5.0; 1 + m]);
     let mut blocked = bvp_runs(m, true);
     let st = blocked.block_structure().unwrap().clone();
-    assert_eq!((st.num_shared(), st.num_blocks(), st.num_params()), (1, m, 1 + m));
+    assert_eq!(
+        (st.num_shared(), st.num_blocks(), st.num_params()),
+        (1, m, 1 + m)
+    );
     let block = fit(&mut blocked, &p0, &opts).unwrap();
     let dense = fit(&mut bvp_runs(m, false), &p0, &opts).unwrap();
     assert!(block.block_jacobian.is_some());

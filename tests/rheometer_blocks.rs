@@ -3,10 +3,8 @@
 //! dense driver lands, for the linear and a robust loss.
 
 use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{
-    Estimator, FitStart, IdentifyOptions, Rheometer, RheometerError,
-};
 use diffbvp::fiber::rheometer::objective::Objective;
+use diffbvp::fiber::rheometer::{Estimator, FitStart, IdentifyOptions, Rheometer, RheometerError};
 use diffbvp::least_squares::{fit, Accuracy, FitOptions, FitResult, LeastSquaresProblem, Loss};
 use std::path::Path;
 
@@ -68,7 +66,10 @@ fn block_fit_of_the_shipped_experiments_is_the_dense_fit() {
         };
         let start = [0.5, 11.51];
         let id = rh.identify(start, &opts).unwrap();
-        assert!(id.fit.block_jacobian.is_some(), "the principled fit declares its blocks");
+        assert!(
+            id.fit.block_jacobian.is_some(),
+            "the principled fit declares its blocks"
+        );
         let gn_scale = f_scale.map_or(1.0, |c| c / sigma);
         let dense = dense_fit(&rh, start, &opts, gn_scale);
         let block = &id.fit;
@@ -83,15 +84,67 @@ fn block_fit_of_the_shipped_experiments_is_the_dense_fit() {
                 "{loss}: parameter {i}: {a} vs {b}, {rel:e} relative, {in_se:e} SE"
             );
         }
-        println!("{loss}: largest difference {worst:e} SE; iterations {} vs {}", block.iterations, dense.iterations);
+        println!(
+            "{loss}: largest difference {worst:e} SE; iterations {} vs {}",
+            block.iterations, dense.iterations
+        );
         let sb = block.standard_errors().unwrap();
         for (a, b) in sb.iter().zip(&se) {
             assert!((a - b).abs() <= 1e-6 * b, "{loss}: se {a} vs {b}");
         }
         let (cb, cd) = (block.covariance().unwrap(), dense.covariance().unwrap());
         for (a, b) in cb.iter().zip(&cd) {
-            assert!((a - b).abs() <= 1e-6 * b.abs().max(1e-12), "{loss}: cov {a} vs {b}");
+            assert!(
+                (a - b).abs() <= 1e-6 * b.abs().max(1e-12),
+                "{loss}: cov {a} vs {b}"
+            );
         }
         assert_eq!(block.dense_jacobian().len(), dense.jacobian.len());
     }
+}
+
+#[test]
+fn progress_is_reported_and_the_plan_is_the_fit_size() {
+    use diffbvp::fiber::rheometer::{FitProgress, ProgressHook};
+    use std::sync::{Arc, Mutex};
+    let rh = rheometer();
+    let start = [0.5, 11.51];
+    let events: Arc<Mutex<(usize, usize, usize)>> = Arc::new(Mutex::new((0, 0, 0)));
+    let seen = events.clone();
+    let opts = IdentifyOptions {
+        progress: Some(ProgressHook::new(move |e| {
+            let mut s = seen.lock().unwrap();
+            match e {
+                FitProgress::Simulated { done, total } => {
+                    s.0 += 1;
+                    s.1 = s.1.max(*done);
+                    assert_eq!(*total, 9);
+                }
+                FitProgress::Iteration(it) => {
+                    s.2 += 1;
+                    assert_eq!(it.iteration, s.2);
+                }
+            }
+        })),
+        ..IdentifyOptions::default()
+    };
+    let plan = rh.plan(start, &opts).unwrap();
+    let id = rh.identify(start, &opts).unwrap();
+    let (simulated, last, iterations) = *events.lock().unwrap();
+    assert_eq!((simulated, last), (9, 9));
+    assert_eq!(iterations, id.fit.iterations);
+    assert_eq!(plan.experiments, 9);
+    assert_eq!(plan.residuals, id.fit.num_residuals());
+    assert_eq!(plan.parameters, id.fit.p.len());
+    assert_eq!(plan.shared_parameters, id.names.len());
+    assert!(plan.seconds > 0.0 && plan.cold_start_s > 0.0 && plan.evaluation_s > 0.0);
+    // the memory planned: at least the final solutions with their linearisations, at most a
+    // few times them (accepted, pending, workspaces) plus the Jacobian
+    let held: usize = id.solutions.iter().map(|s| s.heap_bytes()).sum();
+    assert!(held > 0);
+    assert!(
+        plan.bytes >= held && plan.bytes <= 4 * held + 1_000_000,
+        "planned {} bytes, the solutions hold {held}",
+        plan.bytes
+    );
 }

@@ -43,11 +43,7 @@ fn factors(
     let mut c_inv = Vec::with_capacity(nb.c.len());
     let mut g = Vec::with_capacity(nb.c.len());
     for (c, b) in nb.c.into_iter().zip(&nb.b) {
-        let ci = if c.nrows() == 0 {
-            c
-        } else {
-            c.try_inverse()?
-        };
+        let ci = if c.nrows() == 0 { c } else { c.try_inverse()? };
         let gk = &ci * b.transpose();
         s -= b * &gk;
         c_inv.push(ci);
@@ -263,8 +259,11 @@ mod tests {
         let (nr, np) = (18, 6);
         let r: Vec<f64> = (0..nr).map(|i| ((i * 7 % 5) as f64 - 2.0) * 0.8).collect();
         let w = loss::weights(Loss::SoftL1, 0.5, &r);
-        let (wt, psi): (Vec<f64>, Vec<f64>) =
-            w.iter().zip(&r).map(|((d1, wi), ri)| (*wi, d1 * ri)).unzip();
+        let (wt, psi): (Vec<f64>, Vec<f64>) = w
+            .iter()
+            .zip(&r)
+            .map(|((d1, wi), ri)| (*wi, d1 * ri))
+            .unzip();
         let jd = j.to_dense();
         let (mut h, mut b) = (DMatrix::zeros(np, np), DMatrix::zeros(np, np));
         for i in 0..nr {

@@ -401,7 +401,11 @@ impl BlockJacobian {
 
     /// `(Jᵀ r)` split into its shared part and per block its local part, columns scaled by
     /// `1/d`.
-    pub(crate) fn scaled_gradient(&self, r: &[f64], d: &[f64]) -> (DVector<f64>, Vec<DVector<f64>>) {
+    pub(crate) fn scaled_gradient(
+        &self,
+        r: &[f64],
+        d: &[f64],
+    ) -> (DVector<f64>, Vec<DVector<f64>>) {
         let g = self.tr_mul_vec(r);
         let s = &self.structure;
         let ns = s.num_shared();
@@ -445,7 +449,10 @@ mod tests {
     fn structure_counts_and_ranges() {
         let j = example();
         let s = j.structure();
-        assert_eq!((s.num_params(), s.num_residuals(), s.num_blocks()), (5, 6, 3));
+        assert_eq!(
+            (s.num_params(), s.num_residuals(), s.num_blocks()),
+            (5, 6, 3)
+        );
         assert_eq!((s.rows(1), s.locals(1)), (2..5, 3..5));
         assert_eq!(s.locals(2), 5..5);
         assert_eq!(s.jacobian_len(), 6 * 2 + 2 + 6);

@@ -61,7 +61,12 @@ impl Jacobian {
     pub(super) fn effect(&self, s: &DVector<f64>, nr: usize, np: usize) -> f64 {
         match self {
             Jacobian::Dense(j) => (&DMatrix::from_row_slice(nr, np, j) * s).norm(),
-            Jacobian::Blocks(b) => b.mul_vec(s.as_slice()).iter().map(|v| v * v).sum::<f64>().sqrt(),
+            Jacobian::Blocks(b) => b
+                .mul_vec(s.as_slice())
+                .iter()
+                .map(|v| v * v)
+                .sum::<f64>()
+                .sqrt(),
         }
     }
 
@@ -99,14 +104,8 @@ impl Jacobian {
 
 /// The linearisation `J s + r` at the iterate, in the form the step computation needs.
 pub(super) enum Linearized<'a> {
-    Dense {
-        jm: DMatrix<f64>,
-        rv: DVector<f64>,
-    },
-    Blocks {
-        j: &'a BlockJacobian,
-        r: &'a [f64],
-    },
+    Dense { jm: DMatrix<f64>, rv: DVector<f64> },
+    Blocks { j: &'a BlockJacobian, r: &'a [f64] },
 }
 
 impl<'a> Linearized<'a> {

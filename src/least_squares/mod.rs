@@ -16,6 +16,17 @@
 //! The problem keeps its own state (warm starts): [`LeastSquaresProblem::evaluate`] is called at
 //! trial points, [`LeastSquaresProblem::accept`] when a trial point is accepted.
 //!
+//! **Block-arrow problems.** A problem whose parameters are shared by all residuals plus
+//! parameters local to one block of residuals each (one experiment's take-up factor, one run's
+//! scale) declares it by returning a [`Jacobian::Blocks`] from
+//! [`LeastSquaresProblem::evaluate_jacobian`] (see [`blocks`]; [`BvpResiduals::declare_blocks`]
+//! for BVP runs). The driver then never forms an `N × P` or `P × P` matrix: the trust-region
+//! step is the same Levenberg–Marquardt step, solved through the Schur complement of the
+//! normal equations on the shared parameters (as bundle adjustment does, with the same
+//! Coleman–Li scaling and bounds), and [`FitResult::standard_errors`] and
+//! [`FitResult::block_covariance`] come from the same elimination: time and memory linear in
+//! the number of blocks.
+//!
 //! For the common case — residuals of one or more BVPs at observation points, the model
 //! parameters of each BVP an affine function of the fit parameters — [`BvpResiduals`] is a ready
 //! [`LeastSquaresProblem`]: warm-started solvers, exact Jacobians from forward sensitivities, a

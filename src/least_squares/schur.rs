@@ -64,7 +64,10 @@ pub(super) fn block_trust_region_step(
             continue;
         }
         let eig = SymmetricEigen::new(c);
-        lmax_local = eig.eigenvalues.iter().fold(lmax_local, |m, v| m.max(v.abs()));
+        lmax_local = eig
+            .eigenvalues
+            .iter()
+            .fold(lmax_local, |m, v| m.max(v.abs()));
         let bt = &b * &eig.eigenvectors;
         let gt = eig.eigenvectors.transpose() * g;
         blocks.push(LocalBlock {
@@ -226,7 +229,10 @@ mod tests {
         let s = j.structure();
         let jm = DMatrix::from_row_slice(s.num_residuals(), s.num_params(), &j.to_dense());
         let rv = DVector::from_column_slice(r);
-        trust_region_step(&jm, &rv, d, radius).iter().copied().collect()
+        trust_region_step(&jm, &rv, d, radius)
+            .iter()
+            .copied()
+            .collect()
     }
 
     #[test]
@@ -234,7 +240,9 @@ mod tests {
         for zero_local in [false, true] {
             let j = jacobian(zero_local);
             let nr = j.structure().num_residuals();
-            let r: Vec<f64> = (0..nr).map(|i| ((i * 37 % 11) as f64 - 5.0) * 0.1).collect();
+            let r: Vec<f64> = (0..nr)
+                .map(|i| ((i * 37 % 11) as f64 - 5.0) * 0.1)
+                .collect();
             let d = [1.0, 0.5, 2.0, 1.3, 0.7, 1.0];
             for radius in [1e3, 1.0, 0.3, 1e-3] {
                 let a = block_trust_region_step(&j, &r, &d, radius);

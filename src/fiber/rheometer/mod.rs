@@ -39,11 +39,9 @@ pub use estimator::Estimator;
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
-pub use options::{
-    CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError,
-};
-pub use plan::FitPlan;
+pub use options::{CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError};
 pub use parameter_shift::ParameterShift;
+pub use plan::FitPlan;
 pub use report::{
     AtBound, BoundSide, EffectReport, FitReport, FitWarning, ShapeReport, WarningCode,
 };

@@ -84,8 +84,7 @@ impl Rheometer {
             let ni = layout.params.law_param(crate::fiber::CarreauLike::N);
             near[ni] = (near[ni] - 0.01).max(options.lower[0]);
             let t1 = Instant::now();
-            let warm =
-                simulate_params(model, &near, Some(&cold.solution), sim).map_err(sim_err)?;
+            let warm = simulate_params(model, &near, Some(&cold.solution), sim).map_err(sim_err)?;
             Sensitivities::compute(model, &warm.solution)
                 .map_err(|e| sim_err(crate::fiber::error::FiberError::from(e)))?;
             evaluation_s = evaluation_s.min(t1.elapsed().as_secs_f64());
