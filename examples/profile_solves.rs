@@ -1,13 +1,18 @@
 //! Repeats one benchmark solve for instruction counting (`perf stat -e instructions` or
-//! callgrind): `cargo run --release --example profile_solves -- shock|troesch|bratu|fiber|fiber_candidates
-//! [reps]` (`fiber_candidates`: the fiber with every built-in candidate effect carried at neutral
-//! strength, as `diagnose` solves it: air profiles, process and instrument parameters).
-//! Prints the nodes, meshes, Newton iterations and factorisations of one solve.
+//! callgrind): `cargo run --release --example profile_solves --
+//! shock|troesch|bratu|fiber|fiber_warm|fiber_candidates [reps]`. Prints the nodes, meshes,
+//! Newton iterations and factorisations of one solve. `fiber` is the cold start of
+//! `benches/fiber.rs` (`fiber_cold_v0p53_p2_tol1e-6`), `fiber_warm` its warm re-solve from the
+//! tangent predictor of a nearby linearised solution (`fiber_warm_tangent_v0p53_p2_tol1e-6`,
+//! what a fit does), `fiber_candidates` the fiber with every built-in candidate effect carried
+//! at neutral strength, as `diagnose` solves it.
 
 use diffbvp::fiber::effects::{Effect, ModelSpec};
 use diffbvp::fiber::setup::{Air, Experiment, Material};
+use diffbvp::fiber::simulate::simulate_from;
 use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use diffbvp::mesh::linspace;
+use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{solve, Guess, Solution, SolveOptions};
 use std::hint::black_box;
 
@@ -77,10 +82,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 black_box(solve(&p, &[], black_box(&g), &opts)?);
             }
         }
-        "fiber" | "fiber_candidates" => {
+        "fiber" | "fiber_warm" | "fiber_candidates" => {
             let exp = Experiment::pmma7n_v0p53_p2();
             let physics = match which {
-                "fiber" => Physics::paper(),
+                "fiber" | "fiber_warm" => Physics::paper(),
                 _ => ModelSpec::default()
                     .with_candidates(&Effect::builtin())
                     .physics()?,
@@ -93,6 +98,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 physics,
             )?;
             let fopts = SimulateOptions::with_tol(1e-6);
+            if which == "fiber_warm" {
+                let near = simulate(&m, &[0.79, 11.70], &fopts)?;
+                Sensitivities::compute(&m, &near.solution)?;
+                let s = simulate_from(&m, &[0.8, 11.71], &near, &fopts)?;
+                stats(which, &s.solution);
+                for _ in 0..reps {
+                    black_box(simulate_from(&m, black_box(&[0.8, 11.71]), &near, &fopts)?);
+                }
+                return Ok(());
+            }
             let s = simulate(&m, &[0.8, 11.71], &fopts)?;
             stats(which, &s.solution);
             for _ in 0..reps {

@@ -37,6 +37,13 @@ impl std::fmt::Debug for Linearization {
 }
 
 impl Linearization {
+    /// Bytes on the heap: the Jacobians and the factors (see [`Factorization::heap_bytes`]).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        let c = &self.col;
+        8 * (c.x.len() + c.h.len() + c.jn.len() + c.jm.len() + c.jbc.len())
+            + self.factorization.heap_bytes()
+    }
+
     /// Computes the linearisation at the node values `y` with all parameters
     /// `p = (unknowns, model parameters)` in `col` and `lin` (a solver's workspace or fresh ones),
     /// which must hold this mesh and the midpoint states of `y` (after a residual evaluation at

@@ -193,6 +193,21 @@ impl Solution {
         self.linearization.get().map(|l| &l.factorization)
     }
 
+    /// Bytes this solution holds on the heap: its vectors and, once computed, its cached
+    /// linearisation (Jacobians seeded in all parameters and the factorised Newton matrix; a
+    /// sparse LU's factors estimated). What a fit keeps per run and solution, for planning the
+    /// memory of a large fit.
+    pub fn heap_bytes(&self) -> usize {
+        let v = self.x.len()
+            + self.y.len()
+            + self.yp.len()
+            + self.unknowns.len()
+            + self.params.len()
+            + self.rms_residuals.len()
+            + self.residual_scale.len();
+        8 * v + self.linearization.get().map_or(0, |l| l.heap_bytes())
+    }
+
     /// The linearisation at this solution: the cached one, or computed now (once) with a fresh
     /// workspace and cached. Assumes the public fields are those the solve returned.
     pub(crate) fn linearization<P: Bvp>(&self, problem: &P) -> Result<&Linearization, BvpError> {

@@ -251,6 +251,8 @@ pub struct Solver<'a, P: Bvp> {
     /// The options used by [`solve`](Self::solve).
     pub options: SolveOptions,
     ws: Workspace,
+    /// Whether every solve borrows the thread's workspace (`SPARE`) instead of `ws`.
+    thread_workspace: bool,
 }
 
 /// Everything a solve reuses that does not depend on the problem's type: the collocation
@@ -422,6 +424,7 @@ pub fn solve<P: Bvp>(
         problem,
         options: options.clone(),
         ws,
+        thread_workspace: false,
     };
     let result = solver.solve(params, guess);
     let ws = solver.ws;
@@ -438,7 +441,22 @@ impl<'a, P: Bvp> Solver<'a, P> {
             problem,
             options,
             ws: Workspace::new(n, k, q),
+            thread_workspace: false,
         }
+    }
+
+    /// With `on`, the solver keeps no workspace of its own between solves: every solve borrows
+    /// the calling thread's (as [`solve`] does) and gives it back. For many solvers alive at
+    /// once — one per experiment of a joint fit, solved a few at a time on a thread pool — the
+    /// memory of the Newton-matrix workspaces is then that of one solver per thread instead of
+    /// one per solver; a solve on another mesh size than the thread's last ones sizes them
+    /// anew. Results are the same either way.
+    pub fn use_thread_workspace(&mut self, on: bool) {
+        if on && !self.thread_workspace {
+            let (n, k, q) = (self.ws.col.n, self.ws.col.k, self.ws.col.q);
+            self.ws = Workspace::new(n, k, q);
+        }
+        self.thread_workspace = on;
     }
 
     /// The problem.
@@ -601,7 +619,33 @@ impl<'a, P: Bvp> Solver<'a, P> {
         self.solve_impl(params, guess, opts, initial)
     }
 
+    /// [`solve_inner`](Self::solve_inner) in the solver's own workspace or, with
+    /// [`use_thread_workspace`](Self::use_thread_workspace), in the thread's.
     fn solve_impl(
+        &mut self,
+        params: &[f64],
+        guess: &Guess,
+        opts: &SolveOptions,
+        initial: Option<&Factorization>,
+    ) -> Result<Solution, BvpError> {
+        if !self.thread_workspace {
+            return self.solve_inner(params, guess, opts, initial);
+        }
+        let (n, k, q) = (self.ws.col.n, self.ws.col.k, self.ws.col.q);
+        let spare = SPARE.try_with(|s| s.borrow_mut().take()).ok().flatten();
+        let lent = match spare {
+            Some(ws) => ws.for_dims(n, k, q),
+            None => Workspace::new(n, k, q),
+        };
+        let own = std::mem::replace(&mut self.ws, lent);
+        let result = self.solve_inner(params, guess, opts, initial);
+        let lent = std::mem::replace(&mut self.ws, own);
+        // during thread teardown the slot may be gone: the workspace is then dropped
+        let _ = SPARE.try_with(|s| *s.borrow_mut() = Some(lent));
+        result
+    }
+
+    fn solve_inner(
         &mut self,
         params: &[f64],
         guess: &Guess,

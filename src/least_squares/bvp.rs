@@ -1,11 +1,13 @@
 //! [`BvpResiduals`]: a [`LeastSquaresProblem`] whose residuals come from BVP solves.
 
-use super::LeastSquaresProblem;
+use super::blocks::{BlockJacobian, BlockStructure};
+use super::{Jacobian, LeastSquaresProblem};
 use crate::error::BvpError;
 use crate::problem::Bvp;
 use crate::sensitivity::{residual_jacobian, tangent_guess, PointFunction, Sensitivities};
 use crate::solution::Solution;
 use crate::solve::{Guess, SolveOptions, Solver};
+use std::sync::Arc;
 
 /// One affine link of a [`ParamMap`]: model parameter `q[model] = offset + scale · p[fit]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -484,6 +486,9 @@ pub struct BvpResiduals<'a, P: Bvp, G> {
     loosest: Option<f64>,
     error_per_tol: Option<f64>,
     tol: Option<f64>,
+    // the declared block-arrow structure (`declare_blocks`)
+    blocks: Option<Arc<BlockStructure>>,
+    thread_workspaces: bool,
 }
 
 impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
@@ -497,6 +502,8 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
             loosest: None,
             error_per_tol: None,
             tol: None,
+            blocks: None,
+            thread_workspaces: false,
         }
     }
 
@@ -507,10 +514,95 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
     }
 
     /// Adds a run; its parameter map must refer to fit parameters `< num_params`.
-    pub fn push(&mut self, run: BvpRun<'a, P, G>) -> Result<(), BvpError> {
+    pub fn push(&mut self, mut run: BvpRun<'a, P, G>) -> Result<(), BvpError> {
         run.map.validate(run.q.len(), self.num_params)?;
+        if self.thread_workspaces {
+            run.solver.use_thread_workspace(true);
+        }
         self.runs.push(run);
+        if let Some(ns) = self.blocks.as_ref().map(|b| b.num_shared()) {
+            match self.structure_for(ns, false) {
+                Ok(st) => self.blocks = Some(Arc::new(st)),
+                Err(e) => {
+                    self.runs.pop();
+                    return Err(e);
+                }
+            }
+        }
         Ok(())
+    }
+
+    /// Declares the block-arrow structure (see [`blocks`](super::blocks)): fit parameters
+    /// `0..num_shared` are shared by the runs, and every other fit parameter belongs to exactly
+    /// one run, the runs' own parameters following each other in run order (run 0's first). The
+    /// fit then evaluates a [`Jacobian::Blocks`] and solves its steps and covariance through
+    /// the Schur complement, in time and memory linear in the number of runs. Runs pushed later
+    /// must keep the pattern. `None` turns it off (dense Jacobians, the default).
+    ///
+    /// Errors: a run linking to another run's own parameter, own parameters out of run order,
+    /// fit parameters no run links to.
+    pub fn declare_blocks(&mut self, num_shared: Option<usize>) -> Result<(), BvpError> {
+        self.blocks = match num_shared {
+            None => None,
+            Some(ns) => Some(Arc::new(self.structure_for(ns, true)?)),
+        };
+        Ok(())
+    }
+
+    /// The declared block-arrow structure, if any ([`declare_blocks`](Self::declare_blocks)).
+    pub fn block_structure(&self) -> Option<&Arc<BlockStructure>> {
+        self.blocks.as_ref()
+    }
+
+    /// The block-arrow structure of the runs with `ns` shared fit parameters (`cover`: every
+    /// fit parameter must belong to the shared ones or a run).
+    fn structure_for(&self, ns: usize, cover: bool) -> Result<BlockStructure, BvpError> {
+        if ns > self.num_params {
+            return Err(BvpError::InvalidInput(format!(
+                "declare_blocks: {ns} shared parameters, but the problem has {}",
+                self.num_params
+            )));
+        }
+        let mut next = ns;
+        let mut shape = Vec::with_capacity(self.runs.len());
+        for (k, run) in self.runs.iter().enumerate() {
+            let mut own: Vec<usize> = run
+                .map
+                .links
+                .iter()
+                .map(|l| l.fit)
+                .filter(|&f| f >= ns)
+                .collect();
+            own.sort_unstable();
+            own.dedup();
+            if own.iter().enumerate().any(|(i, &f)| f != next + i) {
+                return Err(BvpError::InvalidInput(format!(
+                    "declare_blocks: run {k} links to fit parameters {own:?}, but its own \
+                     parameters must follow the previous run's, from index {next} on, \
+                     without gaps (shared parameters are 0..{ns})"
+                )));
+            }
+            next += own.len();
+            shape.push((run.points.len(), own.len()));
+        }
+        if cover && next != self.num_params {
+            return Err(BvpError::InvalidInput(format!(
+                "declare_blocks: fit parameters {next}..{} belong to no run",
+                self.num_params
+            )));
+        }
+        Ok(BlockStructure::new(ns, shape))
+    }
+
+    /// Whether the runs' solvers borrow their thread's workspace for every solve instead of
+    /// keeping one each ([`Solver::use_thread_workspace`]): for fits of many runs, whose
+    /// Newton-matrix workspaces would otherwise dominate the memory (default off; results are
+    /// the same). Applies to the runs present and those pushed later.
+    pub fn set_thread_workspaces(&mut self, on: bool) {
+        self.thread_workspaces = on;
+        for run in &mut self.runs {
+            run.solver.use_thread_workspace(on);
+        }
     }
 
     /// Solves the runs in parallel (default) or one after the other. Without the `parallel`
@@ -615,28 +707,7 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
         jacobian: bool,
         starts: Option<&[Guess]>,
     ) -> Result<(Vec<f64>, Vec<f64>), RunError> {
-        if p.len() != self.num_params {
-            return Err(RunError {
-                run: 0,
-                source: BvpError::InvalidInput(format!(
-                    "{} fit parameters given, the problem has {}",
-                    p.len(),
-                    self.num_params
-                )),
-            });
-        }
-        if let Some(g) = starts {
-            if g.len() != self.runs.len() {
-                return Err(RunError {
-                    run: g.len().min(self.runs.len()),
-                    source: BvpError::InvalidInput(format!(
-                        "{} warm starts for {} runs",
-                        g.len(),
-                        self.runs.len()
-                    )),
-                });
-            }
-        }
+        self.check_input(p, starts)?;
         let parts = self.eval_runs(p, jacobian, starts);
         let parts = match parts {
             Ok(parts) => parts,
@@ -671,6 +742,95 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
             r.extend(rk);
         }
         Ok((r, jac))
+    }
+
+    /// Residuals `r(p)` and the block-arrow Jacobian of the declared structure
+    /// ([`declare_blocks`](Self::declare_blocks)), warm-started as
+    /// [`evaluate_from`](Self::evaluate_from); the dense Jacobian if no structure is declared.
+    pub fn evaluate_jacobian_from(
+        &mut self,
+        p: &[f64],
+        starts: Option<&[Guess]>,
+    ) -> Result<(Vec<f64>, Jacobian), RunError> {
+        let Some(structure) = self.blocks.clone() else {
+            let (r, j) = self.evaluate_from(p, true, starts)?;
+            return Ok((r, Jacobian::Dense(j)));
+        };
+        self.check_input(p, starts)?;
+        if structure.num_params() != self.num_params {
+            return Err(RunError {
+                run: self.runs.len().saturating_sub(1),
+                source: BvpError::InvalidInput(format!(
+                    "declared blocks: fit parameters {}..{} belong to no run",
+                    structure.num_params(),
+                    self.num_params
+                )),
+            });
+        }
+        let parts = match self.eval_runs(p, true, starts) {
+            Ok(parts) => parts,
+            Err(e) => {
+                self.discard_pending();
+                return Err(e);
+            }
+        };
+        let ns = structure.num_shared();
+        let mut jac = BlockJacobian::zeros(structure.clone());
+        let mut r = Vec::with_capacity(structure.num_residuals());
+        for (k, ((run, (rk, jk)), (sh, lo))) in self
+            .runs
+            .iter()
+            .zip(parts)
+            .zip(jac.blocks_mut())
+            .enumerate()
+        {
+            let q = run.q.len();
+            let own = structure.locals(k);
+            let nl = own.len();
+            for i in 0..rk.len() {
+                for l in &run.map.links {
+                    let v = if l.scale == 1.0 {
+                        jk[i * q + l.model]
+                    } else {
+                        l.scale * jk[i * q + l.model]
+                    };
+                    if l.fit < ns {
+                        sh[i * ns + l.fit] += v;
+                    } else {
+                        lo[i * nl + (l.fit - own.start)] += v;
+                    }
+                }
+            }
+            r.extend(rk);
+        }
+        Ok((r, Jacobian::Blocks(jac)))
+    }
+
+    /// Checks the parameter vector's length and the number of warm starts.
+    fn check_input(&self, p: &[f64], starts: Option<&[Guess]>) -> Result<(), RunError> {
+        if p.len() != self.num_params {
+            return Err(RunError {
+                run: 0,
+                source: BvpError::InvalidInput(format!(
+                    "{} fit parameters given, the problem has {}",
+                    p.len(),
+                    self.num_params
+                )),
+            });
+        }
+        if let Some(g) = starts {
+            if g.len() != self.runs.len() {
+                return Err(RunError {
+                    run: g.len().min(self.runs.len()),
+                    source: BvpError::InvalidInput(format!(
+                        "{} warm starts for {} runs",
+                        g.len(),
+                        self.runs.len()
+                    )),
+                });
+            }
+        }
+        Ok(())
     }
 
     #[allow(clippy::type_complexity)]
@@ -736,6 +896,9 @@ impl<P: Bvp + Sync, G: PointFunction + Send> LeastSquaresProblem for BvpResidual
     }
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), RunError> {
         self.evaluate_from(p, true, None)
+    }
+    fn evaluate_jacobian(&mut self, p: &[f64]) -> Result<(Vec<f64>, Jacobian), RunError> {
+        self.evaluate_jacobian_from(p, None)
     }
     fn accept(&mut self, _p: &[f64]) {
         self.accept_pending();

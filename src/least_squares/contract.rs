@@ -3,7 +3,7 @@
 //! it comes back (lengths, finite values), so that nothing reaches the linear algebra that would
 //! panic there or turn into a NaN cost or zero standard errors.
 
-use super::{Accuracy, AccuracySchedule, FitError, FitOptions};
+use super::{Accuracy, AccuracySchedule, FitError, FitOptions, Jacobian};
 
 /// Checks the start point, the bounds and the options for a problem of `np` parameters. The
 /// error names the option (or parameter) and its value.
@@ -95,7 +95,7 @@ pub(super) enum Breach {
 /// Jacobian entries, every value finite. The messages name the index and the lengths.
 pub(super) fn check_evaluation(
     r: &[f64],
-    jac: &[f64],
+    jac: &Jacobian,
     np: usize,
     expected: Option<usize>,
 ) -> Result<(), Breach> {
@@ -108,6 +108,10 @@ pub(super) fn check_evaluation(
             )));
         }
     }
+    let jac = match jac {
+        Jacobian::Dense(j) => j,
+        Jacobian::Blocks(b) => return check_blocks(r, b, np),
+    };
     if jac.len() != nr * np {
         return Err(Breach::Size(format!(
             "evaluate() returned a Jacobian of {} entries, expected {nr} residuals x {np} \
@@ -133,9 +137,40 @@ pub(super) fn check_evaluation(
     Ok(())
 }
 
+/// [`check_evaluation`] of a block-arrow Jacobian: its shape and finite entries.
+fn check_blocks(r: &[f64], b: &super::BlockJacobian, np: usize) -> Result<(), Breach> {
+    let nr = r.len();
+    let s = b.structure();
+    if s.num_residuals() != nr || s.num_params() != np {
+        return Err(Breach::Size(format!(
+            "evaluate_jacobian() returned a block Jacobian of {} residuals x {} parameters, \
+             expected {nr} x {np}",
+            s.num_residuals(),
+            s.num_params()
+        )));
+    }
+    if let Some(i) = r.iter().position(|v| !v.is_finite()) {
+        return Err(Breach::NonFinite(format!(
+            "evaluate_jacobian() returned a non-finite residual: r[{i}] = {}",
+            r[i]
+        )));
+    }
+    if !b.is_finite() {
+        return Err(Breach::NonFinite(
+            "evaluate_jacobian() returned a block Jacobian with a non-finite entry".into(),
+        ));
+    }
+    Ok(())
+}
+
 /// Checks the start point's evaluation: any breach is an error
 /// ([`FitError::InvalidInput`]), since there is no accepted point to fall back on.
-pub(super) fn check_start(r: &[f64], jac: &[f64], np: usize, p: &[f64]) -> Result<(), FitError> {
+pub(super) fn check_start(
+    r: &[f64],
+    jac: &Jacobian,
+    np: usize,
+    p: &[f64],
+) -> Result<(), FitError> {
     match check_evaluation(r, jac, np, None) {
         Ok(()) => Ok(()),
         Err(Breach::Size(m)) => Err(FitError::InvalidInput(format!(
@@ -153,11 +188,11 @@ pub(super) fn check_start(r: &[f64], jac: &[f64], np: usize, p: &[f64]) -> Resul
 /// broken contract (mis-sized values) that ends the fit.
 #[allow(clippy::type_complexity)]
 pub(super) fn check_trial<E: std::fmt::Display>(
-    evaluated: Result<(Vec<f64>, Vec<f64>), E>,
+    evaluated: Result<(Vec<f64>, Jacobian), E>,
     np: usize,
     nr: usize,
     p: &[f64],
-) -> Result<Result<(Vec<f64>, Vec<f64>), String>, FitError> {
+) -> Result<Result<(Vec<f64>, Jacobian), String>, FitError> {
     match evaluated {
         Err(e) => Ok(Err(e.to_string())),
         Ok((r, jac)) => match check_evaluation(&r, &jac, np, Some(nr)) {

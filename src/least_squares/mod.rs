@@ -16,6 +16,17 @@
 //! The problem keeps its own state (warm starts): [`LeastSquaresProblem::evaluate`] is called at
 //! trial points, [`LeastSquaresProblem::accept`] when a trial point is accepted.
 //!
+//! **Block-arrow problems.** A problem whose parameters are shared by all residuals plus
+//! parameters local to one block of residuals each (one experiment's take-up factor, one run's
+//! scale) declares it by returning a [`Jacobian::Blocks`] from
+//! [`LeastSquaresProblem::evaluate_jacobian`] (see [`blocks`]; [`BvpResiduals::declare_blocks`]
+//! for BVP runs). The driver then never forms an `N × P` or `P × P` matrix: the trust-region
+//! step is the same Levenberg–Marquardt step, solved through the Schur complement of the
+//! normal equations on the shared parameters (as bundle adjustment does, with the same
+//! Coleman–Li scaling and bounds), and [`FitResult::standard_errors`] and
+//! [`FitResult::block_covariance`] come from the same elimination: time and memory linear in
+//! the number of blocks.
+//!
 //! For the common case — residuals of one or more BVPs at observation points, the model
 //! parameters of each BVP an affine function of the fit parameters — [`BvpResiduals`] is a ready
 //! [`LeastSquaresProblem`]: warm-started solvers, exact Jacobians from forward sensitivities, a
@@ -43,12 +54,21 @@
 //! evaluations. [`BvpResiduals::set_loose_tolerance`] turns an allowed residual error into a BVP
 //! tolerance.
 
+mod block_covariance;
+pub mod blocks;
 mod bvp;
 mod contract;
+mod jacobian;
 pub mod loss;
+mod schur;
 
+pub use block_covariance::BlockCovariance;
+pub use blocks::{BlockJacobian, BlockStructure};
 pub use bvp::{BvpResiduals, BvpRun, ParamLink, ParamMap, RunError};
+pub use jacobian::Jacobian;
 pub use loss::Loss;
+
+use jacobian::Linearized;
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::fmt;
@@ -71,6 +91,15 @@ pub trait LeastSquaresProblem {
     /// named in [`FitIteration::failure`]); at the start point it is a
     /// [`FitError::InvalidInput`] naming the index.
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Self::Error>;
+    /// Residuals and Jacobian in the form the driver works on: a problem with the block-arrow
+    /// structure of [`blocks`] (shared parameters plus parameters local to one block of
+    /// residuals) returns [`Jacobian::Blocks`], and the driver then computes its steps and the
+    /// covariance through the Schur complement, linear in the number of blocks. The default
+    /// returns [`evaluate`](Self::evaluate)'s dense Jacobian.
+    fn evaluate_jacobian(&mut self, p: &[f64]) -> Result<(Vec<f64>, Jacobian), Self::Error> {
+        let (r, j) = self.evaluate(p)?;
+        Ok((r, Jacobian::Dense(j)))
+    }
     /// Called when `p` (the last point passed to `evaluate`) becomes the new iterate.
     fn accept(&mut self, _p: &[f64]) {}
     /// Sets how accurate the following evaluations need to be: `Some(e)` allows a model error
@@ -279,8 +308,13 @@ pub struct FitResult {
     pub cost: f64,
     /// Residuals at `p`.
     pub residuals: Vec<f64>,
-    /// Jacobian at `p` (row-major).
+    /// Jacobian at `p` (row-major `N × P`; **empty** when the problem evaluated a block-arrow
+    /// Jacobian: see [`block_jacobian`](Self::block_jacobian) and
+    /// [`dense_jacobian`](Self::dense_jacobian)).
     pub jacobian: Vec<f64>,
+    /// The block-arrow Jacobian at `p` when the problem evaluated one
+    /// ([`Jacobian::Blocks`]; `None` for a dense fit).
+    pub block_jacobian: Option<BlockJacobian>,
     /// Trial steps done (accepted + rejected).
     pub iterations: usize,
     /// Accepted steps.
@@ -370,8 +404,16 @@ impl FitResult {
     /// robust cost (the rescaled Jacobian of [`loss`]) and `B = Σ (ρ'ᵢ rᵢ)² JᵢᵀJᵢ` the spread of
     /// the per-residual gradients; it needs no noise level and stays valid when the residuals
     /// are not Gaussian.
+    ///
+    /// A block-arrow fit ([`block_jacobian`](Self::block_jacobian)) computes it through the
+    /// Schur complement ([`block_covariance`](Self::block_covariance)) and returns the dense
+    /// `P × P` matrix assembled from it; [`standard_errors`](Self::standard_errors) and
+    /// [`block_covariance`](Self::block_covariance) never form it.
     pub fn covariance(&self) -> Option<Vec<f64>> {
         let np = self.p.len();
+        if self.block_jacobian.is_some() {
+            return Some(self.block_covariance()?.to_dense());
+        }
         if !self.loss.is_linear() {
             return self.sandwich_covariance();
         }
@@ -405,9 +447,44 @@ impl FitResult {
         Some((0..np * np).map(|i| cov[(i / np, i % np)]).collect())
     }
 
-    /// Standard errors of the parameters.
+    /// The covariance of a block-arrow fit in compact form (shared block, per-block local
+    /// blocks and what couples them; linear in the number of blocks): `σ² (JᵀJ)⁻¹` or the
+    /// sandwich as for [`covariance`](Self::covariance). `None` for a dense fit or a singular
+    /// `JᵀJ`.
+    pub fn block_covariance(&self) -> Option<BlockCovariance> {
+        let bj = self.block_jacobian.as_ref()?;
+        if self.loss.is_linear() {
+            return BlockCovariance::linear(bj, self.residual_variance());
+        }
+        let nr = self.residuals.len();
+        let w = loss::weights(self.loss, self.f_scale, &self.residuals);
+        let weights: Vec<f64> = w.iter().map(|(_, wi)| *wi).collect();
+        let psi: Vec<f64> = w
+            .iter()
+            .zip(&self.residuals)
+            .map(|((d1, _), ri)| d1 * ri)
+            .collect();
+        let dof = nr.saturating_sub(self.p.len()).max(1) as f64;
+        BlockCovariance::sandwich(bj, &weights, &psi, nr as f64 / dof)
+    }
+
+    /// The Jacobian at `p`, dense row-major `N × P` (a copy of [`jacobian`](Self::jacobian),
+    /// or the block-arrow Jacobian expanded: `N · P` numbers).
+    pub fn dense_jacobian(&self) -> Vec<f64> {
+        match &self.block_jacobian {
+            Some(b) => b.to_dense(),
+            None => self.jacobian.clone(),
+        }
+    }
+
+    /// Standard errors of the parameters (a block-arrow fit: from the compact covariance,
+    /// without the `P × P` matrix).
     pub fn standard_errors(&self) -> Option<Vec<f64>> {
         let np = self.p.len();
+        if self.block_jacobian.is_some() {
+            let v = self.block_covariance()?.variances();
+            return Some(v.into_iter().map(|x| x.max(0.0).sqrt()).collect());
+        }
         let c = self.covariance()?;
         Some((0..np).map(|i| c[i * np + i].max(0.0).sqrt()).collect())
     }
@@ -536,10 +613,10 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
     if !loose_start {
         problem.set_accuracy(None);
     }
-    let start = match problem.evaluate(&p) {
+    let start = match problem.evaluate_jacobian(&p) {
         Err(_) if loose_start => {
             problem.set_accuracy(None);
-            problem.evaluate(&p)
+            problem.evaluate_jacobian(&p)
         }
         other => other,
     };
@@ -550,6 +627,11 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
     contract::check_start(&r, &jac, np, &p)?;
     problem.accept(&p);
     let nr = r.len();
+    if !jac.has_shape(nr, np) {
+        return Err(FitError::InvalidInput(format!(
+            "the problem returned {nr} residuals and a Jacobian that is not {nr} x {np}"
+        )));
+    }
     if nr < np {
         return Err(FitError::InvalidInput(format!(
             "{nr} residuals for {np} parameters: the fit is underdetermined"
@@ -557,7 +639,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
     }
     let (loss, f_scale) = (options.loss, options.f_scale);
     // the Gauss–Newton view (rescaled under a robust loss; `None`: `r`, `jac` themselves)
-    let mut scaled = loss::rescale(loss, f_scale, &r, &jac, np);
+    let mut scaled = jac.rescaled(loss, f_scale, &r, np);
     let mut cost = loss::robust_cost(loss, f_scale, &r);
     let mut radius = options.initial_radius.min(options.max_radius);
     let mut history = Vec::new();
@@ -587,16 +669,16 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             loose = false;
             problem.set_accuracy(None);
             let (r_t, j_t) =
-                contract::check_trial(problem.evaluate(&p), np, nr, &p)?.map_err(|cause| {
-                    FitError::RefineFailed {
+                contract::check_trial(problem.evaluate_jacobian(&p), np, nr, &p)?.map_err(
+                    |cause| FitError::RefineFailed {
                         p: p.clone(),
                         cause,
-                    }
-                })?;
+                    },
+                )?;
             problem.accept(&p);
             let d2: f64 = r_t.iter().zip(&r).map(|(a, b)| (a - b) * (a - b)).sum();
             switch_model_error = Some((d2 / nr as f64).sqrt());
-            scaled = loss::rescale(loss, f_scale, &r_t, &j_t, np);
+            scaled = j_t.rescaled(loss, f_scale, &r_t, np);
             cost = loss::robust_cost(loss, f_scale, &r_t);
             r = r_t;
             jac = j_t;
@@ -608,12 +690,11 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             );
         }
         let (r_gn, jac_gn) = match &scaled {
-            Some((rs, js)) => (rs.as_slice(), js.as_slice()),
-            None => (r.as_slice(), jac.as_slice()),
+            Some((rs, js)) => (rs.as_slice(), js),
+            None => (r.as_slice(), &jac),
         };
-        let jm = DMatrix::from_row_slice(nr, np, jac_gn);
-        let rv = DVector::from_column_slice(r_gn);
-        let g = jm.transpose() * &rv;
+        let lin = Linearized::new(jac_gn, r_gn, nr, np);
+        let g = lin.gradient();
         let v = cl_scaling(&p, g.as_slice(), lo, hi);
         let scaled_g = (0..np).map(|i| (g[i] * v[i]).abs()).fold(0.0, f64::max);
         if scaled_g <= options.gtol {
@@ -629,7 +710,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             continue;
         }
         let d: Vec<f64> = v.iter().map(|x| 1.0 / x.sqrt()).collect();
-        let s = trust_region_step(&jm, &rv, &d, radius);
+        let s = lin.step(&d, radius);
         // keep strictly inside the box
         let mut t_max = 1.0f64;
         for i in 0..np {
@@ -650,8 +731,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         }
         let step: Vec<f64> = (0..np).map(|i| trial[i] - p[i]).collect();
         let step_vec = DVector::from_column_slice(&step);
-        let jr = &jm * &step_vec;
-        let pred_trial = -(jr.dot(&rv) + 0.5 * jr.norm_squared());
+        let pred_trial = lin.predicted_reduction(&step_vec);
         // Accuracy::Scheduled: the step's length in standard errors, ‖J s‖/σ̂, with σ̂ the RMS
         // residual (at most the soft margin under a robust loss)
         let (sigma, effect) = match schedule {
@@ -661,7 +741,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                 if !loss.is_linear() {
                     sigma = sigma.min(f_scale);
                 }
-                let effect = (&DMatrix::from_row_slice(nr, np, &jac) * &step_vec).norm();
+                let effect = jac.effect(&step_vec, nr, np);
                 (sigma, effect)
             }
             None => (f64::NAN, f64::NAN),
@@ -690,7 +770,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
         iterations += 1;
         let pnorm = p.iter().map(|x| x * x).sum::<f64>().sqrt();
         let snorm = step_vec.norm();
-        match contract::check_trial(problem.evaluate(&trial), np, nr, &trial)? {
+        match contract::check_trial(problem.evaluate_jacobian(&trial), np, nr, &trial)? {
             Ok((r_new, j_new)) => {
                 let cost_new = loss::robust_cost(loss, f_scale, &r_new);
                 let actual = cost - cost_new;
@@ -726,7 +806,7 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
                     accepted_steps += 1;
                     let rel_change = actual.abs() / cost.max(1e-300);
                     p = trial;
-                    scaled = loss::rescale(loss, f_scale, &r_new, &j_new, np);
+                    scaled = j_new.rescaled(loss, f_scale, &r_new, np);
                     r = r_new;
                     jac = j_new;
                     cost = cost_new;
@@ -763,11 +843,16 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             }
         }
     }
+    let (jacobian, block_jacobian) = match jac {
+        Jacobian::Dense(j) => (j, None),
+        Jacobian::Blocks(b) => (Vec::new(), Some(b)),
+    };
     Ok(FitResult {
         p,
         cost,
         residuals: r,
-        jacobian: jac,
+        jacobian,
+        block_jacobian,
         iterations,
         accepted_steps,
         failed_evaluations: failed,

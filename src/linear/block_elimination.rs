@@ -270,6 +270,13 @@ fn eliminate_w<const W: usize>(
 }
 
 impl BlockLu {
+    /// Bytes of the factors on the heap.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        let f = self.blocks.len() + self.dinv.len() + self.last.len() + self.bc.len();
+        let u = self.piv.len() + self.last_piv.len() + self.left.len() + self.right.len();
+        8 * f + std::mem::size_of::<usize>() * u
+    }
+
     /// Number of carried (left boundary) rows `nL` of the current factorisation.
     #[cfg(test)]
     pub(crate) fn carried_rows(&self) -> usize {

@@ -72,6 +72,19 @@ impl std::fmt::Debug for Factorization {
 }
 
 impl Factorization {
+    /// Bytes of the factors on the heap: exact for the structured elimination; for the sparse LU
+    /// an estimate (three numbers per nonzero of the Newton matrix).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        match &self.inner {
+            Inner::Structured(b) => b.heap_bytes(),
+            Inner::Sparse(s) => {
+                let (n, k, m) = (s.pattern.n, s.pattern.k, s.pattern.m);
+                let nnz = (m - 1) * n * (2 * n + k) + (n + k) * (2 * n + k);
+                3 * 8 * nnz + 2 * std::mem::size_of::<usize>() * self.size
+            }
+        }
+    }
+
     /// Dimension of the factored system.
     pub fn size(&self) -> usize {
         self.size

@@ -18,6 +18,7 @@ mod flow_curve_intervals;
 mod independent_model;
 mod landscape;
 mod rheometer;
+mod rheometer_blocks;
 mod robust_statistics;
 mod smoothing;
 mod tolerance_schedule;

@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod block_least_squares;
 mod continuation;
 mod core_accuracy;
 mod least_squares;

@@ -58,7 +58,7 @@ pub(crate) fn discretisation_shift(
     }
     let dr = DVector::from_iterator(r.len(), r_fine.iter().zip(r).map(|(a, b)| a - b));
     let q = id.fit.p.len();
-    let shift = ParameterShift::new(&id.fit.jacobian, r.len(), q)?.derivative(&dr);
+    let shift = ParameterShift::new(&id.fit.dense_jacobian(), r.len(), q)?.derivative(&dr);
     let se = id
         .fit
         .standard_errors()

@@ -129,7 +129,8 @@ pub fn error_budget(
         plan.push(status);
     }
     let principled = id.summary.estimator == Estimator::Principled;
-    let (r, x, q) = (&id.fit.residuals, &id.fit.jacobian, id.fit.p.len());
+    let dense = id.fit.dense_jacobian();
+    let (r, x, q) = (&id.fit.residuals, &dense, id.fit.p.len());
     let n_res = r.len();
     // rows of each experiment
     let counts: Vec<usize> = (0..m)

@@ -10,10 +10,10 @@
 use super::data::Rheometer;
 use super::estimator::Estimator;
 use super::layout::{EffectSlot, FitStart};
-use super::options::{IdentifyOptions, RheometerError};
+use super::options::{FitProgress, IdentifyOptions, RheometerError};
 use super::summary::FitSummary;
 use super::summary_build::SummaryInput;
-use crate::least_squares::{fit, Accuracy, FitOptions, FitResult};
+use crate::least_squares::{fit_observed, Accuracy, FitIteration, FitOptions, FitResult};
 use crate::solution::Solution;
 use std::time::Instant;
 
@@ -114,7 +114,12 @@ impl Rheometer {
         if let Some(t) = warm.stop_tolerance {
             (fo.gtol, fo.xtol, fo.ftol) = (t, t, t);
         }
-        let fit_result = fit(&mut obj, &p0, &fo)?;
+        let mut observer = |it: &FitIteration| {
+            if let Some(hook) = &options.progress {
+                hook.report(&FitProgress::Iteration(it));
+            }
+        };
+        let fit_result = fit_observed(&mut obj, &p0, &fo, &mut observer)?;
         let solutions: Vec<Solution> = obj.solutions();
         let residual_profiles: Vec<(Vec<f64>, Vec<f64>)> = solutions
             .iter()

@@ -13,6 +13,7 @@
 //! * [`objective`]: the least-squares objective over all experiments (solved in parallel,
 //!   warm-started, exact Jacobians from forward sensitivities);
 //! * [`layout`]: which parameters are fitted (law, effect strengths, take-up factors);
+//! * [`plan`]: the time and memory a fit will take, measured on one experiment before it starts;
 //! * [`landscape`]: the cost on a grid (paper Fig. 4);
 //! * [`error_budget()`]: what the data cannot identify (process conditions, instrument,
 //!   material data) propagated through exact sensitivities into a systematic uncertainty;
@@ -45,6 +46,7 @@ mod summary_finding;
 pub mod summary_checks;
 mod summary_read;
 mod summary_text;
+pub mod plan;
 
 pub use data::Rheometer;
 pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
@@ -53,8 +55,9 @@ pub use flow_curve::{BandMethod, FlowCurve, FlowCurveOptions, FlowPoint, StrainR
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
-pub use options::{CarreauFiber, IdentifyOptions, RheometerError};
+pub use options::{CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError};
 pub use parameter_shift::ParameterShift;
+pub use plan::FitPlan;
 pub use profile::{
     NewtonianTest, OneSidedBound, ProfileInterval, ProfileMode, ProfilePoint, ThinningBound,
 };

@@ -7,15 +7,18 @@
 use super::data::Rheometer;
 use super::estimator::{Estimator, PaperResidual, RelativeResidual};
 use super::layout::{FitStart, Layout};
-use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
+use super::options::{CarreauFiber, FitProgress, IdentifyOptions, RheometerError};
 use crate::fiber::error::FiberError;
 use crate::fiber::simulate::{simulate_params, Simulator};
-use crate::least_squares::{BvpResiduals, BvpRun, LeastSquaresProblem, ParamMap, RunError};
+use crate::least_squares::{
+    BvpResiduals, BvpRun, Jacobian, LeastSquaresProblem, ParamMap, RunError,
+};
 use crate::sensitivity::PointFunction;
 use crate::solution::Solution;
 use crate::solve::{Guess, Solver};
 use num_dual::DualNum;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The residual of one experiment at its evaluation points: the estimator's residual with the
 /// experiment's data (owned, so that a [`BvpRun`] can hold it).
@@ -123,6 +126,7 @@ impl<'a> Objective<'a> {
             .unwrap_or(1.0);
         let estimator = options.estimator;
         let ns = layout.num_shared();
+        let simulated = AtomicUsize::new(0);
         let runs: Result<Vec<BvpRun<'a, CarreauFiber, FiberResidual<'a>>>, RheometerError> = rheo
             .models
             .par_iter()
@@ -158,6 +162,13 @@ impl<'a> Objective<'a> {
                         None,
                     ),
                 };
+                if let Some(hook) = &options.progress {
+                    let done = simulated.fetch_add(1, Ordering::Relaxed) + 1;
+                    hook.report(&FitProgress::Simulated {
+                        done,
+                        total: rheo.len(),
+                    });
+                }
                 let lo = model.scaling.reference.length;
                 let dd = model.scaling.diameter();
                 let length = rheo.experiments[k].spinline_length;
@@ -211,8 +222,15 @@ impl<'a> Objective<'a> {
         };
         let mut fit = BvpResiduals::new(num_params);
         fit.set_loose_tolerance(options.loose_tolerance);
+        fit.set_thread_workspaces(true);
         for run in runs? {
             fit.push(run)
+                .map_err(|e| RheometerError::Data(format!("parameter layout: {e}")))?;
+        }
+        if estimator == Estimator::Principled {
+            // the take-up factors are the experiments' own parameters: block-arrow normal
+            // equations, solved through the Schur complement (linear in the experiments)
+            fit.declare_blocks(Some(ns))
                 .map_err(|e| RheometerError::Data(format!("parameter layout: {e}")))?;
         }
         Ok(Objective {
@@ -427,6 +445,11 @@ impl LeastSquaresProblem for Objective<'_> {
     }
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), RheometerError> {
         self.eval(p, true)
+    }
+    fn evaluate_jacobian(&mut self, p: &[f64]) -> Result<(Vec<f64>, Jacobian), RheometerError> {
+        self.runs
+            .evaluate_jacobian_from(p, None)
+            .map_err(|e| self.run_error(p, e))
     }
     fn accept(&mut self, _p: &[f64]) {
         self.runs.accept_pending();

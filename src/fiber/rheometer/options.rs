@@ -9,9 +9,10 @@ use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::simulate::SimulateOptions;
 use crate::fiber::smoothing::SmoothingError;
-use crate::least_squares::{FitError, Loss};
+use crate::least_squares::{FitError, FitIteration, Loss};
 use serde::{Deserialize, Serialize};
 use std::fmt;
+use std::sync::Arc;
 use thiserror::Error;
 
 /// The fiber model the rheometer identifies: Carreau-type law (a Newtonian model is `n = 1`),
@@ -101,6 +102,48 @@ pub struct IdentifyOptions {
     /// effect's name, `"effect.shape"`) with the value in model-parameter units (the profile
     /// likelihood's refits; default none).
     pub hold: Vec<(String, f64)>,
+    /// Called as the identification goes on ([`FitProgress`]: the experiments simulated at the
+    /// start point, then every trial step of the fit), e.g. to draw a progress bar for a large
+    /// fit ([`Rheometer::plan`](super::Rheometer::plan) says beforehand how long it will take).
+    /// `None` (default): nothing reported.
+    pub progress: Option<ProgressHook>,
+}
+
+/// What a running identification reports to [`IdentifyOptions::progress`].
+#[derive(Debug, Clone, Copy)]
+pub enum FitProgress<'a> {
+    /// `done` of `total` experiments simulated at the start point (cold starts, in parallel:
+    /// reported from the worker threads, in completion order).
+    Simulated {
+        /// Experiments done so far.
+        done: usize,
+        /// All experiments.
+        total: usize,
+    },
+    /// One trial step of the least-squares fit done (accepted, rejected or failed).
+    Iteration(&'a FitIteration),
+}
+
+/// A callback for [`IdentifyOptions::progress`]; called from worker threads, so `Send + Sync`.
+#[derive(Clone)]
+pub struct ProgressHook(pub Arc<dyn Fn(&FitProgress<'_>) + Send + Sync>);
+
+impl ProgressHook {
+    /// A hook calling `f`.
+    pub fn new(f: impl Fn(&FitProgress<'_>) + Send + Sync + 'static) -> Self {
+        ProgressHook(Arc::new(f))
+    }
+
+    /// Reports `event`.
+    pub fn report(&self, event: &FitProgress<'_>) {
+        (self.0)(event)
+    }
+}
+
+impl fmt::Debug for ProgressHook {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("ProgressHook(..)")
+    }
 }
 
 impl Default for IdentifyOptions {
@@ -126,6 +169,7 @@ impl Default for IdentifyOptions {
             noise_factors: None,
             cancel: None,
             hold: Vec::new(),
+            progress: None,
         }
     }
 }
