@@ -129,11 +129,11 @@ fn main() -> Result<(), Box<dyn Error>> {
     );
     println!(
         "n = {:.6} +/- {:.6}, kappa = {:.5} +/- {:.5}, RMS {:.4} %",
-        id.n,
+        id.summary.n.value,
         se[0],
-        id.kappa,
+        id.summary.kappa.value,
         se[1],
-        100.0 * id.rms_relative_residual
+        100.0 * id.summary.rms_relative_residual
     );
     println!("time: data {t_data:.2} s, fit {t_fit:.2} s, standard errors {t_se:.3} s");
     Ok(())

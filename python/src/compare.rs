@@ -75,8 +75,7 @@ pub fn compare<'py>(
         }
     };
     request.with = options::effects(&effects)?;
-    request.relative_uncertainty =
-        options::fraction("relative_uncertainty", relative_uncertainty)?;
+    request.relative_uncertainty = options::fraction("relative_uncertainty", relative_uncertainty)?;
     request.simulate.max_nodes = options::max_nodes(max_nodes)?;
     if let Some(t) = options::tol(tol)? {
         request.simulate.tol = t;
@@ -86,8 +85,8 @@ pub fn compare<'py>(
     let (loaded, path) = dataset.data();
     // the comparison checks no cancellation flag: Ctrl-C is raised once it has finished
     let out = interruptible(py, |_cancel| workflow::compare(loaded, &request))?;
-    let cmp = out
-        .map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), Some(request.law)))?;
+    let cmp =
+        out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), Some(request.law)))?;
     let d = PyDict::new(py);
     d.set_item("comparison", serde_to_py(py, &cmp)?)?;
     d.set_item("text", cmp.to_text())?;

@@ -130,3 +130,43 @@ pub fn to_py_err(
     }
     err
 }
+
+/// An error captured on a worker thread in a form that may cross back to Python's thread
+/// (the library's errors hold `Box<dyn Error>` causes, which are not `Send`): the exception
+/// kind, the CLI's text and, for a failed experiment, its name, place and hints.
+pub struct CapturedError {
+    kind: &'static str,
+    text: String,
+    experiment: Option<(String, String, Option<usize>, Vec<String>)>,
+}
+
+impl CapturedError {
+    /// Captures `e` (after naming its experiment as [`to_py_err`] does).
+    pub fn capture(e: &(dyn Error + 'static)) -> Self {
+        CapturedError {
+            kind: kind_of(e),
+            text: cli_text(e),
+            experiment: e.downcast_ref::<ExperimentFailure>().map(|f| {
+                (
+                    f.experiment.clone(),
+                    f.at.path.display().to_string(),
+                    f.at.line,
+                    f.hints.clone(),
+                )
+            }),
+        }
+    }
+
+    /// The Python exception.
+    pub fn into_py(self, py: Python<'_>) -> PyErr {
+        let err = diffbvp_error(py, self.kind, self.text);
+        if let Some((experiment, path, line, hints)) = self.experiment {
+            let v = err.value(py);
+            let _ = v.setattr("experiment", experiment);
+            let _ = v.setattr("path", path);
+            let _ = v.setattr("line", line);
+            let _ = v.setattr("hints", hints);
+        }
+        err
+    }
+}

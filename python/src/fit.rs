@@ -61,7 +61,10 @@ pub fn identification_arrays<'py>(
             let fs = FiberSolution {
                 solution: sol.clone(),
             };
-            pd.set_item(name, profiles_dict(py, &fs.uniform_profiles(model, points))?)?;
+            pd.set_item(
+                name,
+                profiles_dict(py, &fs.uniform_profiles(model, points))?,
+            )?;
         }
         d.set_item("profiles", pd)?;
     }

@@ -4,7 +4,7 @@
 
 use crate::convert::array2;
 use crate::dataset::Dataset;
-use crate::errors::{input_error, to_py_err};
+use crate::errors::{input_error, CapturedError};
 use crate::fit::profiles_dict;
 use crate::options;
 use crate::run::interruptible;
@@ -114,13 +114,17 @@ pub fn simulate<'py>(
                 ControlFlow::Continue(())
             }
         })
+        // the failure crosses back from the worker thread as text and attributes
+        .map_err(|e| match e {
+            SimulateError::Experiment(f) => Err(CapturedError::capture(f.as_ref())),
+            SimulateError::Stopped { .. } => Ok(None),
+            other => Ok(Some(other.to_string())),
+        })
     })?;
     let runs = out.map_err(|e| match e {
-        SimulateError::Experiment(f) => to_py_err(py, Box::new(f), None, None),
-        SimulateError::Stopped { .. } => {
-            pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted")
-        }
-        other => input_error(other.to_string()),
+        Err(captured) => captured.into_py(py),
+        Ok(None) => pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted"),
+        Ok(Some(message)) => input_error(message),
     })?;
     let d = PyDict::new(py);
     d.set_item("law", (law[0], law[1]))?;

@@ -450,7 +450,6 @@ impl Effect {
         Ok(self)
     }
 
-
     /// Name of the model parameter (in [`FiberModel::param_names`](crate::fiber::FiberModel::param_names))
     /// that carries the strength.
     pub fn model_param(&self) -> &'static str {

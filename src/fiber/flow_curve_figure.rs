@@ -16,7 +16,11 @@ use std::path::Path;
 const SIZE: (u32, u32) = (1000, 700);
 
 /// `(log10 ε̇, y)` of the points selected by `keep`, broken (a `NaN` point) where a run ends.
-fn runs(curve: &FlowCurve, keep: impl Fn(usize) -> bool, y: impl Fn(usize) -> f64) -> Vec<(f64, f64)> {
+fn runs(
+    curve: &FlowCurve,
+    keep: impl Fn(usize) -> bool,
+    y: impl Fn(usize) -> f64,
+) -> Vec<(f64, f64)> {
     let mut out = Vec::new();
     let mut open = false;
     for (i, p) in curve.points.iter().enumerate() {
@@ -43,7 +47,8 @@ fn bounds(curve: &FlowCurve, band: impl Fn(usize) -> [f64; 2]) -> Vec<(f64, f64)
 pub fn save_flow_curve_figure(path: &Path, curve: &FlowCurve) -> Result<(), PlotError> {
     let pts = &curve.points;
     let title = format!("Elongational viscosity at {} K", fmt_g(curve.temperature_k));
-    let mut panel = Panel::new(title, "log10(strain rate / (1/s))", "eta_E / (Pa s)").with_log_y(true);
+    let mut panel =
+        Panel::new(title, "log10(strain rate / (1/s))", "eta_E / (Pa s)").with_log_y(true);
     panel = panel.with_series(
         Series::line(
             "identified law (data range)",
@@ -93,7 +98,8 @@ pub fn save_flow_curve_figure(path: &Path, curve: &FlowCurve) -> Result<(), Plot
         .iter()
         .filter_map(|&r| curve.nearest(r).map(|p| (r.log10(), p.eta_pa_s)))
         .collect();
-    panel = panel.with_series(Series::new("ends of the data's range", ends, Style::Rings).with_color(4));
+    panel = panel
+        .with_series(Series::new("ends of the data's range", ends, Style::Rings).with_color(4));
     for (k, iso) in curve.isotherms.iter().enumerate() {
         let pts: Vec<(f64, f64)> = curve
             .points

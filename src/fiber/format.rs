@@ -104,7 +104,10 @@ fn at_place(v: f64, place: i32) -> String {
     };
     let t = format!("{r:.decimals$}");
     // no "-0"
-    if t.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+    if t.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
         t.trim_start_matches('-').to_string()
     } else {
         t

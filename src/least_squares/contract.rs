@@ -165,12 +165,7 @@ fn check_blocks(r: &[f64], b: &super::BlockJacobian, np: usize) -> Result<(), Br
 
 /// Checks the start point's evaluation: any breach is an error
 /// ([`FitError::InvalidInput`]), since there is no accepted point to fall back on.
-pub(super) fn check_start(
-    r: &[f64],
-    jac: &Jacobian,
-    np: usize,
-    p: &[f64],
-) -> Result<(), FitError> {
+pub(super) fn check_start(r: &[f64], jac: &Jacobian, np: usize, p: &[f64]) -> Result<(), FitError> {
     match check_evaluation(r, jac, np, None) {
         Ok(()) => Ok(()),
         Err(Breach::Size(m)) => Err(FitError::InvalidInput(format!(

@@ -668,13 +668,11 @@ pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
             // re-evaluate the iterate at full accuracy and go on from there
             loose = false;
             problem.set_accuracy(None);
-            let (r_t, j_t) =
-                contract::check_trial(problem.evaluate_jacobian(&p), np, nr, &p)?.map_err(
-                    |cause| FitError::RefineFailed {
-                        p: p.clone(),
-                        cause,
-                    },
-                )?;
+            let (r_t, j_t) = contract::check_trial(problem.evaluate_jacobian(&p), np, nr, &p)?
+                .map_err(|cause| FitError::RefineFailed {
+                    p: p.clone(),
+                    cause,
+                })?;
             problem.accept(&p);
             let d2: f64 = r_t.iter().zip(&r).map(|(a, b)| (a - b) * (a - b)).sum();
             switch_model_error = Some((d2 / nr as f64).sqrt());

@@ -10,14 +10,13 @@
 //! [`GUIDE_DRAG`] (unit mN, process category, ranges, independent check) and the term
 //! [`GuideDrag`] (1 mN against the motion per unit strength).
 
-
+use crate::independent::line_force::LineForce;
+use crate::independent::scenarios::{self, NOISE_SD};
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
 use diffbvp::fiber::effects::{Category, Effect, EffectDescriptor, LawChoice, ModelSpec};
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::{Balance, FiberTerm, SiState};
 use diffbvp::DualNum;
-use crate::independent::line_force::LineForce;
-use crate::independent::scenarios::{self, NOISE_SD};
 use std::f64::consts::PI;
 
 /// Where the guide sits \[m\] and the width of its contact \[m\].
@@ -84,27 +83,27 @@ fn a_user_written_candidate_is_found_and_ranked_first() {
     assert_eq!(c.effect, "guide_drag");
     assert_eq!(c.unit, "mN");
     assert!(
-        (c.strength - TRUE_DRAG_MN).abs() <= 3.0 * c.stderr_strength,
+        (c.strength() - TRUE_DRAG_MN).abs() <= 3.0 * c.stderr_strength(),
         "guide_drag = {} ± {} mN, truth {TRUE_DRAG_MN}",
-        c.strength,
-        c.stderr_strength
+        c.strength(),
+        c.stderr_strength()
     );
-    assert!(c.refitted && c.extra_parameters == 1);
+    assert!(c.refitted() && c.extra_parameters == 1);
     // the descriptor's ranges reach the record
     assert_eq!(c.physical_range, [0.0, 10.0]);
     assert_eq!(c.search_range, [-2.0, 20.0]);
     // the refit's residuals are at the noise level and cover the true law
-    let ratio = c.rms_relative_residual_after / NOISE_SD;
+    let ratio = c.rms_relative_residual_after() / NOISE_SD;
     assert!((ratio - 1.0).abs() <= 0.2, "RMS after / noise = {ratio}");
     assert!(
-        c.ci95_n[0] <= sc.law.n && sc.law.n <= c.ci95_n[1],
+        c.ci95_n()[0] <= sc.law.n && sc.law.n <= c.ci95_n()[1],
         "{:?}",
-        c.ci95_n
+        c.ci95_n()
     );
     assert!(
-        c.ci95_kappa[0] <= sc.law.kappa && sc.law.kappa <= c.ci95_kappa[1],
+        c.ci95_kappa()[0] <= sc.law.kappa && sc.law.kappa <= c.ci95_kappa()[1],
         "{:?}",
-        c.ci95_kappa
+        c.ci95_kappa()
     );
     // its detection limit is reported in its unit and category
     let limit = d

@@ -16,12 +16,12 @@ use crate::probe;
 
 use diffbvp::fiber::effects::{Effect, EffectSetting, ModelSpec};
 use diffbvp::fiber::input::{load_experiments_with, parse_experiments, LoadedExperiments};
+use diffbvp::fiber::rheometer::summary_checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 use diffbvp::fiber::rheometer::{
     error_budget, ErrorBudget, Identification, IdentifyOptions, Rheometer, SourceStatus,
     WarningCode,
 };
 use diffbvp::fiber::setup::{ExperimentSet, Inlet};
-use diffbvp::fiber::rheometer::summary_checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 use diffbvp::fiber::uncertainty::{Origin, Scope, Uncertainties};
 use serde_json::Value;
 use std::path::Path;
@@ -541,7 +541,8 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
     let stat_n = b["statistical_n"].as_f64().unwrap();
     let sys = b["systematic_kappa"].as_f64().unwrap();
     let sys_n = b["systematic_n"].as_f64().unwrap();
-    let dominates = (sys > stat && sys > LARGE_STDERR_KAPPA) || (sys_n > stat_n && sys_n > LARGE_STDERR_N);
+    let dominates =
+        (sys > stat && sys > LARGE_STDERR_KAPPA) || (sys_n > stat_n && sys_n > LARGE_STDERR_N);
     let warned = v["warnings"]
         .as_array()
         .unwrap()
@@ -549,10 +550,14 @@ fn cli_prints_the_budget_in_words_and_writes_it_to_json() {
         .any(|w| w["code"] == "systematic");
     assert_eq!(warned, dominates, "{}", v["warnings"]);
     assert!(!warned, "{}", v["warnings"]);
-    assert!(sys > stat, "the defaults still exceed the statistical error: {sys} vs {stat}");
+    assert!(
+        sys > stat,
+        "the defaults still exceed the statistical error: {sys} vs {stat}"
+    );
     // the systematic uncertainty is quoted beside the estimates instead
     assert!(
-        p.stdout.contains("systematic (error budget, one standard uncertainty): n ± "),
+        p.stdout
+            .contains("systematic (error budget, one standard uncertainty): n ± "),
         "{}",
         p.stdout
     );

@@ -177,7 +177,11 @@ fn a_kappa_at_its_lower_bound_is_marked_and_gets_no_interval() {
     );
     assert_eq!(p.stdout.matches("WARNING [at_bound] kappa").count(), 1);
     assert!(!p.stderr.contains("[at_bound]"), "{}", p.stderr);
-    assert!(p.stderr.contains("warning(s) in the report above"), "{}", p.stderr);
+    assert!(
+        p.stderr.contains("warning(s) in the report above"),
+        "{}",
+        p.stderr
+    );
 }
 
 #[test]

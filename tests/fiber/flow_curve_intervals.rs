@@ -6,15 +6,14 @@
 //! report's text (no warnings on the clean shipped data, lines of at most 100 characters,
 //! numbers rounded to their uncertainty).
 
-
+use crate::independent::rng::Rng;
+use crate::independent::scenarios;
 use diffbvp::fiber::effects::LawChoice;
 use diffbvp::fiber::flow_curve_figure::save_flow_curve_figure;
 use diffbvp::fiber::format::{fmt_pm, LINE_WIDTH};
 use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
 use diffbvp::fiber::rheometer::{BandMethod, FitSummary, IdentifyOptions};
 use diffbvp::fiber::workflow::{fit, FitRequest, FitRun};
-use crate::independent::rng::Rng;
-use crate::independent::scenarios;
 use std::path::Path;
 use std::time::Duration;
 
@@ -89,7 +88,10 @@ fn the_band_at_the_median_rate_agrees_with_a_monte_carlo_over_the_covariance() {
          ratio {ratio:.4}",
         p.strain_rate_per_s
     );
-    assert!((ratio - 1.0).abs() < 0.10, "delta {delta} vs Monte Carlo {mc}");
+    assert!(
+        (ratio - 1.0).abs() < 0.10,
+        "delta {delta} vs Monte Carlo {mc}"
+    );
     // the systematic band is wider than nothing and the total contains the statistical one
     assert!(p.sys95_pa_s[1] > p.eta_pa_s && p.total95_pa_s[1] >= p.stat95_pa_s[1]);
     // the covered range is marked: points inside are not extrapolated, a decade beyond are
@@ -128,13 +130,18 @@ fn profile_intervals_agree_with_the_linearised_ones_on_the_shipped_data() {
             hi,
             i.points.len() - 1
         );
-        assert!((lo - 1.0).abs() < 0.10 && (hi - 1.0).abs() < 0.10, "{lo} {hi}");
+        assert!(
+            (lo - 1.0).abs() < 0.10 && (hi - 1.0).abs() < 0.10,
+            "{lo} {hi}"
+        );
     }
     let t = s.newtonian_test.as_ref().unwrap();
     println!("LR | shipped: LR {:.1}, p {:.3e}", t.statistic, t.p_value);
     assert_eq!(t.preferred, LawChoice::Carreau);
     assert!(t.p_value < 1e-6);
-    assert!(s.law_finding().starts_with("strain thinning detected for strain rates"));
+    assert!(s
+        .law_finding()
+        .starts_with("strain thinning detected for strain rates"));
     // the JSON reads back with the new fields
     let back = FitSummary::from_json(&serde_json::to_string(s).unwrap(), "fit.json").unwrap();
     assert_eq!(back.intervals, s.intervals);
@@ -145,7 +152,7 @@ fn profile_intervals_agree_with_the_linearised_ones_on_the_shipped_data() {
 
 /// Generates `sc`, fits it and checks what the report says about a melt without detectable
 /// strain thinning; returns the summary.
-fn no_thinning_case(sc: &independent::dataset::Scenario, fig: &Path) -> FitSummary {
+fn no_thinning_case(sc: &crate::independent::dataset::Scenario, fig: &Path) -> FitSummary {
     let generated = sc.generate().unwrap();
     let data = load_experiments_with(&generated.toml, 4).unwrap();
     let run = fit_of(&data);
@@ -167,7 +174,10 @@ fn no_thinning_case(sc: &independent::dataset::Scenario, fig: &Path) -> FitSumma
         bound.map(|b| b.k_max_pa),
         n.ci95,
         n.reasons,
-        s.intervals.iter().map(|i| i.points.len() - 1).sum::<usize>()
+        s.intervals
+            .iter()
+            .map(|i| i.points.len() - 1)
+            .sum::<usize>()
             + bound.map_or(0, |b| b.points.len() - 1)
     );
     // the Newtonian law is preferred by the likelihood-ratio test
@@ -178,7 +188,10 @@ fn no_thinning_case(sc: &independent::dataset::Scenario, fig: &Path) -> FitSumma
     assert!(b.n_lower95 > 0.0 && b.n_lower95 < 1.0, "{b:?}");
     // the report says so, in the result section
     let finding = s.law_finding();
-    assert!(finding.starts_with("no strain thinning detected for strain rates"), "{finding}");
+    assert!(
+        finding.starts_with("no strain thinning detected for strain rates"),
+        "{finding}"
+    );
     assert!(finding.contains("needs n > ") && finding.contains("the Newtonian law fits as well"));
     let result: String = text.lines().take(10).collect::<Vec<_>>().join("\n");
     assert!(result.contains("no strain thinning detected"), "{result}");
@@ -202,7 +215,10 @@ fn no_thinning_case(sc: &independent::dataset::Scenario, fig: &Path) -> FitSumma
 #[test]
 fn a_newtonian_melt_gets_a_one_sided_bound_and_the_newtonian_law_preferred() {
     let dir = crate::probe::scratch("fc_newtonian");
-    let s = no_thinning_case(&scenarios::newtonian(), &dir.join("flow_curve_newtonian.png"));
+    let s = no_thinning_case(
+        &scenarios::newtonian(),
+        &dir.join("flow_curve_newtonian.png"),
+    );
     // the flat curve: within 2 % of the plateau over the covered rates
     let c = s.flow_curve.as_ref().unwrap();
     for p in c.points.iter().filter(|p| !p.extrapolated) {
@@ -224,7 +240,12 @@ fn the_fit_report_on_the_shipped_data_reads_well_and_writes_the_flow_curve() {
     let (dir, toml, data) = crate::probe::shipped_copy("fc_cli");
     let out = dir.join("out");
     let p = crate::probe::rheometer(
-        &["fit", crate::probe::s(&toml), "--out", crate::probe::s(&out)],
+        &[
+            "fit",
+            crate::probe::s(&toml),
+            "--out",
+            crate::probe::s(&out),
+        ],
         &[&data],
         Duration::from_secs(120),
     );
@@ -232,7 +253,11 @@ fn the_fit_report_on_the_shipped_data_reads_well_and_writes_the_flow_curve() {
     println!("{}", p.stdout);
     // no warnings on the clean shipped data (default uncertainties), once nowhere
     assert!(p.stdout.contains("    warnings: none\n"), "{}", p.stdout);
-    assert!(!p.stdout.contains("WARNING") && !p.stderr.contains("warning"), "{}", p.stderr);
+    assert!(
+        !p.stdout.contains("WARNING") && !p.stderr.contains("warning"),
+        "{}",
+        p.stderr
+    );
     assert_lines_fit(&p.stdout);
     assert_lines_fit(&std::fs::read_to_string(out.join("fit_report.txt")).unwrap());
     // numbers rounded to their uncertainty: the law as value ± error with the error's digits
@@ -249,7 +274,11 @@ fn the_fit_report_on_the_shipped_data_reads_well_and_writes_the_flow_curve() {
         assert!(line.contains(&words), "{words:?} not in {line}");
     }
     // and no full-precision float anywhere in the result section
-    let result: Vec<&str> = p.stdout.lines().take_while(|l| !l.starts_with("[[Fit")).collect();
+    let result: Vec<&str> = p
+        .stdout
+        .lines()
+        .take_while(|l| !l.starts_with("[[Fit"))
+        .collect();
     for l in &result {
         for w in l.split(|c: char| !(c.is_ascii_digit() || c == '.')) {
             let decimals = w.split_once('.').map_or(0, |(_, d)| d.len());

@@ -5,7 +5,6 @@
 //! wandered around one mesh size and stopped with "tolerance not met after 40 mesh
 //! iterations" on 15 of the 26 cases scipy solves.
 
-
 use crate::common::{oscillatory_linear_exact, Oscillatory, OscillatoryKind};
 use diffbvp::mesh::{linspace, MeshOptions};
 use diffbvp::{solve, BvpError, Guess, Solution, SolveOptions};

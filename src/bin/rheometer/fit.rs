@@ -125,7 +125,10 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     }
     for (what, e) in [
         ("error budget", &run.budget_error),
-        ("profile intervals and likelihood-ratio test", &run.profile_error),
+        (
+            "profile intervals and likelihood-ratio test",
+            &run.profile_error,
+        ),
         ("flow curve", &run.flow_curve_error),
     ] {
         if let Some(e) = e {

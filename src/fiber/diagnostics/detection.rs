@@ -241,12 +241,7 @@ impl DetectionLimits {
         );
         s.push_str(&format!(
             "    {:<22} {:<9} {:>13} {:>13}  {:<17} {}\n",
-            "effect",
-            "category",
-            "detected 50 %",
-            "detected 95 %",
-            "shift n at s95",
-            "shift kappa"
+            "effect", "category", "detected 50 %", "detected 95 %", "shift n at s95", "shift kappa"
         ));
         let shift = |v: Option<f64>, se: Option<f64>| match (v, se) {
             (Some(v), Some(se)) => format!("{:+.4} ({se:.1} se)", v),

@@ -290,6 +290,22 @@ fn probability(p: f64) -> String {
 
 impl Diagnosis {
     /// The verdict in words (see [`Verdict`]).
+    /// "; noise level re-estimated with them: x %" where the verdict's noise level is below the
+    /// user's fit's (whose misfit inflated its estimate).
+    fn reestimated(&self, level: f64) -> String {
+        let base = self.base_fit.noise.level;
+        if level.is_finite() && level > 0.0 && level < 0.95 * base {
+            format!(
+                "; noise level {:.3} % re-estimated from these residuals (the {:.3} % of your \
+                 model's fit is inflated by its misfit)",
+                100.0 * level,
+                100.0 * base
+            )
+        } else {
+            String::new()
+        }
+    }
+
     fn verdict_text(&self) -> String {
         match &self.verdict {
             Verdict::Adequate => "VERDICT: the model is adequate for these data: the residuals \
@@ -298,16 +314,19 @@ impl Diagnosis {
             Verdict::Explained {
                 effects,
                 rms_over_noise,
+                noise_level,
             } => format!(
                 "VERDICT: explained by {}: with {} the residuals are at the noise (RMS/noise \
-                 {rms_over_noise:.2}, no structure left along the line).\n",
+                 {rms_over_noise:.2}, no structure left along the line){}.\n",
                 effects.join(" + "),
-                if effects.len() > 1 { "them" } else { "it" }
+                if effects.len() > 1 { "them" } else { "it" },
+                self.reestimated(*noise_level)
             ),
             Verdict::NoneOfTheCandidates {
                 helps,
                 unexplained,
                 rms_over_noise,
+                noise_level,
             } => {
                 let mut t = String::from(
                     "VERDICT: NONE OF THE CANDIDATES explains the misfit: something else is missing",
@@ -326,8 +345,13 @@ impl Diagnosis {
                     ));
                 }
                 t.push_str(&format!(
-                    "; with the best of them RMS/noise is {rms_over_noise:.2}.\n"
+                    "; with the best of them RMS/noise is {rms_over_noise:.2}{}.\n",
+                    self.reestimated(*noise_level)
                 ));
+                t.push_str(
+                    "    The material law (n, kappa) of these fits is NOT A RESULT: a model that \
+                     does not describe the data biases it by what it misses.\n",
+                );
                 for u in unexplained.iter().take(4) {
                     t.push_str(&format!(
                         "    unexplained: s = {:.3}-{:.3} m, the model too {} by {:.1} % ({:.1} \

@@ -149,7 +149,12 @@ impl ErrorBudget {
     pub fn warnings(&self) -> Vec<FitWarning> {
         let mut parts = Vec::new();
         for (label, sys, stat, limit) in [
-            ("kappa", self.systematic_kappa, self.statistical_kappa, LARGE_STDERR_KAPPA),
+            (
+                "kappa",
+                self.systematic_kappa,
+                self.statistical_kappa,
+                LARGE_STDERR_KAPPA,
+            ),
             ("n", self.systematic_n, self.statistical_n, LARGE_STDERR_N),
         ] {
             if let (Some(sys), Some(stat)) = (sys, stat) {
@@ -169,7 +174,7 @@ impl ErrorBudget {
             (e.shift_kappa.unwrap_or(0.0) / LARGE_STDERR_KAPPA)
                 .max(e.shift_n.unwrap_or(0.0) / LARGE_STDERR_N)
         };
-        let mut sources: Vec<(&BudgetEntry, &Source)> = self
+        let mut sources: Vec<(&BudgetEntry, Source)> = self
             .available()
             .filter_map(|e| Some((e, e.source()?)))
             .collect();

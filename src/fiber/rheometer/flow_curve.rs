@@ -251,11 +251,8 @@ fn eta_with_law<L: ViscosityLaw, H: NusseltLaw>(
         p[i] = *v;
     }
     let sc = &model.scaling;
-    model.viscosity_at(
-        t_k / sc.reference.temperature,
-        rate / sc.strain_rate(),
-        &p,
-    ) * sc.reference.viscosity
+    model.viscosity_at(t_k / sc.reference.temperature, rate / sc.strain_rate(), &p)
+        * sc.reference.viscosity
 }
 
 /// The covariance of the law's parameters (names of `law`) from the summary, row-major, with
@@ -299,7 +296,10 @@ fn systematic_shifts(budget: &ErrorBudget) -> Vec<[f64; 2]> {
                 e.sigma * e.dkappa_dq.unwrap_or(0.0),
             ]);
         } else if scope == Scope::Common {
-            out.push(per.iter().fold([0.0, 0.0], |a, v| [a[0] + v[0], a[1] + v[1]]));
+            out.push(
+                per.iter()
+                    .fold([0.0, 0.0], |a, v| [a[0] + v[0], a[1] + v[1]]),
+            );
         } else {
             out.extend(per);
         }
@@ -378,12 +378,10 @@ impl FlowCurve {
                     _ => None,
                 };
                 let stat95 = match band {
-                    BandMethod::Profile => {
-                        trace.iter().fold([eta, eta], |[l, h], law| {
-                            let v = eta_with_law(model, params, law, t_c, rate);
-                            [l.min(v), h.max(v)]
-                        })
-                    }
+                    BandMethod::Profile => trace.iter().fold([eta, eta], |[l, h], law| {
+                        let v = eta_with_law(model, params, law, t_c, rate);
+                        [l.min(v), h.max(v)]
+                    }),
                     _ => {
                         let s = stat_ln.unwrap_or(0.0);
                         [eta * (-s).exp(), eta * s.exp()]
@@ -466,7 +464,10 @@ impl FlowCurve {
                 u8::from(p.extrapolated)
             ));
             for iso in &self.isotherms {
-                s.push_str(&format!(",{:.6e}", iso.eta_pa_s.get(i).copied().unwrap_or(f64::NAN)));
+                s.push_str(&format!(
+                    ",{:.6e}",
+                    iso.eta_pa_s.get(i).copied().unwrap_or(f64::NAN)
+                ));
             }
             s.push('\n');
         }
@@ -475,6 +476,9 @@ impl FlowCurve {
 }
 
 /// The law's parameters among the local model parameters `params`.
-fn law_values<L: ViscosityLaw, H: NusseltLaw>(model: &FiberModel<L, H>, params: &[f64]) -> Vec<f64> {
+fn law_values<L: ViscosityLaw, H: NusseltLaw>(
+    model: &FiberModel<L, H>,
+    params: &[f64],
+) -> Vec<f64> {
     params[model.param_layout().law()].to_vec()
 }

@@ -39,14 +39,14 @@ pub mod layout;
 pub mod objective;
 pub mod options;
 pub mod parameter_shift;
+pub mod plan;
 pub mod profile;
 pub mod summary;
 mod summary_build;
-mod summary_finding;
 pub mod summary_checks;
+mod summary_finding;
 mod summary_read;
 mod summary_text;
-pub mod plan;
 
 pub use data::Rheometer;
 pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};

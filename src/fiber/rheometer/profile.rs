@@ -127,7 +127,13 @@ impl ProfileInterval {
             let zc = level.sqrt();
             if (za - zc) * (zb - zc) < 0.0 && a.law.len() == b.law.len() {
                 let f = (zc - za) / (zb - za);
-                out.push(a.law.iter().zip(&b.law).map(|(x, y)| x + f * (y - x)).collect());
+                out.push(
+                    a.law
+                        .iter()
+                        .zip(&b.law)
+                        .map(|(x, y)| x + f * (y - x))
+                        .collect(),
+                );
             }
         }
         if let Some(last) = pts.last() {
@@ -226,7 +232,10 @@ impl Warm {
                 slot.effect.strength_of(id.local_params[slot.local]),
             ));
             for sh in &slot.shapes {
-                strengths.push((sh.parameter.model_param.to_string(), id.local_params[sh.local]));
+                strengths.push((
+                    sh.parameter.model_param.to_string(),
+                    id.local_params[sh.local],
+                ));
             }
         }
         Warm {
@@ -436,8 +445,7 @@ impl Profiler<'_> {
     /// Hold `target` at `value` (model units); `n` at 1 holds `κ` too (it no longer enters).
     fn hold(&self, target: &Target, value: f64) -> Vec<(String, f64)> {
         let mut h = vec![(target.name.clone(), value)];
-        if target.name == "n" && value >= 1.0 - 1e-9 && self.id.names.iter().any(|n| n == "kappa")
-        {
+        if target.name == "n" && value >= 1.0 - 1e-9 && self.id.names.iter().any(|n| n == "kappa") {
             h.push(("kappa".into(), STRAIN_THINNING_REFERENCE_KAPPA));
         }
         h
@@ -449,10 +457,7 @@ impl Profiler<'_> {
         let c = target.column;
         let theta = fit.p[c];
         let (lo, hi) = (self.id.lower[c], self.id.upper[c]);
-        let se = fit
-            .standard_errors()
-            .map_or(f64::NAN, |s| s[c])
-            .abs();
+        let se = fit.standard_errors().map_or(f64::NAN, |s| s[c]).abs();
         let side_at = super::summary_checks::bound_side(theta, lo, hi);
         let corr = fit.correlation().map_or(0.0, |m| {
             let np = fit.p.len();
@@ -468,7 +473,12 @@ impl Profiler<'_> {
         for (k, dir) in [-1.0f64, 1.0].into_iter().enumerate() {
             let edge = if dir < 0.0 { lo } else { hi };
             if (theta - edge).abs() <= 1e-12 * (hi - lo).abs().max(1.0)
-                || side_at == Some(if dir < 0.0 { BoundSide::Lower } else { BoundSide::Upper })
+                || side_at
+                    == Some(if dir < 0.0 {
+                        BoundSide::Lower
+                    } else {
+                        BoundSide::Upper
+                    })
             {
                 ends[k] = edge;
                 continue;
@@ -487,7 +497,11 @@ impl Profiler<'_> {
             let first = self.walk(walk, &mut points)?;
             if linear {
                 let d = (first / CHI2_95 - 1.0).abs();
-                departure = if departure.is_nan() { d } else { departure.max(d) };
+                departure = if departure.is_nan() {
+                    d
+                } else {
+                    departure.max(d)
+                };
             }
             ends[k] = crossing(&points, theta, dir, CHI2_95).unwrap_or(f64::NAN);
         }
@@ -498,7 +512,10 @@ impl Profiler<'_> {
         }
         // one-sided bounds: at a bound of the search range, or where the two-sided interval
         // stays open towards one end (the data are compatible with that end)
-        let open_side = match (ends[0].is_nan() || ends[0] <= lo, ends[1].is_nan() || ends[1] >= hi) {
+        let open_side = match (
+            ends[0].is_nan() || ends[0] <= lo,
+            ends[1].is_nan() || ends[1] >= hi,
+        ) {
             _ if side_at.is_some() => side_at,
             (false, true) => Some(BoundSide::Upper),
             (true, false) => Some(BoundSide::Lower),
@@ -513,10 +530,7 @@ impl Profiler<'_> {
                 (BoundSide::Upper, true) | (BoundSide::Lower, false) => BoundSide::Lower,
                 _ => BoundSide::Upper,
             };
-            Some(OneSidedBound {
-                side,
-                bound: to(b),
-            })
+            Some(OneSidedBound { side, bound: to(b) })
         });
         let mut reasons = Vec::new();
         if side_at.is_some() {

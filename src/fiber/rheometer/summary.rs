@@ -16,8 +16,8 @@
 use super::budget::ErrorBudget;
 use super::estimator::Estimator;
 use super::flow_curve::{FlowCurve, StrainRateCoverage};
-use super::profile::{NewtonianTest, ProfileInterval};
 pub use super::options::{FitWarning, WarningCode};
+use super::profile::{NewtonianTest, ProfileInterval};
 use crate::fiber::effects::{Category, LawChoice};
 use crate::fiber::noise_summary::NoiseSummary;
 use crate::fiber::serde_nan;

@@ -69,8 +69,7 @@ impl FitSummary {
         });
         if !self.law_fitted() {
             return if self.law == LawChoice::Newtonian {
-                "the model's law is Newtonian (n = 1 fixed): eta_E = Trouton ratio x eta0(T)"
-                    .into()
+                "the model's law is Newtonian (n = 1 fixed): eta_E = Trouton ratio x eta0(T)".into()
             } else {
                 String::new()
             };
@@ -81,7 +80,11 @@ impl FitSummary {
         match t.preferred {
             LawChoice::Newtonian => {
                 let mut s = format!("no strain thinning detected{range}");
-                match t.thinning_bound.as_ref().filter(|b| b.n_lower95.is_finite()) {
+                match t
+                    .thinning_bound
+                    .as_ref()
+                    .filter(|b| b.n_lower95.is_finite())
+                {
                     Some(b) => s.push_str(&format!(
                         "; thinning setting in within them (K < {} Pa) needs n > {} \
                          (one-sided 95 %)",
@@ -102,7 +105,9 @@ impl FitSummary {
             LawChoice::Carreau => {
                 let n = match self.interval("n") {
                     Some(i) if !i.linearised_trusted() => format!("n in {}", i.words()),
-                    _ if self.n.stderr.is_finite() => format!("n = {}", fmt_pm(self.n.value, self.n.stderr)),
+                    _ if self.n.stderr.is_finite() => {
+                        format!("n = {}", fmt_pm(self.n.value, self.n.stderr))
+                    }
                     _ => format!("n = {}", fmt_sig(self.n.value, 4)),
                 };
                 format!(

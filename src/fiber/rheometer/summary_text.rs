@@ -53,11 +53,7 @@ impl FitSummary {
                 fmt_sig(value, 5)
             )
         } else {
-            let undetermined = if se >= 1e5 {
-                " (not determined)"
-            } else {
-                ""
-            };
+            let undetermined = if se >= 1e5 { " (not determined)" } else { "" };
             format!(
                 "    {label} {}{unit}  95% CI {}{unit}{undetermined}",
                 fmt_pm(value, se),
@@ -351,7 +347,10 @@ impl FitSummary {
             let trust = if i.linearised_trusted() {
                 String::new()
             } else {
-                format!(" — linearised interval not trusted: {}", i.reasons.join(", "))
+                format!(
+                    " — linearised interval not trusted: {}",
+                    i.reasons.join(", ")
+                )
             };
             s.push_str(&format!(
                 "    {}: profile {}{compare}{trust} ({} refits)\n",

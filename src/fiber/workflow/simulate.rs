@@ -191,8 +191,8 @@ fn simulate_one(
     };
     // checked in `simulate_experiments`
     let physics = physics_with(&request.effects).map_err(SimulateError::Effects)?;
-    let model =
-        FiberModel::new(&set.material, &set.air, &e, CarreauLike::new(), physics).map_err(failed)?;
+    let model = FiberModel::new(&set.material, &set.air, &e, CarreauLike::new(), physics)
+        .map_err(failed)?;
     let sol = simulate(&model, &request.law, &request.simulate).map_err(failed)?;
     let profiles = match &request.positions {
         Some(p) => sol.profiles(&model, p),

@@ -60,7 +60,9 @@ use super::scan::ScanOptions;
 use super::ties::DEFAULT_TIE_MARGIN;
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
 use crate::fiber::noise_summary::NoiseSummary;
-use crate::fiber::rheometer::{Estimator, Identification, IdentifyOptions, RheometerError};
+use crate::fiber::rheometer::{
+    Estimator, FitWarning, Identification, IdentifyOptions, RheometerError, WarningCode,
+};
 use crate::fiber::setup::ExperimentSet;
 use std::time::Instant;
 use verdict::{Help, Verdict};
@@ -176,6 +178,22 @@ fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
     let fit_options = steps.last().map(|s| s.opts.clone()).unwrap_or_default();
     let first = steps.remove(0);
     let verdict = verdict_of(&first, &found, final_id.as_ref(), &noise);
+    let mut final_fit = final_id.as_ref().map(|id| id.summary.clone());
+    let mut base_fit = first.base.summary.clone();
+    if let Verdict::NoneOfTheCandidates { rms_over_noise, .. } = &verdict {
+        // the law of a model that does not describe the data is biased by what it misses
+        let w = FitWarning::new(
+            WarningCode::Implausible,
+            format!(
+                "none of the candidate effects brings the residuals to the noise (RMS/noise \
+                 {rms_over_noise:.2} with the best of them): the material law (n, kappa) of this \
+                 model is biased by the missing effect and is not a result"
+            ),
+        );
+        for s in final_fit.iter_mut().chain(std::iter::once(&mut base_fit)) {
+            s.warnings.push(w.clone());
+        }
+    }
     let further: Vec<ForwardStep> = steps
         .iter()
         .map(|s| ForwardStep {
@@ -195,7 +213,7 @@ fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
     DiagnosisRun {
         diagnosis: Diagnosis {
             model: first.spec.law,
-            base_fit: first.base.summary.clone(),
+            base_fit,
             // a physical effect that explains part of the residuals significantly shows they
             // are systematic, even where the noise level is too uncertain for the RMS test
             systematic: first.systematic || first.named.is_some(),
@@ -207,7 +225,7 @@ fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
             calibration: first.calibration,
             further_steps: further,
             found,
-            final_fit: final_id.as_ref().map(|id| id.summary.clone()),
+            final_fit,
             verdict,
             wall_time_s: t0.elapsed().as_secs_f64(),
         },
@@ -227,11 +245,13 @@ fn verdict_of(
     noise: &NoiseSummary,
 ) -> Verdict {
     let fit = final_id.unwrap_or(&first.base);
+    let noise = &verdict::noise_for(&fit.summary, noise);
     let (ratio, _) = verdict::at_noise(&fit.summary, noise);
     if !found.is_empty() && verdict::explained(&fit.summary, noise) {
         return Verdict::Explained {
             effects: found.to_vec(),
             rms_over_noise: ratio,
+            noise_level: noise.level,
         };
     }
     if found.is_empty() && !first.systematic {
@@ -256,5 +276,6 @@ fn verdict_of(
             noise.level,
         ),
         rms_over_noise: ratio,
+        noise_level: noise.level,
     }
 }

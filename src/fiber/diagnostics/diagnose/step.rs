@@ -15,7 +15,7 @@ use crate::fiber::diagnostics::candidate::{
 use crate::fiber::diagnostics::detection::{detection_limits, DetectionContext, DetectionLimits};
 use crate::fiber::diagnostics::scores::cosine;
 use crate::fiber::diagnostics::ties::{alternatives_among, Alternative};
-use crate::fiber::effects::{Category, Effect, ModelSpec};
+use crate::fiber::effects::{Effect, ModelSpec};
 use crate::fiber::rheometer::{
     Estimate, Identification, IdentifyOptions, ParameterShift, RheometerError,
 };

@@ -63,6 +63,10 @@ pub enum Verdict {
         effects: Vec<String>,
         /// RMS (outliers excluded) over the noise level with them \[-\].
         rms_over_noise: f64,
+        /// The noise level of the verdict (relative \[-\]): the data's, or re-estimated with
+        /// the named effects where lower (see [`noise_for`]).
+        #[serde(default)]
+        noise_level: f64,
     },
     /// Something is missing that none of the candidates describes (or describes only in part).
     NoneOfTheCandidates {
@@ -72,6 +76,9 @@ pub enum Verdict {
         unexplained: Vec<Unexplained>,
         /// RMS (outliers excluded) over the noise level with the best of them \[-\].
         rms_over_noise: f64,
+        /// The noise level of the verdict (relative \[-\], see [`noise_for`]).
+        #[serde(default)]
+        noise_level: f64,
     },
 }
 
@@ -94,6 +101,18 @@ pub(crate) fn share_of_excess(before: f64, after: f64, j_noise: f64) -> f64 {
     }
 }
 
+/// The noise level the verdict on `fit` uses: a declared level as declared; an estimated one
+/// re-estimated from `fit`'s own residuals where that is lower — the plain model's misfit
+/// inflates a noise estimate (second differences of residuals with a strong systematic part),
+/// and an inflated level would call a poor fit "at the noise".
+pub(crate) fn noise_for(fit: &FitSummary, base: &NoiseSummary) -> NoiseSummary {
+    if base.declared() || !(fit.noise.level < base.level) {
+        base.clone()
+    } else {
+        fit.noise.clone()
+    }
+}
+
 /// RMS (outliers excluded) of `fit`'s residuals over the data's noise level `noise` and the
 /// lag-1 structure statistic of its residuals.
 pub(crate) fn at_noise(fit: &FitSummary, noise: &NoiseSummary) -> (f64, f64) {
@@ -103,9 +122,10 @@ pub(crate) fn at_noise(fit: &FitSummary, noise: &NoiseSummary) -> (f64, f64) {
     (rms / noise.level, lag1_z)
 }
 
-/// Whether `fit` leaves residuals at the noise (see the module documentation).
+/// Whether `fit` leaves residuals at the noise (see the module documentation; the noise level
+/// of [`noise_for`]).
 pub(crate) fn explained(fit: &FitSummary, noise: &NoiseSummary) -> bool {
-    let (ratio, z) = at_noise(fit, noise);
+    let (ratio, z) = at_noise(fit, &noise_for(fit, noise));
     ratio <= EXPLAINED_RMS_OVER_NOISE && z < STRUCTURE_Z
 }
 
