@@ -42,6 +42,8 @@ pub(crate) fn discretisation_shift(
     let mut fine = options.clone();
     fine.simulate.tol = check_tol;
     fine.loose_tolerance = None;
+    // the check is part of the fit already reported, not a fit of its own
+    fine.progress = None;
     let fs = FitStart {
         warm: Some(id.solutions.clone()),
         ..start.clone()
@@ -82,6 +84,8 @@ pub(crate) fn matched(
         return Ok(id);
     };
     let mut opts = options.clone();
+    // progress is reported for the fit itself; its checks and refinements run silently
+    opts.progress = None;
     loop {
         // a check that cannot run (a singular JᵀJ, a solve failing at the finer tolerance)
         // leaves the fit as it is, unchecked (NaN in the record)

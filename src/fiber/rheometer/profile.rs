@@ -411,7 +411,18 @@ impl Profiler<'_> {
         let mut outside: Option<(f64, f64)> = None;
         let mut first = f64::NAN;
         for _ in 0..MAX_REFITS_PER_SIDE {
-            let r = self.refit(w.options, (w.hold)(t), &warm)?;
+            let r = match self.refit(w.options, (w.hold)(t), &warm) {
+                Ok(r) => r,
+                // the model does not solve there (a law far from the data's): halfway back to
+                // the last refit inside, which did solve
+                Err(e) => {
+                    if (t - t_in).abs() <= 1e-6 * (hi - lo).abs().max(1e-300) {
+                        return Err(e);
+                    }
+                    t = t_in + 0.5 * (t - t_in);
+                    continue;
+                }
+            };
             points.push((t, r.deviance, r.law.clone()));
             if first.is_nan() {
                 first = r.deviance;
