@@ -116,13 +116,13 @@ pub fn simulate<'py>(
         })
         // the failure crosses back from the worker thread as text and attributes
         .map_err(|e| match e {
-            SimulateError::Experiment(f) => Err(CapturedError::capture(f.as_ref())),
+            SimulateError::Experiment(f) => Err(Box::new(CapturedError::capture(f.as_ref()))),
             SimulateError::Stopped { .. } => Ok(None),
             other => Ok(Some(other.to_string())),
         })
     })?;
     let runs = out.map_err(|e| match e {
-        Err(captured) => captured.into_py(py),
+        Err(captured) => (*captured).into_py(py),
         Ok(None) => pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted"),
         Ok(Some(message)) => input_error(message),
     })?;
