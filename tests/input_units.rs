@@ -42,7 +42,11 @@ fn assert_same_set(a: &ExperimentSet, b: &ExperimentSet) {
         let n = &x.name;
         assert_eq!(x.name, y.name);
         close(x.mass_flow, y.mass_flow, &format!("{n} mass flow"));
-        close(x.inlet_temperature, y.inlet_temperature, &format!("{n} T_in"));
+        close(
+            x.inlet_temperature,
+            y.inlet_temperature,
+            &format!("{n} T_in"),
+        );
         close(x.air_temperature, y.air_temperature, &format!("{n} T_air"));
         close(x.spinline_length, y.spinline_length, &format!("{n} L"));
         match (x.inlet, y.inlet) {
@@ -73,10 +77,18 @@ fn lab_units_load_to_the_shipped_si_values() {
     assert_eq!(lab.experiments[0].spinline_length, 0.51);
     // the converted copy really is in other units
     let text = std::fs::read_to_string(lab_units()).unwrap();
-    for key in ["mass_flow_g_min", "inlet_temperature_C", "inlet_diameter_mm", "spinline_length_cm"] {
+    for key in [
+        "mass_flow_g_min",
+        "inlet_temperature_C",
+        "inlet_diameter_mm",
+        "spinline_length_cm",
+    ] {
         assert!(text.contains(key), "{key}");
     }
-    assert!(!text.contains("_kg_s ="), "SI mass flow left in the lab-unit copy");
+    assert!(
+        !text.contains("_kg_s ="),
+        "SI mass flow left in the lab-unit copy"
+    );
     let csv = std::fs::read_to_string(lab_units().with_file_name("v0p27_p1.csv")).unwrap();
     assert!(csv.starts_with("position_mm,diameter_um\n"), "{csv}");
 }
@@ -86,7 +98,8 @@ fn lab_units_give_the_same_fit_as_si() {
     let fit = |path: &Path| {
         let set = load_experiments(path).unwrap();
         let rh = Rheometer::new(&set).unwrap();
-        rh.identify([0.7, 11.0], &IdentifyOptions::default()).unwrap()
+        rh.identify([0.7, 11.0], &IdentifyOptions::default())
+            .unwrap()
     };
     let (si, lab) = (fit(&shipped()), fit(&lab_units()));
     close(lab.n, si.n, "n");
@@ -124,9 +137,21 @@ fn every_unit_of_every_key_converts() {
         ("inlet_diameter_m = 1e-3", "inlet_diameter_um = 1000", 1e-3),
         ("spinline_length_m = 0.51", "spinline_length_cm = 51", 0.51),
         ("spinline_length_m = 0.51", "spinline_length_mm = 510", 0.51),
-        ("inlet_temperature_K = 513.15", "inlet_temperature_C = 240", 513.15),
-        ("air_temperature_K = 293.15", "air_temperature_C = 20", 293.15),
-        ("air_temperature_K = 293.15", "air_temperature_C = 5", 278.15),
+        (
+            "inlet_temperature_K = 513.15",
+            "inlet_temperature_C = 240",
+            513.15,
+        ),
+        (
+            "air_temperature_K = 293.15",
+            "air_temperature_C = 20",
+            293.15,
+        ),
+        (
+            "air_temperature_K = 293.15",
+            "air_temperature_C = 5",
+            278.15,
+        ),
     ];
     for (from, to, si) in cases {
         let set = experiment(&BASE.replace(from, to)).unwrap_or_else(|e| panic!("{to}: {e}"));
@@ -200,7 +225,11 @@ fn a_quantity_given_twice_in_different_units_is_refused() {
         BASE.replace("mass_flow_kg_s = 3e-5", "mass_flow_g_min = 3.6")
     );
     let set = parse_experiments(&text, Path::new("u.toml")).unwrap().set;
-    close(set.experiments[0].mass_flow, 6e-5, "experiment overrides defaults");
+    close(
+        set.experiments[0].mass_flow,
+        6e-5,
+        "experiment overrides defaults",
+    );
 }
 
 #[test]
@@ -209,31 +238,57 @@ fn a_value_in_the_wrong_unit_is_still_refused_with_its_line() {
     let e = experiment(&BASE.replace("inlet_diameter_m = 1e-3", "inlet_diameter_m = 1.134"))
         .unwrap_err();
     assert!(e.starts_with("u.toml:20:"), "{e}");
-    assert!(e.contains("`inlet_diameter_m` = 1.134: implausibly large for a diameter in metres"), "{e}");
-    assert!(e.contains("write `inlet_diameter_mm = 1.134` if it is in millimetres"), "{e}");
+    assert!(
+        e.contains("`inlet_diameter_m` = 1.134: implausibly large for a diameter in metres"),
+        "{e}"
+    );
+    assert!(
+        e.contains("write `inlet_diameter_mm = 1.134` if it is in millimetres"),
+        "{e}"
+    );
     let e = experiment(&BASE.replace("spinline_length_m = 0.51", "spinline_length_m = 510"))
         .unwrap_err();
-    assert!(e.starts_with("u.toml:16:") && e.contains("`spinline_length_mm = 510`"), "{e}");
+    assert!(
+        e.starts_with("u.toml:16:") && e.contains("`spinline_length_mm = 510`"),
+        "{e}"
+    );
     // metres under a millimetre key
     let e = experiment(&BASE.replace("inlet_diameter_m = 1e-3", "inlet_diameter_mm = 0.001134"))
         .unwrap_err();
     assert!(e.starts_with("u.toml:20:"), "{e}");
-    assert!(e.contains("implausibly small") && e.contains("`inlet_diameter_m = 0.001134`"), "{e}");
+    assert!(
+        e.contains("implausibly small") && e.contains("`inlet_diameter_m = 0.001134`"),
+        "{e}"
+    );
     // kg/s under a g/min key: the inlet velocity gives it away
-    let e = experiment(&BASE.replace("mass_flow_kg_s = 3e-5", "mass_flow_g_min = 1.8e3"))
-        .unwrap_err();
-    assert!(e.starts_with("u.toml:19:") && e.contains("faster than a melt"), "{e}");
+    let e =
+        experiment(&BASE.replace("mass_flow_kg_s = 3e-5", "mass_flow_g_min = 1.8e3")).unwrap_err();
+    assert!(
+        e.starts_with("u.toml:19:") && e.contains("faster than a melt"),
+        "{e}"
+    );
     // kelvin under a Celsius key that makes it implausible
     let e = experiment(&BASE.replace("air_temperature_K = 293.15", "air_temperature_C = 1500"))
         .unwrap_err();
-    assert!(e.contains("implausibly large") && e.contains("`air_temperature_K = 1500`"), "{e}");
+    assert!(
+        e.contains("implausibly large") && e.contains("`air_temperature_K = 1500`"),
+        "{e}"
+    );
     // below absolute zero
     let e = experiment(&BASE.replace("air_temperature_K = 293.15", "air_temperature_C = -300"))
         .unwrap_err();
     assert!(e.contains("at or below absolute zero"), "{e}");
     // a CSV in metres under a micrometre header
-    let e = parse_measurements("position_m,diameter_um\n0,1.1e-3\n", Path::new("m.csv"), 0.51, 1)
-        .unwrap_err()
-        .to_string();
-    assert!(e.starts_with("m.csv:2:") && e.contains("`diameter_m` (metres)"), "{e}");
+    let e = parse_measurements(
+        "position_m,diameter_um\n0,1.1e-3\n",
+        Path::new("m.csv"),
+        0.51,
+        1,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("m.csv:2:") && e.contains("`diameter_m` (metres)"),
+        "{e}"
+    );
 }

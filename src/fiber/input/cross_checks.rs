@@ -210,7 +210,14 @@ pub(super) fn cross_check(
             let l_alt = u.to_si(l);
             l_alt >= s_last && l_alt - s_last <= options.take_up_warn_beyond * span
         })
-        .map(|u| format!(" (is {} in {}? then write `spinline_length_{}`)", readable(l), u.name, u.suffix))
+        .map(|u| {
+            format!(
+                " (is {} in {}? then write `spinline_length_{}`)",
+                readable(l),
+                u.name,
+                u.suffix
+            )
+        })
         .next()
         .unwrap_or_default();
     let text = format!(

@@ -11,9 +11,9 @@ use super::experiments::{ExperimentDetails, MAX_DRAW_RATIO, MAX_INLET_VISCOSITY_
 use super::schema::{
     keys_of, Quantity, Unit, AIR_TEMPERATURE, EXPERIMENT, EXPERIMENT_TABLES, INLET_DIAMETER,
     INLET_TEMPERATURE, INLET_VELOCITY, MASS_FLOW_Q, MAX_PLAUSIBLE_DIAMETER_M,
-    MAX_PLAUSIBLE_INLET_VELOCITY_M_S, MIN_PLAUSIBLE_INLET_DIAMETER_M, PLAUSIBLE_HEAT_CAPACITY_J_KG_K,
-    PLAUSIBLE_MELT_DENSITY_KG_M3, SPINLINE_LENGTH, STENCIL_VELOCITY, STRING_KEYS, TAKE_UP_DIAMETER,
-    TAKE_UP_PRESSURE, TAKE_UP_VELOCITY,
+    MAX_PLAUSIBLE_INLET_VELOCITY_M_S, MIN_PLAUSIBLE_INLET_DIAMETER_M,
+    PLAUSIBLE_HEAT_CAPACITY_J_KG_K, PLAUSIBLE_MELT_DENSITY_KG_M3, SPINLINE_LENGTH,
+    STENCIL_VELOCITY, STRING_KEYS, TAKE_UP_DIAMETER, TAKE_UP_PRESSURE, TAKE_UP_VELOCITY,
 };
 use super::source::is_stdin_like;
 use super::spanned::{Field, Tab};
@@ -271,7 +271,12 @@ fn temperatures(
     ] {
         let (t, field, unit) = got;
         if *t <= t_vf {
-            let hint = celsius_hint(field, unit, *t, |k| if ok { viscosity_ok(k) } else { k > t_vf });
+            let hint = celsius_hint(
+                field,
+                unit,
+                *t,
+                |k| if ok { viscosity_ok(k) } else { k > t_vf },
+            );
             return Err(field.invalid_in(
                 table,
                 field.finite()?,
@@ -410,7 +415,14 @@ fn inlet(
                 let v = per_q * u.to_si(q_field.finite().unwrap_or(0.0));
                 (1e-5..=MAX_PLAUSIBLE_INLET_VELOCITY_M_S).contains(&v)
             })
-            .map(|u| format!("`{} = {}` if it is in {}", MASS_FLOW_Q.key(u), q_field.raw(), u.name))
+            .map(|u| {
+                format!(
+                    "`{} = {}` if it is in {}",
+                    MASS_FLOW_Q.key(u),
+                    q_field.raw(),
+                    u.name
+                )
+            })
             .collect();
         let diameter_plausible = (1e-4..=5e-3).contains(&d_in);
         let suspect = if diameter_plausible {
@@ -437,7 +449,13 @@ fn inlet(
         ));
     }
     let (derived, v, unit, min, max) = if is_diameter {
-        ("inlet velocity 4 Q/(π ρ d_in²)", u_in, "m/s", 1e-6, MAX_PLAUSIBLE_INLET_VELOCITY_M_S)
+        (
+            "inlet velocity 4 Q/(π ρ d_in²)",
+            u_in,
+            "m/s",
+            1e-6,
+            MAX_PLAUSIBLE_INLET_VELOCITY_M_S,
+        )
     } else {
         (
             "inlet diameter 2 √(Q/(π ρ u_in))",

@@ -213,7 +213,8 @@ fn parse(
             None => Vec::new(),
         };
         uncertainty.experiments.push(own);
-        let (experiment, mut detail, at) = experiment(tab, defaults.as_ref(), &material, &material_at)?;
+        let (experiment, mut detail, at) =
+            experiment(tab, defaults.as_ref(), &material, &material_at)?;
         detail.line = at.name.line;
         unique_name(&experiment.name, &at, &located)?;
         warnings.extend(at.warnings.iter().cloned());

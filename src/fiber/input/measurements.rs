@@ -168,7 +168,9 @@ fn dialect_hint(line: &str, count: usize, cells: &[&str; 4]) -> Option<String> {
                 .into(),
         );
     }
-    let decimal = |a: &str, b: &str| digits(b.split(['e', 'E']).next().unwrap_or(b)) && number(&format!("{a}.{b}"));
+    let decimal = |a: &str, b: &str| {
+        digits(b.split(['e', 'E']).next().unwrap_or(b)) && number(&format!("{a}.{b}"))
+    };
     let decimal_commas = match count {
         4 => decimal(cells[0], cells[1]) && decimal(cells[2], cells[3]),
         3 => {
@@ -380,7 +382,9 @@ impl<'p> Parser<'p> {
         if s > l {
             let fits: Vec<&Unit> = LENGTH
                 .iter()
-                .filter(|u| s > 5.0 * l && u.divisor > pu.divisor && s * pu.divisor / u.divisor <= l)
+                .filter(|u| {
+                    s > 5.0 * l && u.divisor > pu.divisor && s * pu.divisor / u.divisor <= l
+                })
                 .collect();
             let hint = if fits.is_empty() {
                 String::new()
@@ -447,7 +451,10 @@ impl<'p> Parser<'p> {
             let hint = if alt.is_empty() {
                 String::new()
             } else {
-                format!("; if the column is in another unit, name it {}", alt.join(" or "))
+                format!(
+                    "; if the column is in another unit, name it {}",
+                    alt.join(" or ")
+                )
             };
             format!(
                 "diameter {cell} {symbol} is implausibly small for a fiber (< 1 µm); the values \
@@ -556,7 +563,10 @@ mod tests {
         let msg = err("position_m;diameter_m\n0;1e-3\n");
         assert!(msg.contains("semicolons"), "{msg}");
         let msg = err("position_m,diameter_m\n0;1,1e-3\n");
-        assert!(msg.contains("semicolons") && msg.contains("has decimal commas"), "{msg}");
+        assert!(
+            msg.contains("semicolons") && msg.contains("has decimal commas"),
+            "{msg}"
+        );
         let msg = err("position_m\tdiameter_m\n");
         assert!(msg.contains("tabs"), "{msg}");
         let msg = err("position_m,diameter_m,\n");
@@ -567,8 +577,14 @@ mod tests {
         assert!(msg.contains("`1.1E-03`"), "{msg}");
         let msg = err("position_m,diameter_m\n0,1e-3\n20,1e-4\n");
         assert!(msg.contains("`position_mm`"), "{msg}");
-        let msg = err(&format!("position_m,diameter_m\n0,{}\n", "1".repeat(100_000)));
-        assert!(msg.len() < 300 && msg.contains("100000 characters"), "{msg}");
+        let msg = err(&format!(
+            "position_m,diameter_m\n0,{}\n",
+            "1".repeat(100_000)
+        ));
+        assert!(
+            msg.len() < 300 && msg.contains("100000 characters"),
+            "{msg}"
+        );
         let msg = err("position_m,diameter_m\n0,1e-3\n1e308,9e-5\n");
         assert!(msg.contains("1e308") && msg.len() < 200, "{msg}");
     }

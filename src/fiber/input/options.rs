@@ -44,7 +44,10 @@ pub const FIT_BASE_BYTES: u64 = 20_000_000;
 pub fn estimated_fit_memory_bytes(rows: u64, experiments: u64) -> u64 {
     let params = experiments.saturating_add(2);
     FIT_BASE_BYTES
-        .saturating_add(rows.saturating_mul(params).saturating_mul(FIT_BYTES_PER_ENTRY))
+        .saturating_add(
+            rows.saturating_mul(params)
+                .saturating_mul(FIT_BYTES_PER_ENTRY),
+        )
         .saturating_add(experiments.saturating_mul(FIT_BYTES_PER_EXPERIMENT))
 }
 

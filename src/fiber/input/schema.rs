@@ -38,7 +38,11 @@ pub const PLAUSIBLE_RANGES: &[(&str, f64, f64)] = &[
     ("spinline_length_m", 1e-3, 100.0),
     ("inlet_temperature_K", 100.0, 1500.0),
     ("air_temperature_K", 100.0, 1500.0),
-    ("inlet_diameter_m", MIN_PLAUSIBLE_INLET_DIAMETER_M, MAX_PLAUSIBLE_DIAMETER_M),
+    (
+        "inlet_diameter_m",
+        MIN_PLAUSIBLE_INLET_DIAMETER_M,
+        MAX_PLAUSIBLE_DIAMETER_M,
+    ),
     ("air_density_kg_m3", 0.01, 100.0),
     ("air_heat_capacity_J_kg_K", 100.0, 20000.0),
     ("air_kinematic_viscosity_m2_s", 1e-7, 1e-2),
@@ -100,12 +104,7 @@ const fn si(suffix: &'static str, symbol: &'static str) -> Unit {
     }
 }
 
-const fn per(
-    suffix: &'static str,
-    symbol: &'static str,
-    name: &'static str,
-    divisor: f64,
-) -> Unit {
+const fn per(suffix: &'static str, symbol: &'static str, name: &'static str, divisor: f64) -> Unit {
     Unit {
         suffix,
         symbol,
@@ -226,16 +225,36 @@ pub(super) const EXPERIMENT_TABLES: &[&str] = &["uncertainty"];
 pub(super) const MATERIAL: &[Quantity] = &[
     q("density_slope", Rule::Finite, &[si("kg_m3_K", "kg/(m³ K)")]),
     q("density_intercept", Rule::Positive, &[si("kg_m3", "kg/m³")]),
-    q("heat_capacity_slope", Rule::Finite, &[si("J_kg_K2", "J/(kg K²)")]),
-    q("heat_capacity_intercept", Rule::Finite, &[si("J_kg_K", "J/(kg K)")]),
+    q(
+        "heat_capacity_slope",
+        Rule::Finite,
+        &[si("J_kg_K2", "J/(kg K²)")],
+    ),
+    q(
+        "heat_capacity_intercept",
+        Rule::Finite,
+        &[si("J_kg_K", "J/(kg K)")],
+    ),
     q("vft_mu_c", Rule::Positive, &[si("Pa_s", "Pa s")]),
     q("vft_B", Rule::Positive, &[si("K", "K")]),
     q("vft_T_VF", Rule::NonNegative, TEMPERATURE),
     q("trouton_ratio", Rule::Positive, &[si("", "-")]),
     q("air_density", Rule::Positive, &[si("kg_m3", "kg/m³")]),
-    q("air_heat_capacity", Rule::Positive, &[si("J_kg_K", "J/(kg K)")]),
-    q("air_kinematic_viscosity", Rule::Positive, &[si("m2_s", "m²/s")]),
-    q("air_heat_conductivity", Rule::Positive, &[si("W_m_K", "W/(m K)")]),
+    q(
+        "air_heat_capacity",
+        Rule::Positive,
+        &[si("J_kg_K", "J/(kg K)")],
+    ),
+    q(
+        "air_kinematic_viscosity",
+        Rule::Positive,
+        &[si("m2_s", "m²/s")],
+    ),
+    q(
+        "air_heat_conductivity",
+        Rule::Positive,
+        &[si("W_m_K", "W/(m K)")],
+    ),
 ];
 
 pub(super) const MASS_FLOW_Q: Quantity = q("mass_flow", Rule::Positive, MASS_FLOW);

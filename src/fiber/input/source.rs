@@ -247,7 +247,10 @@ fn encoding_error(path: &Path, bytes: &[u8], offset: u64, line: usize, bad: usiz
         .iter()
         .rposition(|&b| b == b'\n')
         .map_or(0, |p| p + 1);
-    let column = String::from_utf8_lossy(&before[line_start..]).chars().count() + 1;
+    let column = String::from_utf8_lossy(&before[line_start..])
+        .chars()
+        .count()
+        + 1;
     let byte = bytes.get(bad).copied().unwrap_or(0);
     let window = &bytes[bad.saturating_sub(128)..(bad + 128).min(bytes.len())];
     let at_byte = format!("byte {} (0x{byte:02X})", offset + bad as u64);

@@ -193,11 +193,7 @@ impl<'a> Tab<'a> {
     }
 
     /// The sub-table `key`, if present; an error if `key` is not a table.
-    pub(super) fn sub_table(
-        &self,
-        key: &str,
-        name: &str,
-    ) -> Result<Option<Tab<'a>>, InputError> {
+    pub(super) fn sub_table(&self, key: &str, name: &str) -> Result<Option<Tab<'a>>, InputError> {
         let Some(field) = self.get(key) else {
             return Ok(None);
         };

@@ -72,9 +72,7 @@ pub(super) fn duplicate_message(text: &str, span: Range<usize>) -> Option<String
         .trim()
         .trim_matches(['"', '\''])
         .to_string();
-    let section_start = lines[..line_no]
-        .iter()
-        .rposition(|l| header(l).is_some());
+    let section_start = lines[..line_no].iter().rposition(|l| header(l).is_some());
     let table = match section_start {
         Some(i) => match header(lines[i]) {
             Some((p, true)) => format!("[[{p}]]"),
@@ -105,9 +103,7 @@ pub(super) fn not_experiments(path: &Path, text: &str) -> Option<InputError> {
         .find(|(_, l)| !l.is_empty() && !l.starts_with('#'))?;
     let json = first.starts_with('{')
         || (first.starts_with('[')
-            && first[1..]
-                .trim_start()
-                .starts_with(['{', '"', '[', ']'])
+            && first[1..].trim_start().starts_with(['{', '"', '[', ']'])
             && !first.starts_with("[["));
     let csv = !json
         && !first.starts_with('[')
@@ -160,7 +156,10 @@ mod tests {
         let m = dup("[material]\na = 1\n[material]\nb = 2\n");
         assert!(m.contains("first on line 1: `[material]`"), "{m}");
         let m = dup("[experiment.uncertainty]\na = 1\n[[experiment]]\nname = \"x\"\n");
-        assert!(m.contains("`[[experiment]]`") && m.contains("line 1"), "{m}");
+        assert!(
+            m.contains("`[[experiment]]`") && m.contains("line 1"),
+            "{m}"
+        );
     }
 
     #[test]
