@@ -156,7 +156,7 @@ pub(super) fn cross_check(
     let data = loaded.details[i]
         .data
         .as_deref()
-        .map(|p| super::source::show(p))
+        .map(super::source::show)
         .unwrap_or_default();
     let d_in = match e.inlet {
         Inlet::Diameter(d) => d,

@@ -156,7 +156,7 @@ fn dialect_hint(line: &str, count: usize, cells: &[&str; 4]) -> Option<String> {
             "the line is separated by tabs, but this reader expects commas: {resave}"
         ));
     }
-    if count == 1 && line.trim().split_whitespace().count() == 2 {
+    if count == 1 && line.split_whitespace().count() == 2 {
         return Some(format!(
             "the line is separated by spaces, but this reader expects commas: {resave}"
         ));
@@ -419,7 +419,7 @@ impl<'p> Parser<'p> {
                     "position {s_cell} {} is smaller than {} {} on line {prev}; positions must \
                      be strictly increasing",
                     pu.symbol,
-                    readable(pu.from_si(last)),
+                    readable(pu.of_si(last)),
                     pu.symbol
                 ));
             }
@@ -443,7 +443,7 @@ impl<'p> Parser<'p> {
                 .map(|u| format!("`diameter_{}` ({})", u.suffix, u.name))
                 .collect::<Vec<_>>()
         };
-        let v = unit.from_si(d);
+        let v = unit.of_si(d);
         let message = if d <= 0.0 {
             format!("diameter {cell} {symbol} is not positive")
         } else if d < min {

@@ -78,7 +78,7 @@ pub(super) struct Unit {
 
 impl Unit {
     /// The SI value of `value` given in this unit.
-    pub(super) fn to_si(&self, value: f64) -> f64 {
+    pub(super) fn to_si(self, value: f64) -> f64 {
         if self.offset != 0.0 {
             value + self.offset
         } else if self.divisor == 1.0 {
@@ -88,8 +88,8 @@ impl Unit {
         }
     }
 
-    /// `si` expressed in this unit.
-    pub(super) fn from_si(&self, si: f64) -> f64 {
+    /// `si` (in the SI unit) expressed in this unit.
+    pub(super) fn of_si(self, si: f64) -> f64 {
         (si - self.offset) * self.divisor
     }
 }
@@ -411,7 +411,7 @@ mod tests {
         assert_eq!(g_min.to_si(60.0), 1e-3);
         let c = INLET_TEMPERATURE.unit_of("inlet_temperature_C").unwrap();
         assert_eq!(c.to_si(240.0), 513.15);
-        assert_eq!(c.from_si(513.15), 240.0);
+        assert_eq!(c.of_si(513.15), 240.0);
         assert_eq!(INLET_DIAMETER.si_key(), "inlet_diameter_m");
         assert_eq!(MATERIAL[7].si_key(), "trouton_ratio");
         let hint = key_hint("mass_flow_pounds_per_hour", &["mass_flow_kg_s"]);
