@@ -13,8 +13,8 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use diffbvp::fiber::input::{
-    estimated_fit_memory_bytes, load_experiments, load_experiments_with_options, InputError,
-    Limit, LoadOptions, DEFAULT_MAX_EXPERIMENTS,
+    estimated_fit_memory_bytes, load_experiments, load_experiments_with_options, InputError, Limit,
+    LoadOptions, DEFAULT_MAX_EXPERIMENTS,
 };
 
 /// A scratch copy of the shipped data set: (scratch dir, TOML, data dir).
@@ -86,7 +86,9 @@ fn dev_zero_and_dev_urandom_are_refused_within_a_second_in_little_memory() {
     // [C21, S04, C24] the CLI used to read /dev/zero at 3 GB/s and /dev/urandom forever
     let (dir, toml, _) = copy("bounds_devices");
     for device in ["/dev/zero", "/dev/urandom"] {
-        let text = std::fs::read_to_string(probe::repo().join("data/pmma7n_synthetic/experiments.toml")).unwrap();
+        let text =
+            std::fs::read_to_string(probe::repo().join("data/pmma7n_synthetic/experiments.toml"))
+                .unwrap();
         std::fs::write(&toml, text).unwrap();
         set_data(&toml, device);
         let line = probe::line_where(&toml, |l| l.contains(device));
@@ -201,7 +203,13 @@ fn encodings_are_named_with_the_byte_and_utf8_is_suggested() {
     let message = refused(&toml, Duration::from_secs(1));
     assert_contains(
         &message,
-        &[&key_line(&toml, "data = \"v0p27_p1.csv\""), "v0p27_p1.csv:1", "UTF-16", "FF FE", "re-save it as UTF-8"],
+        &[
+            &key_line(&toml, "data = \"v0p27_p1.csv\""),
+            "v0p27_p1.csv:1",
+            "UTF-16",
+            "FF FE",
+            "re-save it as UTF-8",
+        ],
     );
     // [c27] random bytes in a CSV
     let random: Vec<u8> = (0..3000u32)
@@ -216,11 +224,17 @@ fn encodings_are_named_with_the_byte_and_utf8_is_suggested() {
     utf16.extend(original.encode_utf16().flat_map(u16::to_le_bytes));
     std::fs::write(&toml, &utf16).unwrap();
     let message = refused(&toml, Duration::from_secs(1));
-    assert_contains(&message, &["experiments.toml:1", "UTF-16", "re-save it as UTF-8"]);
+    assert_contains(
+        &message,
+        &["experiments.toml:1", "UTF-16", "re-save it as UTF-8"],
+    );
     // [F56] a Latin-1 byte in a name; [t29] in a comment
     let latin1 = original.replacen("name = \"v0p27_p1\"", "name = \"Versuch \u{e4}\"", 1);
     let mut bytes = latin1.into_bytes();
-    let i = bytes.windows(2).position(|w| w == "\u{e4}".as_bytes()).unwrap();
+    let i = bytes
+        .windows(2)
+        .position(|w| w == "\u{e4}".as_bytes())
+        .unwrap();
     bytes.splice(i..i + 2, [0xE4]);
     std::fs::write(&toml, &bytes).unwrap();
     let line = bytes[..i].iter().filter(|&&b| b == b'\n').count() + 1;
@@ -236,7 +250,10 @@ fn encodings_are_named_with_the_byte_and_utf8_is_suggested() {
     );
     let comment = original.replacen("[material]", "# temp\u{e9}rature\n[material]", 1);
     let mut bytes = comment.into_bytes();
-    let i = bytes.windows(2).position(|w| w == "\u{e9}".as_bytes()).unwrap();
+    let i = bytes
+        .windows(2)
+        .position(|w| w == "\u{e9}".as_bytes())
+        .unwrap();
     bytes.splice(i..i + 2, [0xE9]);
     std::fs::write(&toml, &bytes).unwrap();
     let message = refused(&toml, Duration::from_secs(1));
@@ -264,18 +281,27 @@ fn long_cells_and_huge_numbers_are_cut_in_messages() {
     std::fs::write(&csv, lines.join("\n") + "\n").unwrap();
     let message = refused(&toml, Duration::from_secs(1));
     assert!(message.len() < 600, "{} bytes: {message}", message.len());
-    assert_contains(&message, &["v0p27_p1.csv:4", "longer than", "max_line_bytes"]);
+    assert_contains(
+        &message,
+        &["v0p27_p1.csv:4", "longer than", "max_line_bytes"],
+    );
     // a 1000-character cell: cut to 80 characters with its length
     lines[3] = format!("0.04,x{}", "1".repeat(1000));
     std::fs::write(&csv, lines.join("\n") + "\n").unwrap();
     let message = refused(&toml, Duration::from_secs(1));
     assert!(message.len() < 600, "{} bytes: {message}", message.len());
-    assert_contains(&message, &["v0p27_p1.csv:4", "non-numeric cell", "(1001 characters)"]);
+    assert_contains(
+        &message,
+        &["v0p27_p1.csv:4", "non-numeric cell", "(1001 characters)"],
+    );
     // [E09] a position of 1e308 is printed as written, not as 309 digits
     lines[3] = "1e308,9e-05".into();
     std::fs::write(&csv, lines.join("\n") + "\n").unwrap();
     let message = refused(&toml, Duration::from_secs(1));
-    assert_contains(&message, &["position 1e308 m lies beyond the spin-line length 0.51 m"]);
+    assert_contains(
+        &message,
+        &["position 1e308 m lies beyond the spin-line length 0.51 m"],
+    );
     assert!(!message.contains("0000000000"), "{message}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -305,15 +331,27 @@ fn the_number_of_experiments_is_capped_before_any_data_is_read() {
             &message,
             &[
                 "experiments.toml:",
-                &format!("{} [[experiment]] tables", if n == 2000 { "2,000" } else { "20,000" }),
-                &format!("more than the limit of {DEFAULT_MAX_EXPERIMENTS}").replace("1000", "1,000"),
+                &format!(
+                    "{} [[experiment]] tables",
+                    if n == 2000 { "2,000" } else { "20,000" }
+                ),
+                &format!("more than the limit of {DEFAULT_MAX_EXPERIMENTS}")
+                    .replace("1000", "1,000"),
                 "max_experiments",
             ],
         );
-        let p = probe::rheometer(&["--quiet", "fit", probe::s(&toml)], &[], Duration::from_secs(30));
-        p.assert_clean_failure(&["max_experiments"]);
+        let p = probe::rheometer(
+            &["--quiet", "fit", probe::s(&toml)],
+            &[],
+            Duration::from_secs(30),
+        );
+        p.assert_clean_failure(&["max_experiments", "--allow-large-inputs"]);
         // 0.05 s and 0.4 s alone; generous for a loaded machine
-        assert!(p.elapsed < Duration::from_secs(5), "{n} experiments: {:?}", p.elapsed);
+        assert!(
+            p.elapsed < Duration::from_secs(5),
+            "{n} experiments: {:?}",
+            p.elapsed
+        );
     }
     // raised, the cap lets them through (parsing only: no fit)
     many_experiments(&toml, 2000);
@@ -322,8 +360,13 @@ fn the_number_of_experiments_is_capped_before_any_data_is_read() {
         ..LoadOptions::default()
     };
     // then the estimated memory of their fit (2000 x 26 rows, 2002 parameters: 8 GB) stops them
-    let e = load_experiments_with_options(&toml, &options).unwrap_err().to_string();
-    assert_contains(&e, &["v0p27_p1.csv:", "2000 experiments", "max_fit_memory_bytes"]);
+    let e = load_experiments_with_options(&toml, &options)
+        .unwrap_err()
+        .to_string();
+    assert_contains(
+        &e,
+        &["v0p27_p1.csv:", "2000 experiments", "max_fit_memory_bytes"],
+    );
     let options = LoadOptions {
         max_fit_memory_bytes: 16 << 30,
         ..options
@@ -353,7 +396,12 @@ fn rows_are_capped_per_file_and_by_the_fit_memory_while_reading() {
     assert_eq!(limit, Limit::RowsPerFile);
     assert_contains(
         &message,
-        &["v0p27_p1.csv:12:", "more than 10 measurement rows", "max_rows_per_file", "thin the data"],
+        &[
+            "v0p27_p1.csv:12:",
+            "more than 10 measurement rows",
+            "max_rows_per_file",
+            "thin the data",
+        ],
     );
     // 9 x 27 = 243 rows fit in 9 experiments only if the cap allows them
     let max = estimated_fit_memory_bytes(100, 9);
@@ -362,7 +410,10 @@ fn rows_are_capped_per_file_and_by_the_fit_memory_while_reading() {
         ..LoadOptions::default()
     });
     assert_eq!(limit, Limit::FitMemory);
-    assert_contains(&message, &["v0p53_p1.csv:", "reach 101 rows", "max_fit_memory_bytes"]);
+    assert_contains(
+        &message,
+        &["v0p53_p1.csv:", "reach 101 rows", "max_fit_memory_bytes"],
+    );
     // [E43, S24] 9 x 1e6 rows: refused while reading, long before the fit's 5.3 GB
     let mut big = String::from("position_m,diameter_m\n");
     for i in 0..1_000_000u32 {
@@ -374,14 +425,27 @@ fn rows_are_capped_per_file_and_by_the_fit_memory_while_reading() {
     let text = std::fs::read_to_string(&toml).unwrap();
     let text = text
         .lines()
-        .map(|l| if l.starts_with("data = ") { "data = \"big.csv\"" } else { l })
+        .map(|l| {
+            if l.starts_with("data = ") {
+                "data = \"big.csv\""
+            } else {
+                l
+            }
+        })
         .collect::<Vec<_>>()
         .join("\n");
     std::fs::write(&toml, text).unwrap();
     let t0 = Instant::now();
     let e = load_experiments(&toml).unwrap_err().to_string();
     assert!(t0.elapsed() < Duration::from_secs(20), "{:?}", t0.elapsed());
-    assert_contains(&e, &["big.csv:", "max_fit_memory_bytes", "the most that a fit of 9"]);
+    assert_contains(
+        &e,
+        &[
+            "big.csv:",
+            "max_fit_memory_bytes",
+            "the most that a fit of 9",
+        ],
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -393,7 +457,14 @@ fn oversized_files_are_refused_from_their_size() {
     f.set_len(200 << 20).unwrap();
     set_data(&toml, "huge.csv");
     let message = refused(&toml, Duration::from_secs(1));
-    assert_contains(&message, &["huge.csv", "larger than the limit of 134 MB", "max_csv_bytes"]);
+    assert_contains(
+        &message,
+        &[
+            "huge.csv",
+            "larger than the limit of 134 MB",
+            "max_csv_bytes",
+        ],
+    );
     let huge_toml = data.join("huge.toml");
     std::fs::File::create(&huge_toml)
         .unwrap()
@@ -406,6 +477,15 @@ fn oversized_files_are_refused_from_their_size() {
         ..LoadOptions::default()
     };
     let e = load_experiments_with_options(&toml, &options).unwrap_err();
-    assert!(matches!(e, InputError::Limit { limit: Limit::TomlBytes, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            InputError::Limit {
+                limit: Limit::TomlBytes,
+                ..
+            }
+        ),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -53,7 +53,11 @@ impl Copy {
         let path = self.data.join(name);
         let text = std::fs::read_to_string(probe::repo().join("data/pmma7n_synthetic").join(name))
             .unwrap();
-        let out: Vec<String> = text.lines().enumerate().map(|(i, l)| edit(i + 1, l)).collect();
+        let out: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| edit(i + 1, l))
+            .collect();
         std::fs::write(&path, out.join("\n") + "\n").unwrap();
         path
     }
@@ -83,16 +87,25 @@ fn assert_contains(message: &str, parts: &[&str]) {
     }
 }
 
+/// A rewrite of one CSV line (1-based line number, text).
+type LineEdit = Box<dyn Fn(usize, &str) -> String>;
+
 #[test]
 fn csv_dialects_are_named() {
     let c = Copy::new("msg_dialects");
     let csv = "v0p27_p1.csv";
     let data_at = c.at("data = \"v0p27_p1.csv\"");
-    let cases: Vec<(&str, Box<dyn Fn(usize, &str) -> String>, Vec<&str>)> = vec![
+    let cases: Vec<(&str, LineEdit, Vec<&str>)> = vec![
         // [E41] only the header separated by semicolons
         (
             "E41",
-            Box::new(|i, l: &str| if i == 1 { l.replace(',', ";") } else { l.into() }),
+            Box::new(|i, l: &str| {
+                if i == 1 {
+                    l.replace(',', ";")
+                } else {
+                    l.into()
+                }
+            }),
             vec!["v0p27_p1.csv:1:", "semicolons", "expects commas"],
         ),
         // [c04] semicolons throughout
@@ -106,14 +119,28 @@ fn csv_dialects_are_named() {
             "c05",
             Box::new(|i, l: &str| {
                 let l = l.replace(',', ";");
-                if i == 1 { l } else { l.replace('.', ",") }
+                if i == 1 {
+                    l
+                } else {
+                    l.replace('.', ",")
+                }
             }),
-            vec!["v0p27_p1.csv:1:", "semicolons `;`", "decimal separator is a comma"],
+            vec![
+                "v0p27_p1.csv:1:",
+                "semicolons `;`",
+                "decimal separator is a comma",
+            ],
         ),
         // [c05b] decimal commas with comma separators
         (
             "c05b",
-            Box::new(|i, l: &str| if i == 1 { l.into() } else { l.replace('.', ",") }),
+            Box::new(|i, l: &str| {
+                if i == 1 {
+                    l.into()
+                } else {
+                    l.replace('.', ",")
+                }
+            }),
             vec!["v0p27_p1.csv:2:", "found 4", "decimal commas (`0,00`)"],
         ),
         // [c20] a trailing comma on every line
@@ -125,7 +152,13 @@ fn csv_dialects_are_named() {
         // [c21] Fortran D exponents
         (
             "c21",
-            Box::new(|i, l: &str| if i == 1 { l.into() } else { l.replace('e', "D") }),
+            Box::new(|i, l: &str| {
+                if i == 1 {
+                    l.into()
+                } else {
+                    l.replace('e', "D")
+                }
+            }),
             vec!["v0p27_p1.csv:2:", "`D` exponents", "`1.1089323E-03`"],
         ),
         // [c24] tab separators
@@ -144,7 +177,12 @@ fn csv_dialects_are_named() {
                 let (s, d) = l.split_once(',').unwrap();
                 format!("{},{d}", s.parse::<f64>().unwrap() * 1000.0)
             }),
-            vec!["v0p27_p1.csv:3:", "position 20 m lies beyond", "millimetres", "`position_mm`"],
+            vec![
+                "v0p27_p1.csv:3:",
+                "position 20 m lies beyond",
+                "millimetres",
+                "`position_mm`",
+            ],
         ),
     ];
     for (id, edit, needles) in cases {
@@ -154,7 +192,10 @@ fn csv_dialects_are_named() {
         for n in needles {
             assert!(message.contains(n), "{id}: `{n}` missing in: {message}");
         }
-        assert!(!message.contains("values must be in metres"), "{id}: {message}");
+        assert!(
+            !message.contains("values must be in metres"),
+            "{id}: {message}"
+        );
     }
     c.restore_csv(csv);
     assert!(load_experiments(&c.toml).is_ok());
@@ -164,7 +205,10 @@ fn csv_dialects_are_named() {
 fn duplicate_keys_and_tables_are_named() {
     let c = Copy::new("msg_duplicates");
     // [t07b] a duplicate key
-    let toml = c.toml("vft_T_VF_K = 273.15\n", "vft_T_VF_K = 273.15\nvft_B_K = 3649.0\n");
+    let toml = c.toml(
+        "vft_T_VF_K = 273.15\n",
+        "vft_T_VF_K = 273.15\nvft_B_K = 3649.0\n",
+    );
     let e = load_experiments(toml).unwrap_err().to_string();
     let first = probe::line_where(toml, |l| l.starts_with("vft_B_K"));
     assert_contains(
@@ -193,10 +237,16 @@ fn duplicate_keys_and_tables_are_named() {
     let first = probe::line_where(&c.toml, |l| l == "[material]");
     assert_contains(
         &e,
-        &["table `[material]` is defined twice", &format!("first on line {first}")],
+        &[
+            "table `[material]` is defined twice",
+            &format!("first on line {first}"),
+        ],
     );
     // [F43] an [experiment.uncertainty] table before any [[experiment]]
-    c.toml("[defaults]", "[experiment.uncertainty]\nmass_flow_rel = 0.05\n\n[defaults]");
+    c.toml(
+        "[defaults]",
+        "[experiment.uncertainty]\nmass_flow_rel = 0.05\n\n[defaults]",
+    );
     let e = c.error();
     assert_contains(
         &e,
@@ -218,14 +268,22 @@ fn a_csv_or_json_file_is_not_an_experiments_file() {
     assert!(matches!(e, InputError::NotExperiments { .. }), "{e}");
     assert_contains(
         &e.to_string(),
-        &["v0p27_p1.csv:1: this is not an experiments file", "CSV table", "data = "],
+        &[
+            "v0p27_p1.csv:1: this is not an experiments file",
+            "CSV table",
+            "data = ",
+        ],
     );
     // [F70] a JSON report given as the TOML
     let json = c.data.join("fit.json");
     std::fs::write(&json, "{\n  \"n\": 0.8,\n  \"kappa\": 11.7\n}\n").unwrap();
     let e = load_experiments(&json).unwrap_err().to_string();
     assert_contains(&e, &["fit.json:1: this is not an experiments file", "JSON"]);
-    let p = probe::rheometer(&["fit", probe::s(&json)], &[&c.data], Duration::from_secs(30));
+    let p = probe::rheometer(
+        &["fit", probe::s(&json)],
+        &[&c.data],
+        Duration::from_secs(30),
+    );
     p.assert_clean_failure(&["not an experiments file", "JSON"]);
 }
 
@@ -237,11 +295,21 @@ fn names_with_stray_spaces_or_only_case_differences_are_refused() {
     let e = c.error();
     assert_contains(
         &e,
-        &[&c.at("name = \"v0p27_p1 \""), "`name` = \"v0p27_p1 \"", "trailing spaces"],
+        &[
+            &c.at("name = \"v0p27_p1 \""),
+            "`name` = \"v0p27_p1 \"",
+            "trailing spaces",
+        ],
     );
     c.toml("name = \"v0p27_p2\"", "name = \"V0P27_P1\"");
     let e = c.error();
-    assert_contains(&e, &["\"V0P27_P1\" differs from \"v0p27_p1\"", "only in upper/lower case"]);
+    assert_contains(
+        &e,
+        &[
+            "\"V0P27_P1\" differs from \"v0p27_p1\"",
+            "only in upper/lower case",
+        ],
+    );
 }
 
 #[test]
@@ -268,12 +336,26 @@ fn names_too_long_for_file_names_are_refused_at_the_toml() {
     // [t15] a 1 MB comment line and a 5000-character name: refused before any work, the name cut
     let text = c
         .shipped
-        .replacen("name = \"v0p27_p1\"", &format!("name = \"{}\"", "n".repeat(5000)), 1)
-        .replacen("[material]", &format!("# {}\n[material]", "c".repeat(1 << 20)), 1);
+        .replacen(
+            "name = \"v0p27_p1\"",
+            &format!("name = \"{}\"", "n".repeat(5000)),
+            1,
+        )
+        .replacen(
+            "[material]",
+            &format!("# {}\n[material]", "c".repeat(1 << 20)),
+            1,
+        );
     std::fs::write(&c.toml, text).unwrap();
     let out = c.dir.join("out");
     let p = probe::rheometer(
-        &["simulate", probe::s(&c.toml), "--take-up-from-data", "--out", probe::s(&out)],
+        &[
+            "simulate",
+            probe::s(&c.toml),
+            "--take-up-from-data",
+            "--out",
+            probe::s(&out),
+        ],
         &[&c.data],
         Duration::from_secs(30),
     );
@@ -320,7 +402,9 @@ fn missing_data_names_the_experiment_and_the_key_to_add() {
         require_data: true,
         ..LoadOptions::default()
     };
-    let e2 = load_experiments_with_options(&c.toml, &options).unwrap_err().to_string();
+    let e2 = load_experiments_with_options(&c.toml, &options)
+        .unwrap_err()
+        .to_string();
     assert_eq!(e, e2);
 }
 
@@ -328,7 +412,10 @@ fn missing_data_names_the_experiment_and_the_key_to_add() {
 fn implausible_material_values_are_refused() {
     let c = Copy::new("msg_material");
     // [F64] a density slope of +1000 kg/(m³ K): 5e5 kg/m³ at the inlet
-    c.toml("density_slope_kg_m3_K = -0.964", "density_slope_kg_m3_K = 1000");
+    c.toml(
+        "density_slope_kg_m3_K = -0.964",
+        "density_slope_kg_m3_K = 1000",
+    );
     let e = c.error();
     assert_contains(
         &e,
@@ -340,7 +427,10 @@ fn implausible_material_values_are_refused() {
         ],
     );
     // [F66] an air heat conductivity of 1e9 W/(m K)
-    c.toml("air_heat_conductivity_W_m_K = 0.031", "air_heat_conductivity_W_m_K = 1e9");
+    c.toml(
+        "air_heat_conductivity_W_m_K = 0.031",
+        "air_heat_conductivity_W_m_K = 1e9",
+    );
     let e = c.error();
     assert_contains(
         &e,
@@ -369,13 +459,20 @@ fn degrees_celsius_in_a_kelvin_key_get_a_hint() {
     );
     c.toml("air_temperature_K = 293.15", "air_temperature_K = 20");
     let e = c.error();
-    assert_contains(&e, &["`air_temperature_C = 20` if it is in degrees Celsius"]);
+    assert_contains(
+        &e,
+        &["`air_temperature_C = 20` if it is in degrees Celsius"],
+    );
     // the other way round: kelvin in a Celsius key is accepted with a warning
-    c.toml("inlet_temperature_K = 513.15", "inlet_temperature_C = 513.15");
+    c.toml(
+        "inlet_temperature_K = 513.15",
+        "inlet_temperature_C = 513.15",
+    );
     let loaded = load_experiments_with(&c.toml, 4).unwrap();
     let w: Vec<String> = loaded.warnings.iter().map(ToString::to_string).collect();
     assert!(
-        w.iter().any(|w| w.contains("if the value is in kelvin, write `inlet_temperature_K = 513.15`")),
+        w.iter()
+            .any(|w| w.contains("if the value is in kelvin, write `inlet_temperature_K = 513.15`")),
         "{w:?}"
     );
 }
@@ -385,9 +482,17 @@ fn mass_flow_unit_slips_are_blamed_on_the_mass_flow_before_any_work() {
     let c = Copy::new("msg_mass_flow");
     for (id, typed, units) in [
         // [F10, t39] g/s typed as kg/s: 1000 times the mass flow
-        ("F10", "1.5690566037735852e-02", vec!["`mass_flow_g_s = 1.5690566037735852e-02` if it is in g/s"]),
+        (
+            "F10",
+            "1.5690566037735852e-02",
+            vec!["`mass_flow_g_s = 1.5690566037735852e-02` if it is in g/s"],
+        ),
         // [F11] kg/h typed as kg/s
-        ("F11", "0.0565", vec!["`mass_flow_kg_h = 0.0565` if it is in kg/h"]),
+        (
+            "F11",
+            "0.0565",
+            vec!["`mass_flow_kg_h = 0.0565` if it is in kg/h"],
+        ),
     ] {
         c.toml("1.5690566037735852e-05", typed);
         let e = c.error();
@@ -405,7 +510,13 @@ fn mass_flow_unit_slips_are_blamed_on_the_mass_flow_before_any_work() {
         }
         let out = c.dir.join("out");
         let p = probe::rheometer(
-            &["simulate", probe::s(&c.toml), "--take-up-from-data", "--out", probe::s(&out)],
+            &[
+                "simulate",
+                probe::s(&c.toml),
+                "--take-up-from-data",
+                "--out",
+                probe::s(&out),
+            ],
             &[&c.data],
             Duration::from_secs(60),
         );
@@ -467,7 +578,10 @@ fn a_spin_line_far_beyond_the_data_is_refused_and_a_little_beyond_warned() {
         "0.003,9.0e-04",
     ];
     std::fs::write(c.data.join("v0p27_p1.csv"), rows.join("\n") + "\n").unwrap();
-    assert_contains(&c.error(), &["cover s = 0 to 0.003 m", "169 times the measured span"]);
+    assert_contains(
+        &c.error(),
+        &["cover s = 0 to 0.003 m", "169 times the measured span"],
+    );
     // the same data with the take-up given by the caller: no check
     let options = LoadOptions {
         take_up_from_data: false,
@@ -479,7 +593,12 @@ fn a_spin_line_far_beyond_the_data_is_refused_and_a_little_beyond_warned() {
     let text = std::fs::read_to_string(c.data.join("v0p27_p1.csv")).unwrap();
     let cut: Vec<&str> = text
         .lines()
-        .filter(|l| l.split(',').next().and_then(|s| s.parse::<f64>().ok()).is_none_or(|s| s <= 0.35))
+        .filter(|l| {
+            l.split(',')
+                .next()
+                .and_then(|s| s.parse::<f64>().ok())
+                .is_none_or(|s| s <= 0.35)
+        })
         .collect();
     std::fs::write(c.data.join("v0p27_p1.csv"), cut.join("\n") + "\n").unwrap();
     let loaded = load_experiments_with(&c.toml, 4).unwrap();
@@ -487,19 +606,48 @@ fn a_spin_line_far_beyond_the_data_is_refused_and_a_little_beyond_warned() {
     assert_eq!(warnings.len(), 1, "{warnings:?}");
     assert_contains(
         &warnings[0],
-        &[&c.at("spinline_length_m"), "\"v0p27_p1\"", "0.17 m beyond", "an extrapolation"],
+        &[
+            &c.at("spinline_length_m"),
+            "\"v0p27_p1\"",
+            "0.17 m beyond",
+            "an extrapolation",
+        ],
     );
+    // the command line shows it once, and not when the take-up diameter is given
+    let out = c.dir.join("out");
+    let args = ["simulate", probe::s(&c.toml), "--out", probe::s(&out)];
+    let p = probe::rheometer(
+        &[&args[..], &["--take-up-from-data"]].concat(),
+        &[],
+        Duration::from_secs(60),
+    );
+    p.assert_success();
+    assert_eq!(p.stderr.matches("warning:").count(), 1, "{}", p.stderr);
+    assert_contains(&p.stderr, &["warning:", "0.17 m beyond"]);
+    let p = probe::rheometer(
+        &[&args[..], &["--take-up-diameter", "1e-4"]].concat(),
+        &[],
+        Duration::from_secs(60),
+    );
+    p.assert_success();
+    assert!(!p.stderr.contains("beyond"), "{}", p.stderr);
     // the shipped data (0.5 of 0.51 m): neither
     std::fs::write(&c.toml, &c.shipped).unwrap();
     c.restore_csv("v0p27_p1.csv");
-    assert!(load_experiments_with(&c.toml, 4).unwrap().warnings.is_empty());
+    assert!(load_experiments_with(&c.toml, 4)
+        .unwrap()
+        .warnings
+        .is_empty());
 }
 
 #[test]
 fn metres_in_a_micrometre_uncertainty_key_are_refused() {
     // [F38] gauge_offset_um = 2e-6 (metres) was accepted
     let c = Copy::new("msg_gauge_offset");
-    c.toml("[material]", "[uncertainty]\ngauge_offset_um = 2e-6\n\n[material]");
+    c.toml(
+        "[material]",
+        "[uncertainty]\ngauge_offset_um = 2e-6\n\n[material]",
+    );
     let e = c.error();
     assert_contains(
         &e,

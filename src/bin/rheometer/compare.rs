@@ -54,7 +54,7 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         with,
         out,
     } = args;
-    let loaded = load_experiments_with(&experiments, 4)?;
+    let loaded = load_input(g, &experiments, take_up_from_data, true)?;
     let inputs = inputs_of(&experiments, &loaded);
     let set = &loaded.set;
     let fit_params = fit.as_ref().map(|p| read_fit(p)).transpose()?;
