@@ -574,11 +574,13 @@ fn interrupt(args: &[&str], watch: &[&Path], ready: impl Fn() -> bool) -> (Probe
 #[test]
 fn sigint_during_simulate_keeps_and_marks_the_finished_profiles() {
     let (dir, _toml, data) = shipped_copy("sigint_simulate");
-    let toml = many_experiments(&data, "many.toml", 120); // 1080 experiments
+    // 1080 experiments: more than the default cap of 1000, lifted by --allow-large-inputs
+    let toml = many_experiments(&data, "many.toml", 120);
     let out = dir.join("sim");
     let ready = || out.is_dir() && profile_files(&out).len() >= 3;
     let (p, stop) = interrupt(
         &[
+            "--allow-large-inputs",
             "simulate",
             s(&toml),
             "--take-up-from-data",

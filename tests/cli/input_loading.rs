@@ -13,15 +13,17 @@ const SHIPPED: &str = concat!(
     "/data/pmma7n_synthetic/experiments.toml"
 );
 
-/// A unique temporary directory, removed on drop.
+/// A unique scratch directory under `target/` (never in /tmp), removed on drop.
 struct TempDir(PathBuf);
 
 impl TempDir {
     fn new() -> Self {
         static COUNTER: AtomicUsize = AtomicUsize::new(0);
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir =
-            std::env::temp_dir().join(format!("diffbvp_input_loading_{}_{n}", std::process::id()));
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("target")
+            .join("test-scratch")
+            .join(format!("input_loading_{}_{n}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         TempDir(dir)
     }
@@ -481,8 +483,8 @@ fn csv_errors_name_file_and_line() {
             "a.csv:3: non-numeric cell `abc` in column `diameter_m`",
         ),
         (
-            replace("position_m,diameter_m", "position_mm,diameter_mm"),
-            "a.csv:1: wrong header `position_mm,diameter_mm`; expected `position_m,diameter_m`",
+            replace("position_m,diameter_m", "position_in,diameter_m"),
+            "a.csv:1: wrong header `position_in,diameter_m`; expected `position_m,diameter_m`",
         ),
         (
             replace("0.20,", "0.05,"),
@@ -490,11 +492,11 @@ fn csv_errors_name_file_and_line() {
         ),
         (
             replace("0.20,", "0.10,"),
-            "a.csv:4: position 0.1 m repeats the one on line 3",
+            "a.csv:4: position 0.10 m repeats the one on line 3",
         ),
         (
             replace("5.0e-4", "-5.0e-4"),
-            "a.csv:3: diameter -0.0005 m is not positive",
+            "a.csv:3: diameter -5.0e-4 m is not positive",
         ),
         (
             replace("5.0e-4", "0"),
@@ -506,7 +508,7 @@ fn csv_errors_name_file_and_line() {
         ),
         (
             replace("0.40,", "0.60,"),
-            "a.csv:6: position 0.6 m lies beyond the spin-line length 0.51 m",
+            "a.csv:6: position 0.60 m lies beyond the spin-line length 0.51 m",
         ),
         (
             replace("0.00,", "-0.01,"),
@@ -524,6 +526,7 @@ fn csv_errors_name_file_and_line() {
     for (csv, expected) in cases {
         let message = csv_error(&csv);
         assert_contains(&message, &["exp.toml:24:", expected]);
+        assert!(!message.contains("look like"), "{message}");
     }
 }
 

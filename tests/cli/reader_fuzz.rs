@@ -371,7 +371,10 @@ fn csv_reader_survives_mutations_of_the_shipped_file() {
 /// directory: errors start with the TOML file, and errors in a CSV file also name that file.
 #[test]
 fn loader_survives_mutated_toml_and_csv_files() {
-    let dir = std::env::temp_dir().join(format!("diffbvp_reader_fuzz_{}", std::process::id()));
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("target")
+        .join("test-scratch")
+        .join(format!("reader_fuzz_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let toml_path = dir.join("experiments.toml");
     let base_toml = shipped_toml();

@@ -58,7 +58,7 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         tol,
         out,
     } = args;
-    let loaded = load_experiments_with(&experiments, 4)?;
+    let loaded = load_input(g, &experiments, take_up_from_data, true)?;
     let inputs = inputs_of(&experiments, &loaded);
     let mut request = match &fit {
         Some(path) => {

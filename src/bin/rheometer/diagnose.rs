@@ -41,7 +41,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         json,
         out,
     } = args;
-    let loaded = load_experiments_with(&experiments, 4)?;
+    let loaded = load_input(g, &experiments, true, true)?;
     let inputs = inputs_of(&experiments, &loaded);
     let spec = ModelSpec {
         law: model,

@@ -76,7 +76,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     if let Some(s) = start {
         checks::check_start(s, &opts)?;
     }
-    let loaded = load_experiments_with(&experiments, 4)?;
+    let loaded = load_input(g, &experiments, true, true)?;
     let inputs = inputs_of(&experiments, &loaded);
     // refuse an output that is an input before spending time on the fit
     if let Some(path) = &json {

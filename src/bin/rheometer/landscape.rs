@@ -49,7 +49,7 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     )?;
     opts.simulate.tol = tol;
     opts.simulate.max_nodes = checks::landscape_max_nodes(g.max_nodes)?;
-    let loaded = load_experiments_with(&experiments, 4)?;
+    let loaded = load_input(g, &experiments, true, true)?;
     let inputs = inputs_of(&experiments, &loaded);
     let outputs = [
         "landscape.csv".to_string(),

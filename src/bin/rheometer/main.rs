@@ -9,7 +9,9 @@ use diffbvp::fiber::effects::{EffectSetting, LawChoice, ModelSpec};
 use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::figures::{self, ExperimentView, ModelCurves, View};
 use diffbvp::fiber::flow_curve_figure::save_flow_curve_figure;
-use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
+use diffbvp::fiber::input::{
+    load_experiments_with_options, InputError, LoadOptions, LoadedExperiments,
+};
 use diffbvp::fiber::output::{
     check_output_dir, create_dir, ensure_not_input, profiles_csv, write_atomically, write_profiles,
     write_text,
@@ -148,6 +150,11 @@ struct Cli {
     /// 1000). A solve that needs more fails and names this flag.
     #[arg(long, global = true, value_parser = checks::parse_max_nodes)]
     max_nodes: Option<usize>,
+    /// Lift the caps on input size (16 MB experiments file, 128 MB and 1,000,000 rows per CSV
+    /// file, 64 kB per CSV line, 1000 experiments, 4 GB estimated fit memory). Inputs must
+    /// still be regular files.
+    #[arg(long, global = true)]
+    allow_large_inputs: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -235,6 +242,8 @@ pub struct Global {
     pub format: FormatArg,
     /// `--max-nodes`, if given.
     pub max_nodes: Option<usize>,
+    /// `--allow-large-inputs`: no caps on input size.
+    pub allow_large_inputs: bool,
 }
 
 impl Global {
@@ -249,6 +258,42 @@ impl Global {
     pub fn warn(&self, s: String) {
         err_line(&format!("warning: {s}"));
     }
+}
+
+/// Loads the experiments file and its CSV files (at least 4 rows each) under the input caps
+/// (lifted by `--allow-large-inputs`), and prints the loader's warnings once.
+/// `take_up_from_data`: whether experiments without a take-up condition will use `d_fit(L)`
+/// of their data (then a spin line far beyond the measured range is refused);
+/// `require_data`: whether every experiment must name a data file.
+pub fn load_input(
+    g: &Global,
+    path: &Path,
+    take_up_from_data: bool,
+    require_data: bool,
+) -> Result<LoadedExperiments, Box<dyn Error>> {
+    let mut options = LoadOptions {
+        take_up_from_data,
+        require_data,
+        ..LoadOptions::with_min_points(4)
+    };
+    if g.allow_large_inputs {
+        options.max_toml_bytes = u64::MAX;
+        options.max_csv_bytes = u64::MAX;
+        options.max_line_bytes = usize::MAX;
+        options.max_rows_per_file = usize::MAX;
+        options.max_experiments = usize::MAX;
+        options.max_fit_memory_bytes = u64::MAX;
+    }
+    let loaded = load_experiments_with_options(path, &options).map_err(|e| match e {
+        InputError::Limit { .. } => {
+            format!("{e} (on the command line: --allow-large-inputs)").into()
+        }
+        e => Box::<dyn Error>::from(e),
+    })?;
+    for w in &loaded.warnings {
+        g.warn(w.to_string());
+    }
+    Ok(loaded)
 }
 
 fn inputs_of(path: &Path, loaded: &LoadedExperiments) -> Vec<PathBuf> {
@@ -307,6 +352,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
         verbose: cli.verbose,
         format: cli.format,
         max_nodes: cli.max_nodes,
+        allow_large_inputs: cli.allow_large_inputs,
     };
     let toml = match &cli.command {
         Command::Simulate(a) => a.experiments.clone(),

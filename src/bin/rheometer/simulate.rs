@@ -45,7 +45,12 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         points,
         out,
     } = args;
-    let loaded = load_experiments_with(&experiments, 4)?;
+    let loaded = load_input(
+        g,
+        &experiments,
+        take_up_from_data && take_up_diameter.is_none(),
+        false,
+    )?;
     let inputs = inputs_of(&experiments, &loaded);
     let set = &loaded.set;
     // every output name is checked against the inputs before any work starts

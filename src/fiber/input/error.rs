@@ -1,8 +1,9 @@
 //! Errors of the input readers: where ([`Location`]: file and line) and what ([`InputError`]).
 
 use std::fmt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use super::options::Limit;
 use crate::fiber::error::Readable;
 
 /// A place in an input file: the path and, where known, the 1-based line.
@@ -16,7 +17,7 @@ pub struct Location {
 
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.path.display())?;
+        write!(f, "{}", ShowPath(&self.path))?;
         match self.line {
             Some(line) => write!(f, ":{line}"),
             None => Ok(()),
@@ -28,14 +29,59 @@ impl fmt::Display for Location {
 /// the TOML table (`[material]`, `[defaults]`, `[[experiment]] #2 "name"`) and key, or the CSV
 /// line, involved.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum InputError {
-    /// The file could not be read (missing, unreadable, not UTF-8).
-    #[error("{}: cannot read file: {source}", path.display())]
+    /// The file could not be read (missing, unreadable).
+    #[error("{}: cannot read file: {source}{hint}", ShowPath(path))]
     Io {
         /// The file.
         path: PathBuf,
         /// The I/O error.
         source: std::io::Error,
+        /// A suggestion (starts with `"; "`) or empty.
+        hint: String,
+    },
+    /// The path is not a regular file (a FIFO, device, socket or directory): refused before it
+    /// is opened, so that nothing blocks or reads without end.
+    #[error("{}: {kind}, not a regular file; {hint}", ShowPath(path))]
+    NotRegular {
+        /// The path.
+        path: PathBuf,
+        /// What it is (`"a FIFO (named pipe)"`, `"a character device"`, …).
+        kind: &'static str,
+        /// What to do.
+        hint: String,
+    },
+    /// A file, line, row count or the data set exceeds a cap of
+    /// [`LoadOptions`](super::LoadOptions).
+    #[error("{at}: {message}")]
+    Limit {
+        /// File and line (if the cap was reached at a line).
+        at: Location,
+        /// The cap.
+        limit: Limit,
+        /// What exceeded it and how to raise it.
+        message: String,
+    },
+    /// The file is not UTF-8 text (another encoding, binary data, a spreadsheet).
+    #[error("{at}{}: {message}", column.map(|c| format!(":{c}")).unwrap_or_default())]
+    Encoding {
+        /// File and line of the first offending byte.
+        at: Location,
+        /// 1-based column (characters) of the offending byte, if known.
+        column: Option<usize>,
+        /// 0-based byte offset of the offending byte in the file.
+        offset: u64,
+        /// What the bytes look like and how to re-save the file.
+        message: String,
+    },
+    /// The file given as the experiments file is something else (a CSV table, a JSON report).
+    #[error("{at}: this is not an experiments file: {message}")]
+    NotExperiments {
+        /// The file (and the line that shows it).
+        at: Location,
+        /// What it looks like and what to pass instead.
+        message: String,
     },
     /// The file is not valid TOML.
     #[error("{at}{}: malformed TOML: {message}", column.map(|c| format!(":{c}")).unwrap_or_default())]
@@ -140,4 +186,108 @@ pub enum InputError {
         /// The error in the data file.
         cause: Box<InputError>,
     },
+}
+
+/// An input that is accepted but doubtful (a take-up diameter extrapolated beyond the
+/// measured positions, a °C value that looks like kelvin): where and what.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InputWarning {
+    /// File and line of the key concerned.
+    pub at: Location,
+    /// What is doubtful and what to do.
+    pub message: String,
+}
+
+impl fmt::Display for InputWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.at, self.message)
+    }
+}
+
+/// A path as shown in messages: as is, or quoted (`"v0p27_p1.csv "`) when leading or trailing
+/// spaces or control characters would be invisible.
+pub(super) struct ShowPath<'a>(pub &'a Path);
+
+impl fmt::Display for ShowPath<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let text = self.0.to_string_lossy();
+        let needs_quotes = text.starts_with(char::is_whitespace)
+            || text.ends_with(char::is_whitespace)
+            || text.chars().any(char::is_control);
+        let text = short(&text, 300);
+        if needs_quotes {
+            write!(f, "{text:?}")
+        } else {
+            write!(f, "{text}")
+        }
+    }
+}
+
+/// `text` cut to at most `max` characters for a message, saying how long it was
+/// (`"1111111111… (1000002 characters)"`).
+pub(super) fn short(text: &str, max: usize) -> String {
+    let n = text.chars().count();
+    if n <= max {
+        return text.to_string();
+    }
+    let head: String = text.chars().take(max.saturating_sub(1)).collect();
+    format!("{head}… ({n} characters)")
+}
+
+/// `x` with 4 significant digits for a message (`14.43`, `1.569e-5`, `1e308`), for computed
+/// values; values as the user typed them are shown as typed.
+pub(super) fn sig(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() {
+        return format!("{x}");
+    }
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{x:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    } else {
+        let s = format!("{x:.3e}");
+        match s.split_once('e') {
+            Some((m, e)) if m.contains('.') => {
+                format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+            }
+            _ => s,
+        }
+    }
+}
+
+/// The `Readable` form of a value for messages.
+pub(super) fn readable(x: f64) -> String {
+    Readable(x).to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_for_messages() {
+        assert_eq!(sig(14.4321), "14.43");
+        assert_eq!(sig(1.5690566037735852e-05), "1.569e-5");
+        assert_eq!(sig(1e308), "1e308");
+        assert_eq!(sig(0.51), "0.51");
+        assert_eq!(sig(513.15), "513.1");
+        assert_eq!(sig(-2.0), "-2");
+        assert_eq!(sig(12345.6), "12346");
+        assert_eq!(readable(1e308), "1e308");
+    }
+
+    #[test]
+    fn long_text_is_cut() {
+        assert_eq!(short("abc", 80), "abc");
+        let long = "1".repeat(1000);
+        let s = short(&long, 80);
+        assert!(s.len() < 110 && s.ends_with("(1000 characters)"), "{s}");
+        assert_eq!(ShowPath(Path::new("a.csv ")).to_string(), "\"a.csv \"");
+        assert_eq!(ShowPath(Path::new("dir/a.csv")).to_string(), "dir/a.csv");
+    }
 }

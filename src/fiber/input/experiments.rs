@@ -1,22 +1,21 @@
 //! Building the experiments from the TOML tables: the material, `[defaults]` and each
-//! `[[experiment]]`, with the plausibility checks of every experiment; loading a whole data set
-//! (TOML and its CSV files).
+//! `[[experiment]]` (see `experiment`), and loading a whole data set (TOML and its CSV files,
+//! with the checks that need both: see `cross_checks`).
 
-use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use toml::de::DeTable;
 
-use super::error::{InputError, Location};
-use super::measurements::{load_measurements, DEFAULT_MIN_POINTS};
-use super::read_text;
-use super::schema::{
-    names, rule_of, Rule, EXPERIMENT_NUMBERS, EXPERIMENT_TABLES, MATERIAL_NUMBERS,
-    MAX_PLAUSIBLE_DIAMETER_M, MIN_PLAUSIBLE_DIAMETER_M, STRING_KEYS, TOP_KEYS,
-};
-use super::spanned::{toml_error, Doc, Field, Tab};
+use super::cross_checks::{check_experiment_memory, cross_check, data_error, FitBudget};
+use super::error::{short, InputError, InputWarning, Location};
+use super::experiment::{experiment, Located, MaterialAt};
+use super::measurements::{read_measurements, DEFAULT_MIN_POINTS};
+use super::options::{show_count, Limit, LoadOptions};
+use super::schema::{keys_of, material_quantity, Rule, EXPERIMENT, MATERIAL, TOP_KEYS};
+use super::source::read_toml;
+use super::spanned::{toml_error, Doc, Tab};
 use super::uncertainty::uncertainty_table;
-use crate::fiber::setup::{Air, Experiment, ExperimentSet, Inlet, Material, TakeUp};
+use crate::fiber::setup::{Air, ExperimentSet, Material};
 use crate::fiber::uncertainty::Uncertainties;
 
 /// Largest plausible zero-shear viscosity of the melt at the inlet \[Pa s\]: 1e12 Pa s is the
@@ -43,42 +42,86 @@ pub struct ExperimentDetails {
 /// An experiment set together with per-experiment details (same order as the experiments).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadedExperiments {
-    /// The model input (measurements are `None` when parsed without reading CSV files).
+    /// The model input, in SI units whatever units the file used (measurements are `None`
+    /// when parsed without reading CSV files).
     pub set: ExperimentSet,
     /// Descriptive metadata and data-file paths.
     pub details: Vec<ExperimentDetails>,
     /// Declared standard uncertainties (`[uncertainty]` and the experiments' own tables; empty
     /// when nothing is declared).
     pub uncertainty: Uncertainties,
+    /// Warnings about inputs that are accepted but doubtful (a take-up diameter extrapolated
+    /// beyond the measured positions, a °C value that looks like kelvin), each naming file and
+    /// line; callers should show them.
+    pub warnings: Vec<InputWarning>,
+    /// The experiments file (for messages).
+    pub path: PathBuf,
 }
 
-/// Loads a TOML experiment file and the CSV files it refers to, requiring at least
-/// [`DEFAULT_MIN_POINTS`] measurements per file.
+impl LoadedExperiments {
+    /// An error naming the first experiment without a data file (file, line of its
+    /// `[[experiment]]` table, and the key to add), for callers that need measurements (a
+    /// fit); `Ok` if every experiment has one.
+    pub fn require_data(&self) -> Result<(), InputError> {
+        let Some(k) = self.details.iter().position(|d| d.data.is_none()) else {
+            return Ok(());
+        };
+        let name = &self.set.experiments[k].name;
+        Err(InputError::MissingKey {
+            at: Location {
+                path: self.path.clone(),
+                line: self.details[k].line,
+            },
+            table: format!("[[experiment]] #{} \"{}\"", k + 1, short(name, 40)),
+            key: "data".into(),
+            hint: format!(
+                ": the experiment has no measurements; add `data = \"{}.csv\"` (the CSV file \
+                 of its measured diameters, relative to the experiments file) to its table",
+                short(name, 40)
+            ),
+        })
+    }
+}
+
+/// Loads a TOML experiment file and the CSV files it refers to with the default
+/// [`LoadOptions`] (at least [`DEFAULT_MIN_POINTS`] measurements per file).
 pub fn load_experiments(path: &Path) -> Result<ExperimentSet, InputError> {
     load_experiments_with(path, DEFAULT_MIN_POINTS).map(|loaded| loaded.set)
 }
 
 /// Loads a TOML experiment file and its CSV files, requiring at least `min_points` rows per
-/// CSV file, and returns the set with the experiments' metadata.
+/// CSV file (otherwise the default [`LoadOptions`]), and returns the set with the experiments'
+/// metadata.
 pub fn load_experiments_with(
     path: &Path,
     min_points: usize,
 ) -> Result<LoadedExperiments, InputError> {
-    let text = read_text(path)?;
-    let mut loaded = parse_experiments(&text, path)?;
-    let doc = Doc::new(path, &text);
+    load_experiments_with_options(path, &LoadOptions::with_min_points(min_points))
+}
+
+/// Loads a TOML experiment file and its CSV files under `options` (caps on sizes, rows and
+/// experiments, enforced while reading; the checks that need the TOML and the data together).
+pub fn load_experiments_with_options(
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<LoadedExperiments, InputError> {
+    let text = read_toml(path, options.max_toml_bytes)?;
+    let (mut loaded, located) = parse(&text, path, options)?;
+    if options.require_data {
+        loaded.require_data()?;
+    }
+    check_experiment_memory(&loaded, options)?;
+    let mut budget = FitBudget::new(loaded.set.experiments.len(), options);
     for (i, details) in loaded.details.iter().enumerate() {
         let Some(data) = &details.data else { continue };
         let experiment = &loaded.set.experiments[i];
-        let measured =
-            load_measurements(data, experiment.spinline_length, min_points).map_err(|cause| {
-                InputError::Data {
-                    at: doc.data_key_location(i),
-                    experiment: experiment.name.clone(),
-                    cause: Box::new(cause),
-                }
-            })?;
+        let measured = read_measurements(data, experiment.spinline_length, options, &mut budget)
+            .map_err(|cause| data_error(&located[i], &experiment.name, cause))?;
         loaded.set.measurements[i] = Some(measured);
+    }
+    for (i, located) in located.iter().enumerate() {
+        let warning = cross_check(&loaded, i, located, options)?;
+        loaded.warnings.extend(warning);
     }
     Ok(loaded)
 }
@@ -86,6 +129,24 @@ pub fn load_experiments_with(
 /// Parses the TOML text of an experiment file without reading any CSV file (all measurements
 /// are `None`). `path` is used in error messages and to resolve the `data` paths.
 pub fn parse_experiments(text: &str, path: &Path) -> Result<LoadedExperiments, InputError> {
+    parse_experiments_with(text, path, &LoadOptions::default())
+}
+
+/// [`parse_experiments`] under `options` (the cap on the number of experiments).
+pub fn parse_experiments_with(
+    text: &str,
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<LoadedExperiments, InputError> {
+    parse(text, path, options).map(|(loaded, _)| loaded)
+}
+
+/// The experiments and where their keys are.
+fn parse(
+    text: &str,
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<(LoadedExperiments, Vec<Located>), InputError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let root = DeTable::parse(text).map_err(|e| toml_error(path, text, &e))?;
     let doc = Doc::new(path, text);
@@ -95,64 +156,74 @@ pub fn parse_experiments(text: &str, path: &Path) -> Result<LoadedExperiments, I
         table: root.get_ref(),
         line: None,
     };
-    top.check_keys(TOP_KEYS)?;
+    top.check_keys(TOP_KEYS)
+        .map_err(|e| super::syntax::not_experiments(path, text).unwrap_or(e))?;
     let relative_uncertainty = match top.get("relative_uncertainty") {
-        Some(field) => Some(relative_uncertainty(&field)?),
+        Some(field) => Some(field.number(Rule::Fraction)?),
         None => None,
     };
     let mut uncertainty = Uncertainties::default();
     if let Some(tab) = top.sub_table("uncertainty", "[uncertainty]")? {
         uncertainty.set = uncertainty_table(&tab)?;
     }
-    let material_tab = top
-        .sub_table("material", "[material]")?
-        .ok_or_else(|| top.missing("material", " (the [material] table)"))?;
+    let material_tab = top.sub_table("material", "[material]")?.ok_or_else(|| {
+        super::syntax::not_experiments(path, text)
+            .unwrap_or_else(|| top.missing("material", " (the [material] table)"))
+    })?;
     let (material, air) = material(&material_tab)?;
+    let at = |key: &str| match material_tab.get(key) {
+        Some(field) => field.at(),
+        None => doc.at_line(material_tab.line),
+    };
+    let material_at = MaterialAt {
+        density: at("density_slope_kg_m3_K"),
+        heat_capacity: at("heat_capacity_slope_J_kg_K2"),
+    };
     let defaults = top.sub_table("defaults", "[defaults]")?;
     if let Some(defaults) = &defaults {
-        defaults.check_keys(&names(EXPERIMENT_NUMBERS))?;
-        for (key, rule) in EXPERIMENT_NUMBERS {
-            if let Some(field) = defaults.get(key) {
-                field.number(*rule)?;
+        defaults.check_keys(&keys_of(EXPERIMENT))?;
+        for q in EXPERIMENT {
+            if let Some((field, unit)) = defaults.quantity(q)? {
+                field.quantity(q, &unit)?;
             }
         }
     }
     let tables = top.experiment_tables()?;
+    if tables.len() > options.max_experiments {
+        return Err(InputError::Limit {
+            at: doc.at_line(tables.get(options.max_experiments).and_then(|t| t.line)),
+            limit: Limit::Experiments,
+            message: format!(
+                "{} [[experiment]] tables, more than the limit of {} (a fit of that many \
+                 experiments would take hours); split the data set, or raise the limit `{}` if \
+                 this is intended",
+                show_count(tables.len() as u64),
+                show_count(options.max_experiments as u64),
+                Limit::Experiments.option()
+            ),
+        });
+    }
     let mut experiments = Vec::with_capacity(tables.len());
     let mut details = Vec::with_capacity(tables.len());
-    let mut seen: Vec<(String, Option<usize>)> = Vec::new();
+    let mut located = Vec::with_capacity(tables.len());
+    let mut warnings = Vec::new();
     for tab in tables {
-        let label = tab.name.clone();
-        let own_name = match tab
-            .get("name")
-            .and_then(|f| f.string().ok().map(str::to_string))
-        {
-            Some(name) => format!("{label} \"{name}\" uncertainty table"),
-            None => format!("{label} uncertainty table"),
-        };
-        let own = match tab.sub_table("uncertainty", &own_name)? {
+        let own = match tab.sub_table("uncertainty", &format!("{} uncertainty table", tab.name))? {
             Some(t) => uncertainty_table(&t)?,
             None => Vec::new(),
         };
         uncertainty.experiments.push(own);
-        let (experiment, mut detail, name_at) = experiment(tab, defaults.as_ref(), &material)?;
-        detail.line = name_at.line;
-        if let Some((_, first)) = seen.iter().find(|(n, _)| *n == experiment.name) {
-            let first = first
-                .map(|l| format!(" (first defined at line {l})"))
-                .unwrap_or_default();
-            return Err(InputError::Inconsistent {
-                at: name_at,
-                table: format!("{label} \"{}\"", experiment.name),
-                message: format!("duplicate experiment name \"{}\"{first}", experiment.name),
-            });
-        }
-        seen.push((experiment.name.clone(), name_at.line));
+        let (experiment, mut detail, at) =
+            experiment(tab, defaults.as_ref(), &material, &material_at)?;
+        detail.line = at.name.line;
+        unique_name(&experiment.name, &at, &located)?;
+        warnings.extend(at.warnings.iter().cloned());
         experiments.push(experiment);
         details.push(detail);
+        located.push(at);
     }
     let measurements = vec![None; experiments.len()];
-    Ok(LoadedExperiments {
+    let loaded = LoadedExperiments {
         set: ExperimentSet {
             material,
             air,
@@ -162,6 +233,38 @@ pub fn parse_experiments(text: &str, path: &Path) -> Result<LoadedExperiments, I
         },
         details,
         uncertainty,
+        warnings,
+        path: path.to_path_buf(),
+    };
+    Ok((loaded, located))
+}
+
+/// Refuses a name used before, also when the two differ only in case (the output files would
+/// collide on case-insensitive file systems: macOS, Windows).
+fn unique_name(name: &str, at: &Located, before: &[Located]) -> Result<(), InputError> {
+    let lower = name.to_lowercase();
+    let Some(first) = before.iter().find(|b| b.name_text.to_lowercase() == lower) else {
+        return Ok(());
+    };
+    let line = first
+        .name
+        .line
+        .map(|l| format!(" (first defined at line {l})"))
+        .unwrap_or_default();
+    let message = if first.name_text == name {
+        format!("duplicate experiment name \"{}\"{line}", short(name, 60))
+    } else {
+        format!(
+            "experiment name \"{}\" differs from \"{}\"{line} only in upper/lower case: their \
+             output files would overwrite each other on macOS and Windows; rename one",
+            short(name, 60),
+            short(&first.name_text, 60)
+        )
+    };
+    Err(InputError::Inconsistent {
+        at: at.name.clone(),
+        table: at.table.clone(),
+        message,
     })
 }
 
@@ -172,317 +275,41 @@ impl ExperimentSet {
     }
 }
 
-fn relative_uncertainty(field: &Field<'_>) -> Result<f64, InputError> {
-    field.number(Rule::Fraction)
-}
-
 fn material(tab: &Tab<'_>) -> Result<(Material, Air), InputError> {
-    tab.check_keys(&names(MATERIAL_NUMBERS))?;
-    let get = |key: &'static str| -> Result<f64, InputError> {
-        let rule = rule_of(MATERIAL_NUMBERS, key).unwrap_or(Rule::Finite);
-        match tab.get(key) {
-            Some(field) => field.number(rule),
-            None if key == "trouton_ratio" => Ok(3.0),
-            None => Err(tab.missing(key, "")),
+    tab.check_keys(&keys_of(MATERIAL))?;
+    let get = |stem: &'static str| -> Result<f64, InputError> {
+        let Some(q) = material_quantity(stem) else {
+            return Err(tab.missing(stem, ""));
+        };
+        match tab.quantity(q)? {
+            Some((field, unit)) => field.quantity(q, &unit),
+            None if stem == "trouton_ratio" => Ok(3.0),
+            None => Err(tab.missing(&q.si_key(), "")),
         }
     };
     let material = Material {
-        density_slope: get("density_slope_kg_m3_K")?,
-        density_intercept: get("density_intercept_kg_m3")?,
-        heat_capacity_slope: get("heat_capacity_slope_J_kg_K2")?,
-        heat_capacity_intercept: get("heat_capacity_intercept_J_kg_K")?,
-        vft_mu_c: get("vft_mu_c_Pa_s")?,
-        vft_b: get("vft_B_K")?,
-        vft_t_vf: get("vft_T_VF_K")?,
+        density_slope: get("density_slope")?,
+        density_intercept: get("density_intercept")?,
+        heat_capacity_slope: get("heat_capacity_slope")?,
+        heat_capacity_intercept: get("heat_capacity_intercept")?,
+        vft_mu_c: get("vft_mu_c")?,
+        vft_b: get("vft_B")?,
+        vft_t_vf: get("vft_T_VF")?,
         trouton: get("trouton_ratio")?,
     };
     let air = Air {
-        density: get("air_density_kg_m3")?,
-        heat_capacity: get("air_heat_capacity_J_kg_K")?,
-        kinematic_viscosity: get("air_kinematic_viscosity_m2_s")?,
-        heat_conductivity: get("air_heat_conductivity_W_m_K")?,
+        density: get("air_density")?,
+        heat_capacity: get("air_heat_capacity")?,
+        kinematic_viscosity: get("air_kinematic_viscosity")?,
+        heat_conductivity: get("air_heat_conductivity")?,
     };
     Ok((material, air))
-}
-
-/// An experiment table backed by `[defaults]`.
-struct Scope<'s, 'a> {
-    table: &'s Tab<'a>,
-    defaults: Option<&'s Tab<'a>>,
-}
-
-impl<'a> Scope<'_, 'a> {
-    fn get(&self, key: &'a str) -> Option<Field<'a>> {
-        self.table
-            .get(key)
-            .or_else(|| self.defaults.and_then(|d| d.get(key)))
-    }
-
-    fn rule(key: &str) -> Rule {
-        rule_of(EXPERIMENT_NUMBERS, key).unwrap_or(Rule::Finite)
-    }
-
-    fn optional(&self, key: &'a str) -> Result<Option<(f64, Field<'a>)>, InputError> {
-        match self.get(key) {
-            Some(field) => Ok(Some((field.number(Self::rule(key))?, field))),
-            None => Ok(None),
-        }
-    }
-
-    fn required(&self, key: &'a str) -> Result<(f64, Field<'a>), InputError> {
-        let hint = " (give it here or in [defaults])";
-        self.optional(key)?
-            .ok_or_else(|| self.table.missing(key, hint))
-    }
-
-    /// One of two mutually exclusive keys, resolved as a pair: the experiment table first,
-    /// then `[defaults]`. Returns `(first_key_given, value, field)`.
-    fn either(&self, a: &'a str, b: &'a str) -> Result<Option<(bool, f64, Field<'a>)>, InputError> {
-        for tab in std::iter::once(self.table).chain(self.defaults) {
-            match (tab.get(a), tab.get(b)) {
-                (Some(_), Some(fb)) => {
-                    return Err(fb.inconsistent(format!("give either `{a}` or `{b}`, not both")))
-                }
-                (Some(fa), None) => return Ok(Some((true, fa.number(Self::rule(a))?, fa))),
-                (None, Some(fb)) => return Ok(Some((false, fb.number(Self::rule(b))?, fb))),
-                (None, None) => {}
-            }
-        }
-        Ok(None)
-    }
-}
-
-/// Parses one `[[experiment]]` table; also returns the location of its name.
-fn experiment(
-    mut tab: Tab<'_>,
-    defaults: Option<&Tab<'_>>,
-    material: &Material,
-) -> Result<(Experiment, ExperimentDetails, Location), InputError> {
-    // name the table by the experiment's name (if readable) before reporting unknown keys
-    if let Some(name) = tab
-        .get("name")
-        .and_then(|f| f.string().ok().map(str::to_string))
-    {
-        tab.name = format!("{} \"{name}\"", tab.name);
-    }
-    tab.check_keys(&[STRING_KEYS, EXPERIMENT_TABLES, &names(EXPERIMENT_NUMBERS)].concat())?;
-    let name_field = tab.get("name").ok_or_else(|| tab.missing("name", ""))?;
-    let name = name_field.string()?.to_string();
-    if name.trim().is_empty() || name.contains(['/', '\\']) || name.chars().any(char::is_control) {
-        return Err(name_field.inconsistent(format!(
-            "`name` = {name:?} must be non-empty, without path separators or control characters"
-        )));
-    }
-    let name_at = name_field.at();
-    let scope = Scope {
-        table: &tab,
-        defaults,
-    };
-    let (mass_flow, q_field) = scope.required("mass_flow_kg_s")?;
-    let (spinline_length, _) = scope.required("spinline_length_m")?;
-    let (inlet_temperature, t_in_field) = scope.required("inlet_temperature_K")?;
-    let (air_temperature, t_air_field) = scope.required("air_temperature_K")?;
-    let table = tab.name.as_str();
-
-    let t_vf = material.vft_t_vf;
-    if inlet_temperature <= t_vf {
-        return Err(t_in_field.invalid_in(
-            table,
-            inlet_temperature,
-            format!(
-                "must exceed the Vogel temperature vft_T_VF_K = {t_vf} K of [material]: the VFT \
-                 viscosity is undefined at and below it"
-            ),
-        ));
-    }
-    if air_temperature <= t_vf {
-        return Err(t_air_field.invalid_in(
-            table,
-            air_temperature,
-            format!(
-                "must exceed the Vogel temperature vft_T_VF_K = {t_vf} K of [material]: the fiber \
-                 cools towards the air temperature, and the VFT viscosity is undefined at and \
-                 below T_VF"
-            ),
-        ));
-    }
-    for (t, field) in [
-        (inlet_temperature, &t_in_field),
-        (air_temperature, &t_air_field),
-    ] {
-        let (rho, cp) = (material.density(t), material.heat_capacity(t));
-        if !(rho > 0.0 && cp > 0.0) {
-            return Err(field.invalid_in(
-                table,
-                t,
-                format!(
-                    "[material] gives a non-positive density ({rho} kg/m³) or heat capacity \
-                     ({cp} J/(kg K)) at this temperature"
-                ),
-            ));
-        }
-    }
-    let mu_in = material.zero_shear_viscosity(inlet_temperature);
-    if !(mu_in.is_finite() && mu_in <= MAX_INLET_VISCOSITY_PA_S) {
-        let what = if mu_in.is_finite() {
-            format!(
-                "a zero-shear viscosity of {mu_in:.3e} Pa s at the inlet, above \
-                 {MAX_INLET_VISCOSITY_PA_S:e} Pa s (a glass, not a melt)"
-            )
-        } else {
-            "an infinite zero-shear viscosity at the inlet (beyond the floating-point range)"
-                .to_string()
-        };
-        return Err(t_in_field.invalid_in(
-            table,
-            inlet_temperature,
-            format!(
-                "the inlet temperature is only {:.4} K above the Vogel temperature \
-                 vft_T_VF_K = {t_vf} K: the VFT law mu_c exp(B/(T - T_VF)) gives {what}",
-                inlet_temperature - t_vf
-            ),
-        ));
-    }
-
-    let (inlet_is_diameter, inlet_value, inlet_field) = scope
-        .either("inlet_diameter_m", "inlet_velocity_m_s")?
-        .ok_or_else(|| InputError::Inconsistent {
-            at: tab.doc.at_line(tab.line),
-            table: tab.name.clone(),
-            message: "missing inlet condition: give `inlet_diameter_m` or `inlet_velocity_m_s` \
-                      (here or in [defaults])"
-                .into(),
-        })?;
-    let inlet = if inlet_is_diameter {
-        Inlet::Diameter(inlet_value)
-    } else {
-        Inlet::Velocity(inlet_value)
-    };
-    // the other inlet quantity, from the mass balance Q = ρ(T_in) u_in π d_in²/4
-    let rho_in = material.density(inlet_temperature);
-    let (d_in, u_in) = match inlet {
-        Inlet::Diameter(d) => (d, 4.0 * mass_flow / (PI * rho_in * d * d)),
-        Inlet::Velocity(u) => (2.0 * (mass_flow / (PI * rho_in * u)).sqrt(), u),
-    };
-    let (derived, value, unit, min, max) = if inlet_is_diameter {
-        ("inlet velocity 4 Q/(π ρ d_in²)", u_in, "m/s", 1e-6, 1e3)
-    } else {
-        (
-            "inlet diameter 2 √(Q/(π ρ u_in))",
-            d_in,
-            "m",
-            MIN_PLAUSIBLE_DIAMETER_M,
-            MAX_PLAUSIBLE_DIAMETER_M,
-        )
-    };
-    if !(value.is_finite() && value >= min && value <= max) {
-        return Err(inlet_field.inconsistent_in(
-            table,
-            format!(
-                "`mass_flow_kg_s` = {mass_flow} (line {}) and `{}` = {inlet_value} give an {derived} \
-                 = {value:.3e} {unit} (with ρ(T_in) = {rho_in:.1} kg/m³), outside the plausible range \
-                 {min:e} to {max:e} {unit}",
-                q_field.at().line.unwrap_or(0),
-                inlet_field.key
-            ),
-        ));
-    }
-    let given = |derived_from: &str| {
-        if derived_from.is_empty() {
-            String::new()
-        } else {
-            format!(" (derived from `mass_flow_kg_s` and `{derived_from}`)")
-        }
-    };
-    let take_up = match scope.either("take_up_diameter_m", "take_up_velocity_m_s")? {
-        None => None,
-        Some((true, d_out, field)) => {
-            let from = given(if inlet_is_diameter {
-                ""
-            } else {
-                "inlet_velocity_m_s"
-            });
-            if d_out >= d_in {
-                return Err(field.inconsistent_in(
-                    table,
-                    format!(
-                        "take-up diameter {d_out} m must be smaller than the inlet diameter {d_in} m{from}"
-                    ),
-                ));
-            }
-            let ratio = (d_in / d_out).powi(2);
-            if ratio > MAX_DRAW_RATIO {
-                return Err(field.inconsistent_in(
-                    table,
-                    format!(
-                        "take-up diameter {d_out} m and inlet diameter {d_in} m{from} give a draw \
-                         ratio (d_in/d_out)² = {ratio:.3e}, above the plausible {MAX_DRAW_RATIO:e}"
-                    ),
-                ));
-            }
-            Some(TakeUp::Diameter(d_out))
-        }
-        Some((false, u_out, field)) => {
-            let from = given(if inlet_is_diameter {
-                "inlet_diameter_m"
-            } else {
-                ""
-            });
-            if u_out <= u_in {
-                return Err(field.inconsistent_in(
-                    table,
-                    format!(
-                        "take-up velocity {u_out} m/s must be larger than the inlet velocity {u_in} m/s{from}"
-                    ),
-                ));
-            }
-            let ratio = u_out / u_in;
-            if ratio > MAX_DRAW_RATIO {
-                return Err(field.inconsistent_in(
-                    table,
-                    format!(
-                        "take-up velocity {u_out} m/s and inlet velocity {u_in} m/s{from} give a \
-                         draw ratio u_out/u_in = {ratio:.3e}, above the plausible {MAX_DRAW_RATIO:e}"
-                    ),
-                ));
-            }
-            Some(TakeUp::Velocity(u_out))
-        }
-    };
-
-    let metadata = |key| scope.optional(key).map(|v| v.map(|(x, _)| x));
-    let data = match tab.get("data") {
-        None => None,
-        Some(field) => {
-            let file = field.string()?;
-            if file.trim().is_empty() {
-                return Err(field.inconsistent("`data` must name a CSV file".into()));
-            }
-            let dir = tab.doc.path.parent().unwrap_or(Path::new(""));
-            Some(dir.join(file))
-        }
-    };
-    let details = ExperimentDetails {
-        stencil_velocity_mm_s: metadata("stencil_velocity_mm_s")?,
-        take_up_pressure_bar: metadata("take_up_pressure_bar")?,
-        data,
-        line: None,
-    };
-    let experiment = Experiment {
-        name,
-        mass_flow,
-        inlet,
-        inlet_temperature,
-        air_temperature,
-        spinline_length,
-        take_up,
-    };
-    Ok((experiment, details, name_at))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fiber::setup::{Inlet, TakeUp};
 
     const MATERIAL: &str = r#"
 [material]

@@ -7,13 +7,18 @@ use std::path::Path;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-use super::error::{InputError, Location};
+use super::error::{readable, short, InputError, Location};
 use super::schema::{
-    key_hint, unit_of, Rule, MAX_PLAUSIBLE_DIAMETER_M, MIN_PLAUSIBLE_DIAMETER_M, PLAUSIBLE_RANGES,
+    key_hint, plausible_range, Quantity, Rule, Unit, MAX_PLAUSIBLE_DIAMETER_M,
+    MIN_PLAUSIBLE_DIAMETER_M,
 };
 
-/// The [`InputError::Toml`] of a TOML syntax error, located by line and column.
+/// The error of a TOML syntax error, located by line and column: a file that is not TOML at
+/// all (JSON, CSV) is said to be so, and a duplicate key or table is named.
 pub(super) fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> InputError {
+    if let Some(other) = super::syntax::not_experiments(path, text) {
+        return other;
+    }
     let (line, column) = match e.span() {
         Some(span) => {
             let (l, c) = line_col(text, span.start);
@@ -21,13 +26,20 @@ pub(super) fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> InputE
         }
         None => (None, None),
     };
+    let message = e.message().trim();
+    let message = match e.span() {
+        Some(span) if message.starts_with("duplicate key") => {
+            super::syntax::duplicate_message(text, span).unwrap_or_else(|| message.to_string())
+        }
+        _ => short(message, 300),
+    };
     InputError::Toml {
         at: Location {
             path: path.to_path_buf(),
             line,
         },
         column,
-        message: e.message().trim().to_string(),
+        message,
     }
 }
 
@@ -51,41 +63,39 @@ pub(super) fn line_col(text: &str, offset: usize) -> (usize, usize) {
 pub(super) struct Doc<'a> {
     pub(super) path: &'a Path,
     pub(super) text: &'a str,
+    /// Byte offsets of the starts of lines 2, 3, … (a line number is a binary search).
+    line_starts: Vec<usize>,
 }
 
 impl<'a> Doc<'a> {
     pub(super) fn new(path: &'a Path, text: &'a str) -> Self {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        Doc { path, text }
+        let line_starts = text
+            .bytes()
+            .enumerate()
+            .filter(|&(_, b)| b == b'\n')
+            .map(|(i, _)| i + 1)
+            .collect();
+        Doc {
+            path,
+            text,
+            line_starts,
+        }
+    }
+
+    /// 1-based line of byte `offset`.
+    pub(super) fn line_of(&self, offset: usize) -> usize {
+        self.line_starts.partition_point(|&start| start <= offset) + 1
     }
 
     pub(super) fn at(&self, span: &Range<usize>) -> Location {
-        self.at_line(Some(line_col(self.text, span.start).0))
+        self.at_line(Some(self.line_of(span.start)))
     }
 
     pub(super) fn at_line(&self, line: Option<usize>) -> Location {
         Location {
             path: self.path.to_path_buf(),
             line,
-        }
-    }
-
-    /// Location of the `data` key of experiment `index` (for errors in its CSV file).
-    pub(super) fn data_key_location(&self, index: usize) -> Location {
-        let span = DeTable::parse(self.text).ok().and_then(|root| {
-            let experiment = root.get_ref().get("experiment")?;
-            let DeValue::Array(array) = experiment.get_ref() else {
-                return None;
-            };
-            let table = array.get(index)?;
-            let DeValue::Table(table) = table.get_ref() else {
-                return None;
-            };
-            table.get("data").map(|v| v.span())
-        });
-        match span {
-            Some(span) => self.at(&span),
-            None => self.at_line(None),
         }
     }
 }
@@ -107,13 +117,41 @@ pub(super) struct Field<'a> {
 }
 
 impl<'a> Tab<'a> {
-    pub(super) fn get(&self, key: &'a str) -> Option<Field<'a>> {
-        self.table.get(key).map(|value| Field {
+    pub(super) fn get(&self, key: &str) -> Option<Field<'a>> {
+        self.table.get_key_value(key).map(|(k, value)| Field {
             doc: self.doc,
             table: self.name.clone(),
-            key,
+            key: k.get_ref().as_ref(),
             value,
         })
+    }
+
+    /// The key of quantity `q` in this table, in whichever unit it is given; an error naming
+    /// both keys if it is given in two units.
+    pub(super) fn quantity(&self, q: &Quantity) -> Result<Option<(Field<'a>, Unit)>, InputError> {
+        let mut found: Option<(Field<'a>, Unit)> = None;
+        for unit in q.units {
+            let Some(field) = self.get(&q.key(unit)) else {
+                continue;
+            };
+            if let Some((first, _)) = &found {
+                let (a, b) = if first.value.span().start <= field.value.span().start {
+                    (first, &field)
+                } else {
+                    (&field, first)
+                };
+                return Err(b.inconsistent(format!(
+                    "`{}` (line {}) and `{}` (line {}) give the same quantity twice, in \
+                     different units; keep one",
+                    a.key,
+                    a.line(),
+                    b.key,
+                    b.line()
+                )));
+            }
+            found = Some((field, *unit));
+        }
+        Ok(found)
     }
 
     pub(super) fn missing(&self, key: &str, hint: &str) -> InputError {
@@ -126,7 +164,9 @@ impl<'a> Tab<'a> {
     }
 
     /// Errors on the first (in file order) key not in `allowed`.
-    pub(super) fn check_keys(&self, allowed: &[&str]) -> Result<(), InputError> {
+    pub(super) fn check_keys<S: AsRef<str>>(&self, allowed: &[S]) -> Result<(), InputError> {
+        let allowed: Vec<&str> = allowed.iter().map(AsRef::as_ref).collect();
+        let allowed = &allowed[..];
         self.check_keys_hinted(allowed, |key| key_hint(key, allowed))
     }
 
@@ -153,11 +193,7 @@ impl<'a> Tab<'a> {
     }
 
     /// The sub-table `key`, if present; an error if `key` is not a table.
-    pub(super) fn sub_table(
-        &self,
-        key: &'a str,
-        name: &str,
-    ) -> Result<Option<Tab<'a>>, InputError> {
+    pub(super) fn sub_table(&self, key: &str, name: &str) -> Result<Option<Tab<'a>>, InputError> {
         let Some(field) = self.get(key) else {
             return Ok(None);
         };
@@ -197,7 +233,7 @@ impl<'a> Tab<'a> {
                     doc: self.doc,
                     name: format!("[[experiment]] #{}", i + 1),
                     table,
-                    line: Some(line_col(self.doc.text, item.span().start).0),
+                    line: Some(self.doc.line_of(item.span().start)),
                 }),
                 other => Err(InputError::WrongType {
                     at: self.doc.at(&item.span()),
@@ -214,6 +250,22 @@ impl<'a> Tab<'a> {
 impl Field<'_> {
     pub(super) fn at(&self) -> Location {
         self.doc.at(&self.value.span())
+    }
+
+    /// 1-based line of the value.
+    pub(super) fn line(&self) -> usize {
+        self.doc.line_of(self.value.span().start)
+    }
+
+    /// The value as written in the file (cut for messages).
+    pub(super) fn raw(&self) -> String {
+        let span = self.value.span();
+        short(self.doc.text.get(span).unwrap_or("?").trim(), 40)
+    }
+
+    /// `` `key` = value (line N)`` for messages.
+    pub(super) fn shown(&self) -> String {
+        format!("`{}` = {} (line {})", self.key, self.raw(), self.line())
     }
 
     pub(super) fn wrong_type(&self, expected: &'static str, found: &DeValue<'_>) -> InputError {
@@ -286,8 +338,8 @@ impl Field<'_> {
         }
     }
 
-    /// The value as a number satisfying `rule`.
-    pub(super) fn number(&self, rule: Rule) -> Result<f64, InputError> {
+    /// The value as a finite number (integers accepted; `nan` and `inf` refused).
+    pub(super) fn finite(&self) -> Result<f64, InputError> {
         // TOML allows `_` between digits (`1_000`); Rust's parsers do not
         let (value, raw) = match self.value.get_ref() {
             DeValue::Float(f) => (f.as_str().replace('_', "").parse::<f64>().ok(), f.as_str()),
@@ -299,58 +351,97 @@ impl Field<'_> {
             ),
             other => return Err(self.wrong_type("a number", other)),
         };
-        let Some(value) = value.filter(|v| v.is_finite()) else {
-            return Err(InputError::NotFinite {
+        match value.filter(|v| v.is_finite()) {
+            Some(value) => Ok(value),
+            None => Err(InputError::NotFinite {
                 at: self.at(),
                 table: self.table.clone(),
                 key: self.key.to_string(),
-                value: raw.to_string(),
-            });
-        };
+                value: short(raw, 40),
+            }),
+        }
+    }
+
+    /// The value as a number satisfying `rule` (no unit conversion, no plausible range).
+    pub(super) fn number(&self, rule: Rule) -> Result<f64, InputError> {
+        let value = self.finite()?;
         match rule {
-            Rule::Finite => Ok(value),
             Rule::Positive | Rule::Diameter if value <= 0.0 => {
                 Err(self.invalid(value, "must be positive"))
             }
             Rule::NonNegative if value < 0.0 => Err(self.invalid(value, "must not be negative")),
-            Rule::Diameter if value > MAX_PLAUSIBLE_DIAMETER_M => Err(self.invalid(
-                value,
-                format!(
-                    "implausibly large for a diameter in metres (> {MAX_PLAUSIBLE_DIAMETER_M} m); \
-                     was it given in millimetres?"
-                ),
-            )),
-            Rule::Diameter if value < MIN_PLAUSIBLE_DIAMETER_M => Err(self.invalid(
-                value,
-                format!(
-                    "implausibly small for a fiber diameter in metres (< {MIN_PLAUSIBLE_DIAMETER_M:e} m \
-                     = 1 µm)"
-                ),
-            )),
             Rule::Fraction if value <= 0.0 || value >= 1.0 => Err(self.invalid(
                 value,
                 "must lie in (0, 1) (a relative uncertainty: 0.015 means 1.5 %)",
             )),
-            _ => self.plausible(value),
+            _ => Ok(value),
         }
     }
 
-    /// `value` if it lies in the key's plausible range ([`PLAUSIBLE_RANGES`]), if it has one.
-    pub(super) fn plausible(&self, value: f64) -> Result<f64, InputError> {
-        match PLAUSIBLE_RANGES.iter().find(|(k, _, _)| *k == self.key) {
-            Some(&(_, min, max)) if value < min || value > max => {
-                let unit = unit_of(self.key);
-                let side = if value < min { "small" } else { "large" };
-                Err(self.invalid(
+    /// The value of quantity `q` given in `unit`, converted to SI, checked against the rule
+    /// and the plausible range of `q` (after conversion), with a hint at the unit that would
+    /// make it plausible.
+    pub(super) fn quantity(&self, q: &Quantity, unit: &Unit) -> Result<f64, InputError> {
+        let value = self.finite()?;
+        let si = unit.to_si(value);
+        let below = if unit.offset == 0.0 {
+            "must be positive".to_string()
+        } else {
+            format!("is at or below absolute zero ({} K)", readable(si))
+        };
+        match q.rule {
+            Rule::Positive | Rule::Diameter if si <= 0.0 => return Err(self.invalid(value, below)),
+            Rule::NonNegative if si < 0.0 => {
+                return Err(self.invalid(
                     value,
-                    format!(
-                        "implausibly {side} for melt spinning (expected {min:e} to {max:e} {unit}); \
-                         check the unit"
-                    ),
+                    if unit.offset == 0.0 {
+                        "must not be negative".to_string()
+                    } else {
+                        below
+                    },
                 ))
             }
-            _ => Ok(value),
+            _ => {}
         }
+        let range = match q.rule {
+            Rule::Diameter => Some(
+                plausible_range(q).unwrap_or((MIN_PLAUSIBLE_DIAMETER_M, MAX_PLAUSIBLE_DIAMETER_M)),
+            ),
+            _ => plausible_range(q),
+        };
+        let Some((min, max)) = range else {
+            return Ok(si);
+        };
+        if (min..=max).contains(&si) {
+            return Ok(si);
+        }
+        let si_unit = q.units[0].symbol;
+        let side = if si < min { "small" } else { "large" };
+        let what = if q.rule == Rule::Diameter {
+            format!("a diameter in {}", unit.name)
+        } else {
+            format!("melt spinning in {}", unit.name)
+        };
+        let converted = if unit.suffix == q.units[0].suffix {
+            String::new()
+        } else {
+            format!(" = {} {si_unit}", readable(si))
+        };
+        let mut reason = format!(
+            "implausibly {side} for {what}{converted} (expected {} to {} {si_unit}); check the unit",
+            readable(min),
+            readable(max)
+        );
+        let fits: Vec<String> = q
+            .units
+            .iter()
+            .filter(|u| u.suffix != unit.suffix && (min..=max).contains(&u.to_si(value)))
+            .map(|u| format!("`{} = {}` if it is in {}", q.key(u), self.raw(), u.name))
+            .collect();
+        if !fits.is_empty() {
+            reason.push_str(&format!(": write {}", fits.join(", or ")));
+        }
+        Err(self.invalid(value, reason))
     }
 }
 
@@ -374,5 +465,8 @@ mod tests {
     fn line_col_counts_characters() {
         assert_eq!(line_col("ab\ncµd", 6), (2, 3));
         assert_eq!(line_col("", 5), (1, 1));
+        let doc = Doc::new(Path::new("x"), "ab\ncd\n\ne");
+        let lines: Vec<usize> = (0..9).map(|i| doc.line_of(i)).collect();
+        assert_eq!(lines, vec![1, 1, 1, 2, 2, 2, 3, 4, 4]);
     }
 }

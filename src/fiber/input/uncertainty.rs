@@ -12,6 +12,10 @@ use super::schema::{closest, Rule};
 use super::spanned::Tab;
 use crate::fiber::uncertainty::{implausible, source, source_keys};
 
+/// Smallest plausible standard uncertainty of a key in micrometres (`gauge_offset_um`) \[µm\]:
+/// 1 nm; a smaller value is probably in metres.
+const MIN_MICROMETRES: f64 = 1e-3;
+
 /// The hint for an unknown key of an `[uncertainty]` table.
 fn hint(key: &str) -> String {
     let keys = source_keys();
@@ -53,6 +57,17 @@ pub(super) fn uncertainty_table(tab: &Tab<'_>) -> Result<Vec<(&'static str, f64)
         }
         if value > s.max {
             return Err(field.invalid(value, implausible(s)));
+        }
+        if s.unit == "µm" && value < MIN_MICROMETRES {
+            return Err(field.invalid(
+                value,
+                format!(
+                    "implausibly small for a standard uncertainty in micrometres (below \
+                     {MIN_MICROMETRES} µm = 1 nm, which no gauge resolves): was it given in \
+                     metres? then write `{key} = {}`",
+                    super::error::sig(value * 1e6)
+                ),
+            ));
         }
         out.push((s.key, value));
     }
