@@ -6,6 +6,9 @@ mod probe;
 
 mod cli_argument_probes;
 mod cli_output_safety;
+mod input_bounds;
 mod input_loading;
+mod input_messages;
 mod input_plausibility;
+mod input_units;
 mod reader_fuzz;

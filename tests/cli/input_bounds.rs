@@ -6,8 +6,6 @@
 //!
 //! Scratch files live under `target/probes` (never in /tmp) and are removed at the end.
 
-mod probe;
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -19,7 +17,7 @@ use diffbvp::fiber::input::{
 
 /// A scratch copy of the shipped data set: (scratch dir, TOML, data dir).
 fn copy(name: &str) -> (PathBuf, PathBuf, PathBuf) {
-    probe::shipped_copy(name)
+    crate::probe::shipped_copy(name)
 }
 
 /// Points experiment `v0p27_p1` at `data`.
@@ -32,7 +30,7 @@ fn set_data(toml: &Path, data: &str) {
 
 /// `file:line:` of the first line of `toml` containing `needle`.
 fn key_line(toml: &Path, needle: &str) -> String {
-    let line = probe::line_where(toml, |l| l.contains(needle));
+    let line = crate::probe::line_where(toml, |l| l.contains(needle));
     format!("{}:{line}:", toml.display())
 }
 
@@ -86,12 +84,13 @@ fn dev_zero_and_dev_urandom_are_refused_within_a_second_in_little_memory() {
     // [C21, S04, C24] the CLI used to read /dev/zero at 3 GB/s and /dev/urandom forever
     let (dir, toml, _) = copy("bounds_devices");
     for device in ["/dev/zero", "/dev/urandom"] {
-        let text =
-            std::fs::read_to_string(probe::repo().join("data/pmma7n_synthetic/experiments.toml"))
-                .unwrap();
+        let text = std::fs::read_to_string(
+            crate::probe::repo().join("data/pmma7n_synthetic/experiments.toml"),
+        )
+        .unwrap();
         std::fs::write(&toml, text).unwrap();
         set_data(&toml, device);
-        let line = probe::line_where(&toml, |l| l.contains(device));
+        let line = crate::probe::line_where(&toml, |l| l.contains(device));
         let message = refused(&toml, Duration::from_secs(1));
         assert_contains(
             &message,
@@ -102,7 +101,7 @@ fn dev_zero_and_dev_urandom_are_refused_within_a_second_in_little_memory() {
                 "a character device, not a regular file",
             ],
         );
-        let (code, stderr, elapsed, kb) = run_measured(&["fit", probe::s(&toml)], &dir);
+        let (code, stderr, elapsed, kb) = run_measured(&["fit", crate::probe::s(&toml)], &dir);
         assert_eq!(code, Some(1), "{stderr}");
         assert!(stderr.contains("character device"), "{stderr}");
         assert!(elapsed < Duration::from_secs(1), "{device}: {elapsed:?}");
@@ -138,7 +137,11 @@ fn fifos_are_refused_before_they_are_opened() {
     mkfifo(&fifo_toml);
     let message = refused(&fifo_toml, Duration::from_secs(1));
     assert_contains(&message, &["pipe.toml", "a FIFO (named pipe)"]);
-    let p = probe::rheometer(&["fit", probe::s(&fifo_toml)], &[], Duration::from_secs(20));
+    let p = crate::probe::rheometer(
+        &["fit", crate::probe::s(&fifo_toml)],
+        &[],
+        Duration::from_secs(20),
+    );
     p.assert_clean_failure(&["pipe.toml", "FIFO"]);
     assert!(p.elapsed < Duration::from_secs(1), "{:?}", p.elapsed);
     // a directory as data
@@ -155,7 +158,7 @@ fn experiments_from_standard_input_need_absolute_data_paths() {
     // [C26] relative data paths were resolved against /dev ("/dev/v0p27_p1.csv")
     let (dir, toml, data) = copy("bounds_stdin");
     let toml_file = std::fs::File::open(&toml).unwrap();
-    let p = probe::run_with(
+    let p = crate::probe::run_with(
         &["fit", "/dev/stdin"],
         &[&data],
         Duration::from_secs(30),
@@ -340,8 +343,8 @@ fn the_number_of_experiments_is_capped_before_any_data_is_read() {
                 "max_experiments",
             ],
         );
-        let p = probe::rheometer(
-            &["--quiet", "fit", probe::s(&toml)],
+        let p = crate::probe::rheometer(
+            &["--quiet", "fit", crate::probe::s(&toml)],
             &[],
             Duration::from_secs(30),
         );

@@ -7,8 +7,6 @@
 //!
 //! Scratch files live under `target/probes` and are removed at the end.
 
-mod probe;
-
 use std::path::{Path, PathBuf};
 
 use diffbvp::fiber::input::{load_experiments, parse_experiments, parse_measurements};
@@ -16,11 +14,11 @@ use diffbvp::fiber::rheometer::{IdentifyOptions, Rheometer};
 use diffbvp::fiber::setup::{ExperimentSet, Inlet};
 
 fn shipped() -> PathBuf {
-    probe::repo().join("data/pmma7n_synthetic/experiments.toml")
+    crate::probe::repo().join("data/pmma7n_synthetic/experiments.toml")
 }
 
 fn lab_units() -> PathBuf {
-    probe::repo().join("tests/data/pmma7n_units/experiments.toml")
+    crate::probe::repo().join("tests/data/pmma7n_units/experiments.toml")
 }
 
 /// |a − b| ≤ 1e-12 |b| (values loaded from decimal text in two units may differ in the last
@@ -102,12 +100,16 @@ fn lab_units_give_the_same_fit_as_si() {
             .unwrap()
     };
     let (si, lab) = (fit(&shipped()), fit(&lab_units()));
-    close(lab.n, si.n, "n");
-    close(lab.kappa, si.kappa, "kappa");
-    for (a, b) in lab.take_up_factors.iter().zip(&si.take_up_factors) {
+    close(lab.summary.n.value, si.summary.n.value, "n");
+    close(lab.summary.kappa.value, si.summary.kappa.value, "kappa");
+    for (a, b) in lab.take_up_factors().iter().zip(si.take_up_factors()) {
         close(*a, *b, "take-up factor");
     }
-    close(lab.rms_relative_residual, si.rms_relative_residual, "RMS");
+    close(
+        lab.summary.rms_relative_residual,
+        si.summary.rms_relative_residual,
+        "RMS",
+    );
 }
 
 const MATERIAL: &str = "[material]\ndensity_slope_kg_m3_K = -0.964\ndensity_intercept_kg_m3 = \

@@ -6,8 +6,6 @@
 //!
 //! Scratch copies live under `target/probes` and are removed at the end.
 
-mod probe;
-
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -25,7 +23,7 @@ struct Copy {
 
 impl Copy {
     fn new(name: &str) -> Self {
-        let (dir, toml, data) = probe::shipped_copy(name);
+        let (dir, toml, data) = crate::probe::shipped_copy(name);
         let shipped = std::fs::read_to_string(&toml).unwrap();
         Copy {
             dir,
@@ -44,15 +42,19 @@ impl Copy {
 
     /// `experiments.toml:LINE:` of the first line containing `needle`.
     fn at(&self, needle: &str) -> String {
-        let line = probe::line_where(&self.toml, |l| l.contains(needle));
+        let line = crate::probe::line_where(&self.toml, |l| l.contains(needle));
         format!("{}:{line}:", self.toml.display())
     }
 
     /// Rewrites CSV `name` line by line.
     fn csv(&self, name: &str, edit: impl Fn(usize, &str) -> String) -> PathBuf {
         let path = self.data.join(name);
-        let text = std::fs::read_to_string(probe::repo().join("data/pmma7n_synthetic").join(name))
-            .unwrap();
+        let text = std::fs::read_to_string(
+            crate::probe::repo()
+                .join("data/pmma7n_synthetic")
+                .join(name),
+        )
+        .unwrap();
         let out: Vec<String> = text
             .lines()
             .enumerate()
@@ -64,7 +66,9 @@ impl Copy {
 
     fn restore_csv(&self, name: &str) {
         std::fs::copy(
-            probe::repo().join("data/pmma7n_synthetic").join(name),
+            crate::probe::repo()
+                .join("data/pmma7n_synthetic")
+                .join(name),
             self.data.join(name),
         )
         .unwrap();
@@ -210,7 +214,7 @@ fn duplicate_keys_and_tables_are_named() {
         "vft_T_VF_K = 273.15\nvft_B_K = 3649.0\n",
     );
     let e = load_experiments(toml).unwrap_err().to_string();
-    let first = probe::line_where(toml, |l| l.starts_with("vft_B_K"));
+    let first = crate::probe::line_where(toml, |l| l.starts_with("vft_B_K"));
     assert_contains(
         &e,
         &[
@@ -234,7 +238,7 @@ fn duplicate_keys_and_tables_are_named() {
     let twice = format!("{}\n[material]\ntrouton_ratio = 3\n", c.shipped);
     std::fs::write(&c.toml, twice).unwrap();
     let e = c.error();
-    let first = probe::line_where(&c.toml, |l| l == "[material]");
+    let first = crate::probe::line_where(&c.toml, |l| l == "[material]");
     assert_contains(
         &e,
         &[
@@ -279,8 +283,8 @@ fn a_csv_or_json_file_is_not_an_experiments_file() {
     std::fs::write(&json, "{\n  \"n\": 0.8,\n  \"kappa\": 11.7\n}\n").unwrap();
     let e = load_experiments(&json).unwrap_err().to_string();
     assert_contains(&e, &["fit.json:1: this is not an experiments file", "JSON"]);
-    let p = probe::rheometer(
-        &["fit", probe::s(&json)],
+    let p = crate::probe::rheometer(
+        &["fit", crate::probe::s(&json)],
         &[&c.data],
         Duration::from_secs(30),
     );
@@ -348,13 +352,13 @@ fn names_too_long_for_file_names_are_refused_at_the_toml() {
         );
     std::fs::write(&c.toml, text).unwrap();
     let out = c.dir.join("out");
-    let p = probe::rheometer(
+    let p = crate::probe::rheometer(
         &[
             "simulate",
-            probe::s(&c.toml),
+            crate::probe::s(&c.toml),
             "--take-up-from-data",
             "--out",
-            probe::s(&out),
+            crate::probe::s(&out),
         ],
         &[&c.data],
         Duration::from_secs(30),
@@ -509,13 +513,13 @@ fn mass_flow_unit_slips_are_blamed_on_the_mass_flow_before_any_work() {
             assert!(e.contains(n), "{id}: `{n}` missing in: {e}");
         }
         let out = c.dir.join("out");
-        let p = probe::rheometer(
+        let p = crate::probe::rheometer(
             &[
                 "simulate",
-                probe::s(&c.toml),
+                crate::probe::s(&c.toml),
                 "--take-up-from-data",
                 "--out",
-                probe::s(&out),
+                crate::probe::s(&out),
             ],
             &[&c.data],
             Duration::from_secs(60),
@@ -615,8 +619,13 @@ fn a_spin_line_far_beyond_the_data_is_refused_and_a_little_beyond_warned() {
     );
     // the command line shows it once, and not when the take-up diameter is given
     let out = c.dir.join("out");
-    let args = ["simulate", probe::s(&c.toml), "--out", probe::s(&out)];
-    let p = probe::rheometer(
+    let args = [
+        "simulate",
+        crate::probe::s(&c.toml),
+        "--out",
+        crate::probe::s(&out),
+    ];
+    let p = crate::probe::rheometer(
         &[&args[..], &["--take-up-from-data"]].concat(),
         &[],
         Duration::from_secs(60),
@@ -624,7 +633,7 @@ fn a_spin_line_far_beyond_the_data_is_refused_and_a_little_beyond_warned() {
     p.assert_success();
     assert_eq!(p.stderr.matches("warning:").count(), 1, "{}", p.stderr);
     assert_contains(&p.stderr, &["warning:", "0.17 m beyond"]);
-    let p = probe::rheometer(
+    let p = crate::probe::rheometer(
         &[&args[..], &["--take-up-diameter", "1e-4"]].concat(),
         &[],
         Duration::from_secs(60),
