@@ -58,22 +58,24 @@
 //! 5. [`least_squares`] (the bounded driver; its [`BvpResiduals`](least_squares::BvpResiduals)
 //!    adaptor solves BVPs and takes their sensitivities).
 //!
-//! `plot` and `atomic_write` stand apart: no solver imports (`atomic_write` is the
-//! temporary-then-rename writing that the figures share with the rheometer's outputs).
+//! `plot`, `html_page` and `atomic_write` stand apart: no solver imports (`atomic_write` is
+//! the temporary-then-rename writing that the figures share with the rheometer's outputs;
+//! `html_page` a self-contained printable report page).
 //!
 //! The toolkit never imports `fiber`. The fiber model and rheometer (`fiber`, feature
 //! `rheometer`), bottom to top:
 //!
 //! 1. `setup`, `error`, `scaling`, `material_law`, `format` (numbers for people), `serde_nan`;
-//! 2. `contributions` (force and heat terms) and `effects` (the candidate effects vocabulary);
+//! 2. `catalog` (one descriptor per effect), `contributions` (force and heat terms) and
+//!    `effects` (the candidate effects vocabulary);
 //! 3. `model` (the BVP);
-//! 4. `cold_start`, `simulate`;
+//! 4. `cold_start`, `simulate`, `profile_sensitivities`;
 //! 5. `smoothing`, `synthetic`, `input`, `output`, `statistics`, `noise_model`,
 //!    `noise_summary` (the one noise level), `take_up`, `uncertainty`;
 //! 6. `rheometer` (inside: `options`, `estimator` → `data` → `layout` → `objective` →
 //!    `identify` → `summary_build`, `error_budget`, `landscape`; the values `summary`,
 //!    `budget` below them);
-//! 7. `figures`;
+//! 7. `figures`, `flow_curve_figure`;
 //! 8. `diagnostics` (`compare`, `candidate` → `ties`, `diagnose` (its stages), `diagnosis`,
 //!    `report`);
 //! 9. `failure_hints`;

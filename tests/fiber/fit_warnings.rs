@@ -145,10 +145,13 @@ fn shipped_data_fit_has_no_warning() {
 
 #[test]
 fn a_kappa_at_its_lower_bound_is_marked_and_gets_no_interval() {
-    // case (a): one experiment's diameters scaled by 0.4 drive κ to its lower bound 7
+    // case (a): one experiment's diameters scaled by 0.4 drive κ to its lower bound 7 (the
+    // first, at the die, kept: the reader refuses an inlet diameter far from it)
     let (dir, toml, data) = probe::shipped_copy("fw_kappa_bound");
     rewrite_diameters(&data.join("v0p53_p2.csv"), |d| {
-        d.iter().map(|x| 0.4 * x).collect()
+        let mut out: Vec<f64> = d.iter().map(|x| 0.4 * x).collect();
+        out[0] = d[0];
+        out
     });
     let (p, v) = fit_cli(&toml, &data, &dir);
     println!("{}", p.stdout);
@@ -240,10 +243,13 @@ fn a_take_up_factor_pinned_at_its_bound_and_a_huge_misfit_are_warned_about() {
 
 #[test]
 fn increasing_diameters_are_named_and_undetermined_parameters_warned_about() {
-    // case (c): one CSV's diameters in reverse order (increasing along the spin line)
+    // case (c): one CSV's diameters after the die in reverse order (increasing along the spin
+    // line; the first, at the die, kept: the reader refuses an inlet diameter far from it)
     let (dir, toml, data) = probe::shipped_copy("fw_increasing");
     rewrite_diameters(&data.join("v0p53_p2.csv"), |d| {
-        d.iter().rev().copied().collect()
+        std::iter::once(d[0])
+            .chain(d[1..].iter().rev().copied())
+            .collect()
     });
     let (p, v) = fit_cli(&toml, &data, &dir);
     println!("{}", p.stdout);

@@ -105,20 +105,25 @@ impl<'a> Scope<'_, 'a> {
     }
 }
 
-/// Parses one `[[experiment]]` table; also returns where its keys are.
-pub(super) fn experiment(
-    mut tab: Tab<'_>,
-    defaults: Option<&Tab<'_>>,
-    material: &Material,
-    material_at: &MaterialAt,
-) -> Result<(Experiment, ExperimentDetails, Located), InputError> {
-    // name the table by the experiment's name (if readable) before reporting unknown keys
+/// Names the table `tab` by its experiment's name (if readable), so that every message about
+/// it (unknown keys, its uncertainty table) names the experiment.
+pub(super) fn name_table(tab: &mut Tab<'_>) {
     if let Some(name) = tab
         .get("name")
         .and_then(|f| f.string().ok().map(str::to_string))
     {
         tab.name = format!("{} \"{}\"", tab.name, short(&name, 40));
     }
+}
+
+/// Parses one `[[experiment]]` table (named by [`name_table`]); also returns where its keys
+/// are.
+pub(super) fn experiment(
+    tab: Tab<'_>,
+    defaults: Option<&Tab<'_>>,
+    material: &Material,
+    material_at: &MaterialAt,
+) -> Result<(Experiment, ExperimentDetails, Located), InputError> {
     let allowed: Vec<String> = STRING_KEYS
         .iter()
         .chain(EXPERIMENT_TABLES)

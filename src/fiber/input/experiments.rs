@@ -8,7 +8,7 @@ use toml::de::DeTable;
 
 use super::cross_checks::{check_experiment_memory, cross_check, data_error, FitBudget};
 use super::error::{short, InputError, InputWarning, Location};
-use super::experiment::{experiment, Located, MaterialAt};
+use super::experiment::{experiment, name_table, Located, MaterialAt};
 use super::measurements::{read_measurements, DEFAULT_MIN_POINTS};
 use super::options::{show_count, Limit, LoadOptions};
 use super::schema::{keys_of, material_quantity, Rule, EXPERIMENT, MATERIAL, TOP_KEYS};
@@ -207,7 +207,8 @@ fn parse(
     let mut details = Vec::with_capacity(tables.len());
     let mut located = Vec::with_capacity(tables.len());
     let mut warnings = Vec::new();
-    for tab in tables {
+    for mut tab in tables {
+        name_table(&mut tab);
         let own = match tab.sub_table("uncertainty", &format!("{} uncertainty table", tab.name))? {
             Some(t) => uncertainty_table(&t)?,
             None => Vec::new(),
