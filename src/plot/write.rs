@@ -1,8 +1,8 @@
-//! Writing a figure: the format follows the extension (PNG or SVG), the figure is rendered in
-//! memory first and then written to a temporary sibling that is renamed into place.
+//! Writing a figure: the format follows the extension (PNG or SVG), the figure is rendered and
+//! encoded in memory first and then written through the output layer
+//! ([`output_files`](crate::output_files)).
 
 use std::error::Error as StdError;
-use std::fs;
 use std::path::Path;
 
 use plotters::coord::Shift;
@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::error::{invalid, PlotError};
 use super::fonts::ensure_font;
-use crate::atomic_write::PendingTemporary;
+use crate::output_files::write_bytes;
 
 /// Largest accepted figure side, in pixels (guards against huge allocations).
 pub const MAX_SIDE: u32 = 16_384;
@@ -58,8 +58,9 @@ impl FigureFormat {
     }
 }
 
-/// Validates, renders in memory, and only then creates directories and writes `path` (through a
-/// temporary sibling renamed into place).
+/// Validates, renders in memory (PNG encoded in memory too), and only then writes `path`
+/// through the output layer ([`write_bytes`]): a regular file via a temporary renamed into
+/// place (missing directories created), a character device or FIFO in place.
 pub(super) fn write_figure<F: Figure>(
     path: &Path,
     size: (u32, u32),
@@ -85,50 +86,42 @@ pub(super) fn write_figure<F: Figure>(
         path: path.to_path_buf(),
         source,
     };
-    let io_err = |source: std::io::Error| PlotError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
 
     // Render first so that a drawing failure leaves no file behind.
-    let mut rgb = Vec::new();
-    let mut svg = String::new();
-    match format {
+    let bytes = match format {
         FigureFormat::Png => {
-            rgb = vec![255u8; w as usize * h as usize * 3];
-            let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-            render(&root, figure).map_err(draw_err)?;
+            let mut rgb = vec![255u8; w as usize * h as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+                render(&root, figure).map_err(draw_err)?;
+            }
+            encode_png(&rgb, size).map_err(|e| draw_err(Box::new(e)))?
         }
         FigureFormat::Svg => {
-            let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-            render(&root, figure).map_err(draw_err)?;
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                render(&root, figure).map_err(draw_err)?;
+            }
+            svg.into_bytes()
         }
-    }
+    };
+    write_bytes(path, &[], &bytes)?;
+    Ok(())
+}
 
-    if let Some(parent) = path.parent() {
-        if !parent.as_os_str().is_empty() {
-            fs::create_dir_all(parent).map_err(io_err)?;
-        }
-    }
-    // written to a temporary sibling and renamed into place: never a half-written figure, and
-    // an existing file (or hard link) at `path` is replaced, not truncated
-    let pending = PendingTemporary::new(path);
-    let tmp = pending.path();
-    let written = match format {
-        FigureFormat::Png => {
-            let mut backend = BitMapBackend::new(tmp, size);
-            backend
-                .blit_bitmap((0, 0), size, &rgb)
-                .and_then(|()| backend.present())
-                .map_err(|e| draw_err(Box::new(e)))
-        }
-        FigureFormat::Svg => fs::write(tmp, svg).map_err(io_err),
-    }
-    .and_then(|()| fs::rename(tmp, path).map_err(io_err));
-    if written.is_err() {
-        let _ = fs::remove_file(tmp);
-    }
-    written
+/// An RGB image of `size` as PNG bytes.
+fn encode_png(rgb: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
+    let mut out = Vec::with_capacity(rgb.len() / 8);
+    let mut enc = png::Encoder::new(&mut out, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_compression(png::Compression::Default);
+    enc.set_adaptive_filter(png::AdaptiveFilterType::Adaptive);
+    let mut writer = enc.write_header()?;
+    writer.write_image_data(rgb)?;
+    writer.finish()?;
+    Ok(out)
 }
 
 fn render<DB, F>(root: &DrawingArea<DB, Shift>, figure: &F) -> DrawResult
