@@ -1181,7 +1181,11 @@ fn x03d_g50_g51_x08b_x02c_numbers_and_negative_values_in_messages() {
     assert!(!p.stderr.contains("did you mean"), "{}", p.stderr);
     let p = land(&["--n-range", "0.9,0.2"]);
     p.assert_clean_failure(&["did you mean 0.2,0.9?"]);
-    let p = land(&["--grid", "-3x3"]);
+    let p = rheometer(
+        &["landscape", t, "--grid", "-3x3", "--out", o],
+        &[&data],
+        LIMIT,
+    );
     p.assert_clean_failure(&["--grid", "\"-3\" is not a count"]);
     // G51: a range of 1e-300 width: no 300-digit numbers in messages or in the CSV
     let p = land(&["--n-range", "0,1e-300"]);

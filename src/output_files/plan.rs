@@ -149,6 +149,9 @@ impl OutputPlan {
             check_dir(&d.path, &self.inputs).map_err(|e| planned(&d.label, e))?;
             removed.extend(remove_stale_temporaries(&d.path));
         }
+        // a file that is (a parent of) an output directory: named as such before the file's
+        // own check would call it "an existing directory"
+        check_files_against_dirs(&self.files, &self.dirs)?;
         let mut targets = Vec::with_capacity(self.files.len());
         for f in &self.files {
             let t = check_file(&f.path, &self.inputs).map_err(|e| planned(&f.label, e))?;
@@ -160,7 +163,7 @@ impl OutputPlan {
             }
             targets.push((f.clone(), t));
         }
-        check_distinct(&targets, &self.dirs)?;
+        check_distinct(&targets)?;
         Ok(CheckedOutputs {
             inputs: self.inputs.clone(),
             targets,
@@ -206,7 +209,8 @@ fn check_file(path: &Path, inputs: &[PathBuf]) -> Result<Target, OutputError> {
     let t = classify(path)?;
     match &t {
         Target::Regular { path: real, exists } => {
-            ensure_not_input(real, inputs)?;
+            // the path as given: a link to an input is named as such
+            ensure_not_input(path, inputs)?;
             if *exists {
                 check_replaceable(real)?;
             }
@@ -292,9 +296,8 @@ pub(super) fn normalized(path: &Path) -> PathBuf {
     out
 }
 
-/// Refuses two outputs that are the same file, or a file that is (a parent of) an output
-/// directory.
-fn check_distinct(targets: &[(Planned, Target)], dirs: &[PlannedDir]) -> Result<(), OutputError> {
+/// Refuses two outputs that are the same file.
+fn check_distinct(targets: &[(Planned, Target)]) -> Result<(), OutputError> {
     let ids: Vec<Identity> = targets.iter().map(|(_, t)| identity(t)).collect();
     let paths: Vec<PathBuf> = targets.iter().map(|(p, _)| normalized(&p.path)).collect();
     for i in 0..targets.len() {
@@ -309,15 +312,25 @@ fn check_distinct(targets: &[(Planned, Target)], dirs: &[PlannedDir]) -> Result<
                 });
             }
         }
-        for d in dirs {
-            // the file is the directory, or one of its parents
-            if normalized(&d.path).starts_with(&paths[i]) {
-                return Err(OutputError::SameOutput {
-                    path: d.path.clone(),
-                    first: targets[i].0.label.clone(),
-                    second: d.label.clone(),
-                });
-            }
+    }
+    Ok(())
+}
+
+/// Refuses a planned file that is an output directory or one of its parents.
+fn check_files_against_dirs(files: &[Planned], dirs: &[PlannedDir]) -> Result<(), OutputError> {
+    let dir_paths: Vec<PathBuf> = dirs.iter().map(|d| normalized(&d.path)).collect();
+    for f in files {
+        let path = normalized(&f.path);
+        if let Some((d, _)) = dirs
+            .iter()
+            .zip(&dir_paths)
+            .find(|(_, dp)| dp.starts_with(&path))
+        {
+            return Err(OutputError::SameOutput {
+                path: d.path.clone(),
+                first: f.label.clone(),
+                second: d.label.clone(),
+            });
         }
     }
     Ok(())

@@ -452,8 +452,10 @@ mod tests {
         let e = classify(Path::new("/dev/stdin")).unwrap_err();
         assert!(e.to_string().contains("standard input"), "{e}");
         assert!(matches!(
-            classify(Path::new("/")),
+            classify(Path::new("/dev")),
             Err(OutputError::IsADirectory { .. })
         ));
+        let e = classify(Path::new("/")).unwrap_err();
+        assert!(e.to_string().contains("names a directory"), "{e}");
     }
 }

@@ -98,6 +98,8 @@ pub fn write_target(
             write(&mut w).and_then(|()| w.flush()).map_err(io_err)
         }
         Target::Regular { path: real, .. } => {
+            // the path as given (a link to an input is named as such), then the file itself
+            ensure_not_input(path, inputs)?;
             ensure_not_input(real, inputs)?;
             replace_regular(real, write)
         }
