@@ -72,7 +72,10 @@ pub enum OutputError {
         dir: PathBuf,
     },
     /// No file can be created in the directory (permissions, read-only file system, ...).
-    #[error("cannot write into {dir} (for {path}): {source}")]
+    #[error(
+        "cannot write into {dir} (for {path}): {source}; choose a directory you can write to, \
+         or change its permissions"
+    )]
     DirectoryNotWritable {
         /// The directory.
         dir: PathBuf,

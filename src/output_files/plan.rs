@@ -201,7 +201,16 @@ fn check_dir(dir: &Path, inputs: &[PathBuf]) -> Result<(), OutputError> {
     }
     // a file that would be created in the directory: its directory (or the first existing
     // ancestor) must accept new files
-    check_directory(&dir.join(".probe"))
+    check_directory(&dir.join(".probe")).map_err(|e| match e {
+        OutputError::DirectoryNotWritable { dir: d, source, .. } => {
+            OutputError::DirectoryNotWritable {
+                dir: d,
+                path: dir.to_path_buf(),
+                source,
+            }
+        }
+        e => e,
+    })
 }
 
 /// Checks one output file (see [`OutputPlan::check`]).

@@ -287,13 +287,8 @@ pub fn check_replaceable(path: &Path) -> Result<(), OutputError> {
             return Err(protected());
         }
         if euid != 0 {
-            // the kernel's own answer for this user (groups and ACLs included); opening for
-            // writing without truncation changes nothing
-            if let Err(e) = fs::OpenOptions::new().write(true).open(path) {
-                if e.kind() == io::ErrorKind::PermissionDenied {
-                    return Err(protected());
-                }
-            }
+            // another user's file in a sticky directory first: the rename would fail whatever
+            // the file's mode
             let dir = parent_dir(path);
             if let Ok(d) = fs::metadata(dir) {
                 let sticky = d.permissions().mode() & 0o1000 != 0;
@@ -302,6 +297,13 @@ pub fn check_replaceable(path: &Path) -> Result<(), OutputError> {
                         path: path.to_path_buf(),
                         dir: dir.to_path_buf(),
                     });
+                }
+            }
+            // the kernel's own answer for this user (groups and ACLs included); opening for
+            // writing without truncation changes nothing
+            if let Err(e) = fs::OpenOptions::new().write(true).open(path) {
+                if e.kind() == io::ErrorKind::PermissionDenied {
+                    return Err(protected());
                 }
             }
         }

@@ -134,7 +134,7 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             ))
             .into())
         }
-        Err(SimulateError::Experiment(f)) => return Err(Box::new(f)),
+        Err(SimulateError::Experiment(f)) => return Err(f),
         Err(e) => return Err(e.to_string().into()),
     };
     // every profile is written; the figures are the last files of the set

@@ -45,8 +45,9 @@ pub struct SimulatedProfile {
 pub enum SimulateError {
     /// An experiment has no usable take-up condition (in words, naming it and what to do).
     TakeUp(String),
-    /// An experiment's model failed (named, with its TOML line and likely causes).
-    Experiment(ExperimentFailure),
+    /// An experiment's model failed (named, with its TOML line and likely causes; boxed: the
+    /// failure is large).
+    Experiment(Box<ExperimentFailure>),
     /// The caller stopped the run after `done` experiments.
     Stopped {
         /// Experiments finished.
@@ -67,7 +68,7 @@ impl fmt::Display for SimulateError {
 impl std::error::Error for SimulateError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            SimulateError::Experiment(e) => Some(e),
+            SimulateError::Experiment(e) => Some(e.as_ref()),
             _ => None,
         }
     }
@@ -151,7 +152,7 @@ fn simulate_one(
                 "the take-up diameter {d:.4e} m is d_fit(L) of the smoothed measurements"
             ));
         }
-        SimulateError::Experiment(f)
+        SimulateError::Experiment(Box::new(f))
     };
     let model = FiberModel::new(
         &set.material,

@@ -51,7 +51,7 @@ pub(crate) fn judge(
         signature_location(&lin.positions, &change);
     record.shape_alternative = other.and_then(|(_, o)| {
         let gap = lin.ic(o.cost, record.extra_parameters).0 - record.delta_bic;
-        credible_shape(&record.effect, &o.identification.summary).then(|| ShapeAlternative {
+        credible_shape(&record.effect, &o.identification.summary).then_some(ShapeAlternative {
             delta_bic_gap: gap,
             refit: o.identification.summary,
         })
