@@ -230,8 +230,10 @@ fn diagnose_reproduces_the_program_with_the_fits_noise_level() {
         s(&file),
     ]);
     let cli = json(&file);
-    let mut options = DiagnoseOptions::default();
-    options.refit_top = 2;
+    let options = DiagnoseOptions {
+        refit_top: 2,
+        ..Default::default()
+    };
     let lib = workflow::diagnose(&data, &ModelSpec::default(), &options).unwrap();
     let d = &lib.diagnosis;
     assert_eq!(
