@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::atomic_write::PendingTemporary;
+use crate::output_files::{write_bytes, OutputError};
 
 /// Why a page could not be built or written.
 #[derive(Debug, Error)]
@@ -55,6 +55,15 @@ pub enum HtmlError {
     IsADirectory {
         /// The requested output path.
         path: PathBuf,
+    },
+    /// The output layer refused the path or failed to write it.
+    #[error("cannot write HTML page {path}: {source}")]
+    Output {
+        /// The requested output path.
+        path: PathBuf,
+        /// What went wrong.
+        #[source]
+        source: Box<OutputError>,
     },
     /// Creating a parent directory or writing the file failed.
     #[error("cannot write HTML page {path}: {source}")]
@@ -349,28 +358,18 @@ impl HtmlPage {
     /// failed write leaves no half-written page and an existing file is replaced whole),
     /// creating missing parent directories.
     pub fn write(&self, path: &Path) -> Result<(), HtmlError> {
-        let io = |source| HtmlError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
         if path.is_dir() {
             return Err(HtmlError::IsADirectory {
                 path: path.to_path_buf(),
             });
         }
-        if let Some(parent) = path.parent() {
-            if !parent.as_os_str().is_empty() {
-                fs::create_dir_all(parent).map_err(io)?;
-            }
-        }
+        // through the output layer: a temporary renamed into place (missing directories
+        // created), a special file written in place
         let html = self.render();
-        let pending = PendingTemporary::new(path);
-        let tmp = pending.path();
-        let written = fs::write(tmp, html).and_then(|()| fs::rename(tmp, path));
-        if written.is_err() {
-            let _ = fs::remove_file(tmp);
-        }
-        written.map_err(io)
+        write_bytes(path, &[], html.as_bytes()).map_err(|source| HtmlError::Output {
+            path: path.to_path_buf(),
+            source: Box::new(source),
+        })
     }
 }
 

@@ -58,8 +58,9 @@
 //! 5. [`least_squares`] (the bounded driver; its [`BvpResiduals`](least_squares::BvpResiduals)
 //!    adaptor solves BVPs and takes their sensitivities).
 //!
-//! `plot`, `html_page` and `atomic_write` stand apart: no solver imports (`atomic_write` is
-//! the temporary-then-rename writing that the figures share with the rheometer's outputs;
+//! `plot`, `html_page` and `output_files` stand apart: no solver imports ([`output_files`] is
+//! the output layer that the figures share with the rheometer: checks of every output before
+//! the work, temporary-then-rename writing of regular files, special files written in place;
 //! `html_page` a self-contained printable report page).
 //!
 //! The toolkit never imports `fiber`. The fiber model and rheometer (`fiber`, feature
@@ -94,8 +95,6 @@
 #![warn(missing_docs)]
 // Numerical kernels index several arrays with the same loop variable, as the formulas do.
 #![allow(clippy::needless_range_loop)]
-#[cfg(feature = "plots")]
-mod atomic_write;
 mod collocation;
 pub mod continuation;
 mod dual_jacobian;
@@ -113,6 +112,8 @@ mod linearization;
 pub mod mesh;
 mod mesh_cycle;
 mod newton;
+#[cfg(feature = "plots")]
+pub mod output_files;
 #[cfg(feature = "plots")]
 pub mod plot;
 pub mod problem;

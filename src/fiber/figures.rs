@@ -167,9 +167,22 @@ pub fn experiment_panels(
 /// over several files by [`experiment_panel_pages`].
 pub const MAX_PANELS_PER_FIGURE: usize = 24;
 
+/// The file names [`experiment_panel_pages`] writes for `experiments` panels into a figure
+/// named `STEM.EXT`: `STEM.EXT` itself up to [`MAX_PANELS_PER_FIGURE`] panels, else
+/// `STEM_1.EXT`, `STEM_2.EXT`, … (so that every output can be checked before the work).
+pub fn panel_page_names(stem: &str, ext: &str, experiments: usize) -> Vec<String> {
+    if experiments <= MAX_PANELS_PER_FIGURE {
+        return vec![format!("{stem}.{ext}")];
+    }
+    (1..=experiments.div_ceil(MAX_PANELS_PER_FIGURE))
+        .map(|k| format!("{stem}_{k}.{ext}"))
+        .collect()
+}
+
 /// Like [`experiment_panels`], split into figures of at most [`MAX_PANELS_PER_FIGURE`] panels
 /// so that any number of experiments can be drawn: up to that many, `path` itself; beyond,
-/// `STEM_1.EXT`, `STEM_2.EXT`, … next to it. Returns the paths written.
+/// `STEM_1.EXT`, `STEM_2.EXT`, … next to it (see [`panel_page_names`]). Returns the paths
+/// written.
 pub fn experiment_panel_pages(
     path: &Path,
     experiments: &[ExperimentView<'_>],
@@ -187,12 +200,13 @@ pub fn experiment_panel_pages(
         .unwrap_or_default();
     let ext = path
         .extension()
-        .map(|e| format!(".{}", e.to_string_lossy()))
+        .map(|e| e.to_string_lossy().into_owned())
         .unwrap_or_default();
+    let names = panel_page_names(&stem, &ext, experiments.len());
     let mut written = Vec::new();
-    for (page, start) in (0..experiments.len())
-        .step_by(MAX_PANELS_PER_FIGURE)
-        .enumerate()
+    for (name, start) in names
+        .iter()
+        .zip((0..experiments.len()).step_by(MAX_PANELS_PER_FIGURE))
     {
         let end = (start + MAX_PANELS_PER_FIGURE).min(experiments.len());
         let page_curves: Vec<ModelCurves<'_>> = curves
@@ -205,7 +219,7 @@ pub fn experiment_panel_pages(
                 ..*c
             })
             .collect();
-        let p = path.with_file_name(format!("{stem}_{}{ext}", page + 1));
+        let p = path.with_file_name(name);
         experiment_panels(&p, &experiments[start..end], &page_curves, view, inputs)?;
         written.push(p);
     }
@@ -265,6 +279,22 @@ pub fn landscape_map(
     };
     save_heatmap(path, &map)?;
     Ok(())
+}
+
+/// Stems of the figures of [`identification_figures`].
+const IDENTIFICATION_FIGURES: [&str; 3] = [
+    "fig2_smoothing",
+    "fig3_newtonian_vs_identified",
+    "fig5_inverse_square",
+];
+
+/// The file names [`identification_figures`] writes for `experiments` experiments with
+/// extension `ext`.
+pub fn identification_figure_names(ext: &str, experiments: usize) -> Vec<String> {
+    IDENTIFICATION_FIGURES
+        .iter()
+        .flat_map(|stem| panel_page_names(stem, ext, experiments))
+        .collect()
 }
 
 /// Paper Fig. 2, 3 and 5 for an identification, written into `dir` with extension `ext`
@@ -332,7 +362,7 @@ pub fn identification_figures(
         .map(|v| ExperimentView { smooth: None, ..*v })
         .collect();
     let mut written = Vec::new();
-    let f2 = dir.join(format!("fig2_smoothing.{ext}"));
+    let f2 = dir.join(format!("{}.{ext}", IDENTIFICATION_FIGURES[0]));
     written.extend(experiment_panel_pages(
         &f2,
         &views,
@@ -340,7 +370,7 @@ pub fn identification_figures(
         View::Diameter,
         inputs,
     )?);
-    let f3 = dir.join(format!("fig3_newtonian_vs_identified.{ext}"));
+    let f3 = dir.join(format!("{}.{ext}", IDENTIFICATION_FIGURES[1]));
     written.extend(experiment_panel_pages(
         &f3,
         &no_smooth,
@@ -348,7 +378,7 @@ pub fn identification_figures(
         View::Diameter,
         inputs,
     )?);
-    let f5 = dir.join(format!("fig5_inverse_square.{ext}"));
+    let f5 = dir.join(format!("{}.{ext}", IDENTIFICATION_FIGURES[2]));
     written.extend(experiment_panel_pages(
         &f5,
         &views,

@@ -1,133 +1,36 @@
 //! Writing results without ever overwriting an input, and without ever leaving a half-written
-//! file.
+//! file: the rheometer's use of the generic output layer [`crate::output_files`].
 //!
 //! * An output is refused if it *is* an input: the same file by device and inode on Unix (so
 //!   hard links and symbolic links to an input are recognised), by canonical path elsewhere.
-//! * Every file is written to a temporary sibling (`.NAME.tmp-PID-N` in the target directory)
-//!   and renamed into place when complete: a failed or interrupted write leaves either the old
-//!   file or nothing, never a truncated one, and the temporary is removed on failure.
+//! * A regular file is written to a temporary in its directory and renamed into place when
+//!   complete: a failed or interrupted write leaves either the old file or nothing, never a
+//!   truncated one. Character devices, FIFOs, `/dev/fd/N` and `-` (standard output) are
+//!   written in place.
 //! * An output directory may be the data directory itself: new files are written next to the
 //!   inputs, and only a name that collides with an input is refused.
+//!
+//! A command collects its outputs in an [`OutputPlan`] and checks them all before any work.
 
 use super::simulate::Profiles;
+pub use crate::output_files::{
+    blocking_file, remove_pending_temporaries, same_file, CheckedOutputs, OutputError, OutputPlan,
+    PartialMarker, PARTIAL_NAME,
+};
 use std::fs;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use thiserror::Error;
-
-/// Writing an output failed.
-#[derive(Debug, Error)]
-pub enum OutputError {
-    /// The output path is one of the inputs (also through a hard or symbolic link).
-    #[error(
-        "refusing to write {path}: it is an input file{}; choose another output directory",
-        alias_note(path, input)
-    )]
-    WouldOverwriteInput {
-        /// The path.
-        path: PathBuf,
-        /// The input it is (the same file, perhaps under another name).
-        input: PathBuf,
-    },
-    /// The output directory is one of the inputs (e.g. `--out` names a measurement CSV).
-    #[error(
-        "refusing to use {path} as the output directory: it is an input file; \
-         choose another output directory"
-    )]
-    DirectoryIsInput {
-        /// The path.
-        path: PathBuf,
-    },
-    /// The output directory, or one of its parents, exists and is not a directory.
-    #[error(
-        "cannot create the output directory {path}: {file} exists and is a file, not a directory"
-    )]
-    NotADirectory {
-        /// The requested directory.
-        path: PathBuf,
-        /// The existing file in its way (the directory itself or a parent).
-        file: PathBuf,
-    },
-    /// An output file path is an existing directory.
-    #[error("cannot write {path}: it is an existing directory")]
-    IsADirectory {
-        /// The path.
-        path: PathBuf,
-    },
-    /// I/O failure.
-    #[error("cannot write {path}: {source}")]
-    Io {
-        /// The path.
-        path: PathBuf,
-        /// Cause.
-        source: std::io::Error,
-    },
-}
-
-/// Whether `a` and `b` are the same file: same device and inode on Unix (hard and symbolic
-/// links included), same canonical path elsewhere. False if either does not exist.
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        match (fs::metadata(a), fs::metadata(b)) {
-            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
-            _ => false,
-        }
-    }
-    #[cfg(not(unix))]
-    {
-        match (fs::canonicalize(a), fs::canonicalize(b)) {
-            (Ok(x), Ok(y)) => x == y,
-            _ => false,
-        }
-    }
-}
 
 /// Fails if `path` exists and is one of `inputs` (the same file, see [`same_file`]), or if it
 /// is an existing directory.
 pub fn ensure_not_input(path: &Path, inputs: &[PathBuf]) -> Result<(), OutputError> {
-    // symlink_metadata: a dangling symbolic link "exists" too (it would be followed on write)
-    if fs::symlink_metadata(path).is_err() {
-        return Ok(());
-    }
-    if let Some(input) = inputs.iter().find(|i| same_file(path, i)) {
-        return Err(OutputError::WouldOverwriteInput {
-            path: path.to_path_buf(),
-            input: input.clone(),
-        });
-    }
+    crate::output_files::ensure_not_input(path, inputs)?;
     if path.is_dir() {
         return Err(OutputError::IsADirectory {
             path: path.to_path_buf(),
         });
     }
     Ok(())
-}
-
-/// `" (the same file as the input X, through a link)"` when the output path names the input
-/// under another name; empty when it is the input's own path.
-fn alias_note(path: &Path, input: &Path) -> String {
-    let same_name = match (fs::canonicalize(path), fs::canonicalize(input)) {
-        (Ok(a), Ok(b)) => a == b && fs::symlink_metadata(path).is_ok_and(|m| !m.is_symlink()),
-        _ => false,
-    };
-    if same_name || path == input {
-        String::new()
-    } else {
-        format!(
-            " (the same file as the input {}, through a link)",
-            input.display()
-        )
-    }
-}
-
-/// The first of `dir` and its ancestors that exists and is not a directory.
-fn blocking_file(dir: &Path) -> Option<PathBuf> {
-    dir.ancestors()
-        .filter(|a| !a.as_os_str().is_empty())
-        .find(|a| a.exists() && !a.is_dir())
-        .map(Path::to_path_buf)
 }
 
 /// Creates `dir` (and parents). A `dir` that is, or lies below, an existing file gives
@@ -139,15 +42,13 @@ pub fn create_dir(dir: &Path) -> Result<(), OutputError> {
             file,
         });
     }
-    fs::create_dir_all(dir).map_err(|source| OutputError::Io {
-        path: dir.to_path_buf(),
-        source,
-    })
+    fs::create_dir_all(dir).map_err(|e| OutputError::io(dir, e))
 }
 
-/// Checks an output directory before any work starts: refuses a `dir` that is one of `inputs`
+/// Checks an output directory: refuses a `dir` that is one of `inputs`
 /// ([`OutputError::DirectoryIsInput`]) or an existing file, and refuses every file of `names`
-/// (written into `dir`) that is an input. Creates nothing.
+/// (written into `dir`) that is an input. Creates nothing. (A command checks all its outputs
+/// at once with an [`OutputPlan`].)
 pub fn check_output_dir(
     dir: &Path,
     names: &[String],
@@ -176,42 +77,18 @@ pub fn create_output_dir(dir: &Path, inputs: &[PathBuf]) -> Result<(), OutputErr
     create_dir(dir)
 }
 
-pub use crate::atomic_write::{remove_pending_temporaries, temporary_sibling};
-
-/// Writes `path` atomically: `write` fills a temporary sibling (see [`temporary_sibling`]),
-/// which is then renamed over `path`. Refuses an input first ([`ensure_not_input`]). On any
-/// failure the temporary is removed and `path` is untouched.
+/// Writes the output `path` with `write`, never over one of `inputs` (see
+/// [`output_files::write_file`](crate::output_files::write_file): regular files atomically,
+/// special files in place).
 pub fn write_atomically(
     path: &Path,
     inputs: &[PathBuf],
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), OutputError> {
-    ensure_not_input(path, inputs)?;
-    let pending = crate::atomic_write::PendingTemporary::new(path);
-    let tmp = pending.path();
-    let io = |source| OutputError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let result = (|| {
-        let file = fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(tmp)?;
-        let mut w = BufWriter::with_capacity(1 << 16, file);
-        write(&mut w)?;
-        // flush errors (a full disk) surface here, before the rename
-        w.into_inner().map_err(|e| e.into_error())?;
-        fs::rename(tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = fs::remove_file(tmp);
-        return Err(io(e));
-    }
-    Ok(())
+    crate::output_files::write_file(path, inputs, write)
 }
 
-/// Writes text to `path` unless it is an input, atomically (see [`write_atomically`]).
+/// Writes text to `path` unless it is an input (see [`write_atomically`]).
 pub fn write_text(path: &Path, text: &str, inputs: &[PathBuf]) -> Result<(), OutputError> {
     write_atomically(path, inputs, |w| w.write_all(text.as_bytes()))
 }
@@ -259,7 +136,10 @@ mod tests {
     use super::*;
 
     fn scratch(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("diffbvp-output-{name}-{}", std::process::id()));
+        let d = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("target")
+            .join("unit-scratch")
+            .join(format!("fiber-output-{name}-{}", std::process::id()));
         let _ = fs::remove_dir_all(&d);
         fs::create_dir_all(&d).unwrap();
         d

@@ -31,6 +31,10 @@ pub enum PlotError {
         #[source]
         source: std::io::Error,
     },
+    /// The output layer refused the path or writing failed (a full disk, a write-protected
+    /// file, ...).
+    #[error(transparent)]
+    Output(#[from] crate::output_files::OutputError),
     /// The bundled font could not be registered.
     #[error("cannot write plot {path}: the bundled font could not be registered")]
     Font {

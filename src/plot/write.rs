@@ -1,5 +1,6 @@
-//! Writing a figure: the format follows the extension (PNG or SVG), the figure is rendered in
-//! memory first and then written to a temporary sibling that is renamed into place.
+//! Writing a figure: the format follows the extension (PNG or SVG), the figure is rendered and
+//! encoded in memory first and then written through the output layer
+//! ([`output_files`](crate::output_files)).
 //!
 //! A PNG is rendered supersampled (at 3 or 2 times its size, see [`supersampling`]) and
 //! reduced with a box filter: plotters' bitmap backend draws lines, circles and polygons
@@ -7,7 +8,6 @@
 //! edges `s² + 1` levels of coverage (and text glyphs placed to a third of a pixel).
 
 use std::error::Error as StdError;
-use std::fs;
 use std::path::Path;
 
 use plotters::coord::Shift;
@@ -15,7 +15,7 @@ use plotters::prelude::*;
 
 use super::error::{invalid, PlotError};
 use super::fonts::ensure_font;
-use crate::atomic_write::PendingTemporary;
+use crate::output_files::write_bytes;
 
 /// Largest accepted figure side, in pixels (guards against huge allocations).
 pub const MAX_SIDE: u32 = 16_384;
@@ -163,8 +163,9 @@ pub(super) fn render_rgb<F: Figure>(
     Ok(downsample(&canvas, size, s))
 }
 
-/// Validates, renders in memory, and only then creates directories and writes `path` (through a
-/// temporary sibling renamed into place).
+/// Validates, renders in memory (PNG encoded in memory too), and only then writes `path`
+/// through the output layer ([`write_bytes`]): a regular file via a temporary renamed into
+/// place (missing directories created), a character device or FIFO in place.
 pub(super) fn write_figure<F: Figure>(
     path: &Path,
     size: (u32, u32),
@@ -174,41 +175,30 @@ pub(super) fn write_figure<F: Figure>(
     if path.is_dir() {
         return Err(invalid(path, "the output path is an existing directory"));
     }
-    let io_err = |source: std::io::Error| PlotError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-
     // Render first so that a drawing failure leaves no file behind.
-    let (rgb, svg) = match format {
-        FigureFormat::Png => (render_rgb(path, size, figure)?, String::new()),
-        FigureFormat::Svg => (Vec::new(), render_svg(path, size, figure)?),
-    };
-
-    if let Some(parent) = path.parent() {
-        if !parent.as_os_str().is_empty() {
-            fs::create_dir_all(parent).map_err(io_err)?;
-        }
-    }
-    // written to a temporary sibling and renamed into place: never a half-written figure, and
-    // an existing file (or hard link) at `path` is replaced, not truncated
-    let pending = PendingTemporary::new(path);
-    let tmp = pending.path();
-    let written = match format {
+    let bytes = match format {
         FigureFormat::Png => {
-            let mut backend = BitMapBackend::new(tmp, size);
-            backend
-                .blit_bitmap((0, 0), size, &rgb)
-                .and_then(|()| backend.present())
-                .map_err(|e| draw_error(path)(Box::new(e)))
+            let rgb = render_rgb(path, size, figure)?;
+            encode_png(&rgb, size).map_err(|e| draw_error(path)(Box::new(e)))?
         }
-        FigureFormat::Svg => fs::write(tmp, svg).map_err(io_err),
-    }
-    .and_then(|()| fs::rename(tmp, path).map_err(io_err));
-    if written.is_err() {
-        let _ = fs::remove_file(tmp);
-    }
-    written
+        FigureFormat::Svg => render_svg(path, size, figure)?.into_bytes(),
+    };
+    write_bytes(path, &[], &bytes)?;
+    Ok(())
+}
+
+/// An RGB image of `size` as PNG bytes.
+fn encode_png(rgb: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
+    let mut out = Vec::with_capacity(rgb.len() / 8);
+    let mut enc = png::Encoder::new(&mut out, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_compression(png::Compression::Default);
+    enc.set_adaptive_filter(png::AdaptiveFilterType::Adaptive);
+    let mut writer = enc.write_header()?;
+    writer.write_image_data(rgb)?;
+    writer.finish()?;
+    Ok(out)
 }
 
 fn render<DB, F>(root: &DrawingArea<DB, Shift>, figure: &F, scale: f64) -> DrawResult

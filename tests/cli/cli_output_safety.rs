@@ -603,9 +603,10 @@ fn sigint_during_simulate_keeps_and_marks_the_finished_profiles() {
         .filter_map(|l| l.strip_prefix("complete "))
         .map(|l| l.split(' ').nth(1).unwrap().to_string())
         .collect();
+    // the manifest lists the figures too (written after the last profile)
     let missing = manifest
         .lines()
-        .filter(|l| l.starts_with("missing "))
+        .filter(|l| l.starts_with("missing ") && l.ends_with("_profile.csv"))
         .count();
     let mut sorted = complete.clone();
     sorted.sort();
@@ -725,7 +726,12 @@ fn simulate_failing_midway_leaves_a_manifest() {
     );
     p.assert_clean_failure(&["v1p06_p3"]);
     let manifest = fs::read_to_string(out.join("PARTIAL.txt")).unwrap();
-    assert!(manifest.contains("8 of 9 profiles written"), "{manifest}");
+    // 9 profiles, profiles.png and diameters_vs_data.png: 8 profiles written
+    assert!(manifest.contains("8 of 11 files written"), "{manifest}");
+    assert!(
+        manifest.contains("missing figure profiles.png"),
+        "{manifest}"
+    );
     assert!(manifest.contains("missing v1p06_p3 "), "{manifest}");
     assert_eq!(profile_files(&out).len(), 8);
 }

@@ -31,37 +31,80 @@ pub const MAX_ABS_KAPPA: f64 = 700.0;
 /// Tolerance range of `landscape --tol`.
 pub const TOL_RANGE: (f64, f64) = (1e-12, 0.1);
 
+/// A number as people read it: the shortest form that reads back exactly, in exponent
+/// notation below 1e-4 and from 1e6 on (`1e308`, not 309 digits).
+pub fn show(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// A value as given, for a message: trimmed and, if very long, cut to its first 40
+/// characters.
+fn given(s: &str) -> String {
+    let t = s.trim();
+    match t.char_indices().nth(40) {
+        Some((i, _)) => format!("{}… ({} characters)", &t[..i], t.chars().count()),
+        None => t.to_string(),
+    }
+}
+
 fn number(s: &str) -> Result<f64, String> {
+    if s.trim() == "--" {
+        return Err(
+            "\"--\" is not a number; negative numbers need no \"--\": write e.g. \
+                    --n -0.1 or --n=-0.1"
+                .into(),
+        );
+    }
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("\"{s}\" is not a number"))?;
+        .map_err(|_| format!("\"{}\" is not a number", given(s)))?;
     if !v.is_finite() {
-        return Err(format!("{s} is not a finite number"));
+        return Err(format!("{} is not a finite number", given(s)));
     }
     Ok(v)
 }
 
-fn count(s: &str) -> Result<usize, String> {
-    s.trim()
-        .parse()
-        .map_err(|_| format!("\"{s}\" is not a whole number >= 0"))
+/// A whole number within `range` (inclusive); `what` says what is counted, as in "give
+/// 2 to 100000 {what}". Negative and non-integer values get the same range message.
+fn count_in(s: &str, range: std::ops::RangeInclusive<usize>, what: &str) -> Result<usize, String> {
+    let (lo, hi) = (*range.start(), *range.end());
+    let out_of_range = |got: &str| format!("give {lo} to {hi} {what} (got {got})");
+    match s.trim().parse::<i128>() {
+        Ok(v) => usize::try_from(v)
+            .ok()
+            .filter(|v| range.contains(v))
+            .ok_or_else(|| out_of_range(&given(s))),
+        Err(_) if number(s).is_ok() => Err(format!(
+            "{}: {}",
+            out_of_range(&given(s)),
+            "a whole number is needed"
+        )),
+        Err(_) => Err(format!(
+            "\"{}\" is not a whole number; give {lo} to {hi} {what}",
+            given(s)
+        )),
+    }
 }
 
 /// `--points`: 2 to [`MAX_POINTS`].
 pub fn parse_points(s: &str) -> Result<usize, String> {
-    let v = count(s)?;
-    if !(2..=MAX_POINTS).contains(&v) {
-        return Err(format!(
-            "give 2 to {MAX_POINTS} output positions per profile (got {v})"
-        ));
-    }
-    Ok(v)
+    count_in(s, 2..=MAX_POINTS, "output positions per profile")
 }
 
 /// `--max-nodes`: [`MIN_MAX_NODES`] to [`MAX_MAX_NODES`].
 pub fn parse_max_nodes(s: &str) -> Result<usize, String> {
-    let v = count(s)?;
+    let v = count_in(s, 0..=usize::MAX, "nodes").map_err(|_| {
+        format!(
+            "the mesh limit must lie in {MIN_MAX_NODES}..={MAX_MAX_NODES} nodes (got {}; \
+             default {DEFAULT_MAX_NODES})",
+            given(s)
+        )
+    })?;
     if !(MIN_MAX_NODES..=MAX_MAX_NODES).contains(&v) {
         return Err(format!(
             "the mesh limit must lie in {MIN_MAX_NODES}..={MAX_MAX_NODES} nodes (got {v}; \
@@ -77,7 +120,8 @@ pub fn parse_fraction(s: &str) -> Result<f64, String> {
     if !(v > 0.0 && v < 1.0) {
         return Err(format!(
             "a relative uncertainty must lie in (0, 1) like the TOML key relative_uncertainty \
-             (got {v}; 0.01 is 1 %)"
+             (got {}; 0.01 is 1 %)",
+            show(v)
         ));
     }
     Ok(v)
@@ -88,7 +132,8 @@ pub fn parse_f_scale(s: &str) -> Result<f64, String> {
     let v = number(s)?;
     if !(v > 0.0 && v < 1.0) {
         return Err(format!(
-            "f_scale is a relative residual in (0, 1) (got {v}; 0.02 is 2 %)"
+            "f_scale is a relative residual in (0, 1) (got {}; 0.02 is 2 %)",
+            show(v)
         ));
     }
     Ok(v)
@@ -99,8 +144,10 @@ pub fn parse_tol(s: &str) -> Result<f64, String> {
     let v = number(s)?;
     if !(TOL_RANGE.0..=TOL_RANGE.1).contains(&v) {
         return Err(format!(
-            "the tolerance must lie in [{:e}, {}] (got {v})",
-            TOL_RANGE.0, TOL_RANGE.1
+            "the tolerance must lie in [{:e}, {}] (got {})",
+            TOL_RANGE.0,
+            TOL_RANGE.1,
+            show(v)
         ));
     }
     Ok(v)
@@ -108,14 +155,12 @@ pub fn parse_tol(s: &str) -> Result<f64, String> {
 
 /// `--refit-top`: 1 to the number of built-in candidate effects.
 pub fn parse_refit_top(s: &str) -> Result<usize, String> {
-    let v = count(s)?;
     let most = Effect::builtin().len();
-    if !(1..=most).contains(&v) {
-        return Err(format!(
-            "give 1 to {most} (the number of candidate effects) candidates to refit (got {v})"
-        ));
-    }
-    Ok(v)
+    count_in(
+        s,
+        1..=most,
+        "candidates to refit (the number of candidate effects is the most)",
+    )
 }
 
 /// `--n`: the Carreau-type law's domain, a finite n >= 0.
@@ -128,7 +173,8 @@ pub fn check_n(v: f64) -> Result<f64, String> {
     if !(v >= 0.0 && v.is_finite()) {
         return Err(format!(
             "the power index n must be >= 0 (the Carreau-type law's domain; 1 is Newtonian), \
-             got {v}"
+             got {}",
+            show(v)
         ));
     }
     Ok(v)
@@ -144,7 +190,8 @@ pub fn check_kappa(v: f64) -> Result<f64, String> {
     if v.is_nan() || v.abs() > MAX_ABS_KAPPA {
         return Err(format!(
             "kappa = ln(K / 1 Pa) must lie in [-{MAX_ABS_KAPPA}, {MAX_ABS_KAPPA}] (K = e^kappa \
-             overflows beyond; the fit searches [7, 20]), got {v}"
+             overflows beyond; the fit searches [7, 20]), got {}",
+            show(v)
         ));
     }
     Ok(v)
@@ -156,7 +203,8 @@ pub fn parse_take_up_diameter(s: &str) -> Result<f64, String> {
     if !(MIN_TAKE_UP_DIAMETER_M..=MAX_PLAUSIBLE_DIAMETER_M).contains(&v) {
         return Err(format!(
             "a take-up diameter must lie in [{MIN_TAKE_UP_DIAMETER_M:e}, \
-             {MAX_PLAUSIBLE_DIAMETER_M}] m (got {v} m; the unit is metres)"
+             {MAX_PLAUSIBLE_DIAMETER_M}] m (got {} m; the unit is metres)",
+            show(v)
         ));
     }
     Ok(v)
@@ -170,14 +218,23 @@ pub fn check_range(
     (lo, hi): (f64, f64),
     [min, max]: [f64; 2],
 ) -> Result<(), String> {
-    if lo >= hi {
+    let given = format!("{flag} {},{}", show(lo), show(hi));
+    if lo == hi {
         return Err(format!(
-            "{flag} {lo},{hi}: give MIN,MAX with MIN < MAX (did you mean {hi},{lo}?)"
+            "{given}: the range is a single value; give MIN,MAX with MIN < MAX, within the \
+             fit's bounds [{min}, {max}] of {name}"
+        ));
+    }
+    if lo > hi {
+        return Err(format!(
+            "{given}: give MIN,MAX with MIN < MAX (did you mean {},{}?)",
+            show(hi),
+            show(lo)
         ));
     }
     if lo < min || hi > max {
         return Err(format!(
-            "{flag} {lo},{hi}: {name} must lie within the fit's bounds [{min}, {max}]"
+            "{given}: {name} must lie within the fit's bounds [{min}, {max}]"
         ));
     }
     Ok(())
@@ -188,9 +245,14 @@ pub fn check_start((n, kappa): (f64, f64), opts: &IdentifyOptions) -> Result<(),
     let inside = |v: f64, i: usize| v >= opts.lower[i] && v <= opts.upper[i];
     if !inside(n, 0) || !inside(kappa, 1) {
         return Err(format!(
-            "--start {n},{kappa}: the start must lie within the fit's bounds n in [{}, {}] and \
+            "--start {},{}: the start must lie within the fit's bounds n in [{}, {}] and \
              kappa in [{}, {}]",
-            opts.lower[0], opts.upper[0], opts.lower[1], opts.upper[1]
+            show(n),
+            show(kappa),
+            opts.lower[0],
+            opts.upper[0],
+            opts.lower[1],
+            opts.upper[1]
         ));
     }
     Ok(())
@@ -206,12 +268,12 @@ fn parse_two<T: std::str::FromStr>(
 ) -> Result<(T, T), String> {
     let parts: Vec<&str> = s.split(separators).collect();
     if parts.len() != 2 {
-        return Err(format!("expected {form}, got \"{s}\""));
+        return Err(format!("expected {form}, got \"{}\"", given(s)));
     }
     let value = |p: &str| {
         p.trim()
             .parse::<T>()
-            .map_err(|_| format!("\"{p}\" is not {what}"))
+            .map_err(|_| format!("\"{}\" is not {what}", given(p)))
     };
     Ok((value(parts[0])?, value(parts[1])?))
 }
@@ -220,7 +282,7 @@ fn parse_two<T: std::str::FromStr>(
 pub fn parse_pair(s: &str) -> Result<(f64, f64), String> {
     let (a, b) = parse_two::<f64>(s, &[','], "two numbers \"A,B\"", "a number")?;
     if !a.is_finite() || !b.is_finite() {
-        return Err(format!("\"{s}\" contains a non-finite number"));
+        return Err(format!("\"{}\" contains a non-finite number", given(s)));
     }
     Ok((a, b))
 }

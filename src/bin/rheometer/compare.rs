@@ -16,8 +16,8 @@ pub struct CompareArgs {
     /// kappa = ln(K / 1 Pa) of the Carreau-type law (without --fit; |kappa| <= 700).
     #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_kappa)]
     pub kappa: Option<f64>,
-    /// Use the Newtonian law (n = 1).
-    #[arg(long)]
+    /// Use the Newtonian law (n = 1; not with --n).
+    #[arg(long, conflicts_with = "n")]
     pub newtonian: bool,
     /// Take the take-up diameter d_fit(L) from the smoothed measurements where the TOML has
     /// none (implied by --fit, which was fitted that way).
@@ -59,7 +59,26 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         out,
     } = args;
     let loaded = load_input(g, &experiments, take_up_from_data, true)?;
-    let inputs = inputs_of(&experiments, &loaded);
+    // every output is checked before the simulations, against the inputs and the fit file
+    let mut plan = outputs::plan_for(&experiments, &loaded);
+    if let Some(f) = &fit {
+        plan.input(f);
+    }
+    let k = loaded.set.experiments.len();
+    let names: Vec<(String, String)> = Comparison::file_names(k, g.format.format())
+        .into_iter()
+        .map(|n| {
+            let label = if n.ends_with(".txt") || n.ends_with(".json") || n.ends_with(".csv") {
+                "table"
+            } else {
+                "figure"
+            };
+            (label.to_string(), n)
+        })
+        .collect();
+    plan.dir(&out, "--out", names.iter().map(|(_, n)| n));
+    plan.dir_files(&out, [PARTIAL_NAME]);
+    let outputs = outputs::check(&plan, g)?;
     let mut request = match &fit {
         Some(path) => {
             let rep = read_fit(path)?;
@@ -109,7 +128,10 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let t0 = std::time::Instant::now();
     let cmp = workflow::compare(&loaded, &request)
         .map_err(|e| checks::name_experiment(Box::new(e), &experiments, Some(request.law)))?;
-    let written = cmp.write(&out, g.format.format(), &inputs)?;
+    let mut dir = outputs::DirWriter::begin(&outputs, &out, "rheometer compare", "files", names)?;
+    let inputs = outputs.inputs();
+    let written = dir.files(|d| cmp.write(d, g.format.format(), inputs))?;
+    dir.finish()?;
     outln!("{}", cmp.to_text());
     g.say(format!(
         "compared {} experiments in {:.1} s; wrote {} files to {}",

@@ -42,38 +42,32 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         out,
     } = args;
     let loaded = load_input(g, &experiments, true, true)?;
-    let inputs = inputs_of(&experiments, &loaded);
     let spec = ModelSpec {
         law: model,
         effects: with,
         candidates: Vec::new(),
     };
     spec.validate()?;
-    // every output is checked before the work starts
+    // every output is checked before the work starts, against the inputs and each other
     let ext = g.format.ext();
-    let names = [
-        "diagnosis.txt".to_string(),
-        "diagnosis.json".to_string(),
-        format!("residuals_before_after.{ext}"),
-        format!("j_profiles.{ext}"),
+    let names = vec![
+        ("report".to_string(), "diagnosis.txt".to_string()),
+        ("json".to_string(), "diagnosis.json".to_string()),
+        (
+            "figure".to_string(),
+            format!("residuals_before_after.{ext}"),
+        ),
+        ("figure".to_string(), format!("j_profiles.{ext}")),
     ];
-    if let Some(dir) = &out {
-        check_output_dir(dir, &names, &inputs)?;
-        if let Some(path) = &json {
-            if let Some(name) = names.iter().find(|n| dir.join(n) == *path) {
-                return Err(format!(
-                    "--json {} is also the {name} of --out {}: one would replace the other; \
-                     choose another file",
-                    path.display(),
-                    dir.display()
-                )
-                .into());
-            }
-        }
-    }
+    let mut plan = outputs::plan_for(&experiments, &loaded);
     if let Some(path) = &json {
-        ensure_not_input(path, &inputs)?;
+        plan.file(path, "--json");
     }
+    if let Some(dir) = &out {
+        plan.dir(dir, "--out", names.iter().map(|(_, n)| n));
+        plan.dir_files(dir, [PARTIAL_NAME]);
+    }
+    let outputs = outputs::check(&plan, g)?;
     let mut opts = DiagnoseOptions::default();
     if let Some(k) = refit_top {
         opts.refit_top = k;
@@ -99,20 +93,21 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     outln!("{text}");
     let js = serde_json::to_string_pretty(&run.diagnosis)?;
     if let Some(path) = json {
-        write_json(&path, &js, &inputs)?;
+        outputs.write_text(&path, &js)?;
         g.say(format!("wrote {}", path.display()));
     }
     let Some(out) = out else {
         g.say("no --out: the report and figures were not written to files".into());
         return Ok(());
     };
-    create_dir(&out)?;
-    write_text(&out.join("diagnosis.txt"), &text, &inputs)?;
-    write_text(&out.join("diagnosis.json"), &js, &inputs)?;
-    let fig = out.join(&names[2]);
-    run.save_figure(&fig)?;
-    let prof = out.join(&names[3]);
-    run.save_profile_figure(&prof)?;
+    let mut dir = outputs::DirWriter::begin(&outputs, &out, "rheometer diagnose", "files", names)?;
+    dir.text("diagnosis.txt", &text)?;
+    dir.text("diagnosis.json", &js)?;
+    let fig = dir.path(&format!("residuals_before_after.{ext}"));
+    dir.files(|_| run.save_figure(&fig).map(|()| vec![fig.clone()]))?;
+    let prof = dir.path(&format!("j_profiles.{ext}"));
+    dir.files(|_| run.save_profile_figure(&prof).map(|()| vec![prof.clone()]))?;
+    dir.finish()?;
     g.say(format!(
         "wrote the report, {} and {} to {}",
         fig.display(),

@@ -7,14 +7,14 @@ use crate::*;
 pub struct FitArgs {
     /// The experiments file (TOML).
     pub experiments: PathBuf,
-    /// Start point "N,KAPPA" (default: the paper's start heuristic).
+    /// Start point "N,KAPPA" of the Carreau-type law (default: the paper's start heuristic).
     #[arg(long, value_parser = checks::parse_pair, allow_hyphen_values = true)]
     pub start: Option<(f64, f64)>,
     /// The estimator.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Principled)]
     pub estimator: EstimatorArg,
     /// Fit the Newtonian model (n = 1; the same as --model newtonian).
-    #[arg(long, conflicts_with = "model")]
+    #[arg(long, conflicts_with_all = ["model", "start"])]
     pub newtonian: bool,
     /// The viscosity law of the model: carreau (n, kappa fitted; the default) or newtonian.
     #[arg(long)]
@@ -33,7 +33,7 @@ pub struct FitArgs {
     #[arg(long, default_value = "linear", value_parser = diffbvp::least_squares::Loss::parse)]
     pub loss: diffbvp::least_squares::Loss,
     /// Soft margin of a robust loss as a relative residual (e.g. 0.02 for 2 %; default: the
-    /// robust noise scale of the data).
+    /// robust noise scale of the data); only with --loss soft_l1, huber or cauchy.
     #[arg(long = "f-scale", value_parser = checks::parse_f_scale, allow_hyphen_values = true)]
     pub f_scale: Option<f64>,
     /// BVP tolerance of the fit (1e-12 to 0.1; default: 1e-4, refined until the
@@ -70,44 +70,52 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         opts.simulate.tol = t;
         opts.max_discretisation_shift = Some(f64::INFINITY);
     }
+    if let Some(c) = f_scale {
+        if loss.is_linear() {
+            return Err(format!(
+                "--f-scale {}: a soft margin needs a robust loss, but the loss is linear \
+                 (least squares, the default of --loss); add --loss soft_l1 (or huber, \
+                 cauchy), or drop --f-scale",
+                checks::show(c)
+            )
+            .into());
+        }
+    }
     opts.loss = loss;
     opts.f_scale = f_scale;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
-    if let Some(s) = start {
-        checks::check_start(s, &opts)?;
-    }
-    let loaded = load_input(g, &experiments, true, true)?;
-    let inputs = inputs_of(&experiments, &loaded);
-    // refuse an output that is an input before spending time on the fit
-    if let Some(path) = &json {
-        ensure_not_input(path, &inputs)?;
-    }
-    if let Some(dir) = &out {
-        for name in [
-            "fit.json",
-            "fit_report.txt",
-            "flow_curve.csv",
-            "flow_curve.json",
-        ] {
-            ensure_not_input(&dir.join(name), &inputs)?;
-        }
-    }
     let law = match (newtonian, model) {
         (true, _) => LawChoice::Newtonian,
         (false, m) => m.unwrap_or_default(),
     };
-    if law == LawChoice::Newtonian && start.is_some() {
-        return Err(
-            "--start: the Newtonian model (n = 1) has no (n, kappa) to start from; \
-                    drop --start or fit the Carreau-type law (--model carreau)"
-                .into(),
-        );
+    if let Some(s) = start {
+        if law == LawChoice::Newtonian {
+            return Err(
+                "--start with --model newtonian: the Newtonian model (n = 1) has no (n, kappa) \
+                 to start from; drop --start or fit the Carreau-type law (--model carreau)"
+                    .into(),
+            );
+        }
+        checks::check_start(s, &opts)?;
     }
     let spec = ModelSpec {
         law,
         effects: with.clone(),
         candidates: Vec::new(),
     };
+    spec.validate()?;
+    let loaded = load_input(g, &experiments, true, true)?;
+    // every output is checked before the fit
+    let mut plan = outputs::plan_for(&experiments, &loaded);
+    if let Some(path) = &json {
+        plan.file(path, "--json");
+    }
+    let names = out.as_ref().map(|_| fit_output_names(&loaded, &with, g));
+    if let (Some(dir), Some(names)) = (&out, &names) {
+        plan.dir(dir, "--out", names.iter().map(|(_, n)| n));
+        plan.dir_files(dir, [PARTIAL_NAME]);
+    }
+    let outputs = outputs::check(&plan, g)?;
     let request = FitRequest {
         model: spec,
         identify: opts,
@@ -146,34 +154,76 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     }
     let text = serde_json::to_string_pretty(rep)?;
     if let Some(path) = json {
-        write_json(&path, &text, &inputs)?;
+        outputs.write_text(&path, &text)?;
         g.say(format!("wrote {}", path.display()));
     }
-    if let Some(dir) = out {
-        write_fit_outputs(&run, &dir, &text, &with, &inputs, g)?;
+    if let (Some(dir), Some(names)) = (out, names) {
+        write_fit_outputs(&run, &outputs, &dir, names, &text, &with, g)?;
     }
     Ok(())
 }
 
-/// The report, JSON, fitted profiles and figures of a fit into `dir`.
+/// The files `fit --out` writes, as `(label, name)`: the report, the JSON, the fitted
+/// profiles, the figures (paged beyond 24 experiments) and, with `--with`, the before/after
+/// residual figure.
+fn fit_output_names(
+    loaded: &LoadedExperiments,
+    with: &[EffectSetting],
+    g: &Global,
+) -> Vec<(String, String)> {
+    let ext = g.format.ext();
+    let mut v = vec![
+        ("report".to_string(), "fit_report.txt".to_string()),
+        ("json".to_string(), "fit.json".to_string()),
+    ];
+    for e in &loaded.set.experiments {
+        v.push((e.name.clone(), format!("{}_fitted_profile.csv", e.name)));
+    }
+    if !with.is_empty() {
+        v.push(("figure".into(), format!("residuals_before_after.{ext}")));
+    }
+    v.push(("table".into(), "flow_curve.csv".to_string()));
+    v.push(("json".into(), "flow_curve.json".to_string()));
+    v.push(("figure".into(), format!("flow_curve.{ext}")));
+    let k = loaded.set.experiments.len();
+    for n in figures::identification_figure_names(ext, k) {
+        v.push(("figure".into(), n));
+    }
+    v
+}
+
+/// The report, JSON, fitted profiles and figures of a fit into `dir` (the files of
+/// `names`), marked incomplete until the last is written.
 fn write_fit_outputs(
     run: &FitRun,
+    outputs: &CheckedOutputs,
     dir: &Path,
+    names: Vec<(String, String)>,
     json: &str,
     with: &[EffectSetting],
-    inputs: &[PathBuf],
     g: &Global,
 ) -> Result<(), Box<dyn Error>> {
     let (rh, id) = (&run.rheometer, &run.identification);
-    create_dir(dir)?;
+    let mut w = outputs::DirWriter::begin(outputs, dir, "rheometer fit", "files", names)?;
+    w.text("fit_report.txt", &run.summary().to_text())?;
+    w.text("fit.json", json)?;
+    for (k, sol) in id.solutions.iter().enumerate() {
+        let fs = FiberSolution {
+            solution: sol.clone(),
+        };
+        let prof = fs.uniform_profiles(&rh.models[k], 101);
+        let name = format!("{}_fitted_profile.csv", rh.experiments[k].name);
+        w.write(&name, |out| write_profiles_csv(out, &prof))?;
+    }
     if let Some(id0) = &run.baseline {
         let names: Vec<String> = with.iter().map(|w| w.effect.name().to_string()).collect();
         let label = names.join(" + ");
         let before = profiles_of(rh, &id0.solutions);
         let after = profiles_of(rh, &id.solutions);
-        let fig = dir.join(format!("residuals_before_after.{}", g.format.ext()));
-        ensure_not_input(&fig, inputs)?;
-        save_residual_figure(&fig, &before, Some((&label, &after)))?;
+        let fig = w.path(&format!("residuals_before_after.{}", g.format.ext()));
+        w.files(|_| {
+            save_residual_figure(&fig, &before, Some((&label, &after))).map(|()| vec![fig.clone()])
+        })?;
         outln!(
             "RMS relative residual: {:.4} % without {label}, {:.4} % with it ({})",
             100.0 * id0.rms(),
@@ -181,40 +231,20 @@ fn write_fit_outputs(
             fig.display()
         );
     }
-    write_text(
-        &dir.join("fit_report.txt"),
-        &run.summary().to_text(),
-        inputs,
-    )?;
-    write_text(&dir.join("fit.json"), json, inputs)?;
     if let Some(curve) = &run.summary().flow_curve {
-        write_text(&dir.join("flow_curve.csv"), &curve.to_csv(), inputs)?;
-        write_text(
-            &dir.join("flow_curve.json"),
-            &serde_json::to_string_pretty(curve)?,
-            inputs,
-        )?;
-        let fig = dir.join(format!("flow_curve.{}", g.format.ext()));
-        ensure_not_input(&fig, inputs)?;
-        save_flow_curve_figure(&fig, curve)?;
-        g.say(format!("wrote {}", fig.display()));
-    }
-    for (k, sol) in id.solutions.iter().enumerate() {
-        let model = &rh.models[k];
-        let fs = FiberSolution {
-            solution: sol.clone(),
-        };
-        let prof = fs.uniform_profiles(model, 101);
-        write_text(
-            &dir.join(format!("{}_fitted_profile.csv", rh.experiments[k].name)),
-            &profiles_csv(&prof),
-            inputs,
-        )?;
+        w.text("flow_curve.csv", &curve.to_csv())?;
+        w.text("flow_curve.json", &serde_json::to_string_pretty(curve)?)?;
+        let fig = w.path(&format!("flow_curve.{}", g.format.ext()));
+        w.files(|_| save_flow_curve_figure(&fig, curve).map(|()| vec![fig.clone()]))?;
     }
     let newtonian = run.newtonian.as_deref().unwrap_or_default();
-    let written = figures::identification_figures(rh, id, newtonian, dir, g.format.ext(), inputs)?;
-    for w in written {
-        g.say(format!("wrote {}", w.display()));
+    let inputs = outputs.inputs();
+    let written = w.files(|dir| {
+        figures::identification_figures(rh, id, newtonian, dir, g.format.ext(), inputs)
+    })?;
+    w.finish()?;
+    for p in written {
+        g.say(format!("wrote {}", p.display()));
     }
     g.say(format!(
         "wrote the report and fitted profiles to {}",

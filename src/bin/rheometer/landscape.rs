@@ -8,7 +8,7 @@ pub struct LandscapeArgs {
     /// The experiments file (TOML).
     pub experiments: PathBuf,
     /// Grid size "NxM" (n values x kappa values).
-    #[arg(long, default_value = "41x41", value_parser = checks::parse_grid)]
+    #[arg(long, default_value = "41x41", allow_hyphen_values = true, value_parser = checks::parse_grid)]
     pub grid: (usize, usize),
     /// Range of n "MIN,MAX" (within the fit's bounds [0, 1]).
     #[arg(long, default_value = "0,1", value_parser = checks::parse_pair, allow_hyphen_values = true)]
@@ -50,12 +50,17 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     opts.simulate.tol = tol;
     opts.simulate.max_nodes = checks::landscape_max_nodes(g.max_nodes)?;
     let loaded = load_input(g, &experiments, true, true)?;
-    let inputs = inputs_of(&experiments, &loaded);
-    let outputs = [
-        "landscape.csv".to_string(),
-        format!("landscape.{}", g.format.ext()),
+    let names = vec![
+        ("table".to_string(), "landscape.csv".to_string()),
+        (
+            "figure".to_string(),
+            format!("landscape.{}", g.format.ext()),
+        ),
     ];
-    check_output_dir(&out, &outputs, &inputs)?;
+    let mut plan = outputs::plan_for(&experiments, &loaded);
+    plan.dir(&out, "--out", names.iter().map(|(_, n)| n));
+    plan.dir_files(&out, [PARTIAL_NAME]);
+    let outputs = outputs::check(&plan, g)?;
     let rh = Rheometer::new(&loaded.set)?;
     let ns = linspace(n_range.0, n_range.1, grid.0);
     let ks = linspace(kappa_range.0, kappa_range.1, grid.1);
@@ -83,9 +88,9 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         &INTERRUPTED,
     )?;
     bar.finish_and_clear();
-    create_dir(&out)?;
-    let path = out.join("landscape.csv");
-    write_atomically(&path, &inputs, |w| write_landscape_csv(w, &run))?;
+    let mut dir = outputs::DirWriter::begin(&outputs, &out, "rheometer landscape", "files", names)?;
+    let path = dir.path("landscape.csv");
+    dir.write("landscape.csv", |w| write_landscape_csv(w, &run))?;
     let total = run.status.len();
     let failed = run.failed();
     if run.cancelled {
@@ -111,7 +116,10 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             "most grid points failed ({failed} of {total}): the ranges --n-range {},{} \
              --kappa-range {},{} reach far beyond where the model has a solution for these \
              experiments; narrow them",
-            n_range.0, n_range.1, kappa_range.0, kappa_range.1
+            checks::show(n_range.0),
+            checks::show(n_range.1),
+            checks::show(kappa_range.0),
+            checks::show(kappa_range.1)
         ));
     }
     let mut markers = Vec::new();
@@ -119,9 +127,13 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         outln!("grid minimum: n = {n:.4}, kappa = {k:.4}, J = {c:.6e}");
         markers.push((n, k, "grid minimum".to_string()));
     }
-    let fig = out.join(format!("landscape.{}", g.format.ext()));
+    let fig = dir.path(&format!("landscape.{}", g.format.ext()));
     let title = format!("J(n, κ), {} estimator", opts.estimator.name());
-    figures::landscape_map(&fig, &l, &title, &markers, &inputs)?;
+    let inputs = outputs.inputs();
+    dir.files(|_| {
+        figures::landscape_map(&fig, &l, &title, &markers, inputs).map(|()| vec![fig.clone()])
+    })?;
+    dir.finish()?;
     g.say(format!(
         "{} points in {:.1} s; wrote {}",
         grid.0 * grid.1,
@@ -144,7 +156,13 @@ fn write_landscape_csv(w: &mut dyn std::io::Write, run: &LandscapeRun) -> std::i
                 PointStatus::Failed => "failed",
                 PointStatus::NotReached => "not_computed",
             };
-            writeln!(w, "{n},{k},{:e},{status}", l.cost[idx])?;
+            writeln!(
+                w,
+                "{},{},{:e},{status}",
+                checks::show(*n),
+                checks::show(*k),
+                l.cost[idx]
+            )?;
         }
     }
     Ok(())

@@ -2,7 +2,7 @@
 //! from your own TOML + CSV measurements.
 
 use clap::{Parser, Subcommand, ValueEnum};
-use diffbvp::fiber::diagnostics::compare::{FigureFormat, MissingTakeUp};
+use diffbvp::fiber::diagnostics::compare::{Comparison, FigureFormat, MissingTakeUp};
 use diffbvp::fiber::diagnostics::diagnose::{DiagnoseOptions, ResidualProfiles};
 use diffbvp::fiber::diagnostics::report::save_residual_figure;
 use diffbvp::fiber::effects::{EffectSetting, LawChoice, ModelSpec};
@@ -12,41 +12,29 @@ use diffbvp::fiber::flow_curve_figure::save_flow_curve_figure;
 use diffbvp::fiber::input::{
     load_experiments_with_options, InputError, LoadOptions, LoadedExperiments,
 };
-use diffbvp::fiber::output::{
-    check_output_dir, create_dir, ensure_not_input, profiles_csv, write_atomically, write_profiles,
-    write_text,
-};
+use diffbvp::fiber::output::write_profiles_csv;
 use diffbvp::fiber::rheometer::{
     Estimator, FitSummary, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
 };
 use diffbvp::fiber::workflow::{self, CompareRequest, FitRequest, FitRun};
 use diffbvp::fiber::{FiberSolution, SimulateOptions};
+use diffbvp::output_files::{CheckedOutputs, PARTIAL_NAME};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// `println!` that never panics: a closed stdout (e.g. `rheometer ... | head`) is ignored,
-/// any other write error (e.g. `> /dev/full`) is remembered and makes the program exit 1 at the
-/// end (see [`out_line`]).
+/// `println!` of the report that never panics (see [`streams::out_line`]): a closed pipe
+/// (`rheometer ... | head`) is ignored, any other write error (`> /dev/full`, a closed
+/// stdout) makes the program exit 1 at the end with a message.
 macro_rules! outln {
     ($($arg:tt)*) => {{
-        $crate::out_line(format_args!($($arg)*));
+        $crate::streams::out_line(format_args!($($arg)*));
     }};
 }
 
-/// The first error writing to stdout other than a closed pipe.
-static STDOUT_ERROR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-
-/// Set by the first SIGINT: `simulate` and `landscape` stop between experiments or grid points,
-/// keep and mark what they finished, and exit with code 130; the other commands end at once
-/// (code 130, no temporary left). A second SIGINT ends the program at once.
-pub static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// Whether SIGINT was received (see [`INTERRUPTED`]).
-pub fn interrupted() -> bool {
-    INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst)
-}
+pub use signals::{interrupted, EXIT_INTERRUPTED, INTERRUPTED};
+pub use streams::err_line;
 
 /// A command stopped by SIGINT after keeping what it finished: reported as
 /// `interrupted: MESSAGE`, exit code 130.
@@ -61,67 +49,16 @@ impl std::fmt::Display for Interrupted {
 
 impl Error for Interrupted {}
 
-/// Exit code after SIGINT (128 + 2, the shell's convention).
-const EXIT_INTERRUPTED: u8 = 130;
-
-/// Writes one line to stdout; remembers the first failure other than a closed pipe.
-pub fn out_line(args: std::fmt::Arguments<'_>) {
-    use std::io::Write as _;
-    let mut o = std::io::stdout().lock();
-    if let Err(e) = o.write_fmt(args).and_then(|()| o.write_all(b"\n")) {
-        note_stdout_error(&e);
-    }
-}
-
-fn note_stdout_error(e: &std::io::Error) {
-    if e.kind() != std::io::ErrorKind::BrokenPipe {
-        let _ = STDOUT_ERROR.set(e.to_string());
-    }
-}
-
-/// Writes one line to stderr, ignoring failures (`2>/dev/full` must not panic).
-pub fn err_line(s: &str) {
-    use std::io::Write as _;
-    let mut e = std::io::stderr().lock();
-    let _ = e.write_all(s.as_bytes()).and_then(|()| e.write_all(b"\n"));
-}
-
-/// SIGINT handling for the commands that stop cleanly.
-#[cfg(unix)]
-mod sigint {
-    use std::sync::atomic::Ordering;
-
-    extern "C" fn on_sigint(_: libc::c_int) {
-        // async-signal-safe only: an atomic swap, and _exit on the second signal
-        if super::INTERRUPTED.swap(true, Ordering::SeqCst) {
-            // SAFETY: _exit is async-signal-safe and takes no pointers
-            unsafe { libc::_exit(i32::from(super::EXIT_INTERRUPTED)) };
-        }
-    }
-
-    /// Installs the handler setting [`super::INTERRUPTED`].
-    pub fn install() {
-        let handler: extern "C" fn(libc::c_int) = on_sigint;
-        // SAFETY: the handler only touches an atomic and calls _exit, both async-signal-safe
-        unsafe {
-            libc::signal(libc::SIGINT, handler as libc::sighandler_t);
-        }
-    }
-}
-
-#[cfg(not(unix))]
-mod sigint {
-    /// Elsewhere SIGINT keeps its default (the program ends at once).
-    pub fn install() {}
-}
-
 // after the macro, which they use
 mod checks;
 mod compare;
 mod diagnose;
 mod fit;
 mod landscape;
+mod outputs;
+mod signals;
 mod simulate;
+mod streams;
 
 #[derive(Parser)]
 #[command(
@@ -148,7 +85,7 @@ struct Cli {
     format: FormatArg,
     /// Largest mesh (nodes) of a BVP solve (50 to 1000000; default 20000, the landscape
     /// 1000). A solve that needs more fails and names this flag.
-    #[arg(long, global = true, value_parser = checks::parse_max_nodes)]
+    #[arg(long, global = true, allow_hyphen_values = true, value_parser = checks::parse_max_nodes)]
     max_nodes: Option<usize>,
     /// Lift the caps on input size (16 MB experiments file, 128 MB and 1,000,000 rows per CSV
     /// file, 64 kB per CSV line, 1000 experiments, 4 GB estimated fit memory). Inputs must
@@ -296,27 +233,11 @@ pub fn load_input(
     Ok(loaded)
 }
 
-fn inputs_of(path: &Path, loaded: &LoadedExperiments) -> Vec<PathBuf> {
-    let mut v = vec![path.to_path_buf()];
-    v.extend(loaded.details.iter().filter_map(|d| d.data.clone()));
-    v
-}
-
 fn estimator(e: EstimatorArg) -> Estimator {
     match e {
         EstimatorArg::Principled => Estimator::Principled,
         EstimatorArg::Paper => Estimator::Paper,
     }
-}
-
-fn write_json(path: &Path, text: &str, inputs: &[PathBuf]) -> Result<(), Box<dyn Error>> {
-    if let Some(parent) = path.parent() {
-        if !parent.as_os_str().is_empty() {
-            create_dir(parent)?;
-        }
-    }
-    write_text(path, text, inputs)?;
-    Ok(())
 }
 
 fn profiles_of(rh: &Rheometer, sols: &[diffbvp::Solution]) -> ResidualProfiles {
@@ -379,26 +300,28 @@ fn main() -> ExitCode {
             // usage errors on stderr (exit 2), --help and --version on stdout (exit 0)
             if let Err(w) = e.print() {
                 if !e.use_stderr() {
-                    note_stdout_error(&w);
+                    streams::note_stdout_error(&w);
                 }
             }
-            return match finish_stdout() {
+            if let Some(note) = negative_number_note() {
+                err_line(&note);
+            }
+            return match streams::finish_stdout() {
                 Err(()) => ExitCode::FAILURE,
                 Ok(()) => ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(1)),
             };
         }
     };
-    // `simulate` and `landscape` stop cleanly (they check the flag between experiments or grid
-    // points); the other commands end at once, without leaving a temporary of a write in
-    // progress behind
-    sigint::install();
+    // `simulate` and `landscape` stop cleanly after SIGINT (they check the flag between
+    // experiments or grid points); the other commands, and every command after SIGTERM or
+    // SIGHUP, end at once, without leaving a temporary of a write in progress behind
     if matches!(cli.command, Command::Simulate(_) | Command::Landscape(_)) {
-        interrupt_watchdog(INTERRUPT_GRACE);
+        signals::install(signals::INTERRUPT_GRACE);
     } else {
-        interrupt_watchdog(std::time::Duration::ZERO);
+        signals::install(std::time::Duration::ZERO);
     }
     let result = run(cli);
-    let stdout_ok = finish_stdout();
+    let stdout_ok = streams::finish_stdout();
     match result {
         Ok(()) if stdout_ok.is_ok() => ExitCode::SUCCESS,
         Ok(()) => ExitCode::FAILURE,
@@ -407,58 +330,48 @@ fn main() -> ExitCode {
                 err_line(&format!("interrupted: {i}"));
                 return ExitCode::from(EXIT_INTERRUPTED);
             }
-            let mut printed = e.to_string();
-            err_line(&format!("error: {printed}"));
-            let mut src = e.source();
-            while let Some(s) = src {
-                // messages that already quote their cause are not repeated
-                let text = s.to_string();
-                if !printed.contains(&text) {
-                    err_line(&format!("  caused by: {text}"));
-                }
-                printed = text;
-                src = s.source();
-            }
-            if let Some(f) = e.downcast_ref::<ExperimentFailure>() {
-                for h in &f.hints {
-                    eprintln!("  hint: {h}");
-                }
-            }
+            report_error(e.as_ref());
             ExitCode::FAILURE
         }
     }
 }
 
-/// Grace period after SIGINT before the program is ended regardless (a single solve that
-/// does not check the flag); outputs are written atomically and `simulate` keeps its
-/// `PARTIAL.txt` manifest up to date, so ending here loses no finished file.
-const INTERRUPT_GRACE: std::time::Duration = std::time::Duration::from_millis(1500);
-
-/// Starts a thread that ends the program `grace` after SIGINT (within 25 ms of it for a zero
-/// grace), after removing the temporaries of writes in progress.
-fn interrupt_watchdog(grace: std::time::Duration) {
-    std::thread::spawn(move || {
-        while !interrupted() {
-            std::thread::sleep(std::time::Duration::from_millis(25));
-        }
-        std::thread::sleep(grace);
-        diffbvp::fiber::output::remove_pending_temporaries();
-        err_line("interrupted: stopped before the current step finished; finished files are kept");
-        std::process::exit(i32::from(EXIT_INTERRUPTED));
-    });
+/// A note for `--n -- -0.1` (clap reads `--` as the value and `-0.1` as flags): negative
+/// numbers are values as they are.
+fn negative_number_note() -> Option<String> {
+    let args: Vec<String> = std::env::args().collect();
+    args.windows(3)
+        .find(|w| {
+            w[0].starts_with("--")
+                && w[1] == "--"
+                && w[2].starts_with('-')
+                && w[2].parse::<f64>().is_ok()
+        })
+        .map(|w| {
+            format!(
+                "note: negative numbers need no \"--\": write {} {} (or {}={})",
+                w[0], w[2], w[0], w[2]
+            )
+        })
 }
 
-/// Flushes stdout; reports (on stderr) the first stdout write error other than a closed pipe.
-fn finish_stdout() -> Result<(), ()> {
-    use std::io::Write as _;
-    if let Err(e) = std::io::stdout().flush() {
-        note_stdout_error(&e);
-    }
-    match STDOUT_ERROR.get() {
-        Some(e) => {
-            err_line(&format!("error: cannot write to standard output: {e}"));
-            Err(())
+/// Prints `error: ...`, the causes not already quoted, and the hints of a failed experiment.
+fn report_error(e: &(dyn Error + 'static)) {
+    let mut printed = e.to_string();
+    err_line(&format!("error: {printed}"));
+    let mut src = e.source();
+    while let Some(s) = src {
+        // messages that already quote their cause are not repeated
+        let text = s.to_string();
+        if !printed.contains(&text) {
+            err_line(&format!("  caused by: {text}"));
         }
-        None => Ok(()),
+        printed = text;
+        src = s.source();
+    }
+    if let Some(f) = e.downcast_ref::<ExperimentFailure>() {
+        for h in &f.hints {
+            err_line(&format!("  hint: {h}"));
+        }
     }
 }

@@ -16,17 +16,23 @@ pub struct SimulateArgs {
     /// kappa = ln(K / 1 Pa) of the Carreau-type law (|kappa| <= 700).
     #[arg(long, default_value_t = 11.71, allow_hyphen_values = true, value_parser = checks::parse_kappa)]
     pub kappa: f64,
-    /// Use the Newtonian law (n = 1).
-    #[arg(long)]
+    /// Use the Newtonian law (n = 1; not with --n).
+    #[arg(long, conflicts_with = "n")]
     pub newtonian: bool,
-    /// Take-up diameter (m, 1e-7 to 0.02) for experiments without one in the TOML.
-    #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_take_up_diameter)]
+    /// Take-up diameter (m, 1e-7 to 0.02) for experiments without one in the TOML (not with
+    /// --take-up-from-data).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_parser = checks::parse_take_up_diameter,
+        conflicts_with = "take_up_from_data"
+    )]
     pub take_up_diameter: Option<f64>,
     /// Take the take-up diameter d_fit(L) from the smoothed measurements where the TOML has none.
     #[arg(long)]
     pub take_up_from_data: bool,
     /// Number of uniform output positions (2 to 100000).
-    #[arg(long, default_value_t = 101, value_parser = checks::parse_points)]
+    #[arg(long, default_value_t = 101, allow_hyphen_values = true, value_parser = checks::parse_points)]
     pub points: usize,
     /// Output directory (created; input files are never overwritten).
     #[arg(long)]
@@ -51,23 +57,30 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         take_up_from_data && take_up_diameter.is_none(),
         false,
     )?;
-    let inputs = inputs_of(&experiments, &loaded);
     let set = &loaded.set;
-    // every output name is checked against the inputs before any work starts
+    // every output is checked before any work starts
     let names: Vec<&str> = set.experiments.iter().map(|e| e.name.as_str()).collect();
     let ext = g.format.ext();
-    let mut outputs: Vec<String> = names.iter().map(|n| format!("{n}_profile.csv")).collect();
-    outputs.extend([
-        PARTIAL.to_string(),
-        format!("profiles.{ext}"),
-        format!("diameters_vs_data.{ext}"),
-    ]);
-    check_output_dir(&out, &outputs, &inputs)?;
-    create_dir(&out)?;
-    // the manifest stays until every profile is written: an interrupted or failed run (or
-    // one still running) is always marked, with the finished experiments listed
-    let mut complete: Vec<&str> = Vec::with_capacity(names.len());
-    write_partial(&out, &names, &complete, &inputs)?;
+    let with_data = set.measurements.iter().filter(|m| m.is_some()).count();
+    let mut entries: Vec<(String, String)> = names
+        .iter()
+        .map(|n| (n.to_string(), format!("{n}_profile.csv")))
+        .collect();
+    entries.push(("figure".into(), format!("profiles.{ext}")));
+    if with_data > 0 {
+        for f in figures::panel_page_names("diameters_vs_data", ext, with_data) {
+            entries.push(("figure".into(), f));
+        }
+    }
+    let mut plan = outputs::plan_for(&experiments, &loaded);
+    plan.dir(&out, "--out", entries.iter().map(|(_, f)| f));
+    plan.dir_files(&out, [PARTIAL_NAME]);
+    let outputs = outputs::check(&plan, g)?;
+    // the manifest stays until every file is written: an interrupted or failed run (or one
+    // still running) is always marked, with the finished experiments listed
+    let mut dir =
+        outputs::DirWriter::begin(&outputs, &out, "rheometer simulate", "files", entries)?;
+    let inputs = outputs.inputs().to_vec();
     let law = if newtonian { [1.0, kappa] } else { [n, kappa] };
     let request = SimulateRequest {
         law,
@@ -88,14 +101,10 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     };
     // each profile written (and the manifest updated) as soon as it is finished
     let mut write_error: Option<Box<dyn Error>> = None;
-    let result = workflow::simulate_experiments(&loaded, &request, |k, p| {
-        let path = out.join(format!("{}_profile.csv", p.name));
-        let written = write_profiles(&path, &p.profiles, &inputs)
-            .map_err(Box::<dyn Error>::from)
-            .and_then(|()| {
-                complete.push(names[k]);
-                write_partial(&out, &names, &complete, &inputs)
-            });
+    let result = workflow::simulate_experiments(&loaded, &request, |_, p| {
+        let name = format!("{}_profile.csv", p.name);
+        let path = dir.path(&name);
+        let written = dir.write(&name, |w| write_profiles_csv(w, &p.profiles));
         if let Err(e) = written {
             write_error = Some(e);
             return ControlFlow::Break(());
@@ -127,22 +136,18 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
                 "simulated {done} of {} experiments; {} lists the profiles written and the \
                  missing ones",
                 names.len(),
-                out.join(PARTIAL).display()
+                out.join(PARTIAL_NAME).display()
             ))
             .into())
         }
         Err(SimulateError::Experiment(f)) => return Err(f),
         Err(e) => return Err(e.to_string().into()),
     };
-    // every profile is written: the figures cannot lose data any more
-    remove_partial(&out, &inputs)?;
-    let fig = out.join(format!("profiles.{ext}"));
-    figures::profile_overview(&fig, &names, &all_profiles, &inputs).map_err(|e| {
-        format!(
-            "the {} profiles were written to {}, but the figure failed: {e}",
-            names.len(),
-            out.display()
-        )
+    // every profile is written; the figures are the last files of the set
+    let fig = format!("profiles.{ext}");
+    dir.files(|d| {
+        let path = d.join(&fig);
+        figures::profile_overview(&path, &names, &all_profiles, &inputs).map(|()| vec![path])
     })?;
     let with_data: Vec<usize> = (0..set.experiments.len())
         .filter(|&k| set.measurements[k].is_some())
@@ -165,22 +170,17 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         let label = if newtonian {
             "Newtonian (n = 1)".to_string()
         } else {
-            format!("n = {n}, κ = {kappa}")
+            format!("n = {}, κ = {}", checks::show(n), checks::show(kappa))
         };
         let curves = [ModelCurves {
             label: &label,
             profiles: &profs,
             dashed: false,
         }];
-        let fig = out.join(format!("diameters_vs_data.{ext}"));
-        let pages = figures::experiment_panel_pages(&fig, &views, &curves, View::Diameter, &inputs)
-            .map_err(|e| {
-                format!(
-                    "the {} profiles were written to {}, but the figure failed: {e}",
-                    names.len(),
-                    out.display()
-                )
-            })?;
+        let pages = dir.files(|d| {
+            let fig = d.join(format!("diameters_vs_data.{ext}"));
+            figures::experiment_panel_pages(&fig, &views, &curves, View::Diameter, &inputs)
+        })?;
         if pages.len() > 1 {
             g.say(format!(
                 "{} experiments with measurements: the diameter figure is split into {} files \
@@ -192,52 +192,11 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             ));
         }
     }
+    dir.finish()?;
     g.say(format!(
         "wrote {} profiles and figures to {}",
         set.experiments.len(),
         out.display()
     ));
     Ok(())
-}
-
-/// Name of the manifest that marks an incomplete `simulate` output directory.
-pub const PARTIAL: &str = "PARTIAL.txt";
-
-/// Writes `DIR/PARTIAL.txt`: which experiments have their profile written and which are missing.
-fn write_partial(
-    out: &Path,
-    names: &[&str],
-    complete: &[&str],
-    inputs: &[PathBuf],
-) -> Result<(), Box<dyn Error>> {
-    let mut text = String::from(
-        "# rheometer simulate: INCOMPLETE output (still running, interrupted or failed).\n\
-         # This file is removed once every profile is written.\n",
-    );
-    text.push_str(&format!(
-        "# {} of {} profiles written\n",
-        complete.len(),
-        names.len()
-    ));
-    for n in names {
-        let state = if complete.contains(n) {
-            "complete"
-        } else {
-            "missing"
-        };
-        text.push_str(&format!("{state} {n} {n}_profile.csv\n"));
-    }
-    write_text(&out.join(PARTIAL), &text, inputs)?;
-    Ok(())
-}
-
-/// Removes `DIR/PARTIAL.txt` (after [`write_partial`]; never an input).
-fn remove_partial(out: &Path, inputs: &[PathBuf]) -> Result<(), Box<dyn Error>> {
-    let path = out.join(PARTIAL);
-    ensure_not_input(&path, inputs)?;
-    match std::fs::remove_file(&path) {
-        Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(format!("cannot remove {}: {e}", path.display()).into()),
-    }
 }

@@ -437,6 +437,18 @@ impl Comparison {
         s
     }
 
+    /// The names of the files [`Comparison::write`] writes for `experiments` experiments in
+    /// `format` (so that a program can check them all before the work).
+    pub fn file_names(experiments: usize, format: FigureFormat) -> Vec<String> {
+        let mut v: Vec<String> = Self::TEXT_FILES.iter().map(|s| s.to_string()).collect();
+        v.extend(compare_figures::figure_names(experiments, format));
+        v
+    }
+
+    /// The text files of [`Comparison::write`].
+    const TEXT_FILES: [&'static str; 3] =
+        ["compare_summary.txt", "compare.json", "compare_points.csv"];
+
     /// Writes `compare_summary.txt`, `compare.json`, `compare_points.csv` and the figures
     /// (see [`compare_figures::write_figures`]) into `dir` (created; refused if it is an input
     /// or a file), never over a file in `inputs`, each file atomically (see
@@ -449,11 +461,8 @@ impl Comparison {
     ) -> Result<Vec<PathBuf>, CompareError> {
         create_output_dir(dir, inputs)?;
         let mut written = Vec::new();
-        for (name, text) in [
-            ("compare_summary.txt", self.to_text()),
-            ("compare.json", self.to_json()?),
-            ("compare_points.csv", self.to_csv()),
-        ] {
+        let texts = [self.to_text(), self.to_json()?, self.to_csv()];
+        for (name, text) in Self::TEXT_FILES.into_iter().zip(texts) {
             let path = dir.join(name);
             write_text(&path, &text, inputs)?;
             written.push(path);

@@ -79,7 +79,8 @@ pub enum SimulateError {
     TakeUp(String),
     /// The effects cannot be combined into a model (in words).
     Effects(String),
-    /// An experiment's model failed (named, with its TOML line and likely causes).
+    /// An experiment's model failed (named, with its TOML line and likely causes; boxed: the
+    /// failure is large).
     Experiment(Box<ExperimentFailure>),
     /// The caller stopped the run after `done` experiments.
     Stopped {

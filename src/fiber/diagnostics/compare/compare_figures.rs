@@ -2,7 +2,9 @@
 //! residuals against the local strain rate, temperature and speed.
 
 use super::{CompareError, Comparison, FigureFormat};
-use crate::fiber::figures::{experiment_panel_pages, ExperimentView, ModelCurves, View};
+use crate::fiber::figures::{
+    experiment_panel_pages, panel_page_names, ExperimentView, ModelCurves, View,
+};
 use crate::fiber::output::ensure_not_input;
 use crate::fiber::simulate::Profiles;
 use crate::fiber::statistics::median;
@@ -43,6 +45,17 @@ fn pooled_trend(cmp: &Comparison, length: f64) -> Vec<(f64, f64)> {
             (xm * length, 100.0 * median(&mut r))
         })
         .collect()
+}
+
+/// The names of the figures [`write_figures`] writes for `experiments` experiments.
+pub fn figure_names(experiments: usize, format: FigureFormat) -> Vec<String> {
+    let ext = format.extension();
+    let mut v = Vec::new();
+    for stem in ["compare_diameters", "compare_inverse_d2"] {
+        v.extend(panel_page_names(stem, ext, experiments));
+    }
+    v.extend(["compare_residuals", "compare_residual_trends"].map(|s| format!("{s}.{ext}")));
+    v
 }
 
 /// Writes into `dir` (which must exist):
