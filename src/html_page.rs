@@ -32,7 +32,6 @@
 //! ```
 
 use std::fmt::Write as _;
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;

@@ -5,6 +5,7 @@
 mod probe;
 
 mod cli_argument_probes;
+mod cli_output_layer;
 mod cli_output_safety;
 mod input_bounds;
 mod input_loading;

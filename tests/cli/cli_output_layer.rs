@@ -5,9 +5,7 @@
 //! `../shared/probes/bad-input-findings.md` it reproduces; every probe checksums the inputs.
 #![cfg(unix)]
 
-mod probe;
-
-use probe::{checksums_below, rheometer, run_with, s, shipped_copy, Probe};
+use crate::probe::{checksums_below, rheometer, run_with, s, shipped_copy, Probe};
 use std::fs;
 use std::os::unix::fs::{FileTypeExt, PermissionsExt};
 use std::path::{Path, PathBuf};
@@ -441,7 +439,7 @@ fn c11_c12_hints_on_a_full_stderr_never_panic() {
     );
     q.assert_clean_failure(&["hint:"]);
     // C12: a failing fit (mass flow 1000 times too large) with hints
-    let bad = probe::variant(
+    let bad = crate::probe::variant(
         &toml,
         "mass_flow.toml",
         "1.5690566037735852e-05",
@@ -745,7 +743,7 @@ fn d05_d07_legal_names_up_to_255_bytes_are_written() {
     assert_json(&fs::read_to_string(&json).unwrap());
     // D05: a 236-byte experiment name gives a 248-byte profile name
     let long = "e".repeat(236);
-    let t = probe::variant(
+    let t = crate::probe::variant(
         &toml,
         "long.toml",
         "name = \"v0p27_p1\"",
@@ -766,7 +764,7 @@ fn d05_d07_legal_names_up_to_255_bytes_are_written() {
 #[test]
 fn d06_a_name_longer_than_the_file_system_allows_is_refused_before_the_work() {
     let (dir, toml, data) = shipped_copy("too_long_names");
-    let t = probe::variant(
+    let t = crate::probe::variant(
         &toml,
         "long.toml",
         "name = \"v0p27_p1\"",
