@@ -164,6 +164,7 @@ impl Dataset {
                 Box::new(InputError::Io {
                     path: path.clone(),
                     source: e,
+                    hint: String::new(),
                 })
             })?;
             Ok(DatasetInner {
