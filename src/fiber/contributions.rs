@@ -277,7 +277,7 @@ pub struct Term {
 impl Term {
     /// Name of its strength as a model parameter: the candidate effect's name where the term's
     /// strength is one (`nusselt_scale` for `convection`, its descriptor
-    /// [`NUSSELT_SCALE`](super::catalog::NUSSELT_SCALE)), else the term's name.
+    /// [`super::catalog::NUSSELT_SCALE`]), else the term's name.
     pub fn parameter_name(&self) -> &'static str {
         match self.kind {
             TermKind::Convection => NUSSELT_SCALE.model_param,

@@ -7,7 +7,7 @@
 //! What each effect is — name, unit, category, neutral value, search and physical range,
 //! shapes, how the strength maps to the model parameter, remedy, error-budget source, how it
 //! enters the model — is its **descriptor** ([`EffectDescriptor`]), one per effect, in
-//! [`catalog`](crate::fiber::catalog) (the table of the built-in effects is there). An
+//! [`crate::fiber::catalog`] (the table of the built-in effects is there). An
 //! [`Effect`] is a descriptor plus the settings of one use (its fixed shape values; for a
 //! user-written effect, its term): every method below reads the descriptor.
 //!
@@ -140,7 +140,7 @@ impl fmt::Debug for UserEffect {
     }
 }
 
-/// A candidate effect: a built-in one (its descriptor in [`catalog`](crate::fiber::catalog))
+/// A candidate effect: a built-in one (its descriptor in [`crate::fiber::catalog`])
 /// or a user-written one. Shape parameters are `Option<f64>`: `None` fits them with the
 /// strength (or keeps the default where the shape is not fitted, see
 /// [`ShapeParameter::fitted_with_strength`]), `Some(v)` fixes them at `v`.

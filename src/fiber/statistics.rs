@@ -3,15 +3,15 @@
 //! (its fit report and data checks), the comparison (`diagnostics::compare`) and the diagnosis
 //! (`diagnostics::diagnose`) compute.
 //!
-//! **The noise model of record is [`NoiseModel`]** (robust scale, scale along the line,
+//! **The noise model of record is [`NoiseModel`](crate::fiber::noise_model::NoiseModel)** (robust scale, scale along the line,
 //! outliers, one lag-1 autocorrelation, the judgement numbers); the comparison uses it. The
 //! older estimators below remain until the diagnosis is switched over:
 //!
 //! | function | used by | what |
 //! |---|---|---|
-//! | [`noise_mad_second_differences`] | the fit report | robust (MAD) SD of spacing-normalised second differences: ignores kinks and outliers (the [`NoiseModel`]'s `sigma` without excluding outliers) |
+//! | [`noise_mad_second_differences`] | the fit report | robust (MAD) SD of spacing-normalised second differences: ignores kinks and outliers (the [`NoiseModel`](crate::fiber::noise_model::NoiseModel)'s `sigma` without excluding outliers) |
 //! | [`noise_rms_second_differences`] | the diagnosis | RMS of plain second differences (uniform spacing assumed): every point counts |
-//! | [`lag1_autocorrelation_about_mean`] | nobody (deprecated: the comparison now uses [`NoiseModel::lag1`]) | each sequence about its own mean (`NaN` without spread) |
+//! | [`lag1_autocorrelation_about_mean`] | nobody (deprecated: the comparison now uses [`NoiseModel::lag1`](crate::fiber::noise_model::NoiseModel::lag1)) | each sequence about its own mean (`NaN` without spread) |
 //! | [`lag1_autocorrelation_about_zero`] | the diagnosis | about zero, i.e. an offset counts as correlation (`0` without spread) |
 //!
 //! The diagnosis's "systematic" test `rms/noise > 1.2` is calibrated on the RMS estimate: the

@@ -21,7 +21,7 @@ use super::blocks::{BlockJacobian, BlockStructure};
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 
-/// The covariance of a block-arrow fit in compact form (see the [module docs](self)).
+/// The covariance of a block-arrow fit in compact form (see the module docs of `least_squares::block_covariance`).
 #[derive(Debug, Clone)]
 pub struct BlockCovariance {
     structure: Arc<BlockStructure>,

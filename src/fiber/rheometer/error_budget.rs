@@ -22,7 +22,7 @@
 //! *per-experiment* one by `√(Σ_k (s_k σ_k)²)`. Sources are independent: the systematic standard
 //! uncertainty is the root-sum-square of the sources' shifts. For `K = e^κ` the relative
 //! uncertainty is that of `κ` (first order). A source whose shift of `κ` or `n` exceeds the
-//! statistical standard error is a [`WarningCode::Systematic`] warning: the data cannot tell.
+//! statistical standard error is a [`WarningCode::Systematic`](super::WarningCode::Systematic) warning: the data cannot tell.
 
 use super::data::Rheometer;
 use super::estimator::Estimator;

@@ -95,7 +95,7 @@ pub struct IdentifyOptions {
     /// A cancellation flag (default `None`), handed to the least-squares driver
     /// ([`FitOptions::cancel`](crate::least_squares::FitOptions::cancel)): once set, a running
     /// identification stops before its next model evaluation with
-    /// [`FitError::Cancelled`](crate::least_squares::FitError::Cancelled) (the Python bindings
+    /// [`crate::least_squares::FitError::Cancelled`] (the Python bindings
     /// set it on Ctrl-C).
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Shared parameters held at a value instead of fitted, by name (`"n"`, `"kappa"`, an

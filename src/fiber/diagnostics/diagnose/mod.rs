@@ -1,11 +1,11 @@
 //! `diagnose`: which physical effects are missing from a user's model — a chain of stages,
 //! each in its own file, passing one record per candidate ([`Candidate`]) along.
 //!
-//! 1. **Fit the user's model** ([`base`]) with the principled estimator (raw relative residuals,
+//! 1. **Fit the user's model** (`base`) with the principled estimator (raw relative residuals,
 //!    take-up diameters fitted): the paper's smoothed-data estimator leaves residuals ~1.4× the
 //!    noise even for a correct model, which would mask missing physics. The candidates are
 //!    carried in the model at neutral strength (which reproduces the user's model exactly).
-//! 2. **Linearise** ([`linearise`]): each candidate's exact sensitivity direction at the fit
+//! 2. **Linearise** (`linearise`): each candidate's exact sensitivity direction at the fit
 //!    (one sensitivity solve per experiment, reusing the factorisation of the last Newton step,
 //!    gives all of them), orthogonalised against the fitted parameters' directions; its
 //!    projection of the residual is the cost it would remove to first order
@@ -16,14 +16,14 @@
 //!    `ρ₁ √N ≈ N(0, 1)`); a candidate that earns its place (stage 6) also marks them
 //!    systematic (the RMS test is weak when the noise is estimated). The detection limits of
 //!    every candidate ([`detection`](super::detection)) come from the same linearisation.
-//! 4. **Search** ([`search`]) every candidate globally, in parallel: its strength scanned over
+//! 4. **Search** (`search`) every candidate globally, in parallel: its strength scanned over
 //!    its search range (and, for effects with a shape, a few shapes), each grid point a
 //!    warm-started refit of the material parameters with the strength fixed; the best grid
 //!    points refined with the strength freed.
-//! 5. **Choose shapes** ([`shapes`]): the default discrete shape unless another is better by
+//! 5. **Choose shapes** (`shapes`): the default discrete shape unless another is better by
 //!    more than the tie margin; the other one kept as a shape alternative where the data cannot
 //!    choose.
-//! 6. **Judge** ([`judge`]) each refit: achieved cost `J`, information criteria
+//! 6. **Judge** (`judge`) each refit: achieved cost `J`, information criteria
 //!    `ΔBIC = N ln(J_after/J_before) + Δk ln N`, `ΔAIC = N ln(J_after/J_before) + 2 Δk`
 //!    (Gaussian errors with unknown variance; `Δk` extra parameters, 2 for strain thinning),
 //!    whether the strength is credible ([`StrengthStatus::Physical`]: a best strength at a
@@ -39,7 +39,7 @@
 //!    less than [`DiagnoseOptions::tie_margin`] (6) above the named one's, and pairs whose
 //!    orthogonalised signatures have `|cos|` above
 //!    [`DiagnoseOptions::indistinguishable_cosine`] (0.9).
-//! 9. **Several effects** ([`step`]): while a named effect does not bring the residuals to the
+//! 9. **Several effects** (`step`): while a named effect does not bring the residuals to the
 //!    noise, it is added to the model (strength and shapes fitted jointly with the law) and the
 //!    search runs again over the remaining candidates, at most
 //!    [`DiagnoseOptions::max_effects`] effects in all.

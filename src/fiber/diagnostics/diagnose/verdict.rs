@@ -64,7 +64,7 @@ pub enum Verdict {
         /// RMS (outliers excluded) over the noise level with them \[-\].
         rms_over_noise: f64,
         /// The noise level of the verdict (relative \[-\]): the data's, or re-estimated with
-        /// the named effects where lower (see [`noise_for`]).
+        /// the named effects where lower (see `noise_for`).
         #[serde(default)]
         noise_level: f64,
     },
@@ -76,7 +76,7 @@ pub enum Verdict {
         unexplained: Vec<Unexplained>,
         /// RMS (outliers excluded) over the noise level with the best of them \[-\].
         rms_over_noise: f64,
-        /// The noise level of the verdict (relative \[-\], see [`noise_for`]).
+        /// The noise level of the verdict (relative \[-\], see `noise_for`).
         #[serde(default)]
         noise_level: f64,
     },
@@ -124,7 +124,7 @@ pub(crate) fn at_noise(fit: &FitSummary, noise: &NoiseSummary) -> (f64, f64) {
 }
 
 /// Whether `fit` leaves residuals at the noise (see the module documentation; the noise level
-/// of [`noise_for`]).
+/// of `noise_for`).
 pub(crate) fn explained(fit: &FitSummary, noise: &NoiseSummary) -> bool {
     let (ratio, z) = at_noise(fit, &noise_for(fit, noise));
     ratio <= EXPLAINED_RMS_OVER_NOISE && z < STRUCTURE_Z
