@@ -120,7 +120,7 @@ fn at_place(v: f64, place: i32) -> String {
 /// `1e-3..1e5`: `fmt_pm(1.2345e6, 2.1e4) = "(1.234 ± 0.021)e6"`. An uncertainty that is not
 /// positive and finite gives the value alone ([`fmt_g`]).
 pub fn fmt_pm(value: f64, uncertainty: f64) -> String {
-    if !(uncertainty.is_finite() && uncertainty > 0.0) || !value.is_finite() {
+    if !(uncertainty.is_finite() && uncertainty > 0.0 && value.is_finite()) {
         return fmt_g(value);
     }
     let big = value.abs().max(uncertainty);
@@ -140,7 +140,7 @@ pub fn fmt_pm(value: f64, uncertainty: f64) -> String {
 /// `v` at the precision an uncertainty `u` supports (the same decimal place as in
 /// [`fmt_pm`]): interval ends and values beside a `±`. `u` not positive and finite: [`fmt_g`].
 pub fn fmt_at(v: f64, u: f64) -> String {
-    if !(u.is_finite() && u > 0.0) || !v.is_finite() {
+    if !(u.is_finite() && u > 0.0 && v.is_finite()) {
         return fmt_g(v);
     }
     let e = decade(v.abs().max(u));

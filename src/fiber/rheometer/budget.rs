@@ -186,7 +186,7 @@ impl ErrorBudget {
                 format!(
                     "the {} ({}, {})",
                     s.what,
-                    sigma_words(&s, e.sigma),
+                    sigma_words(s, e.sigma),
                     match e.origin {
                         Origin::Default => "default",
                         _ => "declared",

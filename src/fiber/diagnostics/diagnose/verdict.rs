@@ -106,7 +106,8 @@ pub(crate) fn share_of_excess(before: f64, after: f64, j_noise: f64) -> f64 {
 /// inflates a noise estimate (second differences of residuals with a strong systematic part),
 /// and an inflated level would call a poor fit "at the noise".
 pub(crate) fn noise_for(fit: &FitSummary, base: &NoiseSummary) -> NoiseSummary {
-    if base.declared() || !(fit.noise.level < base.level) {
+    if base.declared() || fit.noise.level.partial_cmp(&base.level) != Some(std::cmp::Ordering::Less)
+    {
         base.clone()
     } else {
         fit.noise.clone()
