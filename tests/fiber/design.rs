@@ -268,14 +268,13 @@ fn predicted_standard_errors_match_refits_of_independent_simulations() {
     println!(
         "time: base fit {t_fit:.1} s, design of 20 candidates {t_design:.2} s, refits {t_mc:.1} s"
     );
-    // the criterion: predicted and realised within 20 % for the top design
+    // the criterion: predicted and realised within 20 % (the top design; the worst
+    // and the uniform pick too)
     for &(label, p, pred, got) in &lines {
-        if label == "top" {
-            assert!(
-                (got / pred - 1.0).abs() < 0.2,
-                "top design: se({p}) predicted {pred:.4e}, realised {got:.4e}"
-            );
-        }
+        assert!(
+            (got / pred - 1.0).abs() < 0.2,
+            "{label} design: se({p}) predicted {pred:.4e}, realised {got:.4e}"
+        );
     }
     // the top design shrinks κ's standard error more than a uniformly chosen one
     assert!(se_of(&design, top, "kappa") < mean_se_kappa);
