@@ -79,7 +79,8 @@
 //! 7. `figures`, `flow_curve_figure`;
 //! 8. `diagnostics` (`compare`, `candidate` → `ties`, `diagnose` (its stages), `diagnosis`,
 //!    `report`);
-//! 9. `failure_hints`;
+//! 9. `failure_hints`, `design` (inside: `information`, `criteria`, `candidates` →
+//!    `estimation` → `report`);
 //! 10. `workflow` (what each `rheometer` subcommand does, as library calls).
 //!
 //! ## Cargo features

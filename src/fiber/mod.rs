@@ -27,11 +27,14 @@
 //!   `d_fit(L)` of the smoothed data);
 //! * [`synthetic`]: reproducible measurement noise for synthetic data sets;
 //! * [`diagnostics`]: model vs measurement comparison (where and how the model misses the data);
+//! * [`design`]: which experiment next (optimal experimental design from the exact
+//!   sensitivities);
 //! * [`workflow`]: what each `rheometer` subcommand does, as library calls returning values.
 
 pub mod catalog;
 pub mod cold_start;
 pub mod contributions;
+pub mod design;
 pub mod diagnostics;
 pub mod effects;
 pub mod error;

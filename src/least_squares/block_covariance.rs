@@ -33,11 +33,11 @@ pub struct BlockCovariance {
     f: Vec<DMatrix<f64>>,
 }
 
-/// The three factors [`factors`] returns.
-type Factors = (DMatrix<f64>, Vec<DMatrix<f64>>, Vec<DMatrix<f64>>);
+/// `(S⁻¹, [C_k⁻¹], [G_k])` of the block elimination.
+type BlockInverse = (DMatrix<f64>, Vec<DMatrix<f64>>, Vec<DMatrix<f64>>);
 
 /// `C_k⁻¹`, `G_k = C_k⁻¹ B_kᵀ` and `S⁻¹` of `H = Jᵀ W J`; `None` if `H` is singular.
-fn factors(j: &BlockJacobian, w: Option<&[f64]>) -> Option<Factors> {
+fn factors(j: &BlockJacobian, w: Option<&[f64]>) -> Option<BlockInverse> {
     let nb = j.normal_blocks(w, None);
     let mut s = nb.a;
     let mut c_inv = Vec::with_capacity(nb.c.len());

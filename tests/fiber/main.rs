@@ -8,6 +8,7 @@ mod probe;
 
 mod cold_start;
 mod compare;
+mod design;
 mod effects_families;
 mod error_budget;
 mod fiber_physics;

@@ -52,6 +52,7 @@ impl Error for Interrupted {}
 // after the macro, which they use
 mod checks;
 mod compare;
+mod design;
 mod diagnose;
 mod fit;
 mod landscape;
@@ -167,6 +168,15 @@ and the heat map DIR/landscape.png. Ctrl-C stops it, keeping the finished points
     /// Example: rheometer compare data/pmma7n_synthetic/experiments.toml --fit target/fit.json
     /// --out target/compare
     Compare(compare::CompareArgs),
+    /// Which experiment next: fit, then rank candidate experiments (mass flow x take-up) by
+    /// the predicted uncertainty of (n, kappa) after adding each (exact sensitivities).
+    #[command(after_help = "Examples:\n  \
+rheometer design data/pmma7n_synthetic/experiments.toml --grid 9x9\n  \
+rheometer design data/pmma7n_synthetic/experiments.toml --stencil-velocity 0.2,1.6 \
+--take-up-diameter 4e-5,2e-4 --criterion a --out target/design\n\n\
+Writes DIR/design.txt, DIR/design.json and DIR/design.csv (every candidate: predicted \
+standard errors, correlation, criteria, rank, or why the model has no solution there).")]
+    Design(design::DesignArgs),
 }
 
 /// Options shared by every subcommand.
@@ -281,6 +291,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
         Command::Diagnose(a) => a.experiments.clone(),
         Command::Landscape(a) => a.experiments.clone(),
         Command::Compare(a) => a.experiments.clone(),
+        Command::Design(a) => a.experiments.clone(),
     };
     match cli.command {
         Command::Simulate(a) => simulate::run(a, &g),
@@ -288,6 +299,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
         Command::Diagnose(a) => diagnose::run(a, &g),
         Command::Landscape(a) => landscape::run(a, &g),
         Command::Compare(a) => compare::run(a, &g),
+        Command::Design(a) => design::run(a, &g),
     }
     // a failed simulation names its experiment and TOML line, with likely causes
     .map_err(|e| checks::name_experiment(e, &toml, None))

@@ -9,6 +9,7 @@
 //! | `compare` | [`compare()`] | [`Comparison`](crate::fiber::diagnostics::compare::Comparison) |
 //! | `diagnose` | [`diagnose()`] | [`DiagnosisRun`] |
 //! | `landscape` | [`landscape()`] | [`LandscapeRun`] |
+//! | `design` | [`design()`] | [`DesignRun`] (its [`Design`](crate::fiber::design::Design)) |
 //!
 //! ```no_run
 //! use diffbvp::fiber::input::load_experiments_with;
@@ -22,10 +23,12 @@
 //! ```
 
 mod compare;
+mod design;
 mod fit;
 mod simulate;
 
 pub use compare::{compare, CompareRequest};
+pub use design::{design, DesignRun};
 pub use fit::{fit, FitRequest, FitRun};
 pub use simulate::{simulate_experiments, SimulateError, SimulateRequest, SimulatedProfile};
 

@@ -1,0 +1,22 @@
+//! Which experiment next: optimal experimental design for the spinning line from the exact
+//! sensitivities of the BVP.
+//!
+//! * [`information`]: the Fisher information one experiment carries about the fitted
+//!   parameters (exact forward sensitivities of the predicted gauge readings, take-up factor
+//!   profiled out);
+//! * [`criteria`]: predicted covariance, standard errors, correlation of `(n, κ)`, and the D-,
+//!   A- and E-criteria;
+//! * [`candidates`]: the grid of candidate experiments (mass flow × take-up condition) made
+//!   from a template experiment;
+//! * [`estimation`]: the design for estimation, ranking the candidates in parallel;
+//! * [`report`]: the design as text.
+
+pub mod candidates;
+pub mod criteria;
+pub mod estimation;
+pub mod information;
+pub mod report;
+
+pub use candidates::{Candidate, CandidateGrid, TakeUpAxis};
+pub use criteria::{Criterion, Prediction};
+pub use estimation::{design_for_estimation, noise_level, CandidateOutcome, Design, DesignRequest};

@@ -1,0 +1,115 @@
+//! The design as text: the current uncertainty, the best candidates with their predicted
+//! standard errors and gains, the worst, and the infeasible ones.
+
+use super::estimation::{CandidateOutcome, Design};
+use std::fmt::Write as _;
+
+/// How many ranked candidates the text lists.
+pub const TEXT_TOP: usize = 10;
+
+impl Design {
+    /// The design as a text report (top [`TEXT_TOP`] candidates, the worst feasible one, and
+    /// the number of infeasible ones with the first reason).
+    pub fn to_text(&self) -> String {
+        let mut t = String::new();
+        let _ = writeln!(
+            t,
+            "Which experiment next: {} candidates ({} mass flows x {} {} values), template {}, \
+             ranked by the {}-criterion",
+            self.candidates.len(),
+            self.grid.mass_flows.len(),
+            self.grid.take_up.values().len(),
+            self.grid.take_up.label(),
+            self.template,
+            self.criterion.name()
+        );
+        let _ = writeln!(
+            t,
+            "\nNow (predicted from the fit's sensitivities; the fit's own in brackets):"
+        );
+        for (i, p) in self.parameters.iter().enumerate() {
+            let _ = writeln!(
+                t,
+                "  {p:<24} {:>12.5}  se {:>10.3e}  [{:.3e}]",
+                self.values[i], self.current.stderr[i], self.fit_stderr[i]
+            );
+        }
+        if self.current.correlation_n_kappa.is_finite() {
+            let _ = writeln!(
+                t,
+                "  correlation(n, kappa) {:+.3}",
+                self.current.correlation_n_kappa
+            );
+        }
+        let header = self.header();
+        let _ = writeln!(t, "\nBest candidates:\n{header}");
+        for &i in self.ranking.iter().take(TEXT_TOP) {
+            let _ = writeln!(t, "{}", self.line(&self.candidates[i]));
+        }
+        if self.ranking.len() > TEXT_TOP {
+            if let Some(w) = self.worst() {
+                let _ = writeln!(t, "  ...\nWorst feasible candidate:\n{}", self.line(w));
+            }
+        }
+        let bad: Vec<&CandidateOutcome> = self
+            .candidates
+            .iter()
+            .filter(|c| c.infeasible.is_some())
+            .collect();
+        if let Some(first) = bad.first() {
+            let _ = writeln!(
+                t,
+                "\n{} candidates infeasible (no solution of the model), e.g. {}: {}",
+                bad.len(),
+                first.name,
+                first.infeasible.as_deref().unwrap_or("")
+            );
+        }
+        for n in &self.notes {
+            let _ = writeln!(t, "\nNote: {n}");
+        }
+        let _ = writeln!(t, "\n{:.1} s", self.wall_time_s);
+        t
+    }
+
+    fn se_columns(&self) -> Vec<usize> {
+        ["n", "kappa"]
+            .iter()
+            .filter_map(|p| self.index_of(p))
+            .collect()
+    }
+
+    fn header(&self) -> String {
+        let mut h = format!(
+            "  rank  mass flow [kg/s]  {} [{}]",
+            self.grid.take_up.label(),
+            self.grid.take_up.unit()
+        );
+        for c in self.se_columns() {
+            let _ = write!(h, "  se({})", self.parameters[c]);
+        }
+        let _ = write!(h, "  corr(n,kappa)  gain({})", self.criterion.name());
+        h
+    }
+
+    fn line(&self, c: &CandidateOutcome) -> String {
+        let mut l = format!(
+            "  {:>4}  {:>16.4e}  {:>18.4e}",
+            c.rank.unwrap_or(0),
+            c.candidate.mass_flow,
+            c.candidate.take_up
+        );
+        if let Some(p) = &c.prediction {
+            for i in self.se_columns() {
+                let _ = write!(l, "  {:.3e}", p.stderr[i]);
+            }
+            let _ = write!(
+                l,
+                "  {:+.3}  {:.1} %",
+                p.correlation_n_kappa,
+                100.0 * c.gain
+            );
+        }
+        l
+    }
+}
