@@ -197,20 +197,23 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     if let Some(s) = args.start {
         checks::check_start(s, &opts)?;
     }
-    let loaded = load_experiments_with(&args.experiments, 4)?;
-    let inputs = inputs_of(&args.experiments, &loaded);
+    let loaded = load_input(g, &args.experiments, true, true)?;
     let grid = grid_of(&args, &loaded)?;
-    let outputs = [
-        "design.txt".to_string(),
-        "design.json".to_string(),
-        "design.csv".to_string(),
+    // every output is checked before the work starts, against the inputs and each other
+    let names = vec![
+        ("report".to_string(), "design.txt".to_string()),
+        ("json".to_string(), "design.json".to_string()),
+        ("table".to_string(), "design.csv".to_string()),
     ];
-    if let Some(out) = &args.out {
-        check_output_dir(out, &outputs, &inputs)?;
+    let mut plan = outputs::plan_for(&args.experiments, &loaded);
+    if let Some(path) = &args.json {
+        plan.file(path, "--json");
     }
-    if let Some(j) = &args.json {
-        ensure_not_input(j, &inputs)?;
+    if let Some(dir) = &args.out {
+        plan.dir(dir, "--out", names.iter().map(|(_, n)| n));
+        plan.dir_files(dir, [PARTIAL_NAME]);
     }
+    let outputs = outputs::check(&plan, g)?;
     let mut fit_request = FitRequest::new(opts);
     fit_request.start = args.start.map(|(n, k)| [n, k]);
     let mut request = DesignRequest::new(grid, args.criterion);
@@ -227,13 +230,15 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     outln!("{text}");
     let json = serde_json::to_string_pretty(d)?;
     if let Some(j) = &args.json {
-        write_json(j, &json, &inputs)?;
+        outputs.write_text(j, &json)?;
+        g.say(format!("wrote {}", j.display()));
     }
     if let Some(out) = &args.out {
-        create_dir(out)?;
-        write_text(&out.join("design.txt"), &text, &inputs)?;
-        write_text(&out.join("design.json"), &json, &inputs)?;
-        write_text(&out.join("design.csv"), &design_csv(d), &inputs)?;
+        let mut dir = outputs::DirWriter::begin(&outputs, out, "rheometer design", "files", names)?;
+        dir.text("design.txt", &text)?;
+        dir.text("design.json", &json)?;
+        dir.text("design.csv", &design_csv(d))?;
+        dir.finish()?;
         g.say(format!("wrote {}", out.display()));
     }
     Ok(())
