@@ -376,20 +376,31 @@ class FitResult(Result):
         return _long_table(self.profiles, _PROFILE_KEYS)
 
     def flow_curve(self) -> Dict[str, Any]:
-        """The identified law as the experiments see it.
-
-        NOTE (interim): the library's flow curve ``FlowCurve`` (η_E(ε̇) at one temperature
-        with its 95 % bands) is not part of the ``FitSummary`` yet. Until it is, this returns
-        the fitted profiles' own columns — strain rate [1/s], elongational viscosity [Pa s],
-        temperature [K], position [m] along every fitted spin line, as a long table with an
-        ``experiment`` column — not a curve at one temperature and without bands. Once the
-        summary carries ``flow_curve``, that is returned instead (its numeric lists as numpy
-        arrays); nothing is computed here either way.
+        """The flow curve η_E(ε̇) of the fit at one temperature (the library's ``FlowCurve``),
+        as columns of numpy arrays: ``strain_rate_1_s`` [1/s], ``eta_Pa_s`` [Pa s], the 95 %
+        bands ``stat95_lo/hi_Pa_s`` (statistical), ``sys95_lo/hi_Pa_s`` (systematic, from the
+        error budget), ``total95_lo/hi_Pa_s``, and ``extrapolated`` (outside the strain rates
+        the data cover). The curve's temperature, plateau, covered range and finding are in
+        ``summary["flow_curve"]``. A fit without a flow curve (it could not be computed)
+        returns the fitted profiles' own columns instead (strain rate, viscosity, temperature
+        and position along every spin line, with an ``experiment`` column).
         """
         curve = self._data.get("flow_curve")
-        if curve is not None:
-            return _arrays_of(curve)
-        return _long_table(self.profiles, ["strain_rate_1_s", "viscosity_Pa_s", "temperature_K", "position_m"])
+        if curve is None:
+            return _long_table(self.profiles, ["strain_rate_1_s", "viscosity_Pa_s", "temperature_K", "position_m"])
+        pts = curve.get("points", [])
+        col = lambda f: np.asarray([_num(f(p)) for p in pts], dtype=float)
+        return {
+            "strain_rate_1_s": col(lambda p: p["strain_rate_per_s"]),
+            "eta_Pa_s": col(lambda p: p["eta_pa_s"]),
+            "stat95_lo_Pa_s": col(lambda p: p["stat95_pa_s"][0]),
+            "stat95_hi_Pa_s": col(lambda p: p["stat95_pa_s"][1]),
+            "sys95_lo_Pa_s": col(lambda p: p["sys95_pa_s"][0]),
+            "sys95_hi_Pa_s": col(lambda p: p["sys95_pa_s"][1]),
+            "total95_lo_Pa_s": col(lambda p: p["total95_pa_s"][0]),
+            "total95_hi_Pa_s": col(lambda p: p["total95_pa_s"][1]),
+            "extrapolated": np.asarray([bool(p["extrapolated"]) for p in pts], dtype=bool),
+        }
 
     def __repr__(self) -> str:
         n, k = self.n, self.kappa
