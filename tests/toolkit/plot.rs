@@ -229,11 +229,13 @@ fn invalid_requests_are_errors_naming_the_path() {
     fs::create_dir_all(&as_dir).expect("mkdir");
     assert!(save_panels(&as_dir, &panel, 1, (100, 100)).is_err());
     assert!(as_dir.is_dir());
-    // A parent that is a file cannot be created: an I/O error, not a panic.
+    // A parent that is a file cannot be created: an error of the output layer naming it, not
+    // a panic.
     let file = dir.join("plain_file");
     fs::write(&file, b"x").expect("write");
     let err = save_panels(&file.join("x.png"), &panel, 1, (100, 100)).expect_err("parent is file");
-    assert!(matches!(err, PlotError::Io { .. }), "{err}");
+    assert!(matches!(err, PlotError::Output(_)), "{err}");
+    assert!(err.to_string().contains("plain_file"), "{err}");
 }
 
 // ---- issue 31: glyphs, ticks, legends, anti-aliasing, bands, formats, the flow curve ----
