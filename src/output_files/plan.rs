@@ -33,7 +33,7 @@ struct PlannedDir {
 ///
 /// ```
 /// use diffbvp::output_files::OutputPlan;
-/// let dir = std::env::temp_dir().join(format!("diffbvp-plan-doc-{}", std::process::id()));
+/// let dir = std::path::Path::new("target").join(format!("diffbvp-plan-doc-{}", std::process::id()));
 /// std::fs::create_dir_all(&dir)?;
 /// let input = dir.join("data.csv");
 /// std::fs::write(&input, "1,2\n")?;

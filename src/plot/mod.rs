@@ -18,7 +18,8 @@
 //! ```
 //! use diffbvp::plot::{save_heatmap, save_panels, Heatmap, Panel, Series};
 //!
-//! let dir = std::env::temp_dir().join("diffbvp-plot-doc");
+//! // under the build directory (`cargo test` runs doc examples from the crate root)
+//! let dir = std::path::Path::new("target").join("diffbvp-plot-doc");
 //! let z: Vec<f64> = (0..=20).map(|i| f64::from(i) * 0.05).collect();
 //! let model: Vec<(f64, f64)> = z.iter().map(|&z| (z, (-2.0 * z).exp())).collect();
 //! let data: Vec<(f64, f64)> = z.iter().step_by(4).map(|&z| (z, 1.02 * (-2.0 * z).exp())).collect();

@@ -269,7 +269,8 @@ fn rheometer(args: &[&str]) -> (bool, String) {
 
 #[test]
 fn cli_errors_are_clear() {
-    let dir = std::env::temp_dir().join(format!("diffbvp-compare-cli-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("diffbvp-compare-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let toml = "data/pmma7n_synthetic/experiments.toml";
     let out = dir.join("out");
@@ -340,7 +341,8 @@ fn cli_errors_are_clear() {
 
 #[test]
 fn cli_writes_summary_json_and_figures() {
-    let dir = std::env::temp_dir().join(format!("diffbvp-compare-run-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("diffbvp-compare-run-{}", std::process::id()));
     let fit = dir.join("fit.json");
     std::fs::create_dir_all(&dir).unwrap();
     // a fit report as `rheometer fit --json` writes it (NaN standard errors become null)

@@ -471,7 +471,8 @@ fn the_correct_model_stays_consistent_with_noise_and_outliers_are_reported() {
     assert!(json["noise"]["model"]["outliers"].as_array().unwrap().len() >= OUTLIERS.len());
     assert_eq!(json["experiments"][0]["points"][5]["outlier"], true);
     // the figures are written (noise band, pooled trend, outlier rings)
-    let dir = std::env::temp_dir().join(format!("diffbvp-robust-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("diffbvp-robust-{}", std::process::id()));
     let written = cmp
         .write(&dir, diffbvp::plot::FigureFormat::Svg, &[])
         .unwrap();
