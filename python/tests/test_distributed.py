@@ -12,6 +12,7 @@ from conftest import assert_same
 from diffbvp.distributed import bootstrap, map_fits
 
 distributed = pytest.importorskip("dask.distributed")
+dask = pytest.importorskip("dask")
 
 REPLICATES = 4
 
@@ -20,7 +21,10 @@ def test_bootstrap_on_local_cluster_equals_serial(pmma, pmma_fit, scratch):
     opts = {"profile_points": 2}
     serial = bootstrap(None, pmma, pmma_fit, replicates=REPLICATES, seed=7, fit_options=opts)
     assert not serial.failed
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+    # dask's scratch space (its default is a folder in the working or temporary directory)
+    # under the test's scratch directory: nothing left in /tmp
+    with dask.config.set({"temporary-directory": str(scratch / "dask")}), \
+            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None,
                                   local_directory=str(scratch / "dask")) as cluster, \
             distributed.Client(cluster) as client:
