@@ -370,17 +370,23 @@ fn control_with_a_noisy_take_up_names_nothing() {
 /// and noise levels (0.8 %, 1.5 %, 3 %; take-up region 1× or 2× as noisy) varied. Counts the
 /// sets where any effect is named; the search is calibrated to a false-alarm probability of
 /// 5 % per set, so more than 10 of 100 (a binomial tail of 1 % at 5 %) fails. Takes ~10 s per
-/// set: `cargo test --release --test diagnose global::false_alarm_rate -- --ignored --nocapture`.
+/// set: `cargo test --release --test diagnose global::false_alarm_rate -- --ignored --nocapture`
+/// (`DIFFBVP_FALSE_ALARM_FIRST` continues a study at that set's index).
 #[test]
 #[ignore = "a study: ~15 min for 100 sets"]
 fn false_alarm_rate_on_effect_free_sets() {
-    let sets: usize = std::env::var("DIFFBVP_FALSE_ALARM_SETS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(100);
+    let var = |name: &str, default: usize| -> usize {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
+    };
+    let sets = var("DIFFBVP_FALSE_ALARM_SETS", 100);
+    // the first set's index (to continue a study in parts: seeds 7000 + index)
+    let first = var("DIFFBVP_FALSE_ALARM_FIRST", 0);
     let mut alarms = Vec::new();
     let t0 = Instant::now();
-    for k in 0..sets {
+    for k in first..first + sets {
         let name: &'static str = Box::leak(format!("false_alarm_{k}").into_boxed_str());
         let sc = Scenario {
             name,
