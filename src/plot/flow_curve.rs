@@ -9,7 +9,8 @@
 use std::path::Path;
 
 use super::error::{invalid, PlotError};
-use super::panels::{panels_svg, save_panels, Band, Panel, RefLine, Series};
+use super::panel_draw::{panels_svg, save_panels};
+use super::panels::{Band, Panel, RefLine, Series};
 
 /// Points measured elsewhere, drawn as markers beside the flow curve: shear data shown as
 /// `3η` (Trouton), or other elongational data.

@@ -72,7 +72,6 @@ pub use colors::PALETTE;
 pub use error::PlotError;
 pub use flow_curve::{flow_curve_svg, save_flow_curve, FlowCurvePlot, ReferencePoints};
 pub use heatmap::{save_heatmap, Heatmap};
-pub use panels::{
-    panels_svg, save_panels, Band, BandShape, LegendPlacement, Panel, RefLine, Series, Style,
-};
+pub use panel_draw::{panels_svg, save_panels};
+pub use panels::{Band, BandShape, LegendPlacement, Panel, RefLine, Series, Style};
 pub use write::{FigureFormat, MAX_SIDE};

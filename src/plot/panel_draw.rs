@@ -8,13 +8,15 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::axes::{axis_range, Metrics, HUGE};
 use super::colors::PALETTE;
+use super::error::{invalid, PlotError};
 use super::fonts::FONT;
 use super::legend::{
     draw_legend, free_corner, legend_size, LegendEntry, Obstacles, PixelRect, Swatch,
 };
 use super::panels::{BandShape, LegendPlacement, Panel, Style};
 use super::ticks::TickedAxis;
-use super::write::{DrawResult, Figure};
+use super::write::{render_svg, write_figure, DrawResult, Figure};
+use std::path::Path;
 
 /// Neutral colour of bands and reference lines without a palette index.
 const NEUTRAL: RGBColor = RGBColor(90, 90, 90);
@@ -460,6 +462,51 @@ fn band_polygon(panel: &Panel, lower: &[(f64, f64)], upper: &[(f64, f64)]) -> Ve
         .chain(upper.iter().rev().filter(keep))
         .map(|&(x, y)| (x.clamp(-HUGE, HUGE), y.clamp(-HUGE, HUGE)))
         .collect()
+}
+
+/// Checks the request of a panel grid; returns the number of rows and columns.
+fn grid_shape(path: &Path, panels: &[Panel], columns: usize) -> Result<(usize, usize), PlotError> {
+    if panels.is_empty() {
+        return Err(invalid(path, "no panels to draw"));
+    }
+    if columns == 0 {
+        return Err(invalid(path, "the number of columns must be at least 1"));
+    }
+    let columns = columns.min(panels.len());
+    Ok((panels.len().div_ceil(columns), columns))
+}
+
+/// Writes `panels` as a grid with `columns` columns (rows as needed, filled row by row) into a
+/// `size.0 × size.1` pixel figure at `path` (`.png` or `.svg`).
+///
+/// `columns` larger than the number of panels is reduced to it. Errors if there are no panels,
+/// `columns` is 0, or the size is 0 or larger than [`MAX_SIDE`](super::MAX_SIDE).
+pub fn save_panels(
+    path: &Path,
+    panels: &[Panel],
+    columns: usize,
+    size: (u32, u32),
+) -> Result<(), PlotError> {
+    let (rows, columns) = grid_shape(path, panels, columns)?;
+    let grid = PanelGrid {
+        panels,
+        rows,
+        columns,
+    };
+    write_figure(path, size, &grid)
+}
+
+/// The grid of [`save_panels`] as an SVG document in memory (e.g. to embed in an HTML page);
+/// errors name `"<svg>"` as the path.
+pub fn panels_svg(panels: &[Panel], columns: usize, size: (u32, u32)) -> Result<String, PlotError> {
+    let path = Path::new("<svg>");
+    let (rows, columns) = grid_shape(path, panels, columns)?;
+    let grid = PanelGrid {
+        panels,
+        rows,
+        columns,
+    };
+    render_svg(path, size, &grid)
 }
 
 #[cfg(test)]
