@@ -74,7 +74,7 @@
 //! 5. `smoothing`, `synthetic`, `input`, `output`, `statistics`, `noise_model`,
 //!    `noise_summary` (the one noise level), `take_up`, `uncertainty`;
 //! 6. `rheometer` (inside: `options`, `estimator` → `data` → `layout` → `objective` →
-//!    `identify` → `summary_build`, `error_budget`, `landscape`; the values `summary`,
+//!    `identify` → `nested`, `summary_build`, `error_budget`, `landscape`; the values `summary`,
 //!    `budget` below them);
 //! 7. `figures`, `flow_curve_figure`;
 //! 8. `diagnostics` (`compare`, `candidate` → `ties`, `diagnose` (its stages), `diagnosis`,

@@ -18,6 +18,7 @@ mod fit_warnings;
 mod flow_curve_intervals;
 mod independent_model;
 mod landscape;
+mod nested_fit;
 mod rheometer;
 mod rheometer_blocks;
 mod robust_statistics;

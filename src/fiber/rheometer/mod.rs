@@ -10,6 +10,8 @@
 //!   experiment);
 //! * [`identify`]: the start-point heuristic (paper Algorithm 2) and the bounded trust-region
 //!   Gauss–Newton fit;
+//! * [`nested`]: a fit with effects that never ends worse than the model without them
+//!   (also started from the plain model's optimum);
 //! * [`objective`]: the least-squares objective over all experiments (solved in parallel,
 //!   warm-started, exact Jacobians from forward sensitivities);
 //! * [`layout`]: which parameters are fitted (law, effect strengths, take-up factors);
@@ -36,6 +38,7 @@ pub mod flow_curve;
 pub mod identify;
 pub mod landscape;
 pub mod layout;
+pub mod nested;
 pub mod objective;
 pub mod options;
 pub mod parameter_shift;
@@ -55,6 +58,7 @@ pub use flow_curve::{BandMethod, FlowCurve, FlowCurveOptions, FlowPoint, StrainR
 pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
+pub use nested::{NestedFit, NestedStart};
 pub use options::{CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError};
 pub use parameter_shift::ParameterShift;
 pub use plan::FitPlan;

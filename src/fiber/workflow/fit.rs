@@ -109,7 +109,8 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
             (sp.start, Some(sp))
         }
     };
-    let mut id = rh.identify(start, opts)?;
+    // a model with fitted effects never ends worse than the model without them
+    let mut id = rh.identify_nested(start, opts)?.fit;
     let budget = request
         .error_budget
         .then(|| error_budget(&rh, &id, &data.uncertainty, opts));

@@ -96,7 +96,8 @@ impl<'a> Context<'a> {
             ..self.opts.clone()
         };
         let Some(w) = warm else {
-            return self.rh.identify(self.law0, &checked);
+            // the user's effects never leave the fit worse than the model without them
+            return Ok(self.rh.identify_nested(self.law0, &checked)?.fit);
         };
         let start = FitStart {
             strengths: w.fitted_strengths(),

@@ -1,0 +1,119 @@
+//! Fits of a model with fitted effects that never end worse than the same model without them.
+//!
+//! A model with fitted effects contains the plain model: every fitted effect at its neutral
+//! strength reproduces it exactly. Its optimum can therefore be no worse than the plain
+//! model's. A fit started at the heuristic law with the effects at neutral strength takes a
+//! different path through the larger parameter space and can end in a local minimum above the
+//! plain optimum: nothing in the trust-region method forbids it.
+//! [`Rheometer::identify_nested`] therefore also fits the plain model (the fitted effects held
+//! at neutral strength) and starts the full model from its optimum (its law, take-up factors
+//! and solutions, the effects at neutral strength), which can only lower `J`, and keeps the
+//! better of the two fits.
+
+use super::data::Rheometer;
+use super::identify::{Identification, WarmFit};
+use super::layout::FitStart;
+use super::options::{IdentifyOptions, RheometerError};
+use crate::fiber::effects::EffectSetting;
+
+/// Where the kept fit of [`Rheometer::identify_nested`] started.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NestedStart {
+    /// The model has no fitted effect: one fit from the given start.
+    Plain,
+    /// The given start law with the effects at neutral strength ended lowest.
+    Given,
+    /// The plain model's optimum (effects at neutral strength) ended lower than the given
+    /// start.
+    PlainOptimum,
+}
+
+/// The outcome of [`Rheometer::identify_nested`].
+#[derive(Debug)]
+pub struct NestedFit {
+    /// The kept fit (the lower cost of the two starts).
+    pub fit: Identification,
+    /// Where it started.
+    pub start: NestedStart,
+    /// Cost `J` \[-\] of the plain model's optimum (the fitted effects at neutral strength);
+    /// `None` without fitted effects.
+    pub plain_cost: Option<f64>,
+    /// Cost `J` \[-\] the fit from the given start reached (`None` when it failed).
+    pub given_cost: Option<f64>,
+}
+
+impl Rheometer {
+    /// Identification of this model from `start = (n, κ)` that never ends worse than the plain
+    /// model (see the [module](self)). Without fitted effects it is
+    /// [`identify`](Self::identify). Costs two more fits with them. An error of the fit from
+    /// the given start is kept only when the fit from the plain optimum fails too.
+    pub fn identify_nested(
+        &self,
+        start: [f64; 2],
+        options: &IdentifyOptions,
+    ) -> Result<NestedFit, RheometerError> {
+        let fitted = self.spec.effects.iter().any(|s| s.value.is_none());
+        if !fitted {
+            return Ok(NestedFit {
+                fit: self.identify(start, options)?,
+                start: NestedStart::Plain,
+                plain_cost: None,
+                given_cost: None,
+            });
+        }
+        let given = self.identify(start, options);
+        let mut plain_spec = self.spec.clone();
+        for s in &mut plain_spec.effects {
+            if s.value.is_none() {
+                let neutral = s.effect.neutral();
+                *s = EffectSetting::fixed(s.effect.clone(), neutral);
+            }
+        }
+        let from_plain = self
+            .respecified(plain_spec)
+            .and_then(|plain_rh| plain_rh.identify(start, options))
+            .and_then(|plain| {
+                let warm_start = FitStart {
+                    warm: Some(plain.solutions.clone()),
+                    ..FitStart::at(plain.law())
+                };
+                let warm = WarmFit {
+                    take_up: plain.take_up_factors().to_vec(),
+                    stop_tolerance: None,
+                };
+                let cost = plain.summary.cost;
+                self.identify_warm(&warm_start, options, &warm)
+                    .map(|fit| (cost, fit))
+            });
+        match (given, from_plain) {
+            (Ok(g), Ok((plain_cost, p))) => {
+                let given_cost = Some(g.summary.cost);
+                // ties keep the fit from the given start (as before this check)
+                let (fit, start) = if p.summary.cost < g.summary.cost {
+                    (p, NestedStart::PlainOptimum)
+                } else {
+                    (g, NestedStart::Given)
+                };
+                Ok(NestedFit {
+                    fit,
+                    start,
+                    plain_cost: Some(plain_cost),
+                    given_cost,
+                })
+            }
+            (Ok(g), Err(_)) => Ok(NestedFit {
+                given_cost: Some(g.summary.cost),
+                fit: g,
+                start: NestedStart::Given,
+                plain_cost: None,
+            }),
+            (Err(_), Ok((plain_cost, p))) => Ok(NestedFit {
+                fit: p,
+                start: NestedStart::PlainOptimum,
+                plain_cost: Some(plain_cost),
+                given_cost: None,
+            }),
+            (Err(e), Err(_)) => Err(e),
+        }
+    }
+}
