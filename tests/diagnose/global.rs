@@ -98,6 +98,13 @@ fn check(sc: &Scenario, e: &Expect) -> (ExperimentSet, DiagnosisRun) {
         local,
         t
     );
+    // one noise level: a warning of the user's fit that names the noise names the fit's own
+    let level = d.base_fit.noise.describe();
+    for w in &d.base_fit.warnings {
+        if w.message.contains("noise level") && w.message.contains("estimated") {
+            assert!(w.message.contains(&level), "{}: {w} vs {level}", sc.name);
+        }
+    }
     for f in e.found {
         assert!(
             d.found.iter().any(|x| x == f),

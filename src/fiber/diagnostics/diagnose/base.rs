@@ -3,6 +3,8 @@
 use super::DiagnoseOptions;
 use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::fiber::rheometer::identify::WarmFit;
+use crate::fiber::rheometer::summary_checks::check_misfit;
+use crate::fiber::rheometer::WarningCode;
 use crate::fiber::rheometer::{
     Estimator, FitStart, Identification, IdentifyOptions, Layout, Rheometer, RheometerError,
 };
@@ -164,8 +166,17 @@ impl<'a> Context<'a> {
             stop_tolerance: None,
         };
         let mut weighted = self.rh.identify_warm(&start, &self.opts, &warm)?;
-        // the one noise level of these data and this model is the plain fit's
+        // the one noise level of these data and this model is the plain fit's, and the misfit
+        // warning reads it (not the weighted fit's own estimate)
         weighted.summary.noise = base.summary.noise.clone();
+        let mut misfit = Vec::new();
+        check_misfit(&weighted.summary, &mut misfit);
+        let warnings = &mut weighted.summary.warnings;
+        let at = warnings.iter().position(|w| w.code == WarningCode::Misfit);
+        warnings.retain(|w| w.code != WarningCode::Misfit);
+        for (k, w) in misfit.into_iter().enumerate() {
+            warnings.insert(at.unwrap_or(warnings.len()).min(warnings.len()) + k, w);
+        }
         Ok(weighted)
     }
 
