@@ -2,7 +2,7 @@
 
 use super::DiagnoseOptions;
 use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
-use crate::fiber::rheometer::identify::WarmFit;
+use crate::fiber::rheometer::identification::WarmFit;
 use crate::fiber::rheometer::{
     Estimator, FitStart, Identification, IdentifyOptions, Layout, Rheometer, RheometerError,
 };
