@@ -73,12 +73,14 @@
 //! 4. `cold_start`, `simulate`, `profile_sensitivities`;
 //! 5. `smoothing`, `synthetic`, `input`, `output`, `statistics`, `noise_model`,
 //!    `noise_summary` (the one noise level), `take_up`, `uncertainty`;
-//! 6. `rheometer` (inside: `options`, `estimator` → `data` → `layout` → `objective` →
-//!    `identify` → `nested`, `summary_build`, `error_budget`, `landscape`; the values `summary`,
-//!    `budget` below them);
+//! 6. `rheometer` (inside, bottom to top: `estimator` → `options` → `data`, `layout`,
+//!    `parameter_shift` and the values `thresholds`, `budget`, `curve`, `likelihood` →
+//!    `coverage`, `objective`, `plan`, `landscape` → the value `summary` → what reads it
+//!    (`summary_checks`, `summary_text`, `summary_read`) → `summary_build`, `identification` →
+//!    `accuracy` → `identify` → `nested`, `profile`, `flow_curve`, `error_budget` → `summary_finding`);
 //! 7. `figures`, `flow_curve_figure`;
-//! 8. `diagnostics` (`compare`, `candidate` → `ties`, `diagnose` (its stages), `diagnosis`,
-//!    `report`);
+//! 8. `diagnostics` (`compare`, `candidate` → `ties`, `calibration`, `diagnose` (its stages),
+//!    `diagnosis`, `report`);
 //! 9. `failure_hints`, `design` (inside: `information`, `criteria`, `candidates` →
 //!    `estimation` → `report`);
 //! 10. `workflow` (what each `rheometer` subcommand does, as library calls).

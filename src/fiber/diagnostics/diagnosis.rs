@@ -1,9 +1,9 @@
 //! The result of a diagnosis: what is written as JSON ([`Diagnosis`]) and what figures and
 //! the next step need besides ([`DiagnosisRun`]).
 
+use super::calibration::Calibration;
 use super::candidate::{Candidate, Indistinguishable};
 use super::detection::DetectionLimits;
-use super::diagnose::calibrate::Calibration;
 use super::diagnose::verdict::Verdict;
 use super::ties::Alternative;
 use crate::fiber::effects::LawChoice;

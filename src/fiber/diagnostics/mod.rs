@@ -12,6 +12,8 @@
 //!   they explain;
 //! * [`candidate`]: the record of one candidate and how candidates are judged and ranked;
 //! * [`diagnosis`]: the result of a diagnosis (JSON) and what figures need besides;
+//! * [`calibration`]: the look-elsewhere calibration of a diagnosis as a value (the null
+//!   distribution of the best `ΔBIC`), computed by the stage `diagnose::calibrate`;
 //! * [`report`]: the diagnosis in words and its figures;
 //! * [`detection`]: the detection limit of each candidate (the strength the data would reveal)
 //!   and the shift of `(n, κ)` an effect just below it would cause;
@@ -19,6 +21,7 @@
 //!   and the refits of its best points;
 //! * [`ties`]: candidates about as consistent with the data as the named one (alternatives).
 
+pub mod calibration;
 pub mod candidate;
 pub mod compare;
 pub mod detection;

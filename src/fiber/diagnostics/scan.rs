@@ -20,7 +20,7 @@
 //!   [`physical_range`] and [`shape_variants`].
 
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
-use crate::fiber::rheometer::identify::WarmFit;
+use crate::fiber::rheometer::identification::WarmFit;
 use crate::fiber::rheometer::{
     FitStart, Identification, IdentifyOptions, Rheometer, RheometerError,
 };

@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use super::error::{readable, short, sig, InputError, InputWarning, Location};
-use super::experiments::{ExperimentDetails, MAX_DRAW_RATIO, MAX_INLET_VISCOSITY_PA_S};
+use super::loaded::ExperimentDetails;
 use super::schema::{
     keys_of, Quantity, Unit, AIR_TEMPERATURE, EXPERIMENT, EXPERIMENT_TABLES, INLET_DIAMETER,
     INLET_TEMPERATURE, INLET_VELOCITY, MASS_FLOW_Q, MAX_PLAUSIBLE_DIAMETER_M,
@@ -22,6 +22,13 @@ use crate::fiber::setup::{Experiment, Inlet, Material, TakeUp};
 /// Longest experiment name \[bytes\]: the 255-byte file-name limit of common file systems minus
 /// the longest suffix of an output file named after the experiment (`_fitted_profile.csv`).
 pub const MAX_NAME_BYTES: usize = 255 - "_fitted_profile.csv".len();
+
+/// Largest plausible zero-shear viscosity of the melt at the inlet \[Pa s\]: 1e12 Pa s is the
+/// conventional viscosity of a glass at its glass transition; above it the polymer is not a melt.
+pub const MAX_INLET_VISCOSITY_PA_S: f64 = 1e12;
+
+/// Largest plausible draw ratio `u_out/u_in = (d_in/d_out)²` \[-\].
+pub const MAX_DRAW_RATIO: f64 = 1e6;
 
 /// Where the keys of one experiment are, for the checks that need its data too.
 #[derive(Debug, Clone)]

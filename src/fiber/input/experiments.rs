@@ -2,86 +2,23 @@
 //! `[[experiment]]` (see `experiment`), and loading a whole data set (TOML and its CSV files,
 //! with the checks that need both: see `cross_checks`).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use toml::de::DeTable;
 
-use super::cross_checks::{check_experiment_memory, cross_check, data_error, FitBudget};
-use super::error::{short, InputError, InputWarning, Location};
+use super::cross_checks::{check_experiment_memory, cross_check, data_error};
+use super::error::{short, InputError};
 use super::experiment::{experiment, name_table, Located, MaterialAt};
+use super::loaded::LoadedExperiments;
 use super::measurements::{read_measurements, DEFAULT_MIN_POINTS};
 use super::options::{show_count, Limit, LoadOptions};
+use super::row_budget::FitBudget;
 use super::schema::{keys_of, material_quantity, Rule, EXPERIMENT, MATERIAL, TOP_KEYS};
 use super::source::read_toml;
 use super::spanned::{toml_error, Doc, Tab};
 use super::uncertainty::uncertainty_table;
 use crate::fiber::setup::{Air, ExperimentSet, Material};
 use crate::fiber::uncertainty::Uncertainties;
-
-/// Largest plausible zero-shear viscosity of the melt at the inlet \[Pa s\]: 1e12 Pa s is the
-/// conventional viscosity of a glass at its glass transition; above it the polymer is not a melt.
-pub const MAX_INLET_VISCOSITY_PA_S: f64 = 1e12;
-
-/// Largest plausible draw ratio `u_out/u_in = (d_in/d_out)²` \[-\].
-pub const MAX_DRAW_RATIO: f64 = 1e6;
-
-/// Descriptive information on an experiment that is not part of the model input.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ExperimentDetails {
-    /// Stencil velocity of the extruder \[mm/s\] (`stencil_velocity_mm_s`), if given.
-    pub stencil_velocity_mm_s: Option<f64>,
-    /// Take-up (aspirator) pressure \[bar\] (`take_up_pressure_bar`), if given.
-    pub take_up_pressure_bar: Option<f64>,
-    /// The measurement CSV file (resolved against the TOML file's directory), if given.
-    pub data: Option<PathBuf>,
-    /// 1-based line of the experiment's `name` key in the TOML file, if known (for messages
-    /// that name the experiment).
-    pub line: Option<usize>,
-}
-
-/// An experiment set together with per-experiment details (same order as the experiments).
-#[derive(Debug, Clone, PartialEq)]
-pub struct LoadedExperiments {
-    /// The model input, in SI units whatever units the file used (measurements are `None`
-    /// when parsed without reading CSV files).
-    pub set: ExperimentSet,
-    /// Descriptive metadata and data-file paths.
-    pub details: Vec<ExperimentDetails>,
-    /// Declared standard uncertainties (`[uncertainty]` and the experiments' own tables; empty
-    /// when nothing is declared).
-    pub uncertainty: Uncertainties,
-    /// Warnings about inputs that are accepted but doubtful (a take-up diameter extrapolated
-    /// beyond the measured positions, a °C value that looks like kelvin), each naming file and
-    /// line; callers should show them.
-    pub warnings: Vec<InputWarning>,
-    /// The experiments file (for messages).
-    pub path: PathBuf,
-}
-
-impl LoadedExperiments {
-    /// An error naming the first experiment without a data file (file, line of its
-    /// `[[experiment]]` table, and the key to add), for callers that need measurements (a
-    /// fit); `Ok` if every experiment has one.
-    pub fn require_data(&self) -> Result<(), InputError> {
-        let Some(k) = self.details.iter().position(|d| d.data.is_none()) else {
-            return Ok(());
-        };
-        let name = &self.set.experiments[k].name;
-        Err(InputError::MissingKey {
-            at: Location {
-                path: self.path.clone(),
-                line: self.details[k].line,
-            },
-            table: format!("[[experiment]] #{} \"{}\"", k + 1, short(name, 40)),
-            key: "data".into(),
-            hint: format!(
-                ": the experiment has no measurements; add `data = \"{}.csv\"` (the CSV file \
-                 of its measured diameters, relative to the experiments file) to its table",
-                short(name, 40)
-            ),
-        })
-    }
-}
 
 /// Loads a TOML experiment file and the CSV files it refers to with the default
 /// [`LoadOptions`] (at least [`DEFAULT_MIN_POINTS`] measurements per file).
@@ -311,6 +248,7 @@ fn material(tab: &Tab<'_>) -> Result<(Material, Air), InputError> {
 mod tests {
     use super::*;
     use crate::fiber::setup::{Inlet, TakeUp};
+    use std::path::PathBuf;
 
     const MATERIAL: &str = r#"
 [material]

@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use super::cross_checks::FitBudget;
 use super::error::{readable, short, InputError, Location};
 use super::options::{Limit, LoadOptions};
+use super::row_budget::FitBudget;
 use super::schema::{Unit, DIAMETER, LENGTH, MAX_PLAUSIBLE_DIAMETER_M, MIN_PLAUSIBLE_DIAMETER_M};
 use super::source::{text_lines, Lines};
 use crate::fiber::setup::Measurements;

@@ -121,28 +121,35 @@
 //!
 //! # Layout
 //!
-//! * `error`: [`Location`], [`InputError`] and [`InputWarning`], the messages of every failure;
+//! Bottom to top (each file imports only from the files listed before it):
+//!
 //! * `options`: [`LoadOptions`] (the caps) and the fit-memory estimate;
+//! * `error`: [`Location`], [`InputError`] and [`InputWarning`], the messages of every failure;
 //! * `source`: opening regular files only, bounded reading, encoding checks;
 //! * `syntax`: messages for duplicate keys and for files that are not experiments files;
 //! * `schema`: the keys of each table, the rules their values obey, plausible ranges, and
 //!   hints for misspelt or misplaced keys;
 //! * `spanned`: reading the TOML document with spans, so that every error names a line;
-//! * `experiments`: building the [`ExperimentSet`](super::setup::ExperimentSet) from the
-//!   tables, and loading a whole data set;
-//! * `experiment`: one `[[experiment]]` table, its units and plausibility checks;
-//! * `cross_checks`: the checks that need the TOML and the data together;
-//! * `measurements`: reading the measurement CSV files;
 //! * `uncertainty`: reading the `[uncertainty]` tables (declared standard uncertainties of
 //!   process conditions, instrument and material data, see
-//!   [`fiber::uncertainty`](crate::fiber::uncertainty)).
+//!   [`fiber::uncertainty`](crate::fiber::uncertainty));
+//! * `loaded`: what loading yields, as values ([`LoadedExperiments`], [`ExperimentDetails`]);
+//! * `row_budget`: the rows the measurement files may still hold (the per-file cap and the
+//!   fit's memory), counted while they are read;
+//! * `experiment`: one `[[experiment]]` table, its units and plausibility checks;
+//! * `measurements`: reading the measurement CSV files;
+//! * `cross_checks`: the checks that need the TOML and the data together;
+//! * `experiments`: building the [`ExperimentSet`](super::setup::ExperimentSet) from the
+//!   tables, and loading a whole data set (the last step: it calls the others).
 
 mod cross_checks;
 mod error;
 mod experiment;
 mod experiments;
+mod loaded;
 mod measurements;
 mod options;
+mod row_budget;
 mod schema;
 mod source;
 mod spanned;
@@ -150,12 +157,12 @@ mod syntax;
 mod uncertainty;
 
 pub use error::{InputError, InputWarning, Location};
-pub use experiment::MAX_NAME_BYTES;
+pub use experiment::{MAX_DRAW_RATIO, MAX_INLET_VISCOSITY_PA_S, MAX_NAME_BYTES};
 pub use experiments::{
     load_experiments, load_experiments_with, load_experiments_with_options, parse_experiments,
-    parse_experiments_with, ExperimentDetails, LoadedExperiments, MAX_DRAW_RATIO,
-    MAX_INLET_VISCOSITY_PA_S,
+    parse_experiments_with,
 };
+pub use loaded::{ExperimentDetails, LoadedExperiments};
 pub use measurements::{
     load_measurements, load_measurements_with, parse_measurements, CSV_HEADER, DEFAULT_MIN_POINTS,
 };

@@ -13,7 +13,7 @@
 //! [`SolverRecord`](super::SolverRecord).
 
 use super::data::Rheometer;
-use super::identify::{Identification, WarmFit};
+use super::identification::{Identification, WarmFit};
 use super::layout::FitStart;
 use super::options::{IdentifyOptions, RheometerError};
 use super::parameter_shift::ParameterShift;

@@ -2,7 +2,7 @@
 //! table, in words, and as a warning where the systematic uncertainty dominates. Computed by [`error_budget`](super::error_budget()).
 
 use super::options::{FitWarning, WarningCode};
-use super::summary_checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
+use super::thresholds::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 use crate::fiber::uncertainty::{Origin, Scope, Source, SOURCES};
 use serde::{Deserialize, Serialize};
 

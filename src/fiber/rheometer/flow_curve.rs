@@ -23,164 +23,17 @@
 //!   added in quadrature. The total band combines both in quadrature.
 
 use super::budget::ErrorBudget;
-use super::data::Rheometer;
+pub use super::coverage::{StrainRateCoverage, DRAWING_FRACTION};
+pub use super::curve::{BandMethod, FlowCurve, FlowPoint, Isotherm};
 use super::summary::{FitSummary, Z95};
 use crate::fiber::contributions::NusseltLaw;
 use crate::fiber::material_law::ViscosityLaw;
 use crate::fiber::model::FiberModel;
-use crate::fiber::statistics::median;
 use crate::fiber::uncertainty::Scope;
-use crate::solution::Solution;
 use num_dual::Dual64;
-use serde::{Deserialize, Serialize};
 
 /// The 95 % point of the χ² distribution with one degree of freedom (`1.96²`).
 pub const CHI2_1_95: f64 = Z95 * Z95;
-
-/// A measurement position counts towards the strain rates the data cover where the model's
-/// strain rate exceeds this fraction of its largest value along that experiment's line: where
-/// the fiber still draws. Downstream the fiber has frozen; its diameter no longer depends on
-/// the law, while its reduced rate `a_T ε̇` (tiny rate, huge shift factor) would claim
-/// coverage up to 1e12 1/s.
-pub const DRAWING_FRACTION: f64 = 0.01;
-
-/// The strain rates \[1/s\] of a fit's model at the measurement positions where the fiber
-/// draws ([`DRAWING_FRACTION`]) (JSON: `strain_rates` of a fit).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StrainRateCoverage {
-    /// Temperature the reduced rates refer to \[K\]: the median die (inlet) temperature.
-    pub reference_temperature_k: f64,
-    /// Smallest, median and largest model strain rate at the measurement positions where the
-    /// fiber draws \[1/s\], as they occur on the spin line.
-    pub measured_per_s: [f64; 3],
-    /// The same rates shifted to `reference_temperature_k` by the VFT factor
-    /// `η₀(T)/η₀(T_ref)` \[1/s\]: the part of the flow curve at `T_ref` the data probe.
-    pub reduced_per_s: [f64; 3],
-    /// Coldest and hottest melt temperature at those positions \[K\].
-    pub temperature_k: [f64; 2],
-}
-
-impl Rheometer {
-    /// The strain rates the data cover, from the fitted `solutions` (one per experiment) at the
-    /// measurement positions where the fiber draws (`None` without a positive rate).
-    pub fn strain_rate_coverage(&self, solutions: &[Solution]) -> Option<StrainRateCoverage> {
-        let mut inlet: Vec<f64> = self
-            .experiments
-            .iter()
-            .map(|e| e.inlet_temperature)
-            .collect();
-        let t_ref = median(&mut inlet);
-        let (mut raw, mut reduced) = (Vec::new(), Vec::new());
-        let (mut t_lo, mut t_hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        let mut y = [0.0; 4];
-        let mut yp = [0.0; 4];
-        for (k, sol) in solutions.iter().enumerate() {
-            let (Some(model), Some(m)) = (self.models.get(k), self.measurements.get(k)) else {
-                continue;
-            };
-            let sc = &model.scaling;
-            let (lo, t_o) = (sc.reference.length, sc.reference.temperature);
-            let eta0_ref = model.viscosity_at(t_ref / t_o, 0.0, &sol.params);
-            let states: Vec<(f64, f64, f64)> = m
-                .positions
-                .iter()
-                .map(|&s| {
-                    sol.eval_into(s / lo, &mut y, &mut yp);
-                    (y[2], y[3] * sc.strain_rate(), y[2] * t_o)
-                })
-                .collect();
-            let peak = states.iter().map(|s| s.1).fold(0.0, f64::max);
-            for &(t_nd, rate, t) in &states {
-                if !(rate > DRAWING_FRACTION * peak && rate.is_finite() && t.is_finite()) {
-                    continue;
-                }
-                let a_t = model.viscosity_at(t_nd, 0.0, &sol.params) / eta0_ref;
-                raw.push(rate);
-                reduced.push(rate * a_t);
-                t_lo = t_lo.min(t);
-                t_hi = t_hi.max(t);
-            }
-        }
-        let three = |v: &mut Vec<f64>| -> Option<[f64; 3]> {
-            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            (lo.is_finite() && hi.is_finite()).then(|| [lo, median(v), hi])
-        };
-        Some(StrainRateCoverage {
-            reference_temperature_k: t_ref,
-            measured_per_s: three(&mut raw)?,
-            reduced_per_s: three(&mut reduced)?,
-            temperature_k: [t_lo, t_hi],
-        })
-    }
-}
-
-/// How the statistical band was obtained.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum BandMethod {
-    /// Delta method on `ln η_E` from the covariance of the law's parameters.
-    #[default]
-    Delta,
-    /// Envelope of the curves along the likelihood profiles within the 95 % deviance.
-    Profile,
-    /// No fitted law parameter (or no covariance): no statistical band.
-    None,
-}
-
-/// One strain rate of a [`FlowCurve`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FlowPoint {
-    /// Strain rate `ε̇` \[1/s\].
-    pub strain_rate_per_s: f64,
-    /// Elongational viscosity `η_E` \[Pa s\].
-    pub eta_pa_s: f64,
-    /// Statistical 95 % band \[Pa s\] (`[η, η]` without one).
-    pub stat95_pa_s: [f64; 2],
-    /// Systematic 95 % band \[Pa s\] (`[η, η]` without an error budget).
-    pub sys95_pa_s: [f64; 2],
-    /// Both combined in quadrature (on `ln η`) \[Pa s\].
-    pub total95_pa_s: [f64; 2],
-    /// Outside the strain rates the data cover: the law is extrapolated here.
-    pub extrapolated: bool,
-}
-
-/// The curve at another melt temperature (VFT shift), without bands.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Isotherm {
-    /// Temperature \[K\].
-    pub temperature_k: f64,
-    /// `η_E` \[Pa s\] at the strain rates of the curve's points.
-    pub eta_pa_s: Vec<f64>,
-}
-
-/// The identified elongational viscosity against strain rate at one temperature (JSON:
-/// `flow_curve` of a fit, and `flow_curve.json` of `rheometer fit --out`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FlowCurve {
-    /// Temperature of the curve \[K\].
-    pub temperature_k: f64,
-    /// Trouton ratio `η_E0/η_s0` of the material \[-\].
-    pub trouton: f64,
-    /// Newtonian plateau `Tr·η_s0(T)` \[Pa s\] (the zero-rate elongational viscosity).
-    pub plateau_pa_s: f64,
-    /// Strain rates the data cover at this temperature \[1/s\] (`[min, max]`).
-    pub covered_per_s: [f64; 2],
-    /// Median strain rate of the data at this temperature \[1/s\].
-    pub median_per_s: f64,
-    /// How the statistical band was obtained.
-    pub band: BandMethod,
-    /// Whether the systematic band comes from an error budget (else it is zero width).
-    pub systematic: bool,
-    /// The curve, ascending in strain rate.
-    pub points: Vec<FlowPoint>,
-    /// The curve at other melt temperatures along the line.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub isotherms: Vec<Isotherm>,
-    /// What the data support, in one sentence (e.g. "no strain thinning detected ...").
-    #[serde(default)]
-    pub finding: String,
-}
 
 /// Options of [`FlowCurve::of`].
 #[derive(Debug, Clone, PartialEq)]
@@ -425,53 +278,6 @@ impl FlowCurve {
             isotherms,
             finding: summary.law_finding(),
         })
-    }
-
-    /// The point nearest to `rate` \[1/s\] on a log scale.
-    pub fn nearest(&self, rate: f64) -> Option<&FlowPoint> {
-        self.points.iter().min_by(|a, b| {
-            let d = |p: &FlowPoint| (p.strain_rate_per_s / rate).ln().abs();
-            d(a).total_cmp(&d(b))
-        })
-    }
-
-    /// The curve as CSV, units in the header: `strain_rate_per_s, eta_E_Pa_s`, the three bands
-    /// (`stat95_low_Pa_s`, ...), `plateau_Pa_s` (Trouton), `extrapolated` (0/1), and one
-    /// `eta_E_at_<T>K_Pa_s` column per isotherm; the curve's temperature in `temperature_K`.
-    pub fn to_csv(&self) -> String {
-        let mut s = String::from(
-            "strain_rate_per_s,eta_E_Pa_s,stat95_low_Pa_s,stat95_high_Pa_s,sys95_low_Pa_s,\
-             sys95_high_Pa_s,total95_low_Pa_s,total95_high_Pa_s,plateau_Pa_s,temperature_K,\
-             extrapolated",
-        );
-        for iso in &self.isotherms {
-            s.push_str(&format!(",eta_E_at_{:.2}K_Pa_s", iso.temperature_k));
-        }
-        s.push('\n');
-        for (i, p) in self.points.iter().enumerate() {
-            s.push_str(&format!(
-                "{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{}",
-                p.strain_rate_per_s,
-                p.eta_pa_s,
-                p.stat95_pa_s[0],
-                p.stat95_pa_s[1],
-                p.sys95_pa_s[0],
-                p.sys95_pa_s[1],
-                p.total95_pa_s[0],
-                p.total95_pa_s[1],
-                self.plateau_pa_s,
-                self.temperature_k,
-                u8::from(p.extrapolated)
-            ));
-            for iso in &self.isotherms {
-                s.push_str(&format!(
-                    ",{:.6e}",
-                    iso.eta_pa_s.get(i).copied().unwrap_or(f64::NAN)
-                ));
-            }
-            s.push('\n');
-        }
-        s
     }
 }
 

@@ -9,11 +9,13 @@
 
 use super::data::Rheometer;
 use super::estimator::Estimator;
-use super::layout::{EffectSlot, FitStart};
+pub use super::identification::Identification;
+use super::identification::WarmFit;
+use super::layout::FitStart;
 use super::options::{FitProgress, IdentifyOptions, RheometerError};
 use super::summary::FitSummary;
 use super::summary_build::SummaryInput;
-use crate::least_squares::{fit_observed, Accuracy, FitIteration, FitOptions, FitResult};
+use crate::least_squares::{fit_observed, Accuracy, FitIteration, FitOptions};
 use crate::solution::Solution;
 use std::time::Instant;
 
@@ -241,18 +243,6 @@ impl Rheometer {
     }
 }
 
-/// How a fit started from a neighbouring fit differs from a plain identification
-/// ([`Rheometer::identify_warm`]).
-#[derive(Debug, Clone, Default)]
-pub(crate) struct WarmFit {
-    /// Take-up factors to start from (principled estimator; one per experiment, clamped into
-    /// [`IdentifyOptions::take_up_bounds`]); any other length: 1.
-    pub take_up: Vec<f64>,
-    /// Stopping tolerance \[-\] of the gradient, step and cost-change tests (all three);
-    /// `None`: the driver's defaults.
-    pub stop_tolerance: Option<f64>,
-}
-
 /// Result of the start heuristic.
 #[derive(Debug, Clone)]
 pub struct StartPoint {
@@ -262,72 +252,6 @@ pub struct StartPoint {
     pub newtonian_cost: f64,
     /// `(κ, J(n_init, κ))` for every κ tried.
     pub trace: Vec<(f64, f64)>,
-}
-
-/// Result of an identification: its [`FitSummary`] (the outcome, as reported) and what the
-/// next computation needs (the solutions, the least-squares result, the model layout).
-#[derive(Debug, Clone)]
-pub struct Identification {
-    /// The outcome: named estimates with uncertainties, noise level, warnings.
-    pub summary: FitSummary,
-    /// Names of the shared fitted parameters (the first entries of `fit.p`; the take-up factors
-    /// follow).
-    pub names: Vec<String>,
-    /// The model's effects (fixed or fitted) and where their strengths sit.
-    pub effects: Vec<EffectSlot>,
-    /// The fitted local model parameters `[c, n, κ, strengths..., φ = 1]`.
-    pub local_params: Vec<f64>,
-    /// Final fiber solutions, one per experiment.
-    pub solutions: Vec<Solution>,
-    /// The least-squares result (cost, Jacobian, iterations, termination).
-    pub fit: FitResult,
-    /// Lower bounds of `fit.p` (shared parameters in model units, then take-up factors).
-    pub lower: Vec<f64>,
-    /// Upper bounds of `fit.p`.
-    pub upper: Vec<f64>,
-    /// Per experiment: measurement positions \[m\] and relative residuals
-    /// `(d_model − d_meas)/d_meas` \[-\] at the optimum.
-    pub residual_profiles: Vec<(Vec<f64>, Vec<f64>)>,
-}
-
-impl Identification {
-    /// `(n, κ)` of the fitted model.
-    pub fn law(&self) -> [f64; 2] {
-        self.summary.law_params()
-    }
-
-    /// RMS of `(d_model − d_meas)/d_meas` over all raw measurements \[-\].
-    pub fn rms(&self) -> f64 {
-        self.summary.rms_relative_residual
-    }
-
-    /// Take-up factors `φ_k = d_out,k / d_fit,k(L)` (all 1 for the paper's estimator).
-    pub fn take_up_factors(&self) -> &[f64] {
-        &self.summary.take_up_factors
-    }
-
-    /// The fitted strengths (the effects' units) and shapes by model-parameter name: the start
-    /// of a fit that continues from this one ([`FitStart::strengths`]).
-    pub fn fitted_strengths(&self) -> Vec<(String, f64)> {
-        let mut out = Vec::new();
-        for slot in &self.effects {
-            if slot.column.is_some() {
-                out.push((
-                    slot.effect.name().to_string(),
-                    slot.effect.strength_of(self.local_params[slot.local]),
-                ));
-            }
-            for sh in &slot.shapes {
-                if sh.column.is_some() {
-                    out.push((
-                        sh.parameter.model_param.to_string(),
-                        self.local_params[sh.local],
-                    ));
-                }
-            }
-        }
-        out
-    }
 }
 
 /// RMS of `values` (0 for none).

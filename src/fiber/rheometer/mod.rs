@@ -5,11 +5,12 @@
 //!   smoothed data, and the statistically principled relative least squares against the raw
 //!   measurements with the take-up diameters as nuisance parameters;
 //! * [`options`]: what the modules share (the model type, the error, the options of an
-//!   identification, the warnings of a fit);
+//!   identification, the warnings of a fit, the side of a bound);
 //! * [`data`]: the prepared data ([`Rheometer`]: smoothed measurements, one model per
 //!   experiment);
 //! * [`identify`]: the start-point heuristic (paper Algorithm 2) and the bounded trust-region
-//!   Gauss–Newton fit;
+//!   Gauss–Newton fit, its result a value of its own, [`identification`] ([`Identification`]);
+//! * [`accuracy`]: the fit's BVPs solved only as accurately as the noise needs, and the proof;
 //! * [`nested`]: a fit with effects that never ends worse than the model without them
 //!   (also started from the plain model's optimum);
 //! * [`objective`]: the least-squares objective over all experiments (solved in parallel,
@@ -23,21 +24,31 @@
 //!   standard errors and 95% confidence intervals, covariance, the one noise level, warnings),
 //!   rendered as text and JSON and read back by the next step;
 //! * [`flow_curve`]: the identified law as `η_E(ε̇)` at a temperature, with its statistical
-//!   and systematic bands and the strain rates the data cover ([`FlowCurve`]);
+//!   and systematic bands and the strain rates the data cover; the values it yields,
+//!   [`FlowCurve`] and [`StrainRateCoverage`], are in [`curve`] and [`coverage`];
 //! * [`profile`]: profile-likelihood intervals, one-sided bounds at a bound, and the
-//!   likelihood-ratio test against the nested Newtonian law;
+//!   likelihood-ratio test against the nested Newtonian law; the values it yields
+//!   ([`ProfileInterval`], [`NewtonianTest`]) are in [`likelihood`];
 //! * [`summary_checks`]: the checks of a fit (estimates at bounds, misfit, huge errors, data
-//!   the model cannot describe).
+//!   the model cannot describe), their thresholds in [`thresholds`].
+//!
+//! The values a [`FitSummary`] holds (`budget`, `curve`, `coverage`, `likelihood`) sit below
+//! it and the steps that compute them above it, so that no two files import each other (the
+//! order is in the Layers section of the crate's documentation).
 
 pub mod accuracy;
 pub mod budget;
+pub mod coverage;
+pub mod curve;
 pub mod data;
 pub mod error_budget;
 pub mod estimator;
 pub mod flow_curve;
+pub mod identification;
 pub mod identify;
 pub mod landscape;
 pub mod layout;
+pub mod likelihood;
 pub mod nested;
 pub mod objective;
 pub mod options;
@@ -50,23 +61,28 @@ pub mod summary_checks;
 mod summary_finding;
 mod summary_read;
 mod summary_text;
+pub mod thresholds;
 
+pub use coverage::StrainRateCoverage;
+pub use curve::{BandMethod, FlowCurve, FlowPoint};
 pub use data::Rheometer;
 pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
 pub use estimator::Estimator;
-pub use flow_curve::{BandMethod, FlowCurve, FlowCurveOptions, FlowPoint, StrainRateCoverage};
-pub use identify::{Identification, StartPoint, PAPER_TABLE3_STARTS};
+pub use flow_curve::FlowCurveOptions;
+pub use identification::Identification;
+pub use identify::{StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
 pub use nested::{NestedFit, NestedStart};
-pub use options::{CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError};
+pub use likelihood::{NewtonianTest, OneSidedBound, ProfileInterval, ProfilePoint, ThinningBound};
+pub use options::{
+    BoundSide, CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError,
+};
 pub use parameter_shift::ParameterShift;
 pub use plan::FitPlan;
-pub use profile::{
-    NewtonianTest, OneSidedBound, ProfileInterval, ProfileMode, ProfilePoint, ThinningBound,
-};
+pub use profile::ProfileMode;
 pub use summary::{
-    AtBound, BoundSide, Covariance, EffectEstimate, Estimate, FitSummary, FitWarning, SolverRecord,
+    AtBound, Covariance, EffectEstimate, Estimate, FitSummary, FitWarning, SolverRecord,
     WarningCode,
 };
 pub use summary_read::{FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE, FIT_FILE_TAKE_UP_RANGE};

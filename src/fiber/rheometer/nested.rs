@@ -11,7 +11,7 @@
 //! better of the two fits.
 
 use super::data::Rheometer;
-use super::identify::{Identification, WarmFit};
+use super::identification::{Identification, WarmFit};
 use super::layout::FitStart;
 use super::options::{IdentifyOptions, RheometerError};
 use crate::fiber::effects::EffectSetting;

@@ -1,7 +1,7 @@
 //! Types the rheometer's modules share: the model type, the error, the options of an
-//! identification and the warnings of a fit. The layers inside the rheometer, bottom to top:
-//! `options`, `estimator` → `data` → `layout` → `objective` → `identify` → `report`,
-//! `landscape`.
+//! identification, the warnings of a fit and the side of a bound an estimate sits at. Only the
+//! [`estimator`](super::estimator) is below it; the layers inside the rheometer are listed in
+//! the Layers section of the crate's documentation.
 
 use super::estimator::Estimator;
 use crate::fiber::error::FiberError;
@@ -255,5 +255,32 @@ impl FitWarning {
 impl fmt::Display for FitWarning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "[{}] {}", self.code.name(), self.message)
+    }
+}
+
+/// Which bound of its search range an estimate sits at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BoundSide {
+    /// The lower bound.
+    Lower,
+    /// The upper bound.
+    Upper,
+}
+
+impl BoundSide {
+    /// `"lower"` or `"upper"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            BoundSide::Lower => "lower",
+            BoundSide::Upper => "upper",
+        }
+    }
+
+    pub(crate) fn flipped(self) -> Self {
+        match self {
+            BoundSide::Lower => BoundSide::Upper,
+            BoundSide::Upper => BoundSide::Lower,
+        }
     }
 }

@@ -14,10 +14,11 @@
 //! a fit doubtful are in [`summary_checks`](super::summary_checks).
 
 use super::budget::ErrorBudget;
+use super::coverage::StrainRateCoverage;
+use super::curve::FlowCurve;
 use super::estimator::Estimator;
-use super::flow_curve::{FlowCurve, StrainRateCoverage};
-pub use super::options::{FitWarning, WarningCode};
-use super::profile::{NewtonianTest, ProfileInterval};
+use super::likelihood::{NewtonianTest, ProfileInterval};
+pub use super::options::{BoundSide, FitWarning, WarningCode};
 use crate::fiber::effects::{Category, LawChoice};
 use crate::fiber::noise_summary::NoiseSummary;
 use crate::fiber::serde_nan;
@@ -26,33 +27,6 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 /// Half-width of a two-sided 95 % normal interval in standard errors.
 pub const Z95: f64 = 1.959_963_984_540_054;
-
-/// Which bound of its search range an estimate sits at.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum BoundSide {
-    /// The lower bound.
-    Lower,
-    /// The upper bound.
-    Upper,
-}
-
-impl BoundSide {
-    /// `"lower"` or `"upper"`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            BoundSide::Lower => "lower",
-            BoundSide::Upper => "upper",
-        }
-    }
-
-    pub(crate) fn flipped(self) -> Self {
-        match self {
-            BoundSide::Lower => BoundSide::Upper,
-            BoundSide::Upper => BoundSide::Lower,
-        }
-    }
-}
 
 /// An estimate at a bound of its search range (JSON:
 /// `{"parameter": "kappa", "side": "lower", "bound": 7.0, "value": 7.0}`).

@@ -24,35 +24,12 @@ use super::estimator::Estimator;
 use super::layout::EffectSlot;
 use super::options::{FitWarning, WarningCode};
 use super::summary::{BoundSide, FitSummary};
+pub use super::thresholds::{
+    AT_BOUND_TOLERANCE, ILL_CONDITIONED_RCOND, JUMP_SE, LARGE_STDERR_KAPPA, LARGE_STDERR_N,
+    LARGE_STDERR_STRENGTH_FRACTION, MISFIT_RATIO, MISFIT_WITHOUT_NOISE, PLAUSIBLE_N,
+};
 use crate::fiber::format::fmt_g;
 use nalgebra::{DMatrix, SymmetricEigen};
-
-/// An estimate counts as at a bound when it is within this fraction of the width of its search
-/// range from the bound (e.g. `0.001` for `n ∈ [0, 1]`, `0.013` for `κ ∈ [7, 20]`).
-pub const AT_BOUND_TOLERANCE: f64 = 1e-3;
-/// The report warns when the RMS relative residual exceeds this multiple of the noise level.
-pub const MISFIT_RATIO: f64 = 3.0;
-/// Without any noise level (too few points to estimate it), the report warns when the RMS
-/// relative residual exceeds this \[-\].
-pub const MISFIT_WITHOUT_NOISE: f64 = 0.1;
-/// A standard error of `n` above this \[-\] is reported as huge.
-pub const LARGE_STDERR_N: f64 = 0.2;
-/// A standard error of `κ` above this \[-\] (a factor `e` in `K`) is reported as huge.
-pub const LARGE_STDERR_KAPPA: f64 = 1.0;
-/// A fitted strength whose standard error exceeds this fraction of its search range is
-/// reported as undetermined.
-pub const LARGE_STDERR_STRENGTH_FRACTION: f64 = 0.25;
-/// A correlation matrix whose smallest/largest eigenvalue ratio is below this is reported as
-/// ill-conditioned.
-pub const ILL_CONDITIONED_RCOND: f64 = 1e-10;
-
-/// The power index `n` \[-\] polymer melts show in elongation: below 0.2 a fitted `n` is
-/// compensating a model error, not describing a melt.
-pub const PLAUSIBLE_N: [f64; 2] = [0.2, 1.0];
-
-/// A law that moved by more than this many of the plain fit's standard errors is checked
-/// against the gain in fit it bought ([`law_jump`]).
-pub const JUMP_SE: f64 = 20.0;
 
 /// Which bound `value` is at (within [`AT_BOUND_TOLERANCE`] of the range width), if any.
 pub fn bound_side(value: f64, lower: f64, upper: f64) -> Option<BoundSide> {

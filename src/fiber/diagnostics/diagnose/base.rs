@@ -2,7 +2,7 @@
 
 use super::DiagnoseOptions;
 use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
-use crate::fiber::rheometer::identify::WarmFit;
+use crate::fiber::rheometer::identification::WarmFit;
 use crate::fiber::rheometer::summary_checks::check_misfit;
 use crate::fiber::rheometer::WarningCode;
 use crate::fiber::rheometer::{

@@ -20,43 +20,13 @@
 //! figures of `tests/diagnose_calibration.rs`).
 
 use super::linearise::Linearisation;
+pub use crate::fiber::diagnostics::calibration::Calibration;
 use crate::fiber::synthetic::SplitMix64;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 /// Replicates of the bootstrap (default of [`DiagnoseOptions`](super::DiagnoseOptions)).
 pub const DEFAULT_REPLICATES: usize = 2000;
-
-/// The null distribution of the best `ΔBIC` over all candidates and shapes on effect-free data
-/// like the user's.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
-pub struct Calibration {
-    /// Replicates drawn.
-    pub replicates: usize,
-    /// Columns searched (candidates × shapes).
-    pub columns: usize,
-    /// The best `ΔBIC` of each replicate, increasing.
-    #[serde(skip)]
-    pub best: Vec<f64>,
-    /// Its 5 % quantile: a `ΔBIC` below it is a false alarm in fewer than 5 % of effect-free
-    /// data sets like these.
-    pub quantile_5: f64,
-    /// Its median.
-    pub median: f64,
-}
-
-impl Calibration {
-    /// The fraction of replicates whose best `ΔBIC` is at or below `delta_bic` (`NaN` without
-    /// replicates).
-    pub fn false_alarm(&self, delta_bic: f64) -> f64 {
-        if self.best.is_empty() || !delta_bic.is_finite() {
-            return f64::NAN;
-        }
-        let below = self.best.partition_point(|&b| b <= delta_bic);
-        below as f64 / self.best.len() as f64
-    }
-}
 
 /// The orthonormal basis of the columns of the `n × q` row-major `x` (singular values above
 /// `1e-12` of the largest).
