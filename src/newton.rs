@@ -65,167 +65,234 @@ pub(crate) fn newton<P: Bvp>(
     initial: Option<&Factorization>,
     start: Start,
 ) -> Result<NewtonReport, BvpError> {
-    let (n, k, m) = (col.n, col.k, col.m());
-    let size = m * n + k;
+    let size = col.m() * col.n + col.k;
     // a factorisation from a nearby solution on this mesh (simplified Newton from its Jacobian)
     // is used until the contraction test asks for a fresh one
-    let mut borrowed = initial.filter(|f| f.size() == size);
-    work.step.resize(size, 0.0);
-    work.step_new.resize(size, 0.0);
-    work.y_new.resize(m * n, 0.0);
-    work.p_new.resize(p.len(), 0.0);
-
-    // the Jacobian of the start is only evaluated with it when it will be factored
-    let mut fresh_jacobian = start == Start::WithJacobian && borrowed.is_none();
-    if fresh_jacobian {
-        col.residual_and_jacobians(problem, y, p, k)?;
-    } else {
-        col.residual(problem, y, p)?;
-    }
-    // A start that already passes the termination test (a warm start at the parameters it was
-    // solved for, or values interpolated onto a refined mesh that already satisfy the
-    // collocation equations this well) needs no Newton step: no Jacobian, no factorisation. Not
-    // with a step criterion, which needs a step to measure.
-    if settings.step_tol.is_none()
-        && residuals_small(col, scale, settings.tol)
-        && bc_small(col, settings.bc_tol)
-    {
+    let mut it = Iteration {
+        borrowed: initial.filter(|f| f.size() == size),
+        // the Jacobian of the start is only evaluated with it when it will be factored
+        fresh_jacobian: false,
+        recompute: true,
+        cost: 0.0,
+        njev: 0,
+    };
+    it.fresh_jacobian = start == Start::WithJacobian && it.borrowed.is_none();
+    work.resize(size, col.m() * col.n, p.len());
+    if evaluate_start(problem, col, y, p, scale, settings, it.fresh_jacobian)? {
         return Ok(NewtonReport {
             iterations: 0,
             converged: true,
         });
     }
-    let mut recompute = true;
-    let mut cost = 0.0;
-    let mut njev = 0;
     let mut iterations = 0;
     let mut converged = false;
     while iterations < settings.max_iterations {
-        if let (true, Some(f)) = (recompute, borrowed) {
-            work.step.copy_from_slice(&col.res);
-            f.solve_with_scratch(&mut work.step, 1, false, &mut work.solve_scratch)?;
-            if work.step.iter().any(|v| !v.is_finite()) {
-                // not usable here: factor the Jacobian of this iterate instead
-                borrowed = None;
-            } else {
-                cost = dot(&work.step, &work.step);
-                recompute = false;
-            }
-        }
-        if recompute {
-            if !fresh_jacobian {
-                col.jacobians(problem, y, p, k)?;
-            }
-            fresh_jacobian = false;
-            lin.factor(col)?;
-            njev += 1;
-            work.step.copy_from_slice(&col.res);
-            lin.solve(&mut work.step);
-            check_step(&work.step, n, k, &col.x)?;
-            cost = dot(&work.step, &work.step);
-        }
+        newton_step(problem, col, lin, y, p, work, &mut it)?;
         iterations += 1;
-        let cost_prev = cost;
-        let mut alpha = 1.0;
-        let mut accepted_finite = false;
-        for trial in 0..=N_TRIAL {
-            for (i, v) in work.y_new.iter_mut().enumerate() {
-                *v = y[i] - alpha * work.step[i];
-            }
-            work.p_new.copy_from_slice(p);
-            for ((pn, pv), st) in work.p_new[..k]
-                .iter_mut()
-                .zip(&p[..k])
-                .zip(&work.step[m * n..])
-            {
-                *pn = pv - alpha * st;
-            }
-            match col.residual(problem, &work.y_new, &work.p_new) {
-                Ok(()) => {
-                    // A full step that lands on a point passing the termination test is taken
-                    // as it is: the merit value (one more solve) would only decide on damping.
-                    if trial == 0
-                        && terminates(
-                            col,
-                            &work.y_new,
-                            &work.p_new[..k],
-                            inf_norm(&work.step),
-                            scale,
-                            settings,
-                        )
-                    {
-                        accepted_finite = true;
-                        break;
-                    }
-                    work.step_new.copy_from_slice(&col.res);
-                    match borrowed {
-                        Some(f) => f.solve_with_scratch(
-                            &mut work.step_new,
-                            1,
-                            false,
-                            &mut work.solve_scratch,
-                        )?,
-                        None => lin.solve(&mut work.step_new),
-                    }
-                    let cost_new = dot(&work.step_new, &work.step_new);
-                    accepted_finite = cost_new.is_finite();
-                    if accepted_finite && cost_new < (1.0 - 2.0 * alpha * SIGMA) * cost {
-                        cost = cost_new;
-                        break;
-                    }
-                    if accepted_finite && trial == N_TRIAL {
-                        cost = cost_new;
-                    }
-                }
-                Err(BvpError::NonFinite { .. }) => accepted_finite = false,
-                Err(e) => return Err(e),
-            }
-            if trial < N_TRIAL {
-                alpha *= TAU;
-            }
-        }
-        if !accepted_finite {
+        let cost_prev = it.cost;
+        let Some(alpha) = damped_step(problem, col, lin, y, p, scale, settings, work, &mut it)?
+        else {
             // every trial point produced non-finite values: stay where we are
             col.residual(problem, y, p)?;
             return Ok(NewtonReport {
                 iterations,
                 converged: false,
             });
-        }
+        };
         let step_inf = alpha * inf_norm(&work.step);
         if settings.verbose >= 2 {
-            // a failed write to stderr must not panic
-            use std::io::Write as _;
-            let _ = writeln!(
-                std::io::stderr(),
-                "    newton {iterations:>3}: damping {alpha:<6} |step|_inf {step_inf:.3e} |J^-1 F|^2 {cost:.3e}"
-            );
+            log_iteration(iterations, alpha, step_inf, it.cost);
         }
         y.copy_from_slice(&work.y_new);
-        p[..k].copy_from_slice(&work.p_new[..k]);
+        p[..col.k].copy_from_slice(&work.p_new[..col.k]);
 
-        if terminates(col, y, &p[..k], step_inf, scale, settings) {
+        if terminates(col, y, &p[..col.k], step_inf, scale, settings) {
             converged = true;
             break;
         }
-        if njev >= settings.max_jacobians {
+        if it.njev >= settings.max_jacobians {
             break;
         }
         // Keep the factorisation (simplified Newton) only after a full step with good
         // contraction, ‖Δ̄_{k+1}‖ <= ‖Δ_k‖ / 4; a stale Jacobian otherwise costs more
         // iterations than a new factorisation.
-        if alpha == 1.0 && cost <= CONTRACTION_SQ * cost_prev {
+        if alpha == 1.0 && it.cost <= CONTRACTION_SQ * cost_prev {
             std::mem::swap(&mut work.step, &mut work.step_new);
-            recompute = false;
+            it.recompute = false;
         } else {
-            recompute = true;
-            borrowed = None;
+            it.recompute = true;
+            it.borrowed = None;
         }
     }
     Ok(NewtonReport {
         iterations,
         converged,
     })
+}
+
+/// The state of a Newton run between its steps.
+struct Iteration<'f> {
+    /// A factorisation from a nearby solution on this mesh, used until the contraction test
+    /// asks for a fresh one.
+    borrowed: Option<&'f Factorization>,
+    /// Whether `col` holds the Jacobian of the current iterate (evaluated with its residual).
+    fresh_jacobian: bool,
+    /// Whether the next step needs a new correction (else `work.step` holds it).
+    recompute: bool,
+    /// `‖J⁻¹ F‖²` at the current iterate.
+    cost: f64,
+    /// Jacobians factored so far.
+    njev: usize,
+}
+
+/// Evaluates the start (with its Jacobian if `with_jacobian`) and returns whether it already
+/// passes the termination test.
+///
+/// A start that passes (a warm start at the parameters it was solved for, or values
+/// interpolated onto a refined mesh that already satisfy the collocation equations this well)
+/// needs no Newton step: no Jacobian, no factorisation. Not with a step criterion, which needs
+/// a step to measure.
+fn evaluate_start<P: Bvp>(
+    problem: &P,
+    col: &mut Collocation,
+    y: &[f64],
+    p: &[f64],
+    scale: &[f64],
+    settings: &NewtonSettings,
+    with_jacobian: bool,
+) -> Result<bool, BvpError> {
+    if with_jacobian {
+        col.residual_and_jacobians(problem, y, p, col.k)?;
+    } else {
+        col.residual(problem, y, p)?;
+    }
+    Ok(settings.step_tol.is_none()
+        && residuals_small(col, scale, settings.tol)
+        && bc_small(col, settings.bc_tol))
+}
+
+/// The Newton correction `J⁻¹ F` at the current iterate into `work.step`, and its cost: with
+/// the borrowed factorisation while it gives a finite correction, else from a new Jacobian
+/// (factored here). Nothing to do when the last step's correction is kept.
+fn newton_step<'f, P: Bvp>(
+    problem: &P,
+    col: &mut Collocation,
+    lin: &mut LinearSystem,
+    y: &[f64],
+    p: &[f64],
+    work: &mut NewtonWork,
+    it: &mut Iteration<'f>,
+) -> Result<(), BvpError> {
+    if let (true, Some(f)) = (it.recompute, it.borrowed) {
+        work.step.copy_from_slice(&col.res);
+        f.solve_with_scratch(&mut work.step, 1, false, &mut work.solve_scratch)?;
+        if work.step.iter().any(|v| !v.is_finite()) {
+            // not usable here: factor the Jacobian of this iterate instead
+            it.borrowed = None;
+        } else {
+            it.cost = dot(&work.step, &work.step);
+            it.recompute = false;
+        }
+    }
+    if it.recompute {
+        if !it.fresh_jacobian {
+            col.jacobians(problem, y, p, col.k)?;
+        }
+        it.fresh_jacobian = false;
+        lin.factor(col)?;
+        it.njev += 1;
+        work.step.copy_from_slice(&col.res);
+        lin.solve(&mut work.step);
+        check_step(&work.step, col.n, col.k, &col.x)?;
+        it.cost = dot(&work.step, &work.step);
+    }
+    Ok(())
+}
+
+/// The damped step along `work.step`: trial points `work.y_new`, `work.p_new` at `α = 1, τ,
+/// τ², …` (at most [`N_TRIAL`] halvings) until the merit `‖J⁻¹ F(Y_trial)‖²` falls below
+/// `(1 - 2 α σ)` of the current one (a full step that passes the termination test is taken as
+/// it is). Returns `α` with `col` holding the residuals at the trial point and `it.cost` its
+/// merit (that of the last trial when none decreased enough), or `None` when every trial
+/// point was non-finite.
+#[allow(clippy::too_many_arguments)]
+fn damped_step<P: Bvp>(
+    problem: &P,
+    col: &mut Collocation,
+    lin: &mut LinearSystem,
+    y: &[f64],
+    p: &[f64],
+    scale: &[f64],
+    settings: &NewtonSettings,
+    work: &mut NewtonWork,
+    it: &mut Iteration<'_>,
+) -> Result<Option<f64>, BvpError> {
+    let (k, mn) = (col.k, col.m() * col.n);
+    let mut alpha = 1.0;
+    let mut accepted_finite = false;
+    for trial in 0..=N_TRIAL {
+        work.set_trial(y, p, k, mn, alpha);
+        match col.residual(problem, &work.y_new, &work.p_new) {
+            Ok(()) => {
+                // A full step that lands on a point passing the termination test is taken
+                // as it is: the merit value (one more solve) would only decide on damping.
+                if trial == 0
+                    && terminates(
+                        col,
+                        &work.y_new,
+                        &work.p_new[..k],
+                        inf_norm(&work.step),
+                        scale,
+                        settings,
+                    )
+                {
+                    accepted_finite = true;
+                    break;
+                }
+                let cost_new = merit(col, lin, work, it.borrowed)?;
+                accepted_finite = cost_new.is_finite();
+                if accepted_finite && cost_new < (1.0 - 2.0 * alpha * SIGMA) * it.cost {
+                    it.cost = cost_new;
+                    break;
+                }
+                if accepted_finite && trial == N_TRIAL {
+                    it.cost = cost_new;
+                }
+            }
+            Err(BvpError::NonFinite { .. }) => accepted_finite = false,
+            Err(e) => return Err(e),
+        }
+        if trial < N_TRIAL {
+            alpha *= TAU;
+        }
+    }
+    Ok(accepted_finite.then_some(alpha))
+}
+
+/// The merit `‖J⁻¹ F‖²` of the residuals in `col` with the current factorisation (the
+/// borrowed one, else `lin`'s); the correction is left in `work.step_new`.
+fn merit(
+    col: &Collocation,
+    lin: &mut LinearSystem,
+    work: &mut NewtonWork,
+    borrowed: Option<&Factorization>,
+) -> Result<f64, BvpError> {
+    work.step_new.copy_from_slice(&col.res);
+    match borrowed {
+        Some(f) => f.solve_with_scratch(&mut work.step_new, 1, false, &mut work.solve_scratch)?,
+        None => lin.solve(&mut work.step_new),
+    }
+    Ok(dot(&work.step_new, &work.step_new))
+}
+
+/// One line per Newton iteration on stderr (verbose level 2).
+fn log_iteration(iterations: usize, alpha: f64, step_inf: f64, cost: f64) {
+    // a failed write to stderr must not panic
+    use std::io::Write as _;
+    let _ = writeln!(
+        std::io::stderr(),
+        "    newton {iterations:>3}: damping {alpha:<6} |step|_inf {step_inf:.3e} |J^-1 F|^2 {cost:.3e}"
+    );
 }
 
 /// The termination test at the iterate `y`, unknowns `pk`, reached by a correction of infinity
@@ -256,6 +323,33 @@ pub(crate) struct NewtonWork {
     p_new: Vec<f64>,
     /// Scratch of solves with a borrowed factorisation (grown once).
     solve_scratch: Vec<f64>,
+}
+
+impl NewtonWork {
+    /// Sizes the buffers for `size` unknowns, `mn` node values and `np` parameters (no
+    /// allocation once they are large enough).
+    fn resize(&mut self, size: usize, mn: usize, np: usize) {
+        self.step.resize(size, 0.0);
+        self.step_new.resize(size, 0.0);
+        self.y_new.resize(mn, 0.0);
+        self.p_new.resize(np, 0.0);
+    }
+
+    /// The trial point `y − α Δy`, `p[..k] − α Δp` (the rest of `p` as it is) into `y_new`,
+    /// `p_new`, with `Δ` = `step` (node values in its first `mn` entries).
+    fn set_trial(&mut self, y: &[f64], p: &[f64], k: usize, mn: usize, alpha: f64) {
+        for (i, v) in self.y_new.iter_mut().enumerate() {
+            *v = y[i] - alpha * self.step[i];
+        }
+        self.p_new.copy_from_slice(p);
+        for ((pn, pv), st) in self.p_new[..k]
+            .iter_mut()
+            .zip(&p[..k])
+            .zip(&self.step[mn..])
+        {
+            *pn = pv - alpha * st;
+        }
+    }
 }
 
 /// scipy's termination test: `|r_i| < (2/3) h_i · 0.05 tol · (s_c + |f_mid|)`, i.e. the midpoint

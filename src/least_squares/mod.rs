@@ -58,6 +58,7 @@ mod block_covariance;
 pub mod blocks;
 mod bvp;
 mod contract;
+mod driver;
 mod jacobian;
 pub mod loss;
 mod schur;
@@ -65,16 +66,14 @@ mod schur;
 pub use block_covariance::BlockCovariance;
 pub use blocks::{BlockJacobian, BlockStructure};
 pub use bvp::{BvpResiduals, BvpRun, ParamLink, ParamMap, RunError};
+pub use driver::{fit, fit_observed};
 pub use jacobian::Jacobian;
 pub use loss::Loss;
-
-use jacobian::Linearized;
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::Instant;
 
 /// A least-squares problem with exact Jacobians.
 pub trait LeastSquaresProblem {
@@ -508,24 +507,6 @@ fn cost_of(r: &[f64]) -> f64 {
     0.5 * r.iter().map(|v| v * v).sum::<f64>()
 }
 
-/// Coleman–Li scaling vector: distance to the bound the negative gradient points at.
-fn cl_scaling(p: &[f64], g: &[f64], lo: &[f64], hi: &[f64]) -> Vec<f64> {
-    p.iter()
-        .zip(g)
-        .zip(lo.iter().zip(hi))
-        .map(|((&x, &gi), (&l, &u))| {
-            let v = if gi < 0.0 && u.is_finite() {
-                u - x
-            } else if gi > 0.0 && l.is_finite() {
-                x - l
-            } else {
-                1.0
-            };
-            v.abs().clamp(1e-12, 1.0)
-        })
-        .collect()
-}
-
 /// Solves `min ‖J s + r‖²` s.t. `‖D s‖ ≤ Δ` and returns the step `s`.
 fn trust_region_step(j: &DMatrix<f64>, r: &DVector<f64>, d: &[f64], radius: f64) -> DVector<f64> {
     let np = j.ncols();
@@ -572,294 +553,4 @@ fn trust_region_step(j: &DMatrix<f64>, r: &DVector<f64>, d: &[f64], radius: f64)
         u = step_for(hi);
     }
     DVector::from_iterator(np, (0..np).map(|i| u[i] / d[i]))
-}
-
-/// Runs the bounded trust-region Gauss–Newton iteration from `p0`.
-///
-/// Errors before any evaluation: lengths of `p0` and the bounds other than `num_params()`, a
-/// start outside the bounds, invalid options (non-finite or negative tolerances and radii,
-/// `xtol` or `ftol` of 1 or more, `max_iterations = 0`). Errors at the start point: a failed
-/// evaluation ([`FitError::StartFailed`]), a mis-sized or non-finite result
-/// ([`FitError::InvalidInput`], see [`LeastSquaresProblem::evaluate`]), fewer residuals than
-/// parameters. A mis-sized result at a later point also ends the fit with
-/// [`FitError::InvalidInput`]; nothing panics.
-pub fn fit<L: LeastSquaresProblem>(
-    problem: &mut L,
-    p0: &[f64],
-    options: &FitOptions,
-) -> Result<FitResult, FitError> {
-    fit_observed(problem, p0, options, &mut |_: &FitIteration| {})
-}
-
-/// [`fit`], calling `observer` once per iteration with its [`FitIteration`] record (the same
-/// record [`FitResult::history`] keeps).
-pub fn fit_observed<L: LeastSquaresProblem, O: Observer + ?Sized>(
-    problem: &mut L,
-    p0: &[f64],
-    options: &FitOptions,
-    observer: &mut O,
-) -> Result<FitResult, FitError> {
-    let t0 = Instant::now();
-    let np = problem.num_params();
-    let schedule = contract::check_options(np, p0, options)?;
-    let (lo, hi) = (&options.lower, &options.upper);
-    let mut p = p0.to_vec();
-    // the start point at the loosest accuracy the problem offers (no residuals yet to scale
-    // the allowed error by), at full accuracy if that fails or without a schedule
-    if options.cancelled() {
-        return Err(FitError::Cancelled { iterations: 0 });
-    }
-    let loose_start = schedule.is_some() && problem.set_accuracy(Some(f64::INFINITY));
-    if !loose_start {
-        problem.set_accuracy(None);
-    }
-    let start = match problem.evaluate_jacobian(&p) {
-        Err(_) if loose_start => {
-            problem.set_accuracy(None);
-            problem.evaluate_jacobian(&p)
-        }
-        other => other,
-    };
-    let (mut r, mut jac) = start.map_err(|e| FitError::StartFailed {
-        p: p.clone(),
-        cause: e.to_string(),
-    })?;
-    contract::check_start(&r, &jac, np, &p)?;
-    problem.accept(&p);
-    let nr = r.len();
-    if !jac.has_shape(nr, np) {
-        return Err(FitError::InvalidInput(format!(
-            "the problem returned {nr} residuals and a Jacobian that is not {nr} x {np}"
-        )));
-    }
-    if nr < np {
-        return Err(FitError::InvalidInput(format!(
-            "{nr} residuals for {np} parameters: the fit is underdetermined"
-        )));
-    }
-    let (loss, f_scale) = (options.loss, options.f_scale);
-    // the Gauss–Newton view (rescaled under a robust loss; `None`: `r`, `jac` themselves)
-    let mut scaled = jac.rescaled(loss, f_scale, &r, np);
-    let mut cost = loss::robust_cost(loss, f_scale, &r);
-    let mut radius = options.initial_radius.min(options.max_radius);
-    let mut history = Vec::new();
-    let mut record = |it: FitIteration| {
-        observer.observe(&it);
-        history.push(it);
-    };
-    let (mut iterations, mut accepted_steps, mut failed) = (0, 0, 0);
-    // Accuracy::Scheduled: whether the evaluations are loose, the iteration limit of the
-    // full-accuracy phase, the loose trial steps and the model error measured at the switch
-    let mut loose = schedule.is_some();
-    let mut tight_limit: Option<usize> = None;
-    let (mut loose_iterations, mut switch_model_error) = (0, None);
-    // a stopping test met: ends the fit, or (loose) switches to full accuracy
-    let mut stop: Option<Termination> = None;
-    let termination;
-    loop {
-        if options.cancelled() {
-            return Err(FitError::Cancelled { iterations });
-        }
-        if let Some(t) = stop.take() {
-            if !loose {
-                termination = t;
-                break;
-            }
-            // re-evaluate the iterate at full accuracy and go on from there
-            loose = false;
-            problem.set_accuracy(None);
-            let (r_t, j_t) = contract::check_trial(problem.evaluate_jacobian(&p), np, nr, &p)?
-                .map_err(|cause| FitError::RefineFailed {
-                    p: p.clone(),
-                    cause,
-                })?;
-            problem.accept(&p);
-            let d2: f64 = r_t.iter().zip(&r).map(|(a, b)| (a - b) * (a - b)).sum();
-            switch_model_error = Some((d2 / nr as f64).sqrt());
-            scaled = j_t.rescaled(loss, f_scale, &r_t, np);
-            cost = loss::robust_cost(loss, f_scale, &r_t);
-            r = r_t;
-            jac = j_t;
-            radius = radius.max(options.initial_radius.min(options.max_radius));
-            tight_limit = Some(
-                options
-                    .max_iterations
-                    .max(iterations + schedule.map_or(0, |s| s.final_iterations)),
-            );
-        }
-        let (r_gn, jac_gn) = match &scaled {
-            Some((rs, js)) => (rs.as_slice(), js),
-            None => (r.as_slice(), &jac),
-        };
-        let lin = Linearized::new(jac_gn, r_gn, nr, np);
-        let g = lin.gradient();
-        let v = cl_scaling(&p, g.as_slice(), lo, hi);
-        let scaled_g = (0..np).map(|i| (g[i] * v[i]).abs()).fold(0.0, f64::max);
-        if scaled_g <= options.gtol {
-            stop = Some(Termination::Gradient);
-            continue;
-        }
-        if iterations >= tight_limit.unwrap_or(options.max_iterations) {
-            stop = Some(Termination::MaxIterations);
-            continue;
-        }
-        if radius < 1e-12 {
-            stop = Some(Termination::RadiusCollapsed);
-            continue;
-        }
-        let d: Vec<f64> = v.iter().map(|x| 1.0 / x.sqrt()).collect();
-        let s = lin.step(&d, radius);
-        // keep strictly inside the box
-        let mut t_max = 1.0f64;
-        for i in 0..np {
-            if s[i] > 0.0 && hi[i].is_finite() {
-                t_max = t_max.min((hi[i] - p[i]) / s[i]);
-            } else if s[i] < 0.0 && lo[i].is_finite() {
-                t_max = t_max.min((lo[i] - p[i]) / s[i]);
-            }
-        }
-        let theta = 0.995;
-        let mut trial: Vec<f64> = if t_max < 1.0 {
-            (0..np).map(|i| p[i] + theta * t_max * s[i]).collect()
-        } else {
-            (0..np).map(|i| p[i] + s[i]).collect()
-        };
-        for i in 0..np {
-            trial[i] = trial[i].clamp(lo[i], hi[i]);
-        }
-        let step: Vec<f64> = (0..np).map(|i| trial[i] - p[i]).collect();
-        let step_vec = DVector::from_column_slice(&step);
-        let pred_trial = lin.predicted_reduction(&step_vec);
-        // Accuracy::Scheduled: the step's length in standard errors, ‖J s‖/σ̂, with σ̂ the RMS
-        // residual (at most the soft margin under a robust loss)
-        let (sigma, effect) = match schedule {
-            Some(_) => {
-                let dof = nr.saturating_sub(np).max(1) as f64;
-                let mut sigma = (r.iter().map(|x| x * x).sum::<f64>() / dof).sqrt();
-                if !loss.is_linear() {
-                    sigma = sigma.min(f_scale);
-                }
-                let effect = jac.effect(&step_vec, nr, np);
-                (sigma, effect)
-            }
-            None => (f64::NAN, f64::NAN),
-        };
-        let allowed_error = match schedule {
-            Some(sch) if loose => {
-                if effect <= sch.switch_below * sigma {
-                    // the step moves the estimate by less than `switch_below` standard errors
-                    stop = Some(Termination::Step);
-                    continue;
-                }
-                let e = sch.fraction * sigma.max(effect / (nr as f64).sqrt());
-                if problem.set_accuracy(Some(e)) {
-                    Some(e)
-                } else {
-                    // the problem has no loose evaluations: a fixed-accuracy fit
-                    loose = false;
-                    None
-                }
-            }
-            _ => None,
-        };
-        if allowed_error.is_some() {
-            loose_iterations += 1;
-        }
-        iterations += 1;
-        let pnorm = p.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let snorm = step_vec.norm();
-        match contract::check_trial(problem.evaluate_jacobian(&trial), np, nr, &trial)? {
-            Ok((r_new, j_new)) => {
-                let cost_new = loss::robust_cost(loss, f_scale, &r_new);
-                let actual = cost - cost_new;
-                let rho = if pred_trial > 0.0 {
-                    actual / pred_trial
-                } else {
-                    -1.0
-                };
-                let accepted = rho > 1e-4;
-                if rho < 0.25 {
-                    radius *= 0.25;
-                } else if rho > 0.75
-                    && snorm * d.iter().fold(0.0f64, |m, x| m.max(*x)) >= 0.9 * radius
-                {
-                    radius = (2.0 * radius).min(options.max_radius);
-                }
-                record(FitIteration {
-                    iteration: iterations,
-                    p: trial.clone(),
-                    cost: Some(cost_new),
-                    previous_cost: cost,
-                    gain_ratio: Some(rho),
-                    step_norm: snorm,
-                    scaled_gradient: scaled_g,
-                    accepted,
-                    radius,
-                    failure: None,
-                    allowed_error,
-                    elapsed_s: t0.elapsed().as_secs_f64(),
-                });
-                if accepted {
-                    problem.accept(&trial);
-                    accepted_steps += 1;
-                    let rel_change = actual.abs() / cost.max(1e-300);
-                    p = trial;
-                    scaled = j_new.rescaled(loss, f_scale, &r_new, np);
-                    r = r_new;
-                    jac = j_new;
-                    cost = cost_new;
-                    if rel_change < options.ftol {
-                        stop = Some(Termination::CostChange);
-                    } else if snorm <= options.xtol * (options.xtol + pnorm) {
-                        stop = Some(Termination::Step);
-                    }
-                } else if snorm <= options.xtol * (options.xtol + pnorm) {
-                    stop = Some(Termination::Step);
-                } else if let (Some(sch), Some(_)) = (schedule, tight_limit) {
-                    if effect <= sch.negligible_step * sigma {
-                        stop = Some(Termination::Step);
-                    }
-                }
-            }
-            Err(failure) => {
-                failed += 1;
-                radius *= 0.25;
-                record(FitIteration {
-                    iteration: iterations,
-                    p: trial,
-                    cost: None,
-                    previous_cost: cost,
-                    gain_ratio: None,
-                    step_norm: snorm,
-                    scaled_gradient: scaled_g,
-                    accepted: false,
-                    radius,
-                    failure: Some(failure),
-                    allowed_error,
-                    elapsed_s: t0.elapsed().as_secs_f64(),
-                });
-            }
-        }
-    }
-    let (jacobian, block_jacobian) = match jac {
-        Jacobian::Dense(j) => (j, None),
-        Jacobian::Blocks(b) => (Vec::new(), Some(b)),
-    };
-    Ok(FitResult {
-        p,
-        cost,
-        residuals: r,
-        jacobian,
-        block_jacobian,
-        iterations,
-        accepted_steps,
-        failed_evaluations: failed,
-        termination,
-        wall_time_s: t0.elapsed().as_secs_f64(),
-        history,
-        loss,
-        f_scale,
-        loose_iterations,
-        switch_model_error,
-    })
 }

@@ -30,13 +30,17 @@ use super::identify::Identification;
 use super::layout::FitStart;
 use super::options::{IdentifyOptions, RheometerError};
 use super::parameter_shift::ParameterShift;
-use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
+use crate::fiber::effects::{Effect, ModelSpec};
 use crate::fiber::uncertainty::{GaugeColumn, Origin, Scope, Source, Uncertainties, SOURCES};
 use crate::least_squares::LeastSquaresProblem;
 use nalgebra::DVector;
 use std::time::Instant;
 
 pub use super::budget::{BudgetEntry, ErrorBudget, ExperimentSensitivity, SourceStatus};
+
+mod plan;
+
+use plan::{source_columns, Column, SourcePlan};
 
 /// The error-budget sources for a model `spec`: the built-in [`SOURCES`], then the budget
 /// sources of the user-written effects in the model (fitted, fixed or candidates; their
@@ -58,13 +62,6 @@ pub fn budget_sources(spec: &ModelSpec) -> Vec<Source> {
     out
 }
 
-/// How a source's column is obtained.
-enum Column {
-    /// Column `usize` of the augmented objective's Jacobian.
-    Effect(usize),
-    Gauge(GaugeColumn),
-    None(SourceStatus),
-}
 /// The error budget of the fit `id` of `rh` for the declared uncertainties `unc` (defaults for
 /// the rest); `options` are the fit's options (BVP settings, σ).
 pub fn error_budget(
@@ -74,113 +71,130 @@ pub fn error_budget(
     options: &IdentifyOptions,
 ) -> Result<ErrorBudget, RheometerError> {
     let t0 = Instant::now();
-    let m = rh.len();
-    // which sources need which effect
-    let mut spec = rh.spec.clone();
-    let mut free: Vec<String> = Vec::new();
-    let mut strengths: Vec<(String, f64)> = id
-        .effects
-        .iter()
-        .filter(|s| s.column.is_some())
-        .map(|s| {
-            (
-                s.effect.name().to_string(),
-                s.effect.strength_of(id.local_params[s.local]),
-            )
-        })
-        .collect();
     let sources = budget_sources(&rh.spec);
-    let mut plan: Vec<Result<String, SourceStatus>> = Vec::new();
-    for s in &sources {
-        let applies = rh.experiments.iter().any(|e| (s.per_unit)(e).is_some());
-        let status = if !applies {
-            Err(SourceStatus::NotApplicable)
-        } else if let Some(set) = spec
-            .effects
-            .iter_mut()
-            .find(|x| x.effect.name() == s.effect)
-        {
-            match set.value {
-                None if !free.iter().any(|f| f == s.effect) => Err(SourceStatus::Fitted),
-                None => Ok(s.effect.to_string()),
-                Some(v) => {
-                    // a fixed effect: its column at the fixed strength
-                    *set = EffectSetting::fitted(set.effect.clone());
-                    strengths.push((s.effect.to_string(), v));
-                    free.push(s.effect.to_string());
-                    Ok(s.effect.to_string())
-                }
-            }
-        } else if spec.candidates.iter().any(|c| c.name() == s.effect) {
-            if !free.iter().any(|f| f == s.effect) {
-                free.push(s.effect.to_string());
-            }
-            Ok(s.effect.to_string())
-        } else {
-            match s.effect.parse::<Effect>() {
-                Ok(e) => {
-                    spec = spec.with_candidates(&[e]);
-                    free.push(s.effect.to_string());
-                    Ok(s.effect.to_string())
-                }
-                Err(_) => Err(SourceStatus::NotAvailable),
-            }
-        };
-        plan.push(status);
+    let plan = SourcePlan::new(rh, id, &sources);
+    let dense = id.fit.dense_jacobian();
+    let (r, q) = (&id.fit.residuals, id.fit.p.len());
+    let offsets = row_offsets(rh, id, options, dense.len(), q)?;
+    // the effects' columns from the augmented model at the fitted point
+    let mut aug: Option<(Vec<f64>, usize, Vec<String>)> = None;
+    if !plan.free.is_empty() {
+        aug = Some(effect_columns(
+            rh,
+            id,
+            plan.spec,
+            plan.free,
+            plan.strengths,
+            options,
+        )?);
     }
     let principled = id.summary.estimator == Estimator::Principled;
-    let dense = id.fit.dense_jacobian();
-    let (r, x, q) = (&id.fit.residuals, &dense, id.fit.p.len());
-    let n_res = r.len();
-    // rows of each experiment
+    let columns = source_columns(&sources, &plan.status, &aug, principled);
+    let col_of = |name: &str| id.names.iter().position(|n| n == name);
+    let propagation = Propagation {
+        rh,
+        unc,
+        aug: &aug,
+        r,
+        sigma_r: id.summary.noise.declared_level().unwrap_or(1.0),
+        prop: ParameterShift::new(&dense, r.len(), q)?,
+        offsets,
+        ni: col_of("n"),
+        ki: col_of("kappa"),
+    };
+    let entries: Vec<BudgetEntry> = sources
+        .iter()
+        .zip(&columns)
+        .map(|(s, col)| propagation.entry(s, col))
+        .collect();
+    let se = id.fit.standard_errors();
+    let stat = |c: Option<usize>| c.and_then(|c| se.as_ref().map(|s| s[c]));
+    let (stat_n, stat_k) = (stat(propagation.ni), stat(propagation.ki));
+    let rss = |f: fn(&BudgetEntry) -> Option<f64>, fitted: bool| {
+        fitted.then(|| {
+            entries
+                .iter()
+                .filter_map(f)
+                .map(|v| v * v)
+                .sum::<f64>()
+                .sqrt()
+        })
+    };
+    let systematic_n = rss(|e| e.shift_n, propagation.ni.is_some());
+    let systematic_kappa = rss(|e| e.shift_kappa, propagation.ki.is_some());
+    let both = |a: Option<f64>, b: Option<f64>| match (a, b) {
+        (Some(a), Some(b)) => Some(a.hypot(b)),
+        _ => None,
+    };
+    Ok(ErrorBudget {
+        declared: unc.any_declared(),
+        sources: entries,
+        systematic_n,
+        systematic_kappa,
+        systematic_k_rel: systematic_kappa,
+        statistical_n: stat_n,
+        statistical_kappa: stat_k,
+        statistical_k_rel: stat_k,
+        total_n: both(stat_n, systematic_n),
+        total_kappa: both(stat_k, systematic_kappa),
+        wall_time_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// The first row of each experiment's residuals (and the total at the end), checked against
+/// the fit's `n_jac` Jacobian entries for `q` parameters.
+fn row_offsets(
+    rh: &Rheometer,
+    id: &Identification,
+    options: &IdentifyOptions,
+    n_jac: usize,
+    q: usize,
+) -> Result<Vec<usize>, RheometerError> {
+    let m = rh.len();
+    let n_res = id.fit.residuals.len();
     let counts: Vec<usize> = (0..m)
         .map(|k| match id.summary.estimator {
             Estimator::Principled => rh.measurements[k].positions.len(),
             Estimator::Paper => options.n_opt_points,
         })
         .collect();
-    if counts.iter().sum::<usize>() != n_res || x.len() != n_res * q {
+    if counts.iter().sum::<usize>() != n_res || n_jac != n_res * q {
         return Err(RheometerError::Data(format!(
             "error budget: the fit has {n_res} residuals and {q} parameters, the data {} rows",
             counts.iter().sum::<usize>()
         )));
     }
-    // the effects' columns from the augmented model at the fitted point
-    let mut aug: Option<(Vec<f64>, usize, Vec<String>)> = None;
-    if !free.is_empty() {
-        aug = Some(effect_columns(rh, id, spec, free, strengths, options)?);
-    }
-    let sigma_r = id.summary.noise.declared_level().unwrap_or(1.0);
-    let columns: Vec<Column> = sources
-        .iter()
-        .zip(&plan)
-        .map(|(s, p)| match (p, &aug) {
-            (Ok(name), Some((_, _, names))) => names
-                .iter()
-                .position(|n| n == name)
-                .map_or(Column::None(SourceStatus::NotAvailable), Column::Effect),
-            (Err(SourceStatus::NotAvailable), _) => match s.fallback {
-                Some(g) if principled => Column::Gauge(g),
-                _ => Column::None(SourceStatus::NotAvailable),
-            },
-            (Err(st), _) => Column::None(*st),
-            (Ok(_), None) => Column::None(SourceStatus::NotAvailable),
-        })
-        .collect();
-
-    let prop = ParameterShift::new(x, n_res, q)?;
-    let col_of = |name: &str| id.names.iter().position(|n| n == name);
-    let (ni, ki) = (col_of("n"), col_of("kappa"));
-    let se = id.fit.standard_errors();
-    let stat = |c: Option<usize>| c.and_then(|c| se.as_ref().map(|s| s[c]));
-    let (stat_n, stat_k) = (stat(ni), stat(ki));
-
     let mut offsets = vec![0usize; m + 1];
     for k in 0..m {
         offsets[k + 1] = offsets[k] + counts[k];
     }
-    let mut entries = Vec::new();
-    for (s, col) in sources.iter().zip(&columns) {
+    Ok(offsets)
+}
+
+/// What propagating a source's column into the estimate needs.
+struct Propagation<'a> {
+    rh: &'a Rheometer,
+    unc: &'a Uncertainties,
+    /// The augmented Jacobian (row-major, its width and column names).
+    aug: &'a Option<(Vec<f64>, usize, Vec<String>)>,
+    /// The fit's residuals.
+    r: &'a [f64],
+    /// The declared relative noise level (1 without one).
+    sigma_r: f64,
+    /// `−(JᵀJ)⁻¹ Jᵀ` of the fit.
+    prop: ParameterShift,
+    /// The first row of each experiment.
+    offsets: Vec<usize>,
+    /// The columns of `n` and `κ` in the fit's parameters.
+    ni: Option<usize>,
+    ki: Option<usize>,
+}
+
+impl Propagation<'_> {
+    /// The budget entry of source `s` (its column `col`): its sensitivities per experiment
+    /// and the shifts of `n` and `κ` at one standard uncertainty.
+    fn entry(&self, s: &Source, col: &Column) -> BudgetEntry {
+        let (rh, unc, m) = (self.rh, self.unc, self.rh.len());
         let (sigma, origin) = unc
             .sigma(s.key, usize::MAX)
             .unwrap_or((s.default, Origin::Default));
@@ -211,23 +225,58 @@ pub fn error_budget(
             Column::Gauge(_) => SourceStatus::MeasurementModel,
         };
         if !entry.status.has_numbers() {
-            entries.push(entry);
-            continue;
+            return entry;
         }
+        let per = self.sensitivities(s, col, &mut entry.by_experiment);
+        let total = |f: &dyn Fn(&(f64, f64, f64)) -> f64| per.iter().map(f).sum::<f64>();
+        let shift = |f: &dyn Fn(&(f64, f64, f64)) -> f64| match s.scope {
+            Scope::Common => total(&|p| p.0 * f(p)).abs(),
+            Scope::PerExperiment => total(&|p| (p.0 * f(p)).powi(2)).sqrt(),
+        };
+        if self.ni.is_some() {
+            entry.dn_dq = Some(total(&|p| p.1));
+            entry.shift_n = Some(shift(&|p| p.1));
+        }
+        if self.ki.is_some() {
+            entry.dkappa_dq = Some(total(&|p| p.2));
+            entry.shift_kappa = Some(shift(&|p| p.2));
+        }
+        entry
+    }
+
+    /// The sensitivities of `n` and `κ` to source `s` (column `col`) in each experiment it
+    /// applies to, pushed to `by_experiment`; returns them as `(σ_k, dn, dκ)`.
+    fn sensitivities(
+        &self,
+        s: &Source,
+        col: &Column,
+        by_experiment: &mut Vec<ExperimentSensitivity>,
+    ) -> Vec<(f64, f64, f64)> {
+        let (rh, offsets, n_res) = (self.rh, &self.offsets, self.r.len());
         let mut per: Vec<(f64, f64, f64)> = Vec::new(); // (σ_k, dn, dκ)
-        for k in 0..m {
+        for k in 0..rh.len() {
             let e = &rh.experiments[k];
             let Some(factor) = (s.per_unit)(e) else {
                 continue;
             };
             let mut c = DVector::zeros(n_res);
             for i in offsets[k]..offsets[k + 1] {
-                c[i] = factor * column_value(col, &aug, i, r, rh, k, i - offsets[k], sigma_r);
+                c[i] = factor
+                    * column_value(
+                        col,
+                        self.aug,
+                        i,
+                        self.r,
+                        rh,
+                        k,
+                        i - offsets[k],
+                        self.sigma_r,
+                    );
             }
-            let d = prop.derivative(&c);
-            let sk = unc.sigma(s.key, k).map_or(s.default, |v| v.0);
-            let (dn, dk) = (ni.map(|i| d[i]), ki.map(|i| d[i]));
-            entry.by_experiment.push(ExperimentSensitivity {
+            let d = self.prop.derivative(&c);
+            let sk = self.unc.sigma(s.key, k).map_or(s.default, |v| v.0);
+            let (dn, dk) = (self.ni.map(|i| d[i]), self.ki.map(|i| d[i]));
+            by_experiment.push(ExperimentSensitivity {
                 experiment: e.name.clone(),
                 sigma: sk,
                 dn_dq: dn,
@@ -235,50 +284,8 @@ pub fn error_budget(
             });
             per.push((sk, dn.unwrap_or(f64::NAN), dk.unwrap_or(f64::NAN)));
         }
-        let total = |f: &dyn Fn(&(f64, f64, f64)) -> f64| per.iter().map(f).sum::<f64>();
-        let shift = |f: &dyn Fn(&(f64, f64, f64)) -> f64| match s.scope {
-            Scope::Common => total(&|p| p.0 * f(p)).abs(),
-            Scope::PerExperiment => total(&|p| (p.0 * f(p)).powi(2)).sqrt(),
-        };
-        if ni.is_some() {
-            entry.dn_dq = Some(total(&|p| p.1));
-            entry.shift_n = Some(shift(&|p| p.1));
-        }
-        if ki.is_some() {
-            entry.dkappa_dq = Some(total(&|p| p.2));
-            entry.shift_kappa = Some(shift(&|p| p.2));
-        }
-        entries.push(entry);
+        per
     }
-    let rss = |f: fn(&BudgetEntry) -> Option<f64>, fitted: bool| {
-        fitted.then(|| {
-            entries
-                .iter()
-                .filter_map(f)
-                .map(|v| v * v)
-                .sum::<f64>()
-                .sqrt()
-        })
-    };
-    let systematic_n = rss(|e| e.shift_n, ni.is_some());
-    let systematic_kappa = rss(|e| e.shift_kappa, ki.is_some());
-    let both = |a: Option<f64>, b: Option<f64>| match (a, b) {
-        (Some(a), Some(b)) => Some(a.hypot(b)),
-        _ => None,
-    };
-    Ok(ErrorBudget {
-        declared: unc.any_declared(),
-        sources: entries,
-        systematic_n,
-        systematic_kappa,
-        systematic_k_rel: systematic_kappa,
-        statistical_n: stat_n,
-        statistical_kappa: stat_k,
-        statistical_k_rel: stat_k,
-        total_n: both(stat_n, systematic_n),
-        total_kappa: both(stat_k, systematic_kappa),
-        wall_time_s: t0.elapsed().as_secs_f64(),
-    })
 }
 
 /// Row `i` (row `j` of experiment `k`) of a source's column, before its per-unit factor.

@@ -110,31 +110,7 @@ impl Layout {
         options: &IdentifyOptions,
     ) -> Result<Self, RheometerError> {
         spec.validate().map_err(RheometerError::Data)?;
-        let idx = |name: &str| {
-            model
-                .param_index(name)
-                .ok_or_else(|| RheometerError::Data(format!("the model has no parameter {name}")))
-        };
-        let mut template = model.parameters(1.0, &start.law).map_err(|e| {
-            RheometerError::Data(format!("start (n, kappa) = {:?}: {e}", start.law))
-        })?;
-        let params = model.param_layout();
-        let (ni, ki) = (
-            params.law_param(CarreauLike::N),
-            params.law_param(CarreauLike::KAPPA),
-        );
-        let (mut n_free, mut k_free) = (spec.law == LawChoice::Carreau, false);
-        if spec.law == LawChoice::Newtonian {
-            [template[ni], template[ki]] = NEWTONIAN_LAW;
-        }
-        let mut free = Vec::new();
-        let mut names = Vec::new();
-        let (mut lower, mut upper) = (Vec::new(), Vec::new());
-        let mut effects = Vec::new();
-        let mut st_free = false;
-        // shape bounds limited by the spin-line length (the longest of the experiments'
-        // models is not known here: the first model's)
-        let length = model.experiment.spinline_length;
+        let mut b = Builder::new(model, spec, start)?;
         let settings = spec.effects.iter().map(|s| (&s.effect, s.value)).chain(
             spec.candidates
                 .iter()
@@ -143,149 +119,42 @@ impl Layout {
         );
         for (e, value) in settings {
             if e.installs_in_law() {
-                match value {
-                    Some(v) => template[ni] = e.param_value(v),
-                    None => {
-                        n_free = true;
-                        st_free = true;
-                        let s = start
-                            .strength(e.name())
-                            .unwrap_or(e.strength_of(start.law[0]));
-                        template[ni] = e.param_value(s).clamp(options.lower[0], options.upper[0]);
-                        template[ki] = start.law[1];
-                    }
-                }
-                k_free = true;
-                effects.push(EffectSlot {
-                    effect: e.clone(),
-                    local: ni,
-                    column: None,
-                    shapes: Vec::new(),
-                });
-                continue;
-            }
-            let li = idx(e.model_param())?;
-            // shape parameters: at their fixed or default values in the template
-            let mut shapes = Vec::new();
-            for (sp, v) in e.shape_values() {
-                let si = idx(sp.model_param)?;
-                template[si] = v;
-                shapes.push(ShapeSlot {
-                    parameter: sp,
-                    local: si,
-                    column: None,
-                });
-            }
-            match value {
-                Some(v) => {
-                    template[li] = e.param_value(v);
-                    effects.push(EffectSlot {
-                        effect: e.clone(),
-                        local: li,
-                        column: None,
-                        shapes,
-                    });
-                }
-                None => {
-                    let s = start.strength(e.name()).unwrap_or(e.neutral());
-                    template[li] = e.param_value(s);
-                    let (lo, hi) = e.bounds();
-                    let (a, b) = (e.param_value(lo), e.param_value(hi));
-                    let column = Some(free.len());
-                    free.push(li);
-                    names.push(e.name().to_string());
-                    lower.push(a.min(b));
-                    upper.push(a.max(b));
-                    // shape parameters fitted with the strength (unless fixed)
-                    let free_shapes = e.free_shapes();
-                    for slot in &mut shapes {
-                        if !free_shapes.contains(&slot.parameter) {
-                            continue;
-                        }
-                        let sp = &slot.parameter;
-                        if let Some(v) = start.strength(sp.model_param) {
-                            template[slot.local] = v;
-                        }
-                        let (slo, shi) = sp.bounds_for_length(length);
-                        slot.column = Some(free.len());
-                        free.push(slot.local);
-                        names.push(sp.model_param.to_string());
-                        lower.push(slo);
-                        upper.push(shi);
-                    }
-                    effects.push(EffectSlot {
-                        effect: e.clone(),
-                        local: li,
-                        column,
-                        shapes,
-                    });
-                }
+                b.law_effect(e, value, start, options);
+            } else {
+                b.effect(model, e, value, start)?;
             }
         }
         if spec.law == LawChoice::Carreau {
-            k_free = true;
+            b.k_free = true;
         }
-        // the law's parameters go first
-        let mut head = Vec::new();
-        if n_free {
-            head.push((ni, "n", options.lower[0], options.upper[0]));
-        }
-        if k_free {
-            head.push((ki, "kappa", options.lower[1], options.upper[1]));
-        }
-        let shift = head.len();
-        for slot in &mut effects {
-            if let Some(c) = slot.column.as_mut() {
-                *c += shift;
-            }
-            for sh in &mut slot.shapes {
-                if let Some(c) = sh.column.as_mut() {
-                    *c += shift;
-                }
-            }
-            if st_free && slot.effect.installs_in_law() {
-                slot.column = Some(0);
-            }
-        }
-        let mut f2: Vec<usize> = head.iter().map(|h| h.0).collect();
-        let mut n2: Vec<String> = head.iter().map(|h| h.1.to_string()).collect();
-        let mut l2: Vec<f64> = head.iter().map(|h| h.2).collect();
-        let mut u2: Vec<f64> = head.iter().map(|h| h.3).collect();
-        f2.extend(free);
-        n2.extend(names);
-        l2.extend(lower);
-        u2.extend(upper);
-        for (i, &li) in f2.iter().enumerate() {
-            template[li] = template[li].clamp(l2[i], u2[i]);
-        }
-        for (name, v) in &options.hold {
-            let Some(i) = n2.iter().position(|n| n == name) else {
+        let mut layout = b.law_first(options);
+        layout.hold(&options.hold)?;
+        Ok(layout)
+    }
+
+    /// Holds the shared free parameters named in `hold` at their values: out of the fit, the
+    /// columns after them moved down.
+    fn hold(&mut self, hold: &[(String, f64)]) -> Result<(), RheometerError> {
+        for (name, v) in hold {
+            let Some(i) = self.names.iter().position(|n| n == name) else {
                 return Err(RheometerError::Data(format!(
                     "cannot hold {name}: not a fitted parameter of this model ({})",
-                    n2.join(", ")
+                    self.names.join(", ")
                 )));
             };
-            template[f2[i]] = *v;
-            f2.remove(i);
-            n2.remove(i);
-            l2.remove(i);
-            u2.remove(i);
-            for slot in &mut effects {
+            self.template[self.free[i]] = *v;
+            self.free.remove(i);
+            self.names.remove(i);
+            self.lower.remove(i);
+            self.upper.remove(i);
+            for slot in &mut self.effects {
                 drop_column(&mut slot.column, i);
                 for sh in &mut slot.shapes {
                     drop_column(&mut sh.column, i);
                 }
             }
         }
-        Ok(Layout {
-            template,
-            free: f2,
-            names: n2,
-            lower: l2,
-            upper: u2,
-            effects,
-            params,
-        })
+        Ok(())
     }
 
     /// Number of shared free parameters.
@@ -321,5 +190,223 @@ impl Layout {
         }
         p[phi_index] = phi;
         p
+    }
+}
+
+/// The index of the model parameter `name` of `model`.
+fn param_index(model: &CarreauFiber, name: &str) -> Result<usize, RheometerError> {
+    model
+        .param_index(name)
+        .ok_or_else(|| RheometerError::Data(format!("the model has no parameter {name}")))
+}
+
+/// A layout while its effects are added: the template and the shared free parameters other
+/// than the law's (these go first, see [`Builder::law_first`]).
+struct Builder {
+    template: Vec<f64>,
+    params: ParamLayout,
+    /// Local indices of `n` and `κ`.
+    ni: usize,
+    ki: usize,
+    /// Whether `n`, `κ` are fitted, and whether an effect installed in the law fits its
+    /// strength in `n`'s place.
+    n_free: bool,
+    k_free: bool,
+    st_free: bool,
+    free: Vec<usize>,
+    names: Vec<String>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    effects: Vec<EffectSlot>,
+    /// Spin-line length bounding the shape parameters (the longest of the experiments'
+    /// models is not known here: the first model's).
+    length: f64,
+}
+
+impl Builder {
+    /// The template at the start `(n, κ)` (Newtonian values for a Newtonian law), no effects.
+    fn new(
+        model: &CarreauFiber,
+        spec: &ModelSpec,
+        start: &FitStart,
+    ) -> Result<Self, RheometerError> {
+        let mut template = model.parameters(1.0, &start.law).map_err(|e| {
+            RheometerError::Data(format!("start (n, kappa) = {:?}: {e}", start.law))
+        })?;
+        let params = model.param_layout();
+        let (ni, ki) = (
+            params.law_param(CarreauLike::N),
+            params.law_param(CarreauLike::KAPPA),
+        );
+        if spec.law == LawChoice::Newtonian {
+            [template[ni], template[ki]] = NEWTONIAN_LAW;
+        }
+        Ok(Builder {
+            template,
+            params,
+            ni,
+            ki,
+            n_free: spec.law == LawChoice::Carreau,
+            k_free: false,
+            st_free: false,
+            free: Vec::new(),
+            names: Vec::new(),
+            lower: Vec::new(),
+            upper: Vec::new(),
+            effects: Vec::new(),
+            length: model.experiment.spinline_length,
+        })
+    }
+
+    /// An effect installed in the law (its strength in `n`'s place): at its fixed strength,
+    /// or fitted from its start strength with `κ`.
+    fn law_effect(
+        &mut self,
+        e: &Effect,
+        value: Option<f64>,
+        start: &FitStart,
+        options: &IdentifyOptions,
+    ) {
+        let (ni, ki) = (self.ni, self.ki);
+        match value {
+            Some(v) => self.template[ni] = e.param_value(v),
+            None => {
+                self.n_free = true;
+                self.st_free = true;
+                let s = start
+                    .strength(e.name())
+                    .unwrap_or(e.strength_of(start.law[0]));
+                self.template[ni] = e.param_value(s).clamp(options.lower[0], options.upper[0]);
+                self.template[ki] = start.law[1];
+            }
+        }
+        self.k_free = true;
+        self.effects.push(EffectSlot {
+            effect: e.clone(),
+            local: ni,
+            column: None,
+            shapes: Vec::new(),
+        });
+    }
+
+    /// An effect with its own model parameter: at its fixed strength, or fitted (with its
+    /// free shape parameters) from its start strength; its shape parameters at their fixed or
+    /// default values otherwise.
+    fn effect(
+        &mut self,
+        model: &CarreauFiber,
+        e: &Effect,
+        value: Option<f64>,
+        start: &FitStart,
+    ) -> Result<(), RheometerError> {
+        let li = param_index(model, e.model_param())?;
+        // shape parameters: at their fixed or default values in the template
+        let mut shapes = Vec::new();
+        for (sp, v) in e.shape_values() {
+            let si = param_index(model, sp.model_param)?;
+            self.template[si] = v;
+            shapes.push(ShapeSlot {
+                parameter: sp,
+                local: si,
+                column: None,
+            });
+        }
+        let column = match value {
+            Some(v) => {
+                self.template[li] = e.param_value(v);
+                None
+            }
+            None => {
+                let s = start.strength(e.name()).unwrap_or(e.neutral());
+                self.template[li] = e.param_value(s);
+                let (lo, hi) = e.bounds();
+                let (a, b) = (e.param_value(lo), e.param_value(hi));
+                let column = Some(self.free.len());
+                self.push_free(li, e.name().to_string(), a.min(b), a.max(b));
+                self.free_shapes(e, &mut shapes, start);
+                column
+            }
+        };
+        self.effects.push(EffectSlot {
+            effect: e.clone(),
+            local: li,
+            column,
+            shapes,
+        });
+        Ok(())
+    }
+
+    /// The shape parameters of the fitted effect `e` fitted with its strength (unless fixed).
+    fn free_shapes(&mut self, e: &Effect, shapes: &mut [ShapeSlot], start: &FitStart) {
+        let free_shapes = e.free_shapes();
+        for slot in shapes {
+            if !free_shapes.contains(&slot.parameter) {
+                continue;
+            }
+            let sp = &slot.parameter;
+            if let Some(v) = start.strength(sp.model_param) {
+                self.template[slot.local] = v;
+            }
+            let (slo, shi) = sp.bounds_for_length(self.length);
+            slot.column = Some(self.free.len());
+            self.push_free(slot.local, sp.model_param.to_string(), slo, shi);
+        }
+    }
+
+    /// A shared free parameter: local index, name and bounds.
+    fn push_free(&mut self, local: usize, name: String, lower: f64, upper: f64) {
+        self.free.push(local);
+        self.names.push(name);
+        self.lower.push(lower);
+        self.upper.push(upper);
+    }
+
+    /// The layout with the law's free parameters first (the effects' columns shifted after
+    /// them) and the template clamped to the bounds.
+    fn law_first(self, options: &IdentifyOptions) -> Layout {
+        let (ni, ki) = (self.ni, self.ki);
+        let mut head = Vec::new();
+        if self.n_free {
+            head.push((ni, "n", options.lower[0], options.upper[0]));
+        }
+        if self.k_free {
+            head.push((ki, "kappa", options.lower[1], options.upper[1]));
+        }
+        let shift = head.len();
+        let mut effects = self.effects;
+        for slot in &mut effects {
+            if let Some(c) = slot.column.as_mut() {
+                *c += shift;
+            }
+            for sh in &mut slot.shapes {
+                if let Some(c) = sh.column.as_mut() {
+                    *c += shift;
+                }
+            }
+            if self.st_free && slot.effect.installs_in_law() {
+                slot.column = Some(0);
+            }
+        }
+        let mut f2: Vec<usize> = head.iter().map(|h| h.0).collect();
+        let mut n2: Vec<String> = head.iter().map(|h| h.1.to_string()).collect();
+        let mut l2: Vec<f64> = head.iter().map(|h| h.2).collect();
+        let mut u2: Vec<f64> = head.iter().map(|h| h.3).collect();
+        f2.extend(self.free);
+        n2.extend(self.names);
+        l2.extend(self.lower);
+        u2.extend(self.upper);
+        let mut template = self.template;
+        for (i, &li) in f2.iter().enumerate() {
+            template[li] = template[li].clamp(l2[i], u2[i]);
+        }
+        Layout {
+            template,
+            free: f2,
+            names: n2,
+            lower: l2,
+            upper: u2,
+            effects,
+            params: self.params,
+        }
     }
 }

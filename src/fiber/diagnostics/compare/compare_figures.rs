@@ -78,8 +78,31 @@ pub fn write_figures(
     inputs: &[PathBuf],
 ) -> Result<Vec<PathBuf>, CompareError> {
     let ext = format.extension();
+    let mut out = diameter_pages(cmp, dir, ext, inputs)?;
+    let mut save = |name: &str, panels: &[Panel], columns: usize| -> Result<(), CompareError> {
+        let path = dir.join(format!("{name}.{ext}"));
+        ensure_not_input(&path, inputs)?;
+        save_panels(&path, panels, columns, grid_size(panels.len(), columns))?;
+        out.push(path);
+        Ok(())
+    };
+    let range = station_range(cmp);
+    let residuals = [residual_panel(cmp, range), station_mean_panel(cmp, range)];
+    save("compare_residuals", &residuals, 1)?;
+    save("compare_residual_trends", &trend_panels(cmp), 3)?;
+    Ok(out)
+}
+
+/// Measured against model per experiment, as `d` and as `1/d²` (the rheometer's figure
+/// panels): writes `compare_diameters.EXT` and `compare_inverse_d2.EXT` (split into pages) and
+/// returns their paths.
+fn diameter_pages(
+    cmp: &Comparison,
+    dir: &Path,
+    ext: &str,
+    inputs: &[PathBuf],
+) -> Result<Vec<PathBuf>, CompareError> {
     let mut out = Vec::new();
-    // measured vs model per experiment, as d and as 1/d² (the rheometer's figure panels)
     let measured: Vec<(Vec<f64>, Vec<f64>)> = cmp
         .experiments
         .iter()
@@ -118,20 +141,22 @@ pub fn write_figures(
         let path = dir.join(format!("{name}.{ext}"));
         out.extend(experiment_panel_pages(&path, &views, &model, view, inputs)?);
     }
+    Ok(out)
+}
 
-    let mut save = |name: &str, panels: &[Panel], columns: usize| -> Result<(), CompareError> {
-        let path = dir.join(format!("{name}.{ext}"));
-        ensure_not_input(&path, inputs)?;
-        save_panels(&path, panels, columns, grid_size(panels.len(), columns))?;
-        out.push(path);
-        Ok(())
-    };
-    let (s_lo, s_hi) = cmp
-        .stations
+/// The range `(s_lo, s_hi)` \[m\] of the stations.
+fn station_range(cmp: &Comparison) -> (f64, f64) {
+    cmp.stations
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), st| {
             (a.min(st.position_m), b.max(st.position_m))
-        });
+        })
+}
+
+/// The relative residual against `s` per experiment, with the noise model's `±2σ(s/L)` band
+/// (and the given `±2σ`), the pooled trend and the outliers ringed; the bands span the
+/// stations' range `(s_lo, s_hi)`.
+fn residual_panel(cmp: &Comparison, (s_lo, s_hi): (f64, f64)) -> Panel {
     let mut each = Panel::new("relative residual per experiment", "s (m)", "residual (%)");
     for (k, e) in cmp.experiments.iter().enumerate() {
         each = each.with_series(
@@ -188,8 +213,14 @@ pub fn write_figures(
         let label = format!("outliers ({})", outliers.len());
         each = each.with_series(Series::rings(label, outliers).with_color(3));
     }
+    each
+}
+
+/// The pooled station mean of the residuals with its `±2 se` band, and the zero line over
+/// `(s_lo, s_hi)`.
+fn station_mean_panel(cmp: &Comparison, (s_lo, s_hi): (f64, f64)) -> Panel {
     let st = &cmp.stations;
-    let pooled = Panel::new("pooled residual (station mean)", "s (m)", "residual (%)")
+    Panel::new("pooled residual (station mean)", "s (m)", "residual (%)")
         .with_series(
             Series::line(
                 "mean",
@@ -215,16 +246,18 @@ pub fn write_figures(
             )
             .with_color(9),
         )
-        .with_series(Series::line("", vec![(s_lo, 0.0), (s_hi, 0.0)]).with_color(7));
-    save("compare_residuals", &[each, pooled], 1)?;
+        .with_series(Series::line("", vec![(s_lo, 0.0), (s_hi, 0.0)]).with_color(7))
+}
 
+/// The residuals against strain rate, temperature and speed, one colour per experiment.
+fn trend_panels(cmp: &Comparison) -> Vec<Panel> {
     type Getter = fn(&super::ComparedPoint) -> f64;
     let quantities: [(&str, &str, Getter); 3] = [
         ("vs strain rate", "strain rate (1/s)", |p| p.strain_rate_1_s),
         ("vs temperature", "T (K)", |p| p.temperature_k),
         ("vs speed", "u (m/s)", |p| p.speed_m_s),
     ];
-    let trends: Vec<Panel> = quantities
+    quantities
         .iter()
         .map(|(title, xl, get)| {
             let mut panel = Panel::new(*title, *xl, "residual (%)");
@@ -242,7 +275,5 @@ pub fn write_figures(
             }
             panel
         })
-        .collect();
-    save("compare_residual_trends", &trends, 3)?;
-    Ok(out)
+        .collect()
 }

@@ -1,0 +1,299 @@
+//! The diagnosis in words ([`Diagnosis::to_text`]), paragraph by paragraph.
+
+use super::super::candidate::{Candidate, StrengthStatus};
+use super::super::diagnosis::Diagnosis;
+use super::{
+    estimate_with_ci, fmt_range, pm_unit, probability, profile_line, shape_alternative_line,
+    unit_suffix, EXACT_TIE,
+};
+use crate::fiber::format::{fmt_g, wrap_long_lines};
+
+impl Diagnosis {
+    /// The report in words.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        self.fit_paragraph(&mut s);
+        self.outliers_paragraph(&mut s);
+        s.push_str(&self.verdict_text());
+        match (&self.most_likely_missing, self.named()) {
+            (Some(name), Some(c)) => self.named_paragraph(&mut s, name, c),
+            _ => {
+                s.push_str(
+                    "No candidate earns its place: no effect lowers BIC by more than the threshold; \
+                     the model is adequate for these data (or the missing effect is not among the candidates).\n",
+                );
+                if let Some(w) = self.detection.words() {
+                    s.push_str(&format!("{w}\n"));
+                }
+            }
+        }
+        self.further_steps_paragraph(&mut s);
+        self.not_named_paragraph(&mut s);
+        self.candidates_table(&mut s);
+        self.profiles_paragraph(&mut s);
+        self.indistinguishable_paragraph(&mut s);
+        s.push_str(&self.detection.to_text());
+        s.push_str(&format!("wall time {:.2} s\n", self.wall_time_s));
+        wrap_long_lines(&s)
+    }
+
+    /// The heading, the base fit (its warnings) and whether its residuals are noise.
+    fn fit_paragraph(&self, s: &mut String) {
+        let b = &self.base_fit;
+        s.push_str(&format!(
+            "[[Diagnosis: which effect is missing from the {} model?]]\n",
+            match self.model {
+                crate::fiber::effects::LawChoice::Newtonian => "Newtonian",
+                crate::fiber::effects::LawChoice::Carreau => "Carreau-type",
+            }
+        ));
+        s.push_str(&format!(
+            "Your model fitted with the principled estimator: J = {:.4e}, RMS relative residual {:.3} % \
+             over {} measurements; noise level {}.\n",
+            b.cost,
+            100.0 * b.rms_relative_residual,
+            b.residuals,
+            b.noise.describe()
+        ));
+        for w in &b.warnings {
+            s.push_str(&format!("WARNING about your model's fit: {w}\n"));
+        }
+        s.push_str(&format!(
+            "The residuals are {} (RMS/noise = {:.2}, lag-1 autocorrelation {:+.2}).\n",
+            if self.systematic {
+                "SYSTEMATIC: the model misses something"
+            } else {
+                "consistent with noise"
+            },
+            self.rms_over_noise(),
+            self.lag1_autocorrelation()
+        ));
+    }
+
+    /// The outliers, one per line (nothing without any).
+    fn outliers_paragraph(&self, s: &mut String) {
+        if self.outliers().is_empty() {
+            return;
+        }
+        s.push_str(&format!(
+            "OUTLIERS ({}; left out of the noise level, the RMS and the autocorrelation; \
+             `fit --loss huber` down-weights them):\n",
+            self.outliers().len()
+        ));
+        for o in self.outliers() {
+            s.push_str(&format!(
+                "    {} at s = {:.3} m: measured {:.2} um, model {:.2} um, residual {:+.1} % ({:.1} robust sd)\n",
+                o.experiment,
+                o.position_m,
+                1e6 * o.d_meas_m,
+                1e6 * o.d_model_m,
+                100.0 * o.residual,
+                o.deviation_sigmas
+            ));
+        }
+    }
+
+    /// The named cause `c` (`name`): what adding it does, its strength and warnings, the
+    /// material parameters with it, a shape the data cannot choose, and its ties.
+    fn named_paragraph(&self, s: &mut String, name: &str, c: &Candidate) {
+        let b = &self.base_fit;
+        let exact: Vec<&str> = self
+            .alternatives
+            .iter()
+            .filter(|a| a.delta_bic_gap < EXACT_TIE)
+            .map(|a| a.effect.as_str())
+            .collect();
+        let lead = if exact.is_empty() {
+            "Most likely missing:".to_string()
+        } else {
+            format!(
+                "TIE: {name} and {} explain these data equally well (delta BIC gap below \
+                 {EXACT_TIE}); the data cannot choose, and the one listed first is not \
+                 preferred. Taking",
+                exact.join(", ")
+            )
+        };
+        s.push_str(&format!(
+            "{lead} {name}{}. Its signature lies along s = {} (strongest at {:.2} m). \
+             Adding it removes {:.1} % of the misfit ({:.0} % of the excess over the noise; \
+             false-alarm probability of the search {}) (J {:.4e} -> {:.4e}), RMS {:.3} % -> {:.3} %, \
+             delta BIC = {:.1}, delta AIC = {:.1}; fitted strength {}.\n",
+            super::super::ties::or_alternatives(&self.alternatives),
+            fmt_range(c.signature_range_m),
+            c.signature_peak_m,
+            100.0 * (1.0 - c.cost_after / c.cost_before),
+            100.0 * c.share_of_excess,
+            probability(c.false_alarm),
+            c.cost_before,
+            c.cost_after,
+            100.0 * b.rms_relative_residual,
+            100.0 * c.rms_relative_residual_after(),
+            c.delta_bic,
+            c.delta_aic,
+            pm_unit(c.strength(), c.stderr_strength(), &c.unit)
+        ));
+        if let Some(b) = c.at_bound().iter().find(|b| b.parameter == c.effect) {
+            s.push_str(&format!(
+                "WARNING: its strength ends AT ITS {} BOUND {}{}: the data push it beyond its \
+                 search range, so this is not a credible estimate of the effect (a different \
+                 effect, or a process or instrument error, may be behind the misfit).\n",
+                b.side.name().to_uppercase(),
+                fmt_g(b.bound),
+                unit_suffix(&c.unit)
+            ));
+        }
+        if let (StrengthStatus::Physical, Some(note)) = (c.status, &c.status_note) {
+            s.push_str(&format!("NOTE: {note}.\n"));
+        }
+        if c.n().is_finite() {
+            s.push_str(&format!(
+                "With it: n = {}, kappa = {}.\n",
+                estimate_with_ci(c, "n", c.n(), c.ci95_n()),
+                estimate_with_ci(c, "kappa", c.kappa(), c.ci95_kappa())
+            ));
+        }
+        if let Some(a) = &c.shape_alternative {
+            s.push_str(&shape_alternative_line(c, a));
+        }
+        s.push_str(&super::super::ties::ties_paragraph(
+            c,
+            &self.alternatives,
+            &self.candidates,
+        ));
+    }
+
+    /// The further steps (each with the causes found before in the model) and the final fit
+    /// with every cause found.
+    fn further_steps_paragraph(&self, s: &mut String) {
+        for (k, st) in self.further_steps.iter().enumerate() {
+            s.push_str(&format!(
+                "Step {} (with {} in the model, fitted jointly): {}.\n",
+                k + 2,
+                st.model_effects.join(" + "),
+                match st
+                    .named
+                    .as_deref()
+                    .and_then(|n| st.candidates.iter().find(|c| c.effect == n))
+                {
+                    Some(c) => format!(
+                        "{} named too (delta BIC {:.1}, {:.0} % of the remaining excess, \
+                         false-alarm probability {})",
+                        c.effect,
+                        c.delta_bic,
+                        100.0 * c.share_of_excess,
+                        probability(c.false_alarm)
+                    ),
+                    None => "no further candidate earns its place".into(),
+                }
+            ));
+        }
+        if let Some(f) = &self.final_fit {
+            if self.found.len() > 1 {
+                s.push_str(&format!(
+                    "With {}: n = {:.4}, kappa = {:.4}, RMS {:.3} %.\n",
+                    self.found.join(" + "),
+                    f.n.value,
+                    f.kappa.value,
+                    100.0 * f.rms_relative_residual
+                ));
+            }
+        }
+    }
+
+    /// The refits that lower BIC but are not named (outside the physical range, at a bound).
+    fn not_named_paragraph(&self, s: &mut String) {
+        for c in self
+            .candidates
+            .iter()
+            .filter(|c| c.refitted() && c.status != StrengthStatus::Physical && c.delta_bic < 0.0)
+        {
+            if let Some(note) = &c.status_note {
+                s.push_str(&format!(
+                    "NOT NAMED: {} lowers BIC by {:.1} but {note}; not a credible estimate of \
+                     the effect (a different effect, or a process or instrument error, may be \
+                     behind the misfit).\n",
+                    c.effect, -c.delta_bic
+                ));
+            }
+        }
+    }
+
+    /// The table of candidates, two lines each, and its footnote.
+    fn candidates_table(&self, s: &mut String) {
+        s.push_str("[[Candidates, best first (credible refits by delta BIC, then refits at a bound or not physical)]]\n");
+        s.push_str("    effect                   refit  strength ± stderr              RMS after  dBIC     false-al.  excess  status\n");
+        s.push_str("        J after, lin.dJ/J, signature (peak), shape\n");
+        for c in &self.candidates {
+            let shape: String = c
+                .shape()
+                .iter()
+                .map(|p| format!(", {} {}{}", p.name, fmt_g(p.value), unit_suffix(&p.unit)))
+                .collect();
+            s.push_str(&format!(
+                "    {:<24} {:<5}  {:<28} {:>9}  {:>7.1}  {:>9}  {:>6}  {}\n",
+                c.effect,
+                if c.refitted() { "yes" } else { "lin" },
+                pm_unit(c.strength(), c.stderr_strength(), &c.unit),
+                if c.rms_relative_residual_after().is_finite() {
+                    format!("{:.3} %", 100.0 * c.rms_relative_residual_after())
+                } else {
+                    "-".into()
+                },
+                c.delta_bic,
+                probability(c.false_alarm),
+                if c.share_of_excess.is_finite() {
+                    format!("{:.0} %", 100.0 * c.share_of_excess)
+                } else {
+                    "-".into()
+                },
+                c.status.name(),
+            ));
+            s.push_str(&format!(
+                "        J after {:.4e}, lin.dJ/J {:.4}, signature {} (peak {:.2} m){shape}\n",
+                c.cost_after,
+                if c.cost_before > 0.0 {
+                    c.linear_score / c.cost_before
+                } else {
+                    f64::NAN
+                },
+                fmt_range(c.signature_range_m),
+                c.signature_peak_m
+            ));
+        }
+        s.push_str(
+            "(lin.dJ/J: the first-order (linearised) share of J the effect would remove at strength 0; \
+             a refit far better than it means the finite effect differs from its first-order signature.)\n",
+        );
+    }
+
+    /// The candidates' profiles of `J/J_base`, one line each (nothing without any).
+    fn profiles_paragraph(&self, s: &mut String) {
+        let with_profiles: Vec<&Candidate> = self
+            .candidates
+            .iter()
+            .filter(|c| !c.profiles.is_empty())
+            .collect();
+        if !with_profiles.is_empty() {
+            s.push_str("[[Profiles: J/J_base against strength, material parameters refitted at each fixed strength; * = lowest, ! = outside the physical range]]\n");
+            for c in with_profiles {
+                for p in &c.profiles {
+                    s.push_str(&format!("    {}\n", profile_line(p)));
+                }
+            }
+        }
+    }
+
+    /// The pairs of candidates whose signatures the data cannot tell apart.
+    fn indistinguishable_paragraph(&self, s: &mut String) {
+        if self.indistinguishable.is_empty() {
+            s.push_str("No two candidates have strongly correlated signatures.\n");
+        } else {
+            for p in &self.indistinguishable {
+                s.push_str(&format!(
+                    "The data cannot tell {} and {} apart (signature cosine {:+.3}).\n",
+                    p.effects[0], p.effects[1], p.cosine
+                ));
+            }
+        }
+    }
+}
