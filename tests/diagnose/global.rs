@@ -98,6 +98,15 @@ fn check(sc: &Scenario, e: &Expect) -> (ExperimentSet, DiagnosisRun) {
         local,
         t
     );
+    // under "none of the candidates" no law is printed as a result
+    if matches!(d.verdict, Verdict::NoneOfTheCandidates { .. }) {
+        let text = d.to_text();
+        assert!(
+            !text.contains("With it: n ="),
+            "{}: a law printed as a result under none of the candidates",
+            sc.name
+        );
+    }
     // one noise level: a warning of the user's fit that names the noise names the fit's own
     let level = d.base_fit.noise.describe();
     for w in &d.base_fit.warnings {

@@ -2,6 +2,7 @@
 
 use super::super::candidate::{Candidate, StrengthStatus};
 use super::super::diagnosis::Diagnosis;
+use super::super::diagnose::verdict::Verdict;
 use super::{
     estimate_with_ci, fmt_range, pm_unit, probability, profile_line, shape_alternative_line,
     unit_suffix, EXACT_TIE,
@@ -146,8 +147,14 @@ impl Diagnosis {
             s.push_str(&format!("NOTE: {note}.\n"));
         }
         if c.n().is_finite() {
+            // under "none of the candidates" the law with the best candidate is biased too
+            let lead = if matches!(self.verdict, Verdict::NoneOfTheCandidates { .. }) {
+                "With it (NOT A RESULT: the misfit is not explained, see the verdict)"
+            } else {
+                "With it"
+            };
             s.push_str(&format!(
-                "With it: n = {}, kappa = {}.\n",
+                "{lead}: n = {}, kappa = {}.\n",
                 estimate_with_ci(c, "n", c.n(), c.ci95_n()),
                 estimate_with_ci(c, "kappa", c.kappa(), c.ci95_kappa())
             ));
