@@ -76,7 +76,7 @@
 //! 6. `rheometer` (inside: `options`, `estimator` → `data` → `layout` → `objective` →
 //!    `identify` → `summary_build`, `error_budget`, `landscape`; the values `summary`,
 //!    `budget` below them);
-//! 7. `figures`, `flow_curve_figure`;
+//! 7. `figures`, `flow_curve_figure`, `fit_html` (the HTML report of a fit);
 //! 8. `diagnostics` (`compare`, `candidate` → `ties`, `diagnose` (its stages), `diagnosis`,
 //!    `report`);
 //! 9. `failure_hints`, `design` (inside: `information`, `criteria`, `candidates` →

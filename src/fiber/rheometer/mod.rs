@@ -46,7 +46,7 @@ mod summary_build;
 pub mod summary_checks;
 mod summary_finding;
 mod summary_read;
-mod summary_text;
+pub(crate) mod summary_text;
 
 pub use data::Rheometer;
 pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
