@@ -72,7 +72,10 @@ fn fit_html_escapes_user_text_loads_nothing_and_prints_the_estimates_of_the_json
     assert!(!low.contains("<script"), "a <script> element in the page");
     assert!(!low.contains("<img"), "an <img> element in the page");
     // (the handler's text is there, escaped, as part of the file name)
-    assert!(!page.contains(FILE) && !page.contains(NAME), "user text unescaped");
+    assert!(
+        !page.contains(FILE) && !page.contains(NAME),
+        "user text unescaped"
+    );
     // the CSP forbids every load; no link or source names the network
     assert!(
         page.contains("<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none';")
