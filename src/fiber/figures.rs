@@ -13,7 +13,7 @@ use super::simulate::FiberSolution;
 use super::simulate::Profiles;
 use super::smoothing::SmoothFit;
 use crate::plot::{
-    save_heatmap, save_panels, Band, FigureFormat, Heatmap, Panel, PlotError, Series,
+    panels_svg, save_heatmap, save_panels, Band, FigureFormat, Heatmap, Panel, PlotError, Series,
 };
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -413,6 +413,40 @@ pub fn residual_panels(
     inputs: &[PathBuf],
 ) -> Result<(), FigureError> {
     check(path, inputs)?;
+    let panels = residual_panel_list(before, after, noise_sigma);
+    if panels.is_empty() {
+        return Err(FigureError::Plot(PlotError::InvalidInput {
+            path: path.to_path_buf(),
+            reason: "no experiments to draw residuals of".into(),
+        }));
+    }
+    let cols = columns(panels.len());
+    save_panels(path, &panels, cols, grid_size(panels.len()))?;
+    Ok(())
+}
+
+/// The figure of [`residual_panels`] (without `after`) as an SVG document in memory, for an
+/// HTML report; an error without experiments.
+pub fn residuals_svg(
+    views: &[ResidualView<'_>],
+    noise_sigma: Option<f64>,
+) -> Result<String, PlotError> {
+    let panels = residual_panel_list(views, None, noise_sigma);
+    if panels.is_empty() {
+        return Err(PlotError::InvalidInput {
+            path: PathBuf::from("<svg>"),
+            reason: "no experiments to draw residuals of".into(),
+        });
+    }
+    panels_svg(&panels, columns(panels.len()), grid_size(panels.len()))
+}
+
+/// The panels of [`residual_panels`].
+fn residual_panel_list(
+    before: &[ResidualView<'_>],
+    after: Option<(&str, &[ResidualView<'_>])>,
+    noise_sigma: Option<f64>,
+) -> Vec<Panel> {
     let percent = |v: &ResidualView<'_>| -> Vec<(f64, f64)> {
         v.positions
             .iter()
@@ -442,15 +476,7 @@ pub fn residual_panels(
         }
         panels.push(p);
     }
-    if panels.is_empty() {
-        return Err(FigureError::Plot(PlotError::InvalidInput {
-            path: path.to_path_buf(),
-            reason: "no experiments to draw residuals of".into(),
-        }));
-    }
-    let cols = columns(panels.len());
-    save_panels(path, &panels, cols, grid_size(panels.len()))?;
-    Ok(())
+    panels
 }
 
 #[cfg(test)]

@@ -21,6 +21,7 @@
 //! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
 //! * [`figures`]: profile, fit and landscape figures (PNG/SVG);
 //! * [`flow_curve_figure`]: the flow curve `η_E(ε̇)` with its bands (PNG/SVG);
+//! * [`fit_html`]: the HTML report of a fit (self-contained page, from the fit's values);
 //! * [`statistics`]: noise estimates, runs test, autocorrelation and rank correlation of
 //!   residuals;
 //! * [`take_up`]: the take-up condition a model uses (the data set's, a given diameter, or
@@ -40,6 +41,7 @@ pub mod effects;
 pub mod error;
 pub mod failure_hints;
 pub mod figures;
+pub mod fit_html;
 pub mod flow_curve_figure;
 pub mod format;
 pub mod input;

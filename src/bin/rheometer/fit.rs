@@ -1,6 +1,7 @@
 //! `rheometer fit`.
 
 use crate::*;
+use diffbvp::fiber::fit_html::FIT_REPORT_HTML;
 
 /// Arguments of `rheometer fit`.
 #[derive(clap::Args)]
@@ -44,8 +45,12 @@ pub struct FitArgs {
     /// Write the result as JSON to FILE.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Write the report, the fitted profiles and figures (paper Fig. 2, 3, 5; with --with also
-    /// a before/after residual figure) into DIR.
+    /// Write the report as a self-contained HTML page to FILE (verdict, law, flow curve,
+    /// residuals, experiments, warnings, inputs; it loads nothing from the network).
+    #[arg(long)]
+    pub html: Option<PathBuf>,
+    /// Write the report (text and HTML), the fitted profiles and figures (paper Fig. 2, 3, 5;
+    /// with --with also a before/after residual figure) into DIR.
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
@@ -63,6 +68,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         f_scale,
         tol,
         json,
+        html,
         out,
     } = args;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
@@ -109,6 +115,9 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let mut plan = outputs::plan_for(&experiments, &loaded);
     if let Some(path) = &json {
         plan.file(path, "--json");
+    }
+    if let Some(path) = &html {
+        plan.file(path, "--html");
     }
     let names = out.as_ref().map(|_| fit_output_names(&loaded, &with, g));
     if let (Some(dir), Some(names)) = (&out, &names) {
@@ -157,8 +166,14 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         outputs.write_text(&path, &text)?;
         g.say(format!("wrote {}", path.display()));
     }
+    let page = (html.is_some() || out.is_some()).then(|| run.html_report(&loaded).render());
+    if let (Some(path), Some(page)) = (html, &page) {
+        outputs.write_text(&path, page)?;
+        g.say(format!("wrote {}", path.display()));
+    }
     if let (Some(dir), Some(names)) = (out, names) {
-        write_fit_outputs(&run, &outputs, &dir, names, &text, &with, g)?;
+        let page = page.unwrap_or_default();
+        write_fit_outputs(&run, &outputs, &dir, names, (&text, &page), &with, g)?;
     }
     Ok(())
 }
@@ -174,6 +189,7 @@ fn fit_output_names(
     let ext = g.format.ext();
     let mut v = vec![
         ("report".to_string(), "fit_report.txt".to_string()),
+        ("report".to_string(), FIT_REPORT_HTML.to_string()),
         ("json".to_string(), "fit.json".to_string()),
     ];
     for e in &loaded.set.experiments {
@@ -192,14 +208,15 @@ fn fit_output_names(
     v
 }
 
-/// The report, JSON, fitted profiles and figures of a fit into `dir` (the files of
-/// `names`), marked incomplete until the last is written.
+/// The reports, JSON, fitted profiles and figures of a fit into `dir` (the files of
+/// `names`; `(json, html)` the JSON and the HTML page), marked incomplete until the last is
+/// written.
 fn write_fit_outputs(
     run: &FitRun,
     outputs: &CheckedOutputs,
     dir: &Path,
     names: Vec<(String, String)>,
-    json: &str,
+    (json, html): (&str, &str),
     with: &[EffectSetting],
     g: &Global,
 ) -> Result<(), Box<dyn Error>> {
@@ -207,6 +224,7 @@ fn write_fit_outputs(
     let mut w = outputs::DirWriter::begin(outputs, dir, "rheometer fit", "files", names)?;
     w.text("fit_report.txt", &run.summary().to_text())?;
     w.text("fit.json", json)?;
+    w.text(FIT_REPORT_HTML, html)?;
     for (k, sol) in id.solutions.iter().enumerate() {
         let fs = FiberSolution {
             solution: sol.clone(),

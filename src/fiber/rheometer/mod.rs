@@ -60,7 +60,7 @@ mod summary_build;
 pub mod summary_checks;
 mod summary_finding;
 mod summary_read;
-mod summary_text;
+pub(crate) mod summary_text;
 pub mod thresholds;
 
 pub use coverage::StrainRateCoverage;

@@ -228,6 +228,12 @@ impl FitSummary {
         ))
     }
 
+    /// The significant digits `K` is printed with: those its relative error `se(κ)` supports
+    /// (2 to 8).
+    pub(crate) fn k_digits(&self) -> usize {
+        (1 - self.kappa.stderr.max(1e-15).log10().floor() as i64).clamp(2, 8) as usize
+    }
+
     /// `n`, `κ` and `K` (or the Newtonian law).
     fn law_text(&self) -> String {
         let mut s = String::new();
@@ -239,9 +245,7 @@ impl FitSummary {
         s.push_str(&self.estimate_line("kappa:", &self.kappa));
         let k = &self.k_pa;
         if k.has_interval() {
-            // the relative error of K is se(kappa): the digits it supports
-            let digits = (1 - self.kappa.stderr.max(1e-15).log10().floor() as i64).clamp(2, 8);
-            let e = |v: f64| fmt_e(v, digits as usize);
+            let e = |v: f64| fmt_e(v, self.k_digits());
             s.push_str(&format!(
                 "    K:     {} Pa  95% CI [{}, {}] Pa\n",
                 e(k.value),

@@ -4,12 +4,15 @@
 //! without them).
 
 use crate::fiber::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::fiber::figures::ResidualView;
+use crate::fiber::fit_html::{fit_report_page, FitReportInput, ReportExperiment};
 use crate::fiber::input::LoadedExperiments;
 use crate::fiber::rheometer::profile::{intervals, ProfileMode};
 use crate::fiber::rheometer::{
     error_budget, FitSummary, FlowCurve, FlowCurveOptions, Identification, IdentifyOptions,
     Rheometer, RheometerError, StartPoint,
 };
+use crate::html_page::HtmlPage;
 use crate::solution::Solution;
 
 /// What to fit.
@@ -88,6 +91,31 @@ impl FitRun {
     /// The outcome as reported.
     pub fn summary(&self) -> &FitSummary {
         &self.identification.summary
+    }
+
+    /// The HTML report of this fit ([`fit_report_page`]): its summary and flow curve, the
+    /// experiments of `data` (the data set fitted) with the file `data.path`, and the relative
+    /// residuals of the fitted solutions (evaluated, not refitted).
+    pub fn html_report(&self, data: &LoadedExperiments) -> HtmlPage {
+        let rh = &self.rheometer;
+        let residuals: Vec<Vec<f64>> = (self.identification.solutions.iter().enumerate())
+            .map(|(k, sol)| rh.relative_residuals(k, sol))
+            .collect();
+        let views: Vec<ResidualView<'_>> = (rh.experiments.iter().zip(&rh.measurements))
+            .zip(&residuals)
+            .map(|((e, m), r)| ResidualView {
+                name: &e.name,
+                positions: &m.positions,
+                residuals: r,
+            })
+            .collect();
+        let experiments = ReportExperiment::of(data);
+        fit_report_page(&FitReportInput {
+            summary: self.summary(),
+            experiments_file: &data.path,
+            experiments: &experiments,
+            residuals: &views,
+        })
     }
 }
 
