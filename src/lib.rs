@@ -77,7 +77,8 @@
 //!    `parameter_shift` and the values `thresholds`, `budget`, `curve`, `likelihood` →
 //!    `coverage`, `objective`, `plan`, `landscape` → the value `summary` → what reads it
 //!    (`summary_checks`, `summary_text`, `summary_read`) → `summary_build`, `identification` →
-//!    `accuracy` → `identify` → `nested`, `profile`, `flow_curve`, `error_budget` → `summary_finding`);
+//!    `accuracy` → `identify` → `nested`, `profile`, `flow_curve`, `error_budget` →
+//!    `summary_finding`);
 //! 7. `figures`, `flow_curve_figure`, `fit_html` (the HTML report of a fit);
 //! 8. `diagnostics` (`compare`, `candidate` → `ties`, `calibration`, `diagnose` (its stages),
 //!    `diagnosis`, `report`);
