@@ -35,6 +35,11 @@ pub const MISFIT_RATIO: f64 = 3.0;
 /// Without any noise level (too few points to estimate it), the report warns when the RMS
 /// relative residual exceeds this \[-\].
 pub const MISFIT_WITHOUT_NOISE: f64 = 0.1;
+
+/// Misfit over an *estimated* noise level above which the estimate itself is suspect
+/// (c15b): real diameter gauges are not a thousand times more precise than a model's misfit,
+/// but interpolated or synthetic (noiseless) rows dominating the estimate make it so.
+pub const IMPLAUSIBLE_NOISE_RATIO: f64 = 1000.0;
 /// A standard error of `n` above this \[-\] is reported as huge.
 pub const LARGE_STDERR_N: f64 = 0.2;
 /// A standard error of `κ` above this \[-\] (a factor `e` in `K`) is reported as huge.
@@ -224,6 +229,34 @@ fn check_covariance(
     }
 }
 
+/// An effect fixed (`--with radiation=2`) at a strength outside its physical range (G02):
+/// the fit then rests on a model no spinning line can have; an `unphysical` warning naming the effect, its value and its range ([`Effect::judge`](crate::fiber::effects::Effect::judge)).
+pub(crate) fn check_fixed_effects(s: &FitSummary, w: &mut Vec<FitWarning>) {
+    for e in &s.effects {
+        if e.strength.fitted {
+            continue;
+        }
+        let Ok(effect) = e.effect.parse::<crate::fiber::effects::Effect>() else {
+            continue;
+        };
+        if let Some(words) = effect.judge(e.strength.value) {
+            let (lo, hi) = effect.physical_range();
+            w.push(FitWarning::new(
+                WarningCode::Unphysical,
+                format!(
+                    "{} is fixed outside its physical range [{}, {}]: {words}; the fit rests on \
+                     a model no spinning line has (give a value inside the range, or fit it: \
+                     --with {})",
+                    e.effect,
+                    fmt_g(lo),
+                    fmt_g(hi),
+                    e.effect
+                ),
+            ));
+        }
+    }
+}
+
 /// An implausible material law (`n` below [`PLAUSIBLE_N`]: not a result), or a 95 % interval
 /// of `n` reaching beyond `[0, 1]` (the law's own range: the linearised interval is not
 /// reliable there; a large-uncertainty warning).
@@ -366,6 +399,12 @@ pub(crate) fn check_misfit(s: &FitSummary, w: &mut Vec<FitWarning>) {
     }
     if s.noise.declared() {
         m.push_str(" (or the declared relative_uncertainty is too small)");
+    } else if noise.is_finite() && rms > IMPLAUSIBLE_NOISE_RATIO * noise {
+        m.push_str(
+            "; the estimated noise level itself is implausibly small: rows without noise \
+             (interpolated, smoothed or synthetic) in some files dominate the estimate; thin \
+             them or declare relative_uncertainty at the top of the TOML",
+        );
     }
     m.push_str(": check their data, TOML entries (temperatures, take-up) and the model");
     w.push(FitWarning::new(WarningCode::Misfit, m));
