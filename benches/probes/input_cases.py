@@ -189,7 +189,7 @@ def input_probes(Probe, FIT, SIM):
     # 4. TOML content
     for name, fn, needles in [
         ("utf16", lambda s: None, ["UTF-8"]),
-        ("latin1", None, ["UTF-8", "line 28"]),
+        ("latin1", None, ["UTF-8", "experiments.toml:28"]),
         ("missing_material", lambda s: s.replace("[material]", "[materiel]"), ["material"]),
         ("unknown_key", lambda s: s.replace("[defaults]", "[defaults]\nspinline_lenght_m = 0.51"), ["spinline_lenght_m"]),
         ("duplicate_key", lambda s: s.replace("vft_B_K = 3649.0", "vft_B_K = 3649.0\nvft_B_K = 3649.0"), ["vft_B_K"]),

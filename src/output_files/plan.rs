@@ -299,7 +299,13 @@ pub(super) fn normalized(path: &Path) -> PathBuf {
             base = c;
             break;
         }
-        match (base.file_name().map(|n| n.to_os_string()), base.parent()) {
+        // the last component, also `..` (which `file_name` does not return: `out/../out/x`
+        // with `out` still missing must name the same file as `out/x`)
+        let last = base
+            .components()
+            .next_back()
+            .map(|c| c.as_os_str().to_os_string());
+        match (last, base.parent()) {
             (Some(n), Some(p)) => {
                 rest.push(n);
                 base = p.to_path_buf();

@@ -413,6 +413,34 @@ fn c13_a_closed_stdout_loses_the_report_with_a_message_and_exit_one() {
         p.stderr
     );
     assert!(p.elapsed < Duration::from_secs(5));
+    // a stdout the caller opened read-write on /dev/null (bash `1<>`, Python's
+    // subprocess.DEVNULL) is open, not closed: the report goes there, exit 0
+    let p = bash(
+        &format!("\"$BIN\" --quiet fit {} 1<> /dev/null", s(&toml)),
+        &dir,
+        &[&data],
+        LIMIT,
+    );
+    assert_eq!(p.code, Some(0), "{}", p.stderr);
+    assert!(!p.stderr.contains("closed"), "{}", p.stderr);
+}
+
+#[test]
+fn s09_a_json_path_through_a_missing_directory_and_dotdot_is_the_same_file() {
+    // [S09] `out/../out/fit.json` with `out` not yet made names out/fit.json of --out out
+    let (dir, toml, data) = shipped_copy("dotdot_same_file");
+    let p = bash(
+        &format!(
+            "\"$BIN\" --quiet fit {} --json out/../out/fit.json --out out > /dev/null",
+            s(&toml)
+        ),
+        &dir,
+        &[&data],
+        LIMIT,
+    );
+    p.assert_clean_failure(&["--json", "--out", "name the same file"]);
+    assert!(!dir.join("out").join("fit.json").exists());
+    fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
