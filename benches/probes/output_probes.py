@@ -5,6 +5,11 @@ standard streams that fail or close, contradicting flags and odd numbers, signal
 
     python3 benches/probes/output_probes.py            # all probes (a few minutes)
     python3 benches/probes/output_probes.py --quick    # the first 40
+    python3 benches/probes/output_probes.py --only in_ # the probes whose names start so
+
+The hostile inputs (TOML and CSV as devices, FIFOs, sparse giants, deep nesting, NaN/inf, huge
+numbers, unit slips, long lines) are listed in input_cases.py; those reading an unbounded input
+are timed (/usr/bin/time: seconds and peak RSS, limits 1 s and 100 MB).
 
 Every probe runs in a fresh copy of data/pmma7n_synthetic under target/output-probes/ and
 records: exit code, time, panic (exit 101 or "panicked at"), abort (exit 134 or SIGABRT), hang
@@ -26,6 +31,8 @@ import stat
 import subprocess
 import sys
 import time
+
+from input_cases import input_probes
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 BIN = os.path.join(ROOT, "target", "release", "rheometer")
@@ -53,6 +60,10 @@ def kind(path):
 
 def digest(path):
     try:
+        m = os.stat(path)
+        if m.st_size > (64 << 20):
+            # the probes' sparse giants: size and modification time (reading them is the slow part)
+            return "size=%d mtime=%d" % (m.st_size, m.st_mtime_ns)
         with open(path, "rb") as f:
             return hashlib.sha1(f.read()).hexdigest()
     except OSError:
@@ -71,8 +82,9 @@ def inputs_of(d):
 
 class Probe:
     def __init__(self, name, script, expect, needles=(), setup=None, special=(), limit=LIMIT,
-                 quick=False, watch_extra=()):
+                 quick=False, watch_extra=(), measure=False):
         self.name, self.script, self.expect = name, script, expect
+        self.measure = measure
         self.needles, self.setup, self.special = list(needles), setup, list(special)
         self.limit, self.quick, self.watch_extra = limit, quick, list(watch_extra)
 
@@ -88,7 +100,13 @@ def fresh(name):
 def run_probe(p):
     d = fresh(p.name)
     if p.setup:
-        p.setup(d)
+        try:
+            p.setup(d)
+        except (OSError, subprocess.CalledProcessError) as e:
+            return {"name": p.name, "expect": p.expect, "code": None, "time": 0.0, "hang": False,
+                    "panic": False, "abort": False, "changed": [], "replaced": [], "temporaries": [],
+                    "ok": False, "quality": 0, "usage": None, "stderr": ["setup failed: %s" % e],
+                    "missing": p.needles}
     # a fit file for compare probes (made before the inputs are recorded)
     before = inputs_of(os.path.join(d, "data"))
     for extra in p.watch_extra:
@@ -106,6 +124,15 @@ def run_probe(p):
         os.killpg(proc.pid, signal.SIGKILL)
         out, err = proc.communicate()
     dt = time.time() - t0
+    usage = None
+    if p.measure:
+        try:
+            with open(os.path.join(d, "usage.txt")) as f:
+                last = f.read().split("\n")
+            fields = [ln for ln in last if ln.strip() and ln[0].isdigit()][-1].split()
+            usage = {"seconds": float(fields[0]), "peak_rss_mb": int(fields[1]) / 1024.0}
+        except (OSError, IndexError, ValueError):
+            usage = None
     out = out.decode("utf-8", "replace")
     err = err.decode("utf-8", "replace")
     code = proc.returncode
@@ -130,7 +157,7 @@ def run_probe(p):
         "name": p.name, "expect": p.expect, "code": code, "time": round(dt, 2), "hang": hang,
         "panic": panic, "abort": abort, "changed": changed, "replaced": replaced,
         "temporaries": temps, "ok": ok, "quality": quality,
-        "stderr": err.strip().splitlines()[:6], "missing": [n for n in p.needles if n.lower() not in low],
+        "usage": usage, "stderr": err.strip().splitlines()[:6], "missing": [n for n in p.needles if n.lower() not in low],
     }
 
 
@@ -345,7 +372,10 @@ def probes():
         Probe("landscape_csv_readonly", '%s --out out > /dev/null' % LAND, "fail", ["landscape.csv", "write-protected"],
               write_file("out/landscape.csv", mode=0o444)),
         Probe("simulate_long_name_236", '%s --out out > /dev/null' % SIM, "ok", [], long_name_toml(236)),
-        Probe("simulate_long_name_243", '%s --out out > /dev/null' % SIM, "ok", [], long_name_toml(243)),
+        # names are limited at the TOML to what every command's file names allow (fit's
+        # "<name>_fitted_profile.csv": 236 bytes), so 243 is refused before any work
+        Probe("simulate_long_name_243", '%s --out out > /dev/null' % SIM, "fail", ["bytes long", "at most 236"],
+              long_name_toml(243)),
         Probe("simulate_long_name_244", '%s --out out > /dev/null' % SIM, "fail", ["bytes long", "at most 255"], long_name_toml(244)),
         Probe("simulate_long_name_5000", '%s --out out > /dev/null' % SIM, "fail", ["bytes long"], long_name_toml(5000)),
         Probe("fit_long_name_240", '%s --out out > /dev/null' % FIT, "ok", [], long_name_toml(236)),
@@ -364,6 +394,7 @@ def probes():
             Probe("%s_stdout_pipe_closed" % cname, "%s | head -c 0" % base, "ok"),
         ]
     P += [
+        Probe("stdout_devnull_read_write", '"$BIN" --quiet fit $T 1<> /dev/null', "ok"),
         Probe("hints_stderr_full", '"$BIN" simulate $T --take-up-from-data --n 0 --out out 2> /dev/full; test $? -eq 1', "ok"),
         Probe("json_dash_stdout_closed", "%s --json - >&-" % FIT, "fail", ["standard output is closed"]),
         Probe("help_stdout_full", '"$BIN" --help > /dev/full', "fail", ["cannot write to standard output"]),
@@ -409,6 +440,8 @@ def probes():
                        "%s > /dev/null 2>&1 & p=$!; sleep %s; kill -9 $p; wait $p; "
                        "n=$(ls -A out 2>/dev/null | grep -c tmp-); test $n -le 1 && %s > /dev/null 2>&1 && "
                        "test -z \"$(ls -A out | grep tmp-)\" && ! test -e out/PARTIAL.txt" % (big, delay, big), "ok"))
+    # 6. hostile inputs (input_cases.py)
+    P += input_probes(Probe, FIT, SIM)
     return P
 
 
@@ -445,6 +478,9 @@ def main():
     ps = probes()
     if "--quick" in sys.argv:
         ps = [p for p in ps if p.quick][:40]
+    if "--only" in sys.argv:
+        prefix = sys.argv[sys.argv.index("--only") + 1]
+        ps = [p for p in ps if p.name.startswith(prefix)]
     results = []
     for k, p in enumerate(ps):
         r = run_probe(p)
@@ -468,6 +504,19 @@ def main():
         "quality_poor": sum(r["quality"] == 0 for r in results),
         "root_private_dev": bool(os.environ.get("OUTPUT_PROBES_INNER")),
     }
+    measured = [r for r in results if r["usage"]]
+    unmeasured = [r["name"] for r in results if r["usage"] is None and r["name"] in
+                  {p.name for p in ps if p.measure}]
+    if measured:
+        slow = max(measured, key=lambda r: r["usage"]["seconds"])
+        big = max(measured, key=lambda r: r["usage"]["peak_rss_mb"])
+        summary["unbounded_inputs"] = len(measured) + len(unmeasured)
+        summary["unbounded_not_measured"] = unmeasured
+        summary["unbounded_over_1s_or_100mb"] = [
+            r["name"] for r in measured
+            if r["usage"]["seconds"] >= 1.0 or r["usage"]["peak_rss_mb"] >= 100.0]
+        summary["slowest_refusal"] = [slow["name"], slow["usage"]["seconds"], slow["usage"]["peak_rss_mb"]]
+        summary["largest_refusal"] = [big["name"], big["usage"]["seconds"], big["usage"]["peak_rss_mb"]]
     with open(os.path.join(WORK, "report.json"), "w") as f:
         json.dump({"summary": summary, "results": results}, f, indent=1)
     with open(os.path.join(WORK, "report.md"), "w") as f:
@@ -478,6 +527,7 @@ def main():
                 "replaced: %s" % r["replaced"] if r["replaced"] else "",
                 "temporaries: %s" % r["temporaries"] if r["temporaries"] else "",
                 "missing: %s" % r["missing"] if r["expect"] == "fail" and r["missing"] else "",
+                "%.2f s, %.0f MB peak" % (r["usage"]["seconds"], r["usage"]["peak_rss_mb"]) if r["usage"] else "",
             ] if x)
             f.write("| %s | %s | %s | %s | %s | %d | %s |\n" % (
                 r["name"], r["expect"], r["code"], r["time"], "yes" if r["ok"] else "NO", r["quality"], note))

@@ -130,10 +130,21 @@ impl NoiseSummary {
     /// The level in words for a report line: `"1.579 % (estimated: ...)"`.
     pub fn describe(&self) -> String {
         if self.level.is_finite() {
-            format!("{:.3} % ({})", 100.0 * self.level, self.estimator)
+            format!("{} % ({})", percent(self.level), self.estimator)
         } else {
             "unknown (too few points to estimate it; declare relative_uncertainty)".into()
         }
+    }
+}
+
+/// A relative level \[-\] in percent for reports: three decimals (`"1.483"`), or three
+/// significant digits below 0.001 % (`"3.18e-6"`), never `"0.000"` for a positive level.
+pub fn percent(level: f64) -> String {
+    let p = 100.0 * level;
+    if p != 0.0 && p.abs() < 1e-3 {
+        format!("{p:.2e}")
+    } else {
+        format!("{p:.3}")
     }
 }
 

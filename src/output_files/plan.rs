@@ -229,9 +229,26 @@ fn check_file(path: &Path, inputs: &[PathBuf]) -> Result<Target, OutputError> {
             path: p,
             fifo: true,
         } => ensure_not_input(p, inputs)?,
+        Target::Special {
+            path: p,
+            fifo: false,
+        } => probe_device(p)?,
         _ => {}
     }
     Ok(t)
+}
+
+/// Whether the character device `path` takes writes, known before the work: it is opened for
+/// writing (never created) and given a zero-length write, which writes nothing anywhere but
+/// reports the device's refusal (`/dev/full`: "No space left on device"; a device without
+/// write permission: "Permission denied"). A device that fails only on real data (a full
+/// disk behind a block of a longer write, a terminal hung up later) is still reported when
+/// the output is written, after the work.
+fn probe_device(path: &Path) -> Result<(), OutputError> {
+    let io = |e| OutputError::io(path, e);
+    let mut f = fs::OpenOptions::new().write(true).open(path).map_err(io)?;
+    // `write`, not `write_all`: a zero-length `write_all` makes no system call
+    f.write(&[]).map(|_| ()).map_err(io)
 }
 
 /// What makes two outputs the same file.
@@ -282,7 +299,13 @@ pub(super) fn normalized(path: &Path) -> PathBuf {
             base = c;
             break;
         }
-        match (base.file_name().map(|n| n.to_os_string()), base.parent()) {
+        // the last component, also `..` (which `file_name` does not return: `out/../out/x`
+        // with `out` still missing must name the same file as `out/x`)
+        let last = base
+            .components()
+            .next_back()
+            .map(|c| c.as_os_str().to_os_string());
+        match (last, base.parent()) {
             (Some(n), Some(p)) => {
                 rest.push(n);
                 base = p.to_path_buf();

@@ -246,6 +246,24 @@ fn c01_without_root_a_link_to_a_character_device_stays_a_link_to_it() {
 }
 
 #[test]
+fn c03_json_to_dev_full_is_refused_before_the_fit() {
+    // [C03, issue 28 item 2] a zero-length write tells /dev/full's refusal before the work:
+    // the report of the fit never reaches stdout, and the error names the device
+    let (dir, toml, data) = shipped_copy("dev_full_before");
+    let link = dir.join("full.json");
+    std::os::unix::fs::symlink("/dev/full", &link).unwrap();
+    for target in [Path::new("/dev/full"), link.as_path()] {
+        let p = rheometer(&["fit", s(&toml), "--json", s(target)], &[&data], LIMIT);
+        p.assert_clean_failure(&["--json", "no space left on device"]);
+        assert!(!p.stdout.contains("[[Result"), "the fit ran:\n{}", p.stdout);
+        assert!(p.elapsed < Duration::from_secs(5), "{:?}", p.elapsed);
+    }
+    assert_eq!(kind(&link), "symlink");
+    assert_eq!(kind(Path::new("/dev/full")), "char device");
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn a24_a_fifo_is_written_in_place_and_its_reader_gets_the_json() {
     let (dir, toml, data) = shipped_copy("fifo_json");
     let fifo = dir.join("fifo");
@@ -395,6 +413,34 @@ fn c13_a_closed_stdout_loses_the_report_with_a_message_and_exit_one() {
         p.stderr
     );
     assert!(p.elapsed < Duration::from_secs(5));
+    // a stdout the caller opened read-write on /dev/null (bash `1<>`, Python's
+    // subprocess.DEVNULL) is open, not closed: the report goes there, exit 0
+    let p = bash(
+        &format!("\"$BIN\" --quiet fit {} 1<> /dev/null", s(&toml)),
+        &dir,
+        &[&data],
+        LIMIT,
+    );
+    assert_eq!(p.code, Some(0), "{}", p.stderr);
+    assert!(!p.stderr.contains("closed"), "{}", p.stderr);
+}
+
+#[test]
+fn s09_a_json_path_through_a_missing_directory_and_dotdot_is_the_same_file() {
+    // [S09] `out/../out/fit.json` with `out` not yet made names out/fit.json of --out out
+    let (dir, toml, data) = shipped_copy("dotdot_same_file");
+    let p = bash(
+        &format!(
+            "\"$BIN\" --quiet fit {} --json out/../out/fit.json --out out > /dev/null",
+            s(&toml)
+        ),
+        &dir,
+        &[&data],
+        LIMIT,
+    );
+    p.assert_clean_failure(&["--json", "--out", "name the same file"]);
+    assert!(!dir.join("out").join("fit.json").exists());
+    fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -897,6 +943,8 @@ fn dead_pid() -> u32 {
 
 #[test]
 fn b04_b20_temporaries_of_killed_runs_are_removed_by_the_next_run() {
+    // [B04, B04b] temporaries of runs killed at any moment (B04b: later in the run) carry the
+    // dead process's id and are removed by the next run
     let (dir, toml, data) = shipped_copy("stale_temporaries");
     let out = dir.join("sim");
     fs::create_dir_all(&out).unwrap();

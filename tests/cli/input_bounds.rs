@@ -418,6 +418,7 @@ fn rows_are_capped_per_file_and_by_the_fit_memory_while_reading() {
         &["v0p53_p1.csv:", "reach 101 rows", "max_fit_memory_bytes"],
     );
     // [E43, S24] 9 x 1e6 rows: refused while reading, long before the fit's 5.3 GB
+    // [S23] the same input under a memory cap: refused here, so there is no allocation to abort
     let mut big = String::from("position_m,diameter_m\n");
     for i in 0..1_000_000u32 {
         let s = 0.5 * f64::from(i) / 999_999.0;

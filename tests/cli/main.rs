@@ -8,6 +8,7 @@ mod cli_argument_probes;
 mod cli_output_layer;
 mod cli_output_safety;
 mod fit_html;
+mod fit_report_findings;
 mod input_bounds;
 mod input_loading;
 mod input_messages;

@@ -16,13 +16,39 @@ static REPORT_TO_STDERR: AtomicBool = AtomicBool::new(false);
 /// Whether stdout was closed when the program started (see [`stdout_was_closed`]).
 static STDOUT_CLOSED: OnceLock<bool> = OnceLock::new();
 
-/// Whether standard output was closed when the program started (`rheometer ... >&-`). The
-/// Rust runtime opens `/dev/null` read-write on a closed standard descriptor before `main`,
-/// so a closed stdout shows as `/dev/null` open for reading and writing (a shell's
+/// Whether descriptor 1 was closed when the process started, recorded by
+/// [`RECORD_STDOUT`] before the Rust runtime reopens closed standard descriptors.
+#[cfg(target_os = "linux")]
+static STDOUT_CLOSED_AT_START: AtomicBool = AtomicBool::new(false);
+
+/// A constructor (`.init_array`) that runs before the Rust runtime's start-up, which opens
+/// `/dev/null` on closed standard descriptors: it records whether descriptor 1 was open.
+#[cfg(target_os = "linux")]
+#[used]
+#[link_section = ".init_array"]
+static RECORD_STDOUT: extern "C" fn() = {
+    extern "C" fn record() {
+        // SAFETY: F_GETFD only reads descriptor 1's flags (-1 when it is not open)
+        if unsafe { libc::fcntl(1, libc::F_GETFD) } == -1 {
+            STDOUT_CLOSED_AT_START.store(true, Ordering::SeqCst);
+        }
+    }
+    record
+};
+
+/// Whether standard output was closed when the program started (`rheometer ... >&-`). On
+/// Linux a constructor records it before the Rust runtime opens `/dev/null` read-write on a
+/// closed standard descriptor, so a caller's own `/dev/null` opened read-write (Python's
+/// `subprocess.DEVNULL`, systemd's `StandardOutput=null`) is not mistaken for a closed stdout.
+/// Elsewhere a closed stdout is guessed as `/dev/null` open for reading and writing (a shell's
 /// `> /dev/null` opens it write-only).
 pub fn stdout_was_closed() -> bool {
     *STDOUT_CLOSED.get_or_init(|| {
-        #[cfg(unix)]
+        #[cfg(target_os = "linux")]
+        {
+            STDOUT_CLOSED_AT_START.load(Ordering::SeqCst)
+        }
+        #[cfg(all(unix, not(target_os = "linux")))]
         {
             // SAFETY: fstat and fcntl only read descriptor 1's state
             let mut st: libc::stat = unsafe { std::mem::zeroed() };

@@ -334,9 +334,12 @@ fn temperatures(
             field.finite()?,
             format!(
                 "the inlet temperature is only {:.4} K above the Vogel temperature vft_T_VF_K = \
-                 {} K: the VFT law mu_c exp(B/(T - T_VF)) gives {what}{hint}",
+                 {} K: the VFT law mu_c exp(B/(T - T_VF)) with vft_mu_c_Pa_s = {} and vft_B_K = \
+                 {} of [material] gives {what}{hint}",
                 t - t_vf,
-                readable(t_vf)
+                readable(t_vf),
+                readable(material.vft_mu_c),
+                readable(material.vft_b)
             ),
         ));
     }

@@ -183,15 +183,18 @@ impl ErrorBudget {
             .iter()
             .take(3)
             .map(|(e, s)| {
-                format!(
-                    "the {} ({}, {})",
-                    s.what,
-                    sigma_words(s, e.sigma),
-                    match e.origin {
-                        Origin::Default => "default",
-                        _ => "declared",
-                    }
-                )
+                let origin = match e.origin {
+                    Origin::Default => "default",
+                    _ => "declared",
+                };
+                match overrides_words(e, s) {
+                    Some(own) => format!(
+                        "the {} ({}, {origin}; {own})",
+                        s.what,
+                        sigma_words(s, e.sigma)
+                    ),
+                    None => format!("the {} ({}, {origin})", s.what, sigma_words(s, e.sigma)),
+                }
             })
             .collect();
         let remedy = sources.first().map_or("", |(_, s)| s.remedy);
@@ -290,6 +293,9 @@ impl ErrorBudget {
                 };
                 s.push_str(&format!("    {:<21} {:<18} {why}\n", e.key, sigma));
             }
+            if let Some(own) = overrides_words(e, &src) {
+                s.push_str(&format!("    {:<21} {own}\n", ""));
+            }
         }
         let line = |label: &str, sys: Option<f64>, stat: Option<f64>, tot: Option<f64>| {
             format!(
@@ -339,6 +345,32 @@ fn sign(v: f64) -> String {
 /// `σ` in words: "3 K", "2 %", "1 µm".
 fn sigma_words(s: &Source, sigma: f64) -> String {
     format!("{} {}", g3(sigma / s.word_unit.1), s.word_unit.0)
+}
+
+/// The experiments that declare their own standard uncertainty for `e`, in words (`None` if
+/// none does): `"own value in v0p27_p1: 5.00 %"`, at most three named, so that a shift caused
+/// by an override is not attributed to the data-set value alone.
+fn overrides_words(e: &BudgetEntry, s: &Source) -> Option<String> {
+    if e.overridden_in.is_empty() {
+        return None;
+    }
+    let own = |name: &String| {
+        e.by_experiment
+            .iter()
+            .find(|x| &x.experiment == name)
+            .map_or(name.clone(), |x| {
+                format!("{name}: {}", sigma_words(s, x.sigma))
+            })
+    };
+    let named: Vec<String> = e.overridden_in.iter().take(3).map(own).collect();
+    let more = e.overridden_in.len().saturating_sub(3);
+    let rest = if more > 0 {
+        format!(" and {more} more")
+    } else {
+        String::new()
+    };
+    let plural = if e.overridden_in.len() > 1 { "s" } else { "" };
+    Some(format!("own value{plural} in {}{rest}", named.join(", ")))
 }
 
 #[cfg(test)]

@@ -73,8 +73,8 @@ pub use identification::Identification;
 pub use identify::{StartPoint, PAPER_TABLE3_STARTS};
 pub use landscape::{Landscape, LandscapeRun, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
-pub use nested::{NestedFit, NestedStart};
 pub use likelihood::{NewtonianTest, OneSidedBound, ProfileInterval, ProfilePoint, ThinningBound};
+pub use nested::{NestedFit, NestedStart};
 pub use options::{
     BoundSide, CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError,
 };

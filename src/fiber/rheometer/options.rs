@@ -218,6 +218,8 @@ pub enum WarningCode {
     /// the law's range, a jump from the plain fit that the gain in fit does not pay for): the
     /// fit compensates a model error with the viscosity law; not a result.
     Implausible,
+    /// An effect fixed at a strength outside its physical range (`--with radiation=2`).
+    Unphysical,
 }
 
 impl WarningCode {
@@ -232,6 +234,7 @@ impl WarningCode {
             WarningCode::DataTrend => "data_trend",
             WarningCode::Systematic => "systematic",
             WarningCode::Implausible => "implausible",
+            WarningCode::Unphysical => "unphysical",
         }
     }
 }

@@ -160,6 +160,7 @@ impl FitSummary {
         );
         summary_checks::check_misfit(&summary, &mut w);
         summary_checks::check_law(&summary, &mut w);
+        summary_checks::check_fixed_effects(&summary, &mut w);
         summary.warnings = w;
         summary
     }

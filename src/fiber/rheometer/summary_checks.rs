@@ -25,8 +25,9 @@ use super::layout::EffectSlot;
 use super::options::{FitWarning, WarningCode};
 use super::summary::{BoundSide, FitSummary};
 pub use super::thresholds::{
-    AT_BOUND_TOLERANCE, ILL_CONDITIONED_RCOND, JUMP_SE, LARGE_STDERR_KAPPA, LARGE_STDERR_N,
-    LARGE_STDERR_STRENGTH_FRACTION, MISFIT_RATIO, MISFIT_WITHOUT_NOISE, PLAUSIBLE_N,
+    AT_BOUND_TOLERANCE, ILL_CONDITIONED_RCOND, IMPLAUSIBLE_NOISE_RATIO, JUMP_SE,
+    LARGE_STDERR_KAPPA, LARGE_STDERR_N, LARGE_STDERR_STRENGTH_FRACTION, MISFIT_RATIO,
+    MISFIT_WITHOUT_NOISE, PLAUSIBLE_N,
 };
 use crate::fiber::format::fmt_g;
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -201,6 +202,34 @@ fn check_covariance(
     }
 }
 
+/// An effect fixed (`--with radiation=2`) at a strength outside its physical range (G02):
+/// the fit then rests on a model no spinning line can have; an `unphysical` warning naming the effect, its value and its range ([`Effect::judge`](crate::fiber::effects::Effect::judge)).
+pub(crate) fn check_fixed_effects(s: &FitSummary, w: &mut Vec<FitWarning>) {
+    for e in &s.effects {
+        if e.strength.fitted {
+            continue;
+        }
+        let Ok(effect) = e.effect.parse::<crate::fiber::effects::Effect>() else {
+            continue;
+        };
+        if let Some(words) = effect.judge(e.strength.value) {
+            let (lo, hi) = effect.physical_range();
+            w.push(FitWarning::new(
+                WarningCode::Unphysical,
+                format!(
+                    "{} is fixed outside its physical range [{}, {}]: {words}; the fit rests on \
+                     a model no spinning line has (give a value inside the range, or fit it: \
+                     --with {})",
+                    e.effect,
+                    fmt_g(lo),
+                    fmt_g(hi),
+                    e.effect
+                ),
+            ));
+        }
+    }
+}
+
 /// An implausible material law (`n` below [`PLAUSIBLE_N`]: not a result), or a 95 % interval
 /// of `n` reaching beyond `[0, 1]` (the law's own range: the linearised interval is not
 /// reliable there; a large-uncertainty warning).
@@ -343,6 +372,12 @@ pub(crate) fn check_misfit(s: &FitSummary, w: &mut Vec<FitWarning>) {
     }
     if s.noise.declared() {
         m.push_str(" (or the declared relative_uncertainty is too small)");
+    } else if noise.is_finite() && rms > IMPLAUSIBLE_NOISE_RATIO * noise {
+        m.push_str(
+            "; the estimated noise level itself is implausibly small: rows without noise \
+             (interpolated, smoothed or synthetic) in some files dominate the estimate; thin \
+             them or declare relative_uncertainty at the top of the TOML",
+        );
     }
     m.push_str(": check their data, TOML entries (temperatures, take-up) and the model");
     w.push(FitWarning::new(WarningCode::Misfit, m));

@@ -47,7 +47,7 @@ impl FitSummary {
                 fmt_sig(value, 4),
                 side.name().to_uppercase()
             )
-        } else if !se.is_finite() {
+        } else if !(se.is_finite() && se > 0.0) {
             format!(
                 "    {label} {}{unit} (no standard error: singular covariance)",
                 fmt_sig(value, 5)
@@ -122,9 +122,9 @@ impl FitSummary {
         let rms = 100.0 * self.rms_relative_residual;
         if self.noise.level.is_finite() && self.noise.level > 0.0 {
             s.push_str(&format!(
-                "    fit: RMS relative residual {rms:.3} %, {:.2} times the noise level {:.3} %\n",
+                "    fit: RMS relative residual {rms:.3} %, {:.2} times the noise level {} %\n",
                 self.rms_relative_residual / self.noise.level,
-                100.0 * self.noise.level
+                crate::fiber::noise_summary::percent(self.noise.level)
             ));
         } else {
             s.push_str(&format!(

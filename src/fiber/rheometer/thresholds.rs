@@ -11,6 +11,10 @@ pub const MISFIT_RATIO: f64 = 3.0;
 /// Without any noise level (too few points to estimate it), the report warns when the RMS
 /// relative residual exceeds this \[-\].
 pub const MISFIT_WITHOUT_NOISE: f64 = 0.1;
+/// Misfit over an *estimated* noise level above which the estimate itself is suspect
+/// (c15b): real diameter gauges are not a thousand times more precise than a model's misfit,
+/// but interpolated or synthetic (noiseless) rows dominating the estimate make it so.
+pub const IMPLAUSIBLE_NOISE_RATIO: f64 = 1000.0;
 /// A standard error of `n` above this \[-\] is reported as huge.
 pub const LARGE_STDERR_N: f64 = 0.2;
 /// A standard error of `κ` above this \[-\] (a factor `e` in `K`) is reported as huge.

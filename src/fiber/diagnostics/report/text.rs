@@ -1,8 +1,8 @@
 //! The diagnosis in words ([`Diagnosis::to_text`]), paragraph by paragraph.
 
 use super::super::candidate::{Candidate, StrengthStatus};
-use super::super::diagnosis::Diagnosis;
 use super::super::diagnose::verdict::Verdict;
+use super::super::diagnosis::Diagnosis;
 use super::{
     estimate_with_ci, fmt_range, pm_unit, probability, profile_line, shape_alternative_line,
     unit_suffix, EXACT_TIE,
