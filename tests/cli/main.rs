@@ -7,6 +7,7 @@ mod probe;
 mod cli_argument_probes;
 mod cli_output_layer;
 mod cli_output_safety;
+mod design_cli;
 mod input_bounds;
 mod input_loading;
 mod input_messages;
