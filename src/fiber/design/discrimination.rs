@@ -564,8 +564,9 @@ mod tests {
         let mut acc = Normal::zero(1);
         acc.add(&follow, &refit, 0.5);
         assert!(acc.lambda().abs() < 1e-12);
-        // the expected ΔBIC is negative and about −λ for λ ≪ N
+        // the expected ΔBIC is −N ln(1 + λ/(N − q)): about −λ N/(N − q) for λ ≪ N
         let e = expected_delta_bic(2.0, 1000, 10);
-        assert!(e < 0.0 && (e + 2.0).abs() < 0.01, "{e}");
+        assert!((e + 1000.0 * (2.0f64 / 990.0).ln_1p()).abs() < 1e-12, "{e}");
+        assert!((e + 2.0 * 1000.0 / 990.0).abs() < 1e-3, "{e}");
     }
 }
