@@ -40,7 +40,7 @@ pub struct DesignArgs {
     /// direction).
     #[arg(long, default_value = "d", value_parser = Criterion::parse)]
     pub criterion: Criterion,
-    /// Rank the candidates by how well they tell rival explanations apart instead: "A,B[,C]",
+    /// Rank the candidates by how well they tell rival explanations apart instead: "A,B" or "A,B,C",
     /// each the model plus one effect (e.g. mass_flow_scale,nusselt_scale, a tie `diagnose`
     /// reports).
     #[arg(long, value_name = "EFFECT,EFFECT", value_parser = parse_rivals, conflicts_with = "criterion")]
