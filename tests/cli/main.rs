@@ -9,6 +9,7 @@ mod cli_output_layer;
 mod cli_output_safety;
 mod fit_html;
 mod fit_report_findings;
+mod design_cli;
 mod input_bounds;
 mod input_loading;
 mod input_messages;

@@ -9,6 +9,7 @@ mod probe;
 mod cold_start;
 mod compare;
 mod design;
+mod discrimination;
 mod effects_families;
 mod error_budget;
 mod fiber_physics;

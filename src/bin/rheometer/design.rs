@@ -1,7 +1,11 @@
 //! `rheometer design`.
 
 use crate::*;
-use diffbvp::fiber::design::{CandidateGrid, Criterion, Design, DesignRequest, TakeUpAxis};
+use diffbvp::fiber::design::{
+    CandidateGrid, Criterion, Design, DesignRequest, Discrimination, DiscriminationRequest,
+    TakeUpAxis,
+};
+use diffbvp::fiber::effects::Effect;
 use diffbvp::fiber::setup::TakeUp;
 use diffbvp::fiber::take_up::{resolve_take_up, MissingTakeUp};
 
@@ -36,11 +40,17 @@ pub struct DesignArgs {
     /// direction).
     #[arg(long, default_value = "d", value_parser = Criterion::parse)]
     pub criterion: Criterion,
+    /// Rank the candidates by how well they tell rival explanations apart instead: "A,B" or "A,B,C",
+    /// each the model plus one effect (e.g. mass_flow_scale,nusselt_scale, a tie `diagnose`
+    /// reports).
+    #[arg(long, value_name = "EFFECT,EFFECT", value_parser = parse_rivals, conflicts_with = "criterion")]
+    pub discriminate: Option<Rivals>,
     /// Start point "N,KAPPA" of the fit (default: the paper's start heuristic).
     #[arg(long, value_parser = checks::parse_pair, allow_hyphen_values = true)]
     pub start: Option<(f64, f64)>,
     /// Relative noise of the measurements, e.g. 0.015 for 1.5 % (default: the data set's
-    /// relative_uncertainty, else the fit's residual level).
+    /// relative_uncertainty, else the fit's residual level; with --discriminate, the fit
+    /// summary's noise level).
     #[arg(long, value_parser = parse_noise)]
     pub noise: Option<f64>,
     /// BVP tolerance of the candidates' solves (1e-12 to 0.1).
@@ -66,6 +76,31 @@ fn parse_noise(s: &str) -> Result<f64, String> {
         ));
     }
     Ok(v)
+}
+
+/// The rival effects of `--discriminate`.
+#[derive(Clone)]
+pub struct Rivals(pub Vec<Effect>);
+
+/// `--discriminate`: two or more distinct effect names, comma-separated.
+fn parse_rivals(s: &str) -> Result<Rivals, String> {
+    let effects: Vec<Effect> = s
+        .split(',')
+        .map(|t| t.trim().parse::<Effect>())
+        .collect::<Result<_, _>>()?;
+    if effects.len() < 2 {
+        return Err(format!(
+            "give at least two rival effects, comma-separated (e.g. \
+             mass_flow_scale,nusselt_scale); the effects are {}",
+            diffbvp::fiber::effects::ALL_NAMES.join(", ")
+        ));
+    }
+    for (i, e) in effects.iter().enumerate() {
+        if effects[..i].iter().any(|o| o.name() == e.name()) {
+            return Err(format!("effect {} given twice", e.name()));
+        }
+    }
+    Ok(Rivals(effects))
 }
 
 fn range(flag: &str, (lo, hi): (f64, f64), m: usize) -> Result<Vec<f64>, String> {
@@ -190,6 +225,45 @@ fn design_csv(d: &Design) -> String {
     s
 }
 
+/// Every candidate of a design for discrimination as CSV: grid indices, conditions, `λ` and
+/// expected `ΔBIC` of every ordered pair of rivals, rank, and why it is infeasible.
+fn discrimination_csv(d: &Discrimination) -> String {
+    let mut s = String::from("i,j,mass_flow_kg_s,take_up,");
+    for p in &d.current {
+        s.push_str(&format!(
+            "lambda_{t}_vs_{r},dbic_{t}_vs_{r},",
+            t = p.truth,
+            r = p.refitted
+        ));
+    }
+    s.push_str("min_lambda,rank,infeasible\n");
+    for c in &d.candidates {
+        s.push_str(&format!(
+            "{},{},{:e},{:e},",
+            c.candidate.i, c.candidate.j, c.candidate.mass_flow, c.candidate.take_up
+        ));
+        if c.separations.is_empty() {
+            s.push_str(&",".repeat(2 * d.current.len() + 2));
+        } else {
+            for p in &c.separations {
+                s.push_str(&format!("{},{},", p.lambda, p.expected_delta_bic));
+            }
+            s.push_str(&format!(
+                "{},{},",
+                c.min_lambda,
+                c.rank.map_or(String::new(), |r| r.to_string())
+            ));
+        }
+        let why = c.infeasible.as_deref().unwrap_or("");
+        if why.is_empty() {
+            s.push('\n');
+        } else {
+            s.push_str(&format!("\"{}\"\n", why.replace('"', "'")));
+        }
+    }
+    s
+}
+
 /// Runs `rheometer design`.
 pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let mut opts = IdentifyOptions::with_estimator(Estimator::Principled);
@@ -216,19 +290,41 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let outputs = outputs::check(&plan, g)?;
     let mut fit_request = FitRequest::new(opts);
     fit_request.start = args.start.map(|(n, k)| [n, k]);
-    let mut request = DesignRequest::new(grid, args.criterion);
-    request.simulate.tol = args.tol;
-    request.noise = args.noise;
-    request.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
-    g.say(format!(
-        "fitting, then {} candidate experiments ...",
-        request.grid.candidates().len()
-    ));
-    let run = workflow::design(&loaded, &fit_request, &request)?;
-    let d = &run.design;
-    let text = d.to_text();
+    let max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
+    let (text, json, csv) = match &args.discriminate {
+        Some(Rivals(effects)) => {
+            let mut request = DiscriminationRequest::new(grid);
+            request.simulate.tol = args.tol;
+            request.simulate.max_nodes = max_nodes;
+            request.noise = args.noise;
+            g.say(format!(
+                "fitting {} rivals, then {} candidate experiments ...",
+                effects.len(),
+                request.grid.candidates().len()
+            ));
+            let run = workflow::discriminate(&loaded, &fit_request, effects, &request)?;
+            let d = &run.design;
+            (
+                d.to_text(),
+                serde_json::to_string_pretty(d)?,
+                discrimination_csv(d),
+            )
+        }
+        None => {
+            let mut request = DesignRequest::new(grid, args.criterion);
+            request.simulate.tol = args.tol;
+            request.noise = args.noise;
+            request.simulate.max_nodes = max_nodes;
+            g.say(format!(
+                "fitting, then {} candidate experiments ...",
+                request.grid.candidates().len()
+            ));
+            let run = workflow::design(&loaded, &fit_request, &request)?;
+            let d = &run.design;
+            (d.to_text(), serde_json::to_string_pretty(d)?, design_csv(d))
+        }
+    };
     outln!("{text}");
-    let json = serde_json::to_string_pretty(d)?;
     if let Some(j) = &args.json {
         outputs.write_text(j, &json)?;
         g.say(format!("wrote {}", j.display()));
@@ -237,7 +333,7 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         let mut dir = outputs::DirWriter::begin(&outputs, out, "rheometer design", "files", names)?;
         dir.text("design.txt", &text)?;
         dir.text("design.json", &json)?;
-        dir.text("design.csv", &design_csv(d))?;
+        dir.text("design.csv", &csv)?;
         dir.finish()?;
         g.say(format!("wrote {}", out.display()));
     }

@@ -163,6 +163,29 @@ pub fn noise_level(id: &Identification, given: Option<f64>) -> f64 {
     (ss / dof as f64).sqrt()
 }
 
+/// The measurement positions \[m\] of the candidates of `grid`: the grid's or its template's,
+/// those on the template's spin line. Errors: none on the line.
+pub(super) fn candidate_positions(
+    rh: &Rheometer,
+    grid: &CandidateGrid,
+) -> Result<Vec<f64>, RheometerError> {
+    let template = &rh.experiments[grid.template];
+    let positions: Vec<f64> = grid
+        .positions
+        .clone()
+        .unwrap_or_else(|| rh.measurements[grid.template].positions.clone())
+        .into_iter()
+        .filter(|&s| s <= template.spinline_length)
+        .collect();
+    if positions.is_empty() {
+        return Err(RheometerError::Data(format!(
+            "no candidate measurement position lies on the spin line (0 to {} m)",
+            template.spinline_length
+        )));
+    }
+    Ok(positions)
+}
+
 /// The information of the current data: the sum of every experiment's.
 fn current_information(
     rh: &Rheometer,
@@ -247,19 +270,7 @@ pub fn design_for_estimation(
     let current = reference.predict(&current_info).ok_or_else(|| {
         RheometerError::Data("the current information is not positive definite".into())
     })?;
-    let positions: Vec<f64> = grid
-        .positions
-        .clone()
-        .unwrap_or_else(|| rh.measurements[grid.template].positions.clone())
-        .into_iter()
-        .filter(|&s| s <= template.spinline_length)
-        .collect();
-    if positions.is_empty() {
-        return Err(RheometerError::Data(format!(
-            "no candidate measurement position lies on the spin line (0 to {} m)",
-            template.spinline_length
-        )));
-    }
+    let positions = candidate_positions(rh, grid)?;
     let sigmas = vec![level; positions.len()];
     let mut params = id.local_params.clone();
     params[model0.take_up_factor_index()] = 1.0;
@@ -374,7 +385,15 @@ impl Context<'_> {
                     infeasible: None,
                     take_up_reading_m: f64::NAN,
                 };
-                match self.evaluate(&exp, last.as_ref()) {
+                match candidate_information(
+                    self.rh,
+                    &exp,
+                    self.params,
+                    (self.positions, self.sigmas),
+                    self.columns,
+                    last.as_ref(),
+                    self.options,
+                ) {
                     Ok((info, sol)) => {
                         let total: Vec<f64> = self
                             .current_info
@@ -392,39 +411,50 @@ impl Context<'_> {
             })
             .collect()
     }
+}
 
-    /// The candidate's information and solution, or why it has none.
-    fn evaluate(
-        &self,
-        exp: &crate::fiber::setup::Experiment,
-        warm: Option<&Solution>,
-    ) -> Result<(ExperimentInformation, Solution), String> {
-        let rh = self.rh;
-        let physics = rh.spec.physics().map_err(|e| e.to_string())?;
-        let model: CarreauFiber =
-            FiberModel::new(&rh.material, &rh.air, exp, CarreauLike::new(), physics)
-                .map_err(|e| e.to_string())?;
-        let sol = self.solve(&model, warm)?;
-        let info = experiment_information(&model, &sol, self.positions, self.sigmas, self.columns)
-            .map_err(|e| format!("sensitivities: {e}"))?;
-        if info.readings.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
-            return Err("the predicted diameter is not positive along the line".into());
-        }
-        Ok((info, sol))
+/// The information of candidate experiment `exp` under the model of `rh` at the local
+/// parameters `params` (take-up factor 1), measured at `positions` \[m\] with relative noise
+/// `sigmas` \[-\], and its solution; or why it has none. The BVP is warm-started from `warm`
+/// when that is a solution on the same spin line (a cold start where that fails).
+pub(super) fn candidate_information(
+    rh: &Rheometer,
+    exp: &crate::fiber::setup::Experiment,
+    params: &[f64],
+    (positions, sigmas): (&[f64], &[f64]),
+    columns: &Columns,
+    warm: Option<&Solution>,
+    options: &SimulateOptions,
+) -> Result<(ExperimentInformation, Solution), String> {
+    let physics = rh.spec.physics().map_err(|e| e.to_string())?;
+    let model: CarreauFiber =
+        FiberModel::new(&rh.material, &rh.air, exp, CarreauLike::new(), physics)
+            .map_err(|e| e.to_string())?;
+    let sol = solve_candidate(&model, params, warm, options)?;
+    let info = experiment_information(&model, &sol, positions, sigmas, columns)
+        .map_err(|e| format!("sensitivities: {e}"))?;
+    if info.readings.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
+        return Err("the predicted diameter is not positive along the line".into());
     }
+    Ok((info, sol))
+}
 
-    /// Warm start from a neighbour on the same spin line, else (or if that fails) a cold start.
-    fn solve(&self, model: &CarreauFiber, warm: Option<&Solution>) -> Result<Solution, String> {
-        let length = model.length();
-        if let Some(w) = warm.filter(|w| w.x.last().is_some_and(|x| (x - length).abs() < 1e-12)) {
-            let opts = self.options.solve_options();
-            let mut solver = Solver::new(model, opts.clone());
-            if let Ok(sol) = solver.solve_with(self.params, &Guess::from(w), &opts) {
-                return Ok(sol);
-            }
+/// Warm start from a neighbour on the same spin line, else (or if that fails) a cold start.
+fn solve_candidate(
+    model: &CarreauFiber,
+    params: &[f64],
+    warm: Option<&Solution>,
+    options: &SimulateOptions,
+) -> Result<Solution, String> {
+    let length = model.length();
+    if let Some(w) = warm.filter(|w| w.x.last().is_some_and(|x| (x - length).abs() < 1e-12)) {
+        let opts = options.solve_options();
+        let mut solver = Solver::new(model, opts.clone());
+        if let Ok(sol) = solver.solve_with(params, &Guess::from(w), &opts) {
+            return Ok(sol);
         }
-        simulate_params(model, self.params, None, self.options)
-            .map(|s| s.solution)
-            .map_err(|e| e.to_string())
     }
+    simulate_params(model, params, None, options)
+        .map(|s| s.solution)
+        .map_err(|e| e.to_string())
 }

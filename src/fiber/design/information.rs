@@ -50,6 +50,9 @@ pub struct ExperimentInformation {
     /// Relative sensitivities `∂ ln d(s_j)/∂θ_c` \[1/unit\], row-major `points × p` (shared
     /// parameters only).
     pub sensitivities: Vec<f64>,
+    /// Relative sensitivities `∂ ln d(s_j)/∂φ` \[-\] to the take-up factor, one per point
+    /// (empty when the take-up factor is held).
+    pub nuisance_sensitivities: Vec<f64>,
 }
 
 /// The information of one experiment: `model` solved as `sol` (its parameters the fitted
@@ -97,6 +100,7 @@ pub fn experiment_information(
     let mut cross = vec![0.0; p];
     let mut nn = 0.0;
     let mut sensitivities = Vec::with_capacity(xs.len() * p);
+    let mut nuisance_sensitivities = Vec::new();
     let mut row = vec![0.0; p];
     for (j, sigma) in sigmas.iter().enumerate() {
         let jr = &jac[j * q..(j + 1) * q];
@@ -111,6 +115,7 @@ pub fn experiment_information(
             }
         }
         if let Some(t) = columns.nuisance {
+            nuisance_sensitivities.push(jr[t]);
             for a in 0..p {
                 cross[a] += w * row[a] * jr[t];
             }
@@ -129,5 +134,6 @@ pub fn experiment_information(
         matrix,
         readings: values.iter().map(|v| v.exp() * scale).collect(),
         sensitivities,
+        nuisance_sensitivities,
     })
 }

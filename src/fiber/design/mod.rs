@@ -9,14 +9,22 @@
 //! * [`candidates`]: the grid of candidate experiments (mass flow × take-up condition) made
 //!   from a template experiment;
 //! * [`estimation`]: the design for estimation, ranking the candidates in parallel;
-//! * [`report`]: the design as text.
+//! * [`discrimination`]: the design for discrimination, ranking the candidates by how well
+//!   they tell rival explanations (the base model plus one effect or another) apart;
+//! * [`report`], [`discrimination_report`]: the designs as text.
 
 pub mod candidates;
 pub mod criteria;
+pub mod discrimination;
+pub mod discrimination_report;
 pub mod estimation;
 pub mod information;
 pub mod report;
 
 pub use candidates::{Candidate, CandidateGrid, TakeUpAxis};
 pub use criteria::{Criterion, Prediction};
+pub use discrimination::{
+    design_for_discrimination, Discrimination, DiscriminationOutcome, DiscriminationRequest, Rival,
+    RivalFit, Separation,
+};
 pub use estimation::{design_for_estimation, noise_level, CandidateOutcome, Design, DesignRequest};

@@ -65,6 +65,19 @@ impl Design {
                 first.infeasible.as_deref().unwrap_or("")
             );
         }
+        if let Some(b) = self.best() {
+            let _ = writeln!(
+                t,
+                "\nRecommended: {} (mass flow {:.4e} kg/s, {} {:.4e} {}): gain({}) {:.1} %",
+                b.name,
+                b.candidate.mass_flow,
+                self.grid.take_up.label(),
+                b.candidate.take_up,
+                self.grid.take_up.unit(),
+                self.criterion.name(),
+                100.0 * b.gain
+            );
+        }
         for n in &self.notes {
             let _ = writeln!(t, "\nNote: {n}");
         }

@@ -10,6 +10,7 @@
 //! | `diagnose` | [`diagnose()`] | [`DiagnosisRun`] |
 //! | `landscape` | [`landscape()`] | [`LandscapeRun`] |
 //! | `design` | [`design()`] | [`DesignRun`] (its [`Design`](crate::fiber::design::Design)) |
+//! | `design --discriminate` | [`discriminate()`] | [`DiscriminationRun`] (its [`Discrimination`](crate::fiber::design::Discrimination)) |
 //!
 //! ```no_run
 //! use diffbvp::fiber::input::load_experiments_with;
@@ -28,7 +29,7 @@ mod fit;
 mod simulate;
 
 pub use compare::{compare, CompareRequest};
-pub use design::{design, DesignRun};
+pub use design::{design, discriminate, DesignRun, DiscriminationRun};
 pub use fit::{fit, FitRequest, FitRun};
 pub use simulate::{simulate_experiments, SimulateError, SimulateRequest, SimulatedProfile};
 
