@@ -315,20 +315,7 @@ pub fn design_for_discrimination(
     }
     let first = rivals[0];
     let rh0 = first.rheometer;
-    for r in &rivals[1..] {
-        let same = r.rheometer.len() == rh0.len()
-            && r.rheometer
-                .measurements
-                .iter()
-                .zip(&rh0.measurements)
-                .all(|(a, b)| a.positions == b.positions);
-        if !same {
-            return Err(RheometerError::Data(format!(
-                "rivals {} and {} are not fitted to the same data",
-                first.name, r.name
-            )));
-        }
-    }
+    check_same_data(rivals)?;
     let grid = &request.grid;
     grid.validate().map_err(RheometerError::Data)?;
     let template = rh0.experiments.get(grid.template).ok_or_else(|| {
@@ -338,19 +325,7 @@ pub fn design_for_discrimination(
             rh0.len()
         ))
     })?;
-    let summary_noise = &first.fit.summary.noise;
-    let sigma = request.noise.unwrap_or(summary_noise.level);
-    if !(sigma > 0.0 && sigma.is_finite()) {
-        return Err(RheometerError::Data(format!(
-            "no noise level for the design ({sigma}): declare relative_uncertainty in the data \
-             set or give the noise level"
-        )));
-    }
-    let noise_source = if request.noise.is_some() {
-        "given".to_string()
-    } else {
-        format!("the fit's: {}", summary_noise.describe())
-    };
+    let (sigma, noise_source) = design_noise(first, request)?;
     let data: Vec<RivalData> = rivals
         .iter()
         .map(|&r| rival_data(r, sigma))
@@ -446,29 +421,9 @@ pub fn design_for_discrimination(
                 .collect::<Vec<_>>()
         })
         .collect();
-    let mut ranking: Vec<usize> = (0..candidates.len())
-        .filter(|&i| candidates[i].min_lambda.is_finite())
-        .collect();
-    ranking.sort_by(|&a, &b| {
-        candidates[b]
-            .min_lambda
-            .total_cmp(&candidates[a].min_lambda)
-    });
-    for (r, &i) in ranking.iter().enumerate() {
-        candidates[i].rank = Some(r + 1);
-    }
+    let ranking = rank_by_separation(&mut candidates);
     let rival_fits = rival_fits(rivals, n_now);
-    let notes = vec![
-        format!(
-            "predictions assume relative Gaussian noise of {:.3} % on every point ({noise_source}) \
-             and a take-up factor fitted per experiment; they are linearised at each rival's fit",
-            100.0 * sigma
-        ),
-        "lambda(A|B): the excess cost, in units of the noise variance, of rival B refitted to \
-         data that follow rival A; expected dBIC = BIC_A - BIC_B = -N ln(1 + lambda/(N - q)); \
-         ranked by the smaller lambda of the two orders (whichever rival is the truth)"
-            .into(),
-    ];
+    let notes = design_notes(sigma, &noise_source);
     Ok(Discrimination {
         rivals: rival_fits,
         noise_level: sigma,
@@ -481,6 +436,81 @@ pub fn design_for_discrimination(
         notes,
         wall_time_s: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// Errors unless every rival is fitted to the first one's experiments and positions.
+fn check_same_data(rivals: &[Rival<'_>]) -> Result<(), RheometerError> {
+    let first = rivals[0];
+    let rh0 = first.rheometer;
+    for r in &rivals[1..] {
+        let same = r.rheometer.len() == rh0.len()
+            && r.rheometer
+                .measurements
+                .iter()
+                .zip(&rh0.measurements)
+                .all(|(a, b)| a.positions == b.positions);
+        if !same {
+            return Err(RheometerError::Data(format!(
+                "rivals {} and {} are not fitted to the same data",
+                first.name, r.name
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The relative noise level σ \[-\] of the predictions (given, else the first rival's one
+/// noise level) and where it comes from.
+fn design_noise(
+    first: Rival<'_>,
+    request: &DiscriminationRequest,
+) -> Result<(f64, String), RheometerError> {
+    let summary_noise = &first.fit.summary.noise;
+    let sigma = request.noise.unwrap_or(summary_noise.level);
+    if !(sigma > 0.0 && sigma.is_finite()) {
+        return Err(RheometerError::Data(format!(
+            "no noise level for the design ({sigma}): declare relative_uncertainty in the data \
+             set or give the noise level"
+        )));
+    }
+    let source = if request.noise.is_some() {
+        "given".to_string()
+    } else {
+        format!("the fit's: {}", summary_noise.describe())
+    };
+    Ok((sigma, source))
+}
+
+/// Ranks the feasible candidates by their smallest separation, largest first (sets each
+/// candidate's `rank`; returns the indices in rank order).
+fn rank_by_separation(candidates: &mut [DiscriminationOutcome]) -> Vec<usize> {
+    let mut ranking: Vec<usize> = (0..candidates.len())
+        .filter(|&i| candidates[i].min_lambda.is_finite())
+        .collect();
+    ranking.sort_by(|&a, &b| {
+        candidates[b]
+            .min_lambda
+            .total_cmp(&candidates[a].min_lambda)
+    });
+    for (r, &i) in ranking.iter().enumerate() {
+        candidates[i].rank = Some(r + 1);
+    }
+    ranking
+}
+
+/// What the predictions assume, in words.
+fn design_notes(sigma: f64, noise_source: &str) -> Vec<String> {
+    vec![
+        format!(
+            "predictions assume relative Gaussian noise of {:.3} % on every point ({noise_source}) \
+             and a take-up factor fitted per experiment; they are linearised at each rival's fit",
+            100.0 * sigma
+        ),
+        "lambda(A|B): the excess cost, in units of the noise variance, of rival B refitted to \
+         data that follow rival A; expected dBIC = BIC_A - BIC_B = -N ln(1 + lambda/(N - q)); \
+         ranked by the smaller lambda of the two orders (whichever rival is the truth)"
+            .into(),
+    ]
 }
 
 /// The rivals' fits, their `BIC` relative to the best (`N` points).
