@@ -1,6 +1,6 @@
 //! The result of an identification as a value ([`Identification`]: the fit's summary and what
 //! the next computation needs), and how a fit started from a neighbouring one differs from a
-//! plain one ([`WarmFit`]). Produced by [`identify`](super::identify), refined by
+//! plain one (`WarmFit`). Produced by [`identify`](super::identify), refined by
 //! [`accuracy`](super::accuracy), read by the profiles, the error budget and the diagnosis.
 
 use super::layout::EffectSlot;
