@@ -16,7 +16,7 @@ use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::rheometer::{FitStart, Rheometer};
 use diffbvp::fiber::setup::ExperimentSet;
 use independent::dataset::{Faults, Scenario};
-use independent::model::{AirFlow, AirHeat};
+use independent::model::AirHeat;
 use independent::scenarios;
 use std::time::Instant;
 
@@ -32,16 +32,22 @@ struct Expect {
     truth_strengths: Vec<(&'static str, f64)>,
 }
 
-fn run(sc: &Scenario) -> (ExperimentSet, DiagnosisRun, f64) {
+/// The scenario's data set, diagnosed with the default options.
+fn diagnosed(sc: &Scenario) -> (ExperimentSet, DiagnosisRun) {
     let generated = sc.generate().unwrap();
     let set = load_experiments(&generated.toml).unwrap();
-    let t0 = Instant::now();
     let r = diagnose(
         &set,
         &ModelSpec::new(LawChoice::Carreau),
         &DiagnoseOptions::default(),
     )
     .unwrap();
+    (set, r)
+}
+
+fn run(sc: &Scenario) -> (ExperimentSet, DiagnosisRun, f64) {
+    let t0 = Instant::now();
+    let (set, r) = diagnosed(sc);
     let t = t0.elapsed().as_secs_f64();
     println!("{}", r.diagnosis.to_text());
     (set, r, t)
@@ -216,18 +222,7 @@ fn coflow_corners_fast_and_short_slow_and_long() {
             in a local minimum (n = 0.33, J 0.135 against 0.101 refitted from the truth); the \
             verdict is 'none of the candidates' and the law is marked not a result"]
 fn warm_air_and_coflow_together() {
-    let sc = Scenario {
-        name: "warm_air_and_coflow",
-        air_heat: AirHeat::InverseSquare {
-            excess: 150.0,
-            length: 0.08,
-        },
-        air_flow: AirFlow::Aspirator {
-            speed: 60.0,
-            length: 0.10,
-        },
-        ..scenarios::aspirator(60.0, 0.10, 2604)
-    };
+    let sc = scenarios::warm_air_and_coflow();
     check(
         &sc,
         &Expect {
@@ -411,14 +406,7 @@ fn false_alarm_rate_on_effect_free_sets() {
             take_up_noise: [1.0, 2.0][(k / 3) % 2],
             ..scenarios::control()
         };
-        let generated = sc.generate().unwrap();
-        let set = load_experiments(&generated.toml).unwrap();
-        let r = diagnose(
-            &set,
-            &ModelSpec::new(LawChoice::Carreau),
-            &DiagnoseOptions::default(),
-        )
-        .unwrap();
+        let (_, r) = diagnosed(&sc);
         if !r.diagnosis.found.is_empty() {
             println!(
                 "FALSE ALARM | set {k} | noise {} | {:?}",
@@ -467,14 +455,7 @@ fn power_at_twice_the_detection_limit_of_radiation() {
     let mut found = 0;
     for k in 0..sets {
         let sc = scenarios::radiating(emissivity, 9_000 + k as u64);
-        let generated = sc.generate().unwrap();
-        let set = load_experiments(&generated.toml).unwrap();
-        let r = diagnose(
-            &set,
-            &ModelSpec::new(LawChoice::Carreau),
-            &DiagnoseOptions::default(),
-        )
-        .unwrap();
+        let (_, r) = diagnosed(&sc);
         if r.diagnosis.found.iter().any(|f| f == "radiation") {
             found += 1;
         } else {

@@ -10,24 +10,11 @@ use crate::independent;
 use diffbvp::fiber::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
 use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::rheometer::{Estimator, IdentifyOptions, NestedStart, Rheometer};
-use independent::dataset::Scenario;
-use independent::model::{AirFlow, AirHeat};
 use independent::scenarios;
 
 #[test]
 fn a_fitted_effect_never_leaves_the_fit_worse_than_without_it() {
-    let sc = Scenario {
-        name: "nested_warm_air_and_coflow",
-        air_heat: AirHeat::InverseSquare {
-            excess: 150.0,
-            length: 0.08,
-        },
-        air_flow: AirFlow::Aspirator {
-            speed: 60.0,
-            length: 0.10,
-        },
-        ..scenarios::aspirator(60.0, 0.10, 2604)
-    };
+    let sc = scenarios::warm_air_and_coflow();
     let set = load_experiments(&sc.generate().unwrap().toml).unwrap();
     let opts = IdentifyOptions {
         estimator: Estimator::Principled,

@@ -287,6 +287,24 @@ pub fn warm_air(heat: AirHeat, seed: u64) -> Scenario {
     }
 }
 
+/// Warm air near the die (+150 K, inverse-square decay over 0.08 m) and an aspirator jet at
+/// the take-up (60 m/s, Lorentzian of 0.10 m) together: two effects at once (issue 26; the
+/// book's `data/two_effects`).
+pub fn warm_air_and_coflow() -> Scenario {
+    Scenario {
+        name: "warm_air_and_coflow",
+        air_heat: AirHeat::InverseSquare {
+            excess: 150.0,
+            length: 0.08,
+        },
+        air_flow: AirFlow::Aspirator {
+            speed: 60.0,
+            length: 0.10,
+        },
+        ..aspirator(60.0, 0.10, 2604)
+    }
+}
+
 /// Grey-body radiation with emissivity `emissivity`.
 pub fn radiating(emissivity: f64, seed: u64) -> Scenario {
     Scenario {

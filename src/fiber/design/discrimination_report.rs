@@ -2,7 +2,7 @@
 //! reach, the best candidates with their predicted separations, and the infeasible ones.
 
 use super::discrimination::{Discrimination, DiscriminationOutcome, Separation};
-use super::report::TEXT_TOP;
+use super::report::{infeasible_paragraph, TEXT_TOP};
 use std::fmt::Write as _;
 
 impl Discrimination {
@@ -57,20 +57,13 @@ impl Discrimination {
                 );
             }
         }
-        let bad: Vec<&DiscriminationOutcome> = self
-            .candidates
-            .iter()
-            .filter(|c| c.infeasible.is_some())
-            .collect();
-        if let Some(first) = bad.first() {
-            let _ = writeln!(
-                t,
-                "\n{} candidates infeasible (no solution of a rival's model), e.g. {}: {}",
-                bad.len(),
-                first.name,
-                first.infeasible.as_deref().unwrap_or("")
-            );
-        }
+        infeasible_paragraph(
+            &mut t,
+            "a rival's model",
+            self.candidates
+                .iter()
+                .filter_map(|c| Some((c.name.as_str(), c.infeasible.as_deref()?))),
+        );
         if let Some(b) = self.best() {
             let _ = writeln!(
                 t,

@@ -51,20 +51,13 @@ impl Design {
                 let _ = writeln!(t, "  ...\nWorst feasible candidate:\n{}", self.line(w));
             }
         }
-        let bad: Vec<&CandidateOutcome> = self
-            .candidates
-            .iter()
-            .filter(|c| c.infeasible.is_some())
-            .collect();
-        if let Some(first) = bad.first() {
-            let _ = writeln!(
-                t,
-                "\n{} candidates infeasible (no solution of the model), e.g. {}: {}",
-                bad.len(),
-                first.name,
-                first.infeasible.as_deref().unwrap_or("")
-            );
-        }
+        infeasible_paragraph(
+            &mut t,
+            "the model",
+            self.candidates
+                .iter()
+                .filter_map(|c| Some((c.name.as_str(), c.infeasible.as_deref()?))),
+        );
         if let Some(b) = self.best() {
             let _ = writeln!(
                 t,
@@ -124,5 +117,22 @@ impl Design {
             );
         }
         l
+    }
+}
+
+/// The count of infeasible candidates with the first one's name and reason (`(name, reason)`
+/// of each; `model`: what could not be solved, e.g. "the model"); nothing when there are none.
+pub(super) fn infeasible_paragraph<'a>(
+    t: &mut String,
+    model: &str,
+    infeasible: impl Iterator<Item = (&'a str, &'a str)>,
+) {
+    let bad: Vec<(&str, &str)> = infeasible.collect();
+    if let Some((name, reason)) = bad.first() {
+        let _ = writeln!(
+            t,
+            "\n{} candidates infeasible (no solution of {model}), e.g. {name}: {reason}",
+            bad.len()
+        );
     }
 }
