@@ -135,6 +135,16 @@ fn main() -> Result<(), Box<dyn Error>> {
         se[1],
         100.0 * id.summary.rms_relative_residual
     );
+    let solver = &id.summary.solver;
+    println!(
+        "accuracy: BVP tolerance {:.0e}, discretisation shift {:.4} standard errors (checked at \
+         {:.0e}), nodes per experiment {}–{}",
+        solver.bvp_tolerance,
+        solver.discretisation_shift_se,
+        solver.check_tolerance,
+        solver.nodes.iter().min().unwrap_or(&0),
+        solver.nodes.iter().max().unwrap_or(&0)
+    );
     println!("time: data {t_data:.2} s, fit {t_fit:.2} s, standard errors {t_se:.3} s");
     Ok(())
 }

@@ -174,6 +174,33 @@ impl BlockCovariance {
         v
     }
 
+    /// The product `cov · v` (length `P`) without the `P × P` matrix: linear in the number of
+    /// blocks. With `cov = (JᵀJ)⁻¹` (unit variance) and `v = Jᵀ d` it is the least-squares
+    /// response of the parameters to a residual change `d`.
+    pub fn mul_vec(&self, v: &[f64]) -> Vec<f64> {
+        let st = &self.structure;
+        let ns = st.num_shared();
+        let vs = DVector::from_column_slice(&v[..ns]);
+        // Σ_m G_mᵀ v_m and Σ_m E_mᵀ v_m
+        let mut gv = DVector::zeros(ns);
+        let mut ev = DVector::zeros(ns);
+        let mut xs = &self.y * &vs;
+        for k in 0..st.num_blocks() {
+            let vk = DVector::from_column_slice(&v[st.locals(k)]);
+            gv += self.g[k].transpose() * &vk;
+            ev += self.e[k].transpose() * &vk;
+            xs -= self.f[k].transpose() * &vk;
+        }
+        let mut x = Vec::with_capacity(st.num_params());
+        x.extend(xs.iter());
+        for k in 0..st.num_blocks() {
+            let vk = DVector::from_column_slice(&v[st.locals(k)]);
+            let xk = &self.a[k] * &vk - &self.f[k] * &vs + &self.f[k] * &gv - &self.g[k] * &ev;
+            x.extend(xk.iter());
+        }
+        x
+    }
+
     /// The dense covariance (row-major `P × P`: `P²` numbers; for small fits and reports).
     pub fn to_dense(&self) -> Vec<f64> {
         let st = &self.structure;
@@ -224,6 +251,25 @@ mod tests {
         let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for (i, (x, y)) in a.iter().zip(b).enumerate() {
             assert!((x - y).abs() <= 1e-10 * scale, "entry {i}: {x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn products_equal_the_dense_matrix_times_the_vector() {
+        let j = jacobian();
+        let np = 6;
+        let psi: Vec<f64> = (0..18).map(|i| 0.3 + 0.05 * i as f64).collect();
+        let w: Vec<f64> = (0..18).map(|i| 1.0 - 0.02 * i as f64).collect();
+        let v: Vec<f64> = (0..np).map(|i| (i as f64 * 1.3).sin()).collect();
+        for c in [
+            BlockCovariance::linear(&j, 0.7).unwrap(),
+            BlockCovariance::sandwich(&j, &w, &psi, 1.1).unwrap(),
+        ] {
+            let d = c.to_dense();
+            let dense: Vec<f64> = (0..np)
+                .map(|i| (0..np).map(|k| d[i * np + k] * v[k]).sum())
+                .collect();
+            assert_close(&c.mul_vec(&v), &dense);
         }
     }
 

@@ -467,6 +467,30 @@ impl FitResult {
         BlockCovariance::sandwich(bj, &weights, &psi, nr as f64 / dof)
     }
 
+    /// The parameters' least-squares response `Δp = −(JᵀJ)⁻¹ Jᵀ d` to a change `d` of the
+    /// residuals with the model's parameters fixed (length `P`; `None` if `JᵀJ` is singular or
+    /// `d` has the wrong length). A block-arrow fit computes it through the Schur complement:
+    /// time and memory linear in the number of blocks, no `N × P` matrix.
+    pub fn linear_response(&self, d: &[f64]) -> Option<Vec<f64>> {
+        if d.len() != self.residuals.len() {
+            return None;
+        }
+        let np = self.p.len();
+        let g = match &self.block_jacobian {
+            Some(bj) => {
+                let c = BlockCovariance::linear(bj, 1.0)?;
+                c.mul_vec(&bj.tr_mul_vec(d))
+            }
+            None => {
+                let j = DMatrix::from_row_slice(d.len(), np, &self.jacobian);
+                let chol = (j.transpose() * &j).cholesky()?;
+                let x = chol.solve(&(j.transpose() * DVector::from_column_slice(d)));
+                x.iter().copied().collect()
+            }
+        };
+        Some(g.into_iter().map(|x| -x).collect())
+    }
+
     /// The Jacobian at `p`, dense row-major `N × P` (a copy of [`jacobian`](Self::jacobian),
     /// or the block-arrow Jacobian expanded: `N · P` numbers).
     pub fn dense_jacobian(&self) -> Vec<f64> {

@@ -16,9 +16,6 @@ use super::data::Rheometer;
 use super::identification::{Identification, WarmFit};
 use super::layout::FitStart;
 use super::options::{IdentifyOptions, RheometerError};
-use super::parameter_shift::ParameterShift;
-use crate::least_squares::LeastSquaresProblem;
-use nalgebra::DVector;
 
 /// The check re-solves this many times more accurately than the fit.
 pub const CHECK_FACTOR: f64 = 100.0;
@@ -41,6 +38,8 @@ pub(crate) fn discretisation_shift(
     let check_tol = (options.simulate.tol / CHECK_FACTOR).max(TIGHTEST_CHECK);
     let mut fine = options.clone();
     fine.simulate.tol = check_tol;
+    // residuals only: no linearisation kept per experiment
+    fine.simulate.factor_at_solution = false;
     fine.loose_tolerance = None;
     // the check is part of the fit already reported, not a fit of its own
     fine.progress = None;
@@ -49,7 +48,7 @@ pub(crate) fn discretisation_shift(
         ..start.clone()
     };
     let mut obj = rh.objective_from(&fs, &fine)?;
-    let (r_fine, _) = obj.evaluate(&id.fit.p)?;
+    let r_fine = obj.residuals_only(&id.fit.p)?;
     let r = &id.fit.residuals;
     if r_fine.len() != r.len() {
         return Err(RheometerError::Data(format!(
@@ -58,9 +57,14 @@ pub(crate) fn discretisation_shift(
             r.len()
         )));
     }
-    let dr = DVector::from_iterator(r.len(), r_fine.iter().zip(r).map(|(a, b)| a - b));
+    let dr: Vec<f64> = r_fine.iter().zip(r).map(|(a, b)| a - b).collect();
     let q = id.fit.p.len();
-    let shift = ParameterShift::new(&id.fit.dense_jacobian(), r.len(), q)?.derivative(&dr);
+    // through the Schur complement for a block-arrow fit: linear in the experiments
+    let shift = id.fit.linear_response(&dr).ok_or_else(|| {
+        RheometerError::Data(
+            "JᵀJ of the fit is singular (the fit's parameters are not determined)".into(),
+        )
+    })?;
     let se = id
         .fit
         .standard_errors()

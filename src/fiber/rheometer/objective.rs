@@ -333,6 +333,12 @@ impl<'a> Objective<'a> {
         }
     }
 
+    /// The residuals alone at global parameters `p` (no Jacobian, no sensitivities); the
+    /// solutions become pending.
+    pub(super) fn residuals_only(&mut self, p: &[f64]) -> Result<Vec<f64>, RheometerError> {
+        Ok(self.eval(p, false)?.0)
+    }
+
     /// Residuals (and the Jacobian if `with_jacobian`) at global parameters `p`; the solutions
     /// become pending (accepted by [`LeastSquaresProblem::accept`]).
     fn eval(

@@ -10,7 +10,8 @@ use super::summary::{
 use super::summary_checks::{self, bound_side};
 use crate::fiber::effects::LawChoice;
 use crate::fiber::noise_summary::NoiseSummary;
-use crate::least_squares::FitResult;
+use crate::least_squares::{BlockCovariance, FitResult};
+use nalgebra::DMatrix;
 
 /// What an identification hands to [`FitSummary::new`]: the fit and its model's layout.
 pub(crate) struct SummaryInput<'a> {
@@ -44,27 +45,100 @@ pub(crate) struct SummaryInput<'a> {
 struct Uncertainty {
     se: Vec<f64>,
     have_se: bool,
-    corr: Option<Vec<f64>>,
-    cov: Option<Vec<f64>>,
+    cov: Option<CovarianceView>,
+    /// Correlation matrices whose conditioning is checked (see [`CovarianceView::groups`]).
+    corr_groups: Option<Vec<DMatrix<f64>>>,
     sides: Vec<Option<BoundSide>>,
+}
+
+/// Above this many fitted parameters the conditioning is checked on sub-matrices (the
+/// eigen-decomposition of the whole `P × P` correlation costs `P³`).
+const DENSE_CONDITION_LIMIT: usize = 400;
+
+/// The fit's covariance: dense for a dense fit, compact (through the Schur complement, never
+/// `P × P`) for a block-arrow fit.
+enum CovarianceView {
+    Dense { c: Vec<f64>, np: usize },
+    Block(BlockCovariance),
+}
+
+impl CovarianceView {
+    fn of(fit: &FitResult) -> Option<Self> {
+        if fit.block_jacobian.is_some() {
+            fit.block_covariance().map(CovarianceView::Block)
+        } else {
+            fit.covariance()
+                .map(|c| CovarianceView::Dense { c, np: fit.p.len() })
+        }
+    }
+
+    fn get(&self, i: usize, j: usize) -> f64 {
+        match self {
+            CovarianceView::Dense { c, np } => c[i * np + j],
+            CovarianceView::Block(b) => b.get(i, j),
+        }
+    }
+
+    fn variances(&self) -> Vec<f64> {
+        match self {
+            CovarianceView::Dense { c, np } => (0..*np).map(|i| c[i * np + i]).collect(),
+            CovarianceView::Block(b) => b.variances(),
+        }
+    }
+
+    fn correlation(&self, i: usize, j: usize) -> f64 {
+        self.get(i, j) / (self.get(i, i) * self.get(j, j)).sqrt()
+    }
+
+    /// The parameter groups whose correlation matrix is checked for conditioning: all `P`
+    /// parameters up to [`DENSE_CONDITION_LIMIT`]; beyond, for a block-arrow fit, the shared
+    /// parameters with each block's local ones (principal sub-matrices: their conditioning is
+    /// never worse than the whole matrix', so the check may miss a combination spread over
+    /// several experiments but never warns wrongly).
+    fn groups(&self, np: usize) -> Vec<Vec<usize>> {
+        match self {
+            CovarianceView::Block(b) if np > DENSE_CONDITION_LIMIT => {
+                let st = b.structure();
+                (0..st.num_blocks())
+                    .map(|k| (0..st.num_shared()).chain(st.locals(k)).collect())
+                    .collect()
+            }
+            _ => vec![(0..np).collect()],
+        }
+    }
+
+    fn correlation_of(&self, group: &[usize]) -> DMatrix<f64> {
+        DMatrix::from_fn(group.len(), group.len(), |a, b| {
+            self.correlation(group[a], group[b])
+        })
+    }
 }
 
 impl Uncertainty {
     fn of(input: &SummaryInput<'_>) -> Self {
         let fit = input.fit;
         let np = fit.p.len();
-        let se_opt = fit.standard_errors();
+        let cov = CovarianceView::of(fit);
+        let se_opt: Option<Vec<f64>> = cov.as_ref().map(|c| {
+            c.variances()
+                .into_iter()
+                .map(|x| x.max(0.0).sqrt())
+                .collect()
+        });
         let sides = (0..np)
             .map(|c| match (input.lower.get(c), input.upper.get(c)) {
                 (Some(&lo), Some(&hi)) => bound_side(fit.p[c], lo, hi),
                 _ => None,
             })
             .collect();
+        let corr_groups = cov
+            .as_ref()
+            .map(|c| c.groups(np).iter().map(|g| c.correlation_of(g)).collect());
         Uncertainty {
             have_se: se_opt.is_some(),
             se: se_opt.unwrap_or_else(|| vec![f64::NAN; np]),
-            corr: fit.correlation(),
-            cov: fit.covariance(),
+            cov,
+            corr_groups,
             sides,
         }
     }
@@ -100,8 +174,8 @@ impl FitSummary {
             at_bound: kappa.at_bound,
         };
         let np = input.fit.p.len();
-        let correlation_n_kappa = match (ni, ki, &u.corr) {
-            (Some(a), Some(b), Some(c)) => c[a * np + b],
+        let correlation_n_kappa = match (ni, ki, &u.cov) {
+            (Some(a), Some(b), Some(c)) => c.correlation(a, b),
             _ => f64::NAN,
         };
         let effects = effect_estimates(&input, &u);
@@ -154,7 +228,7 @@ impl FitSummary {
             &summary,
             input.effects,
             u.have_se,
-            u.corr.as_deref(),
+            u.corr_groups.as_deref(),
             np,
             &mut w,
         );
@@ -216,7 +290,6 @@ fn effect_estimates(input: &SummaryInput<'_>, u: &Uncertainty) -> Vec<EffectEsti
 /// parameter runs against the strength change the sign of their rows and columns).
 fn covariance(input: &SummaryInput<'_>, u: &Uncertainty) -> Option<Covariance> {
     let cov = u.cov.as_ref()?;
-    let np = input.fit.p.len();
     let ns = input.names.len();
     if ns == 0 {
         return None;
@@ -234,7 +307,7 @@ fn covariance(input: &SummaryInput<'_>, u: &Uncertainty) -> Option<Covariance> {
     let mut matrix = Vec::with_capacity(ns * ns);
     for i in 0..ns {
         for j in 0..ns {
-            matrix.push(sign[i] * sign[j] * cov[i * np + j]);
+            matrix.push(sign[i] * sign[j] * cov.get(i, j));
         }
     }
     Some(Covariance {

@@ -89,7 +89,7 @@ pub(crate) fn check_uncertainty(
     s: &FitSummary,
     slots: &[EffectSlot],
     have_se: bool,
-    corr: Option<&[f64]>,
+    corr: Option<&[DMatrix<f64>]>,
     np: usize,
     w: &mut Vec<FitWarning>,
 ) {
@@ -154,7 +154,7 @@ pub(crate) fn check_uncertainty(
 fn check_covariance(
     s: &FitSummary,
     have_se: bool,
-    corr: Option<&[f64]>,
+    corr: Option<&[DMatrix<f64>]>,
     np: usize,
     w: &mut Vec<FitWarning>,
 ) {
@@ -175,20 +175,30 @@ fn check_covariance(
         ));
         return;
     }
-    let Some(c) = corr else { return };
-    let m = DMatrix::from_row_slice(np, np, c);
-    if m.iter().all(|v| v.is_finite()) {
-        let ev = SymmetricEigen::new(m).eigenvalues;
-        let max = ev.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let min = ev.iter().fold(f64::INFINITY, |a, v| a.min(v.abs()));
-        if max > 0.0 && min / max < ILL_CONDITIONED_RCOND {
+    let Some(groups) = corr else { return };
+    if groups.iter().all(|m| m.iter().all(|v| v.is_finite())) {
+        // the worst reciprocal condition number over the checked correlation matrices
+        let rcond = groups
+            .iter()
+            .map(|m| {
+                let ev = SymmetricEigen::new(m.clone()).eigenvalues;
+                let max = ev.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                let min = ev.iter().fold(f64::INFINITY, |a, v| a.min(v.abs()));
+                if max > 0.0 {
+                    min / max
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .fold(f64::INFINITY, f64::min);
+        if rcond < ILL_CONDITIONED_RCOND {
             w.push(FitWarning::new(
                 WarningCode::IllConditioned,
                 format!(
                     "the covariance is ill-conditioned (reciprocal condition number {:.1e} of \
                      the correlation matrix): some combination of the fitted parameters is not \
                      determined by the data; standard errors are unreliable",
-                    min / max
+                    rcond
                 ),
             ));
         }
