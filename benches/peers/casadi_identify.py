@@ -33,11 +33,13 @@ boundary conditions as equality constraints, solved by IPOPT (CasADi `nlpsol`, e
 MUMPS). Bounds on (n, kappa) are ours: [0, 1] x [7, 20].
 
 Start: (n, kappa) = (0.5, 15), the start our heuristic prints for this data set (`--start`
-changes it). The states are started from the data (a simultaneous method's natural start):
-u from the measured diameters (log-linear interpolation, extrapolated to L) at a guessed
-temperature, epsdot = du/ds, T(s) = T_air + (T_in - T_air) exp(-s/L), N from the constitutive
-relation N = Q mu_e(T, epsdot) epsdot / (Re rho u) at the start (n, kappa). No simulation of ours
-is used.
+changes it). The states start from a shooting solve at that law (class `Shooting`: CVODES from
+the nozzle, epsdot(0) bisected until d(L) meets the data extrapolated to L), the analogue of our
+cold start; no simulation of ours is used. `--init data` starts them from the data instead
+(u from the measured diameters at a guessed temperature, epsdot = du/ds, N from the
+constitutive relation); IPOPT does not converge from there on the shipped data.
+IPOPT options: mu_strategy adaptive (the default monotone strategy fails from the shooting
+start), tol 1e-10, at most 500 iterations.
 
 Output (units): n [-], kappa [-] (K = exp(kappa) Pa), J [-], RMS relative residual [%],
 fitted take-up diameters d(L) [um], IPOPT iterations and status, wall times [s] (build, solve,
