@@ -530,8 +530,8 @@ def main():
         out["ours"] = dict(n=on, kappa=ok, cost=oj, se_n=sn, se_kappa=sk)
         out["diff_se"] = dict(n=(n - on) / sn, kappa=(kappa - ok) / sk)
         print(f"ours: n = {on:.6f} ± {sn:.4f}, kappa = {ok:.6f} ± {sk:.4f}, J = {oj:.7e}")
-        print(f"peer - ours: n {n - on:+.2e} ({out['diff_se']['n']:+.3f} SE), kappa {kappa - ok:+.2e} "
-              f"({out['diff_se']['kappa']:+.3f} SE), J {J - oj:+.3e} ({100 * (J - oj) / oj:+.3f} %)")
+        print(f"peer - ours: n {n - on:+.2e} ({out['diff_se']['n']:+.2e} SE), kappa {kappa - ok:+.2e} "
+              f"({out['diff_se']['kappa']:+.2e} SE), J {J - oj:+.3e} ({100 * (J - oj) / oj:+.3f} %)")
     if a.json:
         with open(a.json, "w") as f:
             json.dump(out, f, indent=1)
