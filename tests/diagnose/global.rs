@@ -439,7 +439,10 @@ fn false_alarm_rate_on_effect_free_sets() {
 /// found; 80 % is the issue's target.
 /// `cargo test --release --test diagnose global::power -- --ignored --nocapture`.
 #[test]
-#[ignore = "a study: ~10 s per set"]
+#[ignore = "a study, ~25 min for 5 x 20 sets; measured (stop 34): radiation 20/20, \
+            die_temperature_offset 20/20, mass_flow_scale 13/20 (the misses name nusselt_scale), \
+            gauge_scale 14/20 (they name inlet_diameter), gauge_offset 9/20 (scattered): short of \
+            80 % for three; something was named in all 100 sets"]
 fn power_at_twice_the_detection_limit() {
     let sets: usize = std::env::var("DIFFBVP_POWER_SETS")
         .ok()
