@@ -150,6 +150,40 @@ fn block_fit_is_the_dense_fit_for_every_loss() {
     }
 }
 
+/// The least-squares response `−(JᵀJ)⁻¹ Jᵀ d` of a block-arrow fit (through the Schur
+/// complement) equals the dense fit's, and both equal the response computed here from the
+/// dense Jacobian by normal equations.
+#[test]
+fn linear_response_of_a_block_fit_is_the_dense_one() {
+    let m = 7;
+    let mut p0 = vec![0.3, 0.0];
+    p0.extend(std::iter::repeat_n(1.0, m));
+    let opts = options(m, Loss::Linear);
+    let block = fit(&mut Decays::new(m, true), &p0, &opts).unwrap();
+    let dense = fit(&mut Decays::new(m, false), &p0, &opts).unwrap();
+    let (nr, np) = (block.residuals.len(), block.p.len());
+    let d: Vec<f64> = (0..nr).map(|i| (0.7 * i as f64).sin()).collect();
+    let j = nalgebra::DMatrix::from_row_slice(nr, np, &block.dense_jacobian());
+    let direct = -(j.transpose() * &j).try_inverse().unwrap()
+        * (j.transpose() * nalgebra::DVector::from_column_slice(&d));
+    let via_block = block.linear_response(&d).unwrap();
+    let via_dense = dense.linear_response(&d).unwrap();
+    let scale = direct.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for i in 0..np {
+        assert!(
+            (via_block[i] - direct[i]).abs() <= 1e-8 * scale,
+            "{i}: {via_block:?} vs {direct}"
+        );
+        assert!(
+            (via_dense[i] - direct[i]).abs() <= 1e-6 * scale,
+            "{i}: {via_dense:?} vs {direct}"
+        );
+    }
+    // a change of the wrong length is refused
+    assert!(block.linear_response(&d[1..]).is_none());
+    assert!(dense.linear_response(&d[1..]).is_none());
+}
+
 /// `y' = −λ y`, `y(0) = a`: model parameters `(λ, a)`.
 struct Decay;
 impl Bvp for Decay {

@@ -29,11 +29,10 @@ use super::estimator::Estimator;
 use super::identify::Identification;
 use super::layout::FitStart;
 use super::options::{IdentifyOptions, RheometerError};
-use super::parameter_shift::ParameterShift;
 use crate::fiber::effects::{Effect, ModelSpec};
 use crate::fiber::uncertainty::{GaugeColumn, Origin, Scope, Source, Uncertainties, SOURCES};
 use crate::least_squares::LeastSquaresProblem;
-use nalgebra::DVector;
+use crate::least_squares::LinearResponse;
 use std::time::Instant;
 
 pub use super::budget::{BudgetEntry, ErrorBudget, ExperimentSensitivity, SourceStatus};
@@ -73,9 +72,8 @@ pub fn error_budget(
     let t0 = Instant::now();
     let sources = budget_sources(&rh.spec);
     let plan = SourcePlan::new(rh, id, &sources);
-    let dense = id.fit.dense_jacobian();
     let (r, q) = (&id.fit.residuals, id.fit.p.len());
-    let offsets = row_offsets(rh, id, options, dense.len(), q)?;
+    let offsets = row_offsets(rh, id, options, r.len() * q, q)?;
     // the effects' columns from the augmented model at the fitted point
     let mut aug: Option<(Vec<f64>, usize, Vec<String>)> = None;
     if !plan.free.is_empty() {
@@ -97,7 +95,12 @@ pub fn error_budget(
         aug: &aug,
         r,
         sigma_r: id.summary.noise.declared_level().unwrap_or(1.0),
-        prop: ParameterShift::new(&dense, r.len(), q)?,
+        // through the Schur complement for a block-arrow fit: linear in the experiments
+        prop: id.fit.linear_response_map().ok_or_else(|| {
+            RheometerError::Data(
+                "JᵀJ of the fit is singular (the fit's parameters are not determined)".into(),
+            )
+        })?,
         offsets,
         ni: col_of("n"),
         ki: col_of("kappa"),
@@ -182,7 +185,7 @@ struct Propagation<'a> {
     /// The declared relative noise level (1 without one).
     sigma_r: f64,
     /// `−(JᵀJ)⁻¹ Jᵀ` of the fit.
-    prop: ParameterShift,
+    prop: LinearResponse<'a>,
     /// The first row of each experiment.
     offsets: Vec<usize>,
     /// The columns of `n` and `κ` in the fit's parameters.
@@ -259,7 +262,7 @@ impl Propagation<'_> {
             let Some(factor) = (s.per_unit)(e) else {
                 continue;
             };
-            let mut c = DVector::zeros(n_res);
+            let mut c = vec![0.0; n_res];
             for i in offsets[k]..offsets[k + 1] {
                 c[i] = factor
                     * column_value(
@@ -273,9 +276,11 @@ impl Propagation<'_> {
                         self.sigma_r,
                     );
             }
-            let d = self.prop.derivative(&c);
+            // `c` has one entry per residual, so the map applies
+            let d = self.prop.apply(&c).unwrap_or_default();
             let sk = self.unc.sigma(s.key, k).map_or(s.default, |v| v.0);
-            let (dn, dk) = (self.ni.map(|i| d[i]), self.ki.map(|i| d[i]));
+            let at = |i: usize| d.get(i).copied().unwrap_or(f64::NAN);
+            let (dn, dk) = (self.ni.map(at), self.ki.map(at));
             by_experiment.push(ExperimentSensitivity {
                 experiment: e.name.clone(),
                 sigma: sk,

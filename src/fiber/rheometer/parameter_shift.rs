@@ -1,7 +1,9 @@
 //! How the fitted parameters move when the model changes with the data fixed: the linear map
-//! `dθ/dq = −(JᵀJ)⁻¹ Jᵀ ∂r/∂q` at a fit, shared by the
-//! [error budget](super::error_budget()) (declared uncertainties of process conditions and
-//! material data) and the detection limits of `diagnose` (the bias an undetected effect causes).
+//! `dθ/dq = −(JᵀJ)⁻¹ Jᵀ ∂r/∂q` at a fit from its dense Jacobian, for the detection limits of
+//! `diagnose` (the bias an undetected effect causes). A fit's own map, linear in the number of
+//! experiments for a block-arrow fit, is
+//! [`FitResult::linear_response_map`](crate::least_squares::FitResult::linear_response_map)
+//! (the [error budget](super::error_budget()) and the discretisation check use it).
 
 use super::options::RheometerError;
 use nalgebra::{DMatrix, DVector};
