@@ -201,6 +201,32 @@ impl BlockCovariance {
         x
     }
 
+    /// The shared rows of `cov · v` (length `n_s`): `Y v_s − Σ_l F_lᵀ v_l`, skipping the blocks
+    /// where `v` is zero (a change confined to one experiment costs `O(n_s²)` per block it
+    /// touches).
+    pub fn mul_vec_shared(&self, v: &[f64]) -> Vec<f64> {
+        let st = &self.structure;
+        let ns = st.num_shared();
+        let mut x: Vec<f64> = (0..ns)
+            .map(|i| (0..ns).map(|j| self.y[(i, j)] * v[j]).sum())
+            .collect();
+        for k in 0..st.num_blocks() {
+            let vk = &v[st.locals(k)];
+            if vk.iter().all(|&a| a == 0.0) {
+                continue;
+            }
+            let f = &self.f[k];
+            for (i, xi) in x.iter_mut().enumerate() {
+                *xi -= vk
+                    .iter()
+                    .enumerate()
+                    .map(|(a, va)| f[(a, i)] * va)
+                    .sum::<f64>();
+            }
+        }
+        x
+    }
+
     /// The dense covariance (row-major `P × P`: `P²` numbers; for small fits and reports).
     pub fn to_dense(&self) -> Vec<f64> {
         let st = &self.structure;
@@ -270,6 +296,7 @@ mod tests {
                 .map(|i| (0..np).map(|k| d[i * np + k] * v[k]).sum())
                 .collect();
             assert_close(&c.mul_vec(&v), &dense);
+            assert_close(&c.mul_vec_shared(&v), &dense[..2]);
         }
     }
 

@@ -620,4 +620,23 @@ impl LinearResponse<'_> {
         };
         Some(x.into_iter().map(|v| -v).collect())
     }
+
+    /// The first `n_shared` entries of [`apply`](Self::apply) (the shared parameters of a
+    /// block-arrow fit come first): for a block fit without the local rows, and a change
+    /// confined to a few blocks costs work in those blocks only (besides `Jᵀ d`).
+    pub fn apply_shared(&self, d: &[f64], n_shared: usize) -> Option<Vec<f64>> {
+        if d.len() != self.residuals {
+            return None;
+        }
+        match &self.kind {
+            ResponseKind::Dense { .. } => Some(self.apply(d)?.into_iter().take(n_shared).collect()),
+            ResponseKind::Block { j, cov } => Some(
+                cov.mul_vec_shared(&j.tr_mul_vec(d))
+                    .into_iter()
+                    .take(n_shared)
+                    .map(|v| -v)
+                    .collect(),
+            ),
+        }
+    }
 }

@@ -179,6 +179,18 @@ fn linear_response_of_a_block_fit_is_the_dense_one() {
             "{i}: {via_dense:?} vs {direct}"
         );
     }
+    // the shared rows alone
+    for (fit, tol) in [(&block, 1e-8), (&dense, 1e-6)] {
+        let map = fit.linear_response_map().unwrap();
+        let shared = map.apply_shared(&d, 2).unwrap();
+        assert_eq!(shared.len(), 2);
+        for i in 0..2 {
+            assert!(
+                (shared[i] - direct[i]).abs() <= tol * scale,
+                "{i}: {shared:?}"
+            );
+        }
+    }
     // a change of the wrong length is refused
     assert!(block.linear_response(&d[1..]).is_none());
     assert!(dense.linear_response(&d[1..]).is_none());

@@ -102,6 +102,7 @@ pub fn error_budget(
             )
         })?,
         offsets,
+        shared: id.names.len(),
         ni: col_of("n"),
         ki: col_of("kappa"),
     };
@@ -186,6 +187,8 @@ struct Propagation<'a> {
     sigma_r: f64,
     /// `−(JᵀJ)⁻¹ Jᵀ` of the fit.
     prop: LinearResponse<'a>,
+    /// The number of shared fitted parameters (`n`, `κ`, strengths, shapes: the first).
+    shared: usize,
     /// The first row of each experiment.
     offsets: Vec<usize>,
     /// The columns of `n` and `κ` in the fit's parameters.
@@ -276,8 +279,9 @@ impl Propagation<'_> {
                         self.sigma_r,
                     );
             }
-            // `c` has one entry per residual, so the map applies
-            let d = self.prop.apply(&c).unwrap_or_default();
+            // `c` has one entry per residual, so the map applies; `n` and `κ` are shared
+            // parameters (the first columns)
+            let d = self.prop.apply_shared(&c, self.shared).unwrap_or_default();
             let sk = self.unc.sigma(s.key, k).map_or(s.default, |v| v.0);
             let at = |i: usize| d.get(i).copied().unwrap_or(f64::NAN);
             let (dn, dk) = (self.ni.map(at), self.ki.map(at));
