@@ -9,8 +9,11 @@ import time
 
 from conftest import PMMA, ROOT
 
+# the child restores Python's own Ctrl-C handler: a shell that starts the tests in the
+# background passes SIGINT on as ignored, and Python then installs no handler at all
 SCRIPT = f"""
-import sys, time, diffbvp
+import signal, sys, time, diffbvp
+signal.signal(signal.SIGINT, signal.default_int_handler)
 ds = diffbvp.load({str(PMMA)!r})
 print("ready", flush=True)
 t0 = time.time()
