@@ -8,15 +8,16 @@
 use crate::independent::dataset::{ExperimentSpec, Scenario};
 use crate::independent::model::{Law, Line};
 use crate::independent::rng::Rng;
-use crate::independent::scenarios::{control, NOISE_SD};
+use crate::independent::scenarios::control;
 use crate::independent::solve::diameters;
+use crate::noisy_data::noisy_set;
 use diffbvp::fiber::design::{
     design_for_estimation, CandidateGrid, CandidateOutcome, Criterion, Design, DesignRequest,
     TakeUpAxis,
 };
 use diffbvp::fiber::input::load_experiments_with;
 use diffbvp::fiber::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
-use diffbvp::fiber::setup::{Experiment, ExperimentSet, Measurements};
+use diffbvp::fiber::setup::{Experiment, ExperimentSet};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -131,23 +132,7 @@ fn realise(b: &Base, candidate: Option<&CandidateOutcome>, replicates: usize) ->
     }
     let set_of = |seed: u64| {
         let mut rng = Rng::new(seed);
-        ExperimentSet {
-            experiments: experiments.clone(),
-            measurements: clean
-                .iter()
-                .zip(&positions)
-                .map(|(d, s)| {
-                    Some(Measurements {
-                        positions: s.clone(),
-                        diameters: d
-                            .iter()
-                            .map(|v| v * (1.0 + NOISE_SD * rng.normal()))
-                            .collect(),
-                    })
-                })
-                .collect(),
-            ..b.set.clone()
-        }
+        noisy_set(&b.set, experiments.clone(), &clean, &positions, &mut rng)
     };
     let opts = replicate_options();
     let first = Rheometer::new(&set_of(1)).unwrap();

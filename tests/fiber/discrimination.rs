@@ -18,8 +18,9 @@
 use crate::independent::dataset::{Faults, Scenario};
 use crate::independent::model::Line;
 use crate::independent::rng::Rng;
-use crate::independent::scenarios::{with_faults, NOISE_SD};
+use crate::independent::scenarios::with_faults;
 use crate::independent::solve::diameters;
+use crate::noisy_data::noisy_set;
 use diffbvp::fiber::design::{
     design_for_discrimination, CandidateGrid, Discrimination, DiscriminationRequest, Rival,
     TakeUpAxis,
@@ -27,7 +28,7 @@ use diffbvp::fiber::design::{
 use diffbvp::fiber::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
 use diffbvp::fiber::input::load_experiments_with;
 use diffbvp::fiber::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
-use diffbvp::fiber::setup::{Experiment, ExperimentSet, Measurements};
+use diffbvp::fiber::setup::{Experiment, ExperimentSet};
 use diffbvp::fiber::simulate::{simulate_params, SimulateOptions};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -160,23 +161,7 @@ fn data_set(r: &Reference, extra: Option<&Added>, seed: u64) -> ExperimentSet {
         clean.push(a.clean.clone());
         positions.push(a.positions.clone());
     }
-    ExperimentSet {
-        experiments,
-        measurements: clean
-            .iter()
-            .zip(&positions)
-            .map(|(d, s)| {
-                Some(Measurements {
-                    positions: s.clone(),
-                    diameters: d
-                        .iter()
-                        .map(|v| v * (1.0 + NOISE_SD * rng.normal()))
-                        .collect(),
-                })
-            })
-            .collect(),
-        ..r.set.clone()
-    }
+    noisy_set(&r.set, experiments, &clean, &positions, &mut rng)
 }
 
 /// The outcome of one replicate: `(ranked first and earns its place, separated, gap)` with

@@ -20,6 +20,7 @@ mod flow_curve_intervals;
 mod independent_model;
 mod landscape;
 mod nested_fit;
+mod noisy_data;
 mod rheometer;
 mod rheometer_blocks;
 mod robust_statistics;
