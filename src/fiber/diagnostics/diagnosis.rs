@@ -31,7 +31,9 @@ pub struct Diagnosis {
     pub candidates: Vec<Candidate>,
     /// Pairs of candidates with nearly parallel signatures.
     pub indistinguishable: Vec<Indistinguishable>,
-    /// The most likely missing effect, if one earns its place (the best by `ΔBIC`).
+    /// The best single candidate that may be named (the first step's, best by `ΔBIC`), if one
+    /// earns its place. A pair that explains the data better ([`pair`](Self::pair)) replaces
+    /// it in [`found`](Self::found).
     pub most_likely_missing: Option<String>,
     /// Other candidates about as consistent with the data as the named one: they earn their
     /// place too, with a `ΔBIC` less than the tie margin above the named one's (best first;
@@ -50,9 +52,15 @@ pub struct Diagnosis {
     /// The steps after the first: each with the effects found before in the model.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub further_steps: Vec<ForwardStep>,
-    /// The effects found, in order (the first is `most_likely_missing`).
+    /// The effects found, in order (the first is `most_likely_missing`, unless a pair replaced
+    /// the forward search's result).
     #[serde(default)]
     pub found: Vec<String>,
+    /// The best pair of candidates fitted jointly (stage 9b), where one qualifies: it replaces
+    /// the forward search's result when clearly better by `ΔBIC` (`found` then lists it), else
+    /// it is reported beside it as an explanation as good.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pair: Option<super::pair::PairFound>,
     /// The fit with all found effects (fitted jointly), if any was found.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub final_fit: Option<FitSummary>,

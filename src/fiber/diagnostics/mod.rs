@@ -27,6 +27,7 @@ pub mod compare;
 pub mod detection;
 pub mod diagnose;
 pub mod diagnosis;
+pub mod pair;
 pub mod report;
 pub mod scan;
 pub mod scores;

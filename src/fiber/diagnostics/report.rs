@@ -252,7 +252,17 @@ pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), Plo
 /// `"0.804 ± 0.007 (95% CI [0.790, 0.818])"` (rounded to the standard error behind the
 /// interval), or the estimate marked at its bound without an interval.
 fn estimate_with_ci(c: &Candidate, name: &str, value: f64, ci: [f64; 2]) -> String {
-    match c.at_bound().iter().find(|b| b.parameter == name) {
+    estimate_with_ci_bounds(c.at_bound(), name, value, ci)
+}
+
+/// [`estimate_with_ci`] of a fit's estimate `name` (its bounds from `at_bound`).
+fn estimate_with_ci_bounds(
+    at_bound: &[crate::fiber::rheometer::AtBound],
+    name: &str,
+    value: f64,
+    ci: [f64; 2],
+) -> String {
+    match at_bound.iter().find(|b| b.parameter == name) {
         Some(b) => format!(
             "{} (AT ITS {} BOUND: no valid 95% CI)",
             fmt_g(value),
@@ -309,11 +319,8 @@ impl DiagnosisRun {
 
     /// Writes the before/after residual figure.
     pub fn save_figure(&self, path: &Path) -> Result<(), PlotError> {
-        let name = self
-            .diagnosis
-            .most_likely_missing
-            .clone()
-            .unwrap_or_default();
+        // the "after" residuals are the final fit's, with every effect found
+        let name = self.diagnosis.found.join(" + ");
         save_residual_figure(
             path,
             &self.residuals_before,

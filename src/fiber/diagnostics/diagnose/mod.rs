@@ -42,7 +42,12 @@
 //! 9. **Several effects** (`step`): while a named effect does not bring the residuals to the
 //!    noise, it is added to the model (strength and shapes fitted jointly with the law) and the
 //!    search runs again over the remaining candidates, at most
-//!    [`DiagnoseOptions::max_effects`] effects in all.
+//!    [`DiagnoseOptions::max_effects`] effects in all. Then, wherever there is something to
+//!    explain, every pair of refitted candidates is fitted jointly (`pairs`, [`PairFound`](super::pair::PairFound)): two effects
+//!    that hide each other (warm air heating where radiation cools) each explain little
+//!    alone, and a third effect can mimic their sum with a biased law. A pair clearly better
+//!    by `ΔBIC` replaces the forward search's result; one as good is reported beside it, and
+//!    where the two laws disagree neither is a result.
 //! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, or none of the
 //!     candidates (which help and how much, where the unexplained residual lies).
 
@@ -50,6 +55,7 @@ mod base;
 pub mod calibrate;
 mod judge;
 mod linearise;
+mod pairs;
 mod search;
 mod shapes;
 mod signature;
@@ -159,27 +165,108 @@ pub fn diagnose(
         let next = step::run(set, &spec, &opts, Some(refit))?;
         steps.push(next);
     }
-    Ok(assemble(steps, t0))
+    // two effects that hide each other: every pair fitted jointly, as a challenge to what the
+    // steps found, wherever there is something to explain
+    let pair = if options.max_effects >= 2 && something_to_explain(&steps) {
+        let (dbic, fit) = steps_result(&steps);
+        let noise = &steps[0].base.summary.noise;
+        let settled: Vec<String> = match fit {
+            Some(f) if verdict::explained(f, noise) => steps
+                .iter()
+                .filter_map(|s| s.named_candidate().map(|c| c.effect.clone()))
+                .collect(),
+            _ => Vec::new(),
+        };
+        pairs::search(set, base_spec, options, &steps[0], &settled).and_then(|(p, id)| {
+            crate::fiber::diagnostics::pair::against_steps(
+                p,
+                dbic,
+                fit,
+                options.tie_margin,
+                &id.summary,
+            )
+            .map(|p| (p, id))
+        })
+    } else {
+        None
+    };
+    Ok(assemble(steps, pair, t0))
+}
+
+/// Whether the user's residuals are systematic or an effect was named.
+fn something_to_explain(steps: &[step::Step]) -> bool {
+    steps
+        .first()
+        .is_some_and(|f| f.systematic || steps.iter().any(|s| s.named.is_some()))
+}
+
+/// `ΔBIC` against the user's model of the steps' final fit (all effects found), and that fit
+/// (`0` and `None` when nothing was found).
+fn steps_result(steps: &[step::Step]) -> (f64, Option<&crate::fiber::rheometer::FitSummary>) {
+    let Some(first) = steps.first() else {
+        return (0.0, None);
+    };
+    let Some(fit) = steps
+        .iter()
+        .rev()
+        .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id))
+    else {
+        return (0.0, None);
+    };
+    let k: usize = steps
+        .iter()
+        .filter_map(|s| s.named_candidate().map(|c| c.extra_parameters))
+        .sum();
+    let n = first.base.fit.num_residuals() as f64;
+    let dbic =
+        crate::fiber::diagnostics::pair::delta_bic(n, first.base.summary.cost, fit.summary.cost, k);
+    (dbic, Some(&fit.summary))
 }
 
 /// The diagnosis of the steps: the first step's records, the further steps', the effects
 /// found, the final fit and the verdict.
-fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
+fn assemble(
+    mut steps: Vec<step::Step>,
+    pair: Option<(crate::fiber::diagnostics::pair::PairFound, Identification)>,
+    t0: Instant,
+) -> DiagnosisRun {
     let noise = steps[0].base.summary.noise.clone();
-    let found: Vec<String> = steps
+    let mut found: Vec<String> = steps
         .iter()
         .filter_map(|s| s.named_candidate().map(|c| c.effect.clone()))
         .collect();
     // the final model: the last named refit (all found effects, fitted jointly)
-    let final_id: Option<Identification> = steps
+    let mut final_id: Option<Identification> = steps
         .iter()
         .rev()
         .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id.clone()));
-    let fit_options = steps.last().map(|s| s.opts.clone()).unwrap_or_default();
+    let mut fit_options = steps.last().map(|s| s.opts.clone()).unwrap_or_default();
+    // a pair found by the joint search replaces what the steps found when clearly better
+    let pair = pair.map(|(p, id)| {
+        if p.replaces {
+            found = p.effects.to_vec();
+            final_id = Some(id);
+            fit_options = steps[0].opts.clone();
+        }
+        p
+    });
     let first = steps.remove(0);
     let verdict = verdict_of(&first, &found, final_id.as_ref(), &noise);
     let mut final_fit = final_id.as_ref().map(|id| id.summary.clone());
     let mut base_fit = first.base.summary.clone();
+    if let Some([n_pair, n_steps]) = pair.as_ref().and_then(|p| p.laws_disagree) {
+        let w = FitWarning::new(
+            WarningCode::Implausible,
+            format!(
+                "two explanations fit the data equally well and disagree on the material law (n \
+                 = {n_pair:.3} with the pair of effects, {n_steps:.3} with the forward search's \
+                 effects): the law is not a result"
+            ),
+        );
+        final_fit
+            .iter_mut()
+            .for_each(|s| s.warnings.push(w.clone()));
+    }
     if let Verdict::NoneOfTheCandidates { rms_over_noise, .. } = &verdict {
         // the law of a model that does not describe the data is biased by what it misses
         let w = FitWarning::new(
@@ -225,6 +312,7 @@ fn assemble(mut steps: Vec<step::Step>, t0: Instant) -> DiagnosisRun {
             calibration: first.calibration,
             further_steps: further,
             found,
+            pair,
             final_fit,
             verdict,
             wall_time_s: t0.elapsed().as_secs_f64(),

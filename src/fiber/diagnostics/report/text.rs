@@ -4,8 +4,8 @@ use super::super::candidate::{Candidate, StrengthStatus};
 use super::super::diagnose::verdict::Verdict;
 use super::super::diagnosis::Diagnosis;
 use super::{
-    estimate_with_ci, fmt_range, pm_unit, probability, profile_line, shape_alternative_line,
-    unit_suffix, EXACT_TIE,
+    estimate_with_ci, estimate_with_ci_bounds, fmt_range, pm_unit, probability, profile_line,
+    shape_alternative_line, unit_suffix, EXACT_TIE,
 };
 use crate::fiber::format::{fmt_g, wrap_long_lines};
 
@@ -28,6 +28,7 @@ impl Diagnosis {
                 }
             }
         }
+        self.pair_paragraph(&mut s);
         self.further_steps_paragraph(&mut s);
         self.not_named_paragraph(&mut s);
         self.candidates_table(&mut s);
@@ -104,7 +105,10 @@ impl Diagnosis {
             .filter(|a| a.delta_bic_gap < EXACT_TIE)
             .map(|a| a.effect.as_str())
             .collect();
-        let lead = if exact.is_empty() {
+        let replaced = self.pair.as_ref().is_some_and(|p| p.replaces);
+        let lead = if replaced {
+            "Best single candidate (a pair explains the data better, below):".to_string()
+        } else if exact.is_empty() {
             "Most likely missing:".to_string()
         } else {
             format!(
@@ -150,6 +154,14 @@ impl Diagnosis {
             // under "none of the candidates" the law with the best candidate is biased too
             let lead = if matches!(self.verdict, Verdict::NoneOfTheCandidates { .. }) {
                 "With it (NOT A RESULT: the misfit is not explained, see the verdict)"
+            } else if replaced {
+                "With it alone (NOT A RESULT: the pair below explains the data)"
+            } else if self
+                .pair
+                .as_ref()
+                .is_some_and(|p| p.laws_disagree.is_some())
+            {
+                "With it (NOT A RESULT: a pair below explains the data as well and disagrees on n)"
             } else {
                 "With it"
             };
@@ -167,6 +179,54 @@ impl Diagnosis {
             &self.alternatives,
             &self.candidates,
         ));
+    }
+
+    /// The pair named by the joint search of pairs, with its strengths.
+    fn pair_paragraph(&self, s: &mut String) {
+        let Some(p) = &self.pair else { return };
+        let strengths: Vec<String> = p
+            .effects
+            .iter()
+            .filter_map(|e| {
+                let est = p.fit.as_ref().or(self.final_fit.as_ref())?.effect(e)?;
+                let unit = self.candidate(e).map_or("", |c| c.unit.as_str());
+                Some(format!(
+                    "{e} {}",
+                    pm_unit(est.strength.value, est.strength.stderr, unit)
+                ))
+            })
+            .collect();
+        let lead = if p.replaces {
+            "Fitted in pairs, the best explanation"
+        } else {
+            "Fitted in pairs, an explanation as good as the one above (delta BIC within the tie \
+             margin)"
+        };
+        s.push_str(&format!(
+            "{lead}: {} jointly bring the residuals to the noise: delta BIC {:.1} against your \
+             model (the forward search's result: {:.1}), {:.1} against {} alone and {:.1} against \
+             {} alone; strengths {}; {} of {} starts reached this optimum ({} pairs of refitted \
+             candidates tried).\n",
+            p.effects.join(" + "),
+            p.delta_bic,
+            p.delta_bic_of_steps,
+            p.delta_bic_against_single[0],
+            p.effects[0],
+            p.delta_bic_against_single[1],
+            p.effects[1],
+            strengths.join(", "),
+            p.starts_at_optimum,
+            p.starts,
+            p.pairs_tried
+        ));
+        if let Some([n_pair, n_steps]) = p.laws_disagree {
+            s.push_str(&format!(
+                "WARNING: the two explanations disagree on the material law (n = {n_pair:.3} with \
+                 the pair, {n_steps:.3} without; 95 % intervals apart): the data cannot tell \
+                 which is right, so neither law is a result. A measurement that separates the \
+                 effects (the air temperature along the line, the fiber temperature) decides.\n"
+            ));
+        }
     }
 
     /// The further steps (each with the causes found before in the model) and the final fit
@@ -196,11 +256,22 @@ impl Diagnosis {
         }
         if let Some(f) = &self.final_fit {
             if self.found.len() > 1 {
+                let lead = if matches!(self.verdict, Verdict::NoneOfTheCandidates { .. }) {
+                    " (NOT A RESULT: the misfit is not explained, see the verdict)"
+                } else if self
+                    .pair
+                    .as_ref()
+                    .is_some_and(|p| p.laws_disagree.is_some())
+                {
+                    " (NOT A RESULT: an explanation as good disagrees on n)"
+                } else {
+                    ""
+                };
                 s.push_str(&format!(
-                    "With {}: n = {:.4}, kappa = {:.4}, RMS {:.3} %.\n",
+                    "With {}{lead}: n = {}, kappa = {}, RMS {:.3} %.\n",
                     self.found.join(" + "),
-                    f.n.value,
-                    f.kappa.value,
+                    estimate_with_ci_bounds(&f.at_bound, "n", f.n.value, f.n.ci95),
+                    estimate_with_ci_bounds(&f.at_bound, "kappa", f.kappa.value, f.kappa.ci95),
                     100.0 * f.rms_relative_residual
                 ));
             }
