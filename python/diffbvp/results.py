@@ -559,7 +559,10 @@ class Diagnosis(Result):
     JSON of ``rheometer diagnose``).
 
     ``verdict`` (``{"kind": "explained" | "adequate" | "none_of_the_candidates", ...}``),
-    ``found`` (the effects found, in order), ``most_likely_missing``, ``candidates`` (best
+    ``found`` (the effects found, in order), ``most_likely_missing``, ``pair`` (the best
+    pair of candidates fitted jointly, where one qualifies: ``replaces`` says whether it is
+    the explanation, ``laws_disagree`` whether an explanation as good disagrees on n),
+    ``candidates`` (best
     first, as :class:`Candidate` with their refits), ``base_fit`` (the user's model) and
     ``final_fit`` (with all found effects, fitted jointly) as :class:`FitResult`,
     ``calibration`` (the look-elsewhere calibration), ``further_steps``, ``alternatives``,
@@ -607,8 +610,15 @@ class Diagnosis(Result):
 
     @property
     def most_likely_missing(self) -> Optional[str]:
-        """The first effect found (the best that earns its place), or None."""
+        """The best single candidate that may be named (the forward search's first step), or
+        None. A pair that explains the data better replaces it in ``found`` (see ``pair``)."""
         return self._data.get("most_likely_missing")
+
+    @property
+    def pair(self) -> Optional[Dict[str, Any]]:
+        """The best pair of candidates fitted jointly, where one qualifies (``effects``,
+        ``delta_bic``, ``delta_bic_of_steps``, ``replaces``, ``laws_disagree``), or None."""
+        return self._data.get("pair")
 
     @property
     def candidates(self) -> List[Candidate]:

@@ -104,3 +104,17 @@ def test_take_up_rules(pmma):
     sim = diffbvp.simulate(pmma, 0.8, 11.7, take_up_diameter=1e-4, points=3)
     for e in sim:
         assert e["profiles"]["diameter_m"][-1] == pytest.approx(1e-4, rel=1e-6)
+
+
+def test_a_pair_that_explains_better_replaces_the_single_candidate():
+    """Radiation and warm air hide each other (data/radiation_warm_air, truth n = 0.8): the best
+    single candidate reaches the noise with a biased law; the pair fitted jointly replaces it."""
+    from conftest import ROOT
+
+    d = diffbvp.diagnose(diffbvp.load(ROOT / "data" / "radiation_warm_air" / "experiments.toml"))
+    assert d.pair is not None and d.pair["replaces"], d.pair
+    assert sorted(d.found) == ["air_temperature_profile", "radiation"]
+    assert d.most_likely_missing not in d.found
+    assert d.pair["delta_bic"] < d.pair["delta_bic_of_steps"] - 6.0
+    lo, hi = d.final_fit.n.ci95
+    assert lo <= 0.8 <= hi, (lo, hi)
