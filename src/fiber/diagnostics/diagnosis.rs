@@ -57,8 +57,10 @@ pub struct Diagnosis {
     #[serde(default)]
     pub found: Vec<String>,
     /// The best pair of candidates fitted jointly (stage 9b), where one qualifies: it replaces
-    /// the forward search's result when clearly better by `ΔBIC` (`found` then lists it), else
-    /// it is reported beside it as an explanation as good.
+    /// the forward search's result when better by more than its
+    /// [`replace_margin`](super::pair::PairFound::replace_margin) in `ΔBIC` (`found` then lists
+    /// it), else it is reported beside it (with its fit), and where the two laws disagree the
+    /// law is no result.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pair: Option<super::pair::PairFound>,
     /// The fit with all found effects (fitted jointly), if any was found.

@@ -71,10 +71,22 @@ impl Diagnosis {
                 noise_level,
             } => format!(
                 "VERDICT: explained by {}: with {} the residuals are at the noise (RMS/noise \
-                 {rms_over_noise:.2}, no structure left along the line){}.\n",
+                 {rms_over_noise:.2}, no structure left along the line){}{}.\n",
                 effects.join(" + "),
                 if effects.len() > 1 { "them" } else { "it" },
-                self.reestimated(*noise_level)
+                self.reestimated(*noise_level),
+                match self.pair.as_ref().filter(|p| !p.replaces) {
+                    Some(p) if p.laws_disagree.is_some() => format!(
+                        "; OR by {} about as well, with another law: the data cannot tell them \
+                         apart, and the material law is NOT A RESULT",
+                        p.effects.join(" + ")
+                    ),
+                    Some(p) => format!(
+                        "; or by {} about as well, with the same law",
+                        p.effects.join(" + ")
+                    ),
+                    None => String::new(),
+                }
             ),
             Verdict::NoneOfTheCandidates {
                 helps,

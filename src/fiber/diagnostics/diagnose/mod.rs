@@ -46,8 +46,9 @@
 //!    explain, every pair of refitted candidates is fitted jointly (`pairs`, [`PairFound`](super::pair::PairFound)): two effects
 //!    that hide each other (warm air heating where radiation cools) each explain little
 //!    alone, and a third effect can mimic their sum with a biased law. A pair clearly better
-//!    by `ΔBIC` replaces the forward search's result; one as good is reported beside it, and
-//!    where the two laws disagree neither is a result.
+//!    by `ΔBIC` (beyond a margin corrected for the pairs tried) replaces the forward search's
+//!    result; one within it is reported beside it, and where the two laws disagree neither is
+//!    a result.
 //! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, or none of the
 //!     candidates (which help and how much, where the unexplained residual lies).
 
@@ -254,18 +255,16 @@ fn assemble(
     let verdict = verdict_of(&first, &found, final_id.as_ref(), &noise);
     let mut final_fit = final_id.as_ref().map(|id| id.summary.clone());
     let mut base_fit = first.base.summary.clone();
-    if let Some([n_pair, n_steps]) = pair.as_ref().and_then(|p| p.laws_disagree) {
+    let disagreeing = pair
+        .as_ref()
+        .filter(|p| p.laws_disagree.is_some())
+        .and_then(|p| p.fit.as_ref());
+    if let (Some(pf), Some(f)) = (disagreeing, final_fit.as_mut()) {
         let w = FitWarning::new(
             WarningCode::Implausible,
-            format!(
-                "two explanations fit the data equally well and disagree on the material law (n \
-                 = {n_pair:.3} with the pair of effects, {n_steps:.3} with the forward search's \
-                 effects): the law is not a result"
-            ),
+            crate::fiber::diagnostics::pair::disagreement(pf, f),
         );
-        final_fit
-            .iter_mut()
-            .for_each(|s| s.warnings.push(w.clone()));
+        f.warnings.push(w);
     }
     if let Verdict::NoneOfTheCandidates { rms_over_noise, .. } = &verdict {
         // the law of a model that does not describe the data is biased by what it misses

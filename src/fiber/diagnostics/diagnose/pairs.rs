@@ -16,10 +16,10 @@
 //! * each member earns its place beside the other (`ΔBIC` of the pair against the other
 //!   member alone below [`DiagnoseOptions::earn_threshold`]).
 //!
-//! The kept pair with the lowest `ΔBIC` (against the user's model) replaces the forward
-//! search's result when it is lower by more than [`DiagnoseOptions::tie_margin`]; within the
-//! margin it is reported beside it as an equally good explanation, and where the two
-//! explanations' laws disagree the law is no result ([`laws_disagree`](crate::fiber::diagnostics::pair::laws_disagree)).
+//! The kept pair with the lowest `ΔBIC` (against the user's model) is judged against the
+//! forward search's result by [`against_steps`](crate::fiber::diagnostics::pair): it replaces
+//! it only beyond a margin corrected for the pairs tried, and within it a disagreeing law is
+//! no result.
 
 use super::step::Step;
 use super::DiagnoseOptions;
@@ -203,6 +203,7 @@ fn judge(
         starts_at_optimum: at,
         pairs_tried: tried,
         delta_bic_of_steps: 0.0,
+        replace_margin: 0.0,
         replaces: false,
         laws_disagree: None,
         fit: None,

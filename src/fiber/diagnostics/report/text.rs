@@ -161,7 +161,7 @@ impl Diagnosis {
                 .as_ref()
                 .is_some_and(|p| p.laws_disagree.is_some())
             {
-                "With it (NOT A RESULT: a pair below explains the data as well and disagrees on n)"
+                "With it (NOT A RESULT: a pair below explains the data as well and disagrees on the law)"
             } else {
                 "With it"
             };
@@ -197,10 +197,18 @@ impl Diagnosis {
             })
             .collect();
         let lead = if p.replaces {
-            "Fitted in pairs, the best explanation"
+            format!(
+                "Fitted in pairs, the best explanation (better than the forward search's result by \
+                 more than {:.1} in delta BIC: the tie margin and 2 ln of the pairs tried)",
+                p.replace_margin
+            )
         } else {
-            "Fitted in pairs, an explanation as good as the one above (delta BIC within the tie \
-             margin)"
+            format!(
+                "Fitted in pairs, an explanation the data do not clearly separate from the one \
+                 above (delta BIC within the tie margin above it, or less than {:.1} below it: \
+                 the tie margin and 2 ln of the pairs tried)",
+                p.replace_margin
+            )
         };
         s.push_str(&format!(
             "{lead}: {} jointly bring the residuals to the noise: delta BIC {:.1} against your \
@@ -219,13 +227,21 @@ impl Diagnosis {
             p.starts,
             p.pairs_tried
         ));
-        if let Some([n_pair, n_steps]) = p.laws_disagree {
+        if let Some(pf) = p.fit.as_ref() {
             s.push_str(&format!(
-                "WARNING: the two explanations disagree on the material law (n = {n_pair:.3} with \
-                 the pair, {n_steps:.3} without; 95 % intervals apart): the data cannot tell \
-                 which is right, so neither law is a result. A measurement that separates the \
-                 effects (the air temperature along the line, the fiber temperature) decides.\n"
+                "With {}: n = {}, kappa = {}, RMS {:.3} %.\n",
+                p.effects.join(" + "),
+                estimate_with_ci_bounds(&pf.at_bound, "n", pf.n.value, pf.n.ci95),
+                estimate_with_ci_bounds(&pf.at_bound, "kappa", pf.kappa.value, pf.kappa.ci95),
+                100.0 * pf.rms_relative_residual
             ));
+            if let (Some(_), Some(f)) = (p.laws_disagree, self.final_fit.as_ref()) {
+                s.push_str(&format!(
+                    "WARNING: {}. A measurement that separates the effects (the air temperature \
+                     along the line, the fiber temperature, the throughput) decides.\n",
+                    crate::fiber::diagnostics::pair::disagreement(pf, f)
+                ));
+            }
         }
     }
 
@@ -299,8 +315,8 @@ impl Diagnosis {
     /// The table of candidates, two lines each, and its footnote.
     fn candidates_table(&self, s: &mut String) {
         s.push_str("[[Candidates, best first (credible refits by delta BIC, then refits at a bound or not physical)]]\n");
-        s.push_str("    effect                   refit  strength ± stderr              RMS after  dBIC     false-al.  excess  status\n");
-        s.push_str("        J after, lin.dJ/J, signature (peak), shape\n");
+        s.push_str("    effect                   refit  strength ± stderr      RMS after     dBIC  false-al.  excess\n");
+        s.push_str("        status, J after, lin.dJ/J, signature (peak), shape\n");
         for c in &self.candidates {
             let shape: String = c
                 .shape()
@@ -308,7 +324,7 @@ impl Diagnosis {
                 .map(|p| format!(", {} {}{}", p.name, fmt_g(p.value), unit_suffix(&p.unit)))
                 .collect();
             s.push_str(&format!(
-                "    {:<24} {:<5}  {:<28} {:>9}  {:>7.1}  {:>9}  {:>6}  {}\n",
+                "    {:<24} {:<5}  {:<22} {:>9}  {:>7.1}  {:>9}  {:>6}\n",
                 c.effect,
                 if c.refitted() { "yes" } else { "lin" },
                 pm_unit(c.strength(), c.stderr_strength(), &c.unit),
@@ -324,10 +340,10 @@ impl Diagnosis {
                 } else {
                     "-".into()
                 },
-                c.status.name(),
             ));
             s.push_str(&format!(
-                "        J after {:.4e}, lin.dJ/J {:.4}, signature {} (peak {:.2} m){shape}\n",
+                "        {}, J after {:.4e}, lin.dJ/J {:.4}, signature {} (peak {:.2} m){shape}\n",
+                c.status.name(),
                 c.cost_after,
                 if c.cost_before > 0.0 {
                     c.linear_score / c.cost_before
