@@ -107,8 +107,9 @@ pub(crate) fn search(
         .into_par_iter()
         .filter_map(|(i, j)| {
             let (a, b) = (&members[i], &members[j]);
-            let (id, starts, at) = fit_pair(set, base_spec, first, a, b, &[a.start(b)]).ok()?;
-            Some((i, j, id, starts, at))
+            let starts = [a.start(b)];
+            let (id, at) = best_of(fit_pair(set, base_spec, first, a, b, &starts).ok()?)?;
+            Some((i, j, id, starts.len(), at))
         })
         .collect();
     let best = fits
@@ -131,29 +132,19 @@ pub(crate) fn search(
     // neutral as its optimum's (the user's law, warm solutions); the best of all starts is kept
     let (i, j, p, id) = best;
     let (a, b) = (&members[i], &members[j]);
-    let mut fits = vec![id];
-    for scale in [2.0, 0.5] {
-        let strengths = a
-            .scaled(&fits[0].summary, scale)
-            .into_iter()
-            .chain(b.scaled(&fits[0].summary, scale))
-            .collect();
-        if let Ok(id) = fit_pair(set, base_spec, first, a, b, &[strengths]) {
-            fits.push(id.0);
-        }
-    }
-    let starts = p.starts + 2;
-    let lowest = fits
+    let more: Vec<Vec<(String, f64)>> = [2.0, 0.5]
         .iter()
-        .map(|f| f.summary.cost)
-        .fold(f64::INFINITY, f64::min);
-    let at = fits
-        .iter()
-        .filter(|f| f.summary.cost <= lowest * (1.0 + SAME_OPTIMUM))
-        .count();
-    let id = fits
-        .into_iter()
-        .min_by(|x, y| x.summary.cost.total_cmp(&y.summary.cost))?;
+        .map(|&scale| {
+            a.scaled(&id.summary, scale)
+                .into_iter()
+                .chain(b.scaled(&id.summary, scale))
+                .collect()
+        })
+        .collect();
+    let mut fits = fit_pair(set, base_spec, first, a, b, &more).unwrap_or_default();
+    fits.push(id);
+    let starts = p.starts + more.len();
+    let (id, at) = best_of(fits)?;
     let p = judge(first, options, a, b, &id, starts, at, tried)?;
     Some((p, id))
 }
@@ -246,8 +237,8 @@ fn member<'a>(c: &'a Candidate, options: &DiagnoseOptions) -> Option<Member<'a>>
 }
 
 /// The joint fit of `a` and `b` from each of `starts` (start strengths and shapes by name; the
-/// law of the user's fit, its solutions as warm starts): the best fit, the number of starts
-/// and how many reached it.
+/// law of the user's fit, its solutions as warm starts, one model for all starts): the fits
+/// that converged.
 fn fit_pair(
     set: &ExperimentSet,
     base_spec: &ModelSpec,
@@ -255,7 +246,7 @@ fn fit_pair(
     a: &Member<'_>,
     b: &Member<'_>,
     starts: &[Vec<(String, f64)>],
-) -> Result<(Identification, usize, usize), RheometerError> {
+) -> Result<Vec<Identification>, RheometerError> {
     let mut spec = base_spec.clone();
     spec.candidates.clear();
     let spec = spec
@@ -279,18 +270,22 @@ fn fit_pair(
             fits.push(id);
         }
     }
-    let starts = starts.len();
-    let best = fits
+    Ok(fits)
+}
+
+/// The fit of lowest `J` among `fits` and how many of them reached it (relative `J` within
+/// [`SAME_OPTIMUM`]); `None` without any fit.
+fn best_of(fits: Vec<Identification>) -> Option<(Identification, usize)> {
+    let lowest = fits
         .iter()
-        .map(|id| id.summary.cost)
+        .map(|f| f.summary.cost)
         .fold(f64::INFINITY, f64::min);
     let at = fits
         .iter()
-        .filter(|id| id.summary.cost <= best * (1.0 + SAME_OPTIMUM))
+        .filter(|f| f.summary.cost <= lowest * (1.0 + SAME_OPTIMUM))
         .count();
-    let id = fits
+    let best = fits
         .into_iter()
-        .min_by(|x, y| x.summary.cost.total_cmp(&y.summary.cost))
-        .ok_or_else(|| RheometerError::Data("no start of the pair's fit converged".into()))?;
-    Ok((id, starts, at))
+        .min_by(|x, y| x.summary.cost.total_cmp(&y.summary.cost))?;
+    Some((best, at))
 }

@@ -8,6 +8,7 @@ use super::{
     shape_alternative_line, unit_suffix, EXACT_TIE,
 };
 use crate::fiber::format::{fmt_g, wrap_long_lines};
+use crate::fiber::rheometer::FitSummary;
 
 impl Diagnosis {
     /// The report in words.
@@ -152,18 +153,12 @@ impl Diagnosis {
         }
         if c.n().is_finite() {
             // under "none of the candidates" the law with the best candidate is biased too
-            let lead = if matches!(self.verdict, Verdict::NoneOfTheCandidates { .. }) {
-                "With it (NOT A RESULT: the misfit is not explained, see the verdict)"
-            } else if replaced {
-                "With it alone (NOT A RESULT: the pair below explains the data)"
-            } else if self
-                .pair
-                .as_ref()
-                .is_some_and(|p| p.laws_disagree.is_some())
-            {
-                "With it (NOT A RESULT: a pair below explains the data as well and disagrees on the law)"
-            } else {
-                "With it"
+            let lead = match self.law_not_a_result() {
+                Some(why) if !replaced => format!("With it (NOT A RESULT: {why})"),
+                _ if replaced => {
+                    "With it alone (NOT A RESULT: the pair below explains the data)".to_string()
+                }
+                _ => "With it".to_string(),
             };
             s.push_str(&format!(
                 "{lead}: n = {}, kappa = {}.\n",
@@ -179,6 +174,22 @@ impl Diagnosis {
             &self.alternatives,
             &self.candidates,
         ));
+    }
+
+    /// Why the final law is not a result, if it is not: the misfit is not explained, or a
+    /// pair beside the result explains the data as well with another law.
+    fn law_not_a_result(&self) -> Option<&'static str> {
+        if matches!(self.verdict, Verdict::NoneOfTheCandidates { .. }) {
+            Some("the misfit is not explained, see the verdict")
+        } else if self
+            .pair
+            .as_ref()
+            .is_some_and(|p| p.laws_disagree.is_some())
+        {
+            Some("a pair explains the data as well and disagrees on the law")
+        } else {
+            None
+        }
     }
 
     /// The pair named by the joint search of pairs, with its strengths.
@@ -228,13 +239,7 @@ impl Diagnosis {
             p.pairs_tried
         ));
         if let Some(pf) = p.fit.as_ref() {
-            s.push_str(&format!(
-                "With {}: n = {}, kappa = {}, RMS {:.3} %.\n",
-                p.effects.join(" + "),
-                estimate_with_ci_bounds(&pf.at_bound, "n", pf.n.value, pf.n.ci95),
-                estimate_with_ci_bounds(&pf.at_bound, "kappa", pf.kappa.value, pf.kappa.ci95),
-                100.0 * pf.rms_relative_residual
-            ));
+            s.push_str(&law_line(&p.effects.join(" + "), "", pf));
             if let (Some(_), Some(f)) = (p.laws_disagree, self.final_fit.as_ref()) {
                 s.push_str(&format!(
                     "WARNING: {}. A measurement that separates the effects (the air temperature \
@@ -272,24 +277,10 @@ impl Diagnosis {
         }
         if let Some(f) = &self.final_fit {
             if self.found.len() > 1 {
-                let lead = if matches!(self.verdict, Verdict::NoneOfTheCandidates { .. }) {
-                    " (NOT A RESULT: the misfit is not explained, see the verdict)"
-                } else if self
-                    .pair
-                    .as_ref()
-                    .is_some_and(|p| p.laws_disagree.is_some())
-                {
-                    " (NOT A RESULT: an explanation as good disagrees on n)"
-                } else {
-                    ""
-                };
-                s.push_str(&format!(
-                    "With {}{lead}: n = {}, kappa = {}, RMS {:.3} %.\n",
-                    self.found.join(" + "),
-                    estimate_with_ci_bounds(&f.at_bound, "n", f.n.value, f.n.ci95),
-                    estimate_with_ci_bounds(&f.at_bound, "kappa", f.kappa.value, f.kappa.ci95),
-                    100.0 * f.rms_relative_residual
-                ));
+                let note = self
+                    .law_not_a_result()
+                    .map_or(String::new(), |why| format!(" (NOT A RESULT: {why})"));
+                s.push_str(&law_line(&self.found.join(" + "), &note, f));
             }
         }
     }
@@ -390,4 +381,14 @@ impl Diagnosis {
             }
         }
     }
+}
+
+/// `With <effects><note>: n = …, kappa = …, RMS … %.`: a fit's law with its intervals.
+fn law_line(effects: &str, note: &str, f: &FitSummary) -> String {
+    format!(
+        "With {effects}{note}: n = {}, kappa = {}, RMS {:.3} %.\n",
+        estimate_with_ci_bounds(&f.at_bound, "n", f.n.value, f.n.ci95),
+        estimate_with_ci_bounds(&f.at_bound, "kappa", f.kappa.value, f.kappa.ci95),
+        100.0 * f.rms_relative_residual
+    )
 }
