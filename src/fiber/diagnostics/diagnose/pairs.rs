@@ -52,15 +52,18 @@ impl Member<'_> {
     }
 
     /// Start values `scale` times as far from neutral as the strength fitted in `fit` (its
-    /// fitted shapes as fitted).
+    /// fitted shapes as fitted), kept inside the strength's search range (a start outside it
+    /// would fail and count as a start that missed the optimum).
     fn scaled(&self, fit: &FitSummary, scale: f64) -> Vec<(String, f64)> {
         let Some(e) = fit.effect(self.effect.name()) else {
             return self.start.clone();
         };
         let neutral = self.effect.neutral();
+        let (lo, hi) = self.effect.bounds();
+        let inset = 1e-3 * (hi - lo);
         let mut v = vec![(
             self.candidate.effect.clone(),
-            neutral + scale * (e.strength.value - neutral),
+            (neutral + scale * (e.strength.value - neutral)).clamp(lo + inset, hi - inset),
         )];
         for (name, _) in self.start.iter().skip(1) {
             let short = name.rsplit('.').next().unwrap_or(name);
