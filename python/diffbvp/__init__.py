@@ -322,10 +322,11 @@ def diagnose(dataset: Union[Dataset, PathLike], *, model: str = "carreau",
     diagnose``: fits your model (``model``, ``effects``), scores every candidate effect
     (default: all built-in ones, or ``candidates`` by name), searches and refits them, ranks
     them by ΔBIC with a look-elsewhere calibration (false-alarm probability), adds the found
-    effect and searches again, and gives a verdict (explained, adequate, none of the
-    candidates). ``refit_top``: how many candidates get the search and refits; ``start``:
-    (n, κ) of your fit; ``tol``: BVP tolerance (default 1e-4). Takes tens of seconds on the
-    shipped data (2 cores)."""
+    effect and searches again, and gives a verdict (explained, adequate, ambiguous, none of the
+    candidates; ``Diagnosis.law_is_a_result`` says whether its law may be used).
+    ``refit_top``: how many candidates get the search and refits; ``start``: (n, κ) of your
+    fit; ``tol``: BVP tolerance (default 1e-4). Takes about 5 s on the shipped data and up
+    to half a minute where two effects are missing (2 cores)."""
     d = _native.diagnose(_ds(dataset), model=model, effects=_effects(effects),
                          candidates=None if candidates is None else [str(c) for c in candidates],
                          refit_top=refit_top, start=start, tol=tol, max_nodes=max_nodes)

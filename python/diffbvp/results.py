@@ -558,7 +558,8 @@ class Diagnosis(Result):
     """The outcome of :func:`diffbvp.diagnose`: the library's ``Diagnosis`` as a dict (the
     JSON of ``rheometer diagnose``).
 
-    ``verdict`` (``{"kind": "explained" | "adequate" | "none_of_the_candidates", ...}``),
+    ``verdict`` (``{"kind": "explained" | "adequate" | "ambiguous" |
+    "none_of_the_candidates", ...}``), ``law_is_a_result``,
     ``found`` (the effects found, in order), ``most_likely_missing``, ``pair`` (the best
     pair of candidates fitted jointly, where one qualifies: ``replaces`` says whether it is
     the explanation, ``laws_disagree`` whether an explanation as good disagrees on n),
@@ -599,9 +600,19 @@ class Diagnosis(Result):
     @property
     def verdict(self) -> Dict[str, Any]:
         """What the diagnosis concludes: ``{"kind": "explained", "effects", "rms_over_noise"}``,
-        ``{"kind": "adequate"}`` or ``{"kind": "none_of_the_candidates", "helps",
-        "unexplained", "rms_over_noise"}``."""
+        ``{"kind": "adequate"}``, ``{"kind": "ambiguous", "effects", "alternatives",
+        "rms_over_noise", "n_range", "kappa_range"}`` (explanations as good that disagree on
+        the law, each alternative a list of effects: the law is not a result, ``n_range`` and
+        ``kappa_range`` span them all) or
+        ``{"kind": "none_of_the_candidates", "helps", "unexplained", "rms_over_noise"}``."""
         return self._data["verdict"]
+
+    @property
+    def law_is_a_result(self) -> bool:
+        """Whether the verdict leaves the final fit's law (n, kappa) a result: the model is
+        adequate or the misfit is explained. False when it is "ambiguous" or "none of the
+        candidates": then no law of this diagnosis is a result, whatever its interval."""
+        return self.verdict.get("kind") in ("adequate", "explained")
 
     @property
     def found(self) -> List[str]:

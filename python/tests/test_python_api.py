@@ -120,6 +120,10 @@ def test_a_pair_as_good_with_another_law_makes_the_law_no_result():
     assert p["laws_disagree"] is not None
     assert d.found == [d.most_likely_missing]
     assert any("neither law is a result" in w["message"] for w in d.final_fit.warnings)
+    # the verdict's own kind says so: a notebook that checks it never takes this law
+    assert d.verdict["kind"] == "ambiguous" and not d.law_is_a_result, d.verdict
+    assert ["air_temperature_profile", "radiation"] in [sorted(a) for a in d.verdict["alternatives"]]
+    assert d.verdict["n_range"][0] <= 0.8 <= d.verdict["n_range"][1], d.verdict
     # the two explanations' envelope holds the truth
     lo = min(d.final_fit.n.ci95[0], p["fit"]["n"]["ci95"][0])
     hi = max(d.final_fit.n.ci95[1], p["fit"]["n"]["ci95"][1])

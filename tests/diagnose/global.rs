@@ -77,11 +77,7 @@ fn check(sc: &Scenario, e: &Expect) -> (ExperimentSet, DiagnosisRun) {
     let (set, r, t) = run(sc);
     let d = &r.diagnosis;
     let fit = d.final_fit.as_ref().unwrap_or(&d.base_fit);
-    let verdict = match &d.verdict {
-        Verdict::Adequate => "adequate",
-        Verdict::Explained { .. } => "explained",
-        Verdict::NoneOfTheCandidates { .. } => "none of the candidates",
-    };
+    let verdict = d.verdict.kind();
     let local = if d.found.is_empty() {
         f64::NAN
     } else {
@@ -288,9 +284,30 @@ fn radiation_and_warm_air_never_a_wrong_law() {
     let mut effects = pair.effects.to_vec();
     effects.sort();
     assert_eq!(effects, ["air_temperature_profile", "radiation"]);
+    // the verdict is of its own kind, with the range both laws span
+    let Verdict::Ambiguous {
+        alternatives,
+        n_range,
+        kappa_range,
+        ..
+    } = &d.verdict
+    else {
+        panic!("verdict {:?}", d.verdict)
+    };
+    assert!(
+        alternatives.contains(&pair.effects.to_vec()),
+        "{alternatives:?}"
+    );
+    assert!(
+        n_range[0] <= n[0] && n[1] <= n_range[1],
+        "{n_range:?} {n:?}"
+    );
+    assert!(kappa_range[0] <= k[0] && k[1] <= kappa_range[1]);
+    assert!(!d.verdict.law_is_a_result());
     // the report says so (its lines wrapped at 100 characters)
     let text = d.to_text().split_whitespace().collect::<Vec<_>>().join(" ");
     assert!(text.contains("neither law is a result"), "{text}");
+    assert!(text.contains("VERDICT: AMBIGUOUS"), "{text}");
 }
 
 /// Two effects that hide each other: warm air heats where radiation cools. Alone, radiation
@@ -427,11 +444,57 @@ fn control_with_a_noisy_take_up_names_nothing() {
     );
 }
 
+/// What the diagnosis says of the material law against the truth: `"flagged"` where the law is
+/// marked not a result (an `implausible` warning on the fit it reports; `"flagged, range
+/// misses"` where an ambiguous verdict's range of the laws misses the truth), else `"holds"` where
+/// both `n` and `κ` lie within 3 standard errors of the truth, else `"WRONG"`: a wrong law
+/// printed with confidence (the number issue 26 must keep at zero). Also the larger of the two
+/// distances in standard errors.
+fn law_outcome(r: &DiagnosisRun, sc: &Scenario) -> (&'static str, f64) {
+    let d = &r.diagnosis;
+    let fit = d.final_fit.as_ref().unwrap_or(&d.base_fit);
+    let z =
+        |e: &diffbvp::fiber::rheometer::Estimate, truth: f64| (e.value - truth).abs() / e.stderr;
+    let worst = z(&fit.n, sc.law.n).max(z(&fit.kappa, sc.law.kappa));
+    let flagged = !d.verdict.law_is_a_result()
+        || fit
+            .warnings
+            .iter()
+            .any(|w| w.code == diffbvp::fiber::rheometer::WarningCode::Implausible);
+    if let Verdict::Ambiguous {
+        n_range,
+        kappa_range,
+        ..
+    } = &d.verdict
+    {
+        let holds = |r: &[f64; 2], v: f64| r[0] <= v && v <= r[1];
+        if !(holds(n_range, sc.law.n) && holds(kappa_range, sc.law.kappa)) {
+            return ("flagged, range misses", worst);
+        }
+    }
+    if flagged {
+        ("flagged", worst)
+    } else if worst <= 3.0 {
+        ("holds", worst)
+    } else {
+        ("WRONG", worst)
+    }
+}
+
+/// How many of `sets` laws may lie more than 3 standard errors from the truth by chance where
+/// the model is right: `n` and `κ` each miss by that with probability 0.27 %, a set at most
+/// 0.54 %; 2 % of the sets (at least 2) is beyond that by a binomial tail of about 2 % at 100
+/// sets.
+fn chance_wrong_laws(sets: usize) -> usize {
+    (sets / 50).max(2)
+}
+
 /// The false-alarm rate of the whole diagnosis on effect-free data (issue 26): `N` data sets of
 /// the independent model without any effect (`DIFFBVP_FALSE_ALARM_SETS`, default 100), seeds
 /// and noise levels (0.8 %, 1.5 %, 3 %; take-up region 1× or 2× as noisy) varied. Counts the
 /// sets where any effect is named; the search is calibrated to a false-alarm probability of
-/// 5 % per set, so more than 10 of 100 (a binomial tail of 1 % at 5 %) fails. Takes ~10 s per
+/// 5 % per set, so more than 10 of 100 (a binomial tail of 1 % at 5 %) fails. The law reported
+/// is checked against the truth as in the power study ([`law_outcome`]). Takes ~10 s per
 /// set: `cargo test --release --test diagnose global::false_alarm_rate -- --ignored --nocapture`
 /// (`DIFFBVP_FALSE_ALARM_FIRST` continues a study at that set's index).
 #[test]
@@ -447,6 +510,7 @@ fn false_alarm_rate_on_effect_free_sets() {
     // the first set's index (to continue a study in parts: seeds 7000 + index)
     let first = var("DIFFBVP_FALSE_ALARM_FIRST", 0);
     let mut alarms = Vec::new();
+    let mut wrong = 0;
     let t0 = Instant::now();
     for k in first..first + sets {
         let name: &'static str = Box::leak(format!("false_alarm_{k}").into_boxed_str());
@@ -458,6 +522,11 @@ fn false_alarm_rate_on_effect_free_sets() {
             ..scenarios::control()
         };
         let (_, r) = diagnosed(&sc);
+        let (law, z) = law_outcome(&r, &sc);
+        if law == "WRONG" {
+            println!("WRONG LAW | set {k} | {z:.1} se from the truth");
+            wrong += 1;
+        }
         // a pair reported beside the result is an alarm too
         let pair = r.diagnosis.pair.as_ref().map(|p| p.effects.clone());
         if !r.diagnosis.found.is_empty() || pair.is_some() {
@@ -470,10 +539,15 @@ fn false_alarm_rate_on_effect_free_sets() {
     }
     let rate = alarms.len() as f64 / sets as f64;
     println!(
-        "FALSE ALARMS | {} of {sets} effect-free sets ({:.1} %) | {:.0} s",
+        "FALSE ALARMS | {} of {sets} effect-free sets ({:.1} %) | wrong laws printed as a result \
+         {wrong} | {:.0} s",
         alarms.len(),
         100.0 * rate,
         t0.elapsed().as_secs_f64()
+    );
+    assert!(
+        wrong <= chance_wrong_laws(sets),
+        "{wrong} wrong laws printed with confidence in {sets} sets"
     );
     assert!(
         alarms.len() * 10 <= sets,
@@ -488,14 +562,21 @@ fn false_alarm_rate_on_effect_free_sets() {
 /// strength `s95` of each on the effect-free control (the diagnosis' own detection table),
 /// then `N` data sets of the independent model with the effect at `2 s95`
 /// (`DIFFBVP_POWER_SETS`, default 20; seeds varied, the control's noise level;
-/// `DIFFBVP_POWER_EFFECTS`, a comma-separated subset). Counts the sets where the effect is
-/// found; 80 % is the issue's target.
+/// `DIFFBVP_POWER_EFFECTS`, a comma-separated subset; `DIFFBVP_POWER_TEXT` prints the report
+/// of each miss and wrong law; `DIFFBVP_POWER_FIRST` starts at that set). Counts the sets where
+/// the effect is found; 80 % is the issue's target. In every set, found or missed, the law the diagnosis
+/// reports is checked against the truth ([`law_outcome`]): a law more than 3 standard errors
+/// off and not marked as no result is a wrong law printed with confidence, allowed only as
+/// often as chance gives it ([`chance_wrong_laws`]).
 /// `cargo test --release --test diagnose global::power -- --ignored --nocapture`.
 #[test]
-#[ignore = "a study, ~25 min for 5 x 20 sets; measured (stop 34): radiation 20/20, \
-            die_temperature_offset 20/20, mass_flow_scale 13/20 (the misses name nusselt_scale), \
-            gauge_scale 14/20 (they name inlet_diameter), gauge_offset 9/20 (scattered): short of \
-            80 % for three; something was named in all 100 sets"]
+#[ignore = "a study, ~20 min for 5 x 20 sets; measured (stop 36): radiation 20/20, \
+            die_temperature_offset 20/20, mass_flow_scale 13/20 (the misses name nusselt_scale; \
+            the law is no result in all 20: the twins disagree on it), gauge_scale 14/20 (they \
+            name inlet_diameter; the law holds in all 20), gauge_offset 9/20 (2 x s95 = 26.9 um \
+            lies beyond its +-20 um physical range; the law is no result in 12): short of 80 % \
+            for three; wrong laws printed with confidence 0 of 100 (12 before the ambiguity \
+            stage)"]
 fn power_at_twice_the_detection_limit() {
     let sets: usize = std::env::var("DIFFBVP_POWER_SETS")
         .ok()
@@ -508,11 +589,17 @@ fn power_at_twice_the_detection_limit() {
         "gauge_scale",
         "gauge_offset",
     ];
+    // the first set's index (to continue a study or look at one set: seeds 9000 + index)
+    let first: usize = std::env::var("DIFFBVP_POWER_FIRST")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
     let chosen: Vec<String> = std::env::var("DIFFBVP_POWER_EFFECTS")
         .map(|v| v.split(',').map(|s| s.trim().to_string()).collect())
         .unwrap_or_else(|_| all.iter().map(|s| s.to_string()).collect());
     let (_, control, _) = run(&scenarios::control());
     let mut short = Vec::new();
+    let mut wrong = 0;
     for effect in all.iter().filter(|e| chosen.iter().any(|c| c == *e)) {
         let limit = control
             .diagnosis
@@ -560,28 +647,56 @@ fn power_at_twice_the_detection_limit() {
             ),
         };
         let mut found = 0;
+        let mut laws = [0usize; 4];
         let t0 = Instant::now();
-        for k in 0..sets {
+        for k in first..first + sets {
             let sc = scenario(9_000 + k as u64);
             let (_, r) = diagnosed(&sc);
-            if r.diagnosis.found.iter().any(|f| f == effect) {
+            let (law, z) = law_outcome(&r, &sc);
+            let kinds = ["holds", "flagged", "WRONG", "flagged, range misses"];
+            laws[kinds.iter().position(|l| *l == law).unwrap()] += 1;
+            let hit = r.diagnosis.found.iter().any(|f| f == effect);
+            if hit {
                 found += 1;
-            } else {
+            }
+            let odd = !hit || law == "WRONG" || law == "flagged, range misses";
+            if odd && std::env::var_os("DIFFBVP_POWER_TEXT").is_some() {
+                println!("{}", r.diagnosis.to_text());
+            }
+            if odd {
                 println!(
-                    "MISSED | {effect} | set {k} | found {:?} | most likely {:?}",
-                    r.diagnosis.found, r.diagnosis.most_likely_missing
+                    "{} | {effect} | set {k} | found {:?} | most likely {:?} | law {law} ({z:.1} \
+                     se from the truth)",
+                    if hit { "FOUND" } else { "MISSED" },
+                    r.diagnosis.found,
+                    r.diagnosis.most_likely_missing
                 );
             }
         }
         println!(
-            "POWER | {effect} at 2 x s95 = 2 x {:.4} {}: found in {found} of {sets} sets | {:.0} s",
+            "POWER | {effect} at 2 x s95 = 2 x {:.4} {}: found in {found} of {sets} sets | law \
+             holds {} flagged {} (range misses the truth {}) WRONG {} | {:.0} s",
             limit.s95,
             limit.unit,
+            laws[0],
+            laws[1] + laws[3],
+            laws[3],
+            laws[2],
             t0.elapsed().as_secs_f64()
         );
+        wrong += laws[2];
         if found * 10 < sets * 8 {
             short.push(format!("{effect}: {found} of {sets}"));
         }
     }
+    let all_sets = sets
+        * all
+            .iter()
+            .filter(|e| chosen.iter().any(|c| c == *e))
+            .count();
+    assert!(
+        wrong <= chance_wrong_laws(all_sets),
+        "{wrong} wrong laws printed with confidence in {all_sets} sets"
+    );
     assert!(short.is_empty(), "power below 80 %: {short:?}");
 }

@@ -48,6 +48,18 @@ impl StrengthStatus {
             StrengthStatus::Undetermined => "undetermined",
         }
     }
+
+    /// How a refit's strength stands, as a phrase to follow the effect's name in a sentence
+    /// (empty where it is credible or not refitted).
+    pub fn qualifier(&self) -> &'static str {
+        match self {
+            StrengthStatus::AtBound => " at a bound of its search range",
+            StrengthStatus::Unphysical => " at a strength outside its physical range",
+            StrengthStatus::ImplausibleLaw => " with an implausible law",
+            StrengthStatus::Undetermined => " with an undetermined strength",
+            StrengthStatus::NotRefitted | StrengthStatus::Physical => "",
+        }
+    }
 }
 
 /// A candidate's refit with another value of a discrete shape (the co-flow's tail `r`: 0 the

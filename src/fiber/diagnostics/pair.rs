@@ -103,8 +103,19 @@ pub fn laws_disagree(a: &FitSummary, b: &FitSummary) -> bool {
 /// The union of two fits' 95 % intervals of `n` and of `κ`: where the law lies when the data
 /// cannot choose between the two explanations.
 pub fn law_envelope(a: &FitSummary, b: &FitSummary) -> [[f64; 2]; 2] {
-    let union = |x: [f64; 2], y: [f64; 2]| [x[0].min(y[0]), x[1].max(y[1])];
-    [union(a.n.ci95, b.n.ci95), union(a.kappa.ci95, b.kappa.ci95)]
+    law_envelope_of([a, b])
+}
+
+/// The union of the 95 % intervals of `n` and of `κ` over `fits`: where the law lies when the
+/// data cannot choose between them.
+pub fn law_envelope_of<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> [[f64; 2]; 2] {
+    let mut n = [f64::INFINITY, f64::NEG_INFINITY];
+    let mut k = n;
+    for f in fits {
+        n = [n[0].min(f.n.ci95[0]), n[1].max(f.n.ci95[1])];
+        k = [k[0].min(f.kappa.ci95[0]), k[1].max(f.kappa.ci95[1])];
+    }
+    [n, k]
 }
 
 /// The sentence on two explanations that disagree on the law: both `n`, the envelope, and

@@ -42,6 +42,25 @@ fn probability(p: f64) -> String {
     }
 }
 
+/// " What decides: ..." — the independent checks of `effects` (each once; empty where none has
+/// one, as for physics, which data at other conditions decide).
+fn what_decides<'a>(effects: impl Iterator<Item = &'a String>) -> String {
+    let mut checks: Vec<String> = Vec::new();
+    for e in effects {
+        if let Some(c) = super::ties::independent_check(e) {
+            let line = format!("{c} (for {e})");
+            if !checks.contains(&line) {
+                checks.push(line);
+            }
+        }
+    }
+    if checks.is_empty() {
+        String::new()
+    } else {
+        format!(" What decides: {}.", checks.join("; "))
+    }
+}
+
 impl Diagnosis {
     /// The verdict in words (see [`Verdict`]).
     /// "; noise level re-estimated with them: x %" where the verdict's noise level is below the
@@ -76,17 +95,44 @@ impl Diagnosis {
                 if effects.len() > 1 { "them" } else { "it" },
                 self.reestimated(*noise_level),
                 match self.pair.as_ref().filter(|p| !p.replaces) {
-                    Some(p) if p.laws_disagree.is_some() => format!(
-                        "; OR by {} about as well, with another law: the data cannot tell them \
-                         apart, and the material law is NOT A RESULT",
-                        p.effects.join(" + ")
-                    ),
                     Some(p) => format!(
                         "; or by {} about as well, with the same law",
                         p.effects.join(" + ")
                     ),
                     None => String::new(),
                 }
+            ),
+            Verdict::Ambiguous {
+                effects,
+                alternatives,
+                rms_over_noise,
+                noise_level,
+                n_range,
+                kappa_range,
+            } => format!(
+                "VERDICT: AMBIGUOUS: explained by {} (RMS/noise {rms_over_noise:.2}, no structure \
+                 left along the line){}, OR by {} about as well, with another law: the data \
+                 cannot tell these explanations apart, and the material law is NOT A RESULT \
+                 (over all, n lies in [{:.3}, {:.3}] and kappa in [{:.2}, {:.2}], 95 % \
+                 intervals).{}\n",
+                effects.join(" + "),
+                self.reestimated(*noise_level),
+                alternatives
+                    .iter()
+                    .map(|a| match a.as_slice() {
+                        [one] => format!(
+                            "{one}{}",
+                            self.candidate(one).map_or("", |c| c.status.qualifier())
+                        ),
+                        _ => a.join(" + "),
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", OR by "),
+                n_range[0],
+                n_range[1],
+                kappa_range[0],
+                kappa_range[1],
+                what_decides(effects.iter().chain(alternatives.iter().flatten()))
             ),
             Verdict::NoneOfTheCandidates {
                 helps,
@@ -377,4 +423,26 @@ fn shape_alternative_line(c: &Candidate, a: &ShapeAlternative) -> String {
         shift(r.n.value, c.n(), se_of(c.ci95_n())),
         shift(r.kappa.value, c.kappa(), se_of(c.ci95_kappa()))
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::what_decides;
+
+    #[test]
+    fn the_checks_that_decide_are_named_once_each() {
+        let effects: Vec<String> = ["air_temperature_profile", "gauge_offset", "mass_flow_scale"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let t = what_decides(effects.iter().chain(effects.iter()));
+        assert!(t.starts_with(" What decides: "), "{t}");
+        assert!(t.contains("reference wire (for gauge_offset)"), "{t}");
+        assert!(t.contains("(for mass_flow_scale)"), "{t}");
+        assert_eq!(t.matches("gauge_offset").count(), 1, "{t}");
+        // physics has no independent check here: data at other conditions decide
+        assert!(!t.contains("air_temperature_profile"), "{t}");
+        let physics = ["radiation".to_string()];
+        assert_eq!(what_decides(physics.iter()), "");
+    }
 }

@@ -342,12 +342,20 @@ pub(super) fn ties_paragraph(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::fiber::diagnostics::candidate::StrengthStatus;
     use crate::fiber::rheometer::summary::tests::refit_summary;
 
-    fn cand(effect: &str, status: StrengthStatus, dbic: f64, n: f64, kappa: f64) -> Candidate {
+    /// A candidate with a refit (unless not refitted): `ΔBIC` `dbic`, law `(n, kappa)` with
+    /// standard errors 0.01 and 0.1.
+    pub(crate) fn cand(
+        effect: &str,
+        status: StrengthStatus,
+        dbic: f64,
+        n: f64,
+        kappa: f64,
+    ) -> Candidate {
         Candidate {
             effect: effect.into(),
             unit: "-".into(),

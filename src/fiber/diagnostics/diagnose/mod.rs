@@ -49,9 +49,11 @@
 //!    by `ΔBIC` (beyond a margin corrected for the pairs tried) replaces the forward search's
 //!    result; one within it is reported beside it, and where the two laws disagree neither is
 //!    a result.
-//! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, or none of the
+//! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, ambiguous (a tied
+//!     candidate or a pair beside the result with another law, `ambiguity`), or none of the
 //!     candidates (which help and how much, where the unexplained residual lies).
 
+mod ambiguity;
 mod base;
 pub mod calibrate;
 mod judge;
@@ -191,7 +193,7 @@ pub fn diagnose(
     } else {
         None
     };
-    Ok(assemble(steps, pair, t0))
+    Ok(assemble(steps, pair, options, t0))
 }
 
 /// Whether the user's residuals are systematic or an effect was named.
@@ -229,6 +231,7 @@ fn steps_result(steps: &[step::Step]) -> (f64, Option<&crate::fiber::rheometer::
 fn assemble(
     mut steps: Vec<step::Step>,
     pair: Option<(crate::fiber::diagnostics::pair::PairFound, Identification)>,
+    options: &DiagnoseOptions,
     t0: Instant,
 ) -> DiagnosisRun {
     let noise = steps[0].base.summary.noise.clone();
@@ -242,29 +245,36 @@ fn assemble(
         .rev()
         .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id.clone()));
     let mut fit_options = steps.last().map(|s| s.opts.clone()).unwrap_or_default();
+    let mut result_dbic = steps_result(&steps).0;
     // a pair found by the joint search replaces what the steps found when clearly better
     let pair = pair.map(|(p, id)| {
         if p.replaces {
             found = p.effects.to_vec();
             final_id = Some(id);
             fit_options = steps[0].opts.clone();
+            result_dbic = p.delta_bic;
         }
         p
     });
     let first = steps.remove(0);
-    let verdict = verdict_of(&first, &found, final_id.as_ref(), &noise);
+    let mut verdict = verdict_of(&first, &found, final_id.as_ref(), &noise);
     let mut final_fit = final_id.as_ref().map(|id| id.summary.clone());
     let mut base_fit = first.base.summary.clone();
-    let disagreeing = pair
-        .as_ref()
-        .filter(|p| p.laws_disagree.is_some())
-        .and_then(|p| p.fit.as_ref());
-    if let (Some(pf), Some(f)) = (disagreeing, final_fit.as_mut()) {
-        let w = FitWarning::new(
-            WarningCode::Implausible,
-            crate::fiber::diagnostics::pair::disagreement(pf, f),
+    // explanations the data cannot tell apart from the result that disagree on its law
+    if let Some(f) = final_fit.as_mut() {
+        let rivals = ambiguity::disagreeing_rivals(
+            &first.candidates,
+            &found,
+            f,
+            result_dbic,
+            pair.as_ref(),
+            options,
         );
-        f.warnings.push(w);
+        if !rivals.is_empty() {
+            let w = ambiguity::warning(f, &rivals);
+            verdict = ambiguity::verdict(verdict, f, &rivals);
+            f.warnings.push(w);
+        }
     }
     if let Verdict::NoneOfTheCandidates { rms_over_noise, .. } = &verdict {
         // the law of a model that does not describe the data is biased by what it misses

@@ -10,6 +10,11 @@
 //!   (lag-1 autocorrelation `ρ₁ √pairs` below 3). Otherwise the verdict is "none of the
 //!   candidates": which ones help and how much, and where along the line (and in which
 //!   experiments) the unexplained residual lies — a user-written effect is the next step.
+//! * Where a candidate tied with the named one, or a pair of candidates fitted jointly within
+//!   the look-elsewhere margin (see [`pair`](crate::fiber::diagnostics::pair)), explains the
+//!   data about as well with a law outside the result's intervals, the verdict is "ambiguous":
+//!   the data cannot tell the explanations apart, and the law is not a result (the range all
+//!   span is given; see [`ambiguity`](super::ambiguity)).
 
 use crate::fiber::diagnostics::compare::segments::{find_segments, SegmentOptions};
 use crate::fiber::noise_summary::NoiseSummary;
@@ -68,6 +73,25 @@ pub enum Verdict {
         #[serde(default)]
         noise_level: f64,
     },
+    /// The named effects bring the residuals to the noise, but explanations the data cannot
+    /// tell apart from them (a candidate tied with the named one, a pair fitted jointly within
+    /// the look-elsewhere margin) disagree on the material law: the cause is not determined and
+    /// the law is not a result (see `ambiguity`).
+    Ambiguous {
+        /// The forward search's effects, in the order they were found.
+        effects: Vec<String>,
+        /// The other explanations whose law disagrees, each as its effects (one tied
+        /// candidate, or a pair fitted jointly).
+        alternatives: Vec<Vec<String>>,
+        /// RMS (outliers excluded) over the noise level with `effects` \[-\].
+        rms_over_noise: f64,
+        /// The noise level of the verdict (relative \[-\], see `noise_for`).
+        noise_level: f64,
+        /// Where `n` lies over all these explanations' 95 % intervals \[-\].
+        n_range: [f64; 2],
+        /// Where `κ = ln K` lies over all these explanations' 95 % intervals (`K` in Pa·s).
+        kappa_range: [f64; 2],
+    },
     /// Something is missing that none of the candidates describes (or describes only in part).
     NoneOfTheCandidates {
         /// The candidates that help, most first (named ones included).
@@ -80,6 +104,26 @@ pub enum Verdict {
         #[serde(default)]
         noise_level: f64,
     },
+}
+
+impl Verdict {
+    /// The short name of the verdict's kind, as in JSON (`"adequate"`, `"explained"`,
+    /// `"ambiguous"`, `"none_of_the_candidates"`).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Verdict::Adequate => "adequate",
+            Verdict::Explained { .. } => "explained",
+            Verdict::Ambiguous { .. } => "ambiguous",
+            Verdict::NoneOfTheCandidates { .. } => "none_of_the_candidates",
+        }
+    }
+
+    /// Whether the verdict leaves the material law of the final fit a result: not under
+    /// "none of the candidates" (the law is biased by what is missing) nor "ambiguous" (two
+    /// explanations disagree on it).
+    pub fn law_is_a_result(&self) -> bool {
+        matches!(self, Verdict::Adequate | Verdict::Explained { .. })
+    }
 }
 
 /// `J` the noise alone leaves after fitting `q` parameters to `n` residuals of noise level
@@ -165,5 +209,32 @@ mod tests {
         assert_eq!(share_of_excess(90.0, 80.0, 100.0), 0.0);
         let sd = vec![0.5; 100];
         assert!((noise_cost(&sd, 10) - 0.25 * 90.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_ambiguous_verdict_leaves_no_law_a_result_and_says_so_in_json() {
+        let v = Verdict::Ambiguous {
+            effects: vec!["air_coflow_line".into()],
+            alternatives: vec![vec!["air_temperature_profile".into(), "radiation".into()]],
+            rms_over_noise: 1.01,
+            noise_level: 0.015,
+            n_range: [0.744, 0.813],
+            kappa_range: [11.47, 12.13],
+        };
+        assert!(!v.law_is_a_result());
+        let json = serde_json::to_value(&v).unwrap();
+        assert_eq!(json["kind"], v.kind());
+        assert_eq!(json["kind"], "ambiguous");
+        assert_eq!(json["n_range"][1], 0.813);
+        assert_eq!(serde_json::from_value::<Verdict>(json).unwrap(), v);
+        assert!(Verdict::Adequate.law_is_a_result());
+        let none = Verdict::NoneOfTheCandidates {
+            helps: vec![],
+            unexplained: vec![],
+            rms_over_noise: 2.0,
+            noise_level: 0.015,
+        };
+        assert!(!none.law_is_a_result());
+        assert_eq!(serde_json::to_value(&none).unwrap()["kind"], none.kind());
     }
 }

@@ -181,12 +181,13 @@ impl Diagnosis {
     fn law_not_a_result(&self) -> Option<&'static str> {
         if matches!(self.verdict, Verdict::NoneOfTheCandidates { .. }) {
             Some("the misfit is not explained, see the verdict")
-        } else if self
-            .pair
-            .as_ref()
-            .is_some_and(|p| p.laws_disagree.is_some())
+        } else if matches!(self.verdict, Verdict::Ambiguous { .. })
+            || self
+                .pair
+                .as_ref()
+                .is_some_and(|p| p.laws_disagree.is_some())
         {
-            Some("a pair explains the data as well and disagrees on the law")
+            Some("another explanation as good disagrees on the law, see the verdict")
         } else {
             None
         }
