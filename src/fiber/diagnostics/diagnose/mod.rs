@@ -49,9 +49,10 @@
 //!    by `ΔBIC` (beyond a margin corrected for the pairs tried) replaces the forward search's
 //!    result; one within it is reported beside it, and where the two laws disagree neither is
 //!    a result.
-//! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, ambiguous (a tied
-//!     candidate or a pair beside the result with another law, `ambiguity`), or none of the
-//!     candidates (which help and how much, where the unexplained residual lies).
+//! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, ambiguous (a
+//!     candidate within the tie margin, credible or refused only for its strength's range, or
+//!     a pair beside the result, with another law: `ambiguity`), or none of the candidates
+//!     (which help and how much, where the unexplained residual lies).
 
 mod ambiguity;
 mod base;

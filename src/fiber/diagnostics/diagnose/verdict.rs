@@ -10,11 +10,13 @@
 //!   (lag-1 autocorrelation `ρ₁ √pairs` below 3). Otherwise the verdict is "none of the
 //!   candidates": which ones help and how much, and where along the line (and in which
 //!   experiments) the unexplained residual lies — a user-written effect is the next step.
-//! * Where a candidate tied with the named one, or a pair of candidates fitted jointly within
-//!   the look-elsewhere margin (see [`pair`](crate::fiber::diagnostics::pair)), explains the
-//!   data about as well with a law outside the result's intervals, the verdict is "ambiguous":
+//! * Where a candidate within the tie margin of the result (credible, or refused only for a
+//!   strength outside its physical range or at a search bound), or a pair of candidates fitted
+//!   jointly within the look-elsewhere margin (see [`pair`](crate::fiber::diagnostics::pair)),
+//!   explains the data about as well with a law outside the result's intervals, the verdict
+//!   is "ambiguous":
 //!   the data cannot tell the explanations apart, and the law is not a result (the range all
-//!   span is given; see [`ambiguity`](super::ambiguity)).
+//!   span is given; see the stage `ambiguity`).
 
 use crate::fiber::diagnostics::compare::segments::{find_segments, SegmentOptions};
 use crate::fiber::noise_summary::NoiseSummary;
