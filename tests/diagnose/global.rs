@@ -278,7 +278,7 @@ fn radiation_and_warm_air_never_a_wrong_law() {
     assert!(flagged, "a wrong law printed as a result: {:?}", fit.n);
     let pair = d.pair.as_ref().expect("the disagreeing explanation");
     let pf = pair.fit.as_ref().expect("the pair's fit beside the result");
-    let [n, k] = diffbvp::fiber::diagnostics::pair::law_envelope(pf, fit);
+    let [n, k] = diffbvp::fiber::diagnostics::pair::law_envelope_of([pf, fit]);
     assert!(holds(n, sc.law.n) && holds(k, sc.law.kappa), "{n:?} {k:?}");
     // the pair beside the result is the truth's
     let mut effects = pair.effects.to_vec();

@@ -100,12 +100,6 @@ pub fn laws_disagree(a: &FitSummary, b: &FitSummary) -> bool {
         || outside(b.kappa.value, a.kappa.ci95)
 }
 
-/// The union of two fits' 95 % intervals of `n` and of `κ`: where the law lies when the data
-/// cannot choose between the two explanations.
-pub fn law_envelope(a: &FitSummary, b: &FitSummary) -> [[f64; 2]; 2] {
-    law_envelope_of([a, b])
-}
-
 /// The union of the 95 % intervals of `n` and of `κ` over `fits`: where the law lies when the
 /// data cannot choose between them.
 pub fn law_envelope_of<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> [[f64; 2]; 2] {
@@ -118,16 +112,26 @@ pub fn law_envelope_of<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> [[
     [n, k]
 }
 
-/// The sentence on two explanations that disagree on the law: both `n`, the envelope, and
-/// that neither law is a result.
-pub fn disagreement(pair_fit: &FitSummary, steps_fit: &FitSummary) -> String {
-    let [n, k] = law_envelope(pair_fit, steps_fit);
+/// The sentence on explanations that disagree on the law: the result's `n` (`result`, the
+/// named effects), each rival's (`rivals`: its label, e.g. its effects, and its fit), the range
+/// all span, and that none of the laws is a result.
+pub fn disagreement(result: &FitSummary, rivals: &[(String, &FitSummary)]) -> String {
+    let [n, k] = law_envelope_of(rivals.iter().map(|(_, f)| *f).chain([result]));
+    let laws: Vec<String> = rivals
+        .iter()
+        .map(|(label, f)| format!("{:.3} with {label}", f.n.value))
+        .collect();
     format!(
-        "two explanations of the data that the diagnosis cannot tell apart disagree on the \
-         material law (n = {:.3} with the pair of effects, {:.3} with the forward search's \
-         effects): neither law is a result; over both, n lies in [{:.3}, {:.3}] and kappa in \
-         [{:.2}, {:.2}] (95 % intervals)",
-        pair_fit.n.value, steps_fit.n.value, n[0], n[1], k[0], k[1]
+        "explanations of the data that the diagnosis cannot tell apart disagree on the material \
+         law (n = {:.3} with the named effects, {}): {} law is a result; over all, n lies in \
+         [{:.3}, {:.3}] and kappa in [{:.2}, {:.2}] (95 % intervals)",
+        result.n.value,
+        laws.join(", "),
+        if rivals.len() == 1 { "neither" } else { "no" },
+        n[0],
+        n[1],
+        k[0],
+        k[1]
     )
 }
 

@@ -28,7 +28,7 @@
 use super::verdict::Verdict;
 use super::DiagnoseOptions;
 use crate::fiber::diagnostics::candidate::{Candidate, StrengthStatus};
-use crate::fiber::diagnostics::pair::{law_envelope_of, laws_disagree, PairFound};
+use crate::fiber::diagnostics::pair::{disagreement, law_envelope_of, laws_disagree, PairFound};
 use crate::fiber::rheometer::{FitSummary, FitWarning, WarningCode};
 
 /// A rival explanation: its effects, whether its strengths are credible, and its fit.
@@ -91,39 +91,18 @@ pub(crate) fn disagreeing_rivals<'a>(
 }
 
 /// The warning on the result's fit where rivals disagree on the law: each law, the range all
-/// span, and that none is a result. The pair's own sentence where it is the only rival (the
-/// report's pair paragraph quotes it).
+/// span, and that none is a result ([`disagreement`]).
 pub(crate) fn warning(result: &FitSummary, rivals: &[Rival<'_>]) -> FitWarning {
-    let message = match rivals {
-        [r] if r.effects.len() == 2 => crate::fiber::diagnostics::pair::disagreement(r.fit, result),
-        _ => {
-            let [n, k] = law_envelope_of(rivals.iter().map(|r| r.fit).chain([result]));
-            let laws: Vec<String> = rivals
-                .iter()
-                .map(|r| {
-                    format!(
-                        "{:.3} with {}{}",
-                        r.fit.n.value,
-                        r.effects.join(" + "),
-                        r.status.qualifier()
-                    )
-                })
-                .collect();
-            format!(
-                "explanations of the data that the diagnosis cannot tell apart disagree on the \
-                 material law (n = {:.3} with the named effects, {}): {} law is a result; over \
-                 all, n lies in [{:.3}, {:.3}] and kappa in [{:.2}, {:.2}] (95 % intervals)",
-                result.n.value,
-                laws.join(", "),
-                if rivals.len() == 1 { "neither" } else { "no" },
-                n[0],
-                n[1],
-                k[0],
-                k[1]
+    let labelled: Vec<(String, &FitSummary)> = rivals
+        .iter()
+        .map(|r| {
+            (
+                format!("{}{}", r.effects.join(" + "), r.status.qualifier()),
+                r.fit,
             )
-        }
-    };
-    FitWarning::new(WarningCode::Implausible, message)
+        })
+        .collect();
+    FitWarning::new(WarningCode::Implausible, disagreement(result, &labelled))
 }
 
 /// The verdict `explained` made ambiguous by `rivals` (unchanged where there is none or the

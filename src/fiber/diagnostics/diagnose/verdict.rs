@@ -230,6 +230,15 @@ mod tests {
         assert_eq!(json["n_range"][1], 0.813);
         assert_eq!(serde_json::from_value::<Verdict>(json).unwrap(), v);
         assert!(Verdict::Adequate.law_is_a_result());
+        let explained = Verdict::Explained {
+            effects: vec!["radiation".into()],
+            rms_over_noise: 1.0,
+            noise_level: 0.015,
+        };
+        assert!(explained.law_is_a_result());
+        for v in [&Verdict::Adequate, &explained] {
+            assert_eq!(serde_json::to_value(v).unwrap()["kind"], v.kind());
+        }
         let none = Verdict::NoneOfTheCandidates {
             helps: vec![],
             unexplained: vec![],

@@ -176,20 +176,17 @@ impl Diagnosis {
         ));
     }
 
-    /// Why the final law is not a result, if it is not: the misfit is not explained, or a
-    /// pair beside the result explains the data as well with another law.
+    /// Why the final law is not a result, if the verdict says it is not: the misfit is not
+    /// explained, or another explanation as good disagrees on the law.
     fn law_not_a_result(&self) -> Option<&'static str> {
-        if matches!(self.verdict, Verdict::NoneOfTheCandidates { .. }) {
-            Some("the misfit is not explained, see the verdict")
-        } else if matches!(self.verdict, Verdict::Ambiguous { .. })
-            || self
-                .pair
-                .as_ref()
-                .is_some_and(|p| p.laws_disagree.is_some())
-        {
-            Some("another explanation as good disagrees on the law, see the verdict")
-        } else {
-            None
+        match self.verdict {
+            Verdict::NoneOfTheCandidates { .. } => {
+                Some("the misfit is not explained, see the verdict")
+            }
+            Verdict::Ambiguous { .. } => {
+                Some("another explanation as good disagrees on the law, see the verdict")
+            }
+            Verdict::Adequate | Verdict::Explained { .. } => None,
         }
     }
 
@@ -245,7 +242,10 @@ impl Diagnosis {
                 s.push_str(&format!(
                     "WARNING: {}. A measurement that separates the effects (the air temperature \
                      along the line, the fiber temperature, the throughput) decides.\n",
-                    crate::fiber::diagnostics::pair::disagreement(pf, f)
+                    crate::fiber::diagnostics::pair::disagreement(
+                        f,
+                        &[(p.effects.join(" + "), pf)]
+                    )
                 ));
             }
         }
