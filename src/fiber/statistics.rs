@@ -1,7 +1,8 @@
 //! Statistics of relative residuals: noise estimates, the Wald–Wolfowitz runs test, lag-1
 //! autocorrelation and Spearman rank correlation. One home for the statistics the rheometer
 //! (its fit report and data checks), the comparison (`diagnostics::compare`) and the diagnosis
-//! (`diagnostics::diagnose`) compute.
+//! (`diagnostics::diagnose`) compute; tail probabilities of the F distribution in
+//! [`distributions`].
 //!
 //! **The noise model of record is [`NoiseModel`](crate::fiber::noise_model::NoiseModel)** (robust scale, scale along the line,
 //! outliers, one lag-1 autocorrelation, the judgement numbers); the comparison uses it. The
@@ -17,6 +18,8 @@
 //! The diagnosis's "systematic" test `rms/noise > 1.2` is calibrated on the RMS estimate: the
 //! robust estimate is smaller where the residual has kinks, and on the shipped correct-model
 //! control (RMS 1.682 %, robust noise 1.36 %) it would call the noise systematic.
+
+pub mod distributions;
 
 use serde::{Deserialize, Serialize};
 
