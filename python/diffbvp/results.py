@@ -567,7 +567,8 @@ class Diagnosis(Result):
     first, as :class:`Candidate` with their refits), ``base_fit`` (the user's model) and
     ``final_fit`` (with all found effects, fitted jointly) as :class:`FitResult`,
     ``calibration`` (the look-elsewhere calibration), ``further_steps``, ``alternatives``,
-    ``indistinguishable``, ``detection``. Arrays: ``residuals_before`` and
+    ``indistinguishable``, ``detection``, ``consistency`` (for each found effect, whether its
+    strength is the same in every experiment). Arrays: ``residuals_before`` and
     ``residuals_after`` (name → ``position_m``, ``relative_residual``) of the base and final
     fit.
     """
@@ -604,8 +605,20 @@ class Diagnosis(Result):
         "rms_over_noise", "n_range", "kappa_range"}`` (explanations as good that disagree on
         the law, each alternative a list of effects: the law is not a result, ``n_range`` and
         ``kappa_range`` span them all) or
-        ``{"kind": "none_of_the_candidates", "helps", "unexplained", "rms_over_noise"}``."""
+        ``{"kind": "none_of_the_candidates", "helps", "unexplained", "rms_over_noise",
+        "stand_ins"}`` (``stand_ins``: found effects that bring the residuals to the noise only
+        with a strength that differs between the experiments, see ``consistency``)."""
         return self._data["verdict"]
+
+    @property
+    def consistency(self) -> List[Dict[str, Any]]:
+        """For each found effect, the test that its strength is the same in every experiment
+        (a score test of the final fit against a strength varying with the conditions that
+        differ between the experiments): ``effect``, ``unit``, ``strength``, ``conditions``,
+        ``f_statistic``, ``dof``, ``p_value``, ``level``, ``share_of_cost`` and
+        ``by_experiment`` (name, first-order strength). An effect with ``p_value < level`` is a
+        stand-in for something else, and the verdict is "none of the candidates"."""
+        return list(self._data.get("consistency", []))
 
     @property
     def law_is_a_result(self) -> bool:

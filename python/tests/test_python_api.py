@@ -106,6 +106,22 @@ def test_take_up_rules(pmma):
         assert e["profiles"]["diameter_m"][-1] == pytest.approx(1e-4, rel=1e-6)
 
 
+def test_a_stand_in_effect_makes_the_law_no_result():
+    """Strain hardening (data/strain_hardening, outside the candidates, truth n = 0.8):
+    radiation brings the residuals to the noise with a biased law, but only with a strength
+    that differs between the experiments, so it is a stand-in and the law is no result."""
+    from conftest import ROOT
+
+    d = diffbvp.diagnose(diffbvp.load(ROOT / "data" / "strain_hardening" / "experiments.toml"))
+    assert d.verdict["kind"] == "none_of_the_candidates" and not d.law_is_a_result, d.verdict
+    stand_ins = d.verdict["stand_ins"]
+    assert [c["effect"] for c in stand_ins] == d.found, (stand_ins, d.found)
+    c = d.consistency[0]
+    assert c["p_value"] < c["level"] and c["dof"][0] == len(c["conditions"]) >= 1, c
+    assert len(c["by_experiment"]) == 9
+    assert "NONE OF THE CANDIDATES" in d.text and "With it: n =" not in d.text
+
+
 def test_a_pair_as_good_with_another_law_makes_the_law_no_result():
     """Radiation and warm air hide each other (data/radiation_warm_air, truth n = 0.8): the best
     single candidate reaches the noise with a biased law; the true pair, fitted jointly, is

@@ -335,10 +335,10 @@ fn radiation_and_warm_air_together() {
     );
 }
 
+/// Radiation (0.51) brings this hardening's residuals to the noise (RMS/noise 1.02) with a law
+/// 3.3 standard errors off (n = 0.863 against 0.8): only the consistency stage tells, since the
+/// radiation it needs grows with the throughput and the draw-down.
 #[test]
-#[ignore = "known shortfall (issue 26): radiation (0.51) explains the hardening to the noise \
-            (RMS/noise 1.02), n = 0.863 [0.827, 0.899] against 0.8: the diameters alone do not \
-            tell this hardening from radiative cooling"]
 fn strain_hardening_is_none_of_the_candidates() {
     let sc = Scenario {
         name: "strain_hardening",
@@ -363,6 +363,13 @@ fn strain_hardening_is_none_of_the_candidates() {
         "{:?}",
         d.verdict
     );
+    // the named effect is a stand-in: its strength differs between the experiments
+    assert!(
+        d.consistency.iter().any(|c| !c.consistent()),
+        "{:?}",
+        d.consistency
+    );
+    assert!(!d.verdict.law_is_a_result());
     // nothing named that removes less than half the excess misfit
     for c in d.candidates.iter().filter(|c| d.found.contains(&c.effect)) {
         assert!(
@@ -374,6 +381,41 @@ fn strain_hardening_is_none_of_the_candidates() {
     }
     let text = d.to_text();
     assert!(text.contains("NONE OF THE CANDIDATES"), "{text}");
+    assert!(!text.contains("With it: n ="), "{text}");
+}
+
+/// Strong hardening (β = 0.3, seed 12002 of `hardening_study`): the Nusselt factor is named
+/// but leaves the residuals above the noise, and the fit of step 2 (with it in the model) ends
+/// where the simulation fails (`n` → 0). That failure once ended the whole diagnosis with an
+/// error; now the forward search stops, says why, and the verdict stands on step 1.
+#[test]
+fn a_failing_further_step_ends_the_search_not_the_diagnosis() {
+    let sc = Scenario {
+        name: "strong_hardening",
+        hardening: 0.3,
+        seed: 12_002,
+        acceptable: vec![],
+        expected: None,
+        ..scenarios::control()
+    };
+    let (_, r) = diagnosed(&sc);
+    let d = &r.diagnosis;
+    let text = d.to_text();
+    println!(
+        "GLOBAL | strong_hardening | found {:?} | verdict {} | stopped {:?}",
+        d.found,
+        d.verdict.kind(),
+        d.stopped
+    );
+    assert!(
+        matches!(d.verdict, Verdict::NoneOfTheCandidates { .. }),
+        "{text}"
+    );
+    assert!(!d.verdict.law_is_a_result());
+    if let Some(why) = &d.stopped {
+        assert!(why.starts_with("step 2 (with "), "{why}");
+        assert!(text.contains("the forward search stopped early"), "{text}");
+    }
 }
 
 #[test]
@@ -600,6 +642,7 @@ fn power_at_twice_the_detection_limit() {
     let (_, control, _) = run(&scenarios::control());
     let mut short = Vec::new();
     let mut wrong = 0;
+    let mut all_stand_ins = 0;
     for effect in all.iter().filter(|e| chosen.iter().any(|c| c == *e)) {
         let limit = control
             .diagnosis
@@ -647,6 +690,7 @@ fn power_at_twice_the_detection_limit() {
             ),
         };
         let mut found = 0;
+        let mut stand_ins = 0;
         let mut laws = [0usize; 4];
         let t0 = Instant::now();
         for k in first..first + sets {
@@ -658,6 +702,28 @@ fn power_at_twice_the_detection_limit() {
             let hit = r.diagnosis.found.iter().any(|f| f == effect);
             if hit {
                 found += 1;
+            }
+            // a found effect called a stand-in by the consistency stage: the true one (a false
+            // rejection) or another in its place (a proxy, rightly rejected)
+            let rejected: Vec<&str> = r
+                .diagnosis
+                .consistency
+                .iter()
+                .filter(|c| !c.consistent())
+                .map(|c| c.effect.as_str())
+                .collect();
+            if rejected.contains(effect) {
+                stand_ins += 1;
+            }
+            if !rejected.is_empty() {
+                println!(
+                    "STAND-IN | {effect} | set {k} | {:?}",
+                    r.diagnosis
+                        .consistency
+                        .iter()
+                        .map(|c| (c.effect.as_str(), c.f_statistic, c.p_value))
+                        .collect::<Vec<_>>()
+                );
             }
             let odd = !hit || law == "WRONG" || law == "flagged, range misses";
             if odd && std::env::var_os("DIFFBVP_POWER_TEXT").is_some() {
@@ -675,7 +741,8 @@ fn power_at_twice_the_detection_limit() {
         }
         println!(
             "POWER | {effect} at 2 x s95 = 2 x {:.4} {}: found in {found} of {sets} sets | law \
-             holds {} flagged {} (range misses the truth {}) WRONG {} | {:.0} s",
+             holds {} flagged {} (range misses the truth {}) WRONG {} | the true effect \
+             called a stand-in {stand_ins} | {:.0} s",
             limit.s95,
             limit.unit,
             laws[0],
@@ -685,6 +752,7 @@ fn power_at_twice_the_detection_limit() {
             t0.elapsed().as_secs_f64()
         );
         wrong += laws[2];
+        all_stand_ins += stand_ins;
         if found * 10 < sets * 8 {
             short.push(format!("{effect}: {found} of {sets}"));
         }
@@ -698,5 +766,88 @@ fn power_at_twice_the_detection_limit() {
         wrong <= chance_wrong_laws(all_sets),
         "{wrong} wrong laws printed with confidence in {all_sets} sets"
     );
+    // the consistency test rejects a true effect with probability 1 % (its level)
+    assert!(
+        all_stand_ins <= chance_stand_ins(all_sets),
+        "the true effect called a stand-in in {all_stand_ins} of {all_sets} sets"
+    );
     assert!(short.is_empty(), "power below 80 %: {short:?}");
+}
+
+/// How many of `sets` true effects the consistency stage may call stand-ins by chance: its
+/// level is 1 %; 4 % of the sets (at least 3) is beyond that by a binomial tail of 0.4 % at 100
+/// sets.
+fn chance_stand_ins(sets: usize) -> usize {
+    (sets / 25).max(3)
+}
+
+/// Strain hardening, an effect no candidate describes, at several strengths and seeds
+/// (`DIFFBVP_HARDENING_SETS` per strength, default 10; strengths `β` = 0.1, 0.15, 0.3 in
+/// `η₀ exp(β ε_H)`): how often the diagnosis says "none of the candidates" (directly, or because
+/// the effect it would name is a stand-in whose strength differs between the experiments), how
+/// often it names a candidate, and whether the law it reports holds ([`law_outcome`]); wrong
+/// laws printed with confidence are allowed only as often as chance gives them.
+/// `cargo test --release --test diagnose global::hardening_study -- --ignored --nocapture`.
+#[test]
+#[ignore = "a study, ~6 min for 3 x 10 sets"]
+fn hardening_study() {
+    let sets: usize = std::env::var("DIFFBVP_HARDENING_SETS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(10);
+    let mut wrong = 0;
+    for beta in [0.1, 0.15, 0.3] {
+        let (mut none, mut stand_in, mut named) = (0, 0, 0);
+        let mut laws = [0usize; 4];
+        let t0 = Instant::now();
+        for k in 0..sets {
+            let sc = Scenario {
+                name: "hardening_study",
+                hardening: beta,
+                seed: 12_000 + k as u64,
+                acceptable: vec![],
+                expected: None,
+                ..scenarios::control()
+            };
+            let (_, r) = diagnosed(&sc);
+            let d = &r.diagnosis;
+            let (law, z) = law_outcome(&r, &sc);
+            let kinds = ["holds", "flagged", "WRONG", "flagged, range misses"];
+            laws[kinds.iter().position(|l| *l == law).unwrap()] += 1;
+            match &d.verdict {
+                Verdict::NoneOfTheCandidates { stand_ins, .. } if !stand_ins.is_empty() => {
+                    stand_in += 1
+                }
+                Verdict::NoneOfTheCandidates { .. } => none += 1,
+                Verdict::Explained { .. } | Verdict::Ambiguous { .. } => named += 1,
+                Verdict::Adequate => {}
+            }
+            println!(
+                "HARDENING | beta {beta} | set {k} | verdict {} | found {:?} | consistency {:?} | \
+                 law {law} ({z:.1} se from the truth)",
+                d.verdict.kind(),
+                d.found,
+                d.consistency
+                    .iter()
+                    .map(|c| (c.effect.as_str(), c.f_statistic, c.p_value))
+                    .collect::<Vec<_>>()
+            );
+        }
+        println!(
+            "HARDENING | beta {beta}: none of the candidates {none}, by a stand-in {stand_in}, \
+             a candidate named {named}, adequate {} of {sets} | law holds {} flagged {} WRONG {} \
+             | {:.0} s",
+            sets - none - stand_in - named,
+            laws[0],
+            laws[1] + laws[3],
+            laws[2],
+            t0.elapsed().as_secs_f64()
+        );
+        wrong += laws[2];
+    }
+    assert!(
+        wrong <= chance_wrong_laws(3 * sets),
+        "{wrong} wrong laws printed with confidence in {} sets",
+        3 * sets
+    );
 }

@@ -671,4 +671,52 @@ fn diagnose_marks_a_candidate_refit_at_its_bound() {
         .find(|l| l.trim_start().starts_with("radiation "))
         .unwrap();
     assert!(!radiation_line.contains("BOUND"), "{radiation_line}");
+    // the hidden radiation's emissivity is one number: the consistency stage finds it the same
+    // in every experiment
+    let cons = v["consistency"].as_array().unwrap();
+    assert!(
+        cons.iter().any(|c| c["effect"] == "radiation"
+            && c["p_value"].as_f64().unwrap() >= c["level"].as_f64().unwrap()),
+        "{cons:?}"
+    );
+    assert!(p
+        .stdout
+        .contains("One strength in every experiment? radiation: yes"));
+}
+
+/// `fit --with radiation` on the strain-hardening data (an effect no candidate describes):
+/// radiation brings the residuals to the noise, but only with a strength that grows with the
+/// throughput and the draw-down, so the fit warns that it is a stand-in and its law no result;
+/// on the hidden-radiation data (radiation the true cause) it does not.
+#[test]
+fn a_stand_in_effect_is_warned_about_by_fit() {
+    let dir = probe::scratch("fit_warn_stand_in");
+    for (set, stand_in) in [("strain_hardening", true), ("hidden_radiation", false)] {
+        let toml = probe::copy_data_set(set, &dir);
+        let data = dir.join(set);
+        let json = dir.join(format!("{set}.json"));
+        let p = probe::rheometer(
+            &[
+                "fit",
+                toml.to_str().unwrap(),
+                "--with",
+                "radiation",
+                "--json",
+                json.to_str().unwrap(),
+            ],
+            &[&data],
+            LIMIT,
+        );
+        p.assert_success();
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let warned = warning_with(&v, "implausible", "one strength in every experiment");
+        assert_eq!(warned, stand_in, "{set}: {}", p.stdout);
+        assert_eq!(
+            p.stdout.contains("stands in for something else"),
+            stand_in,
+            "{}",
+            p.stdout
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
 }

@@ -66,6 +66,14 @@ pub struct Diagnosis {
     /// The fit with all found effects (fitted jointly), if any was found.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub final_fit: Option<FitSummary>,
+    /// For each found effect, whether its strength in the final fit is the same in every
+    /// experiment (stage `consistency`; empty where the test cannot be done).
+    #[serde(default)]
+    pub consistency: Vec<super::diagnose::consistency::Consistency>,
+    /// Why the forward search stopped before its last step, where a step failed (the effects
+    /// found before it stand; `None` where every step ran).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
     /// What the diagnosis concludes.
     pub verdict: Verdict,
     /// Wall time \[s\].

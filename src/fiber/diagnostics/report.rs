@@ -1,6 +1,7 @@
 //! The diagnosis in words, and the before/after residual figure.
 
 use super::candidate::{Candidate, ShapeAlternative};
+use super::diagnose::consistency::Consistency;
 use super::diagnose::verdict::Verdict;
 use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::scan::Profile;
@@ -39,6 +40,16 @@ fn probability(p: f64) -> String {
         "< 0.05 %".into()
     } else {
         format!("{:.1} %", 100.0 * p)
+    }
+}
+
+/// "p < 0.05 %" or "p = 1.2 %".
+fn p_text(p: f64) -> String {
+    let t = probability(p);
+    if t.starts_with('<') {
+        format!("p {t}")
+    } else {
+        format!("p = {t}")
     }
 }
 
@@ -139,11 +150,14 @@ impl Diagnosis {
                 unexplained,
                 rms_over_noise,
                 noise_level,
+                stand_ins,
             } => {
                 let mut t = String::from(
                     "VERDICT: NONE OF THE CANDIDATES explains the misfit: something else is missing",
                 );
-                if helps.is_empty() {
+                if !stand_ins.is_empty() {
+                    t = stand_in_text(stand_ins, *rms_over_noise, &self.reestimated(*noise_level));
+                } else if helps.is_empty() {
                     t.push_str("; no candidate helps");
                 } else {
                     let h: Vec<String> = helps
@@ -156,10 +170,12 @@ impl Diagnosis {
                         h.join(", ")
                     ));
                 }
-                t.push_str(&format!(
-                    "; with the best of them RMS/noise is {rms_over_noise:.2}{}.\n",
-                    self.reestimated(*noise_level)
-                ));
+                if stand_ins.is_empty() {
+                    t.push_str(&format!(
+                        "; with the best of them RMS/noise is {rms_over_noise:.2}{}.\n",
+                        self.reestimated(*noise_level)
+                    ));
+                }
                 t.push_str(
                     "    The material law (n, kappa) of these fits is NOT A RESULT: a model that \
                      does not describe the data biases it by what it misses.\n",
@@ -189,6 +205,56 @@ impl Diagnosis {
             }
         }
     }
+}
+
+/// The verdict's first line where the named effects bring the residuals to the noise only
+/// with strengths that differ between the experiments.
+fn stand_in_text(stand_ins: &[Consistency], rms_over_noise: f64, reestimated: &str) -> String {
+    let each: Vec<String> = stand_ins
+        .iter()
+        .map(|c| {
+            // values to a tenth of the spread between the experiments
+            let spread = c.extremes().map_or(0.0, |(lo, hi)| hi.1 - lo.1);
+            let fmt_strength = |v: f64| fmt_at(v, spread / 10.0);
+            let unit = if c.unit == "-" { "" } else { c.unit.as_str() };
+            let range = match c.extremes() {
+                Some((lo, hi)) => format!(
+                    "from {} {unit} ({}) to {} {unit} ({})",
+                    fmt_strength(lo.1),
+                    lo.0,
+                    fmt_strength(hi.1),
+                    hi.0
+                ),
+                None => String::new(),
+            };
+            format!(
+                "{} (one strength {} {unit} for all) varies with {}: to first order {range} \
+                 (F = {:.1} on {} and {} degrees of freedom, {})",
+                c.effect,
+                fmt_strength(c.strength),
+                c.conditions.join(", "),
+                c.f_statistic,
+                c.dof[0],
+                c.dof[1],
+                p_text(c.p_value)
+            )
+            .replace(" ,", ",")
+            .replace("  ", " ")
+        })
+        .collect();
+    format!(
+        "VERDICT: NONE OF THE CANDIDATES explains the data: with {} the residuals are at the \
+         noise (RMS/noise {rms_over_noise:.2}{reestimated}), but only with a strength that is \
+         not the same in every experiment, which a physical constant or one instrument's error \
+         is not: {}. It stands in for an effect none of the candidates describes (a process \
+         error that differs between the runs would do the same: check them).\n",
+        stand_ins
+            .iter()
+            .map(|c| c.effect.as_str())
+            .collect::<Vec<_>>()
+            .join(" + "),
+        each.join("; ")
+    )
 }
 
 /// One profile in a line: up to 9 points (the lowest always among them) as `strength: J/J_base`.

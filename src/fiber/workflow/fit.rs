@@ -3,6 +3,7 @@
 //! the figures need (the Newtonian reference and, for a model with added effects, the same fit
 //! without them).
 
+use crate::fiber::diagnostics::diagnose::consistency;
 use crate::fiber::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::fiber::figures::ResidualView;
 use crate::fiber::fit_html::{fit_report_page, FitReportInput, ReportExperiment};
@@ -139,6 +140,19 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
     };
     // a model with fitted effects never ends worse than the model without them
     let mut id = rh.identify_nested(start, opts)?.fit;
+    // an effect whose strength must differ between the experiments is a stand-in
+    let fitted: Vec<String> = id
+        .summary
+        .effects
+        .iter()
+        .filter(|e| e.strength.fitted)
+        .map(|e| e.effect.clone())
+        .collect();
+    for c in consistency::check(&id, &fitted, &data.set) {
+        if !c.consistent() {
+            id.summary.warnings.push(consistency::warning(&c));
+        }
+    }
     let budget = request
         .error_budget
         .then(|| error_budget(&rh, &id, &data.uncertainty, opts));

@@ -1,5 +1,5 @@
-//! Stage 10b: explanations the data cannot tell apart from the result, and whether they agree
-//! on the material law.
+//! Stage 11a (part of the verdict): explanations the data cannot tell apart from the result,
+//! and whether they agree on the material law.
 //!
 //! The diagnosis' result (the effects it names, fitted jointly with the law) has rivals it
 //! cannot exclude:

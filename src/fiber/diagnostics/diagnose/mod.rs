@@ -49,7 +49,13 @@
 //!    by `ΔBIC` (beyond a margin corrected for the pairs tried) replaces the forward search's
 //!    result; one within it is reported beside it, and where the two laws disagree neither is
 //!    a result.
-//! 10. **Verdict** ([`verdict`]): explained by the named effects, adequate, ambiguous (a
+//! 10. **One strength in every experiment** ([`consistency`]): a score test of the final fit
+//!     against each found effect's strength varying with the conditions that differ between
+//!     the experiments (no new fit); an effect that fails is a stand-in for something else.
+//!     Where the residuals would otherwise be explained, the verdict is then "none of the
+//!     candidates" (with its stand-ins). A further step whose fit fails ends the forward
+//!     search there ([`Diagnosis::stopped`]), not the diagnosis.
+//! 11. **Verdict** ([`verdict`]): explained by the named effects, adequate, ambiguous (a
 //!     candidate within the tie margin, credible or refused only for its strength's range, or
 //!     a pair beside the result, with another law: `ambiguity`), or none of the candidates
 //!     (which help and how much, where the unexplained residual lies).
@@ -57,6 +63,7 @@
 mod ambiguity;
 mod base;
 pub mod calibrate;
+pub mod consistency;
 mod judge;
 mod linearise;
 mod pairs;
@@ -148,6 +155,7 @@ pub fn diagnose(
     let t0 = Instant::now();
     let first = step::run(set, base_spec, options, None)?;
     let mut steps = vec![first];
+    let mut stopped = None;
     while steps.len() < options.max_effects.max(1) {
         let Some(last) = steps.last() else { break };
         let Some((variant, refit)) = &last.named_refit else {
@@ -166,8 +174,20 @@ pub fn diagnose(
             break;
         }
         opts.start = Some(refit.law());
-        let next = step::run(set, &spec, &opts, Some(refit))?;
-        steps.push(next);
+        // a further step that fails (its fit of the model with the effects found so far cannot
+        // be evaluated) ends the search with what the steps before found, and says why
+        match step::run(set, &spec, &opts, Some(refit)) {
+            Ok(next) => steps.push(next),
+            Err(e) => {
+                let with: Vec<&str> = spec.effects.iter().map(|e| e.effect.name()).collect();
+                stopped = Some(format!(
+                    "step {} (with {} in the model) could not be run: {e}",
+                    steps.len() + 1,
+                    with.join(" + ")
+                ));
+                break;
+            }
+        }
     }
     // two effects that hide each other: every pair fitted jointly, as a challenge to what the
     // steps found, wherever there is something to explain
@@ -194,7 +214,9 @@ pub fn diagnose(
     } else {
         None
     };
-    Ok(assemble(steps, pair, options, t0))
+    let mut run = assemble(set, steps, pair, options, t0);
+    run.diagnosis.stopped = stopped;
+    Ok(run)
 }
 
 /// Whether the user's residuals are systematic or an effect was named.
@@ -230,6 +252,7 @@ fn steps_result(steps: &[step::Step]) -> (f64, Option<&crate::fiber::rheometer::
 /// The diagnosis of the steps: the first step's records, the further steps', the effects
 /// found, the final fit and the verdict.
 fn assemble(
+    set: &ExperimentSet,
     mut steps: Vec<step::Step>,
     pair: Option<(crate::fiber::diagnostics::pair::PairFound, Identification)>,
     options: &DiagnoseOptions,
@@ -258,7 +281,17 @@ fn assemble(
         p
     });
     let first = steps.remove(0);
-    let mut verdict = verdict_of(&first, &found, final_id.as_ref(), &noise);
+    // one strength for every experiment, or a stand-in for something else
+    let consistency = final_id
+        .as_ref()
+        .map(|id| consistency::check(id, &found, set))
+        .unwrap_or_default();
+    let stand_ins: Vec<consistency::Consistency> = consistency
+        .iter()
+        .filter(|c| !c.consistent())
+        .cloned()
+        .collect();
+    let mut verdict = verdict_of(&first, &found, final_id.as_ref(), &noise, stand_ins);
     let mut final_fit = final_id.as_ref().map(|id| id.summary.clone());
     let mut base_fit = first.base.summary.clone();
     // explanations the data cannot tell apart from the result that disagree on its law
@@ -277,16 +310,24 @@ fn assemble(
             f.warnings.push(w);
         }
     }
-    if let Verdict::NoneOfTheCandidates { rms_over_noise, .. } = &verdict {
+    if let Verdict::NoneOfTheCandidates {
+        rms_over_noise,
+        stand_ins,
+        ..
+    } = &verdict
+    {
         // the law of a model that does not describe the data is biased by what it misses
-        let w = FitWarning::new(
-            WarningCode::Implausible,
-            format!(
-                "none of the candidate effects brings the residuals to the noise (RMS/noise \
-                 {rms_over_noise:.2} with the best of them): the material law (n, kappa) of this \
-                 model is biased by the missing effect and is not a result"
+        let w = match stand_ins.first() {
+            Some(c) => consistency::warning(c),
+            None => FitWarning::new(
+                WarningCode::Implausible,
+                format!(
+                    "none of the candidate effects brings the residuals to the noise (RMS/noise \
+                     {rms_over_noise:.2} with the best of them): the material law (n, kappa) of \
+                     this model is biased by the missing effect and is not a result"
+                ),
             ),
-        );
+        };
         for s in final_fit.iter_mut().chain(std::iter::once(&mut base_fit)) {
             s.warnings.push(w.clone());
         }
@@ -324,6 +365,8 @@ fn assemble(
             found,
             pair,
             final_fit,
+            consistency,
+            stopped: None,
             verdict,
             wall_time_s: t0.elapsed().as_secs_f64(),
         },
@@ -341,11 +384,13 @@ fn verdict_of(
     found: &[String],
     final_id: Option<&Identification>,
     noise: &NoiseSummary,
+    stand_ins: Vec<consistency::Consistency>,
 ) -> Verdict {
     let fit = final_id.unwrap_or(&first.base);
     let noise = &verdict::noise_for(&fit.summary, noise);
     let (ratio, _) = verdict::at_noise(&fit.summary, noise);
-    if !found.is_empty() && verdict::explained(&fit.summary, noise) {
+    let at_noise = !found.is_empty() && verdict::explained(&fit.summary, noise);
+    if at_noise && stand_ins.is_empty() {
         return Verdict::Explained {
             effects: found.to_vec(),
             rms_over_noise: ratio,
@@ -375,5 +420,7 @@ fn verdict_of(
         ),
         rms_over_noise: ratio,
         noise_level: noise.level,
+        // effects that would explain the data but for their varying strength
+        stand_ins: if at_noise { stand_ins } else { Vec::new() },
     }
 }

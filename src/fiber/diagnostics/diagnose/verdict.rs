@@ -1,4 +1,4 @@
-//! Stage 9: the verdict — what the diagnosis may say.
+//! Stage 11: the verdict — what the diagnosis may say.
 //!
 //! * An effect is named as missing only when it earns its place (credible strength and law,
 //!   `ΔBIC` below the threshold), is unlikely to be a false alarm of the search over all
@@ -10,6 +10,9 @@
 //!   (lag-1 autocorrelation `ρ₁ √pairs` below 3). Otherwise the verdict is "none of the
 //!   candidates": which ones help and how much, and where along the line (and in which
 //!   experiments) the unexplained residual lies — a user-written effect is the next step.
+//!   It is "none of the candidates" too where the named effects bring the residuals to the
+//!   noise only with a strength that differs between the experiments (the stage
+//!   [`consistency`](super::consistency)): they stand in for something else.
 //! * Where a candidate within the tie margin of the result (credible, or refused only for a
 //!   strength outside its physical range or at a search bound), or a pair of candidates fitted
 //!   jointly within the look-elsewhere margin (see [`pair`](crate::fiber::diagnostics::pair)),
@@ -105,6 +108,11 @@ pub enum Verdict {
         /// The noise level of the verdict (relative \[-\], see `noise_for`).
         #[serde(default)]
         noise_level: f64,
+        /// Named effects that bring the residuals to the noise, but only with a strength that
+        /// differs between the experiments (stage `consistency`): stand-ins for an effect none
+        /// of the candidates describes (empty where the residuals are not at the noise).
+        #[serde(default)]
+        stand_ins: Vec<super::consistency::Consistency>,
     },
 }
 
@@ -244,8 +252,13 @@ mod tests {
             unexplained: vec![],
             rms_over_noise: 2.0,
             noise_level: 0.015,
+            stand_ins: vec![],
         };
         assert!(!none.law_is_a_result());
         assert_eq!(serde_json::to_value(&none).unwrap()["kind"], none.kind());
+        // a file written before the consistency stage reads with no stand-ins
+        let old = serde_json::json!({"kind": "none_of_the_candidates", "helps": [],
+            "unexplained": [], "rms_over_noise": 2.0, "noise_level": 0.015});
+        assert_eq!(serde_json::from_value::<Verdict>(old).unwrap(), none);
     }
 }

@@ -29,8 +29,9 @@ impl Diagnosis {
                 }
             }
         }
-        self.pair_paragraph(&mut s);
         self.further_steps_paragraph(&mut s);
+        self.consistency_paragraph(&mut s);
+        self.pair_paragraph(&mut s);
         self.not_named_paragraph(&mut s);
         self.candidates_table(&mut s);
         self.profiles_paragraph(&mut s);
@@ -180,6 +181,9 @@ impl Diagnosis {
     /// explained, or another explanation as good disagrees on the law.
     fn law_not_a_result(&self) -> Option<&'static str> {
         match self.verdict {
+            Verdict::NoneOfTheCandidates { ref stand_ins, .. } if !stand_ins.is_empty() => Some(
+                "the effect's strength differs between the experiments: a stand-in, see the verdict",
+            ),
             Verdict::NoneOfTheCandidates { .. } => {
                 Some("the misfit is not explained, see the verdict")
             }
@@ -254,6 +258,12 @@ impl Diagnosis {
     /// The further steps (each with the causes found before in the model) and the final fit
     /// with every cause found.
     fn further_steps_paragraph(&self, s: &mut String) {
+        if let Some(why) = &self.stopped {
+            s.push_str(&format!(
+                "NOTE: the forward search stopped early: {why}; what the steps before found \
+                 stands.\n"
+            ));
+        }
         for (k, st) in self.further_steps.iter().enumerate() {
             s.push_str(&format!(
                 "Step {} (with {} in the model, fitted jointly): {}.\n",
@@ -283,6 +293,31 @@ impl Diagnosis {
                     .map_or(String::new(), |why| format!(" (NOT A RESULT: {why})"));
                 s.push_str(&law_line(&self.found.join(" + "), &note, f));
             }
+        }
+    }
+
+    /// Whether each found effect's strength is the same in every experiment.
+    fn consistency_paragraph(&self, s: &mut String) {
+        for c in &self.consistency {
+            s.push_str(&format!(
+                "One strength in every experiment? {}: {} (score test against a strength varying \
+                 with {}: F = {:.2} on {} and {} degrees of freedom, {}; it would remove \
+                 {:.1} % of J){}.\n",
+                c.effect,
+                if c.consistent() { "yes" } else { "NO" },
+                c.conditions.join(", "),
+                c.f_statistic,
+                c.dof[0],
+                c.dof[1],
+                super::p_text(c.p_value),
+                100.0 * c.share_of_cost,
+                if c.consistent() {
+                    ""
+                } else {
+                    ": an effect whose strength must change with the experiment's conditions \
+                     stands in for something else"
+                }
+            ));
         }
     }
 
