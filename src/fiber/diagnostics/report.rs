@@ -7,6 +7,7 @@ use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::scan::Profile;
 use crate::fiber::format::{fmt_at, fmt_g, fmt_pm};
 use crate::fiber::rheometer::summary::Z95;
+use crate::fiber::rheometer::summary_text::fmt_p;
 use crate::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
 
@@ -40,16 +41,6 @@ fn probability(p: f64) -> String {
         "< 0.05 %".into()
     } else {
         format!("{:.1} %", 100.0 * p)
-    }
-}
-
-/// "p < 0.05 %" or "p = 1.2 %".
-fn p_text(p: f64) -> String {
-    let t = probability(p);
-    if t.starts_with('<') {
-        format!("p {t}")
-    } else {
-        format!("p = {t}")
     }
 }
 
@@ -236,7 +227,7 @@ fn stand_in_text(stand_ins: &[Consistency], rms_over_noise: f64, reestimated: &s
                 c.f_statistic,
                 c.dof[0],
                 c.dof[1],
-                p_text(c.p_value)
+                fmt_p(c.p_value)
             )
             .replace(" ,", ",")
             .replace("  ", " ")

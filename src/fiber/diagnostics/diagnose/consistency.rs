@@ -19,6 +19,7 @@
 //! noise level does not enter. An effect fails the test when `P(F > f)` is below
 //! [`CONSISTENCY_LEVEL`] divided by the number of effects tested.
 
+use crate::fiber::rheometer::summary_text::fmt_p;
 use crate::fiber::rheometer::{FitWarning, Identification, WarningCode};
 use crate::fiber::setup::ExperimentSet;
 use crate::fiber::statistics::distributions::f_survival;
@@ -96,7 +97,7 @@ pub fn warning(c: &Consistency) -> FitWarning {
         WarningCode::Implausible,
         format!(
             "{} does not have one strength in every experiment: letting it vary with {} removes \
-             {:.1} % of J (F = {:.2} on {} and {} degrees of freedom, p = {:.1e}){range}; an \
+             {:.1} % of J (F = {:.2} on {} and {} degrees of freedom, {}){range}; an \
              effect that must change with the experiment's conditions stands in for something \
              else, and the material law (n, kappa) fitted with it is biased and not a result",
             c.effect,
@@ -105,7 +106,7 @@ pub fn warning(c: &Consistency) -> FitWarning {
             c.f_statistic,
             c.dof[0],
             c.dof[1],
-            c.p_value
+            fmt_p(c.p_value)
         ),
     )
 }

@@ -8,6 +8,7 @@ use super::{
     shape_alternative_line, unit_suffix, EXACT_TIE,
 };
 use crate::fiber::format::{fmt_g, wrap_long_lines};
+use crate::fiber::rheometer::summary_text::fmt_p;
 use crate::fiber::rheometer::FitSummary;
 
 impl Diagnosis {
@@ -309,7 +310,7 @@ impl Diagnosis {
                 c.f_statistic,
                 c.dof[0],
                 c.dof[1],
-                super::p_text(c.p_value),
+                fmt_p(c.p_value),
                 100.0 * c.share_of_cost,
                 if c.consistent() {
                     ""
