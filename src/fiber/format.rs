@@ -137,6 +137,14 @@ pub fn fmt_pm(value: f64, uncertainty: f64) -> String {
     )
 }
 
+/// `" unit"`, or nothing for a dimensionless quantity (unit `""` or `"-"`).
+pub fn unit_suffix(unit: &str) -> String {
+    match unit.trim() {
+        "" | "-" => String::new(),
+        u => format!(" {u}"),
+    }
+}
+
 /// `v` at the precision an uncertainty `u` supports (the same decimal place as in
 /// [`fmt_pm`]): interval ends and values beside a `±`. `u` not positive and finite: [`fmt_g`].
 pub fn fmt_at(v: f64, u: f64) -> String {

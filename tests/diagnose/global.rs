@@ -523,6 +523,9 @@ fn law_outcome(r: &DiagnosisRun, sc: &Scenario) -> (&'static str, f64) {
     }
 }
 
+/// The outcomes [`law_outcome`] gives, in the order the studies count them.
+const LAW_OUTCOMES: [&str; 4] = ["holds", "flagged", "WRONG", "flagged, range misses"];
+
 /// How many of `sets` laws may lie more than 3 standard errors from the truth by chance where
 /// the model is right: `n` and `κ` each miss by that with probability 0.27 %, a set at most
 /// 0.54 %; 2 % of the sets (at least 2) is beyond that by a binomial tail of about 2 % at 100
@@ -699,8 +702,7 @@ fn power_at_twice_the_detection_limit() {
             let sc = scenario(9_000 + k as u64);
             let (_, r) = diagnosed(&sc);
             let (law, z) = law_outcome(&r, &sc);
-            let kinds = ["holds", "flagged", "WRONG", "flagged, range misses"];
-            laws[kinds.iter().position(|l| *l == law).unwrap()] += 1;
+            laws[LAW_OUTCOMES.iter().position(|l| *l == law).unwrap()] += 1;
             let hit = r.diagnosis.found.iter().any(|f| f == effect);
             if hit {
                 found += 1;
@@ -816,8 +818,7 @@ fn hardening_study() {
             let (_, r) = diagnosed(&sc);
             let d = &r.diagnosis;
             let (law, z) = law_outcome(&r, &sc);
-            let kinds = ["holds", "flagged", "WRONG", "flagged, range misses"];
-            laws[kinds.iter().position(|l| *l == law).unwrap()] += 1;
+            laws[LAW_OUTCOMES.iter().position(|l| *l == law).unwrap()] += 1;
             match &d.verdict {
                 Verdict::NoneOfTheCandidates { stand_ins, .. } if !stand_ins.is_empty() => {
                     stand_in += 1

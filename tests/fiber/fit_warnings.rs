@@ -56,19 +56,21 @@ fn edit(path: &Path, from: &str, to: &str) {
 /// Runs `rheometer fit TOML --json JSON` (inputs watched), expects success, returns the probe
 /// and the JSON.
 fn fit_cli(toml: &Path, data: &Path, dir: &Path) -> (probe::Probe, Value) {
-    let json = dir.join("fit.json");
-    let p = probe::rheometer(
-        &[
-            "fit",
-            toml.to_str().unwrap(),
-            "--json",
-            json.to_str().unwrap(),
-        ],
-        &[data],
-        LIMIT,
-    );
+    fit_cli_with(toml, data, &dir.join("fit.json"), &[])
+}
+
+/// [`fit_cli`] writing the JSON to `json`, with more arguments (`--with radiation`).
+fn fit_cli_with(toml: &Path, data: &Path, json: &Path, args: &[&str]) -> (probe::Probe, Value) {
+    let mut all = vec![
+        "fit",
+        toml.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ];
+    all.extend_from_slice(args);
+    let p = probe::rheometer(&all, &[data], LIMIT);
     p.assert_success();
-    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
     (p, v)
 }
 
@@ -693,22 +695,8 @@ fn a_stand_in_effect_is_warned_about_by_fit() {
     let dir = probe::scratch("fit_warn_stand_in");
     for (set, stand_in) in [("strain_hardening", true), ("hidden_radiation", false)] {
         let toml = probe::copy_data_set(set, &dir);
-        let data = dir.join(set);
         let json = dir.join(format!("{set}.json"));
-        let p = probe::rheometer(
-            &[
-                "fit",
-                toml.to_str().unwrap(),
-                "--with",
-                "radiation",
-                "--json",
-                json.to_str().unwrap(),
-            ],
-            &[&data],
-            LIMIT,
-        );
-        p.assert_success();
-        let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let (p, v) = fit_cli_with(&toml, &dir.join(set), &json, &["--with", "radiation"]);
         let warned = warning_with(&v, "implausible", "one strength in every experiment");
         assert_eq!(warned, stand_in, "{set}: {}", p.stdout);
         assert_eq!(

@@ -69,7 +69,7 @@ pub struct Diagnosis {
     /// For each found effect, whether its strength in the final fit is the same in every
     /// experiment (stage `consistency`; empty where the test cannot be done).
     #[serde(default)]
-    pub consistency: Vec<super::diagnose::consistency::Consistency>,
+    pub consistency: Vec<super::consistency::Consistency>,
     /// Why the forward search stopped before its last step, where a step failed (the effects
     /// found before it stand; `None` where every step ran).
     #[serde(default, skip_serializing_if = "Option::is_none")]

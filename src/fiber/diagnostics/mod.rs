@@ -19,11 +19,14 @@
 //!   and the shift of `(n, κ)` an effect just below it would cause;
 //! * [`scan`]: the global search of one candidate's strength (and shape): the profile of `J`
 //!   and the refits of its best points;
-//! * [`ties`]: candidates about as consistent with the data as the named one (alternatives).
+//! * [`ties`]: candidates about as consistent with the data as the named one (alternatives);
+//! * [`consistency`]: whether a fitted effect has one strength in every experiment (a score
+//!   test of the fit; the diagnosis' stage 10 and `fit --with` both use it).
 
 pub mod calibration;
 pub mod candidate;
 pub mod compare;
+pub mod consistency;
 pub mod detection;
 pub mod diagnose;
 pub mod diagnosis;

@@ -1,13 +1,12 @@
 //! The diagnosis in words, and the before/after residual figure.
 
 use super::candidate::{Candidate, ShapeAlternative};
-use super::diagnose::consistency::Consistency;
+use super::consistency::Consistency;
 use super::diagnose::verdict::Verdict;
 use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::scan::Profile;
-use crate::fiber::format::{fmt_at, fmt_g, fmt_pm};
+use crate::fiber::format::{fmt_at, fmt_g, fmt_pm, unit_suffix};
 use crate::fiber::rheometer::summary::Z95;
-use crate::fiber::rheometer::summary_text::fmt_p;
 use crate::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
 
@@ -15,14 +14,6 @@ mod text;
 
 fn fmt_range(r: [f64; 2]) -> String {
     format!("{:.2}–{:.2} m", r[0], r[1])
-}
-
-/// `" unit"`, or nothing for a dimensionless quantity.
-fn unit_suffix(unit: &str) -> String {
-    match unit.trim() {
-        "" | "-" => String::new(),
-        u => format!(" {u}"),
-    }
 }
 
 /// `value ± se unit` rounded to the uncertainty.
@@ -204,33 +195,14 @@ fn stand_in_text(stand_ins: &[Consistency], rms_over_noise: f64, reestimated: &s
     let each: Vec<String> = stand_ins
         .iter()
         .map(|c| {
-            // values to a tenth of the spread between the experiments
-            let spread = c.extremes().map_or(0.0, |(lo, hi)| hi.1 - lo.1);
-            let fmt_strength = |v: f64| fmt_at(v, spread / 10.0);
-            let unit = if c.unit == "-" { "" } else { c.unit.as_str() };
-            let range = match c.extremes() {
-                Some((lo, hi)) => format!(
-                    "from {} {unit} ({}) to {} {unit} ({})",
-                    fmt_strength(lo.1),
-                    lo.0,
-                    fmt_strength(hi.1),
-                    hi.0
-                ),
-                None => String::new(),
-            };
             format!(
-                "{} (one strength {} {unit} for all) varies with {}: to first order {range} \
-                 (F = {:.1} on {} and {} degrees of freedom, {})",
+                "{} (one strength {} for all) varies with {}: to first order {} ({})",
                 c.effect,
-                fmt_strength(c.strength),
+                c.strength_words(c.strength),
                 c.conditions.join(", "),
-                c.f_statistic,
-                c.dof[0],
-                c.dof[1],
-                fmt_p(c.p_value)
+                c.spread_words(),
+                c.test_words()
             )
-            .replace(" ,", ",")
-            .replace("  ", " ")
         })
         .collect();
     format!(

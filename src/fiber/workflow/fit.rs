@@ -3,7 +3,7 @@
 //! the figures need (the Newtonian reference and, for a model with added effects, the same fit
 //! without them).
 
-use crate::fiber::diagnostics::diagnose::consistency;
+use crate::fiber::diagnostics::consistency;
 use crate::fiber::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::fiber::figures::ResidualView;
 use crate::fiber::fit_html::{fit_report_page, FitReportInput, ReportExperiment};

@@ -63,7 +63,6 @@
 mod ambiguity;
 mod base;
 pub mod calibrate;
-pub mod consistency;
 mod judge;
 mod linearise;
 mod pairs;
@@ -73,6 +72,7 @@ mod signature;
 mod step;
 pub mod verdict;
 
+use super::consistency;
 use super::scan::ScanOptions;
 use super::ties::DEFAULT_TIE_MARGIN;
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};

@@ -12,7 +12,7 @@
 //!   experiments) the unexplained residual lies — a user-written effect is the next step.
 //!   It is "none of the candidates" too where the named effects bring the residuals to the
 //!   noise only with a strength that differs between the experiments (the stage
-//!   [`consistency`](super::consistency)): they stand in for something else.
+//!   [`consistency`](crate::fiber::diagnostics::consistency)): they stand in for something else.
 //! * Where a candidate within the tie margin of the result (credible, or refused only for a
 //!   strength outside its physical range or at a search bound), or a pair of candidates fitted
 //!   jointly within the look-elsewhere margin (see [`pair`](crate::fiber::diagnostics::pair)),
@@ -112,7 +112,7 @@ pub enum Verdict {
         /// differs between the experiments (stage `consistency`): stand-ins for an effect none
         /// of the candidates describes (empty where the residuals are not at the noise).
         #[serde(default)]
-        stand_ins: Vec<super::consistency::Consistency>,
+        stand_ins: Vec<crate::fiber::diagnostics::consistency::Consistency>,
     },
 }
 

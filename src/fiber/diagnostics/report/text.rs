@@ -8,7 +8,6 @@ use super::{
     shape_alternative_line, unit_suffix, EXACT_TIE,
 };
 use crate::fiber::format::{fmt_g, wrap_long_lines};
-use crate::fiber::rheometer::summary_text::fmt_p;
 use crate::fiber::rheometer::FitSummary;
 
 impl Diagnosis {
@@ -302,15 +301,11 @@ impl Diagnosis {
         for c in &self.consistency {
             s.push_str(&format!(
                 "One strength in every experiment? {}: {} (score test against a strength varying \
-                 with {}: F = {:.2} on {} and {} degrees of freedom, {}; it would remove \
-                 {:.1} % of J){}.\n",
+                 with {}: {}; it would remove {:.1} % of J){}.\n",
                 c.effect,
                 if c.consistent() { "yes" } else { "NO" },
                 c.conditions.join(", "),
-                c.f_statistic,
-                c.dof[0],
-                c.dof[1],
-                fmt_p(c.p_value),
+                c.test_words(),
                 100.0 * c.share_of_cost,
                 if c.consistent() {
                     ""

@@ -1,4 +1,5 @@
-//! Stage 10: is each named effect's strength the same in every experiment?
+//! Is each fitted effect's strength the same in every experiment? (the diagnosis' stage 10,
+//! and the check of `fit --with`)
 //!
 //! A physical constant (an emissivity, a Nusselt factor, the gauge's calibration, the air's
 //! profile around one line) has one value in every run. An effect that brings the residuals to
@@ -19,11 +20,13 @@
 //! noise level does not enter. An effect fails the test when `P(F > f)` is below
 //! [`CONSISTENCY_LEVEL`] divided by the number of effects tested.
 
+use crate::fiber::format::{fmt_at, unit_suffix};
 use crate::fiber::rheometer::summary_text::fmt_p;
 use crate::fiber::rheometer::{FitWarning, Identification, WarningCode};
 use crate::fiber::setup::ExperimentSet;
 use crate::fiber::statistics::distributions::f_survival;
 use crate::least_squares::Loss;
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
@@ -82,31 +85,54 @@ impl Consistency {
             .max_by(|a, b| a.1.total_cmp(&b.1))?;
         Some((lo, hi))
     }
+
+    /// A strength in words, to a tenth of the spread between the experiments, with its unit.
+    pub fn strength_words(&self, v: f64) -> String {
+        let spread = self.extremes().map_or(0.0, |(lo, hi)| hi.1 - lo.1);
+        format!("{}{}", fmt_at(v, spread / 10.0), unit_suffix(&self.unit))
+    }
+
+    /// "from 0.09 (v0p27_p1) to 0.84 (v1p06_p3)": the lowest and the highest first-order
+    /// strength (empty without experiments).
+    pub fn spread_words(&self) -> String {
+        match self.extremes() {
+            Some((lo, hi)) => format!(
+                "from {} ({}) to {} ({})",
+                self.strength_words(lo.1),
+                lo.0,
+                self.strength_words(hi.1),
+                hi.0
+            ),
+            None => String::new(),
+        }
+    }
+
+    /// "F = 20.06 on 2 and 220 degrees of freedom, p = 9.9e-9".
+    pub fn test_words(&self) -> String {
+        format!(
+            "F = {:.2} on {} and {} degrees of freedom, {}",
+            self.f_statistic,
+            self.dof[0],
+            self.dof[1],
+            fmt_p(self.p_value)
+        )
+    }
 }
 
 /// The `implausible` warning of a fit whose effect fails the test: the law is not a result.
 pub fn warning(c: &Consistency) -> FitWarning {
-    let range = match c.extremes() {
-        Some((lo, hi)) => format!(
-            ", to first order from {:.3} ({}) to {:.3} ({})",
-            lo.1, lo.0, hi.1, hi.0
-        ),
-        None => String::new(),
-    };
     FitWarning::new(
         WarningCode::Implausible,
         format!(
             "{} does not have one strength in every experiment: letting it vary with {} removes \
-             {:.1} % of J (F = {:.2} on {} and {} degrees of freedom, {}){range}; an \
-             effect that must change with the experiment's conditions stands in for something \
-             else, and the material law (n, kappa) fitted with it is biased and not a result",
+             {:.1} % of J ({}), to first order {}; an effect that must change with the \
+             experiment's conditions stands in for something else, and the material law (n, \
+             kappa) fitted with it is biased and not a result",
             c.effect,
             c.conditions.join(", "),
             100.0 * c.share_of_cost,
-            c.f_statistic,
-            c.dof[0],
-            c.dof[1],
-            fmt_p(c.p_value)
+            c.test_words(),
+            c.spread_words()
         ),
     )
 }
@@ -268,33 +294,16 @@ fn conditions(id: &Identification, set: &ExperimentSet) -> Option<Vec<(String, V
     Some(kept)
 }
 
-/// Solves the small symmetric positive definite system `g x = b` (Cholesky); `None` if `g` is
-/// not positive definite.
+/// Solves the small symmetric positive definite system `g x = b` (row-major `g`, Cholesky);
+/// `None` if `g` is not positive definite.
 fn solve_spd(g: &[f64], b: &[f64]) -> Option<Vec<f64>> {
     let d = b.len();
-    let mut l = vec![0.0; d * d];
-    for i in 0..d {
-        for j in 0..=i {
-            let s = g[i * d + j] - (0..j).map(|k| l[i * d + k] * l[j * d + k]).sum::<f64>();
-            if i == j {
-                if s <= 0.0 {
-                    return None;
-                }
-                l[i * d + i] = s.sqrt();
-            } else {
-                l[i * d + j] = s / l[j * d + j];
-            }
-        }
-    }
-    let mut y = vec![0.0; d];
-    for i in 0..d {
-        y[i] = (b[i] - (0..i).map(|k| l[i * d + k] * y[k]).sum::<f64>()) / l[i * d + i];
-    }
-    let mut x = vec![0.0; d];
-    for i in (0..d).rev() {
-        x[i] = (y[i] - (i + 1..d).map(|k| l[k * d + i] * x[k]).sum::<f64>()) / l[i * d + i];
-    }
-    Some(x)
+    let chol = DMatrix::from_row_slice(d, d, g).cholesky()?;
+    Some(
+        chol.solve(&DVector::from_column_slice(b))
+            .as_slice()
+            .to_vec(),
+    )
 }
 
 /// The test for each of `effects` (their strengths fitted in `id`, a least-squares fit on
