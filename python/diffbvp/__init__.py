@@ -316,7 +316,8 @@ def compare(dataset: Union[Dataset, PathLike], fit: Optional[FitResult] = None, 
 def diagnose(dataset: Union[Dataset, PathLike], *, model: str = "carreau",
              effects: Union[None, str, Iterable[str]] = None,
              candidates: Optional[Iterable[str]] = None, refit_top: Optional[int] = None,
-             start: Optional[Tuple[float, float]] = None, tol: Optional[float] = None,
+             start: Optional[Tuple[float, float]] = None, loss: str = "linear",
+             f_scale: Optional[float] = None, tol: Optional[float] = None,
              max_nodes: Optional[int] = None) -> Diagnosis:
     """Which physical effects are missing? The library's diagnose workflow, as ``rheometer
     diagnose``: fits your model (``model``, ``effects``), scores every candidate effect
@@ -325,11 +326,15 @@ def diagnose(dataset: Union[Dataset, PathLike], *, model: str = "carreau",
     effect and searches again, and gives a verdict (explained, adequate, ambiguous, none of the
     candidates; ``Diagnosis.law_is_a_result`` says whether its law may be used).
     ``refit_top``: how many candidates get the search and refits; ``start``: (n, κ) of your
-    fit; ``tol``: BVP tolerance (default 1e-4). Takes about 5 s on the shipped data and up
+    fit; ``loss`` (``"soft_l1"``, ``"huber"``, ``"cauchy"``) and ``f_scale``: a robust loss
+    whose fit of your model weights the points for every fit of the diagnosis (default: least
+    squares, the gross outliers of the noise model left out; ``Diagnosis.robust`` says how it
+    weighted them); ``tol``: BVP tolerance (default 1e-4). Takes about 5 s on the shipped data and up
     to half a minute where two effects are missing (2 cores)."""
     d = _native.diagnose(_ds(dataset), model=model, effects=_effects(effects),
                          candidates=None if candidates is None else [str(c) for c in candidates],
-                         refit_top=refit_top, start=start, tol=tol, max_nodes=max_nodes)
+                         refit_top=refit_top, start=start, loss=loss, f_scale=f_scale, tol=tol,
+                         max_nodes=max_nodes)
     return Diagnosis._from_native(d)
 
 

@@ -621,6 +621,14 @@ class Diagnosis(Result):
         return list(self._data.get("consistency", []))
 
     @property
+    def robust(self) -> Optional[Dict[str, Any]]:
+        """How a robust loss (``diagnose(..., loss=...)``) weighted the points: ``loss``,
+        ``f_scale`` (soft margin, relative residual), ``f_scale_source``, ``down_weighted``
+        (points beyond the margin), ``points``, ``smallest_weight``; ``None`` for least
+        squares."""
+        return self._data.get("robust")
+
+    @property
     def law_is_a_result(self) -> bool:
         """Whether the verdict leaves the final fit's law (n, kappa) a result: the model is
         adequate or the misfit is explained. False when it is "ambiguous" or "none of the

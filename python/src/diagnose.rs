@@ -22,7 +22,7 @@ use pyo3::types::PyDict;
 /// "final_arrays": {...} | None}` (arrays as in `fit`'s result, without profiles).
 #[pyfunction]
 #[pyo3(signature = (dataset, *, model="carreau", effects=Vec::new(), candidates=None,
-    refit_top=None, start=None, tol=None, max_nodes=None))]
+    refit_top=None, start=None, loss="linear", f_scale=None, tol=None, max_nodes=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose<'py>(
     py: Python<'py>,
@@ -32,6 +32,8 @@ pub fn diagnose<'py>(
     candidates: Option<Vec<String>>,
     refit_top: Option<usize>,
     start: Option<(f64, f64)>,
+    loss: &str,
+    f_scale: Option<f64>,
     tol: Option<f64>,
     max_nodes: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -65,6 +67,14 @@ pub fn diagnose<'py>(
     if let Some(s) = start {
         options::check_start(s, &opts.identify)?;
         opts.start = Some([s.0, s.1]);
+    }
+    opts.identify.loss = options::loss(loss)?;
+    opts.identify.f_scale = options::f_scale(f_scale)?;
+    if f_scale.is_some() && opts.identify.loss.is_linear() {
+        return Err(input_error(
+            "f_scale: a soft margin needs a robust loss, but loss is \"linear\" (least \
+             squares); give loss=\"soft_l1\" (or \"huber\", \"cauchy\"), or drop f_scale",
+        ));
     }
     opts.identify.simulate.max_nodes = options::max_nodes(max_nodes)?;
     if let Some(t) = options::tol(tol)? {

@@ -1155,6 +1155,10 @@ fn g25_g68_value_dependent_contradictions_are_refused_before_the_fit() {
             vec!["--f-scale", "linear"],
         ),
         (
+            vec!["diagnose", t, "--f-scale", "0.02"],
+            vec!["--f-scale 0.02", "robust loss", "--loss soft_l1"],
+        ),
+        (
             vec!["fit", t, "--model", "newtonian", "--start", "0.5,12"],
             vec!["--start", "--model newtonian", "no (n, kappa)"],
         ),

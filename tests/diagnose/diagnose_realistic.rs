@@ -12,9 +12,11 @@
 
 use crate::independent;
 
+use diffbvp::fiber::diagnostics::diagnose::verdict::Verdict;
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, Candidate, DiagnoseOptions, DiagnosisRun};
 use diffbvp::fiber::effects::{LawChoice, ModelSpec};
 use diffbvp::fiber::input::load_experiments;
+use diffbvp::least_squares::Loss;
 use independent::dataset::{Faults, Scenario};
 use independent::model::AirHeat;
 use independent::scenarios::{self, NOISE_SD};
@@ -22,17 +24,17 @@ use std::time::Instant;
 
 /// Generates, loads and diagnoses `sc`, printing the baseline line.
 fn run(sc: &Scenario) -> DiagnosisRun {
+    run_with(sc, &DiagnoseOptions::default())
+}
+
+/// [`run`] with the diagnosis' `options`.
+fn run_with(sc: &Scenario, options: &DiagnoseOptions) -> DiagnosisRun {
     let t0 = Instant::now();
     let generated = sc.generate().unwrap();
     let t_gen = t0.elapsed().as_secs_f64();
     let set = load_experiments(&generated.toml).unwrap();
     let t1 = Instant::now();
-    let r = diagnose(
-        &set,
-        &ModelSpec::new(LawChoice::Carreau),
-        &DiagnoseOptions::default(),
-    )
-    .unwrap();
+    let r = diagnose(&set, &ModelSpec::new(LawChoice::Carreau), options).unwrap();
     let t_diag = t1.elapsed().as_secs_f64();
     let d = &r.diagnosis;
     println!("{}", d.to_text());
@@ -417,7 +419,58 @@ fn gauge_offset_is_found() {
 #[test]
 fn outliers_name_no_physics() {
     let sc = scenarios::outliers();
-    assert_nothing_missing(&sc, &run(&sc));
+    let r = run(&sc);
+    assert_nothing_missing(&sc, &r);
+    assert_outliers_are_only_outliers(&sc, &r);
+    // left out of the fits: the diagnosis weights them by its noise model, not a loss
+    assert!(r.diagnosis.robust.is_none());
+}
+
+#[test]
+fn outliers_under_a_robust_loss_name_no_physics() {
+    let sc = Scenario {
+        seed: 2611,
+        ..scenarios::outliers()
+    };
+    let mut options = DiagnoseOptions::default();
+    options.identify.loss = Loss::Huber;
+    let r = run_with(&sc, &options);
+    assert_nothing_missing(&sc, &r);
+    assert_outliers_are_only_outliers(&sc, &r);
+    let w = r
+        .diagnosis
+        .robust
+        .as_ref()
+        .expect("the weights of the huber loss");
+    assert_eq!(w.loss, Loss::Huber);
+    let planted = sc.generate().unwrap().outliers.len();
+    assert!(w.down_weighted >= planted, "{w:?}");
+    assert!(w.smallest_weight < 0.5, "{w:?}");
+    assert!(r
+        .diagnosis
+        .to_text()
+        .contains("Loss huber: the points are weighted"));
+}
+
+/// Gross outliers on a correct model: the residuals are noise once they are left out (the fit
+/// the diagnosis judges is not bent by them), the verdict "adequate" with the law a result,
+/// and every planted outlier flagged.
+fn assert_outliers_are_only_outliers(sc: &Scenario, r: &DiagnosisRun) {
+    let d = &r.diagnosis;
+    assert!(!d.systematic, "{}", d.to_text());
+    assert!(matches!(d.verdict, Verdict::Adequate), "{}", d.to_text());
+    assert!(d.verdict.law_is_a_result());
+    let flagged: Vec<(usize, usize)> = d
+        .outliers()
+        .iter()
+        .map(|o| (o.experiment_index, o.point_index))
+        .collect();
+    for o in &sc.generate().unwrap().outliers {
+        assert!(
+            flagged.contains(o),
+            "outlier {o:?} missed; flagged {flagged:?}"
+        );
+    }
 }
 
 #[test]

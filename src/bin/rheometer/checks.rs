@@ -139,6 +139,38 @@ pub fn parse_f_scale(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
+/// `--loss` and `--f-scale` of `fit` and `diagnose`.
+#[derive(clap::Args)]
+pub struct LossArgs {
+    /// The loss: linear (least squares), or a robust loss that down-weights outliers:
+    /// soft_l1, huber, cauchy (as in scipy's least_squares; needs the principled estimator).
+    #[arg(long, default_value = "linear", value_parser = diffbvp::least_squares::Loss::parse)]
+    pub loss: diffbvp::least_squares::Loss,
+    /// Soft margin of a robust loss as a relative residual (e.g. 0.02 for 2 %; default: the
+    /// robust noise scale of the data); only with --loss soft_l1, huber or cauchy.
+    #[arg(long = "f-scale", value_parser = parse_f_scale, allow_hyphen_values = true)]
+    pub f_scale: Option<f64>,
+}
+
+impl LossArgs {
+    /// Sets the loss and its soft margin of `opts`. Error: a soft margin without a robust loss.
+    pub fn apply(&self, opts: &mut IdentifyOptions) -> Result<(), String> {
+        if let Some(c) = self.f_scale {
+            if self.loss.is_linear() {
+                return Err(format!(
+                    "--f-scale {}: a soft margin needs a robust loss, but the loss is linear \
+                     (least squares, the default of --loss); add --loss soft_l1 (or huber, \
+                     cauchy), or drop --f-scale",
+                    show(c)
+                ));
+            }
+        }
+        opts.loss = self.loss;
+        opts.f_scale = self.f_scale;
+        Ok(())
+    }
+}
+
 /// `--tol`: in [`TOL_RANGE`].
 pub fn parse_tol(s: &str) -> Result<f64, String> {
     let v = number(s)?;

@@ -18,6 +18,11 @@ pub struct DiagnoseArgs {
     /// (default: all).
     #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_refit_top)]
     pub refit_top: Option<usize>,
+    /// The loss of your model's fit and its soft margin: a robust loss weights the points
+    /// for every fit of the diagnosis (default: least squares with the gross outliers of the
+    /// noise model left out).
+    #[command(flatten)]
+    pub robust: checks::LossArgs,
     /// BVP tolerance of the fits (1e-12 to 0.1; default 1e-4, matched to the noise).
     #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_tol)]
     pub tol: Option<f64>,
@@ -37,6 +42,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         model,
         with,
         refit_top,
+        robust,
         tol,
         json,
         out,
@@ -72,6 +78,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     if let Some(k) = refit_top {
         opts.refit_top = k;
     }
+    robust.apply(&mut opts.identify)?;
     opts.identify.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     if let Some(t) = tol {
         opts.identify.simulate.tol = t;

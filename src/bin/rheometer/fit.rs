@@ -28,15 +28,9 @@ pub struct FitArgs {
     /// material data: vft_b_offset, vft_t_vf_offset (K, viscosity at T_o held).
     #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,
-    /// The loss of the fit: linear (least squares), or a robust loss that down-weights
-    /// outliers: soft_l1, huber, cauchy (as in scipy's least_squares; needs the principled
-    /// estimator).
-    #[arg(long, default_value = "linear", value_parser = diffbvp::least_squares::Loss::parse)]
-    pub loss: diffbvp::least_squares::Loss,
-    /// Soft margin of a robust loss as a relative residual (e.g. 0.02 for 2 %; default: the
-    /// robust noise scale of the data); only with --loss soft_l1, huber or cauchy.
-    #[arg(long = "f-scale", value_parser = checks::parse_f_scale, allow_hyphen_values = true)]
-    pub f_scale: Option<f64>,
+    /// The loss of the fit and its soft margin.
+    #[command(flatten)]
+    pub robust: checks::LossArgs,
     /// BVP tolerance of the fit (1e-12 to 0.1; default: 1e-4, refined until the
     /// discretisation moves no estimate by more than 0.01 standard errors). Given, it is kept
     /// and the shift only reported.
@@ -64,8 +58,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         newtonian,
         model,
         with,
-        loss,
-        f_scale,
+        robust,
         tol,
         json,
         html,
@@ -76,19 +69,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         opts.simulate.tol = t;
         opts.max_discretisation_shift = Some(f64::INFINITY);
     }
-    if let Some(c) = f_scale {
-        if loss.is_linear() {
-            return Err(format!(
-                "--f-scale {}: a soft margin needs a robust loss, but the loss is linear \
-                 (least squares, the default of --loss); add --loss soft_l1 (or huber, \
-                 cauchy), or drop --f-scale",
-                checks::show(c)
-            )
-            .into());
-        }
-    }
-    opts.loss = loss;
-    opts.f_scale = f_scale;
+    robust.apply(&mut opts)?;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     let law = match (newtonian, model) {
         (true, _) => LawChoice::Newtonian,

@@ -8,22 +8,72 @@ use super::diagnose::verdict::Verdict;
 use super::ties::Alternative;
 use crate::fiber::effects::LawChoice;
 use crate::fiber::rheometer::{FitSummary, Identification, IdentifyOptions};
+use crate::least_squares::Loss;
 use serde::{Deserialize, Serialize};
 
 /// Relative residuals along the spin line, per experiment: `(name, [(s in m, residual)])`.
 pub type ResidualProfiles = Vec<(String, Vec<(f64, f64)>)>;
 
+/// How the robust loss of `diagnose --loss` weighted the points: the user's model fitted
+/// with the loss, each point then given the weight the loss gives it at that fit (its
+/// residual's `ρ'`, against the local noise where the noise varies along the line), and every
+/// further fit of the diagnosis a least-squares fit with these weights (so that its evidence,
+/// `ΔBIC`, stays a Gaussian likelihood ratio). Each further step weights the points again from
+/// its own fit.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RobustWeights {
+    /// The loss.
+    pub loss: Loss,
+    /// Its soft margin `C`, a relative residual \[-\].
+    pub f_scale: f64,
+    /// Where `f_scale` came from (given, or the robust noise scale of the data).
+    pub f_scale_source: String,
+    /// Points beyond the soft margin (`|r| > C`, against the local noise), which the loss
+    /// down-weights.
+    pub down_weighted: usize,
+    /// All points.
+    pub points: usize,
+    /// The smallest weight of a point relative to an ordinary one (`ρ'`, 1 inside the margin)
+    /// \[-\].
+    pub smallest_weight: f64,
+}
+
+impl RobustWeights {
+    /// The weights in words.
+    pub fn words(&self) -> String {
+        format!(
+            "Loss {}: the points are weighted as the robust fit of your model weights them \
+             (soft margin {:.3} % relative residual, {}); {} of {} points lie beyond it and are \
+             down-weighted (the smallest weight {:.3}); every fit of the diagnosis uses these \
+             weights.",
+            self.loss,
+            100.0 * self.f_scale,
+            self.f_scale_source,
+            self.down_weighted,
+            self.points,
+            self.smallest_weight
+        )
+    }
+}
+
 /// The diagnosis (what is written as JSON).
 ///
-/// The noise level, the outliers and the residual statistics the judgement uses are those of
-/// the user's fit, [`base_fit`](Self::base_fit)`.noise`: the same numbers `rheometer fit`
-/// prints for the same data and model.
+/// The noise level the judgement uses is the user's plain fit's,
+/// [`base_fit`](Self::base_fit)`.noise.level`: the same number `rheometer fit` prints for the
+/// same data and model. The residual statistics (RMS over the noise, lag-1 autocorrelation,
+/// outliers) are those of the fit the diagnosis judges: the user's model with its points
+/// weighted by the local noise and the gross outliers left out (or weighted by a robust loss),
+/// which `fit` prints too where the noise is even and there are no outliers.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Diagnosis {
     /// The user's law.
     pub model: LawChoice,
     /// The user's fit (principled estimator), with its one noise level.
     pub base_fit: FitSummary,
+    /// How a robust loss weighted the points (`None`: least squares, the gross outliers of
+    /// the noise model left out).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robust: Option<RobustWeights>,
     /// Whether the residuals are systematic: `rms_over_noise > 1.2`, or `ρ₁ √N > 3`, or a
     /// candidate earns its place (its refit lowers BIC below the threshold).
     pub systematic: bool,

@@ -185,7 +185,10 @@ impl Rheometer {
     /// The soft margin `C` \[-\] (relative residual) of a robust loss and where it comes from
     /// (`NaN` and `""` for the linear loss). Errors: a robust loss with the paper's estimator,
     /// a non-positive `f_scale`.
-    fn robust_margin(&self, options: &IdentifyOptions) -> Result<(f64, String), RheometerError> {
+    pub(crate) fn robust_margin(
+        &self,
+        options: &IdentifyOptions,
+    ) -> Result<(f64, String), RheometerError> {
         if options.loss.is_linear() {
             return Ok((f64::NAN, String::new()));
         }

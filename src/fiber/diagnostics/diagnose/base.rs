@@ -1,7 +1,9 @@
 //! Stage 1: the setting of a diagnosis and the user's fit.
 
 use super::DiagnoseOptions;
+use crate::fiber::diagnostics::diagnosis::RobustWeights;
 use crate::fiber::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::fiber::noise_summary::NoiseSummary;
 use crate::fiber::rheometer::identification::WarmFit;
 use crate::fiber::rheometer::summary_checks::check_misfit;
 use crate::fiber::rheometer::WarningCode;
@@ -9,6 +11,7 @@ use crate::fiber::rheometer::{
     Estimator, FitStart, Identification, IdentifyOptions, Layout, Rheometer, RheometerError,
 };
 use crate::fiber::setup::ExperimentSet;
+use crate::least_squares::Loss;
 use std::sync::Arc;
 
 /// Weight factor of a gross outlier in the diagnosis' fits (its residual counts 1/1000).
@@ -38,6 +41,12 @@ pub(crate) struct Context<'a> {
     pub layout: Layout,
     /// Spin-line length \[m\] that bounds the shapes (the shortest line).
     pub length: f64,
+    /// The user's robust loss (`None`: least squares): it weights the points
+    /// ([`weighted_base`](Self::weighted_base)), and the fits after the user's are least
+    /// squares with its weights.
+    pub robust: Option<Loss>,
+    /// How the robust loss weighted the points at this step's fit.
+    pub weights: Option<RobustWeights>,
 }
 
 impl<'a> Context<'a> {
@@ -53,6 +62,12 @@ impl<'a> Context<'a> {
         // the diagnosis' many fits run at the matched tolerance without each checking it; the
         // user's fit is checked (fit_base)
         let check = opts.max_discretisation_shift.take();
+        let robust = (!opts.loss.is_linear()).then_some(opts.loss);
+        // a further step starts with the weights the loss gave the previous step's fit: its
+        // fit is least squares with them (the loss would down-weight the same points twice)
+        if opts.noise_factors.is_some() {
+            opts.loss = Loss::Linear;
+        }
         let spec = base_spec.clone().with_candidates(&options.candidates);
         let rh = Rheometer::with_spec(set, spec.clone())?;
         let sigma = opts
@@ -83,6 +98,8 @@ impl<'a> Context<'a> {
             law0,
             layout,
             length,
+            robust,
+            weights: None,
         })
     }
 
@@ -115,47 +132,88 @@ impl<'a> Context<'a> {
 
     /// Stage 1 (cont.): the user's fit again with each point weighted by its local noise level
     /// where the noise varies along the line (the take-up region noisier), and with the gross
-    /// outliers of its noise model left out (weighted by [`OUTLIER_FACTOR`]); every later fit
+    /// outliers of its noise model left out (weighted by [`OUTLIER_FACTOR`]) — or, with a
+    /// robust loss, each point down-weighted as the loss weights it at this fit
+    /// ([`RobustWeights`]; least squares from here on); every later fit
     /// of the diagnosis uses the same weights, so that neither the noisier points nor the
     /// outliers dominate the cost and a flexible candidate cannot earn its place by fitting
-    /// them. Unchanged when the noise is declared, or even and without outliers.
+    /// them. Unchanged when the noise is declared, or even and without outliers (a further
+    /// step's fit, which starts with the previous step's weights, is then refitted without
+    /// them).
     pub fn weighted_base(
         &mut self,
         base: Identification,
     ) -> Result<Identification, RheometerError> {
         let noise = &base.summary.noise;
-        let Some(m) = noise.model.as_ref() else {
-            return Ok(base);
+        let robust = match self.robust {
+            Some(loss) => {
+                let o = IdentifyOptions {
+                    loss,
+                    ..self.opts.clone()
+                };
+                Some((loss, self.rh.robust_margin(&o)?))
+            }
+            None => None,
         };
-        let varies = m.varies_along_line && !noise.declared() && noise.level > 0.0;
-        if !varies && m.outliers.is_empty() {
-            return Ok(base);
+        let model = noise.model.as_ref();
+        let varies =
+            model.is_some_and(|m| m.varies_along_line) && !noise.declared() && noise.level > 0.0;
+        let outliers = model.is_some_and(|m| !m.outliers.is_empty());
+        if !varies && !outliers && robust.is_none() {
+            // a further step's fit carries the previous step's weights: this step's noise
+            // model has no use for them
+            if self.opts.noise_factors.take().is_none() {
+                return Ok(base);
+            }
+            return self.refit_weighted(base);
         }
-        let factors: Vec<Vec<f64>> = self
-            .rh
-            .measurements
-            .iter()
-            .enumerate()
-            .map(|(k, meas)| {
-                meas.positions
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &s)| {
-                        let f = if varies {
-                            m.local_sigma_at(k, s) / noise.level
-                        } else {
-                            1.0
-                        };
-                        if m.is_outlier(k, i) {
-                            f * OUTLIER_FACTOR
-                        } else {
-                            f
-                        }
-                    })
-                    .collect()
-            })
-            .collect();
+        // each point's noise factor: its local noise level over the one level, times the
+        // robust loss's down-weighting (1/√ρ' of its residual against the local soft margin)
+        // or, without a loss, OUTLIER_FACTOR for a gross outlier
+        let mut beyond = 0;
+        let mut smallest = 1.0_f64;
+        let mut factors = Vec::with_capacity(self.rh.measurements.len());
+        for (k, meas) in self.rh.measurements.iter().enumerate() {
+            let r = base.residual_profiles.get(k).map(|p| p.1.as_slice());
+            let mut fk = Vec::with_capacity(meas.positions.len());
+            for (i, &s) in meas.positions.iter().enumerate() {
+                let f = match model {
+                    Some(m) if varies => m.local_sigma_at(k, s) / noise.level,
+                    _ => 1.0,
+                };
+                fk.push(match robust {
+                    Some((loss, (c, _))) => {
+                        let ri = r.and_then(|r| r.get(i)).copied().unwrap_or(0.0);
+                        let z = (ri / (c * f)).powi(2);
+                        let w = loss.rho(z).1.clamp(f64::EPSILON, 1.0);
+                        beyond += usize::from(z > 1.0);
+                        smallest = smallest.min(w);
+                        f / w.sqrt()
+                    }
+                    None if model.is_some_and(|m| m.is_outlier(k, i)) => f * OUTLIER_FACTOR,
+                    None => f,
+                });
+            }
+            factors.push(fk);
+        }
+        if let Some((loss, (c, source))) = robust {
+            self.weights = Some(RobustWeights {
+                loss,
+                f_scale: c,
+                f_scale_source: source,
+                down_weighted: beyond,
+                points: factors.iter().map(Vec::len).sum(),
+                smallest_weight: smallest,
+            });
+        }
+        self.opts.loss = Loss::Linear;
         self.opts.noise_factors = Some(Arc::new(factors));
+        self.refit_weighted(base)
+    }
+
+    /// `base` refitted with the weights of [`IdentifyOptions::noise_factors`] as they now
+    /// stand, keeping its noise summary.
+    fn refit_weighted(&self, base: Identification) -> Result<Identification, RheometerError> {
         let start = FitStart {
             warm: Some(base.solutions.clone()),
             strengths: base.fitted_strengths(),
@@ -167,8 +225,18 @@ impl<'a> Context<'a> {
         };
         let mut weighted = self.rh.identify_warm(&start, &self.opts, &warm)?;
         // the one noise level of these data and this model is the plain fit's, and the misfit
-        // warning reads it (not the weighted fit's own estimate)
-        weighted.summary.noise = base.summary.noise.clone();
+        // warning reads it (not the weighted fit's own estimate); the residual statistics
+        // (RMS, lag-1 autocorrelation, outliers) are the weighted fit's own, the fit every
+        // later stage judges (the plain fit's are bent by the outliers it fits)
+        let plain = &base.summary.noise;
+        let own = weighted.summary.noise.model.take();
+        weighted.summary.noise = NoiseSummary {
+            rms_over_noise: own
+                .as_ref()
+                .map_or(plain.rms_over_noise, |m| m.rms / plain.level),
+            model: own.or_else(|| plain.model.clone()),
+            ..plain.clone()
+        };
         let mut misfit = Vec::new();
         check_misfit(&weighted.summary, &mut misfit);
         let warnings = &mut weighted.summary.warnings;

@@ -88,7 +88,7 @@ pub use super::candidate::{
     earns_its_place, rank_order, strength_status, Candidate, Indistinguishable, ShapeAlternative,
     StrengthStatus, PHYSICAL_RANGE_SE,
 };
-pub use super::diagnosis::{Diagnosis, DiagnosisRun, ForwardStep, ResidualProfiles};
+pub use super::diagnosis::{Diagnosis, DiagnosisRun, ForwardStep, ResidualProfiles, RobustWeights};
 pub use step::MAX_FALSE_ALARM;
 
 /// Options of [`diagnose`].
@@ -174,6 +174,10 @@ pub fn diagnose(
             break;
         }
         opts.start = Some(refit.law());
+        // the refit it starts from was weighted by the previous step's noise weights: the same
+        // weights keep its optimum (unweighted, the outliers and the noisier take-up points
+        // would pull the law away before this step's own noise model could weight them)
+        opts.identify.noise_factors = last.opts.noise_factors.clone();
         // a further step that fails (its fit of the model with the effects found so far cannot
         // be evaluated) ends the search with what the steps before found, and says why
         match step::run(set, &spec, &opts, Some(refit)) {
@@ -352,6 +356,7 @@ fn assemble(
         diagnosis: Diagnosis {
             model: first.spec.law,
             base_fit,
+            robust: first.weights.clone(),
             // a physical effect that explains part of the residuals significantly shows they
             // are systematic, even where the noise level is too uncertain for the RMS test
             systematic: first.systematic || first.named.is_some(),

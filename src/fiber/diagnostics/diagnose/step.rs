@@ -13,6 +13,7 @@ use crate::fiber::diagnostics::candidate::{
     earns_its_place, rank_order, Candidate, Indistinguishable,
 };
 use crate::fiber::diagnostics::detection::{detection_limits, DetectionContext, DetectionLimits};
+use crate::fiber::diagnostics::diagnosis::RobustWeights;
 use crate::fiber::diagnostics::scores::cosine;
 use crate::fiber::diagnostics::ties::{alternatives_among, Alternative};
 use crate::fiber::effects::{Effect, ModelSpec};
@@ -48,6 +49,8 @@ pub(crate) struct Step {
     pub systematic: bool,
     /// The fit settings of this step (the noise weights included).
     pub opts: IdentifyOptions,
+    /// How the robust loss weighted the points at this step (`None`: least squares).
+    pub weights: Option<RobustWeights>,
 }
 
 impl Step {
@@ -123,6 +126,7 @@ pub(crate) fn run(
         calibration,
         systematic,
         opts: ctx.opts.clone(),
+        weights: ctx.weights.clone(),
     })
 }
 

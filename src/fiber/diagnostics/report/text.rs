@@ -59,6 +59,9 @@ impl Diagnosis {
             b.residuals,
             b.noise.describe()
         ));
+        if let Some(r) = &self.robust {
+            s.push_str(&format!("{}\n", r.words()));
+        }
         for w in &b.warnings {
             s.push_str(&format!("WARNING about your model's fit: {w}\n"));
         }
@@ -79,9 +82,12 @@ impl Diagnosis {
         if self.outliers().is_empty() {
             return;
         }
+        let fits = match &self.robust {
+            Some(r) => format!("the {} loss down-weighted them in the fits", r.loss),
+            None => "and out of the fits; `--loss huber` lets a robust loss weight them".into(),
+        };
         s.push_str(&format!(
-            "OUTLIERS ({}; left out of the noise level, the RMS and the autocorrelation; \
-             `fit --loss huber` down-weights them):\n",
+            "OUTLIERS ({}; left out of the noise level, the RMS and the autocorrelation, {fits}):\n",
             self.outliers().len()
         ));
         for o in self.outliers() {
