@@ -385,11 +385,13 @@ fn strain_hardening_is_none_of_the_candidates() {
 }
 
 /// Strong hardening (β = 0.3, seed 12002 of `hardening_study`): the Nusselt factor is named
-/// but leaves the residuals above the noise, and the fit of step 2 (with it in the model) ends
-/// where the simulation fails (`n` → 0). That failure once ended the whole diagnosis with an
-/// error; now the forward search stops, says why, and the verdict stands on step 1.
+/// but leaves the residuals above the noise. Step 2's fit (with it in the model) once started
+/// without the noise weights of step 1, ran to `n` → 0 where the simulation fails, and ended
+/// the whole diagnosis with an error (later: the search stopped there, `Diagnosis::stopped`).
+/// It now starts from step 1's weights, as the refit it continues was fitted, and every step
+/// runs; the verdict is still "none of the candidates".
 #[test]
-fn a_failing_further_step_ends_the_search_not_the_diagnosis() {
+fn a_further_step_starts_from_the_weights_of_the_step_before() {
     let sc = Scenario {
         name: "strong_hardening",
         hardening: 0.3,
@@ -412,10 +414,8 @@ fn a_failing_further_step_ends_the_search_not_the_diagnosis() {
         "{text}"
     );
     assert!(!d.verdict.law_is_a_result());
-    if let Some(why) = &d.stopped {
-        assert!(why.starts_with("step 2 (with "), "{why}");
-        assert!(text.contains("the forward search stopped early"), "{text}");
-    }
+    assert_eq!(d.stopped, None, "{text}");
+    assert!(!d.further_steps.is_empty(), "{text}");
 }
 
 #[test]
@@ -536,8 +536,9 @@ fn chance_wrong_laws(sets: usize) -> usize {
 
 /// The false-alarm rate of the whole diagnosis on effect-free data (issue 26): `N` data sets of
 /// the independent model without any effect (`DIFFBVP_FALSE_ALARM_SETS`, default 100), seeds
-/// and noise levels (0.8 %, 1.5 %, 3 %; take-up region 1× or 2× as noisy) varied. Counts the
-/// sets where any effect is named; the search is calibrated to a false-alarm probability of
+/// and noise levels (0.8 %, 1.5 %, 3 %; take-up region 1× or 2× as noisy) varied, every
+/// fourth set with six gross outliers. Counts the sets where any effect is named (and, printed
+/// beside, those with the verdict "none of the candidates"); the search is calibrated to a false-alarm probability of
 /// 5 % per set, so more than 10 of 100 (a binomial tail of 1 % at 5 %) fails. The law reported
 /// is checked against the truth as in the power study ([`law_outcome`]). Takes ~10 s per
 /// set: `cargo test --release --test diagnose global::false_alarm_rate -- --ignored --nocapture`
@@ -555,6 +556,7 @@ fn false_alarm_rate_on_effect_free_sets() {
     // the first set's index (to continue a study in parts: seeds 7000 + index)
     let first = var("DIFFBVP_FALSE_ALARM_FIRST", 0);
     let mut alarms = Vec::new();
+    let mut nones = Vec::new();
     let mut wrong = 0;
     let t0 = Instant::now();
     for k in first..first + sets {
@@ -564,10 +566,25 @@ fn false_alarm_rate_on_effect_free_sets() {
             seed: 7_000 + k as u64,
             noise_sd: [0.008, 0.015, 0.03][k % 3],
             take_up_noise: [1.0, 2.0][(k / 3) % 2],
+            // every fourth set with gross outliers (+15 … +35 %), which are no missing effect
+            faults: Faults {
+                outliers: if k % 4 == 3 { 6 } else { 0 },
+                ..Faults::none()
+            },
             ..scenarios::control()
         };
         let (_, r) = diagnosed(&sc);
         let (law, z) = law_outcome(&r, &sc);
+        // crying wolf without naming anything: "none of the candidates" on effect-free data
+        if matches!(r.diagnosis.verdict, Verdict::NoneOfTheCandidates { .. }) {
+            println!(
+                "NONE OF THE CANDIDATES | set {k} | noise {} | outliers {} | RMS/noise {:.2}",
+                sc.noise_sd,
+                sc.faults.outliers,
+                r.diagnosis.rms_over_noise()
+            );
+            nones.push(k);
+        }
         if law == "WRONG" {
             println!("WRONG LAW | set {k} | {z:.1} se from the truth");
             wrong += 1;
@@ -584,10 +601,11 @@ fn false_alarm_rate_on_effect_free_sets() {
     }
     let rate = alarms.len() as f64 / sets as f64;
     println!(
-        "FALSE ALARMS | {} of {sets} effect-free sets ({:.1} %) | wrong laws printed as a result \
-         {wrong} | {:.0} s",
+        "FALSE ALARMS | {} of {sets} effect-free sets ({:.1} %) | verdict none of the \
+         candidates {} | wrong laws printed as a result {wrong} | {:.0} s",
         alarms.len(),
         100.0 * rate,
+        nones.len(),
         t0.elapsed().as_secs_f64()
     );
     assert!(

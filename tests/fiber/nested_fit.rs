@@ -36,7 +36,7 @@ fn a_fitted_effect_never_leaves_the_fit_worse_than_without_it() {
         );
         assert_ne!(nested.start, NestedStart::Plain);
         // the plain model's optimum is one start: the kept fit can only be lower
-        let j_plain_here = nested.plain_cost.unwrap();
+        let j_plain_here = nested.plain_cost().unwrap();
         assert!(
             (j_plain_here - j_plain).abs() <= 1e-6 * j_plain,
             "{name}: the plain model with the effect held neutral gave J {j_plain_here:e}, the \

@@ -35,11 +35,19 @@ pub struct NestedFit {
     pub fit: Identification,
     /// Where it started.
     pub start: NestedStart,
-    /// Cost `J` \[-\] of the plain model's optimum (the fitted effects at neutral strength);
-    /// `None` without fitted effects.
-    pub plain_cost: Option<f64>,
+    /// The plain model's fit (the fitted effects held at neutral strength, the fixed ones as
+    /// given); `None` without fitted effects or when it failed.
+    pub plain: Option<Identification>,
     /// Cost `J` \[-\] the fit from the given start reached (`None` when it failed).
     pub given_cost: Option<f64>,
+}
+
+impl NestedFit {
+    /// Cost `J` \[-\] of the plain model's optimum (the fitted effects at neutral strength);
+    /// `None` without fitted effects.
+    pub fn plain_cost(&self) -> Option<f64> {
+        self.plain.as_ref().map(|p| p.summary.cost)
+    }
 }
 
 impl Rheometer {
@@ -57,7 +65,7 @@ impl Rheometer {
             return Ok(NestedFit {
                 fit: self.identify(start, options)?,
                 start: NestedStart::Plain,
-                plain_cost: None,
+                plain: None,
                 given_cost: None,
             });
         }
@@ -81,12 +89,11 @@ impl Rheometer {
                     take_up: plain.take_up_factors().to_vec(),
                     stop_tolerance: None,
                 };
-                let cost = plain.summary.cost;
                 self.identify_warm(&warm_start, options, &warm)
-                    .map(|fit| (cost, fit))
+                    .map(|fit| (plain, fit))
             });
         match (given, from_plain) {
-            (Ok(g), Ok((plain_cost, p))) => {
+            (Ok(g), Ok((plain, p))) => {
                 let given_cost = Some(g.summary.cost);
                 // ties keep the fit from the given start (as before this check)
                 let (fit, start) = if p.summary.cost < g.summary.cost {
@@ -97,7 +104,7 @@ impl Rheometer {
                 Ok(NestedFit {
                     fit,
                     start,
-                    plain_cost: Some(plain_cost),
+                    plain: Some(plain),
                     given_cost,
                 })
             }
@@ -105,12 +112,12 @@ impl Rheometer {
                 given_cost: Some(g.summary.cost),
                 fit: g,
                 start: NestedStart::Given,
-                plain_cost: None,
+                plain: None,
             }),
-            (Err(_), Ok((plain_cost, p))) => Ok(NestedFit {
+            (Err(_), Ok((plain, p))) => Ok(NestedFit {
                 fit: p,
                 start: NestedStart::PlainOptimum,
-                plain_cost: Some(plain_cost),
+                plain: Some(plain),
                 given_cost: None,
             }),
             (Err(e), Err(_)) => Err(e),

@@ -139,7 +139,8 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
         }
     };
     // a model with fitted effects never ends worse than the model without them
-    let mut id = rh.identify_nested(start, opts)?.fit;
+    let nested = rh.identify_nested(start, opts)?;
+    let mut id = nested.fit;
     // an effect whose strength must differ between the experiments is a stand-in
     let fitted: Vec<String> = id
         .summary
@@ -184,15 +185,20 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
         }
         Err(e) => Some(e),
     };
-    let baseline = if request.baseline && !request.model.effects.is_empty() {
+    // the model without its effects: the nested fit's plain model where every effect is
+    // fitted (held at neutral strength it is that model), else fitted here
+    let all_fitted = request.model.effects.iter().all(|e| e.value.is_none());
+    let baseline = if !request.baseline || request.model.effects.is_empty() {
+        None
+    } else if let (true, Some(plain)) = (all_fitted, nested.plain) {
+        Some(plain)
+    } else {
         let rh0 = Rheometer::with_spec(&data.set, ModelSpec::new(request.model.law))?;
         let s0 = match request.model.law {
             LawChoice::Carreau => id.law(),
             LawChoice::Newtonian => [1.0, STRAIN_THINNING_REFERENCE_KAPPA],
         };
         Some(rh0.identify(s0, opts)?)
-    } else {
-        None
     };
     let newtonian = if request.newtonian_reference {
         Some(rh.newtonian_solutions(id.law()[1], opts)?)
