@@ -73,7 +73,8 @@ pub fn diagnose<'py>(
     if f_scale.is_some() && opts.identify.loss.is_linear() {
         return Err(input_error(
             "f_scale: a soft margin needs a robust loss, but loss is \"linear\" (least \
-             squares); give loss=\"soft_l1\" (or \"huber\", \"cauchy\"), or drop f_scale",
+             squares); give loss=\"soft_l1\" (or \"huber\", \"cauchy\"), or drop f_scale"
+                .to_string(),
         ));
     }
     opts.identify.simulate.max_nodes = options::max_nodes(max_nodes)?;

@@ -212,7 +212,7 @@ impl<'a> Context<'a> {
     }
 
     /// `base` refitted with the weights of [`IdentifyOptions::noise_factors`] as they now
-    /// stand, keeping its noise summary.
+    /// stand, keeping `base`'s noise level (the residual statistics are the refit's own).
     fn refit_weighted(&self, base: Identification) -> Result<Identification, RheometerError> {
         let start = FitStart {
             warm: Some(base.solutions.clone()),
