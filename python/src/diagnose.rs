@@ -68,15 +68,7 @@ pub fn diagnose<'py>(
         options::check_start(s, &opts.identify)?;
         opts.start = Some([s.0, s.1]);
     }
-    opts.identify.loss = options::loss(loss)?;
-    opts.identify.f_scale = options::f_scale(f_scale)?;
-    if f_scale.is_some() && opts.identify.loss.is_linear() {
-        return Err(input_error(
-            "f_scale: a soft margin needs a robust loss, but loss is \"linear\" (least \
-             squares); give loss=\"soft_l1\" (or \"huber\", \"cauchy\"), or drop f_scale"
-                .to_string(),
-        ));
-    }
+    options::robust_loss(&mut opts.identify, loss, f_scale)?;
     opts.identify.simulate.max_nodes = options::max_nodes(max_nodes)?;
     if let Some(t) = options::tol(tol)? {
         opts.identify.simulate.tol = t;

@@ -95,8 +95,7 @@ pub fn fit<'py>(
     profile_points: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut opts = IdentifyOptions::with_estimator(options::estimator(estimator)?);
-    opts.loss = options::loss(loss)?;
-    opts.f_scale = options::f_scale(f_scale)?;
+    options::robust_loss(&mut opts, loss, f_scale)?;
     opts.relative_uncertainty = options::fraction("relative_uncertainty", relative_uncertainty)?;
     opts.simulate.max_nodes = options::max_nodes(max_nodes)?;
     if let Some(t) = options::tol(tol)? {

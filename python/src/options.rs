@@ -85,12 +85,30 @@ pub fn effects(items: &[String]) -> PyResult<Vec<EffectSetting>> {
 }
 
 /// The loss by name (`"linear"`, `"soft_l1"`, `"huber"`, `"cauchy"`).
-pub fn loss(name: &str) -> PyResult<Loss> {
+fn loss(name: &str) -> PyResult<Loss> {
     Loss::parse(name).map_err(|e| input_error(format!("loss: {e}")))
 }
 
+/// Sets the loss (by name) and its soft margin `f_scale` of `opts`, as `fit` and `diagnose`
+/// take them. Errors: an unknown loss, a margin outside (0, 1), a margin without a robust
+/// loss.
+pub fn robust_loss(opts: &mut IdentifyOptions, name: &str, margin: Option<f64>) -> PyResult<()> {
+    let l = loss(name)?;
+    let c = f_scale(margin)?;
+    if c.is_some() && l.is_linear() {
+        return Err(input_error(
+            "f_scale: a soft margin needs a robust loss, but loss is \"linear\" (least \
+             squares); give loss=\"soft_l1\" (or \"huber\", \"cauchy\"), or drop f_scale"
+                .to_string(),
+        ));
+    }
+    opts.loss = l;
+    opts.f_scale = c;
+    Ok(())
+}
+
 /// `f_scale`: a relative residual in (0, 1).
-pub fn f_scale(v: Option<f64>) -> PyResult<Option<f64>> {
+fn f_scale(v: Option<f64>) -> PyResult<Option<f64>> {
     match v {
         Some(v) if !(v > 0.0 && v < 1.0) => Err(input_error(format!(
             "f_scale is a relative residual in (0, 1) (got {v}; 0.02 is 2 %)"

@@ -126,7 +126,7 @@ def test_a_robust_loss_weights_the_diagnosis_and_outliers_are_no_missing_physics
     """Gross outliers on a correct model (data/hidden_outliers, made by the independent
     simulator): with the huber loss the diagnosis weights the points as the robust fit does,
     says so, and names nothing; the law is a result. A soft margin without a robust loss is
-    an input error."""
+    an input error, in ``diagnose`` as in ``fit``."""
     from conftest import ROOT
 
     ds = diffbvp.load(ROOT / "data" / "hidden_outliers" / "experiments.toml")
@@ -135,8 +135,9 @@ def test_a_robust_loss_weights_the_diagnosis_and_outliers_are_no_missing_physics
     assert w is not None and w["loss"] == "huber" and w["down_weighted"] >= 7, w
     assert d.verdict["kind"] == "adequate" and d.law_is_a_result, d.verdict
     assert d.found == [] and "Loss huber: the points are weighted" in d.text
-    with pytest.raises(diffbvp.InputError, match="f_scale"):
-        diffbvp.diagnose(ds, f_scale=0.02)
+    for run in (diffbvp.diagnose, diffbvp.fit):
+        with pytest.raises(diffbvp.InputError, match="f_scale: a soft margin needs a robust loss"):
+            run(ds, f_scale=0.02)
 
 
 def test_a_pair_as_good_with_another_law_makes_the_law_no_result():

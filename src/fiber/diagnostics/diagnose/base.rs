@@ -63,11 +63,6 @@ impl<'a> Context<'a> {
         // user's fit is checked (fit_base)
         let check = opts.max_discretisation_shift.take();
         let robust = (!opts.loss.is_linear()).then_some(opts.loss);
-        // a further step starts with the weights the loss gave the previous step's fit: its
-        // fit is least squares with them (the loss would down-weight the same points twice)
-        if opts.noise_factors.is_some() {
-            opts.loss = Loss::Linear;
-        }
         let spec = base_spec.clone().with_candidates(&options.candidates);
         let rh = Rheometer::with_spec(set, spec.clone())?;
         let sigma = opts
@@ -118,6 +113,13 @@ impl<'a> Context<'a> {
             // the user's effects never leave the fit worse than the model without them
             return Ok(self.rh.identify_nested(self.law0, &checked)?.fit);
         };
+        // a further step: `w` was fitted with the previous step's weights, which carry a robust
+        // loss's down-weighting, so this fit is least squares with them (the loss again would
+        // down-weight the same points twice)
+        let checked = IdentifyOptions {
+            loss: Loss::Linear,
+            ..checked
+        };
         let start = FitStart {
             strengths: w.fitted_strengths(),
             warm: Some(w.solutions.clone()),
@@ -145,16 +147,16 @@ impl<'a> Context<'a> {
         base: Identification,
     ) -> Result<Identification, RheometerError> {
         let noise = &base.summary.noise;
-        let robust = match self.robust {
-            Some(loss) => {
+        let robust = self
+            .robust
+            .map(|loss| {
                 let o = IdentifyOptions {
                     loss,
                     ..self.opts.clone()
                 };
-                Some((loss, self.rh.robust_margin(&o)?))
-            }
-            None => None,
-        };
+                self.rh.robust_margin(&o).map(|m| (loss, m))
+            })
+            .transpose()?;
         let model = noise.model.as_ref();
         let varies =
             model.is_some_and(|m| m.varies_along_line) && !noise.declared() && noise.level > 0.0;
