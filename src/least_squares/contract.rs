@@ -45,6 +45,15 @@ pub(super) fn check_options(
             )));
         }
     }
+    if let Some(v) = options.relative_offset {
+        if !(v.is_finite() && v > 0.0 && v < 1.0) {
+            return Err(FitError::InvalidInput(format!(
+                "FitOptions::relative_offset must lie in (0, 1), got {v}: it compares the \
+                 Gauss-Newton step with the residuals' scatter (Bates and Watts use 1e-3); \
+                 None turns the test off"
+            )));
+        }
+    }
     // relative tolerances: 1 or more stops at the first step whatever it does
     for (name, v) in [("xtol", options.xtol), ("ftol", options.ftol)] {
         if v >= 1.0 {

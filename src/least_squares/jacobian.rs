@@ -138,6 +138,34 @@ impl<'a> Linearized<'a> {
         }
     }
 
+    /// The relative offset of Bates and Watts at this linearisation:
+    /// `(‖J s‖/√P) / (‖r + J s‖/√(N − P))` for the Gauss–Newton step `s` (`d`: the step's
+    /// scaling, which does not change the Gauss–Newton step where `JᵀJ` is regular). `0` where
+    /// the residuals vanish with the step; `N ≤ P` counts as one degree of freedom.
+    pub(super) fn relative_offset(&self, d: &[f64], nr: usize, np: usize) -> f64 {
+        let s = self.step(d, f64::INFINITY);
+        let (js, r): (Vec<f64>, &[f64]) = match self {
+            Linearized::Dense { jm, rv } => ((jm * &s).iter().copied().collect(), rv.as_slice()),
+            Linearized::Blocks { j, r } => (j.mul_vec(s.as_slice()), *r),
+        };
+        let along: f64 = js.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let across: f64 = js
+            .iter()
+            .zip(r)
+            .map(|(a, b)| (a + b) * (a + b))
+            .sum::<f64>()
+            .sqrt();
+        let dof = nr.saturating_sub(np).max(1) as f64;
+        let scatter = across / dof.sqrt();
+        if scatter > 0.0 {
+            along / (np.max(1) as f64).sqrt() / scatter
+        } else if along > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        }
+    }
+
     /// The predicted reduction `−(rᵀ J s + ½‖J s‖²)` of `½‖J s + r‖²`.
     pub(super) fn predicted_reduction(&self, s: &DVector<f64>) -> f64 {
         match self {

@@ -190,6 +190,17 @@ pub struct FitOptions {
     pub f_scale: f64,
     /// How accurately the model is evaluated (default [`Accuracy::Fixed`]).
     pub accuracy: Accuracy,
+    /// Tolerance of the relative-offset convergence criterion of Bates and Watts (1981;
+    /// default `None`: not used): the fit ends ([`Termination::RelativeOffset`]) when the
+    /// Gauss–Newton step to the optimum of the linearised problem, measured in the residuals
+    /// against their scatter,
+    /// `(‖J s_GN‖/√P) / (‖r + J s_GN‖/√(N − P))`, is below it. The estimate is then within
+    /// `tol·√P` standard errors of that optimum (`‖J s‖/σ̂` is a step's length in standard
+    /// errors). Unlike `ftol` and `xtol` it is scale-free and statistical: a model evaluated
+    /// with a small numerical error (a BVP solved to a tolerance) makes the cost noisy at a
+    /// level `ftol` may lie below, and the trust region then spends its iterations on that
+    /// noise. Bates and Watts use 10⁻³.
+    pub relative_offset: Option<f64>,
     /// A cancellation flag (default `None`): once set (by another thread, e.g. a signal
     /// handler or an interactive front end), the fit stops before its next model evaluation
     /// with [`FitError::Cancelled`].
@@ -211,6 +222,7 @@ impl FitOptions {
             loss: Loss::Linear,
             f_scale: 1.0,
             accuracy: Accuracy::Fixed,
+            relative_offset: None,
             cancel: None,
         }
     }
@@ -236,6 +248,8 @@ pub enum Termination {
     MaxIterations,
     /// The trust radius collapsed (repeated failures or no decrease possible).
     RadiusCollapsed,
+    /// The relative offset fell below [`FitOptions::relative_offset`].
+    RelativeOffset,
 }
 
 impl fmt::Display for Termination {
@@ -246,6 +260,7 @@ impl fmt::Display for Termination {
             Termination::CostChange => "cost change below ftol",
             Termination::MaxIterations => "maximum number of iterations reached",
             Termination::RadiusCollapsed => "trust radius collapsed",
+            Termination::RelativeOffset => "relative offset below its tolerance (Bates-Watts)",
         };
         f.write_str(s)
     }

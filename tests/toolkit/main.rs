@@ -15,5 +15,6 @@ mod linear_solvers;
 mod mesh_passes;
 mod oscillatory_mesh;
 mod plot;
+mod relative_offset;
 mod scipy_problems;
 mod sensitivities;

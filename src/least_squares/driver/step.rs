@@ -48,13 +48,20 @@ impl Driver<'_> {
         if scaled_gradient <= o.gtol {
             return Err(Termination::Gradient);
         }
+        let d: Vec<f64> = v.iter().map(|x| 1.0 / x.sqrt()).collect();
+        // at the optimum to within the tolerance, whatever numerical noise the cost carries
+        // (not in the loose phase of a schedule: its evaluations are not yet the final model)
+        if let Some(tol) = o.relative_offset.filter(|_| !self.loose) {
+            if lin.relative_offset(&d, nr, np) <= tol {
+                return Err(Termination::RelativeOffset);
+            }
+        }
         if self.iterations >= self.tight_limit.unwrap_or(o.max_iterations) {
             return Err(Termination::MaxIterations);
         }
         if self.radius < 1e-12 {
             return Err(Termination::RadiusCollapsed);
         }
-        let d: Vec<f64> = v.iter().map(|x| 1.0 / x.sqrt()).collect();
         let s = lin.step(&d, self.radius);
         let trial = inside_box(&self.p, &s, &o.lower, &o.upper);
         let step: Vec<f64> = (0..np).map(|i| trial[i] - self.p[i]).collect();

@@ -1,0 +1,139 @@
+//! The relative-offset stopping test of Bates and Watts (`FitOptions::relative_offset`) on a
+//! model evaluated with a small numerical error, as a BVP solved to a tolerance is: the cost
+//! then carries noise that `ftol` lies below, and the trust region spends its iterations on it.
+
+use diffbvp::least_squares::{
+    fit, FitError, FitOptions, FitResult, LeastSquaresProblem, Termination,
+};
+
+/// `y = a e^{−b x}` at 40 points of `[0, 2]`, with Gaussian-like noise of σ = 0.01 (a fixed
+/// pseudo-random sequence, written here); the model's residuals carry a deterministic error of
+/// RMS about `numerical` that changes with every bit of `p` (a discretisation whose mesh
+/// changes between evaluations), the Jacobian is the smooth model's.
+struct NoisyDecay {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    numerical: f64,
+}
+
+/// A uniform number in `[-1, 1)` from a 64-bit state (splitmix64).
+fn unit(mut z: u64) -> f64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+}
+
+impl NoisyDecay {
+    fn new(numerical: f64) -> Self {
+        let x: Vec<f64> = (0..40).map(|i| 2.0 * i as f64 / 39.0).collect();
+        // sum of four uniforms, scaled to unit variance (σ of U[-1,1) is 1/√3), times 0.01
+        let y = x
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                let g: f64 =
+                    (0..4).map(|k| unit(1000 * i as u64 + k)).sum::<f64>() * (3.0f64 / 4.0).sqrt();
+                2.0 * (-1.3 * x).exp() + 0.01 * g
+            })
+            .collect();
+        NoisyDecay { x, y, numerical }
+    }
+}
+
+impl LeastSquaresProblem for NoisyDecay {
+    type Error = String;
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
+        let seed = p[0].to_bits() ^ p[1].to_bits().rotate_left(17);
+        let mut r = Vec::with_capacity(self.x.len());
+        let mut j = Vec::with_capacity(2 * self.x.len());
+        for (i, (&x, &y)) in self.x.iter().zip(&self.y).enumerate() {
+            let e = (-p[1] * x).exp();
+            r.push(p[0] * e - y + self.numerical * unit(seed ^ (i as u64) << 40));
+            j.push(e);
+            j.push(-p[0] * x * e);
+        }
+        Ok((r, j))
+    }
+}
+
+fn options(relative_offset: Option<f64>) -> FitOptions {
+    FitOptions {
+        relative_offset,
+        ..FitOptions::with_bounds(vec![0.1, 0.1], vec![10.0, 10.0])
+    }
+}
+
+fn run(numerical: f64, relative_offset: Option<f64>) -> FitResult {
+    fit(
+        &mut NoisyDecay::new(numerical),
+        &[1.0, 0.5],
+        &options(relative_offset),
+    )
+    .unwrap()
+}
+
+/// The largest distance of `a` from the exact optimum `b`, in `b`'s standard errors.
+fn distance_se(a: &FitResult, b: &FitResult) -> f64 {
+    let se = b.standard_errors().unwrap();
+    (0..2)
+        .map(|i| ((a.p[i] - b.p[i]) / se[i]).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_fit_ends_at_the_optimum_to_within_the_relative_offset_and_not_on_numerical_noise() {
+    // the exact optimum: the smooth model, tight tolerances
+    let exact = run(0.0, None);
+    assert_ne!(exact.termination, Termination::MaxIterations);
+    // a numerical error of 1e-7 per residual (1e-5 of the noise): ftol = 1e-10 lies below the
+    // cost noise it makes (~ 2 |r| 1e-7 √N / ‖r‖² ≈ 1e-6 relative)
+    let by_ftol = run(1e-7, None);
+    let by_offset = run(1e-7, Some(1e-3));
+    println!(
+        "exact: {} iterations ({}); ftol: {} iterations ({}), {:.2e} se off; relative offset: {} \
+         iterations ({}), {:.2e} se off",
+        exact.iterations,
+        exact.termination,
+        by_ftol.iterations,
+        by_ftol.termination,
+        distance_se(&by_ftol, &exact),
+        by_offset.iterations,
+        by_offset.termination,
+        distance_se(&by_offset, &exact),
+    );
+    assert_eq!(by_offset.termination, Termination::RelativeOffset);
+    assert!(
+        by_offset.iterations < by_ftol.iterations,
+        "{} iterations with the relative offset, {} with ftol",
+        by_offset.iterations,
+        by_ftol.iterations
+    );
+    // within 1e-3 √P standard errors of the optimum, plus what the numerical error itself
+    // moves it (1e-7 against σ = 0.01 over 40 points: ~1e-5 se)
+    let bound = 1e-3 * 2f64.sqrt() + 1e-4;
+    assert!(
+        distance_se(&by_offset, &exact) <= bound,
+        "{} se from the exact optimum",
+        distance_se(&by_offset, &exact)
+    );
+    // on the smooth model it ends at the optimum as well, and no later than ftol does
+    let smooth = run(0.0, Some(1e-3));
+    assert!(distance_se(&smooth, &exact) <= 1e-3 * 2f64.sqrt());
+    assert!(smooth.iterations <= exact.iterations);
+}
+
+#[test]
+fn a_relative_offset_outside_zero_to_one_is_refused_naming_the_option() {
+    for bad in [0.0, -1e-3, 1.0, f64::NAN, f64::INFINITY] {
+        let e = fit(&mut NoisyDecay::new(0.0), &[1.0, 0.5], &options(Some(bad))).unwrap_err();
+        let FitError::InvalidInput(m) = &e else {
+            panic!("{bad}: {e}")
+        };
+        assert!(m.contains("FitOptions::relative_offset"), "{m}");
+    }
+}
