@@ -43,7 +43,12 @@ pub(crate) fn discretisation_shift(
     fine.loose_tolerance = None;
     // the check is part of the fit already reported, not a fit of its own
     fine.progress = None;
+    // the objective solves every experiment when it is built: at the optimum, so that the
+    // evaluation below starts from those fine solutions (built at the fit's own start law, it
+    // solved a far-away point first and re-solved the optimum from there: 2.3 times the cost)
     let fs = FitStart {
+        law: id.law(),
+        strengths: id.fitted_strengths(),
         warm: Some(id.solutions.clone()),
         ..start.clone()
     };
