@@ -139,13 +139,12 @@ impl<'a> Linearized<'a> {
     }
 
     /// The relative offset of Bates and Watts at this linearisation:
-    /// `(‖J s‖/√P) / (‖r + J s‖/√(N − P))` for the Gauss–Newton step `s` (`d`: the step's
-    /// scaling, which does not change the Gauss–Newton step where `JᵀJ` is regular). `0` where
-    /// the residuals vanish with the step; `N ≤ P` counts as one degree of freedom.
-    pub(super) fn relative_offset(&self, d: &[f64], nr: usize, np: usize) -> f64 {
-        let s = self.step(d, f64::INFINITY);
+    /// `(‖J s‖/√P) / (‖r + J s‖/√(N − P))` for the Gauss–Newton step `s` (`step(d, ∞)`; the
+    /// scaling `d` does not change it where `JᵀJ` is regular). `0` where the residuals vanish
+    /// with the step; `N ≤ P` counts as one degree of freedom.
+    pub(super) fn relative_offset(&self, s: &DVector<f64>, nr: usize, np: usize) -> f64 {
         let (js, r): (Vec<f64>, &[f64]) = match self {
-            Linearized::Dense { jm, rv } => ((jm * &s).iter().copied().collect(), rv.as_slice()),
+            Linearized::Dense { jm, rv } => ((jm * s).iter().copied().collect(), rv.as_slice()),
             Linearized::Blocks { j, r } => (j.mul_vec(s.as_slice()), *r),
         };
         let along: f64 = js.iter().map(|v| v * v).sum::<f64>().sqrt();

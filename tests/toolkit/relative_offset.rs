@@ -53,7 +53,7 @@ impl LeastSquaresProblem for NoisyDecay {
         let mut j = Vec::with_capacity(2 * self.x.len());
         for (i, (&x, &y)) in self.x.iter().zip(&self.y).enumerate() {
             let e = (-p[1] * x).exp();
-            r.push(p[0] * e - y + self.numerical * unit(seed ^ (i as u64) << 40));
+            r.push(p[0] * e - y + self.numerical * unit(seed ^ ((i as u64) << 40)));
             j.push(e);
             j.push(-p[0] * x * e);
         }

@@ -46,12 +46,7 @@ pub(crate) fn discretisation_shift(
     // the objective solves every experiment when it is built: at the optimum, so that the
     // evaluation below starts from those fine solutions (built at the fit's own start law, it
     // solved a far-away point first and re-solved the optimum from there: 2.3 times the cost)
-    let fs = FitStart {
-        law: id.law(),
-        strengths: id.fitted_strengths(),
-        warm: Some(id.solutions.clone()),
-        ..start.clone()
-    };
+    let fs = at_optimum(start, id);
     let mut obj = rh.objective_from(&fs, &fine)?;
     let r_fine = obj.residuals_only(&id.fit.p)?;
     let r = &id.fit.residuals;
@@ -81,6 +76,17 @@ pub(crate) fn discretisation_shift(
     Ok((worst, check_tol))
 }
 
+/// `start` moved to the optimum of `id`: its law and fitted strengths, warm from its solutions
+/// (what the check and a refinement of `id` start from).
+fn at_optimum(start: &FitStart, id: &Identification) -> FitStart {
+    FitStart {
+        law: id.law(),
+        strengths: id.fitted_strengths(),
+        warm: Some(id.solutions.clone()),
+        ..start.clone()
+    }
+}
+
 /// The fit `id` (started from `start`) checked and, where the discretisation moves an estimate
 /// by more than the options allow, refined at tighter tolerances until it does not.
 pub(crate) fn matched(
@@ -108,12 +114,7 @@ pub(crate) fn matched(
         }
         // refine: a tighter tolerance, warm from this fit
         opts.simulate.tol = (opts.simulate.tol / 10.0).max(TIGHTEST_TOLERANCE);
-        let next = FitStart {
-            law: id.law(),
-            strengths: id.fitted_strengths(),
-            warm: Some(id.solutions.clone()),
-            ..start.clone()
-        };
+        let next = at_optimum(start, &id);
         let warm = WarmFit {
             take_up: id.take_up_factors().to_vec(),
             stop_tolerance: None,

@@ -50,9 +50,15 @@ impl Driver<'_> {
         }
         let d: Vec<f64> = v.iter().map(|x| 1.0 / x.sqrt()).collect();
         // at the optimum to within the tolerance, whatever numerical noise the cost carries
-        // (not in the loose phase of a schedule: its evaluations are not yet the final model)
-        if let Some(tol) = o.relative_offset.filter(|_| !self.loose) {
-            if lin.relative_offset(&d, nr, np) <= tol {
+        // (not in the loose phase of a schedule: its evaluations are not yet the final model);
+        // the Gauss–Newton step it measures is also the trust-region step when it lies inside
+        // the radius, so it is computed once
+        let gauss_newton = o
+            .relative_offset
+            .filter(|_| !self.loose)
+            .map(|tol| (tol, lin.step(&d, f64::INFINITY)));
+        if let Some((tol, s_gn)) = &gauss_newton {
+            if lin.relative_offset(s_gn, nr, np) <= *tol {
                 return Err(Termination::RelativeOffset);
             }
         }
@@ -62,7 +68,10 @@ impl Driver<'_> {
         if self.radius < 1e-12 {
             return Err(Termination::RadiusCollapsed);
         }
-        let s = lin.step(&d, self.radius);
+        let s = match gauss_newton {
+            Some((_, s_gn)) if scaled_norm(&s_gn, &d) <= self.radius => s_gn,
+            _ => lin.step(&d, self.radius),
+        };
         let trial = inside_box(&self.p, &s, &o.lower, &o.upper);
         let step: Vec<f64> = (0..np).map(|i| trial[i] - self.p[i]).collect();
         let step = DVector::from_column_slice(&step);
@@ -95,6 +104,15 @@ impl Driver<'_> {
             },
         }
     }
+}
+
+/// `‖D s‖`, the length of the step `s` in the trust region's scaled variables.
+fn scaled_norm(s: &DVector<f64>, d: &[f64]) -> f64 {
+    s.iter()
+        .zip(d)
+        .map(|(x, di)| (x * di) * (x * di))
+        .sum::<f64>()
+        .sqrt()
 }
 
 /// The trial point `p + s` kept strictly inside the box `[lo, hi]`: a step that would leave it
