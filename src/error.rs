@@ -25,6 +25,28 @@ pub enum BvpError {
         tol: f64,
     },
 
+    /// Refinement would grow the mesh beyond [`SolveOptions::growth_limit`](crate::solve::SolveOptions::growth_limit)
+    /// allows for the mesh the solve started from: the start is far from a solution at these
+    /// parameters (or there is none), and the caller should take a shorter step.
+    #[error(
+        "the mesh would grow from the start's {start_nodes} nodes to {nodes}, beyond the growth \
+         limit of {limit} nodes (SolveOptions::growth_limit): the start is far from a solution at \
+         these parameters, or there is none; take a shorter step or start closer (the largest \
+         scaled RMS residual reached was {max_residual:.3e}, tol {tol:.1e})"
+    )]
+    MeshGrowthLimit {
+        /// Nodes of the start's mesh.
+        start_nodes: usize,
+        /// Nodes the next mesh would have had.
+        nodes: usize,
+        /// The limit the growth limit set for this solve.
+        limit: usize,
+        /// Largest RMS collocation residual on the last mesh.
+        max_residual: f64,
+        /// Requested tolerance.
+        tol: f64,
+    },
+
     /// The Newton matrix is singular.
     #[error("singular Jacobian: {detail}")]
     SingularJacobian {

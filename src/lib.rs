@@ -129,4 +129,4 @@ pub use linear::{Factorization, LinearSolverKind};
 pub use num_dual::DualNum;
 pub use problem::Bvp;
 pub use solution::{Solution, SolveStats};
-pub use solve::{solve, Guess, ResidualScale, SolveOptions, Solver};
+pub use solve::{solve, GrowthLimit, Guess, ResidualScale, SolveOptions, Solver};

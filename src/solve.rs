@@ -75,6 +75,34 @@ pub struct SolveOptions {
     /// the predicted residual, [`MeshOptions::default`](crate::mesh::MeshOptions::default);
     /// [`MeshOptions::scipy`](crate::mesh::MeshOptions::scipy) gives scipy's 1-or-2-node rule).
     pub mesh: mesh::MeshOptions,
+    /// How far the mesh may grow beyond the mesh of the guess (default `None`: up to
+    /// `max_nodes`). A warm start whose solution needs many times its nodes was far from it:
+    /// at a trial point of a fit or a continuation step beyond the region where the problem
+    /// has a solution, the mesh otherwise refines towards `max_nodes` before the solve fails,
+    /// at a cost of hundreds of ordinary solves. With a limit such a solve fails early with
+    /// [`BvpError::MeshGrowthLimit`] and the caller takes a shorter step.
+    pub growth_limit: Option<GrowthLimit>,
+}
+
+/// A limit on the growth of the mesh within one solve ([`SolveOptions::growth_limit`]): the
+/// solve fails once a refinement would need more than
+/// `max(at_least, factor × nodes of the guess)` nodes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GrowthLimit {
+    /// Largest growth over the guess's mesh \[-\] (at least 1).
+    pub factor: f64,
+    /// Nodes always allowed, whatever the guess's mesh (a cold start from a coarse guess
+    /// legitimately refines it many times).
+    pub at_least: usize,
+}
+
+impl GrowthLimit {
+    /// The largest mesh a solve from a guess of `start_nodes` nodes may reach.
+    pub fn nodes(&self, start_nodes: usize) -> usize {
+        let grown = (self.factor * start_nodes as f64).ceil();
+        // `as` saturates: a huge factor means no limit
+        (grown as usize).max(self.at_least)
+    }
 }
 
 impl Default for SolveOptions {
@@ -94,6 +122,7 @@ impl Default for SolveOptions {
             verbose: 0,
             linear_solver: LinearSolverKind::Auto,
             mesh: mesh::MeshOptions::default(),
+            growth_limit: None,
         }
     }
 }
@@ -176,6 +205,16 @@ impl SolveOptions {
             }
         }
         self.mesh.validate()?;
+        if let Some(g) = &self.growth_limit {
+            if !(g.factor >= 1.0 && g.factor.is_finite()) || g.at_least < 2 {
+                return Err(BvpError::InvalidInput(format!(
+                    "SolveOptions::growth_limit must have a finite factor of at least 1 and \
+                     allow at least 2 nodes, got factor {} and at_least {}; typical values are \
+                     factor 16 and at_least 1000, or None for no limit",
+                    g.factor, g.at_least
+                )));
+            }
+        }
         if let ResidualScale::PerComponent(s) = &self.scale {
             if s.len() != n || s.iter().any(|v| !(*v > 0.0 && v.is_finite())) {
                 return Err(BvpError::InvalidInput(format!(
@@ -666,6 +705,11 @@ impl<'a, P: Bvp> Solver<'a, P> {
         // the mesh options of this solve: the rule switches to scipy's when the mesh cycles
         let mut control = MeshControl::new(&opts.mesh);
         let mut coarsenings_left = if opts.coarsen && opts.adapt { 3 } else { 0 };
+        // the largest mesh this solve may reach from its guess (below `max_nodes`)
+        let growth_limit = opts
+            .growth_limit
+            .map(|g| g.nodes(guess.x.len()))
+            .filter(|&l| l < opts.max_nodes);
         let mut iteration = 0;
         // values interpolated onto a refined mesh rarely pass the termination test as they
         // are: their Jacobian is evaluated with their residual (one pass instead of two)
@@ -753,6 +797,15 @@ impl<'a, P: Bvp> Solver<'a, P> {
             }
             if let Some(new_x) = refined {
                 self.keep_system(lin);
+                if let Some(limit) = growth_limit.filter(|&l| new_x.len() > l) {
+                    return Err(BvpError::MeshGrowthLimit {
+                        start_nodes: guess.x.len(),
+                        nodes: new_x.len(),
+                        limit,
+                        max_residual: max_res,
+                        tol: opts.tol,
+                    });
+                }
                 if new_x.len() > opts.max_nodes {
                     return Err(BvpError::MaxNodesExceeded {
                         nodes: new_x.len(),

@@ -125,6 +125,17 @@ pub fn hints(
         experiment.air_temperature,
         material.vft_t_vf,
     );
+    if let Some(BvpError::MeshGrowthLimit {
+        start_nodes, limit, ..
+    }) = root.or(solver)
+    {
+        out.push(format!(
+            "the solve started from a solution of {start_nodes} nodes and would have needed \
+             more than {limit}: the parameters lie far from that solution, or beyond the region \
+             where the fiber has a solution (a fit rejects such a trial step and takes a \
+             shorter one); in the library, SimulateOptions::growth_limit = None lifts the limit"
+        ));
+    }
     if let Some(m) = max_nodes {
         out.push(format!(
             "the mesh needed more than {m} nodes: raise the limit with --max-nodes (in the \
@@ -350,6 +361,26 @@ mod tests {
         let thin = experiment(513.15, 293.15, 1e-5);
         let h = hints(&err, &thin, &m, Some([0.8, 11.71]));
         assert!(h.iter().any(|s| s.contains("too thin")), "{h:?}");
+    }
+
+    #[test]
+    fn a_growth_limit_is_explained_not_blamed_on_max_nodes() {
+        let m = Material::pmma7n();
+        let e = experiment(513.15, 293.15, 9e-5);
+        let err = FiberError::Solver(BvpError::MeshGrowthLimit {
+            start_nodes: 60,
+            nodes: 900,
+            limit: 480,
+            max_residual: 1.0,
+            tol: 1e-4,
+        });
+        let h = hints(&err, &e, &m, Some([0.8, 11.71]));
+        assert!(
+            h.iter()
+                .any(|s| s.contains("60 nodes") && s.contains("more than 480")),
+            "{h:?}"
+        );
+        assert!(!h.iter().any(|s| s.contains("--max-nodes")), "{h:?}");
     }
 
     #[test]

@@ -27,7 +27,7 @@ use super::model::FiberModel;
 use crate::mesh::{linspace, MeshOptions};
 use crate::sensitivity::tangent_guess;
 use crate::solution::Solution;
-use crate::solve::{Guess, ResidualScale, SolveOptions, Solver};
+use crate::solve::{GrowthLimit, Guess, ResidualScale, SolveOptions, Solver};
 
 /// Options of [`simulate`].
 #[derive(Debug, Clone)]
@@ -61,6 +61,12 @@ pub struct SimulateOptions {
     /// the 9 shipped experiments; with the smooth constant one pass reaches `tol` on all 9
     /// (1–2 % more nodes).
     pub smooth_cold_final: bool,
+    /// How far a solve may refine beyond the mesh it starts from (default `None`: up to
+    /// `max_nodes`; see [`SolveOptions::growth_limit`]). The refinements of the diagnosis set it
+    /// ([`ScanOptions::refine_growth_limit`](crate::fiber::diagnostics::scan::ScanOptions::refine_growth_limit)):
+    /// a trial point beyond the region where the fiber has a solution then fails in
+    /// milliseconds instead of refining towards `max_nodes`.
+    pub growth_limit: Option<GrowthLimit>,
 }
 
 impl Default for SimulateOptions {
@@ -76,6 +82,7 @@ impl Default for SimulateOptions {
             required_positions: Vec::new(),
             mesh: MeshOptions::default(),
             smooth_cold_final: true,
+            growth_limit: None,
         }
     }
 }
@@ -90,10 +97,14 @@ impl SimulateOptions {
     }
 
     /// The toolkit options of a cold start's final solve: [`solve_options`](Self::solve_options)
-    /// with smooth error constants if [`smooth_cold_final`](Self::smooth_cold_final).
+    /// with smooth error constants if [`smooth_cold_final`](Self::smooth_cold_final), and no
+    /// [`growth_limit`](Self::growth_limit): that solve starts from the continuation path's
+    /// end point at the same parameters, solved loosely, and its growth is the tolerance's
+    /// (tenfold from a coarse path mesh is common), not a sign of a far start.
     pub fn cold_final_options(&self) -> SolveOptions {
         let mut o = self.solve_options();
         o.mesh.smooth |= self.smooth_cold_final;
+        o.growth_limit = None;
         o
     }
 
@@ -106,6 +117,7 @@ impl SimulateOptions {
             scale: ResidualScale::PerComponent(self.scale.to_vec()),
             factor_at_solution: self.factor_at_solution,
             mesh: self.mesh.clone(),
+            growth_limit: self.growth_limit,
             ..Default::default()
         }
     }

@@ -324,10 +324,15 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         let sol = match cached {
             Some(sol) => sol,
             None => {
-                let opts = match tol {
+                let mut opts = match tol {
                     Some(t) => self.loose_options(t),
                     None => self.solver.options.clone(),
                 };
+                if self.q == self.accepted.params {
+                    // a re-solve at the accepted solution's own parameters (at another
+                    // tolerance): its mesh grows with the tolerance, not because the start is far
+                    opts.growth_limit = None;
+                }
                 if predicted {
                     match self
                         .solver

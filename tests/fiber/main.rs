@@ -17,6 +17,7 @@ mod fiber_reference;
 mod fiber_terms;
 mod fit_warnings;
 mod flow_curve_intervals;
+mod growth_limit;
 mod independent_model;
 mod landscape;
 mod nested_fit;
