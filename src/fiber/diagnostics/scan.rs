@@ -64,7 +64,8 @@ pub struct ScanOptions {
     /// profile value needs the diameters to ~1e-5, far below the measurement noise; the
     /// refinements solve at the fit's tolerance).
     pub grid_tol: f64,
-    /// How far the BVP solves of a refinement may refine beyond the mesh they start from
+    /// How far the BVP solves of a refinement (and of the pairs' joint fits) may refine
+    /// beyond the mesh they start from
     /// (default [`REFINE_GROWTH_LIMIT`]; `None`: up to `max_nodes`): a trial step beyond the
     /// region where the fiber has a solution then fails in milliseconds instead of refining
     /// towards 20 000 nodes, and the trust region takes a shorter one. The grid fits run

@@ -32,6 +32,7 @@ use crate::fiber::rheometer::{
 };
 use crate::fiber::setup::ExperimentSet;
 use crate::least_squares::Loss;
+use crate::solve::GrowthLimit;
 use rayon::prelude::*;
 
 /// Relative `J` within which two starts reached the same optimum \[-\].
@@ -106,12 +107,14 @@ pub(crate) fn search(
         }
     }
     let tried = pairs.len();
+    // the joint fits are refits like the single ones: the same mesh-growth limit
+    let limit = options.scan.refine_growth_limit;
     let fits: Vec<(usize, usize, Identification, usize, usize)> = pairs
         .into_par_iter()
         .filter_map(|(i, j)| {
             let (a, b) = (&members[i], &members[j]);
             let starts = [a.start(b)];
-            let (id, at) = best_of(fit_pair(set, base_spec, first, a, b, &starts).ok()?)?;
+            let (id, at) = best_of(fit_pair(set, base_spec, first, (a, b), &starts, limit).ok()?)?;
             Some((i, j, id, starts.len(), at))
         })
         .collect();
@@ -144,7 +147,7 @@ pub(crate) fn search(
                 .collect()
         })
         .collect();
-    let mut fits = fit_pair(set, base_spec, first, a, b, &more).unwrap_or_default();
+    let mut fits = fit_pair(set, base_spec, first, (a, b), &more, limit).unwrap_or_default();
     fits.push(id);
     let starts = p.starts + more.len();
     let (id, at) = best_of(fits)?;
@@ -240,15 +243,15 @@ fn member<'a>(c: &'a Candidate, options: &DiagnoseOptions) -> Option<Member<'a>>
 }
 
 /// The joint fit of `a` and `b` from each of `starts` (start strengths and shapes by name; the
-/// law of the user's fit, its solutions as warm starts, one model for all starts): the fits
-/// that converged.
+/// law of the user's fit, its solutions as warm starts, one model for all starts, BVP solves
+/// with the mesh-growth limit `limit`): the fits that converged.
 fn fit_pair(
     set: &ExperimentSet,
     base_spec: &ModelSpec,
     first: &Step,
-    a: &Member<'_>,
-    b: &Member<'_>,
+    (a, b): (&Member<'_>, &Member<'_>),
     starts: &[Vec<(String, f64)>],
+    limit: Option<GrowthLimit>,
 ) -> Result<Vec<Identification>, RheometerError> {
     let mut spec = base_spec.clone();
     spec.candidates.clear();
@@ -258,10 +261,11 @@ fn fit_pair(
     let rh = Rheometer::with_spec(set, spec)?;
     // least squares, as the single refits the pair is judged against (whatever the loss of
     // the user's fit)
-    let opts = IdentifyOptions {
+    let mut opts = IdentifyOptions {
         loss: Loss::Linear,
         ..first.opts.clone()
     };
+    opts.simulate.growth_limit = limit;
     let mut fits = Vec::new();
     for st in starts {
         let start = FitStart {
