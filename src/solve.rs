@@ -797,23 +797,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
             }
             if let Some(new_x) = refined {
                 self.keep_system(lin);
-                if let Some(limit) = growth_limit.filter(|&l| new_x.len() > l) {
-                    return Err(BvpError::MeshGrowthLimit {
-                        start_nodes: guess.x.len(),
-                        nodes: new_x.len(),
-                        limit,
-                        max_residual: max_res,
-                        tol: opts.tol,
-                    });
-                }
-                if new_x.len() > opts.max_nodes {
-                    return Err(BvpError::MaxNodesExceeded {
-                        nodes: new_x.len(),
-                        max_nodes: opts.max_nodes,
-                        max_residual: max_res,
-                        tol: opts.tol,
-                    });
-                }
+                allowed_size(new_x.len(), guess.x.len(), growth_limit, max_res, opts)?;
                 y = resample(&x, &y, &self.ws.col.f, n, &new_x);
                 x = new_x;
                 stats.mesh_refinements += 1;
@@ -883,6 +867,36 @@ impl<'a, P: Bvp> Solver<'a, P> {
             linearization,
         })
     }
+}
+
+/// Whether a refined mesh of `nodes` nodes may be solved: within the growth limit `limit`
+/// (already resolved for a guess of `start_nodes` nodes) and within `opts.max_nodes`; the error
+/// says which bound it exceeds, with the largest scaled residual `max_res` reached.
+fn allowed_size(
+    nodes: usize,
+    start_nodes: usize,
+    limit: Option<usize>,
+    max_res: f64,
+    opts: &SolveOptions,
+) -> Result<(), BvpError> {
+    if let Some(limit) = limit.filter(|&l| nodes > l) {
+        return Err(BvpError::MeshGrowthLimit {
+            start_nodes,
+            nodes,
+            limit,
+            max_residual: max_res,
+            tol: opts.tol,
+        });
+    }
+    if nodes > opts.max_nodes {
+        return Err(BvpError::MaxNodesExceeded {
+            nodes,
+            max_nodes: opts.max_nodes,
+            max_residual: max_res,
+            tol: opts.tol,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

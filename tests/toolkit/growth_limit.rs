@@ -10,84 +10,56 @@ use diffbvp::{solve, BvpError, GrowthLimit, Guess, Solution, SolveOptions};
 /// steep one at `eps = 1e-3` (about 600 nodes at tol 1e-6).
 fn smooth_start() -> Solution {
     let g = Guess::constant(linspace(-1.0, 1.0, 5), &[0.0, 0.0]);
-    solve(&Shock { eps: 0.1 }, &[], &g, &SolveOptions::with_tol(1e-6)).unwrap()
+    solve(&Shock { eps: 0.1 }, &[], &g, &options(None)).unwrap()
+}
+
+/// Options at tol 1e-6 with growth limit `(factor, at_least)` (`None`: no limit).
+fn options(limit: Option<(f64, usize)>) -> SolveOptions {
+    SolveOptions {
+        growth_limit: limit.map(|(factor, at_least)| GrowthLimit { factor, at_least }),
+        ..SolveOptions::with_tol(1e-6)
+    }
+}
+
+/// The shock layer at `eps` warm-started from `start`, with growth limit `limit`.
+fn from(start: &Solution, eps: f64, limit: Option<(f64, usize)>) -> Result<Solution, BvpError> {
+    solve(&Shock { eps }, &[], &Guess::from(start), &options(limit))
 }
 
 #[test]
 fn a_far_warm_start_fails_at_the_limit() {
     let start = smooth_start();
     let m = start.nodes();
-    let steep = Shock { eps: 1e-3 };
-    let free = solve(
-        &steep,
-        &[],
-        &Guess::from(&start),
-        &SolveOptions::with_tol(1e-6),
-    )
-    .unwrap();
+    let free = from(&start, 1e-3, None).unwrap();
     // the steep layer needs many times the smooth one's nodes: a limit of 3x binds
     assert!(free.nodes() > 3 * m, "{} nodes from {m}", free.nodes());
-    let limited = SolveOptions {
-        growth_limit: Some(GrowthLimit {
-            factor: 3.0,
-            at_least: 10,
-        }),
-        ..SolveOptions::with_tol(1e-6)
-    };
-    match solve(&steep, &[], &Guess::from(&start), &limited) {
-        Err(BvpError::MeshGrowthLimit {
+    let err = from(&start, 1e-3, Some((3.0, 10))).expect_err("the limit binds");
+    let text = err.to_string();
+    match err {
+        BvpError::MeshGrowthLimit {
             start_nodes,
             nodes,
             limit,
             ..
-        }) => {
+        } => {
             assert_eq!(start_nodes, m);
             assert_eq!(limit, 3 * m);
             assert!(nodes > limit, "{nodes} nodes wanted, limit {limit}");
-            let text = BvpError::MeshGrowthLimit {
-                start_nodes,
-                nodes,
-                limit,
-                max_residual: 1.0,
-                tol: 1e-6,
-            }
-            .to_string();
             assert!(text.contains("growth_limit"), "{text}");
         }
         other => panic!("expected MeshGrowthLimit, got {other:?}"),
     }
     // `at_least` lets a coarse start grow that far whatever the factor
-    let floor = SolveOptions {
-        growth_limit: Some(GrowthLimit {
-            factor: 1.0,
-            at_least: free.nodes() * 4,
-        }),
-        ..SolveOptions::with_tol(1e-6)
-    };
-    let s = solve(&steep, &[], &Guess::from(&start), &floor).unwrap();
+    let s = from(&start, 1e-3, Some((1.0, free.nodes() * 4))).unwrap();
     assert_eq!(s.x, free.x);
 }
 
 #[test]
 fn a_limit_that_does_not_bind_changes_nothing() {
     let start = smooth_start();
-    let steep = Shock { eps: 1e-2 };
-    let free = solve(
-        &steep,
-        &[],
-        &Guess::from(&start),
-        &SolveOptions::with_tol(1e-6),
-    )
-    .unwrap();
+    let free = from(&start, 1e-2, None).unwrap();
     let factor = free.nodes() as f64 / start.nodes() as f64 + 1.0;
-    let limited = SolveOptions {
-        growth_limit: Some(GrowthLimit {
-            factor,
-            at_least: 2,
-        }),
-        ..SolveOptions::with_tol(1e-6)
-    };
-    let s = solve(&steep, &[], &Guess::from(&start), &limited).unwrap();
+    let s = from(&start, 1e-2, Some((factor, 2))).unwrap();
     assert_eq!(s.x, free.x);
     assert_eq!(s.y, free.y);
     assert_eq!(s.stats.newton_iterations, free.stats.newton_iterations);
