@@ -45,6 +45,24 @@ pub(super) fn check_options(
             )));
         }
     }
+    if !options.x_scale.is_empty() && options.x_scale.len() != np {
+        return Err(FitError::InvalidInput(format!(
+            "FitOptions::x_scale has {} entries for {np} parameters: give one scale per \
+             parameter, or none (every scale 1)",
+            options.x_scale.len()
+        )));
+    }
+    if let Some((i, v)) = options
+        .x_scale
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+    {
+        return Err(FitError::InvalidInput(format!(
+            "FitOptions::x_scale[{i}] must be positive and finite, got {v}: it is parameter \
+             {i}'s characteristic scale in its own unit"
+        )));
+    }
     if let Some(v) = options.relative_offset {
         if !(v.is_finite() && v > 0.0 && v < 1.0) {
             return Err(FitError::InvalidInput(format!(

@@ -201,6 +201,16 @@ pub struct FitOptions {
     /// level `ftol` may lie below, and the trust region then spends its iterations on that
     /// noise. Bates and Watts use 10⁻³.
     pub relative_offset: Option<f64>,
+    /// Characteristic scale of each parameter, in its own unit (default empty: 1 for every
+    /// parameter). The trust region is taken in the scaled variables `p_i / x_scale_i`
+    /// (scipy's `x_scale`): the radii ([`initial_radius`](Self::initial_radius),
+    /// [`max_radius`](Self::max_radius)) and the Coleman–Li distances to the bounds, which
+    /// count as far at one scale unit, are in those units, and so is the `gtol` measure. A
+    /// parameter whose useful range spans hundreds of its units (an air speed in m/s, a
+    /// temperature offset in K) otherwise moves at most `max_radius` units per iteration: a fit
+    /// that must travel 100 m/s spends 100 iterations on it. Empty, or one positive finite
+    /// value per parameter.
+    pub x_scale: Vec<f64>,
     /// A cancellation flag (default `None`): once set (by another thread, e.g. a signal
     /// handler or an interactive front end), the fit stops before its next model evaluation
     /// with [`FitError::Cancelled`].
@@ -223,6 +233,7 @@ impl FitOptions {
             f_scale: 1.0,
             accuracy: Accuracy::Fixed,
             relative_offset: None,
+            x_scale: Vec::new(),
             cancel: None,
         }
     }

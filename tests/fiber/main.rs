@@ -10,6 +10,7 @@ mod cold_start;
 mod compare;
 mod design;
 mod discrimination;
+mod effect_scale;
 mod effects_families;
 mod error_budget;
 mod fiber_physics;

@@ -19,3 +19,4 @@ mod plot;
 mod relative_offset;
 mod scipy_problems;
 mod sensitivities;
+mod x_scale;

@@ -239,11 +239,18 @@ impl Candidate {
 /// [`PHYSICAL_RANGE_SE`] standard errors. A strength beyond the physical range by less is
 /// [`StrengthStatus::Physical`] with a note saying so (noise alone puts a true value at the
 /// limit that far beyond it).
+///
+/// `unbounded` is the strength's optimum with its bounds lifted, to first order (the refit's
+/// Gauss–Newton step from where it ended, [`unbounded_optimum`]); where given and the strength
+/// ends at a search bound beyond its physical range, a strength whose unbounded optimum lies
+/// within [`PHYSICAL_RANGE_SE`] standard errors of the physical limit is credible, with a note
+/// (the data do not bound it on that side).
 pub fn strength_status(
     effect: &Effect,
     strength: f64,
     stderr: f64,
     at_bound: &[AtBound],
+    unbounded: Option<f64>,
 ) -> (StrengthStatus, Option<String>) {
     let (lo, hi) = search_range(effect);
     let unit = effect.unit();
@@ -258,6 +265,9 @@ pub fn strength_status(
             })
         });
     if let Some((s, b)) = side {
+        if let Some(note) = unbounded.and_then(|u| flat_beyond_physics(effect, b, u, stderr)) {
+            return (StrengthStatus::Physical, Some(note));
+        }
         return (
             StrengthStatus::AtBound,
             Some(format!(
@@ -271,6 +281,57 @@ pub fn strength_status(
         Ok(()) => (StrengthStatus::Physical, None),
         Err(why) => beyond_physical(effect, strength, stderr, why),
     }
+}
+
+/// A strength at the search bound `bound` that lies beyond the physical range, with its
+/// unbounded optimum `unbounded` (first order): where that optimum lies within
+/// [`PHYSICAL_RANGE_SE`] standard errors (`stderr`) of the physical limit, the data do not push
+/// the strength beyond physics, they do not bound it on that side (a short co-flow's speed
+/// trades off against its decay length: with unit trust-region scales its refit crawled 1 m/s
+/// per iteration and stopped inside the range by chance, with scaled ones it runs along the
+/// flat valley to the bound). Returns the note that says so, or `None` (a bound inside the
+/// physical range, or an optimum further beyond: the status stays "at a bound").
+fn flat_beyond_physics(effect: &Effect, bound: f64, unbounded: f64, stderr: f64) -> Option<String> {
+    let (plo, phi) = effect.physical_range();
+    let (limit, beyond) = if bound > phi {
+        (phi, unbounded.max(bound) - phi)
+    } else if bound < plo {
+        (plo, plo - unbounded.min(bound))
+    } else {
+        return None;
+    };
+    let ok = stderr.is_finite() && stderr > 0.0 && beyond.is_finite();
+    if !(ok && beyond <= PHYSICAL_RANGE_SE * stderr) {
+        return None;
+    }
+    let u = match effect.unit() {
+        "-" => String::new(),
+        unit => format!(" {unit}"),
+    };
+    Some(format!(
+        "{} = {bound} +/- {stderr:.4}{u} is best at its search bound; without the bound its \
+         optimum would lie {:.2} standard errors beyond its physical limit {limit}{u}: the data \
+         do not bound it on that side (it trades off against the effect's shape), consistent \
+         with a value inside the physical range",
+        effect.name(),
+        beyond / stderr
+    ))
+}
+
+/// The optimum of the fit parameter `name` of `id` with the bounds lifted, to first order: its
+/// value plus its component of the Gauss–Newton step `−(JᵀJ)⁻¹Jᵀr` from where the fit ended
+/// (`None` without that parameter, or with a singular `JᵀJ`).
+pub fn unbounded_optimum(id: &crate::fiber::rheometer::Identification, name: &str) -> Option<f64> {
+    let i = id.names.iter().position(|n| n == name)?;
+    let fit = &id.fit;
+    let (nr, np) = (fit.residuals.len(), fit.p.len());
+    let j = nalgebra::DMatrix::from_row_slice(nr, np, &fit.dense_jacobian());
+    let r = nalgebra::DVector::from_column_slice(&fit.residuals);
+    let step = (j.transpose() * &j)
+        .cholesky()?
+        .solve(&(-(j.transpose() * r)));
+    let v = fit.p[i] + step[i];
+    v.is_finite().then_some(v)
 }
 
 /// A strength outside the physical range: credible with a note if within
@@ -399,34 +460,52 @@ mod tests {
     #[test]
     fn a_strength_at_a_bound_or_beyond_the_physical_range_is_not_credible() {
         let rad = Effect::Radiation;
-        let (s, note) = strength_status(&rad, 0.9, 0.1, &[]);
+        let (s, note) = strength_status(&rad, 0.9, 0.1, &[], None);
         assert_eq!((s, note), (StrengthStatus::Physical, None));
-        let (s, note) = strength_status(&rad, 1.6, 0.1, &[]);
+        let (s, note) = strength_status(&rad, 1.6, 0.1, &[], None);
         assert_eq!(s, StrengthStatus::Unphysical);
         assert!(note.unwrap().contains("> 1: not physical"));
         // beyond the limit by less than 1.96 standard errors: consistent with it, said so
-        let (s, note) = strength_status(&rad, 1.02, 0.09, &[]);
+        let (s, note) = strength_status(&rad, 1.02, 0.09, &[], None);
         assert_eq!(s, StrengthStatus::Physical);
         let note = note.unwrap();
         assert!(
             note.contains("radiation = 1.0200 +/- 0.0900 lies beyond its physical limit 1 by 0.22 standard errors"),
             "{note}"
         );
-        let (s, _) = strength_status(&rad, -0.19, 0.1, &[]);
+        let (s, _) = strength_status(&rad, -0.19, 0.1, &[], None);
         assert_eq!(s, StrengthStatus::Physical);
         // by more, or without a valid standard error: not physical
         assert_eq!(
-            strength_status(&rad, 1.2, 0.1, &[]).0,
+            strength_status(&rad, 1.2, 0.1, &[], None).0,
             StrengthStatus::Unphysical
         );
         assert_eq!(
-            strength_status(&rad, 1.02, f64::NAN, &[]).0,
+            strength_status(&rad, 1.02, f64::NAN, &[], None).0,
             StrengthStatus::Unphysical
         );
         // at the search bound 2 (found by value, without an at_bound entry)
-        let (s, note) = strength_status(&rad, 2.0, 0.5, &[]);
+        let (s, note) = strength_status(&rad, 2.0, 0.5, &[], None);
         assert_eq!(s, StrengthStatus::AtBound);
         assert!(note.unwrap().contains("upper bound 2"));
+        // at a search bound beyond the physical range, its unbounded optimum within 1.96
+        // standard errors of the limit: the data do not bound it on that side, said so
+        let (s, note) = strength_status(&rad, 2.0, 0.6, &[], Some(2.0));
+        assert_eq!(s, StrengthStatus::Physical);
+        let note = note.unwrap();
+        assert!(
+            note.contains("radiation = 2 +/- 0.6000 is best at its search bound; without the bound its optimum would lie 1.67 standard errors beyond its physical limit 1"),
+            "{note}"
+        );
+        // the data pushing it further (its unbounded optimum 2.5), without the optimum, or
+        // without a standard error: at a bound
+        for (se, unbounded) in [(0.6, Some(2.5)), (0.6, None), (f64::NAN, Some(2.0))] {
+            assert_eq!(
+                strength_status(&rad, 2.0, se, &[], unbounded).0,
+                StrengthStatus::AtBound,
+                "{se} {unbounded:?}"
+            );
+        }
         // listed by the fit report
         let c = Effect::AirCoflow {
             decay_length: Some(0.25),
@@ -438,7 +517,7 @@ mod tests {
             bound: -5.0,
             value: -5.0,
         };
-        let (s, note) = strength_status(&c, -5.0, 1.0, &[ab]);
+        let (s, note) = strength_status(&c, -5.0, 1.0, &[ab], Some(-5.0));
         assert_eq!(s, StrengthStatus::AtBound);
         let note = note.unwrap();
         assert!(
@@ -453,7 +532,7 @@ mod tests {
             value: 20.0,
         };
         assert_eq!(
-            strength_status(&c, 3.0, 1.0, &[other]).0,
+            strength_status(&c, 3.0, 1.0, &[other], None).0,
             StrengthStatus::Physical
         );
     }

@@ -113,6 +113,10 @@ impl Rheometer {
             cancel: options.cancel.clone(),
             ..FitOptions::with_bounds(lower.clone(), upper.clone())
         };
+        // the effects' strengths and shapes in units of their ranges (take-up factors: 1)
+        let mut x_scale = obj.layout.x_scale();
+        x_scale.resize(lower.len(), 1.0);
+        fo.x_scale = x_scale;
         if let Some(t) = warm.stop_tolerance {
             (fo.gtol, fo.xtol, fo.ftol) = (t, t, t);
         }

@@ -81,6 +81,12 @@ fn drop_column(c: &mut Option<usize>, i: usize) {
     };
 }
 
+/// Fraction of an effect parameter's search range that is one unit of the fit's trust region
+/// ([`Layout::x_scale`]): a co-flow searched over −100…600 m/s moves up to 70 m/s per iteration
+/// instead of 1 m/s (with a unit scale, a refit that had to travel 100 m/s ran out of its 100
+/// iterations on the way).
+pub const EFFECT_SCALE_FRACTION: f64 = 0.1;
+
 /// The parameter layout of one fit.
 #[derive(Debug, Clone)]
 pub struct Layout {
@@ -160,6 +166,23 @@ impl Layout {
     /// Number of shared free parameters.
     pub fn num_shared(&self) -> usize {
         self.free.len()
+    }
+
+    /// The trust region's scale of each shared free parameter
+    /// ([`FitOptions::x_scale`](crate::least_squares::FitOptions::x_scale)): 1 for `n` and
+    /// `κ`; for an effect's strength or shape, [`EFFECT_SCALE_FRACTION`] of its search range
+    /// where that exceeds 1 in the parameter's unit (an air speed in m/s, a temperature in
+    /// K), else 1 (radii of O(1) parameters stay as they were).
+    pub fn x_scale(&self) -> Vec<f64> {
+        self.names
+            .iter()
+            .zip(self.lower.iter().zip(&self.upper))
+            .map(|(name, (&lo, &hi))| match name.as_str() {
+                "n" | "kappa" => 1.0,
+                _ if (hi - lo).is_finite() => (EFFECT_SCALE_FRACTION * (hi - lo)).max(1.0),
+                _ => 1.0,
+            })
+            .collect()
     }
 
     /// The shared free values of the template.

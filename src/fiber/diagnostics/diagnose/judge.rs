@@ -6,7 +6,7 @@ use super::linearise::Linearisation;
 use super::shapes::Choice;
 use super::signature::{named_residuals, signature_location};
 use crate::fiber::diagnostics::candidate::{
-    strength_status, Candidate, ShapeAlternative, StrengthStatus,
+    strength_status, unbounded_optimum, Candidate, ShapeAlternative, StrengthStatus,
 };
 use crate::fiber::diagnostics::diagnosis::ResidualProfiles;
 use crate::fiber::effects::Effect;
@@ -31,7 +31,8 @@ pub(crate) fn judge(
         .effect(&record.effect)
         .map(|e| (e.strength.value, e.strength.stderr));
     let (s, se) = strength.unwrap_or((f64::NAN, f64::NAN));
-    let (status, note) = match credibility(&variant, &record.effect, s, se, summary) {
+    let unbounded = unbounded_optimum(&id, &record.effect);
+    let (status, note) = match credibility(&variant, &record.effect, (s, se, unbounded), summary) {
         (StrengthStatus::Physical, note) => {
             plausibility(base, summary).unwrap_or((StrengthStatus::Physical, note))
         }
@@ -63,11 +64,10 @@ pub(crate) fn judge(
 fn credibility(
     variant: &Effect,
     effect: &str,
-    strength: f64,
-    stderr: f64,
+    (strength, stderr, unbounded): (f64, f64, Option<f64>),
     summary: &FitSummary,
 ) -> (StrengthStatus, Option<String>) {
-    let (status, note) = strength_status(variant, strength, stderr, &summary.at_bound);
+    let (status, note) = strength_status(variant, strength, stderr, &summary.at_bound, unbounded);
     if status != StrengthStatus::Physical {
         return (status, note);
     }

@@ -186,8 +186,14 @@ fn judge(
     let vs = [against(a, b), against(b, a)];
     let credible = [a, b].iter().all(|m| {
         s.effect(m.effect.name()).is_some_and(|e| {
-            strength_status(&m.effect, e.strength.value, e.strength.stderr, &s.at_bound).0
-                == StrengthStatus::Physical
+            strength_status(
+                &m.effect,
+                e.strength.value,
+                e.strength.stderr,
+                &s.at_bound,
+                None,
+            )
+            .0 == StrengthStatus::Physical
         })
     });
     let law_free = s.bound_of("n").is_none() && s.bound_of("kappa").is_none();
