@@ -88,9 +88,10 @@ pub trait NusseltLaw: Send + Sync {
         pr
     }
 
-    /// `𝒩` with an extra regularisation `extra_sq` (≥ 0, dimensionless) of the inclination
-    /// dependence, used with an air co-flow (see [`COFLOW_INCLINATION_REGULARISATION`]); it is
-    /// exactly 0 in still air. Default: ignores `extra_sq`.
+    /// `𝒩` with an extra regularisation `extra_sq` (≥ 0, dimensionless) of the Reynolds
+    /// number and the inclination dependence where the relative speed changes sign, used with an
+    /// air co-flow (see [`COFLOW_INCLINATION_REGULARISATION`]); it is exactly 0 in still air.
+    /// Default: ignores `extra_sq`.
     fn nusselt_regularised<D: DualNum<Primitive = f64> + Copy>(
         &self,
         re_tau: D,
@@ -103,14 +104,20 @@ pub trait NusseltLaw: Send + Sync {
     }
 }
 
-/// Extra inclination regularisation `ε_c` \[-\] with an air co-flow: the default Nusselt law's
-/// inclination factor becomes `1 − ½ Re_τ²/(Re² + ε_i² + ε_c² w²/(1 + w²))`,
+/// Extra regularisation `ε_c` \[-\] with an air co-flow, of the default Nusselt law's
+/// inclination factor, `1 − ½ Re_τ²/(Re² + ε_i² + ε_c² w²/(1 + w²))`, and of its Reynolds
+/// number, `Re_ε = √(Re² + ε_r² + ε_c² w²/(1 + w²))`, with
 /// `w = v_air/`[`COFLOW_REGULARISATION_SPEED`]. Where the air overtakes the fiber the relative
-/// speed changes sign and the unregularised factor jumps from ½ to 1 and back within
-/// `|Re| ≲ 1e-3` (a layer of ~1e-5 m the collocation cannot resolve cheaply); `ε_c` widens it.
-/// In still air (`v_air = 0`, also a co-flow of strength 0) the term vanishes identically, with
-/// zero derivative, so the base model is reproduced exactly. Elsewhere it changes `𝒩` by
-/// `≲ ε_c²/(2 Re²)` (0.1% at `Re = 1`).
+/// speed changes sign: the unregularised inclination factor jumps from ½ to 1 and back within
+/// `|Re| ≲ 1e-3`, and `Nu_CB ∝ Re_ε^½` has a cusp there of width `ε_r` = 1e-3. Both are layers
+/// of ~1e-5 m the collocation cannot resolve cheaply: with the cusp at `ε_r`, a solve whose
+/// crossing point moved refined its mesh 4–10 times, down to intervals of 6e-6 m (on the
+/// shipped data's diagnosis, 1398 such solves took 3.5 s of 7 s of solving; with `ε_c` on the
+/// Reynolds number too, 442 took 0.9 s). `ε_c` widens both layers. In still air (`v_air = 0`,
+/// also a co-flow of strength 0) the term vanishes identically, with zero derivative, so the
+/// base model is reproduced exactly. Elsewhere it changes the inclination factor (½ for the
+/// tangential flow along the fiber) by `≲ ε_c²/Re²` relative (0.25% at `Re = 1`) and `Re_ε^½`
+/// by `≲ ε_c²/(4 Re²)` (0.06%).
 pub const COFLOW_INCLINATION_REGULARISATION: f64 = 0.05;
 
 /// Air speed scale \[m/s\] of the co-flow regularisation weight `w` (see
@@ -162,7 +169,7 @@ impl NusseltLaw for InclinedChurchillBernstein {
         pr_arg: f64,
         extra_sq: D,
     ) -> D {
-        let re_eps2 = re_sq + self.re_regularisation * self.re_regularisation;
+        let re_eps2 = re_sq + self.re_regularisation * self.re_regularisation + extra_sq;
         let inc2 =
             re_sq + self.inclination_regularisation * self.inclination_regularisation + extra_sq;
         let inclination = -(re_tau * re_tau / inc2) * 0.5 + 1.0;
@@ -1323,6 +1330,39 @@ fn coflow_decay<D: DualNum<Primitive = f64> + Copy>(u: D, r: D) -> D {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The co-flow's extra regularisation: none in still air (the base model exactly), at most
+    /// the documented relative change at `Re ≥ 1`, and a Nusselt number whose slope in `Re`
+    /// stays bounded across the point where the air overtakes the fiber (without it, the
+    /// `Re^½` cusp of width 1e-3 makes the slope reach ~10 per unit `Re`).
+    #[test]
+    fn coflow_regularisation_widens_the_crossing_and_leaves_still_air_alone() {
+        use num_dual::Dual64;
+        let law = InclinedChurchillBernstein::default();
+        let pr = law.prandtl_argument(0.7);
+        let eps2 = COFLOW_INCLINATION_REGULARISATION * COFLOW_INCLINATION_REGULARISATION;
+        let plain = |re: f64| law.nusselt(re, re * re, pr);
+        let coflow = |re: f64| law.nusselt_regularised(re, re * re, pr, eps2);
+        for re in [0.0, 1e-4, 0.3, 2.0, 50.0] {
+            let still: f64 = law.nusselt_regularised(re, re * re, pr, 0.0);
+            assert_eq!(still.to_bits(), plain(re).to_bits(), "Re {re}");
+        }
+        for re in [1.0, 3.0, 30.0, 300.0] {
+            let rel = (coflow(re) / plain(re) - 1.0).abs();
+            // inclination factor ≤ ε²/Re², Re_ε^½ ≤ ε²/(4 Re²) (relative)
+            assert!(rel <= 1.25 * eps2 / (re * re), "Re {re}: {rel:e}");
+        }
+        let slope = |f: &dyn Fn(Dual64) -> Dual64, re: f64| f(Dual64::from_re(re).derivative()).eps;
+        let max_slope = |f: &dyn Fn(Dual64) -> Dual64| {
+            (-400..=400)
+                .map(|i| slope(f, f64::from(i) * 2.5e-4))
+                .fold(0.0f64, |a, v| a.max(v.abs()))
+        };
+        let wide = max_slope(&|re| law.nusselt_regularised(re, re * re, pr, Dual64::from(eps2)));
+        let narrow = max_slope(&|re| law.nusselt(re, re * re, pr));
+        assert!(wide < 3.0, "slope with the co-flow's regularisation {wide}");
+        assert!(narrow > 5.0 * wide, "slope without {narrow} against {wide}");
+    }
 
     #[test]
     fn coflow_decay_spans_exponential_and_algebraic_tails() {
