@@ -279,6 +279,9 @@ fn rival_data<'a>(rival: Rival<'a>, sigma: f64) -> Result<RivalData<'a>, Rheomet
                     source,
                 })
         })
+        // the first failure in the experiments' order (the same on every run)
+        .collect::<Vec<_>>()
+        .into_iter()
         .collect();
     let mut params = id.local_params.clone();
     params[model0.take_up_factor_index()] = 1.0;

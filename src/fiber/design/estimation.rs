@@ -207,6 +207,9 @@ fn current_information(
                 },
             )
         })
+        // the first failure in the experiments' order (the same on every run)
+        .collect::<Vec<_>>()
+        .into_iter()
         .collect();
     let p = columns.shared.len();
     let mut total = vec![0.0; p * p];

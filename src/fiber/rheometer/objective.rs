@@ -215,6 +215,10 @@ impl<'a> Objective<'a> {
                     _ => run,
                 })
             })
+            // the first failure in the experiments' order, not the first to finish: the same
+            // input names the same experiment on every run
+            .collect::<Vec<_>>()
+            .into_iter()
             .collect();
         let num_params = match estimator {
             Estimator::Paper => ns,
@@ -399,6 +403,8 @@ impl<'a> Objective<'a> {
                             run.set_accepted(sol.solution);
                             Ok(())
                         })
+                        .collect::<Vec<_>>()
+                        .into_iter()
                         .collect();
                 res?;
                 self.eval(&p, false)?.0

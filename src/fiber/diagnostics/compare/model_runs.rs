@@ -143,6 +143,10 @@ pub fn simulate_experiments(
                 curve,
             })
         })
+        // the first failure in the experiments' order, not the first to finish: the same
+        // input names the same experiment on every run
+        .collect::<Vec<_>>()
+        .into_iter()
         .collect()
 }
 

@@ -89,6 +89,9 @@ pub(crate) fn linearise(
     let parts: Vec<Part> = (0..m)
         .into_par_iter()
         .map(|k| experiment_part(rh, base, k, &ctx.opts, ctx.sigma))
+        // the first failure in the experiments' order (the same on every run)
+        .collect::<Vec<_>>()
+        .into_iter()
         .collect::<Result<_, RheometerError>>()?;
     let mut r = Vec::new();
     let mut x = Vec::new();
@@ -274,5 +277,8 @@ pub(crate) fn shape_columns(
             }
             Some(Ok((ctx.cands[i].extra_parameters(), col)))
         })
+        // the first failure in the jobs' order (the same on every run)
+        .collect::<Vec<_>>()
+        .into_iter()
         .collect()
 }
