@@ -66,7 +66,8 @@
 //! The toolkit never imports `fiber`. The fiber model and rheometer (`fiber`, feature
 //! `rheometer`), bottom to top:
 //!
-//! 1. `setup`, `error`, `scaling`, `material_law`, `format` (numbers for people), `serde_nan`;
+//! 1. `setup`, `error`, `scaling`, `material_law`, `format` (numbers for people), `serde_nan`,
+//!    `in_order` (the first failure of a parallel loop in the experiments' order);
 //! 2. `catalog` (one descriptor per effect), `contributions` (force and heat terms) and
 //!    `effects` (the candidate effects vocabulary);
 //! 3. `model` (the BVP);

@@ -44,6 +44,7 @@ pub mod figures;
 pub mod fit_html;
 pub mod flow_curve_figure;
 pub mod format;
+pub(crate) mod in_order;
 pub mod input;
 pub mod material_law;
 pub mod model;

@@ -495,6 +495,33 @@ impl FitResult {
         BlockCovariance::sandwich(bj, &weights, &psi, nr as f64 / dof)
     }
 
+    /// The Gauss–Newton step `s = −(JᵀJ)⁺Jᵀr` from `p` with the bounds lifted (the minimum of
+    /// the linearised `½‖J s + r‖²`; directions `JᵀJ` does not determine get no step): how far,
+    /// to first order, the unconstrained optimum lies from an estimate the bounds stopped. The
+    /// same step the driver's relative-offset test measures; a block-arrow fit solves it through
+    /// the Schur complement. `None` under a robust loss (its steps are taken on rescaled
+    /// residuals) or where a component is not finite.
+    pub fn gauss_newton_step(&self) -> Option<Vec<f64>> {
+        if !self.loss.is_linear() {
+            return None;
+        }
+        let (nr, np) = (self.residuals.len(), self.p.len());
+        let lin = match &self.block_jacobian {
+            Some(j) => jacobian::Linearized::Blocks {
+                j,
+                r: &self.residuals,
+            },
+            None => jacobian::Linearized::Dense {
+                jm: DMatrix::from_row_slice(nr, np, &self.jacobian),
+                rv: DVector::from_column_slice(&self.residuals),
+            },
+        };
+        let s = lin.step(&vec![1.0; np], f64::INFINITY);
+        s.iter()
+            .all(|v| v.is_finite())
+            .then(|| s.iter().copied().collect())
+    }
+
     /// The Jacobian at `p`, dense row-major `N × P` (a copy of [`jacobian`](Self::jacobian),
     /// or the block-arrow Jacobian expanded: `N · P` numbers).
     pub fn dense_jacobian(&self) -> Vec<f64> {

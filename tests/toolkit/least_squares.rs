@@ -134,3 +134,62 @@ fn observer_sees_every_iteration() {
     assert_eq!(res.p, res2.p);
     assert_eq!(res.iterations, res2.iterations);
 }
+
+/// `y = a + b x` at 11 points (a linear model: one Gauss–Newton step from anywhere reaches its
+/// least-squares optimum exactly).
+struct Line {
+    x: Vec<f64>,
+    y: Vec<f64>,
+}
+
+impl diffbvp::least_squares::LeastSquaresProblem for Line {
+    type Error = String;
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
+        let r = self.x.iter().zip(&self.y).map(|(x, y)| p[0] + p[1] * x - y);
+        let j = self.x.iter().flat_map(|&x| [1.0, x]);
+        Ok((r.collect(), j.collect()))
+    }
+}
+
+#[test]
+fn the_gauss_newton_step_from_a_bound_reaches_the_unbounded_optimum() {
+    let x: Vec<f64> = (0..11).map(|i| i as f64 / 10.0).collect();
+    let y: Vec<f64> = x
+        .iter()
+        .enumerate()
+        .map(|(i, x)| 2.0 + 0.5 * x + 0.01 * ((i * 7 % 5) as f64 - 2.0))
+        .collect();
+    // the unbounded least-squares line, by the normal equations
+    let n = x.len() as f64;
+    let (sx, sy) = (x.iter().sum::<f64>(), y.iter().sum::<f64>());
+    let sxx: f64 = x.iter().map(|v| v * v).sum();
+    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
+    let b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+    let a = (sy - b * sx) / n;
+    // a bounded at 1.5: the fit stops there
+    let opts = FitOptions::with_bounds(vec![-10.0, -10.0], vec![1.5, 10.0]);
+    let mut line = Line { x, y };
+    let res = fit(&mut line, &[0.0, 0.0], &opts).unwrap();
+    assert!((res.p[0] - 1.5).abs() < 1e-6, "{:?}", res.p);
+    let s = res.gauss_newton_step().unwrap();
+    assert!(
+        (res.p[0] + s[0] - a).abs() < 1e-9,
+        "{} against {a}",
+        res.p[0] + s[0]
+    );
+    assert!(
+        (res.p[1] + s[1] - b).abs() < 1e-9,
+        "{} against {b}",
+        res.p[1] + s[1]
+    );
+    // under a robust loss the step of ½‖r‖² is not that fit's: none
+    let robust = FitOptions {
+        loss: diffbvp::least_squares::Loss::Huber,
+        ..opts
+    };
+    let res = fit(&mut line, &[0.0, 0.0], &robust).unwrap();
+    assert!(res.gauss_newton_step().is_none());
+}

@@ -30,6 +30,7 @@
 use super::candidates::{Candidate, CandidateGrid};
 use super::estimation::{candidate_information, candidate_positions, shared_columns};
 use super::information::{experiment_information, Columns, ExperimentInformation};
+use crate::fiber::in_order::CollectInOrder;
 use crate::fiber::rheometer::{Identification, Rheometer, RheometerError};
 use crate::fiber::simulate::SimulateOptions;
 use crate::solution::Solution;
@@ -279,10 +280,7 @@ fn rival_data<'a>(rival: Rival<'a>, sigma: f64) -> Result<RivalData<'a>, Rheomet
                     source,
                 })
         })
-        // the first failure in the experiments' order (the same on every run)
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect();
+        .collect_in_order();
     let mut params = id.local_params.clone();
     params[model0.take_up_factor_index()] = 1.0;
     Ok(RivalData {

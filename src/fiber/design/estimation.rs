@@ -11,6 +11,7 @@
 use super::candidates::{Candidate, CandidateGrid};
 use super::criteria::{Criterion, Prediction, Reference};
 use super::information::{experiment_information, Columns, ExperimentInformation};
+use crate::fiber::in_order::CollectInOrder;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::rheometer::{CarreauFiber, Identification, Rheometer, RheometerError};
@@ -207,10 +208,7 @@ fn current_information(
                 },
             )
         })
-        // the first failure in the experiments' order (the same on every run)
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect();
+        .collect_in_order();
     let p = columns.shared.len();
     let mut total = vec![0.0; p * p];
     for part in parts? {

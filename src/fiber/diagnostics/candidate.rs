@@ -319,19 +319,13 @@ fn flat_beyond_physics(effect: &Effect, bound: f64, unbounded: f64, stderr: f64)
 }
 
 /// The optimum of the fit parameter `name` of `id` with the bounds lifted, to first order: its
-/// value plus its component of the Gauss–Newton step `−(JᵀJ)⁻¹Jᵀr` from where the fit ended
-/// (`None` without that parameter, or with a singular `JᵀJ`).
+/// value plus its component of the fit's Gauss–Newton step
+/// ([`FitResult::gauss_newton_step`](crate::least_squares::FitResult::gauss_newton_step);
+/// `None` without that parameter or that step).
 pub fn unbounded_optimum(id: &crate::fiber::rheometer::Identification, name: &str) -> Option<f64> {
     let i = id.names.iter().position(|n| n == name)?;
-    let fit = &id.fit;
-    let (nr, np) = (fit.residuals.len(), fit.p.len());
-    let j = nalgebra::DMatrix::from_row_slice(nr, np, &fit.dense_jacobian());
-    let r = nalgebra::DVector::from_column_slice(&fit.residuals);
-    let step = (j.transpose() * &j)
-        .cholesky()?
-        .solve(&(-(j.transpose() * r)));
-    let v = fit.p[i] + step[i];
-    v.is_finite().then_some(v)
+    let step = id.fit.gauss_newton_step()?;
+    Some(id.fit.p[i] + step[i])
 }
 
 /// A strength outside the physical range: credible with a note if within

@@ -9,6 +9,7 @@ use super::estimator::{Estimator, PaperResidual, RelativeResidual};
 use super::layout::{FitStart, Layout};
 use super::options::{CarreauFiber, FitProgress, IdentifyOptions, RheometerError};
 use crate::fiber::error::FiberError;
+use crate::fiber::in_order::CollectInOrder;
 use crate::fiber::simulate::{simulate_params, Simulator};
 use crate::least_squares::{
     BvpResiduals, BvpRun, Jacobian, LeastSquaresProblem, ParamMap, RunError,
@@ -215,11 +216,7 @@ impl<'a> Objective<'a> {
                     _ => run,
                 })
             })
-            // the first failure in the experiments' order, not the first to finish: the same
-            // input names the same experiment on every run
-            .collect::<Vec<_>>()
-            .into_iter()
-            .collect();
+            .collect_in_order();
         let num_params = match estimator {
             Estimator::Paper => ns,
             Estimator::Principled => ns + rheo.len(),
@@ -403,9 +400,7 @@ impl<'a> Objective<'a> {
                             run.set_accepted(sol.solution);
                             Ok(())
                         })
-                        .collect::<Vec<_>>()
-                        .into_iter()
-                        .collect();
+                        .collect_in_order();
                 res?;
                 self.eval(&p, false)?.0
             }

@@ -2,6 +2,7 @@
 //! conditions (from the data set, from the smoothed data, or as fitted) and the physics.
 
 use super::{compare, CompareError, CompareOptions, Comparison, SimulatedExperiment};
+use crate::fiber::in_order::CollectInOrder;
 use crate::fiber::material_law::CarreauLike;
 use crate::fiber::model::FiberModel;
 use crate::fiber::rheometer::FitSummary;
@@ -143,11 +144,7 @@ pub fn simulate_experiments(
                 curve,
             })
         })
-        // the first failure in the experiments' order, not the first to finish: the same
-        // input names the same experiment on every run
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect()
+        .collect_in_order()
 }
 
 /// Simulates every experiment of `set` with `setup` and compares with the measurements

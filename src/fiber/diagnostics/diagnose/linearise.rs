@@ -7,6 +7,7 @@ use super::signature::signature_location;
 use crate::fiber::diagnostics::candidate::{Candidate, StrengthStatus};
 use crate::fiber::diagnostics::scan::{physical_range, search_range, shape_variants};
 use crate::fiber::diagnostics::scores::{linear_scores, LinearScore};
+use crate::fiber::in_order::CollectInOrder;
 use crate::fiber::rheometer::estimator::RelativeResidual;
 use crate::fiber::rheometer::{Identification, IdentifyOptions, Rheometer, RheometerError};
 use crate::fiber::FiberError;
@@ -89,10 +90,7 @@ pub(crate) fn linearise(
     let parts: Vec<Part> = (0..m)
         .into_par_iter()
         .map(|k| experiment_part(rh, base, k, &ctx.opts, ctx.sigma))
-        // the first failure in the experiments' order (the same on every run)
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect::<Result<_, RheometerError>>()?;
+        .collect_in_order()?;
     let mut r = Vec::new();
     let mut x = Vec::new();
     let mut cols: Vec<Vec<f64>> = vec![Vec::new(); ctx.cands.len()];
@@ -277,8 +275,5 @@ pub(crate) fn shape_columns(
             }
             Some(Ok((ctx.cands[i].extra_parameters(), col)))
         })
-        // the first failure in the jobs' order (the same on every run)
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect()
+        .collect_in_order()
 }
