@@ -13,7 +13,7 @@ use std::time::Instant;
 
 mod step;
 
-use step::{Proposal, StepSize};
+use step::{scaled_norm, Proposal, StepSize};
 
 /// Runs the bounded trust-region Gauss–Newton iteration from `p0`.
 ///
@@ -90,7 +90,30 @@ struct Driver<'o> {
     switch_model_error: Option<f64>,
     /// A stopping test met: ends the fit, or (loose) switches to full accuracy.
     stop: Option<Termination>,
+    /// With [`FitOptions::relative_offset`]: the largest jump of the cost seen at a rejected
+    /// short trial step (0: none yet), the numerical noise floor of the cost.
+    noise_floor: f64,
 }
+
+/// A rejected trial step no longer than this in every scaled parameter (`|s_i| / x_scale_i`)
+/// whose cost rose by more than [`JUMP_FACTOR`] times the reduction it was predicted to give
+/// measures the cost's numerical noise: at so short a step a smooth model's gain ratio is close
+/// to 1, a rise that large is a jump (a BVP whose adapted mesh changed between the two points).
+const SHORT_STEP: f64 = 1e-2;
+
+/// See [`SHORT_STEP`].
+const JUMP_FACTOR: f64 = 10.0;
+
+/// The fit ends ([`Termination::NoiseFloor`]) when the Gauss–Newton step's predicted gain is at
+/// most this many times the noise floor: a trial would have to beat the noise at both of the
+/// points it compares.
+const NOISE_FLOOR_FACTOR: f64 = 2.0;
+
+/// ... and when the relative offset is at most this many times its tolerance: a jump of the
+/// cost measures the residuals' numerical error projected on the residuals themselves, not on
+/// the estimates, and may be large where the estimates hardly move; the fit never stops further
+/// than this many times the asked distance from the optimum.
+const NOISE_FLOOR_OFFSET_FACTOR: f64 = 10.0;
 
 /// A trial point's evaluation.
 struct Evaluated {
@@ -162,6 +185,7 @@ impl<'o> Driver<'o> {
             loose_iterations: 0,
             switch_model_error: None,
             stop: None,
+            noise_floor: 0.0,
         })
     }
 
@@ -246,7 +270,7 @@ impl<'o> Driver<'o> {
             }
             Err(failure) => {
                 self.failed += 1;
-                self.radius *= 0.25;
+                self.radius = 0.25 * self.shrink_base(&proposal);
                 let record = FitIteration {
                     iteration: self.iterations,
                     step_norm: proposal.step.norm(),
@@ -294,6 +318,12 @@ impl<'o> Driver<'o> {
         }
     }
 
+    /// What a rejected or failed step shrinks the trust radius from: the step's own scaled
+    /// length where it is shorter than the radius.
+    fn shrink_base(&self, proposal: &Proposal) -> f64 {
+        self.radius.min(scaled_norm(&proposal.step, &proposal.d))
+    }
+
     /// The iteration's record to the observer and the history.
     fn record<O: Observer + ?Sized>(&mut self, observer: &mut O, record: FitIteration) {
         observer.observe(&record);
@@ -328,7 +358,10 @@ impl<'o> Driver<'o> {
         };
         let accepted = rho > 1e-4;
         if rho < 0.25 {
-            self.radius *= 0.25;
+            // a quarter of the step taken, not of the radius: a step shorter than the radius
+            // (the Gauss–Newton step inside it, or one cut at the box) would otherwise be
+            // proposed again unchanged until the radius fell below it
+            self.radius = 0.25 * self.shrink_base(&proposal);
         } else if rho > 0.75
             && snorm * proposal.d.iter().fold(0.0f64, |m, x| m.max(*x)) >= 0.9 * self.radius
         {
@@ -363,9 +396,20 @@ impl<'o> Driver<'o> {
             }
         } else if small_step {
             self.stop = Some(Termination::Step);
-        } else if let (Some(sch), Some(_)) = (self.schedule, self.tight_limit) {
-            if size.effect <= sch.negligible_step * size.sigma {
-                self.stop = Some(Termination::Step);
+        } else {
+            if let (Some(sch), Some(_)) = (self.schedule, self.tight_limit) {
+                if size.effect <= sch.negligible_step * size.sigma {
+                    self.stop = Some(Termination::Step);
+                }
+            }
+            if o.relative_offset.is_some() && !self.loose {
+                // a jump of the cost at a short step: its numerical noise floor
+                let xs = |i: usize| o.x_scale.get(i).copied().unwrap_or(1.0);
+                let short = (0..self.np).all(|i| proposal.step[i].abs() <= SHORT_STEP * xs(i));
+                let rise = -actual;
+                if short && rise > JUMP_FACTOR * proposal.predicted.max(0.0) {
+                    self.noise_floor = self.noise_floor.max(rise);
+                }
             }
         }
     }

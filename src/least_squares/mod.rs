@@ -199,7 +199,8 @@ pub struct FitOptions {
     /// errors). Unlike `ftol` and `xtol` it is scale-free and statistical: a model evaluated
     /// with a small numerical error (a BVP solved to a tolerance) makes the cost noisy at a
     /// level `ftol` may lie below, and the trust region then spends its iterations on that
-    /// noise. Bates and Watts use 10⁻³.
+    /// noise. Bates and Watts use 10⁻³. Set, it also ends the fit when the remaining gain is
+    /// within the cost's numerical noise ([`Termination::NoiseFloor`]).
     pub relative_offset: Option<f64>,
     /// Characteristic scale of each parameter, in its own unit (default empty: 1 for every
     /// parameter). The trust region is taken in the scaled variables `p_i / x_scale_i`
@@ -261,6 +262,15 @@ pub enum Termination {
     RadiusCollapsed,
     /// The relative offset fell below [`FitOptions::relative_offset`].
     RelativeOffset,
+    /// With [`FitOptions::relative_offset`] set: the gain the Gauss–Newton step predicts is
+    /// within twice the cost's numerical noise, measured as the largest jump of the cost at a
+    /// rejected trial step shorter than 1 % of every parameter's scale (a rise of more than 10
+    /// times the predicted gain, which a smooth model does not make at so short a step). A model
+    /// evaluated by BVP solves whose adapted mesh changes between nearby points has such jumps;
+    /// the trust region would otherwise shrink towards the jump for the rest of its budget.
+    /// Only where the relative offset is within 10 times its tolerance: the estimate is then
+    /// within `10 · relative_offset · √P` standard errors of the optimum of the linearisation.
+    NoiseFloor,
 }
 
 impl fmt::Display for Termination {
@@ -272,6 +282,7 @@ impl fmt::Display for Termination {
             Termination::MaxIterations => "maximum number of iterations reached",
             Termination::RadiusCollapsed => "trust radius collapsed",
             Termination::RelativeOffset => "relative offset below its tolerance (Bates-Watts)",
+            Termination::NoiseFloor => "predicted gain within the cost's numerical noise",
         };
         f.write_str(s)
     }

@@ -137,3 +137,88 @@ fn a_relative_offset_outside_zero_to_one_is_refused_naming_the_option() {
         assert!(m.contains("FitOptions::relative_offset"), "{m}");
     }
 }
+
+/// [`NoisyDecay`] without numerical noise but with one jump of the cost: beyond `a = edge` every
+/// residual carries an extra `offset` (as a BVP's adapted mesh gains nodes there), which makes
+/// the cost rise by about `N offset² / 2` across the edge.
+struct SteppedDecay {
+    smooth: NoisyDecay,
+    edge: f64,
+    offset: f64,
+}
+
+impl LeastSquaresProblem for SteppedDecay {
+    type Error = String;
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
+        let (mut r, j) = self.smooth.evaluate(p)?;
+        if p[0] > self.edge {
+            r.iter_mut().for_each(|v| *v += self.offset);
+        }
+        Ok((r, j))
+    }
+}
+
+#[test]
+fn a_fit_against_a_jump_of_the_cost_ends_at_its_noise_floor_not_its_iteration_budget() {
+    let exact = run(0.0, None);
+    let se = exact.standard_errors().unwrap();
+    // the edge 0.001 standard errors of `a` below the optimum, approached from a = 1; the
+    // offset (10 % of the noise) makes the cost rise by ~2e-6 across it, far more than is left
+    // to gain beyond it
+    let stepped = |edge_se: f64, relative_offset| {
+        let mut problem = SteppedDecay {
+            smooth: NoisyDecay::new(0.0),
+            edge: exact.p[0] - edge_se * se[0],
+            offset: 1e-3,
+        };
+        fit(&mut problem, &[1.0, 0.5], &options(relative_offset)).unwrap()
+    };
+    let by_ftol = stepped(0.001, None);
+    let by_floor = stepped(0.001, Some(1e-3));
+    println!(
+        "ftol: {} iterations ({}), {:.3} se off; noise floor: {} iterations ({}), {:.3} se off",
+        by_ftol.iterations,
+        by_ftol.termination,
+        distance_se(&by_ftol, &exact),
+        by_floor.iterations,
+        by_floor.termination,
+        distance_se(&by_floor, &exact),
+    );
+    assert_eq!(by_floor.termination, Termination::NoiseFloor);
+    assert!(
+        by_floor.iterations < by_ftol.iterations,
+        "{} iterations at the noise floor, {} with ftol",
+        by_floor.iterations,
+        by_ftol.iterations
+    );
+    // it ends in front of the edge, within 0.01 standard errors of where the tight tests end
+    assert!(by_floor.p[0] <= exact.p[0] - 0.001 * se[0]);
+    assert!(
+        distance_se(&by_floor, &by_ftol) <= 0.01,
+        "{} se from the best point in front of the edge",
+        distance_se(&by_floor, &by_ftol)
+    );
+    // an edge 0.01 standard errors of `a` before the optimum stalls the fit 0.25 standard errors
+    // (of `b`) away from it: further than ten times the asked distance (1e-3 √2), so the fit
+    // does not end at the noise floor there
+    let stalled = stepped(0.01, Some(1e-3));
+    println!(
+        "stalled: {} iterations ({}), {:.3} se off",
+        stalled.iterations,
+        stalled.termination,
+        distance_se(&stalled, &exact)
+    );
+    assert!(distance_se(&stalled, &exact) > 10.0 * 1e-3 * 2f64.sqrt());
+    assert_ne!(stalled.termination, Termination::NoiseFloor);
+    // where the cost has no jump (the edge beyond the optimum) it never ends at a noise floor
+    let mut beyond = SteppedDecay {
+        smooth: NoisyDecay::new(0.0),
+        edge: exact.p[0] + 10.0 * se[0],
+        offset: 1e-3,
+    };
+    let smooth = fit(&mut beyond, &[1.0, 0.5], &options(Some(1e-3))).unwrap();
+    assert_eq!(smooth.termination, Termination::RelativeOffset);
+}

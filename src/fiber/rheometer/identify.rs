@@ -125,6 +125,21 @@ impl Rheometer {
                 hook.report(&FitProgress::Iteration(it));
             }
         };
+        if let Some(t) = options
+            .optimum_tolerance
+            .filter(|t| !(*t > 0.0 && *t <= 1.0))
+        {
+            return Err(RheometerError::Data(format!(
+                "IdentifyOptions::optimum_tolerance must lie in (0, 1] standard errors, got {t}: \
+                 it is how close to the optimum the fit must come (default 0.01)"
+            )));
+        }
+        if warm.stop_tolerance.is_none() {
+            // within `optimum_tolerance` standard errors of the optimum: the relative offset
+            // below that over √P
+            let np = lower.len().max(1) as f64;
+            fo.relative_offset = options.optimum_tolerance.map(|t| t / np.sqrt());
+        }
         let fit_result = fit_observed(&mut obj, &p0, &fo, &mut observer)?;
         let solutions: Vec<Solution> = obj.solutions();
         let residual_profiles: Vec<(Vec<f64>, Vec<f64>)> = solutions

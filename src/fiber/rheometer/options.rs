@@ -88,6 +88,16 @@ pub struct IdentifyOptions {
     /// accurately at the optimum and refined at tighter tolerances until it holds (see
     /// [`accuracy`](super::accuracy)). `None`: no check, `simulate.tol` as given.
     pub max_discretisation_shift: Option<f64>,
+    /// How close \[standard errors\] to the optimum of the discretised model the fit must
+    /// come (default `Some(0.01)`, the same budget as the discretisation's shift): it stops
+    /// when the Gauss–Newton step to the optimum of its linearisation moves the estimate by
+    /// less (the relative offset of Bates and Watts below `optimum_tolerance / √P`, with `P`
+    /// fitted parameters), or when the gain that step predicts is within the cost's numerical
+    /// noise ([`Termination::NoiseFloor`](crate::least_squares::Termination::NoiseFloor)).
+    /// `None`: only the tight tests on the cost change, the step and the gradient (1e-8–1e-10),
+    /// which a cost evaluated by BVP solves can keep from ending for tens of iterations.
+    /// Outside `(0, 1]`: an error.
+    pub optimum_tolerance: Option<f64>,
     /// Relative noise factor of each measurement, per experiment (`σ_j / σ`, ≈ 1 on average;
     /// principled estimator): a noise that varies along the line (the take-up region noisier)
     /// weights the points by it. `None`: all points alike.
@@ -166,6 +176,7 @@ impl Default for IdentifyOptions {
             f_scale: None,
             loose_tolerance: Some(1e-3),
             max_discretisation_shift: Some(0.01),
+            optimum_tolerance: Some(0.01),
             noise_factors: None,
             cancel: None,
             hold: Vec::new(),

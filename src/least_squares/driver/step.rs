@@ -62,8 +62,15 @@ impl Driver<'_> {
             .filter(|_| !self.loose)
             .map(|tol| (tol, lin.step(&d, f64::INFINITY)));
         if let Some((tol, s_gn)) = &gauss_newton {
-            if lin.relative_offset(s_gn, nr, np) <= *tol {
+            let offset = lin.relative_offset(s_gn, nr, np);
+            if offset <= *tol {
                 return Err(Termination::RelativeOffset);
+            }
+            if self.noise_floor > 0.0
+                && offset <= super::NOISE_FLOOR_OFFSET_FACTOR * tol
+                && lin.predicted_reduction(s_gn) <= super::NOISE_FLOOR_FACTOR * self.noise_floor
+            {
+                return Err(Termination::NoiseFloor);
             }
         }
         if self.iterations >= self.tight_limit.unwrap_or(o.max_iterations) {
@@ -111,7 +118,7 @@ impl Driver<'_> {
 }
 
 /// `‖D s‖`, the length of the step `s` in the trust region's scaled variables.
-fn scaled_norm(s: &DVector<f64>, d: &[f64]) -> f64 {
+pub(super) fn scaled_norm(s: &DVector<f64>, d: &[f64]) -> f64 {
     s.iter()
         .zip(d)
         .map(|(x, di)| (x * di) * (x * di))
