@@ -646,8 +646,8 @@ fn false_alarm_rate_on_effect_free_sets() {
             confidence 0 of 200 (12 of the first 100 before the ambiguity stage); stop 37, \
             same sets and counts: the true effect called a stand-in 0 of 149 times it was \
             found, 6 proxies named for a gauge error rejected as stand-ins; stop 42, sets \
-            0-5, found + in a reported tie: mass_flow_scale 3 + 2 of 6, gauge_scale 3 + 2 of 6, \
-            gauge_offset 3 + 0 of 6, WRONG 0"]
+            0-25, found + in a reported tie: mass_flow_scale 16 + 9 of 26, gauge_scale 18 + 7 \
+            of 26, gauge_offset 11 + 0 of 26, WRONG 0 of 78"]
 fn power_at_twice_the_detection_limit() {
     let sets: usize = std::env::var("DIFFBVP_POWER_SETS")
         .ok()
