@@ -223,6 +223,26 @@ pub fn diagnose(
     Ok(run)
 }
 
+/// `profiles` (positions and residuals per experiment) without the points the noise model of
+/// their fit flags as gross outliers (the report lists those on their own).
+fn without_outliers(
+    profiles: &[(Vec<f64>, Vec<f64>)],
+    noise: &crate::fiber::noise_summary::NoiseSummary,
+) -> Vec<(Vec<f64>, Vec<f64>)> {
+    profiles
+        .iter()
+        .enumerate()
+        .map(|(k, (s, r))| {
+            s.iter()
+                .zip(r)
+                .enumerate()
+                .filter(|(i, _)| !noise.is_outlier(k, *i))
+                .map(|(_, (s, r))| (*s, *r))
+                .unzip()
+        })
+        .collect()
+}
+
 /// Whether the user's residuals are systematic or an effect was named.
 fn something_to_explain(steps: &[step::Step]) -> bool {
     steps
@@ -419,7 +439,7 @@ fn verdict_of(
     Verdict::NoneOfTheCandidates {
         helps,
         unexplained: verdict::unexplained(
-            &fit.residual_profiles,
+            &without_outliers(&fit.residual_profiles, &fit.summary.noise),
             &fit.summary.experiments,
             noise.level,
         ),

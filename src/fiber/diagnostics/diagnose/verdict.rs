@@ -184,14 +184,19 @@ pub(crate) fn explained(fit: &FitSummary, noise: &NoiseSummary) -> bool {
     ratio <= EXPLAINED_RMS_OVER_NOISE && z < STRUCTURE_Z
 }
 
-/// Where `fit`'s residuals (`(positions, residuals)` per experiment, names `names`) stay
-/// systematic, at the noise level `sigma`.
+/// Where the residuals of `profiles` (positions and relative residuals per experiment, named
+/// `names`) stay systematic at the noise level `sigma`: the segments of the pooled residual
+/// ([`find_segments`]). Where the pooled residual has none, because the experiments' residuals
+/// differ in sign at one position (an effect whose strength changes with the runs), each
+/// experiment is searched on its own, and its segments are listed with it alone, strongest
+/// first, at most [`MAX_PER_EXPERIMENT_SEGMENTS`].
 pub(crate) fn unexplained(
     profiles: &[(Vec<f64>, Vec<f64>)],
     names: &[String],
     sigma: f64,
 ) -> Vec<Unexplained> {
-    find_segments(profiles, sigma, &SegmentOptions::default())
+    let options = SegmentOptions::default();
+    let pooled: Vec<Unexplained> = find_segments(profiles, sigma, &options)
         .into_iter()
         .map(|seg| Unexplained {
             start_m: seg.start_m,
@@ -205,12 +210,74 @@ pub(crate) fn unexplained(
                 .filter_map(|(k, _)| names.get(*k).cloned())
                 .collect(),
         })
-        .collect()
+        .collect();
+    if !pooled.is_empty() {
+        return pooled;
+    }
+    let mut own: Vec<Unexplained> = profiles
+        .iter()
+        .enumerate()
+        .flat_map(|(k, profile)| {
+            let name = names.get(k).cloned().unwrap_or_else(|| format!("#{k}"));
+            find_segments(std::slice::from_ref(profile), sigma, &options)
+                .into_iter()
+                .map(move |seg| Unexplained {
+                    start_m: seg.start_m,
+                    end_m: seg.end_m,
+                    mean: seg.mean,
+                    z: seg.z,
+                    experiments: vec![name.clone()],
+                })
+        })
+        .collect();
+    own.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
+    own.truncate(MAX_PER_EXPERIMENT_SEGMENTS);
+    own
 }
+
+/// The most segments [`unexplained`] lists from the experiments searched one by one.
+pub const MAX_PER_EXPERIMENT_SEGMENTS: usize = 6;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn residuals_of_opposite_sign_in_two_runs_are_located_run_by_run() {
+        // 0.00, 0.01, ..., 0.50 m; +3 % in run a and -3 % in run b over 0.10-0.20 m, zero
+        // elsewhere: the pooled residual cancels, each run alone is 9.9 standard errors off
+        let s: Vec<f64> = (0..=50).map(|i| 0.01 * i as f64).collect();
+        let bump = |sign: f64| -> Vec<f64> {
+            s.iter()
+                .map(|&x| {
+                    if (0.095..0.205).contains(&x) {
+                        sign * 0.03
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        };
+        let profiles = vec![(s.clone(), bump(1.0)), (s.clone(), bump(-1.0))];
+        let names = vec!["a".to_string(), "b".to_string()];
+        assert!(find_segments(&profiles, 0.01, &SegmentOptions::default()).is_empty());
+        let u = unexplained(&profiles, &names, 0.01);
+        assert_eq!(u.len(), 2, "{u:?}");
+        for seg in &u {
+            assert!((seg.start_m - 0.10).abs() < 0.006 && (seg.end_m - 0.20).abs() < 0.006);
+            assert!((seg.mean.abs() - 0.03).abs() < 1e-12 && seg.z.abs() > 9.0);
+            let run = if seg.mean > 0.0 { "a" } else { "b" };
+            assert_eq!(seg.experiments, vec![run.to_string()]);
+        }
+        // where the runs agree, the pooled segment is reported with both
+        let same = vec![(s.clone(), bump(1.0)), (s.clone(), bump(1.0))];
+        let u = unexplained(&same, &names, 0.01);
+        assert_eq!(u.len(), 1);
+        assert_eq!(u[0].experiments, names);
+        // white noise stays unlocated
+        let flat = vec![(s.clone(), vec![0.0; s.len()]), (s, vec![0.0; 51])];
+        assert!(unexplained(&flat, &names, 0.01).is_empty());
+    }
 
     #[test]
     fn shares_of_the_excess() {
