@@ -404,8 +404,7 @@ impl<'o> Driver<'o> {
             }
             if o.relative_offset.is_some() && !self.loose {
                 // a jump of the cost at a short step: its numerical noise floor
-                let xs = |i: usize| o.x_scale.get(i).copied().unwrap_or(1.0);
-                let short = (0..self.np).all(|i| proposal.step[i].abs() <= SHORT_STEP * xs(i));
+                let short = (0..self.np).all(|i| proposal.step[i].abs() <= SHORT_STEP * o.scale(i));
                 let rise = -actual;
                 if short && rise > JUMP_FACTOR * proposal.predicted.max(0.0) {
                     self.noise_floor = self.noise_floor.max(rise);

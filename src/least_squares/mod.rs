@@ -239,6 +239,11 @@ impl FitOptions {
         }
     }
 
+    /// Parameter `i`'s [`x_scale`](Self::x_scale) (1 where none is given).
+    pub(super) fn scale(&self, i: usize) -> f64 {
+        self.x_scale.get(i).copied().unwrap_or(1.0)
+    }
+
     /// Whether [`cancel`](Self::cancel) is set.
     pub fn cancelled(&self) -> bool {
         self.cancel

@@ -50,7 +50,7 @@ fn dense_fit(rh: &Rheometer, start: [f64; 2], opts: &IdentifyOptions, f_scale: f
         f_scale,
         accuracy: Accuracy::scheduled(),
         // identify's stopping test: within `optimum_tolerance` standard errors of the optimum
-        relative_offset: opts.optimum_tolerance.map(|t| t / (p0.len() as f64).sqrt()),
+        relative_offset: opts.relative_offset(p0.len()).unwrap(),
         ..FitOptions::with_bounds(lo, hi)
     };
     fit(&mut Dense(obj), &p0, &fo).unwrap()

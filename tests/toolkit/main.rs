@@ -7,6 +7,7 @@ mod common;
 mod block_least_squares;
 mod continuation;
 mod core_accuracy;
+mod decay_model;
 mod growth_limit;
 mod html_page;
 mod least_squares;

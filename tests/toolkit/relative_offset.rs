@@ -2,6 +2,7 @@
 //! model evaluated with a small numerical error, as a BVP solved to a tolerance is: the cost
 //! then carries noise that `ftol` lies below, and the trust region spends its iterations on it.
 
+use super::decay_model;
 use diffbvp::least_squares::{
     fit, FitError, FitOptions, FitResult, LeastSquaresProblem, Termination,
 };
@@ -49,15 +50,10 @@ impl LeastSquaresProblem for NoisyDecay {
     }
     fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
         let seed = p[0].to_bits() ^ p[1].to_bits().rotate_left(17);
-        let mut r = Vec::with_capacity(self.x.len());
-        let mut j = Vec::with_capacity(2 * self.x.len());
-        for (i, (&x, &y)) in self.x.iter().zip(&self.y).enumerate() {
-            let e = (-p[1] * x).exp();
-            r.push(p[0] * e - y + self.numerical * unit(seed ^ ((i as u64) << 40)));
-            j.push(e);
-            j.push(-p[0] * x * e);
-        }
-        Ok((r, j))
+        let numerical = self.numerical;
+        Ok(decay_model::residuals(&self.x, &self.y, p, |i| {
+            numerical * unit(seed ^ ((i as u64) << 40))
+        }))
     }
 }
 
@@ -75,6 +71,16 @@ fn run(numerical: f64, relative_offset: Option<f64>) -> FitResult {
         &options(relative_offset),
     )
     .unwrap()
+}
+
+/// `a`'s iterations, why it stopped and its distance from `exact`, for the test's output.
+fn outcome(a: &FitResult, exact: &FitResult) -> String {
+    format!(
+        "{} iterations ({}), {:.2e} se off",
+        a.iterations,
+        a.termination,
+        distance_se(a, exact)
+    )
 }
 
 /// The largest distance of `a` from the exact optimum `b`, in `b`'s standard errors.
@@ -95,16 +101,10 @@ fn a_fit_ends_at_the_optimum_to_within_the_relative_offset_and_not_on_numerical_
     let by_ftol = run(1e-7, None);
     let by_offset = run(1e-7, Some(1e-3));
     println!(
-        "exact: {} iterations ({}); ftol: {} iterations ({}), {:.2e} se off; relative offset: {} \
-         iterations ({}), {:.2e} se off",
-        exact.iterations,
-        exact.termination,
-        by_ftol.iterations,
-        by_ftol.termination,
-        distance_se(&by_ftol, &exact),
-        by_offset.iterations,
-        by_offset.termination,
-        distance_se(&by_offset, &exact),
+        "exact: {}; ftol: {}; relative offset: {}",
+        outcome(&exact, &exact),
+        outcome(&by_ftol, &exact),
+        outcome(&by_offset, &exact)
     );
     assert_eq!(by_offset.termination, Termination::RelativeOffset);
     assert!(
@@ -179,17 +179,13 @@ fn a_fit_against_a_jump_of_the_cost_ends_at_its_noise_floor_not_its_iteration_bu
     let by_ftol = stepped(0.001, None);
     let by_floor = stepped(0.001, Some(1e-3));
     println!(
-        "ftol: {} iterations ({}), {:.3} se off; noise floor: {} iterations ({}), {:.3} se off",
-        by_ftol.iterations,
-        by_ftol.termination,
-        distance_se(&by_ftol, &exact),
-        by_floor.iterations,
-        by_floor.termination,
-        distance_se(&by_floor, &exact),
+        "ftol: {}; noise floor: {}",
+        outcome(&by_ftol, &exact),
+        outcome(&by_floor, &exact)
     );
     assert_eq!(by_floor.termination, Termination::NoiseFloor);
     assert!(
-        by_floor.iterations < by_ftol.iterations,
+        2 * by_floor.iterations <= by_ftol.iterations,
         "{} iterations at the noise floor, {} with ftol",
         by_floor.iterations,
         by_ftol.iterations
@@ -205,20 +201,13 @@ fn a_fit_against_a_jump_of_the_cost_ends_at_its_noise_floor_not_its_iteration_bu
     // (of `b`) away from it: further than ten times the asked distance (1e-3 √2), so the fit
     // does not end at the noise floor there
     let stalled = stepped(0.01, Some(1e-3));
-    println!(
-        "stalled: {} iterations ({}), {:.3} se off",
-        stalled.iterations,
-        stalled.termination,
-        distance_se(&stalled, &exact)
-    );
+    println!("stalled: {}", outcome(&stalled, &exact));
     assert!(distance_se(&stalled, &exact) > 10.0 * 1e-3 * 2f64.sqrt());
     assert_ne!(stalled.termination, Termination::NoiseFloor);
-    // where the cost has no jump (the edge beyond the optimum) it never ends at a noise floor
-    let mut beyond = SteppedDecay {
-        smooth: NoisyDecay::new(0.0),
-        edge: exact.p[0] + 10.0 * se[0],
-        offset: 1e-3,
-    };
-    let smooth = fit(&mut beyond, &[1.0, 0.5], &options(Some(1e-3))).unwrap();
-    assert_eq!(smooth.termination, Termination::RelativeOffset);
+    // where the cost has no jump (the edge 10 standard errors beyond the optimum) it never
+    // ends at a noise floor
+    assert_eq!(
+        stepped(-10.0, Some(1e-3)).termination,
+        Termination::RelativeOffset
+    );
 }

@@ -79,9 +79,14 @@ impl Rheometer {
         warm: &WarmFit,
     ) -> Result<Identification, RheometerError> {
         let t0 = Instant::now();
+        // checked before any simulation: the layout's size is known only with the objective,
+        // the tolerance's range is not
+        options.relative_offset(1)?;
         let mut obj = self.objective_from(start, options)?;
         let mut p0 = obj.initial_parameters();
         let (lower, upper) = obj.bounds();
+        // within `optimum_tolerance` standard errors of the optimum
+        let relative_offset = options.relative_offset(lower.len())?;
         let ns = obj.layout.num_shared();
         if options.estimator == Estimator::Principled && warm.take_up.len() == self.len() {
             let [lo, hi] = options.take_up_bounds;
@@ -125,20 +130,8 @@ impl Rheometer {
                 hook.report(&FitProgress::Iteration(it));
             }
         };
-        if let Some(t) = options
-            .optimum_tolerance
-            .filter(|t| !(*t > 0.0 && *t <= 1.0))
-        {
-            return Err(RheometerError::Data(format!(
-                "IdentifyOptions::optimum_tolerance must lie in (0, 1] standard errors, got {t}: \
-                 it is how close to the optimum the fit must come (default 0.01)"
-            )));
-        }
         if warm.stop_tolerance.is_none() {
-            // within `optimum_tolerance` standard errors of the optimum: the relative offset
-            // below that over √P
-            let np = lower.len().max(1) as f64;
-            fo.relative_offset = options.optimum_tolerance.map(|t| t / np.sqrt());
+            fo.relative_offset = relative_offset;
         }
         let fit_result = fit_observed(&mut obj, &p0, &fo, &mut observer)?;
         let solutions: Vec<Solution> = obj.solutions();

@@ -96,7 +96,7 @@ pub struct IdentifyOptions {
     /// noise ([`Termination::NoiseFloor`](crate::least_squares::Termination::NoiseFloor)).
     /// `None`: only the tight tests on the cost change, the step and the gradient (1e-8–1e-10),
     /// which a cost evaluated by BVP solves can keep from ending for tens of iterations.
-    /// Outside `(0, 1]`: an error.
+    /// Outside `(0, 1)`: an error.
     pub optimum_tolerance: Option<f64>,
     /// Relative noise factor of each measurement, per experiment (`σ_j / σ`, ≈ 1 on average;
     /// principled estimator): a noise that varies along the line (the take-up region noisier)
@@ -193,6 +193,20 @@ impl IdentifyOptions {
         match self.noise_factors.as_ref().and_then(|f| f.get(k)) {
             Some(f) if f.len() == n => f.iter().map(|w| sigma * w).collect(),
             _ => vec![sigma; n],
+        }
+    }
+
+    /// The relative offset of Bates and Watts ([`FitOptions::relative_offset`](crate::least_squares::FitOptions::relative_offset))
+    /// of a fit of `num_params` parameters that stops within
+    /// [`optimum_tolerance`](Self::optimum_tolerance) standard errors of the optimum:
+    /// `optimum_tolerance / √P`. An error naming the option where it lies outside `(0, 1)`.
+    pub fn relative_offset(&self, num_params: usize) -> Result<Option<f64>, RheometerError> {
+        match self.optimum_tolerance {
+            Some(t) if !(t > 0.0 && t < 1.0) => Err(RheometerError::Data(format!(
+                "IdentifyOptions::optimum_tolerance must lie in (0, 1) standard errors, got \
+                 {t}: it is how close to the optimum the fit must come (default 0.01)"
+            ))),
+            t => Ok(t.map(|t| t / (num_params.max(1) as f64).sqrt())),
         }
     }
 
@@ -296,5 +310,27 @@ impl BoundSide {
             BoundSide::Lower => BoundSide::Upper,
             BoundSide::Upper => BoundSide::Lower,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_optimum_tolerance_is_a_relative_offset_over_root_p_and_refused_outside_its_range() {
+        let mut o = IdentifyOptions::default();
+        // 0.01 standard errors over 16 parameters: 0.01 / 4
+        assert_eq!(o.relative_offset(16).unwrap(), Some(0.0025));
+        o.optimum_tolerance = None;
+        assert_eq!(o.relative_offset(16).unwrap(), None);
+        for bad in [0.0, -0.01, 1.0, 1.5, f64::NAN, f64::INFINITY] {
+            o.optimum_tolerance = Some(bad);
+            let e = o.relative_offset(16).unwrap_err().to_string();
+            assert!(e.contains("IdentifyOptions::optimum_tolerance"), "{e}");
+        }
+        // below 1 for one parameter too: the driver's relative offset lies in (0, 1)
+        o.optimum_tolerance = Some(0.5);
+        assert_eq!(o.relative_offset(1).unwrap(), Some(0.5));
     }
 }

@@ -4,7 +4,7 @@
 use super::super::jacobian::Linearized;
 #[cfg(doc)]
 use super::super::Accuracy;
-use super::super::Termination;
+use super::super::{FitOptions, Termination};
 use super::Driver;
 use nalgebra::DVector;
 
@@ -43,16 +43,15 @@ impl Driver<'_> {
         };
         let lin = Linearized::new(jac_gn, r_gn, nr, np);
         let g = lin.gradient();
-        let xs = |i: usize| o.x_scale.get(i).copied().unwrap_or(1.0);
         // the Coleman–Li distances in the scaled variables p_i / x_scale_i
-        let v = cl_scaling(&self.p, g.as_slice(), &o.lower, &o.upper, &o.x_scale);
+        let v = cl_scaling(&self.p, g.as_slice(), o);
         let scaled_gradient = (0..np)
-            .map(|i| (g[i] * xs(i) * v[i]).abs())
+            .map(|i| (g[i] * o.scale(i) * v[i]).abs())
             .fold(0.0, f64::max);
         if scaled_gradient <= o.gtol {
             return Err(Termination::Gradient);
         }
-        let d: Vec<f64> = (0..np).map(|i| 1.0 / (v[i].sqrt() * xs(i))).collect();
+        let d: Vec<f64> = (0..np).map(|i| 1.0 / (v[i].sqrt() * o.scale(i))).collect();
         // at the optimum to within the tolerance, whatever numerical noise the cost carries
         // (not in the loose phase of a schedule: its evaluations are not yet the final model);
         // the Gauss–Newton step it measures is also the trust-region step when it lies inside
@@ -151,14 +150,14 @@ fn inside_box(p: &[f64], s: &DVector<f64>, lo: &[f64], hi: &[f64]) -> Vec<f64> {
 }
 
 /// Coleman–Li scaling vector: distance to the bound the negative gradient points at, in units
-/// of the parameter's scale `x_scale` (1 where it has none) and at most 1.
-fn cl_scaling(p: &[f64], g: &[f64], lo: &[f64], hi: &[f64], x_scale: &[f64]) -> Vec<f64> {
+/// of the parameter's scale ([`FitOptions::scale`]) and at most 1.
+fn cl_scaling(p: &[f64], g: &[f64], o: &FitOptions) -> Vec<f64> {
     p.iter()
         .zip(g)
-        .zip(lo.iter().zip(hi))
+        .zip(o.lower.iter().zip(&o.upper))
         .enumerate()
         .map(|(i, ((&x, &gi), (&l, &u)))| {
-            let scale = x_scale.get(i).copied().unwrap_or(1.0);
+            let scale = o.scale(i);
             let v = if gi < 0.0 && u.is_finite() {
                 u - x
             } else if gi > 0.0 && l.is_finite() {

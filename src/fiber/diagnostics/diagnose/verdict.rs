@@ -21,7 +21,7 @@
 //!   the data cannot tell the explanations apart, and the law is not a result (the range all
 //!   span is given; see the stage `ambiguity`).
 
-use crate::fiber::diagnostics::compare::segments::{find_segments, SegmentOptions};
+use crate::fiber::diagnostics::compare::segments::{find_segments, Segment, SegmentOptions};
 use crate::fiber::noise_summary::NoiseSummary;
 use crate::fiber::rheometer::FitSummary;
 use serde::{Deserialize, Serialize};
@@ -198,17 +198,14 @@ pub(crate) fn unexplained(
     let options = SegmentOptions::default();
     let pooled: Vec<Unexplained> = find_segments(profiles, sigma, &options)
         .into_iter()
-        .map(|seg| Unexplained {
-            start_m: seg.start_m,
-            end_m: seg.end_m,
-            mean: seg.mean,
-            z: seg.z,
-            experiments: seg
+        .map(|seg| {
+            let experiments = seg
                 .per_experiment
                 .iter()
                 .filter(|(_, v)| (*v > 0.0) == (seg.mean > 0.0))
                 .filter_map(|(k, _)| names.get(*k).cloned())
-                .collect(),
+                .collect();
+            located(&seg, experiments)
         })
         .collect();
     if !pooled.is_empty() {
@@ -221,13 +218,7 @@ pub(crate) fn unexplained(
             let name = names.get(k).cloned().unwrap_or_else(|| format!("#{k}"));
             find_segments(std::slice::from_ref(profile), sigma, &options)
                 .into_iter()
-                .map(move |seg| Unexplained {
-                    start_m: seg.start_m,
-                    end_m: seg.end_m,
-                    mean: seg.mean,
-                    z: seg.z,
-                    experiments: vec![name.clone()],
-                })
+                .map(move |seg| located(&seg, vec![name.clone()]))
         })
         .collect();
     own.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
@@ -235,8 +226,19 @@ pub(crate) fn unexplained(
     own
 }
 
+/// The segment `seg` as an unexplained stretch of `experiments`.
+fn located(seg: &Segment, experiments: Vec<String>) -> Unexplained {
+    Unexplained {
+        start_m: seg.start_m,
+        end_m: seg.end_m,
+        mean: seg.mean,
+        z: seg.z,
+        experiments,
+    }
+}
+
 /// The most segments [`unexplained`] lists from the experiments searched one by one.
-pub const MAX_PER_EXPERIMENT_SEGMENTS: usize = 6;
+pub(crate) const MAX_PER_EXPERIMENT_SEGMENTS: usize = 6;
 
 #[cfg(test)]
 mod tests {
