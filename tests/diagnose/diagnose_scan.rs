@@ -122,3 +122,74 @@ fn radiation_needing_emissivity_above_one_is_reported_and_not_named() {
     assert!(js.contains("\"status\":\"unphysical\"") || js.contains("\"status\":\"at_bound\""));
     assert!(js.contains("\"profiles\""));
 }
+
+/// The grid points' looser BVP tolerance (`ScanOptions::grid_tol`, 1e-3 against the fits'
+/// 1e-4) on `data/hidden_radiation` (radiation ε = 0.9 by the project's simulator): the
+/// profile points that can start a refit (`J` within 1.2 times the user's) move by less than
+/// 2 in ΔBIC, and the best refit, which solves at the fit's tolerance, ends at the same
+/// optimum: its strength within 0.1 of its standard error (ten times the fits' stopping
+/// distance, the bound of their noise floor) and its ΔBIC within 0.1.
+#[test]
+fn the_grid_tolerance_moves_no_refit() {
+    use diffbvp::fiber::diagnostics::scan::{scan_candidate, CandidateScan, ScanOptions};
+    use diffbvp::fiber::effects::Effect;
+    use diffbvp::fiber::input::load_experiments;
+    use diffbvp::fiber::rheometer::{FitStart, IdentifyOptions, Rheometer};
+
+    let toml = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/hidden_radiation/experiments.toml");
+    let set = load_experiments(&toml).unwrap();
+    let rh = Rheometer::with_spec(&set, ModelSpec::new(LawChoice::Carreau)).unwrap();
+    let opts = IdentifyOptions::default();
+    let law0 = rh.start_heuristic(&opts).unwrap().start;
+    let base = rh.identify_from(&FitStart::at(law0), &opts).unwrap();
+    let cost_base = 2.0 * base.fit.cost;
+    let radiation: Effect = "radiation".parse().unwrap();
+    let scan = |grid_tol: f64| -> CandidateScan {
+        let so = ScanOptions {
+            grid_tol,
+            ..ScanOptions::default()
+        };
+        scan_candidate(&rh, &radiation, Vec::new(), &base, cost_base, &opts, &so).unwrap()
+    };
+    let loose = scan(ScanOptions::default().grid_tol);
+    let tight = scan(1e-4);
+    assert_eq!(ScanOptions::default().grid_tol, 1e-3);
+    let n = set
+        .measurements
+        .iter()
+        .flatten()
+        .map(|m| m.positions.len())
+        .sum::<usize>() as f64;
+    let dbic = |a: f64, b: f64| n * (a / b).ln();
+    let mut compared = 0;
+    for (p, q) in loose.profile.points.iter().zip(&tight.profile.points) {
+        assert_eq!(p.strength, q.strength);
+        if q.cost <= 1.2 * cost_base {
+            compared += 1;
+            let d = dbic(p.cost, q.cost);
+            println!(
+                "ε = {:.4}: J {:.6e} / {:.6e}, ΔBIC {d:+.3}",
+                p.strength, p.cost, q.cost
+            );
+            assert!(d.abs() < 2.0, "grid point {}: ΔBIC {d}", p.strength);
+        }
+    }
+    assert!(compared >= 3, "{compared} grid points near the user's J");
+    let (a, b) = (&loose.refits[0], &tight.refits[0]);
+    let strength = |r: &diffbvp::fiber::diagnostics::scan::Refit| {
+        r.identification
+            .summary
+            .effect("radiation")
+            .unwrap()
+            .strength
+            .clone()
+    };
+    let (sa, sb) = (strength(a), strength(b));
+    println!(
+        "refits: ε {:.6} / {:.6} ± {:.4}, J {:.8e} / {:.8e}",
+        sa.value, sb.value, sb.stderr, a.cost, b.cost
+    );
+    assert!((sa.value - sb.value).abs() < 0.1 * sb.stderr);
+    assert!(dbic(a.cost, b.cost).abs() < 0.1);
+}

@@ -203,7 +203,7 @@ pub(crate) fn unexplained(
                 .per_experiment
                 .iter()
                 .filter(|(_, v)| (*v > 0.0) == (seg.mean > 0.0))
-                .filter_map(|(k, _)| names.get(*k).cloned())
+                .map(|(k, _)| name_of(names, *k))
                 .collect();
             located(&seg, experiments)
         })
@@ -215,7 +215,7 @@ pub(crate) fn unexplained(
         .iter()
         .enumerate()
         .flat_map(|(k, profile)| {
-            let name = names.get(k).cloned().unwrap_or_else(|| format!("#{k}"));
+            let name = name_of(names, k);
             find_segments(std::slice::from_ref(profile), sigma, &options)
                 .into_iter()
                 .map(move |seg| located(&seg, vec![name.clone()]))
@@ -224,6 +224,11 @@ pub(crate) fn unexplained(
     own.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
     own.truncate(MAX_PER_EXPERIMENT_SEGMENTS);
     own
+}
+
+/// Experiment `k`'s name in `names` (`#k` if there is none).
+fn name_of(names: &[String], k: usize) -> String {
+    names.get(k).cloned().unwrap_or_else(|| format!("#{k}"))
 }
 
 /// The segment `seg` as an unexplained stretch of `experiments`.
