@@ -115,6 +115,15 @@ const NOISE_FLOOR_FACTOR: f64 = 2.0;
 /// than this many times the asked distance from the optimum.
 const NOISE_FLOOR_OFFSET_FACTOR: f64 = 10.0;
 
+/// Trial steps over which [`Termination::Stalled`] measures the fit's pace.
+const STALL_WINDOW: usize = 10;
+
+/// [`Termination::Stalled`]: the most the rest of the iteration budget may lower `‖r‖²` at the
+/// pace of the last [`STALL_WINDOW`] trial steps, in units of the residual variance `σ̂²`, for
+/// the fit to end now (a move of 0.1 standard errors along a direction of the cost's curvature
+/// changes `‖r‖²` by that much).
+const STALL_CHI2: f64 = 0.01;
+
 /// A trial point's evaluation.
 struct Evaluated {
     r: Vec<f64>,
@@ -316,6 +325,29 @@ impl<'o> Driver<'o> {
             }
             _ => Ok(None),
         }
+    }
+
+    /// Whether the fit has stalled ([`Termination::Stalled`]): at the pace of the last
+    /// [`STALL_WINDOW`] trial steps (all at full accuracy), the trial steps left in the budget
+    /// would lower `‖r‖²` by at most [`STALL_CHI2`] times the residual variance
+    /// `σ̂² = ‖r‖²/(N − P)` (at most `f_scale²` under a robust loss).
+    fn stalled(&self) -> bool {
+        let k = self.history.len();
+        let limit = self.tight_limit.unwrap_or(self.options.max_iterations);
+        if k < STALL_WINDOW || self.iterations >= limit {
+            return false;
+        }
+        let window = &self.history[k - STALL_WINDOW..];
+        if window.iter().any(|h| h.allowed_error.is_some()) {
+            return false;
+        }
+        let dof = self.nr.saturating_sub(self.np).max(1) as f64;
+        let mut variance = self.r.iter().map(|x| x * x).sum::<f64>() / dof;
+        if !self.options.loss.is_linear() {
+            variance = variance.min(self.options.f_scale * self.options.f_scale);
+        }
+        let pace = 2.0 * (window[0].previous_cost - self.cost) / STALL_WINDOW as f64;
+        pace * (limit - self.iterations) as f64 <= STALL_CHI2 * variance
     }
 
     /// What a rejected or failed step shrinks the trust radius from: the step's own scaled

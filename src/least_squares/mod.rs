@@ -276,6 +276,16 @@ pub enum Termination {
     /// Only where the relative offset is within 10 times its tolerance: the estimate is then
     /// within `10 · relative_offset · √P` standard errors of the optimum of the linearisation.
     NoiseFloor,
+    /// With [`FitOptions::relative_offset`] set: at the pace of the last 10 trial steps (all
+    /// at full accuracy), the trial steps left in the iteration budget would lower `‖r‖²` by at
+    /// most 0.01 times the residual variance `σ̂² = ‖r‖²/(N − P)` (at most `f_scale²` under a
+    /// robust loss). Ending there gives the result the rest of the budget would give, to within
+    /// that, if the pace holds. A fit crawling along a curved valley, where the Gauss–Newton
+    /// model holds only over steps far shorter than the distance to the optimum it predicts,
+    /// or a trust region whose every step towards the optimum is rejected, ends here instead of
+    /// at [`MaxIterations`](Self::MaxIterations). Like that, not a convergence test: the
+    /// relative offset at the end says how far the linearisation still places the optimum.
+    Stalled,
 }
 
 impl fmt::Display for Termination {
@@ -288,6 +298,10 @@ impl fmt::Display for Termination {
             Termination::RadiusCollapsed => "trust radius collapsed",
             Termination::RelativeOffset => "relative offset below its tolerance (Bates-Watts)",
             Termination::NoiseFloor => "predicted gain within the cost's numerical noise",
+            Termination::Stalled => {
+                "stalled: at the pace of the last 10 steps, the rest of the budget would lower the cost by \
+                 less than 0.01 of the residual variance"
+            }
         };
         f.write_str(s)
     }

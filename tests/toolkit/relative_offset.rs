@@ -211,3 +211,87 @@ fn a_fit_against_a_jump_of_the_cost_ends_at_its_noise_floor_not_its_iteration_bu
         Termination::RelativeOffset
     );
 }
+
+/// A narrow curved valley that the data determine only weakly along its length: the residuals
+/// `1000 (q − p²)` (the valley `q = p²`), `w (1 − p)` (where along it the optimum lies, weight
+/// `w`) and 40 residuals of fixed noise (σ = 0.01) that set the residual variance. The trust
+/// region follows the valley in steps far shorter than the distance along it.
+struct Banana {
+    along: f64,
+    noise: Vec<f64>,
+}
+
+impl Banana {
+    fn new(along: f64) -> Self {
+        let noise = (0..40)
+            .map(|i| {
+                (0..4).map(|k| unit(7000 + 100 * i + k)).sum::<f64>() * (0.75f64).sqrt() * 0.01
+            })
+            .collect();
+        Banana { along, noise }
+    }
+}
+
+impl LeastSquaresProblem for Banana {
+    type Error = String;
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn evaluate(&mut self, p: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
+        let mut r = vec![1000.0 * (p[1] - p[0] * p[0]), self.along * (1.0 - p[0])];
+        let mut j = vec![-2000.0 * p[0], 1000.0, -self.along, 0.0];
+        r.extend(&self.noise);
+        j.extend(std::iter::repeat_n(0.0, 2 * self.noise.len()));
+        Ok((r, j))
+    }
+}
+
+#[test]
+fn a_fit_crawling_along_a_curved_valley_ends_when_its_budget_would_no_longer_matter() {
+    let options = |relative_offset| FitOptions {
+        relative_offset,
+        ..FitOptions::with_bounds(vec![-5.0, -5.0], vec![5.0, 5.0])
+    };
+    let run = |along: f64, relative_offset| {
+        fit(
+            &mut Banana::new(along),
+            &[-1.2, 1.0],
+            &options(relative_offset),
+        )
+        .unwrap()
+    };
+    // where the data pull hard along the valley the fit makes real progress on every step:
+    // it runs as it would without the test
+    for along in [1.0, 0.1] {
+        let (full, tested) = (run(along, None), run(along, Some(1e-3)));
+        println!(
+            "along {along}: {} / {}",
+            full.termination, tested.termination
+        );
+        assert_ne!(tested.termination, Termination::Stalled);
+        assert_eq!(tested.p, full.p);
+    }
+    // weakly pulled, the trust region crawls and the budget ends far from the optimum (1, 1);
+    // the test ends the crawl early with the cost the budget reaches, to within 0.01 of the
+    // residual variance at the pace of the crawl (0.02 allowed: the pace changes)
+    for along in [0.01, 0.005, 0.001] {
+        let (full, tested) = (run(along, None), run(along, Some(1e-3)));
+        let variance = 2.0 * full.cost / (full.num_residuals() - 2) as f64;
+        let dchi2 = 2.0 * (tested.cost - full.cost) / variance;
+        println!(
+            "along {along}: budget {} iterations ({}), p {:?}; stalled after {}, p {:?}, \
+             d chi2 {dchi2:.2e}",
+            full.iterations, full.termination, full.p, tested.iterations, tested.p
+        );
+        assert_eq!(full.termination, Termination::MaxIterations);
+        assert!(full.p[0] < 0.5, "the crawl reached {:?}", full.p);
+        assert_eq!(tested.termination, Termination::Stalled);
+        assert!(
+            4 * tested.iterations <= 3 * full.iterations,
+            "{} iterations against {}",
+            tested.iterations,
+            full.iterations
+        );
+        assert!(dchi2 <= 0.02, "{dchi2}");
+    }
+}

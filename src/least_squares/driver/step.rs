@@ -72,6 +72,9 @@ impl Driver<'_> {
                 return Err(Termination::NoiseFloor);
             }
         }
+        if o.relative_offset.is_some() && !self.loose && self.stalled() {
+            return Err(Termination::Stalled);
+        }
         if self.iterations >= self.tight_limit.unwrap_or(o.max_iterations) {
             return Err(Termination::MaxIterations);
         }
