@@ -283,8 +283,9 @@ pub enum Termination {
     /// that, if the pace holds. A fit crawling along a curved valley, where the Gauss–Newton
     /// model holds only over steps far shorter than the distance to the optimum it predicts,
     /// or a trust region whose every step towards the optimum is rejected, ends here instead of
-    /// at [`MaxIterations`](Self::MaxIterations). Like that, not a convergence test: the
-    /// relative offset at the end says how far the linearisation still places the optimum.
+    /// at [`MaxIterations`](Self::MaxIterations). Like that, not a convergence test:
+    /// [`FitResult::gauss_newton_gain`] says how much lower the linearisation at the end still
+    /// places the optimum.
     Stalled,
 }
 
@@ -532,6 +533,20 @@ impl FitResult {
     /// the Schur complement. `None` under a robust loss (its steps are taken on rescaled
     /// residuals) or where a component is not finite.
     pub fn gauss_newton_step(&self) -> Option<Vec<f64>> {
+        self.gauss_newton().map(|(s, _)| s)
+    }
+
+    /// The decrease of the cost `½‖r‖²` the linearisation predicts for the
+    /// [`gauss_newton_step`](Self::gauss_newton_step), `½‖J s‖²` (bounds lifted: part of it may
+    /// lie beyond them). Twice it over the [`residual_variance`](Self::residual_variance) is
+    /// the `χ²` a fit that stopped short of its optimum leaves, to first order. `None` where
+    /// the step is.
+    pub fn gauss_newton_gain(&self) -> Option<f64> {
+        self.gauss_newton().map(|(_, g)| g)
+    }
+
+    /// [`gauss_newton_step`](Self::gauss_newton_step) and its predicted gain.
+    fn gauss_newton(&self) -> Option<(Vec<f64>, f64)> {
         if !self.loss.is_linear() {
             return None;
         }
@@ -547,9 +562,9 @@ impl FitResult {
             },
         };
         let s = lin.step(&vec![1.0; np], f64::INFINITY);
-        s.iter()
-            .all(|v| v.is_finite())
-            .then(|| s.iter().copied().collect())
+        let gain = lin.predicted_reduction(&s);
+        (s.iter().all(|v| v.is_finite()) && gain.is_finite())
+            .then(|| (s.iter().copied().collect(), gain))
     }
 
     /// The Jacobian at `p`, dense row-major `N × P` (a copy of [`jacobian`](Self::jacobian),

@@ -708,3 +708,62 @@ fn a_stand_in_effect_is_warned_about_by_fit() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn a_fit_stopped_short_of_its_optimum_says_so_and_a_converged_one_does_not() {
+    let set =
+        load_experiments(&probe::repo().join("data/pmma7n_synthetic/experiments.toml")).unwrap();
+    let rh = Rheometer::new(&set).unwrap();
+    let fit = |max_iterations| {
+        // one accuracy throughout: a schedule gives its final phase iterations of its own
+        let opts = IdentifyOptions {
+            max_iterations,
+            loose_tolerance: None,
+            ..IdentifyOptions::with_estimator(Estimator::Principled)
+        };
+        rh.identify([0.5, 14.0], &opts).unwrap()
+    };
+    let not_converged = |s: &FitSummary| {
+        s.warnings
+            .iter()
+            .filter(|w| w.code == WarningCode::NotConverged)
+            .count()
+    };
+    let full = fit(100);
+    let short = fit(2);
+    println!("{}", short.summary.to_text());
+    assert_eq!(
+        not_converged(&full.summary),
+        0,
+        "{:?}",
+        full.summary.warnings
+    );
+    assert_eq!(
+        not_converged(&short.summary),
+        1,
+        "{:?}",
+        short.summary.warnings
+    );
+    let text = short.summary.to_text();
+    assert!(text.contains("without converging"), "{text}");
+    let json: Value =
+        serde_json::from_str(&serde_json::to_string(&short.summary).unwrap()).unwrap();
+    assert!(
+        json["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w["code"] == "not_converged"),
+        "{json}"
+    );
+    // the warning is right: the converged fit lies more than one unit of chi^2 lower
+    let variance = short.fit.residual_variance();
+    let chi2 = (short.summary.cost - full.summary.cost) / variance;
+    let predicted = 2.0 * short.fit.gauss_newton_gain().unwrap() / variance;
+    println!("the converged fit is {chi2:.1} lower in chi^2 (predicted {predicted:.1})");
+    assert!(chi2 >= 1.0, "{chi2}");
+    assert!(
+        (0.5..=2.0).contains(&(predicted / chi2)),
+        "predicted {predicted}, reached {chi2}"
+    );
+}

@@ -245,6 +245,10 @@ pub enum WarningCode {
     Implausible,
     /// An effect fixed at a strength outside its physical range (`--with radiation=2`).
     Unphysical,
+    /// The fit ended without a convergence test being met (its iteration budget spent, a stall
+    /// or a collapsed trust region) where its linearisation still places the optimum at least
+    /// one unit of `χ²` lower: the estimates and intervals may belong to a point short of it.
+    NotConverged,
 }
 
 impl WarningCode {
@@ -260,6 +264,7 @@ impl WarningCode {
             WarningCode::Systematic => "systematic",
             WarningCode::Implausible => "implausible",
             WarningCode::Unphysical => "unphysical",
+            WarningCode::NotConverged => "not_converged",
         }
     }
 }

@@ -233,6 +233,7 @@ impl FitSummary {
             &mut w,
         );
         summary_checks::check_misfit(&summary, &mut w);
+        summary_checks::check_convergence(fit, &mut w);
         summary_checks::check_law(&summary, &mut w);
         summary_checks::check_fixed_effects(&summary, &mut w);
         summary.warnings = w;

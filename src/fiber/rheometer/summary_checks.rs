@@ -14,6 +14,9 @@
 //!   search range, or a `K` interval reaching `0` or `∞`.
 //! * **A singular or ill-conditioned covariance** (no standard errors, or a correlation matrix
 //!   with reciprocal condition number below [`ILL_CONDITIONED_RCOND`]).
+//! * **A fit short of its optimum**: it ended without a convergence test being met (iteration
+//!   budget, stall, collapsed trust region) and the Gauss–Newton step from its end would still
+//!   lower `χ²` by at least [`NOT_CONVERGED_CHI2`].
 //! * **Data the model cannot describe**: measured diameters that do not decrease along the spin
 //!   line ([`Rheometer::data_warnings`](super::Rheometer::data_warnings)).
 //!
@@ -27,9 +30,10 @@ use super::summary::{BoundSide, FitSummary};
 pub use super::thresholds::{
     AT_BOUND_TOLERANCE, ILL_CONDITIONED_RCOND, IMPLAUSIBLE_NOISE_RATIO, JUMP_SE,
     LARGE_STDERR_KAPPA, LARGE_STDERR_N, LARGE_STDERR_STRENGTH_FRACTION, MISFIT_RATIO,
-    MISFIT_WITHOUT_NOISE, PLAUSIBLE_N,
+    MISFIT_WITHOUT_NOISE, NOT_CONVERGED_CHI2, PLAUSIBLE_N,
 };
 use crate::fiber::format::fmt_g;
+use crate::least_squares::{FitResult, Termination};
 use nalgebra::{DMatrix, SymmetricEigen};
 
 /// Which bound `value` is at (within [`AT_BOUND_TOLERANCE`] of the range width), if any.
@@ -320,6 +324,39 @@ pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarnin
 }
 
 /// The misfit against the fit's one noise level, naming the worst experiments.
+/// The fit `fit` ended without a convergence test being met and its linearisation places the
+/// optimum at least [`NOT_CONVERGED_CHI2`] lower in `χ²` (not checked under a robust loss,
+/// whose steps are taken on rescaled residuals).
+pub(crate) fn check_convergence(fit: &FitResult, w: &mut Vec<FitWarning>) {
+    let stopped_short = matches!(
+        fit.termination,
+        Termination::MaxIterations | Termination::Stalled | Termination::RadiusCollapsed
+    );
+    if !stopped_short {
+        return;
+    }
+    let variance = fit.residual_variance();
+    let Some(gain) = fit.gauss_newton_gain() else {
+        return;
+    };
+    let chi2 = 2.0 * gain / variance;
+    if chi2.is_nan() || chi2 < NOT_CONVERGED_CHI2 {
+        return;
+    }
+    w.push(FitWarning::new(
+        WarningCode::NotConverged,
+        format!(
+            "the fit ended without converging ({} after {} iterations): its linearisation still \
+             places the optimum {chi2:.1} lower in chi^2 (about {:.1} standard errors away, \
+             possibly beyond the bounds); the estimates and intervals may belong to a point \
+             short of it",
+            fit.termination,
+            fit.iterations,
+            chi2.sqrt()
+        ),
+    ));
+}
+
 pub(crate) fn check_misfit(s: &FitSummary, w: &mut Vec<FitWarning>) {
     let rms = s.rms_relative_residual;
     let noise = s.noise.level;

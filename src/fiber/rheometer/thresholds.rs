@@ -33,3 +33,8 @@ pub const PLAUSIBLE_N: [f64; 2] = [0.2, 1.0];
 /// A law that moved by more than this many of the plain fit's standard errors is checked
 /// against the gain in fit it bought ([`law_jump`](super::summary_checks::law_jump)).
 pub const JUMP_SE: f64 = 20.0;
+
+/// A fit that ended without a convergence test being met is reported as not converged when its
+/// linearisation still places the optimum at least this much lower in `χ²` (`‖J s‖²/σ̂²` of the
+/// Gauss–Newton step `s`; one unit is a move of about one standard error).
+pub const NOT_CONVERGED_CHI2: f64 = 1.0;
