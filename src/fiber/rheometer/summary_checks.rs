@@ -323,7 +323,6 @@ pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarnin
     }
 }
 
-/// The misfit against the fit's one noise level, naming the worst experiments.
 /// The fit `fit` ended without a convergence test being met and its linearisation places the
 /// optimum at least [`NOT_CONVERGED_CHI2`] lower in `χ²` (not checked under a robust loss,
 /// whose steps are taken on rescaled residuals).
@@ -357,6 +356,7 @@ pub(crate) fn check_convergence(fit: &FitResult, w: &mut Vec<FitWarning>) {
     ));
 }
 
+/// The misfit against the fit's one noise level, naming the worst experiments.
 pub(crate) fn check_misfit(s: &FitSummary, w: &mut Vec<FitWarning>) {
     let rms = s.rms_relative_residual;
     let noise = s.noise.level;
