@@ -329,8 +329,8 @@ impl<'o> Driver<'o> {
 
     /// Whether the fit has stalled ([`Termination::Stalled`]): at the pace of the last
     /// [`STALL_WINDOW`] trial steps (all at full accuracy), the trial steps left in the budget
-    /// would lower `‖r‖²` by at most [`STALL_CHI2`] times the residual variance
-    /// `σ̂² = ‖r‖²/(N − P)` (at most `f_scale²` under a robust loss).
+    /// would lower `‖r‖²` by at most [`STALL_CHI2`] times the
+    /// [`residual_variance`](Self::residual_variance).
     fn stalled(&self) -> bool {
         let k = self.history.len();
         let limit = self.tight_limit.unwrap_or(self.options.max_iterations);
@@ -341,13 +341,20 @@ impl<'o> Driver<'o> {
         if window.iter().any(|h| h.allowed_error.is_some()) {
             return false;
         }
-        let dof = self.nr.saturating_sub(self.np).max(1) as f64;
-        let mut variance = self.r.iter().map(|x| x * x).sum::<f64>() / dof;
-        if !self.options.loss.is_linear() {
-            variance = variance.min(self.options.f_scale * self.options.f_scale);
-        }
         let pace = 2.0 * (window[0].previous_cost - self.cost) / STALL_WINDOW as f64;
-        pace * (limit - self.iterations) as f64 <= STALL_CHI2 * variance
+        pace * (limit - self.iterations) as f64 <= STALL_CHI2 * self.residual_variance()
+    }
+
+    /// `σ̂² = ‖r‖²/(N − P)` at the iterate, at most `f_scale²` under a robust loss: the
+    /// residuals' scatter that step sizes and progress are measured against.
+    fn residual_variance(&self) -> f64 {
+        let dof = self.nr.saturating_sub(self.np).max(1) as f64;
+        let variance = self.r.iter().map(|x| x * x).sum::<f64>() / dof;
+        if self.options.loss.is_linear() {
+            variance
+        } else {
+            variance.min(self.options.f_scale * self.options.f_scale)
+        }
     }
 
     /// What a rejected or failed step shrinks the trust radius from: the step's own scaled

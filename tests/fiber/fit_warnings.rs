@@ -759,6 +759,8 @@ fn a_fit_stopped_short_of_its_optimum_says_so_and_a_converged_one_does_not() {
     // the warning is right: the converged fit lies more than one unit of chi^2 lower
     let variance = short.fit.residual_variance();
     let chi2 = (short.summary.cost - full.summary.cost) / variance;
+    // the prediction is first order from 12 standard errors away (measured 155.9 against
+    // 165.7): within a factor 2 of what the converged fit reaches
     let predicted = 2.0 * short.fit.gauss_newton_gain().unwrap() / variance;
     println!("the converged fit is {chi2:.1} lower in chi^2 (predicted {predicted:.1})");
     assert!(chi2 >= 1.0, "{chi2}");

@@ -26,18 +26,19 @@ fn unit(mut z: u64) -> f64 {
     (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
 }
 
+/// A Gaussian-like number of unit variance: the sum of the four uniforms `unit(seed + k)`
+/// (σ of U[-1, 1) is 1/√3).
+fn normal(seed: u64) -> f64 {
+    (0..4).map(|k| unit(seed + k)).sum::<f64>() * (3.0f64 / 4.0).sqrt()
+}
+
 impl NoisyDecay {
     fn new(numerical: f64) -> Self {
         let x: Vec<f64> = (0..40).map(|i| 2.0 * i as f64 / 39.0).collect();
-        // sum of four uniforms, scaled to unit variance (σ of U[-1,1) is 1/√3), times 0.01
         let y = x
             .iter()
             .enumerate()
-            .map(|(i, &x)| {
-                let g: f64 =
-                    (0..4).map(|k| unit(1000 * i as u64 + k)).sum::<f64>() * (3.0f64 / 4.0).sqrt();
-                2.0 * (-1.3 * x).exp() + 0.01 * g
-            })
+            .map(|(i, &x)| 2.0 * (-1.3 * x).exp() + 0.01 * normal(1000 * i as u64))
             .collect();
         NoisyDecay { x, y, numerical }
     }
@@ -223,11 +224,7 @@ struct Banana {
 
 impl Banana {
     fn new(along: f64) -> Self {
-        let noise = (0..40)
-            .map(|i| {
-                (0..4).map(|k| unit(7000 + 100 * i + k)).sum::<f64>() * (0.75f64).sqrt() * 0.01
-            })
-            .collect();
+        let noise = (0..40).map(|i| 0.01 * normal(7000 + 100 * i)).collect();
         Banana { along, noise }
     }
 }
@@ -273,7 +270,8 @@ fn a_fit_crawling_along_a_curved_valley_ends_when_its_budget_would_no_longer_mat
     }
     // weakly pulled, the trust region crawls and the budget ends far from the optimum (1, 1);
     // the test ends the crawl early with the cost the budget reaches, to within 0.01 of the
-    // residual variance at the pace of the crawl (0.02 allowed: the pace changes)
+    // residual variance at the pace of the crawl (measured 1.1e-2, 9.9e-3, 7e-5; 0.015
+    // allowed: the pace changes a little over the rest of the budget)
     for along in [0.01, 0.005, 0.001] {
         let (full, tested) = (run(along, None), run(along, Some(1e-3)));
         let variance = 2.0 * full.cost / (full.num_residuals() - 2) as f64;
@@ -292,6 +290,6 @@ fn a_fit_crawling_along_a_curved_valley_ends_when_its_budget_would_no_longer_mat
             tested.iterations,
             full.iterations
         );
-        assert!(dchi2 <= 0.02, "{dchi2}");
+        assert!(dchi2 <= 0.015, "{dchi2}");
     }
 }

@@ -97,17 +97,13 @@ impl Driver<'_> {
         })
     }
 
-    /// Accuracy::Scheduled: the step's length in standard errors, ‖J s‖/σ̂, with σ̂ the RMS
-    /// residual (at most the soft margin under a robust loss).
+    /// Accuracy::Scheduled: the step's length in standard errors, ‖J s‖/σ̂, with σ̂ the
+    /// [`residual_variance`](Self::residual_variance)'s root.
     pub(super) fn step_size(&self, step: &DVector<f64>) -> StepSize {
         let (np, nr) = (self.np, self.nr);
         match self.schedule {
             Some(_) => {
-                let dof = nr.saturating_sub(np).max(1) as f64;
-                let mut sigma = (self.r.iter().map(|x| x * x).sum::<f64>() / dof).sqrt();
-                if !self.options.loss.is_linear() {
-                    sigma = sigma.min(self.options.f_scale);
-                }
+                let sigma = self.residual_variance().sqrt();
                 let effect = self.jac.effect(step, nr, np);
                 StepSize { sigma, effect }
             }
