@@ -6,6 +6,8 @@
 
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, StrengthStatus};
 use diffbvp::fiber::effects::{LawChoice, ModelSpec};
+use diffbvp::fiber::input::load_experiments;
+use diffbvp::fiber::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
 use diffbvp::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
 use diffbvp::fiber::simulate::simulate_params;
 use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
@@ -123,6 +125,19 @@ fn radiation_needing_emissivity_above_one_is_reported_and_not_named() {
     assert!(js.contains("\"profiles\""));
 }
 
+/// `data/hidden_radiation` (radiation ε = 0.9 by the project's simulator), the user's plain
+/// Carreau model and its fit from the start heuristic.
+fn hidden_radiation_fit() -> (ExperimentSet, Rheometer, Identification) {
+    let toml = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/hidden_radiation/experiments.toml");
+    let set = load_experiments(&toml).unwrap();
+    let rh = Rheometer::with_spec(&set, ModelSpec::new(LawChoice::Carreau)).unwrap();
+    let opts = IdentifyOptions::default();
+    let law0 = rh.start_heuristic(&opts).unwrap().start;
+    let base = rh.identify_from(&FitStart::at(law0), &opts).unwrap();
+    (set, rh, base)
+}
+
 /// The grid points' looser BVP tolerance (`ScanOptions::grid_tol`, 1e-3 against the fits'
 /// 1e-4) on `data/hidden_radiation` (radiation ε = 0.9 by the project's simulator): the
 /// profile points that can start a refit (`J` within 1.2 times the user's) move by less than
@@ -133,16 +148,9 @@ fn radiation_needing_emissivity_above_one_is_reported_and_not_named() {
 fn the_grid_tolerance_moves_no_refit() {
     use diffbvp::fiber::diagnostics::scan::{scan_candidate, CandidateScan, ScanOptions};
     use diffbvp::fiber::effects::Effect;
-    use diffbvp::fiber::input::load_experiments;
-    use diffbvp::fiber::rheometer::{FitStart, IdentifyOptions, Rheometer};
 
-    let toml = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("data/hidden_radiation/experiments.toml");
-    let set = load_experiments(&toml).unwrap();
-    let rh = Rheometer::with_spec(&set, ModelSpec::new(LawChoice::Carreau)).unwrap();
+    let (set, rh, base) = hidden_radiation_fit();
     let opts = IdentifyOptions::default();
-    let law0 = rh.start_heuristic(&opts).unwrap().start;
-    let base = rh.identify_from(&FitStart::at(law0), &opts).unwrap();
     let cost_base = 2.0 * base.fit.cost;
     let radiation: Effect = "radiation".parse().unwrap();
     let scan = |grid_tol: f64| -> CandidateScan {
@@ -192,4 +200,78 @@ fn the_grid_tolerance_moves_no_refit() {
     );
     assert!((sa.value - sb.value).abs() < 0.1 * sb.stderr);
     assert!(dbic(a.cost, b.cost).abs() < 0.1);
+}
+
+/// The grid points' mesh-growth limit (`ScanOptions::grid_growth_limit`) on
+/// `data/hidden_radiation`, co-flow with a 0.25 m decay and no tail: on the positive side the
+/// grid fits' law runs towards `n → 0`, where a trial solve refines towards 20 000 nodes
+/// before it fails. The limit binds there (the profile changes where `J` is many times the
+/// user's), and moves no grid point that can start a refit (`J` within 1.2 times the user's)
+/// and not the best refit.
+#[test]
+fn the_grid_growth_limit_moves_no_refit() {
+    use diffbvp::fiber::diagnostics::scan::{
+        scan_candidate, CandidateScan, ScanOptions, GRID_GROWTH_LIMIT,
+    };
+    use diffbvp::fiber::effects::Effect;
+    use diffbvp::GrowthLimit;
+
+    let (_, rh, base) = hidden_radiation_fit();
+    let opts = IdentifyOptions::default();
+    let cost_base = 2.0 * base.fit.cost;
+    let coflow = "air_coflow"
+        .parse::<Effect>()
+        .unwrap()
+        .with_shape("decay_length", 0.25)
+        .unwrap()
+        .with_shape("tail", 0.0)
+        .unwrap();
+    let scan = |limit: Option<GrowthLimit>| -> CandidateScan {
+        let so = ScanOptions {
+            grid_growth_limit: limit,
+            ..ScanOptions::default()
+        };
+        scan_candidate(&rh, &coflow, Vec::new(), &base, cost_base, &opts, &so).unwrap()
+    };
+    assert_eq!(
+        ScanOptions::default().grid_growth_limit,
+        Some(GRID_GROWTH_LIMIT)
+    );
+    let limited = scan(Some(GRID_GROWTH_LIMIT));
+    let free = scan(None);
+    let at = |s: &CandidateScan, v: f64| {
+        s.profile
+            .points
+            .iter()
+            .find(|p| p.strength == v)
+            .map(|p| p.cost / cost_base)
+    };
+    let mut strengths: Vec<f64> = limited
+        .profile
+        .points
+        .iter()
+        .chain(&free.profile.points)
+        .map(|p| p.strength)
+        .collect();
+    strengths.sort_by(f64::total_cmp);
+    strengths.dedup();
+    let mut differ = 0;
+    let mut near = 0;
+    for v in strengths {
+        let (a, b) = (at(&limited, v), at(&free, v));
+        println!("{v:9.3} m/s: J/J_user {a:?} (limit) {b:?} (none)");
+        if a != b {
+            differ += 1;
+        }
+        if b.is_some_and(|b| b <= 1.2) {
+            near += 1;
+            assert_eq!(a, b, "a grid point near the user's J moved at {v} m/s");
+        }
+    }
+    // the limit did bind (a side's walk or a grid value changed), far from the user's J
+    assert!(differ > 0, "the grid growth limit never bound");
+    assert!(near >= 3, "{near} grid points near the user's J");
+    let (a, b) = (&limited.refits[0], &free.refits[0]);
+    println!("refits: J {:.8e} / {:.8e}", a.cost, b.cost);
+    assert_eq!(a.cost, b.cost);
 }
