@@ -319,10 +319,6 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         self.pending = None;
         let cached = match (start, tol, self.calibration.take()) {
             (None, Some(t), Some((tc, sol))) if t == tc && sol.params == self.q => Some(sol),
-            // the accepted solution is the solve at these very parameters, and it meets this
-            // run's tolerance on its own mesh (e.g. the fit's start point, solved when the run
-            // was built): a second solve would only repeat it
-            (None, None, _) if self.meets_tolerance_at_q() => Some(self.accepted.clone()),
             _ => None,
         };
         let sol = match cached {
@@ -367,17 +363,6 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         };
         self.pending = Some(sol);
         Ok(out)
-    }
-
-    /// Whether the accepted solution is a solve at the current model parameters `q` that meets
-    /// the solver's tolerances (collocation and boundary residuals) at full accuracy.
-    fn meets_tolerance_at_q(&self) -> bool {
-        let opts = &self.solver.options;
-        let acc = &self.accepted;
-        !self.accepted_loose
-            && acc.params == self.q
-            && acc.stats.max_residual <= opts.tol
-            && acc.stats.max_bc_residual <= opts.bc_tol.unwrap_or(opts.tol)
     }
 
     /// The solver's options with tolerance `tol` (a boundary tolerance of its own at least
@@ -1088,41 +1073,6 @@ mod tests {
                 );
             }
         }
-    }
-
-    /// An evaluation at the accepted solution's own parameters (a fit's first one, at the
-    /// start the runs were solved at) reuses that solution when it meets the run's tolerance,
-    /// and solves again when it does not.
-    #[test]
-    fn an_evaluation_at_the_accepted_parameters_solves_only_if_the_tolerance_asks() {
-        let p = [1.1, 0.7];
-        let mut problem = two_runs(p);
-        let before = problem.solutions();
-        problem.evaluate(&p).unwrap();
-        for (run, old) in problem.runs().iter().zip(&before) {
-            let new = run.pending().unwrap();
-            assert_eq!((&new.x, &new.y, new.stats), (&old.x, &old.y, old.stats));
-        }
-        // a start solved less accurately than the run asks for is solved again
-        let map = ParamMap::new(vec![0.0; 2]).link(0, 0).link(1, 1);
-        let q0 = map.model_params(&p);
-        let guess = Guess::constant(linspace(0.0, 1.0, 6), &[q0[1]]);
-        let loose = Solver::new(&Decay, SolveOptions::with_tol(1e-3))
-            .solve(&q0, &guess)
-            .unwrap();
-        assert!(loose.stats.max_residual > 1e-9, "{:?}", loose.stats);
-        let misfit = Misfit {
-            data: vec![0.0; 4],
-            w: 1.0,
-        };
-        let xs = vec![0.2, 0.4, 0.6, 0.8];
-        let solver = Solver::new(&Decay, SolveOptions::with_tol(1e-9));
-        let run = BvpRun::new(solver, loose.clone(), xs, misfit, map).unwrap();
-        let mut one = BvpResiduals::new(2).with_run(run).unwrap();
-        one.evaluate(&p).unwrap();
-        let new = one.runs()[0].pending().unwrap();
-        assert!(new.stats.max_residual <= 1e-9, "{:?}", new.stats);
-        assert!(new.x.len() > loose.x.len(), "{} nodes", new.x.len());
     }
 
     #[test]

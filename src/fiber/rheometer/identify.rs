@@ -82,22 +82,17 @@ impl Rheometer {
         // checked before any simulation: the layout's size is known only with the objective,
         // the tolerance's range is not
         options.relative_offset(1)?;
-        // the warm take-up factors, within their bounds: the experiments are solved there when
-        // the objective is built, and the fit starts there
-        let take_up: Option<Vec<f64>> = (options.estimator == Estimator::Principled
-            && warm.take_up.len() == self.len())
-        .then(|| {
-            let [lo, hi] = options.take_up_bounds;
-            warm.take_up.iter().map(|t| t.clamp(lo, hi)).collect()
-        });
-        let mut obj = super::objective::Objective::new(self, start, options, take_up.as_deref())?;
+        let mut obj = self.objective_from(start, options)?;
         let mut p0 = obj.initial_parameters();
         let (lower, upper) = obj.bounds();
         // within `optimum_tolerance` standard errors of the optimum
         let relative_offset = options.relative_offset(lower.len())?;
         let ns = obj.layout.num_shared();
-        if let Some(t) = &take_up {
-            p0[ns..].copy_from_slice(t);
+        if options.estimator == Estimator::Principled && warm.take_up.len() == self.len() {
+            let [lo, hi] = options.take_up_bounds;
+            for (p, t) in p0[ns..].iter_mut().zip(&warm.take_up) {
+                *p = t.clamp(lo, hi);
+            }
         }
         let (f_scale, f_scale_source) = self.robust_margin(options)?;
         let sigma = options

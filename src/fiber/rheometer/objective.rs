@@ -85,7 +85,7 @@ impl Rheometer {
         start: [f64; 2],
         options: &IdentifyOptions,
     ) -> Result<Objective<'_>, RheometerError> {
-        Objective::new(self, &FitStart::at(start), options, None)
+        Objective::new(self, &FitStart::at(start), options)
     }
 
     /// An objective for a general start (free candidates, start strengths, warm starts).
@@ -94,19 +94,15 @@ impl Rheometer {
         start: &FitStart,
         options: &IdentifyOptions,
     ) -> Result<Objective<'_>, RheometerError> {
-        Objective::new(self, start, options, None)
+        Objective::new(self, start, options)
     }
 }
 
 impl<'a> Objective<'a> {
-    /// The objective with every experiment solved at the start: the law and strengths of
-    /// `fit_start` and the take-up factors `take_up` (one per experiment; `None`: 1), so that
-    /// the fit's first evaluation at the same parameters needs no second solve.
     pub(super) fn new(
         rheo: &'a Rheometer,
         fit_start: &FitStart,
         options: &IdentifyOptions,
-        take_up: Option<&[f64]>,
     ) -> Result<Self, RheometerError> {
         let start = fit_start.law;
         let layout = Layout::new(&rheo.models[0], &rheo.spec, fit_start, options)?;
@@ -138,7 +134,7 @@ impl<'a> Objective<'a> {
             .enumerate()
             .map(|(k, model)| {
                 let phi_idx = model.take_up_factor_index();
-                let p = layout.local(&shared0, take_up.map_or(1.0, |t| t[k]), phi_idx);
+                let p = layout.local(&shared0, 1.0, phi_idx);
                 let warm = fit_start.warm.as_ref().map(|w| &w[k]);
                 let sim_err = |source: FiberError| RheometerError::Simulation {
                     experiment: rheo.experiments[k].name.clone(),
