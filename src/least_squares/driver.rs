@@ -348,8 +348,7 @@ impl<'o> Driver<'o> {
     /// `σ̂² = ‖r‖²/(N − P)` at the iterate, at most `f_scale²` under a robust loss: the
     /// residuals' scatter that step sizes and progress are measured against.
     fn residual_variance(&self) -> f64 {
-        let dof = self.nr.saturating_sub(self.np).max(1) as f64;
-        let variance = self.r.iter().map(|x| x * x).sum::<f64>() / dof;
+        let variance = super::variance_of(super::cost_of(&self.r), self.nr, self.np);
         if self.options.loss.is_linear() {
             variance
         } else {

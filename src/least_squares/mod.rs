@@ -438,14 +438,12 @@ impl FitResult {
     /// Residual variance `‖r‖²/(N − p)` (the Gauss–Newton estimate of σ² for unit weights;
     /// of the raw residuals under a robust loss).
     pub fn residual_variance(&self) -> f64 {
-        let np = self.p.len();
-        let dof = self.residuals.len().saturating_sub(np).max(1);
         let cost = if self.loss.is_linear() {
             self.cost
         } else {
             cost_of(&self.residuals)
         };
-        2.0 * cost / dof as f64
+        variance_of(cost, self.residuals.len(), self.p.len())
     }
 
     /// Number of residuals a robust loss down-weights (`|rᵢ| > f_scale`; 0 for the linear
@@ -605,6 +603,12 @@ impl FitResult {
 
 fn cost_of(r: &[f64]) -> f64 {
     0.5 * r.iter().map(|v| v * v).sum::<f64>()
+}
+
+/// The residual variance `2 cost/(N − P)` of `nr` residuals with least-squares cost
+/// `cost = ½‖r‖²` and `np` parameters (at least one degree of freedom).
+fn variance_of(cost: f64, nr: usize, np: usize) -> f64 {
+    2.0 * cost / nr.saturating_sub(np).max(1) as f64
 }
 
 /// Solves `min ‖J s + r‖²` s.t. `‖D s‖ ≤ Δ` and returns the step `s`.

@@ -41,14 +41,14 @@ pub const REFINE_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
     at_least: 1000,
 };
 
-/// The growth limit of the grid points' BVP solves ([`ScanOptions::grid_growth_limit`]): 5000
-/// nodes, about 200 times the mesh a grid point needs at its tolerance 1e-3 (20–50 nodes per
-/// experiment). A grid fit's trial step towards `n → 0` (a co-flow or a strain-thinning branch
+/// The growth limit of the grid points' BVP solves ([`ScanOptions::grid_growth_limit`]): 16
+/// times the start's mesh, always 5000 nodes (the floor is what binds: about 100–250 times the
+/// mesh a grid point needs at its tolerance 1e-3, 20–50 nodes per experiment). A grid fit's trial step towards `n → 0` (a co-flow or a strain-thinning branch
 /// the law follows) makes the mesh grow towards `max_nodes` (20 000) before the solve fails:
 /// 15 of a strong co-flow set's 200 grid fits took 62 % of its grid time that way, 0.3–0.9 s
 /// each. With this limit such a solve fails at a quarter of that mesh; the few grid solves
 /// that succeed beyond it (up to 9 700 nodes seen on 12 data sets) fail instead, which changed
-/// 9 of 2 500 grid points on those sets, all at `J` above 1.15 times the user's, and no refit,
+/// 9 of about 2 400 grid points on those sets, all at `J` above 1.15 times the user's, and no refit,
 /// ranking or verdict.
 pub const GRID_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
     factor: 16.0,
