@@ -7,13 +7,21 @@ use crate::*;
 pub struct DiagnoseArgs {
     /// The experiments file (TOML).
     pub experiments: PathBuf,
-    /// The viscosity law of your model: carreau or newtonian.
-    #[arg(long, default_value = "carreau")]
-    pub model: LawChoice,
+    /// The viscosity law of your model: carreau or newtonian (default: carreau, or the law
+    /// of --from).
+    #[arg(long)]
+    pub model: Option<LawChoice>,
     /// Effects already in your model (fitted or "=VALUE" fixed, shapes fixed after colons as
     /// in "air_coflow:decay_length=0.2"); repeatable.
     #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,
+    /// Continue from a previous result: FILE is the JSON of `rheometer fit --json` or of
+    /// `rheometer diagnose --json` (its final fit). Its effects are in your model (strengths
+    /// fitted where they were fitted, fitted shapes free), your model's fit starts from its
+    /// law and strengths, and the search looks for what is still missing; --with adds further
+    /// effects. The law is the file's unless --model says otherwise.
+    #[arg(long, value_name = "FILE")]
+    pub from: Option<PathBuf>,
     /// How many candidates (best linearised score first) get the global search and refits
     /// (default: all).
     #[arg(long, allow_hyphen_values = true, value_parser = checks::parse_refit_top)]
@@ -41,16 +49,36 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         experiments,
         model,
         with,
+        from,
         refit_top,
         robust,
         tol,
         json,
         out,
     } = args;
+    let previous = from.as_deref().map(previous::read_previous).transpose()?;
+    let law = match (model, &previous) {
+        (Some(m), _) => m,
+        (None, Some(p)) => p.fit.law,
+        (None, None) => LawChoice::default(),
+    };
+    let mut opts = DiagnoseOptions::default();
+    let effects = match &previous {
+        Some(p) => {
+            opts.start = p.start(law, &opts.identify)?.map(|(n, k)| [n, k]);
+            let c = p.joined_with(with)?;
+            opts.start_strengths = c.starts;
+            c.effects
+        }
+        None => with,
+    };
     let loaded = load_input(g, &experiments, true, true)?;
+    if let Some(p) = &previous {
+        p.check_experiments(&loaded)?;
+    }
     let spec = ModelSpec {
-        law: model,
-        effects: with,
+        law,
+        effects,
         candidates: Vec::new(),
     };
     spec.validate()?;
@@ -66,6 +94,9 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         ("figure".to_string(), format!("j_profiles.{ext}")),
     ];
     let mut plan = outputs::plan_for(&experiments, &loaded);
+    if let Some(p) = &previous {
+        plan.input(&p.path);
+    }
     if let Some(path) = &json {
         plan.file(path, "--json");
     }
@@ -74,7 +105,6 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         plan.dir_files(dir, [PARTIAL_NAME]);
     }
     let outputs = outputs::check(&plan, g)?;
-    let mut opts = DiagnoseOptions::default();
     if let Some(k) = refit_top {
         opts.refit_top = k;
     }

@@ -28,6 +28,13 @@ pub struct FitArgs {
     /// material data: vft_b_offset, vft_t_vf_offset (K, viscosity at T_o held).
     #[arg(long = "with", value_name = "EFFECT[=VALUE][:SHAPE=VALUE]")]
     pub with: Vec<EffectSetting>,
+    /// Continue from a previous result: FILE is the JSON of `rheometer fit --json` or of
+    /// `rheometer diagnose --json` (its final fit: the model with the effects it found). Its
+    /// effects join the model (strengths fitted where they were fitted, fitted shapes free),
+    /// and the fit starts from its law and strengths; --with adds further effects. The law
+    /// is the file's unless --model says otherwise.
+    #[arg(long, value_name = "FILE", conflicts_with = "start")]
+    pub from: Option<PathBuf>,
     /// The loss of the fit and its soft margin.
     #[command(flatten)]
     pub robust: checks::LossArgs,
@@ -58,12 +65,14 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         newtonian,
         model,
         with,
+        from,
         robust,
         tol,
         json,
         html,
         out,
     } = args;
+    let previous = from.as_deref().map(previous::read_previous).transpose()?;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
     if let Some(t) = tol {
         opts.simulate.tol = t;
@@ -71,9 +80,19 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     }
     robust.apply(&mut opts)?;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
-    let law = match (newtonian, model) {
-        (true, _) => LawChoice::Newtonian,
-        (false, m) => m.unwrap_or_default(),
+    let law = match (newtonian, model, &previous) {
+        (true, _, _) => LawChoice::Newtonian,
+        (false, Some(m), _) => m,
+        (false, None, Some(p)) => p.fit.law,
+        (false, None, None) => LawChoice::default(),
+    };
+    let (with, start, start_strengths) = match &previous {
+        Some(p) => {
+            let start = p.start(law, &opts)?;
+            let c = p.joined_with(with)?;
+            (c.effects, start, c.starts)
+        }
+        None => (with, start, Vec::new()),
     };
     if let Some(s) = start {
         if law == LawChoice::Newtonian {
@@ -92,8 +111,14 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     };
     spec.validate()?;
     let loaded = load_input(g, &experiments, true, true)?;
+    if let Some(p) = &previous {
+        p.check_experiments(&loaded)?;
+    }
     // every output is checked before the fit
     let mut plan = outputs::plan_for(&experiments, &loaded);
+    if let Some(p) = &previous {
+        plan.input(&p.path);
+    }
     if let Some(path) = &json {
         plan.file(path, "--json");
     }
@@ -110,6 +135,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         model: spec,
         identify: opts,
         start: start.map(|(n, k)| [n, k]),
+        start_strengths,
         baseline: out.is_some(),
         newtonian_reference: out.is_some(),
         ..FitRequest::new(IdentifyOptions::default())

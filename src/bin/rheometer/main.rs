@@ -57,6 +57,7 @@ mod diagnose;
 mod fit;
 mod landscape;
 mod outputs;
+mod previous;
 mod signals;
 mod simulate;
 mod streams;

@@ -85,4 +85,6 @@ pub use summary::{
     AtBound, Covariance, EffectEstimate, Estimate, FitSummary, FitWarning, SolverRecord,
     WarningCode,
 };
-pub use summary_read::{FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE, FIT_FILE_TAKE_UP_RANGE};
+pub use summary_read::{
+    ContinuedEffects, FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE, FIT_FILE_TAKE_UP_RANGE,
+};

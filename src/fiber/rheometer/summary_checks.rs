@@ -282,8 +282,12 @@ pub(crate) fn check_law(s: &FitSummary, w: &mut Vec<FitWarning>) {
 /// variance: moving a parameter `z` standard errors costs `z²`): worth a note (the added
 /// effect may buy a different law rather than explain the data; a plain fit biased by a
 /// missing effect moves by many of its standard errors too). Returns the jump in standard
-/// errors.
+/// errors. A plain fit whose own law is implausible (`n` below [`PLAUSIBLE_N`]) is no
+/// reference: a refit that moves it into the plausible range is not checked against it.
 pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarning)> {
+    if base.n.value < PLAUSIBLE_N[0] && refit.n.value >= PLAUSIBLE_N[0] {
+        return None;
+    }
     let z = |a: &super::summary::Estimate, b: &super::summary::Estimate| {
         if a.fitted && b.fitted && a.stderr > 0.0 && a.stderr.is_finite() {
             ((b.value - a.value) / a.stderr).abs()
@@ -428,4 +432,35 @@ pub(crate) fn check_misfit(s: &FitSummary, w: &mut Vec<FitWarning>) {
     }
     m.push_str(": check their data, TOML entries (temperatures, take-up) and the model");
     w.push(FitWarning::new(WarningCode::Misfit, m));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fiber::rheometer::summary::tests::refit_summary;
+
+    /// A refit moved 30 standard errors of the plain fit's `n` with a gain of 100 in units
+    /// of the noise variance (worth 900): a jump from a plausible law, none from an
+    /// implausible one into the plausible range.
+    #[test]
+    fn a_law_jump_is_judged_from_a_plausible_plain_fit_only() {
+        let mut refit = refit_summary("a", (0.5, 0.1), (0.8, 0.01), (11.7, 0.1));
+        refit.residuals = 1001;
+        refit.cost = 0.5; // 4 fitted parameters: σ̂² = 0.5 / 997
+        let with_base = |n: f64, se: f64| {
+            let mut base = refit_summary("a", (0.0, 0.0), (n, se), (11.7, 0.1));
+            base.cost = refit.cost + 100.0 * refit.cost / 997.0;
+            base
+        };
+        let (jump, w) = law_jump(&with_base(0.5, 0.01), &refit).expect("a jump from n = 0.5");
+        assert!((jump - 30.0).abs() < 1e-9, "{jump}");
+        assert_eq!(w.code, WarningCode::Implausible);
+        // the plain fit's own n = 0.18 is implausible: no reference to jump from
+        assert!(law_jump(&with_base(0.18, 0.01), &refit).is_none());
+        // a refit that stays implausible is still judged against it (0.10 -> 0.16, 30 se)
+        let mut low = refit.clone();
+        low.n.value = 0.16;
+        let (jump, _) = law_jump(&with_base(0.10, 0.002), &low).expect("a jump below 0.2");
+        assert!((jump - 30.0).abs() < 1e-6, "{jump}");
+    }
 }

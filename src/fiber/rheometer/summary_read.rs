@@ -1,10 +1,10 @@
 //! Reading a [`FitSummary`] back from its JSON (`rheometer fit --json`): the next step
-//! (`compare --fit`, `fit --from`, `diagnose --from`) starts from it. Every field the next
+//! (`compare --fit`, `fit --from`) starts from it. Every field the next
 //! step needs is checked, and errors name the file and the field.
 
 use super::estimator::Estimator;
 use super::summary::{FitSummary, WarningCode};
-use crate::fiber::effects::Effect;
+use crate::fiber::effects::{Effect, EffectSetting};
 use crate::fiber::error::Readable;
 use serde_json::Value;
 
@@ -16,6 +16,17 @@ pub const FIT_FILE_KAPPA_RANGE: [f64; 2] = [0.0, 50.0];
 /// The range of take-up factors accepted from a fit file: the rheometer's default search range
 /// (`IdentifyOptions::take_up_bounds`), which every fit of the `rheometer` program uses \[-\].
 pub const FIT_FILE_TAKE_UP_RANGE: [f64; 2] = [0.5, 1.5];
+
+/// A previous fit's effects as the model of a next fit
+/// ([`FitSummary::continued_effects`]).
+#[derive(Debug, Clone)]
+pub struct ContinuedEffects {
+    /// The effects, strengths fitted or fixed as in the previous fit, fitted shapes free.
+    pub effects: Vec<EffectSetting>,
+    /// Start values of the fitted strengths (by effect name) and shapes (by model-parameter
+    /// name).
+    pub starts: Vec<(String, f64)>,
+}
 
 fn kind(v: &Value) -> &'static str {
     match v {
@@ -253,6 +264,62 @@ impl FitSummary {
         Ok(s)
     }
 
+    /// A fit to continue from: the JSON text of a fit report (`rheometer fit --json`) or of a
+    /// diagnosis (`rheometer diagnose --json`: its final fit, the model with the effects it
+    /// found, or without one its base fit); `source` names the file in errors.
+    pub fn from_fit_or_diagnosis_json(text: &str, source: &str) -> Result<Self, String> {
+        let value: Value =
+            serde_json::from_str(text).map_err(|e| format!("{source} is not valid JSON: {e}"))?;
+        let diagnosis = value
+            .as_object()
+            .filter(|o| o.contains_key("verdict") && o.contains_key("base_fit"));
+        let Some(obj) = diagnosis else {
+            return Self::from_json(text, source);
+        };
+        let (field, fit) = match obj.get("final_fit").filter(|v| !v.is_null()) {
+            Some(f) => ("final_fit", f),
+            None => ("base_fit", &obj["base_fit"]),
+        };
+        Self::from_json(
+            &fit.to_string(),
+            &format!("{source} (the diagnosis' field \"{field}\")"),
+        )
+    }
+
+    /// The effects of this fit as the model of a next fit, and where its fitted parameters
+    /// start: each effect with the strength fitted where it was fitted (else fixed at its
+    /// value), its fitted shapes free again and the others fixed at their values; the start
+    /// values of the fitted strengths (by effect name) and shapes (by model-parameter name),
+    /// as [`FitStart::strengths`](super::FitStart::strengths) takes them.
+    pub fn continued_effects(&self) -> Result<ContinuedEffects, String> {
+        let mut effects = Vec::new();
+        let mut starts = Vec::new();
+        for e in &self.effects {
+            let mut effect: Effect = e.effect.parse()?;
+            let settings = effect.shape_settings();
+            for sh in &e.shapes {
+                let Some((sp, _)) = settings.iter().find(|(sp, _)| sp.name == sh.name) else {
+                    return Err(format!(
+                        "{} has no shape parameter \"{}\"",
+                        e.effect, sh.name
+                    ));
+                };
+                if sh.fitted {
+                    starts.push((sp.model_param.to_string(), sh.value));
+                } else {
+                    effect = effect.with_shape(&sh.name, sh.value)?;
+                }
+            }
+            if e.strength.fitted {
+                starts.push((effect.name().to_string(), e.strength.value));
+                effects.push(EffectSetting::fitted(effect));
+            } else {
+                effects.push(EffectSetting::fixed(effect, e.strength.value));
+            }
+        }
+        Ok(ContinuedEffects { effects, starts })
+    }
+
     /// Checks the values (as read from a file `source`): `n` in [`FIT_FILE_N_RANGE`], `κ` in
     /// [`FIT_FILE_KAPPA_RANGE`], take-up factors in [`FIT_FILE_TAKE_UP_RANGE`], effects known,
     /// once each, with finite strengths inside their search ranges, and as many experiment
@@ -396,5 +463,82 @@ impl FitSummary {
             ));
         }
         Ok(Some(self.take_up_factors.clone()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fiber::rheometer::summary::tests::refit_summary;
+    use crate::fiber::rheometer::Estimate;
+
+    /// A fit with a co-flow: strength 27 ± 3 m/s, decay length fitted, tail fixed at 0.5.
+    fn coflow_fit(n: f64) -> FitSummary {
+        let mut f = refit_summary("air_coflow", (27.0, 3.0), (n, 0.02), (11.6, 0.2));
+        f.effects[0].shapes = vec![
+            Estimate::fitted("decay_length", 0.19, "m", 0.012, None),
+            Estimate {
+                fitted: false,
+                ..Estimate::fitted("tail", 0.5, "-", 0.0, None)
+            },
+        ];
+        f
+    }
+
+    #[test]
+    fn a_previous_fit_continues_with_its_fitted_shapes_free_and_its_values_as_starts() {
+        let c = coflow_fit(0.8).continued_effects().unwrap();
+        assert_eq!(c.effects.len(), 1);
+        assert!(c.effects[0].value.is_none(), "the strength is fitted again");
+        match &c.effects[0].effect {
+            Effect::AirCoflow { decay_length, tail } => {
+                assert_eq!((*decay_length, *tail), (None, Some(0.5)));
+            }
+            e => panic!("{e:?}"),
+        }
+        assert_eq!(
+            c.starts,
+            vec![
+                ("air_coflow.decay_length".to_string(), 0.19),
+                ("air_coflow".to_string(), 27.0)
+            ]
+        );
+        // a fixed strength stays fixed, and starts nothing
+        let mut fixed = coflow_fit(0.8);
+        fixed.effects[0].strength.fitted = false;
+        let c = fixed.continued_effects().unwrap();
+        assert_eq!(c.effects[0].value, Some(27.0));
+        assert_eq!(c.starts.len(), 1);
+    }
+
+    #[test]
+    fn a_diagnosis_file_gives_its_final_fit_or_else_its_base_fit() {
+        let base = serde_json::to_value(coflow_fit(0.3)).unwrap();
+        let last = serde_json::to_value(coflow_fit(0.8)).unwrap();
+        let doc = |final_fit: Value| {
+            serde_json::json!({
+                "verdict": {"kind": "explained"},
+                "base_fit": base.clone(),
+                "final_fit": final_fit,
+            })
+            .to_string()
+        };
+        let f = FitSummary::from_fit_or_diagnosis_json(&doc(last.clone()), "d.json").unwrap();
+        assert_eq!(f.n.value, 0.8);
+        let f = FitSummary::from_fit_or_diagnosis_json(&doc(Value::Null), "d.json").unwrap();
+        assert_eq!(f.n.value, 0.3);
+        // a fit report reads as itself
+        let f = FitSummary::from_fit_or_diagnosis_json(&last.to_string(), "f.json").unwrap();
+        assert_eq!(f.n.value, 0.8);
+        // errors name the file and the diagnosis' field
+        let mut broken = last.clone();
+        broken["n"] = serde_json::json!("high");
+        let e = FitSummary::from_fit_or_diagnosis_json(&doc(broken), "d.json").unwrap_err();
+        assert!(
+            e.contains("d.json") && e.contains("final_fit") && e.contains("\"n\""),
+            "{e}"
+        );
+        let e = FitSummary::from_fit_or_diagnosis_json("{", "d.json").unwrap_err();
+        assert!(e.contains("d.json") && e.contains("JSON"), "{e}");
     }
 }

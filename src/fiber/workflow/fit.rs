@@ -10,8 +10,8 @@ use crate::fiber::fit_html::{fit_report_page, FitReportInput, ReportExperiment};
 use crate::fiber::input::LoadedExperiments;
 use crate::fiber::rheometer::profile::{intervals, ProfileMode};
 use crate::fiber::rheometer::{
-    error_budget, FitSummary, FlowCurve, FlowCurveOptions, Identification, IdentifyOptions,
-    Rheometer, RheometerError, StartPoint,
+    error_budget, FitStart, FitSummary, FlowCurve, FlowCurveOptions, Identification,
+    IdentifyOptions, Rheometer, RheometerError, StartPoint,
 };
 use crate::html_page::HtmlPage;
 use crate::solution::Solution;
@@ -26,6 +26,11 @@ pub struct FitRequest {
     /// Start `(n, κ)`; `None`: the paper's start heuristic for a fitted law, `(1, 13.5)` for a
     /// Newtonian one.
     pub start: Option<[f64; 2]>,
+    /// Start values of the effects' fitted strengths (by effect name) and shapes (by
+    /// model-parameter name), e.g. a previous fit's ([`FitSummary::continued_effects`]; `fit
+    /// --from`). The fit from them (at `start`) is kept where it ends lower than the nested
+    /// fit, which starts the effects at neutral strength.
+    pub start_strengths: Vec<(String, f64)>,
     /// Also fit the model without its added effects (the before/after residuals of a model
     /// with effects; nothing for the paper's model).
     pub baseline: bool,
@@ -48,6 +53,7 @@ impl FitRequest {
             model: ModelSpec::default(),
             identify,
             start: None,
+            start_strengths: Vec::new(),
             baseline: false,
             newtonian_reference: false,
             error_budget: true,
@@ -141,6 +147,19 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
     // a model with fitted effects never ends worse than the model without them
     let nested = rh.identify_nested(start, opts)?;
     let mut id = nested.fit;
+    if !request.start_strengths.is_empty() {
+        let from = FitStart {
+            strengths: request.start_strengths.clone(),
+            ..FitStart::at(start)
+        };
+        // a start that fails to solve leaves the nested fit, which never ends worse than the
+        // plain model
+        if let Ok(f) = rh.identify_from(&from, opts) {
+            if f.summary.cost < id.summary.cost {
+                id = f;
+            }
+        }
+    }
     // an effect whose strength must differ between the experiments is a stand-in
     let fitted: Vec<String> = id
         .summary

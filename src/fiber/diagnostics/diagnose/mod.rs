@@ -75,6 +75,7 @@ pub mod verdict;
 use super::consistency;
 use super::scan::ScanOptions;
 use super::ties::DEFAULT_TIE_MARGIN;
+use crate::fiber::diagnostics::scan::refitted_effect;
 use crate::fiber::effects::{Effect, EffectSetting, ModelSpec};
 use crate::fiber::noise_summary::NoiseSummary;
 use crate::fiber::rheometer::{
@@ -115,6 +116,11 @@ pub struct DiagnoseOptions {
     pub tie_margin: f64,
     /// Start `(n, κ)` of the user's Carreau fit (default: the paper's start heuristic).
     pub start: Option<[f64; 2]>,
+    /// Start values of the user's fitted effects: strengths by effect name, shapes by
+    /// model-parameter name, e.g. a previous fit's (`diagnose --from`). The user's fit from
+    /// them is kept where it ends lower than the nested fit, which starts them at neutral
+    /// strength (default: none).
+    pub start_strengths: Vec<(String, f64)>,
     /// Largest false-alarm probability of the search at which an effect is named (default
     /// 0.05; see [`calibrate`]).
     pub max_false_alarm: f64,
@@ -135,6 +141,7 @@ impl Default for DiagnoseOptions {
             earn_threshold: -10.0,
             tie_margin: DEFAULT_TIE_MARGIN,
             start: None,
+            start_strengths: Vec::new(),
             max_false_alarm: MAX_FALSE_ALARM,
             calibration_replicates: calibrate::DEFAULT_REPLICATES,
             max_effects: 2,
@@ -166,7 +173,17 @@ pub fn diagnose(
         }
         let mut spec = last.spec.clone();
         spec.candidates.clear();
-        let spec = spec.with(EffectSetting::fitted(variant.clone()));
+        // the effect its refit fitted: the fitted shapes free again (the variant fixes them at
+        // the grid's values), the discrete ones at the variant's
+        let effect = match options
+            .candidates
+            .iter()
+            .find(|c| c.name() == variant.name())
+        {
+            Some(c) => refitted_effect(c, variant).map_err(RheometerError::Data)?,
+            None => variant.clone(),
+        };
+        let spec = spec.with(EffectSetting::fitted(effect));
         let mut opts = options.clone();
         opts.candidates
             .retain(|c| !spec.effects.iter().any(|e| e.effect.name() == c.name()));

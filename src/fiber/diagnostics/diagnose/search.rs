@@ -63,6 +63,13 @@ pub(crate) fn scan_all(
                 .map(move |(v, s)| (i, v, s))
         })
         .collect();
+    // where the user's law is implausible, the sides are walked inwards again from the
+    // diagnosis' start law (unless the options name another)
+    let mut scan_options = ctx.options.scan.clone();
+    if ctx.spec.law == LawChoice::Carreau {
+        scan_options.restart_law = scan_options.restart_law.or(Some(ctx.law0));
+    }
+    let scan_options = &scan_options;
     let scans: Vec<(usize, Result<ProfileScan, RheometerError>)> = jobs
         .into_par_iter()
         .map(|(i, v, s)| {
@@ -74,7 +81,7 @@ pub(crate) fn scan_all(
                 base,
                 lin.cost_before,
                 &ctx.opts,
-                &ctx.options.scan,
+                scan_options,
             );
             (i, sc)
         })

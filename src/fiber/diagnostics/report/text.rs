@@ -421,10 +421,36 @@ impl Diagnosis {
     }
 }
 
-/// `With <effects><note>: n = …, kappa = …, RMS … %.`: a fit's law with its intervals.
+/// `With <effects><note>: n = …, kappa = …, RMS … %; strengths: …`: a fit's law with its
+/// intervals, and the fitted strengths and shapes of its effects (a model with several effects
+/// is one fit: its strengths are not those of each effect's own refit).
 fn law_line(effects: &str, note: &str, f: &FitSummary) -> String {
+    let fitted: Vec<String> = f
+        .effects
+        .iter()
+        .filter(|e| e.strength.fitted)
+        .map(|e| {
+            let shapes: Vec<String> = e
+                .shapes
+                .iter()
+                .filter(|sh| sh.fitted)
+                .map(|sh| format!("{} {}", sh.name, pm_unit(sh.value, sh.stderr, &sh.unit)))
+                .collect();
+            let strength = pm_unit(e.strength.value, e.strength.stderr, &e.strength.unit);
+            if shapes.is_empty() {
+                format!("{} {strength}", e.effect)
+            } else {
+                format!("{} {strength} ({})", e.effect, shapes.join(", "))
+            }
+        })
+        .collect();
+    let strengths = if fitted.is_empty() {
+        String::new()
+    } else {
+        format!("; strengths: {}", fitted.join(", "))
+    };
     format!(
-        "With {effects}{note}: n = {}, kappa = {}, RMS {:.3} %.\n",
+        "With {effects}{note}: n = {}, kappa = {}, RMS {:.3} %{strengths}.\n",
         estimate_with_ci_bounds(&f.at_bound, "n", f.n.value, f.n.ci95),
         estimate_with_ci_bounds(&f.at_bound, "kappa", f.kappa.value, f.kappa.ci95),
         100.0 * f.rms_relative_residual

@@ -1,0 +1,82 @@
+//! `--from FILE` of `fit` and `diagnose`: the previous result (a fit report or a diagnosis)
+//! a fit continues from, its effects joined with the ones `--with` adds.
+
+use crate::*;
+use diffbvp::fiber::rheometer::ContinuedEffects;
+
+/// A previous result `fit --from` or `diagnose --from` continues from.
+pub struct Previous {
+    /// The file.
+    pub path: PathBuf,
+    /// Its fit (a diagnosis' final fit).
+    pub fit: FitSummary,
+}
+
+impl Previous {
+    /// The start `(n, κ)` of a fit of `law` from the file's law (none for a Newtonian model),
+    /// checked against the fit's bounds.
+    pub fn start(
+        &self,
+        law: LawChoice,
+        opts: &IdentifyOptions,
+    ) -> Result<Option<(f64, f64)>, String> {
+        if law != LawChoice::Carreau {
+            return Ok(None);
+        }
+        let s = (self.fit.n.value, self.fit.kappa.value);
+        checks::check_start(s, opts).map_err(|e| {
+            format!(
+                "--from {}: its law cannot start this fit ({e})",
+                self.path.display()
+            )
+        })?;
+        Ok(Some(s))
+    }
+
+    /// Checks that the file is a fit of the experiments of `loaded`, in their order.
+    pub fn check_experiments(&self, loaded: &LoadedExperiments) -> Result<(), String> {
+        let names: Vec<String> = loaded
+            .set
+            .experiments
+            .iter()
+            .map(|e| e.name.clone())
+            .collect();
+        self.fit
+            .check_experiments(&names, &self.path.display().to_string())
+    }
+
+    /// The model's effects: the file's (continued) and then `with`, each effect once; the
+    /// start values of the file's fitted strengths and shapes.
+    pub fn joined_with(&self, with: Vec<EffectSetting>) -> Result<ContinuedEffects, String> {
+        let source = self.path.display();
+        let c = self
+            .fit
+            .continued_effects()
+            .map_err(|e| format!("--from {source}: {e}"))?;
+        let mut effects = c.effects;
+        for w in with {
+            let name = w.effect.name();
+            if effects.iter().any(|e| e.effect.name() == name) {
+                return Err(format!(
+                    "--with {name}: {name} is in the model of --from {source} already (its                      strength is fitted from the file's value); drop this --with, or fit                      without --from to give {name} yourself"
+                ));
+            }
+            effects.push(w);
+        }
+        Ok(ContinuedEffects {
+            effects,
+            starts: c.starts,
+        })
+    }
+}
+
+/// Reads the file of `--from`: a fit report or a diagnosis.
+pub fn read_previous(path: &Path) -> Result<Previous, Box<dyn Error>> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("--from: cannot read {}: {e}", path.display()))?;
+    let fit = FitSummary::from_fit_or_diagnosis_json(&text, &path.display().to_string())?;
+    Ok(Previous {
+        path: path.to_path_buf(),
+        fit,
+    })
+}
