@@ -258,7 +258,8 @@ def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float
         effects: Union[None, str, Iterable[str]] = None, loss: str = "linear",
         f_scale: Optional[float] = None, relative_uncertainty: Optional[float] = None,
         error_budget: bool = True, tol: Optional[float] = None, max_nodes: Optional[int] = None,
-        profile_points: int = 101) -> FitResult:
+        profile_points: int = 101,
+        start_from: Union[None, FitResult, Diagnosis, Mapping[str, Any], PathLike] = None) -> FitResult:
     """Identifies (n, κ) and the strengths of fitted effects: the library's fit workflow, as
     ``rheometer fit``. Returns the fit's ``FitSummary`` (:class:`FitResult`).
 
@@ -273,14 +274,19 @@ def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float
     time; a bootstrap replicate can do without); ``tol``: BVP tolerance [-] kept as given
     (default: 1e-4, refined until the discretisation moves no estimate by more than 0.01
     standard errors); ``max_nodes``: mesh limit (default 20000); ``profile_points``:
-    positions of the fitted profiles. Warnings of the fit are in ``FitResult.warnings``; a
-    budget that could not be computed is in ``FitResult.notes`` and warned about.
+    positions of the fitted profiles; ``start_from``: continue from a previous result (a
+    :class:`FitResult`, a :class:`Diagnosis` — its final fit, the model with the effects it
+    found — their dicts, or the path of a ``fit --json`` / ``diagnose --json`` file): its
+    effects join the model (strengths fitted where they were fitted, fitted shapes free) and
+    the fit starts from its law and strengths; ``effects`` adds further ones (``start`` not
+    with it). Warnings of the fit are in ``FitResult.warnings``; a budget that could not be
+    computed is in ``FitResult.notes`` and warned about.
     """
     d = _native.fit(_ds(dataset), start=None if start is None else (float(start[0]), float(start[1])),
                     estimator=estimator, model=model, effects=_effects(effects), loss=loss,
                     f_scale=f_scale, relative_uncertainty=relative_uncertainty,
                     error_budget=error_budget, tol=tol, max_nodes=max_nodes,
-                    profile_points=profile_points)
+                    profile_points=profile_points, start_from=_previous(start_from))
     result = FitResult._from_native(d)
     for note in result.notes:
         _warnings.warn(note, RuntimeWarning, stacklevel=2)
@@ -318,7 +324,9 @@ def diagnose(dataset: Union[Dataset, PathLike], *, model: str = "carreau",
              candidates: Optional[Iterable[str]] = None, refit_top: Optional[int] = None,
              start: Optional[Tuple[float, float]] = None, loss: str = "linear",
              f_scale: Optional[float] = None, tol: Optional[float] = None,
-             max_nodes: Optional[int] = None) -> Diagnosis:
+             max_nodes: Optional[int] = None,
+             start_from: Union[None, FitResult, Diagnosis, Mapping[str, Any], PathLike] = None
+             ) -> Diagnosis:
     """Which physical effects are missing? The library's diagnose workflow, as ``rheometer
     diagnose``: fits your model (``model``, ``effects``), scores every candidate effect
     (default: all built-in ones, or ``candidates`` by name), searches and refits them, ranks
@@ -329,13 +337,37 @@ def diagnose(dataset: Union[Dataset, PathLike], *, model: str = "carreau",
     fit; ``loss`` (``"soft_l1"``, ``"huber"``, ``"cauchy"``) and ``f_scale``: a robust loss
     whose fit of your model weights the points for every fit of the diagnosis (default: least
     squares, the gross outliers of the noise model left out; ``Diagnosis.robust`` says how it
-    weighted them); ``tol``: BVP tolerance (default 1e-4). Takes about 5 s on the shipped data and up
+    weighted them); ``tol``: BVP tolerance (default 1e-4); ``start_from``: a previous result
+    whose effects are in your model, fitted from its law and strengths (as in :func:`fit`), so
+    that the search looks for what is still missing. Takes about 5 s on the shipped data and up
     to half a minute where two effects are missing (2 cores)."""
     d = _native.diagnose(_ds(dataset), model=model, effects=_effects(effects),
                          candidates=None if candidates is None else [str(c) for c in candidates],
                          refit_top=refit_top, start=start, loss=loss, f_scale=f_scale, tol=tol,
-                         max_nodes=max_nodes)
+                         max_nodes=max_nodes, start_from=_previous(start_from))
     return Diagnosis._from_native(d)
+
+
+def _previous(start_from: Union[None, FitResult, Diagnosis, Mapping[str, Any], PathLike]
+              ) -> Optional[str]:
+    """A result to continue from as the JSON text the library reads (``fit --from``)."""
+    import json
+    if start_from is None:
+        return None
+    if isinstance(start_from, FitResult):
+        return json.dumps(start_from.summary)
+    if isinstance(start_from, Diagnosis):
+        return json.dumps(start_from.diagnosis)
+    if isinstance(start_from, Mapping):
+        return json.dumps(dict(start_from))
+    if isinstance(start_from, (str, os.PathLike)):
+        try:
+            with open(start_from, encoding="utf-8") as f:
+                return f.read()
+        except OSError as e:
+            raise InputError(f"start_from: cannot read {os.fspath(start_from)}: {e}") from e
+    raise TypeError("start_from: give a FitResult, a Diagnosis, their dict, or the path of a "
+                    f"fit or diagnosis JSON file (got {type(start_from).__name__})")
 
 
 def landscape(dataset: Union[Dataset, PathLike], *, grid: Tuple[int, int] = (41, 41),

@@ -30,7 +30,7 @@ def fit(dataset: Dataset, *, start: Optional[Tuple[float, float]] = None, estima
         model: str = "carreau", effects: Sequence[str] = ..., loss: str = "linear",
         f_scale: Optional[float] = None, relative_uncertainty: Optional[float] = None,
         error_budget: bool = True, tol: Optional[float] = None, max_nodes: Optional[int] = None,
-        profile_points: int = 101) -> Dict[str, Any]:
+        profile_points: int = 101, start_from: Optional[str] = None) -> Dict[str, Any]:
     """{"summary": FitSummary dict, "text": str, "arrays": {"residual_profiles", "profiles"},
     "notes": [str]}"""
 def simulate(dataset: Dataset, n: float = 0.8, kappa: float = 11.71, *, effects: Sequence[str] = ...,
@@ -46,7 +46,7 @@ def compare(dataset: Dataset, fit: Optional[Mapping[str, Any]] = None, *, n: Opt
 def diagnose(dataset: Dataset, *, model: str = "carreau", effects: Sequence[str] = ...,
              candidates: Optional[Sequence[str]] = None, refit_top: Optional[int] = None,
              start: Optional[Tuple[float, float]] = None, tol: Optional[float] = None,
-             max_nodes: Optional[int] = None) -> Dict[str, Any]:
+             max_nodes: Optional[int] = None, start_from: Optional[str] = None) -> Dict[str, Any]:
     """{"diagnosis": Diagnosis dict, "text": str, "base_arrays": {"residual_profiles"},
     "final_arrays": {"residual_profiles"} | None}"""
 def landscape(dataset: Dataset, *, grid: Tuple[int, int] = (41, 41),

@@ -22,7 +22,8 @@ use pyo3::types::PyDict;
 /// "final_arrays": {...} | None}` (arrays as in `fit`'s result, without profiles).
 #[pyfunction]
 #[pyo3(signature = (dataset, *, model="carreau", effects=Vec::new(), candidates=None,
-    refit_top=None, start=None, loss="linear", f_scale=None, tol=None, max_nodes=None))]
+    refit_top=None, start=None, loss="linear", f_scale=None, tol=None, max_nodes=None,
+    start_from=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose<'py>(
     py: Python<'py>,
@@ -36,15 +37,34 @@ pub fn diagnose<'py>(
     f_scale: Option<f64>,
     tol: Option<f64>,
     max_nodes: Option<usize>,
+    start_from: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let law = options::law(model)?;
+    let (loaded, path) = dataset.data();
+    let names: Vec<String> = loaded
+        .set
+        .experiments
+        .iter()
+        .map(|e| e.name.clone())
+        .collect();
+    let mut opts = DiagnoseOptions::default();
+    let continued = options::continued(
+        start_from.as_deref(),
+        options::effects(&effects)?,
+        start,
+        law,
+        &opts.identify,
+        &names,
+    )?;
+    opts.start_strengths = continued.starts;
+    let start = continued.start;
     let spec = ModelSpec {
-        law: options::law(model)?,
-        effects: options::effects(&effects)?,
+        law,
+        effects: continued.effects,
         candidates: Vec::new(),
     };
     spec.validate()
         .map_err(|e| input_error(format!("effects: {e}")))?;
-    let mut opts = DiagnoseOptions::default();
     if let Some(c) = candidates {
         opts.candidates = c
             .iter()
@@ -74,7 +94,6 @@ pub fn diagnose<'py>(
         opts.identify.simulate.tol = t;
         opts.identify.max_discretisation_shift = Some(f64::INFINITY);
     }
-    let (loaded, path) = dataset.data();
     let out = interruptible(py, |cancel| {
         let mut opts = opts;
         opts.identify.cancel = Some(cancel);

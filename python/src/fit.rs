@@ -77,7 +77,7 @@ pub fn identification_arrays<'py>(
 #[pyfunction]
 #[pyo3(signature = (dataset, *, start=None, estimator="principled", model="carreau",
     effects=Vec::new(), loss="linear", f_scale=None, relative_uncertainty=None,
-    error_budget=true, tol=None, max_nodes=None, profile_points=101))]
+    error_budget=true, tol=None, max_nodes=None, profile_points=101, start_from=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
@@ -93,6 +93,7 @@ pub fn fit<'py>(
     tol: Option<f64>,
     max_nodes: Option<usize>,
     profile_points: usize,
+    start_from: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut opts = IdentifyOptions::with_estimator(options::estimator(estimator)?);
     options::robust_loss(&mut opts, loss, f_scale)?;
@@ -112,9 +113,26 @@ pub fn fit<'py>(
             options::MAX_POINTS
         )));
     }
+    let law = options::law(model)?;
+    let (loaded, path) = dataset.data();
+    let names: Vec<String> = loaded
+        .set
+        .experiments
+        .iter()
+        .map(|e| e.name.clone())
+        .collect();
+    let continued = options::continued(
+        start_from.as_deref(),
+        options::effects(&effects)?,
+        start,
+        law,
+        &opts,
+        &names,
+    )?;
+    let start = continued.start;
     let spec = ModelSpec {
-        law: options::law(model)?,
-        effects: options::effects(&effects)?,
+        law,
+        effects: continued.effects,
         candidates: Vec::new(),
     };
     if spec.law == LawChoice::Newtonian && start.is_some() {
@@ -127,10 +145,10 @@ pub fn fit<'py>(
     let request = FitRequest {
         model: spec,
         start: start.map(|(n, k)| [n, k]),
+        start_strengths: continued.starts,
         error_budget,
         ..FitRequest::new(opts)
     };
-    let (loaded, path) = dataset.data();
     let out = interruptible(py, |cancel| {
         let mut request = request;
         request.identify.cancel = Some(cancel);

@@ -3,7 +3,7 @@
 
 use crate::errors::input_error;
 use diffbvp::fiber::effects::{EffectSetting, LawChoice};
-use diffbvp::fiber::rheometer::{Estimator, IdentifyOptions};
+use diffbvp::fiber::rheometer::{Estimator, FitSummary, IdentifyOptions};
 use diffbvp::least_squares::Loss;
 use pyo3::prelude::*;
 
@@ -170,4 +170,57 @@ pub fn check_range(
         )));
     }
     Ok(())
+}
+
+/// A fit or diagnosis to continue from (`start_from`): the model's effects and where the fit
+/// starts.
+pub struct Continued {
+    /// The previous fit's effects (fitted strengths and shapes free), then `effects`.
+    pub effects: Vec<EffectSetting>,
+    /// The start `(n, κ)`: the previous law for a Carreau model, else the given `start`.
+    pub start: Option<(f64, f64)>,
+    /// Start values of the previous fit's fitted strengths and shapes.
+    pub starts: Vec<(String, f64)>,
+}
+
+/// `start_from` (the JSON text of a fit report or a diagnosis, as `rheometer fit --from`
+/// reads it) joined with `effects`, the law `law` and the given `start`; checked against the
+/// data set's experiment `names` and the fit's bounds in `opts`.
+pub fn continued(
+    start_from: Option<&str>,
+    effects: Vec<EffectSetting>,
+    start: Option<(f64, f64)>,
+    law: LawChoice,
+    opts: &IdentifyOptions,
+    names: &[String],
+) -> PyResult<Continued> {
+    let Some(text) = start_from else {
+        return Ok(Continued {
+            effects,
+            start,
+            starts: Vec::new(),
+        });
+    };
+    if start.is_some() {
+        return Err(input_error(
+            "start and start_from: the fit starts from start_from's law; give one of them".into(),
+        ));
+    }
+    let previous =
+        FitSummary::from_fit_or_diagnosis_json(text, "start_from").map_err(input_error)?;
+    previous
+        .check_experiments(names, "start_from")
+        .map_err(input_error)?;
+    let c = previous
+        .continued_with(effects, "effects", "start_from")
+        .map_err(input_error)?;
+    let start = (law == LawChoice::Carreau).then_some((previous.n.value, previous.kappa.value));
+    if let Some(s) = start {
+        check_start(s, opts)?;
+    }
+    Ok(Continued {
+        effects: c.effects,
+        start,
+        starts: c.starts,
+    })
 }

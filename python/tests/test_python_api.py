@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import pickle
 
 import numpy as np
@@ -162,3 +163,32 @@ def test_a_pair_as_good_with_another_law_makes_the_law_no_result():
     lo = min(d.final_fit.n.ci95[0], p["fit"]["n"]["ci95"][0])
     hi = max(d.final_fit.n.ci95[1], p["fit"]["n"]["ci95"][1])
     assert lo <= 0.8 <= hi, (lo, hi)
+
+
+def test_a_fit_and_a_diagnosis_continue_from_a_previous_result(radiation_diagnosis, rheometer,
+                                                                scratch):
+    """``start_from`` as ``--from``: the diagnosis' effects join the model, the fit starts from
+    its law and strengths, and the numbers are the CLI's; a diagnosis from a fit has the fit's
+    effects in the user's model."""
+    from conftest import RADIATION, cli_json
+    ds = diffbvp.load(RADIATION)
+    assert "radiation" in radiation_diagnosis.found
+    fit = diffbvp.fit(ds, start_from=radiation_diagnosis)
+    assert "radiation" in fit.summary["fitted"]
+    path = scratch / "radiation_diagnosis.json"
+    path.write_text(json.dumps(radiation_diagnosis.diagnosis))
+    assert_same(diffbvp.fit(ds, start_from=path).summary, fit.summary, rel=0.0)
+    cli = cli_json(rheometer, scratch, "fit_from", "fit", str(RADIATION), "--from", str(path))
+    assert_same(cli, fit.summary, rel=1e-12)
+    # the same optimum as the diagnosis' final fit, which it starts from
+    final = radiation_diagnosis.final_fit
+    assert abs(fit.n.value - final.n.value) <= 0.05 * final.n.stderr
+    with pytest.raises(diffbvp.InputError, match="start_from"):
+        diffbvp.fit(ds, start_from=fit, start=(0.5, 12.0))
+    with pytest.raises(diffbvp.InputError, match="effects radiation"):
+        diffbvp.fit(ds, start_from=fit, effects="radiation=0.5")
+    with pytest.raises(TypeError, match="start_from"):
+        diffbvp.fit(ds, start_from=3)
+    d = diffbvp.diagnose(ds, start_from=fit, refit_top=2)
+    assert "radiation" in d.base_fit.summary["fitted"]
+    assert all(c.effect != "radiation" for c in d.candidates)

@@ -48,25 +48,8 @@ impl Previous {
     /// The model's effects: the file's (continued) and then `with`, each effect once; the
     /// start values of the file's fitted strengths and shapes.
     pub fn joined_with(&self, with: Vec<EffectSetting>) -> Result<ContinuedEffects, String> {
-        let source = self.path.display();
-        let c = self
-            .fit
-            .continued_effects()
-            .map_err(|e| format!("--from {source}: {e}"))?;
-        let mut effects = c.effects;
-        for w in with {
-            let name = w.effect.name();
-            if effects.iter().any(|e| e.effect.name() == name) {
-                return Err(format!(
-                    "--with {name}: {name} is in the model of --from {source} already (its                      strength is fitted from the file's value); drop this --with, or fit                      without --from to give {name} yourself"
-                ));
-            }
-            effects.push(w);
-        }
-        Ok(ContinuedEffects {
-            effects,
-            starts: c.starts,
-        })
+        let source = format!("--from {}", self.path.display());
+        self.fit.continued_with(with, "--with", &source)
     }
 }
 

@@ -320,6 +320,37 @@ impl FitSummary {
         Ok(ContinuedEffects { effects, starts })
     }
 
+    /// [`continued_effects`](Self::continued_effects) joined with further effects `with`
+    /// (each effect once): the model of a next fit that continues from this one. `with_label`
+    /// names where `with` came from (`"--with"`, `"effects"`) and `source` this fit (`"--from
+    /// fit.json"`) in errors.
+    pub fn continued_with(
+        &self,
+        with: Vec<EffectSetting>,
+        with_label: &str,
+        source: &str,
+    ) -> Result<ContinuedEffects, String> {
+        let c = self
+            .continued_effects()
+            .map_err(|e| format!("{source}: {e}"))?;
+        let mut effects = c.effects;
+        for w in with {
+            let name = w.effect.name();
+            if effects.iter().any(|e| e.effect.name() == name) {
+                return Err(format!(
+                    "{with_label} {name}: {name} is in the model of {source} already (its \
+                     strength is fitted from that fit's value); give it once: drop it from \
+                     {with_label}, or start without {source} to give {name} yourself"
+                ));
+            }
+            effects.push(w);
+        }
+        Ok(ContinuedEffects {
+            effects,
+            starts: c.starts,
+        })
+    }
+
     /// Checks the values (as read from a file `source`): `n` in [`FIT_FILE_N_RANGE`], `κ` in
     /// [`FIT_FILE_KAPPA_RANGE`], take-up factors in [`FIT_FILE_TAKE_UP_RANGE`], effects known,
     /// once each, with finite strengths inside their search ranges, and as many experiment
