@@ -150,7 +150,7 @@ fn a_diagnosis_continues_from_a_fit_with_its_effects() {
     )
     .assert_success();
     let diag = dir.join("diagnosis.json");
-    run(
+    let p = run(
         &[
             "diagnose",
             "--quiet",
@@ -163,8 +163,14 @@ fn a_diagnosis_continues_from_a_fit_with_its_effects() {
             s(&diag),
         ],
         &dd,
-    )
-    .assert_success();
+    );
+    p.assert_success();
+    // the report says what the user's model holds
+    assert!(
+        p.stdout.contains("Effects in your model: radiation"),
+        "{}",
+        p.stdout
+    );
     let (f, d) = (read(&fit), read(&diag));
     let base = &d["base_fit"];
     assert!(

@@ -59,6 +59,26 @@ impl Diagnosis {
             b.residuals,
             b.noise.describe()
         ));
+        // effects the user put in the model (--with, --from): what the search starts from
+        let fixed: Vec<String> = b
+            .effects
+            .iter()
+            .filter(|e| !e.strength.fitted)
+            .map(|e| {
+                format!(
+                    "{} {} (fixed)",
+                    e.effect,
+                    pm_unit(e.strength.value, 0.0, &e.strength.unit)
+                )
+            })
+            .collect();
+        let in_model: Vec<String> = fitted_effects(b).into_iter().chain(fixed).collect();
+        if !in_model.is_empty() {
+            s.push_str(&format!(
+                "Effects in your model: {}.\n",
+                in_model.join(", ")
+            ));
+        }
         if let Some(r) = &self.robust {
             s.push_str(&format!("{}\n", r.words()));
         }
@@ -421,12 +441,10 @@ impl Diagnosis {
     }
 }
 
-/// `With <effects><note>: n = …, kappa = …, RMS … %; strengths: …`: a fit's law with its
-/// intervals, and the fitted strengths and shapes of its effects (a model with several effects
-/// is one fit: its strengths are not those of each effect's own refit).
-fn law_line(effects: &str, note: &str, f: &FitSummary) -> String {
-    let fitted: Vec<String> = f
-        .effects
+/// The fitted effects of `f`, each as `"air_coflow 27.2 ± 2.8 m/s (decay_length 0.192 ±
+/// 0.012 m)"` (its fitted shapes in brackets).
+fn fitted_effects(f: &FitSummary) -> Vec<String> {
+    f.effects
         .iter()
         .filter(|e| e.strength.fitted)
         .map(|e| {
@@ -443,7 +461,14 @@ fn law_line(effects: &str, note: &str, f: &FitSummary) -> String {
                 format!("{} {strength} ({})", e.effect, shapes.join(", "))
             }
         })
-        .collect();
+        .collect()
+}
+
+/// `With <effects><note>: n = …, kappa = …, RMS … %; strengths: …`: a fit's law with its
+/// intervals, and the fitted strengths and shapes of its effects (a model with several effects
+/// is one fit: its strengths are not those of each effect's own refit).
+fn law_line(effects: &str, note: &str, f: &FitSummary) -> String {
+    let fitted = fitted_effects(f);
     let strengths = if fitted.is_empty() {
         String::new()
     } else {
