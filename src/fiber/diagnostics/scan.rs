@@ -10,6 +10,9 @@
 //!   warm-started from its inner neighbour (law and fiber solutions); the first point whose fit
 //!   fails ends that side, and the failure is recorded in the profile, not an error; so does a
 //!   point whose `J` exceeds [`ScanOptions::stop_above`] times the user's.
+//! * **Inward walk** ([`walk_in`]): where the user's law is implausible (it compensates a
+//!   missing effect), each side is walked again from its outermost point inwards, started
+//!   from a plausible law ([`ScanOptions::restart_law`]); every point keeps the lower `J`.
 //! * **Shapes** ([`shape_variants`]): effects with a shape (today the decay lengths of
 //!   `air_coflow` and `air_temperature_profile`) are scanned for a few shapes, each a variant of
 //!   the effect.
@@ -109,9 +112,9 @@ pub struct ScanOptions {
     /// Bracketing runs only where the walk's lowest `J` lies this fraction below the user's
     /// `J` (default 0.02): elsewhere there is no basin to localise.
     pub bracket_below: f64,
-    /// The plausible material law `(n, κ)` a side is walked inwards from where its outward
-    /// walk followed an implausible law (default `None`: no inward walk; the diagnosis sets
-    /// its start law).
+    /// The plausible material law `(n, κ)` each side is walked back inwards from where the
+    /// user's law is implausible (`n` below 0.2; see [`walk_in`]; default `None`: no inward
+    /// walk; the diagnosis sets its start law).
     pub restart_law: Option<[f64; 2]>,
     /// Gauss–Newton iteration limit of the inward walk's first (outermost) fit (default 20).
     pub restart_iterations: usize,
@@ -432,9 +435,9 @@ pub struct GridStart {
     pub take_up: Vec<f64>,
     /// Fiber solutions, one per experiment.
     pub solutions: Vec<Solution>,
-    /// The fitted strengths and shapes of the model's other effects (by model-parameter
-    /// name; empty on the user's model): a further step's grid fits and refinements start
-    /// from its effects' values, not from their neutral ones.
+    /// The fitted strengths (by effect name) and shapes (by model-parameter name) of the
+    /// model's other effects (empty on a model without fitted effects): a further step's grid
+    /// fits and refinements start from its effects' values, not from their neutral ones.
     pub strengths: Vec<(String, f64)>,
     /// `J = Σ r²`.
     pub cost: f64,
@@ -641,7 +644,7 @@ fn needs_inward_walk(done: &[(f64, GridStart)], base: &GridStart) -> bool {
 /// [`ScanOptions::restart_iterations`] steps, then every point inwards warm-started from its
 /// outer neighbour's inward fit (`fit(strength, law, from, iterations)`); each point keeps the
 /// lower `J` of its two fits.
-fn walk_in<E>(
+pub fn walk_in<E>(
     mut done: Vec<(f64, GridStart)>,
     law: [f64; 2],
     scan: &ScanOptions,
