@@ -254,7 +254,7 @@ def simulate(dataset: Union[Dataset, PathLike], n: float = 0.8, kappa: float = 1
 
 
 def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float]] = None,
-        estimator: str = "principled", model: str = "carreau",
+        estimator: str = "principled", model: Optional[str] = None,
         effects: Union[None, str, Iterable[str]] = None, loss: str = "linear",
         f_scale: Optional[float] = None, relative_uncertainty: Optional[float] = None,
         error_budget: bool = True, tol: Optional[float] = None, max_nodes: Optional[int] = None,
@@ -265,7 +265,7 @@ def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float
 
     ``start``: (n, κ) (default: the paper's start heuristic); ``estimator``: ``"principled"``
     (relative least squares against the raw data, take-up diameters fitted) or ``"paper"``;
-    ``model``: ``"carreau"`` or ``"newtonian"``; ``effects``: ``"radiation"`` (strength
+    ``model``: ``"carreau"`` or ``"newtonian"`` (default: carreau, or ``start_from``'s law); ``effects``: ``"radiation"`` (strength
     fitted), ``"radiation=0.9"`` (fixed), ``"air_coflow=40:decay_length=0.2"`` (shape fixed);
     ``loss``: ``"linear"``, ``"soft_l1"``, ``"huber"``, ``"cauchy"``; ``f_scale``: soft
     margin of a robust loss as a relative residual [-]; ``relative_uncertainty``: the
@@ -319,7 +319,7 @@ def compare(dataset: Union[Dataset, PathLike], fit: Optional[FitResult] = None, 
     return Comparison(d["comparison"], d["text"], notes)
 
 
-def diagnose(dataset: Union[Dataset, PathLike], *, model: str = "carreau",
+def diagnose(dataset: Union[Dataset, PathLike], *, model: Optional[str] = None,
              effects: Union[None, str, Iterable[str]] = None,
              candidates: Optional[Iterable[str]] = None, refit_top: Optional[int] = None,
              start: Optional[Tuple[float, float]] = None, loss: str = "linear",

@@ -27,7 +27,7 @@ class Dataset:
     def __len__(self) -> int: ...
 
 def fit(dataset: Dataset, *, start: Optional[Tuple[float, float]] = None, estimator: str = "principled",
-        model: str = "carreau", effects: Sequence[str] = ..., loss: str = "linear",
+        model: Optional[str] = None, effects: Sequence[str] = ..., loss: str = "linear",
         f_scale: Optional[float] = None, relative_uncertainty: Optional[float] = None,
         error_budget: bool = True, tol: Optional[float] = None, max_nodes: Optional[int] = None,
         profile_points: int = 101, start_from: Optional[str] = None) -> Dict[str, Any]:
@@ -43,7 +43,7 @@ def compare(dataset: Dataset, fit: Optional[Mapping[str, Any]] = None, *, n: Opt
             effects: Sequence[str] = ..., relative_uncertainty: Optional[float] = None,
             tol: Optional[float] = None, max_nodes: Optional[int] = None) -> Dict[str, Any]:
     """{"comparison": Comparison dict, "text": str}"""
-def diagnose(dataset: Dataset, *, model: str = "carreau", effects: Sequence[str] = ...,
+def diagnose(dataset: Dataset, *, model: Optional[str] = None, effects: Sequence[str] = ...,
              candidates: Optional[Sequence[str]] = None, refit_top: Optional[int] = None,
              start: Optional[Tuple[float, float]] = None, tol: Optional[float] = None,
              max_nodes: Optional[int] = None, start_from: Optional[str] = None) -> Dict[str, Any]:

@@ -21,14 +21,14 @@ use pyo3::types::PyDict;
 /// Returns `{"diagnosis": Diagnosis as dict, "text": the report, "base_arrays": {...},
 /// "final_arrays": {...} | None}` (arrays as in `fit`'s result, without profiles).
 #[pyfunction]
-#[pyo3(signature = (dataset, *, model="carreau", effects=Vec::new(), candidates=None,
+#[pyo3(signature = (dataset, *, model=None, effects=Vec::new(), candidates=None,
     refit_top=None, start=None, loss="linear", f_scale=None, tol=None, max_nodes=None,
     start_from=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose<'py>(
     py: Python<'py>,
     dataset: &Dataset,
-    model: &str,
+    model: Option<&str>,
     effects: Vec<String>,
     candidates: Option<Vec<String>>,
     refit_top: Option<usize>,
@@ -39,7 +39,6 @@ pub fn diagnose<'py>(
     max_nodes: Option<usize>,
     start_from: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let law = options::law(model)?;
     let (loaded, path) = dataset.data();
     let names: Vec<String> = loaded
         .set
@@ -52,12 +51,13 @@ pub fn diagnose<'py>(
         start_from.as_deref(),
         options::effects(&effects)?,
         start,
-        law,
+        model,
         &opts.identify,
         &names,
     )?;
     opts.start_strengths = continued.starts;
     let start = continued.start;
+    let law = continued.law;
     let spec = ModelSpec {
         law,
         effects: continued.effects,

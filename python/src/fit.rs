@@ -75,7 +75,7 @@ pub fn identification_arrays<'py>(
 /// `rheometer fit`. Returns `{"summary": FitSummary as dict, "text": the report, "arrays":
 /// {"residual_profiles", "profiles"}, "notes": [str]}`.
 #[pyfunction]
-#[pyo3(signature = (dataset, *, start=None, estimator="principled", model="carreau",
+#[pyo3(signature = (dataset, *, start=None, estimator="principled", model=None,
     effects=Vec::new(), loss="linear", f_scale=None, relative_uncertainty=None,
     error_budget=true, tol=None, max_nodes=None, profile_points=101, start_from=None))]
 #[allow(clippy::too_many_arguments)]
@@ -84,7 +84,7 @@ pub fn fit<'py>(
     dataset: &Dataset,
     start: Option<(f64, f64)>,
     estimator: &str,
-    model: &str,
+    model: Option<&str>,
     effects: Vec<String>,
     loss: &str,
     f_scale: Option<f64>,
@@ -113,7 +113,6 @@ pub fn fit<'py>(
             options::MAX_POINTS
         )));
     }
-    let law = options::law(model)?;
     let (loaded, path) = dataset.data();
     let names: Vec<String> = loaded
         .set
@@ -125,11 +124,12 @@ pub fn fit<'py>(
         start_from.as_deref(),
         options::effects(&effects)?,
         start,
-        law,
+        model,
         &opts,
         &names,
     )?;
     let start = continued.start;
+    let law = continued.law;
     let spec = ModelSpec {
         law,
         effects: continued.effects,

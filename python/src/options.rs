@@ -172,30 +172,36 @@ pub fn check_range(
     Ok(())
 }
 
-/// A fit or diagnosis to continue from (`start_from`): the model's effects and where the fit
-/// starts.
+/// A fit or diagnosis to continue from (`start_from`): the model's law and effects and where
+/// the fit starts.
 pub struct Continued {
+    /// The law: `model`'s, else the previous fit's, else Carreau-type.
+    pub law: LawChoice,
     /// The previous fit's effects (fitted strengths and shapes free), then `effects`.
     pub effects: Vec<EffectSetting>,
-    /// The start `(n, κ)`: the previous law for a Carreau model, else the given `start`.
+    /// The start `(n, κ)`: the previous law where both are Carreau-type, else the given
+    /// `start`.
     pub start: Option<(f64, f64)>,
     /// Start values of the previous fit's fitted strengths and shapes.
     pub starts: Vec<(String, f64)>,
 }
 
 /// `start_from` (the JSON text of a fit report or a diagnosis, as `rheometer fit --from`
-/// reads it) joined with `effects`, the law `law` and the given `start`; checked against the
-/// data set's experiment `names` and the fit's bounds in `opts`.
+/// reads it) joined with `effects`, the law `model` (default: the previous fit's) and the
+/// given `start`; checked against the data set's experiment `names` and the fit's bounds in
+/// `opts`.
 pub fn continued(
     start_from: Option<&str>,
     effects: Vec<EffectSetting>,
     start: Option<(f64, f64)>,
-    law: LawChoice,
+    model: Option<&str>,
     opts: &IdentifyOptions,
     names: &[String],
 ) -> PyResult<Continued> {
+    let given = model.map(law).transpose()?;
     let Some(text) = start_from else {
         return Ok(Continued {
+            law: given.unwrap_or_default(),
             effects,
             start,
             starts: Vec::new(),
@@ -214,11 +220,15 @@ pub fn continued(
     let c = previous
         .continued_with(effects, "effects", "start_from")
         .map_err(input_error)?;
-    let start = (law == LawChoice::Carreau).then_some((previous.n.value, previous.kappa.value));
+    let law = given.unwrap_or(previous.law);
+    // a Newtonian fit's n = 1 is no start of a Carreau-type fit (the heuristic is)
+    let carreau = law == LawChoice::Carreau && previous.law == LawChoice::Carreau;
+    let start = carreau.then_some((previous.n.value, previous.kappa.value));
     if let Some(s) = start {
         check_start(s, opts)?;
     }
     Ok(Continued {
+        law,
         effects: c.effects,
         start,
         starts: c.starts,

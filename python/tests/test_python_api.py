@@ -189,6 +189,12 @@ def test_a_fit_and_a_diagnosis_continue_from_a_previous_result(radiation_diagnos
         diffbvp.fit(ds, start_from=fit, effects="radiation=0.5")
     with pytest.raises(TypeError, match="start_from"):
         diffbvp.fit(ds, start_from=3)
+    # the law is the file's unless model says otherwise
+    newtonian = diffbvp.fit(ds, model="newtonian", error_budget=False)
+    again = diffbvp.fit(ds, start_from=newtonian, error_budget=False)
+    assert again.summary["law"] == newtonian.summary["law"] != fit.summary["law"]
+    assert diffbvp.fit(ds, start_from=newtonian, model="carreau",
+                       error_budget=False).summary["law"] == fit.summary["law"]
     d = diffbvp.diagnose(ds, start_from=fit, refit_top=2)
     assert "radiation" in d.base_fit.summary["fitted"]
     assert all(c.effect != "radiation" for c in d.candidates)

@@ -13,14 +13,15 @@ pub struct Previous {
 }
 
 impl Previous {
-    /// The start `(n, κ)` of a fit of `law` from the file's law (none for a Newtonian model),
-    /// checked against the fit's bounds.
+    /// The start `(n, κ)` of a fit of `law` from the file's law, checked against the fit's
+    /// bounds; none unless both are Carreau-type (a Newtonian fit's n = 1 is no start: the
+    /// heuristic is).
     pub fn start(
         &self,
         law: LawChoice,
         opts: &IdentifyOptions,
     ) -> Result<Option<(f64, f64)>, String> {
-        if law != LawChoice::Carreau {
+        if law != LawChoice::Carreau || self.fit.law != LawChoice::Carreau {
             return Ok(None);
         }
         let s = (self.fit.n.value, self.fit.kappa.value);
