@@ -283,9 +283,16 @@ pub(crate) fn check_law(s: &FitSummary, w: &mut Vec<FitWarning>) {
 /// effect may buy a different law rather than explain the data; a plain fit biased by a
 /// missing effect moves by many of its standard errors too). Returns the jump in standard
 /// errors. A plain fit whose own law is implausible (`n` below [`PLAUSIBLE_N`]) is no
-/// reference: a refit that moves it into the plausible range is not checked against it.
+/// reference: a refit that moves it clearly into the plausible range (the 95 % interval of
+/// its `n` above the lower bound, or its value where it has no interval) is not checked
+/// against it.
 pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarning)> {
-    if base.n.value < PLAUSIBLE_N[0] && refit.n.value >= PLAUSIBLE_N[0] {
+    let lowest = if refit.n.has_interval() {
+        refit.n.ci95[0]
+    } else {
+        refit.n.value
+    };
+    if base.n.value < PLAUSIBLE_N[0] && lowest >= PLAUSIBLE_N[0] {
         return None;
     }
     let z = |a: &super::summary::Estimate, b: &super::summary::Estimate| {
@@ -457,9 +464,17 @@ mod tests {
         assert_eq!(w.code, WarningCode::Implausible);
         // the plain fit's own n = 0.18 is implausible: no reference to jump from
         assert!(law_jump(&with_base(0.18, 0.01), &refit).is_none());
+        // unless the refit's interval reaches below 0.2 (0.24 ± 0.03: [0.18, 0.30])
+        let mut edge = refit_summary("a", (0.5, 0.1), (0.24, 0.03), (11.7, 0.1));
+        edge.residuals = refit.residuals;
+        edge.cost = refit.cost;
+        let base = with_base(0.15, 0.003);
+        assert!(base.n.value < PLAUSIBLE_N[0] && edge.n.ci95[0] < PLAUSIBLE_N[0]);
+        assert!(law_jump(&base, &edge).is_some());
         // a refit that stays implausible is still judged against it (0.10 -> 0.16, 30 se)
-        let mut low = refit.clone();
-        low.n.value = 0.16;
+        let mut low = refit_summary("a", (0.5, 0.1), (0.16, 0.01), (11.7, 0.1));
+        low.residuals = refit.residuals;
+        low.cost = refit.cost;
         let (jump, _) = law_jump(&with_base(0.10, 0.002), &low).expect("a jump below 0.2");
         assert!((jump - 30.0).abs() < 1e-6, "{jump}");
     }
