@@ -40,12 +40,6 @@ pub fn diagnose<'py>(
     start_from: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (loaded, path) = dataset.data();
-    let names: Vec<String> = loaded
-        .set
-        .experiments
-        .iter()
-        .map(|e| e.name.clone())
-        .collect();
     let mut opts = DiagnoseOptions::default();
     let continued = options::continued(
         start_from.as_deref(),
@@ -53,7 +47,7 @@ pub fn diagnose<'py>(
         start,
         model,
         &opts.identify,
-        &names,
+        &loaded.set.names(),
     )?;
     opts.start_strengths = continued.starts;
     let start = continued.start;

@@ -114,19 +114,13 @@ pub fn fit<'py>(
         )));
     }
     let (loaded, path) = dataset.data();
-    let names: Vec<String> = loaded
-        .set
-        .experiments
-        .iter()
-        .map(|e| e.name.clone())
-        .collect();
     let continued = options::continued(
         start_from.as_deref(),
         options::effects(&effects)?,
         start,
         model,
         &opts,
-        &names,
+        &loaded.set.names(),
     )?;
     let start = continued.start;
     let law = continued.law;

@@ -181,3 +181,10 @@ pub struct ExperimentSet {
     /// Relative measurement uncertainty of the diameters \[-\], if given.
     pub relative_uncertainty: Option<f64>,
 }
+
+impl ExperimentSet {
+    /// The experiments' names, in order.
+    pub fn names(&self) -> Vec<String> {
+        self.experiments.iter().map(|e| e.name.clone()).collect()
+    }
+}

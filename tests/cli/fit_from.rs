@@ -7,7 +7,7 @@ use crate::probe;
 
 use probe::{s, Probe};
 use serde_json::Value;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 const LIMIT: Duration = Duration::from_secs(120);
@@ -28,20 +28,27 @@ fn strength(fit: &Value, effect: &str) -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// The hidden-radiation data fitted with radiation, then again from that fit: the second fit
-/// has radiation in its model without `--with`, fitted, at the same optimum; a third adds a
-/// co-flow to it and ends no worse.
-#[test]
-fn a_fit_continues_from_a_previous_fit_with_its_effects() {
-    let dir = probe::scratch("fit_from_fit");
+/// A scratch copy of `data/hidden_radiation` for test `name`, fitted with radiation: (scratch
+/// dir, TOML, data dir, the fit's JSON `fit.json` in the data dir).
+fn radiation_fit(name: &str) -> (PathBuf, PathBuf, PathBuf, PathBuf) {
+    let dir = probe::scratch(name);
     let toml = probe::copy_data_set("hidden_radiation", &dir);
     let dd = dir.join("hidden_radiation");
-    let first = dir.join("first.json");
+    let fit = dd.join("fit.json");
     run(
-        &["fit", s(&toml), "--with", "radiation", "--json", s(&first)],
+        &["fit", s(&toml), "--with", "radiation", "--json", s(&fit)],
         &dd,
     )
     .assert_success();
+    (dir, toml, dd, fit)
+}
+
+/// The hidden-radiation data fitted with radiation, then again from that fit: the second fit
+/// has radiation in its model without `--with`, fitted, at the same optimum; a third adds a
+/// die temperature offset to it and ends no worse.
+#[test]
+fn a_fit_continues_from_a_previous_fit_with_its_effects() {
+    let (dir, toml, dd, first) = radiation_fit("fit_from_fit");
     let second = dir.join("second.json");
     let p = run(
         &["fit", s(&toml), "--from", s(&first), "--json", s(&second)],
@@ -88,15 +95,7 @@ fn a_fit_continues_from_a_previous_fit_with_its_effects() {
 /// file, and no input changes.
 #[test]
 fn bad_uses_of_from_are_refused_by_name() {
-    let dir = probe::scratch("fit_from_bad");
-    let toml = probe::copy_data_set("hidden_radiation", &dir);
-    let dd = dir.join("hidden_radiation");
-    let fit = dd.join("fit.json");
-    run(
-        &["fit", s(&toml), "--with", "radiation", "--json", s(&fit)],
-        &dd,
-    )
-    .assert_success();
+    let (_, toml, dd, fit) = radiation_fit("fit_from_bad");
     run(
         &[
             "fit",
@@ -140,15 +139,7 @@ fn bad_uses_of_from_are_refused_by_name() {
 /// from the file's value), no longer a candidate, and the user's fit is the file's optimum.
 #[test]
 fn a_diagnosis_continues_from_a_fit_with_its_effects() {
-    let dir = probe::scratch("diagnose_from_fit");
-    let toml = probe::copy_data_set("hidden_radiation", &dir);
-    let dd = dir.join("hidden_radiation");
-    let fit = dir.join("fit.json");
-    run(
-        &["fit", s(&toml), "--with", "radiation", "--json", s(&fit)],
-        &dd,
-    )
-    .assert_success();
+    let (dir, toml, dd, fit) = radiation_fit("diagnose_from_fit");
     let diag = dir.join("diagnosis.json");
     let p = run(
         &[

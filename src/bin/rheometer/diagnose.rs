@@ -57,11 +57,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         out,
     } = args;
     let previous = from.as_deref().map(previous::read_previous).transpose()?;
-    let law = match (model, &previous) {
-        (Some(m), _) => m,
-        (None, Some(p)) => p.fit.law,
-        (None, None) => LawChoice::default(),
-    };
+    let law = previous::law(model, previous.as_ref());
     let mut opts = DiagnoseOptions::default();
     let effects = match &previous {
         Some(p) => {

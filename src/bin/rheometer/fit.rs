@@ -80,12 +80,12 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     }
     robust.apply(&mut opts)?;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
-    let law = match (newtonian, model, &previous) {
-        (true, _, _) => LawChoice::Newtonian,
-        (false, Some(m), _) => m,
-        (false, None, Some(p)) => p.fit.law,
-        (false, None, None) => LawChoice::default(),
+    let model = if newtonian {
+        Some(LawChoice::Newtonian)
+    } else {
+        model
     };
+    let law = previous::law(model, previous.as_ref());
     let (with, start, start_strengths) = match &previous {
         Some(p) => {
             let start = p.start(law, &opts)?;

@@ -12,6 +12,11 @@ pub struct Previous {
     pub fit: FitSummary,
 }
 
+/// The law of a fit: `model` where given, else the previous result's, else Carreau-type.
+pub fn law(model: Option<LawChoice>, previous: Option<&Previous>) -> LawChoice {
+    model.or(previous.map(|p| p.fit.law)).unwrap_or_default()
+}
+
 impl Previous {
     /// The start `(n, κ)` of a fit of `law` from the file's law, checked against the fit's
     /// bounds; none unless both are Carreau-type (a Newtonian fit's n = 1 is no start: the
@@ -36,14 +41,8 @@ impl Previous {
 
     /// Checks that the file is a fit of the experiments of `loaded`, in their order.
     pub fn check_experiments(&self, loaded: &LoadedExperiments) -> Result<(), String> {
-        let names: Vec<String> = loaded
-            .set
-            .experiments
-            .iter()
-            .map(|e| e.name.clone())
-            .collect();
         self.fit
-            .check_experiments(&names, &self.path.display().to_string())
+            .check_experiments(&loaded.set.names(), &self.path.display().to_string())
     }
 
     /// The model's effects: the file's (continued) and then `with`, each effect once; the

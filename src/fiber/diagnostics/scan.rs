@@ -650,18 +650,24 @@ pub fn walk_in<E>(
     scan: &ScanOptions,
     mut fit: impl FnMut(f64, [f64; 2], &GridStart, usize) -> Result<GridStart, E>,
 ) -> Vec<(f64, GridStart)> {
-    let mut prev: Option<GridStart> = None;
+    // the inward neighbour's fit: kept in `done` (at `kept`) or, where the outward fit was
+    // lower, held here; moved, never copied
+    let mut held: Option<GridStart> = None;
+    let mut kept: Option<usize> = None;
     for k in (0..done.len()).rev() {
         let here = &done[k].1;
-        let r = match &prev {
+        let prev = kept.map(|j| &done[j].1).or(held.as_ref());
+        let r = match prev {
             None => fit(here.strength, law, here, scan.restart_iterations),
             Some(p) => fit(here.strength, p.law, p, scan.inner_max_iterations.max(1)),
         };
         let Ok(p) = r else { break };
-        if p.cost < here.cost {
-            done[k].1 = p.clone();
+        if p.cost < done[k].1.cost {
+            done[k].1 = p;
+            (kept, held) = (Some(k), None);
+        } else {
+            (kept, held) = (None, Some(p));
         }
-        prev = Some(p);
     }
     done
 }

@@ -26,6 +26,9 @@ pub enum NestedStart {
     /// The plain model's optimum (effects at neutral strength) ended lower than the given
     /// start.
     PlainOptimum,
+    /// The given start law with the effects at given strengths (a previous fit's) ended
+    /// lowest ([`Rheometer::identify_nested_from`]).
+    GivenStrengths,
 }
 
 /// The outcome of [`Rheometer::identify_nested`].
@@ -122,5 +125,32 @@ impl Rheometer {
             }),
             (Err(e), Err(_)) => Err(e),
         }
+    }
+
+    /// [`identify_nested`](Self::identify_nested) and, with `strengths` (start values of the
+    /// fitted effects' strengths by effect name and shapes by model-parameter name, e.g. a
+    /// previous fit's), also the fit from them at `start`; the lowest cost is kept. A fit from
+    /// them that fails leaves the nested fit, which never ends worse than the plain model.
+    pub fn identify_nested_from(
+        &self,
+        start: [f64; 2],
+        strengths: &[(String, f64)],
+        options: &IdentifyOptions,
+    ) -> Result<NestedFit, RheometerError> {
+        let mut nested = self.identify_nested(start, options)?;
+        if strengths.is_empty() {
+            return Ok(nested);
+        }
+        let from = FitStart {
+            strengths: strengths.to_vec(),
+            ..FitStart::at(start)
+        };
+        if let Ok(f) = self.identify_from(&from, options) {
+            if f.summary.cost < nested.fit.summary.cost {
+                nested.fit = f;
+                nested.start = NestedStart::GivenStrengths;
+            }
+        }
+        Ok(nested)
     }
 }

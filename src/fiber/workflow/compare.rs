@@ -96,8 +96,7 @@ pub fn compare(
         ..Default::default()
     };
     if let Some((fit, source)) = &request.fit {
-        let names: Vec<String> = set.experiments.iter().map(|e| e.name.clone()).collect();
-        fit.check_experiments(&names, source)
+        fit.check_experiments(&set.names(), source)
             .map_err(CompareError::Data)?;
         setup.apply_fit(fit, set.experiments.len(), source)?;
         options.fitted_parameters = fit.fitted_parameters();

@@ -10,8 +10,8 @@ use crate::fiber::fit_html::{fit_report_page, FitReportInput, ReportExperiment};
 use crate::fiber::input::LoadedExperiments;
 use crate::fiber::rheometer::profile::{intervals, ProfileMode};
 use crate::fiber::rheometer::{
-    error_budget, FitStart, FitSummary, FlowCurve, FlowCurveOptions, Identification,
-    IdentifyOptions, Rheometer, RheometerError, StartPoint,
+    error_budget, FitSummary, FlowCurve, FlowCurveOptions, Identification, IdentifyOptions,
+    Rheometer, RheometerError, StartPoint,
 };
 use crate::html_page::HtmlPage;
 use crate::solution::Solution;
@@ -145,21 +145,9 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
         }
     };
     // a model with fitted effects never ends worse than the model without them
-    let nested = rh.identify_nested(start, opts)?;
+    // (and from the effects' given strengths, where that ends lower)
+    let nested = rh.identify_nested_from(start, &request.start_strengths, opts)?;
     let mut id = nested.fit;
-    if !request.start_strengths.is_empty() {
-        let from = FitStart {
-            strengths: request.start_strengths.clone(),
-            ..FitStart::at(start)
-        };
-        // a start that fails to solve leaves the nested fit, which never ends worse than the
-        // plain model
-        if let Ok(f) = rh.identify_from(&from, opts) {
-            if f.summary.cost < id.summary.cost {
-                id = f;
-            }
-        }
-    }
     // an effect whose strength must differ between the experiments is a stand-in
     let fitted: Vec<String> = id
         .summary

@@ -110,20 +110,13 @@ impl<'a> Context<'a> {
             ..self.opts.clone()
         };
         let Some(w) = warm else {
-            // the user's effects never leave the fit worse than the model without them
-            let nested = self.rh.identify_nested(self.law0, &checked)?.fit;
-            if self.options.start_strengths.is_empty() {
-                return Ok(nested);
-            }
-            // and the fit from the effects' given values, where it ends lower
-            let from = FitStart {
-                strengths: self.options.start_strengths.clone(),
-                ..FitStart::at(self.law0)
-            };
-            return Ok(match self.rh.identify_from(&from, &checked) {
-                Ok(f) if f.summary.cost < nested.summary.cost => f,
-                _ => nested,
-            });
+            // the user's effects never leave the fit worse than the model without them (and
+            // start from their given values too, where that ends lower)
+            let strengths = &self.options.start_strengths;
+            return Ok(self
+                .rh
+                .identify_nested_from(self.law0, strengths, &checked)?
+                .fit);
         };
         // a further step: `w` was fitted with the previous step's weights, which carry a robust
         // loss's down-weighting, so this fit is least squares with them (the loss again would
