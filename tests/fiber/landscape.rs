@@ -54,3 +54,52 @@ fn strongly_strain_thinning_corner_is_missing() {
         l.cost
     );
 }
+
+/// The sample rows behind the CLI's time estimate are the landscape's own rows: a landscape
+/// that keeps them is bit for bit the one computed without a sample, its progress starts at
+/// the sample's points, and a sample of another grid or tolerance is refused.
+#[test]
+fn a_landscape_keeps_its_sample_rows_unchanged() {
+    use diffbvp::fiber::rheometer::PointStatus;
+    use std::sync::atomic::AtomicBool;
+    let set = load_experiments(Path::new("data/pmma7n_synthetic/experiments.toml")).unwrap();
+    let rh = Rheometer::new(&set).unwrap();
+    let mut o = IdentifyOptions::with_estimator(Estimator::Paper);
+    o.simulate.tol = 1e-4;
+    // the last n has no solution: failed points are kept as well
+    let ns = [1.0, 0.8, 0.6, 0.4, 0.0];
+    let ks = [10.0, 11.0, 11.71, 12.5, 13.0];
+    let never = AtomicBool::new(false);
+    let plain = rh.landscape_with(&ns, &ks, &o, |_| {}, &never).unwrap();
+    let sample = rh.landscape_sample(&ns, &ks, &o, &never).unwrap();
+    assert_eq!(sample.rows(), 3, "the smallest, middle and largest kappa");
+    assert!(sample.row_s() > 0.0 && sample.remaining_s(2) > 0.0);
+    let mut first_progress = None;
+    let kept = rh
+        .landscape_from(
+            &ns,
+            &ks,
+            &o,
+            Some(sample.clone()),
+            |d| {
+                first_progress.get_or_insert(d);
+            },
+            &never,
+        )
+        .unwrap();
+    assert_eq!(first_progress, Some(3 * ns.len()));
+    assert_eq!(kept.status, plain.status);
+    assert!(kept.status.contains(&PointStatus::Failed));
+    let bits = |c: &[f64]| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&kept.landscape.cost), bits(&plain.landscape.cost));
+    // another grid, another tolerance: refused
+    let err = rh
+        .landscape_from(&ns[..4], &ks, &o, Some(sample.clone()), |_| {}, &never)
+        .unwrap_err();
+    assert!(err.to_string().contains("another grid"), "{err}");
+    let mut loose = o.clone();
+    loose.simulate.tol = 1e-3;
+    assert!(rh
+        .landscape_from(&ns, &ks, &loose, Some(sample), |_| {}, &never)
+        .is_err());
+}

@@ -6,10 +6,9 @@ use diffbvp::fiber::effects::Effect;
 use diffbvp::fiber::failure_hints::ExperimentFailure;
 use diffbvp::fiber::input::{parse_experiments, Location, MAX_PLAUSIBLE_DIAMETER_M};
 use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;
-use diffbvp::fiber::rheometer::{IdentifyOptions, Rheometer};
+use diffbvp::fiber::rheometer::{IdentifyOptions, LandscapeSample};
 use std::error::Error;
 use std::path::Path;
-use std::time::Instant;
 
 /// Largest `--points` of `simulate` (rows per profile CSV; 1e6 rows took 1.8 GB of memory and
 /// 86 MB per CSV for the 9 shipped experiments, 1e5 a tenth).
@@ -375,104 +374,28 @@ pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, String> {
     }
 }
 
-/// A measured estimate of a landscape's run time.
-pub struct LandscapeEstimate {
-    /// Grid points.
-    pub points: usize,
-    /// Worker threads the rows are spread over.
-    pub threads: usize,
-    /// Points per row.
-    pub row_points: usize,
-    /// Estimated time of one row, from the sampled rows \[s\].
-    pub row_s: f64,
-    /// Estimated total \[s\].
-    pub total_s: f64,
-}
-
-impl LandscapeEstimate {
-    /// "landscape: 441 points on 2 threads, about 16 s (estimated from sample rows: about 1.5 s
-    /// per row of 21 points)".
-    pub fn message(&self) -> String {
-        let t = self.total_s;
-        let about = if t < 90.0 {
-            format!("{t:.0} s")
-        } else if t < 5400.0 {
-            format!("{:.0} min", t / 60.0)
-        } else {
-            format!("{:.1} h", t / 3600.0)
-        };
-        format!(
-            "landscape: {} points on {} threads, about {about} (estimated from sample rows: \
-             about {:.2} s per row of {} points)",
-            self.points, self.threads, self.row_s, self.row_points
-        )
-    }
-}
-
-/// Estimates the run time of `rh.landscape(ns, ks, opts)` by walking two rows (the smallest
-/// and the middle κ; the smallest has the largest region without solution) as the landscape
-/// does: from the Newtonian solution towards smaller n, warm-started, up to the first failure,
-/// on at most 6 evenly picked values of n. The time per solved point is scaled to the row's
-/// points above the failure, and a failure counts four times (the landscape retries it with
-/// bisected steps).
-pub fn landscape_estimate(
-    rh: &Rheometer,
-    ns: &[f64],
-    ks: &[f64],
-    opts: &IdentifyOptions,
-) -> Result<LandscapeEstimate, Box<dyn Error>> {
-    let mut o = opts.clone();
-    o.simulate.factor_at_solution = false;
-    let mut order = ns.to_vec();
-    order.sort_by(|a, b| b.total_cmp(a));
-    let stride = order.len().div_ceil(6).max(1);
-    let mut sample: Vec<f64> = order.iter().copied().step_by(stride).collect();
-    if let Some(&last) = order.last() {
-        if sample.last() != Some(&last) {
-            sample.push(last);
-        }
-    }
-    let mut rows = vec![ks[0]];
-    if ks.len() > 2 {
-        rows.push(ks[ks.len() / 2]);
-    }
-    let mut cold_s = 0.0;
-    let mut row_s = 0.0;
-    for &kappa in &rows {
-        let t0 = Instant::now();
-        let mut obj = rh.objective([1.0, kappa], &o)?;
-        cold_s += t0.elapsed().as_secs_f64();
-        let (mut solved, mut solved_s, mut failed_at, mut failed_s) = (0usize, 0.0, None, 0.0);
-        for &n in &sample {
-            let t = Instant::now();
-            // a failing point costs time as well; its error does not matter here
-            let ok = obj.try_cost_at(n, kappa).is_ok();
-            let dt = t.elapsed().as_secs_f64();
-            if ok {
-                solved += 1;
-                solved_s += dt;
-            } else {
-                failed_at = Some(n);
-                failed_s = dt;
-                break;
-            }
-        }
-        let reached = match failed_at {
-            Some(nf) => order.iter().filter(|&&n| n > nf).count(),
-            None => order.len(),
-        };
-        row_s += solved_s / solved.max(1) as f64 * reached as f64 + 4.0 * failed_s;
-    }
-    let cold_s = cold_s / rows.len() as f64;
-    let row_s = row_s / rows.len() as f64;
-    let threads = rayon::current_num_threads().clamp(1, ks.len().max(1));
-    // every worker starts with a cold start at n = 1, and the landscape makes one more
-    let total_s = row_s * ks.len().div_ceil(threads) as f64 + 2.0 * cold_s;
-    Ok(LandscapeEstimate {
-        points: ns.len() * ks.len(),
-        threads,
-        row_points: ns.len(),
-        row_s,
-        total_s,
-    })
+/// The estimate of a landscape's run time, from its sample rows (computed and timed exactly as
+/// the landscape computes its rows, [`Rheometer::landscape_sample`](diffbvp::fiber::rheometer::Rheometer::landscape_sample); the run keeps them):
+/// "landscape: 441 points on 2 threads, about 16 s (measured on 3 of its 21 rows, 1.5 s in
+/// all: about 0.65 s per row of 21 points)". `grid` is (n values, κ values), `sample_s` the
+/// wall time the sample took.
+pub fn landscape_estimate(sample: &LandscapeSample, grid: (usize, usize), sample_s: f64) -> String {
+    let threads = rayon::current_num_threads().clamp(1, grid.1.max(1));
+    let t = sample_s + sample.remaining_s(threads);
+    let about = if t < 90.0 {
+        format!("{t:.0} s")
+    } else if t < 5400.0 {
+        format!("{:.0} min", t / 60.0)
+    } else {
+        format!("{:.1} h", t / 3600.0)
+    };
+    format!(
+        "landscape: {} points on {threads} threads, about {about} (measured on {} of its {} \
+         rows, {sample_s:.1} s in all: about {:.2} s per row of {} points)",
+        grid.0 * grid.1,
+        sample.rows(),
+        grid.1,
+        sample.row_s(),
+        grid.0
+    )
 }

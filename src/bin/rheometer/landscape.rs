@@ -64,9 +64,15 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let rh = Rheometer::new(&loaded.set)?;
     let ns = linspace(n_range.0, n_range.1, grid.0);
     let ks = linspace(kappa_range.0, kappa_range.1, grid.1);
+    let t0 = std::time::Instant::now();
+    // a few rows first, timed: the estimate comes from the real work, and the run keeps them
+    let sample = rh.landscape_sample(&ns, &ks, &opts, &INTERRUPTED)?;
     if !g.quiet {
-        let est = checks::landscape_estimate(&rh, &ns, &ks, &opts)?;
-        g.say(est.message());
+        g.say(checks::landscape_estimate(
+            &sample,
+            grid,
+            t0.elapsed().as_secs_f64(),
+        ));
     }
     let bar = if g.quiet {
         ProgressBar::hidden()
@@ -79,11 +85,11 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         b.set_message("landscape");
         b
     };
-    let t0 = std::time::Instant::now();
-    let run = rh.landscape_with(
+    let run = rh.landscape_from(
         &ns,
         &ks,
         &opts,
+        Some(sample),
         |d| bar.set_position(d as u64),
         &INTERRUPTED,
     )?;

@@ -28,6 +28,7 @@ use crate::solve::Guess;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
+use std::time::Instant;
 
 /// Largest mesh of a landscape solve (at the CLI's tolerance 1e-4 the solutions need 60–300
 /// nodes except right at the edge of the region where the BVP has a solution).
@@ -138,105 +139,115 @@ impl Rheometer {
         ns: &[f64],
         kappas: &[f64],
         options: &IdentifyOptions,
+        progress: impl FnMut(usize) + Send,
+        cancel: &AtomicBool,
+    ) -> Result<LandscapeRun, RheometerError> {
+        self.landscape_from(ns, kappas, options, None, progress, cancel)
+    }
+
+    /// Walks a few rows of the landscape `ns × kappas` (the smallest, middle and largest `κ`:
+    /// the smallest has the largest region without solution, where failing solves cost most)
+    /// exactly as [`Rheometer::landscape_with`] does, in parallel, and times them: the
+    /// estimate of the whole run ([`LandscapeSample::remaining_s`]) comes from the real
+    /// computation, and [`Rheometer::landscape_from`] keeps these rows instead of computing
+    /// them again.
+    pub fn landscape_sample(
+        &self,
+        ns: &[f64],
+        kappas: &[f64],
+        options: &IdentifyOptions,
+        cancel: &AtomicBool,
+    ) -> Result<LandscapeSample, RheometerError> {
+        if ns.is_empty() || kappas.is_empty() {
+            return Err(RheometerError::Data("the landscape grid is empty".into()));
+        }
+        let walk = RowWalk::new(self, ns, kappas, options, None)?;
+        let mut picked = vec![0, kappas.len() / 2, kappas.len() - 1];
+        picked.dedup();
+        let rows: Vec<SampledRow> = picked
+            .par_iter()
+            .map_init(
+                || walk.objective(self),
+                |obj, &j| {
+                    let t0 = Instant::now();
+                    let (cost, status) = walk.row(obj.as_mut(), kappas[j], cancel);
+                    SampledRow {
+                        kappa_index: j,
+                        cost,
+                        status,
+                        seconds: t0.elapsed().as_secs_f64(),
+                    }
+                },
+            )
+            .collect();
+        Ok(LandscapeSample {
+            n: ns.to_vec(),
+            kappa: kappas.to_vec(),
+            tol: options.simulate.tol,
+            newtonian: walk.newtonian,
+            rows,
+        })
+    }
+
+    /// [`Rheometer::landscape_with`] that keeps the rows of `sample` (from
+    /// [`Rheometer::landscape_sample`] on the same grid and tolerance; an error otherwise)
+    /// instead of computing them again; `progress` counts them as done from the start.
+    pub fn landscape_from(
+        &self,
+        ns: &[f64],
+        kappas: &[f64],
+        options: &IdentifyOptions,
+        sample: Option<LandscapeSample>,
         mut progress: impl FnMut(usize) + Send,
         cancel: &AtomicBool,
     ) -> Result<LandscapeRun, RheometerError> {
         if ns.is_empty() || kappas.is_empty() {
             return Err(RheometerError::Data("the landscape grid is empty".into()));
         }
-        let mut opts = options.clone();
-        opts.simulate.factor_at_solution = false;
-        // a solve that diverges must fail fast, not refine towards 20 000 nodes
-        opts.simulate.max_nodes = opts.simulate.max_nodes.min(LANDSCAPE_MAX_NODES);
-        let mut order: Vec<usize> = (0..ns.len()).collect();
-        order.sort_by(|&a, &b| ns[b].total_cmp(&ns[a]));
-        let newtonian = self.objective([1.0, kappas[0]], &opts)?.solutions();
-        let done = AtomicUsize::new(0);
+        let mut kept: Vec<Option<(Vec<f64>, Vec<PointStatus>)>> = vec![None; kappas.len()];
+        let mut newtonian = None;
+        if let Some(sample) = sample {
+            let same = sample.n == ns
+                && sample.kappa == kappas
+                && sample.tol == options.simulate.tol
+                && sample.rows.iter().all(|r| r.kappa_index < kappas.len());
+            if !same {
+                return Err(RheometerError::Data(
+                    "the landscape sample was computed on another grid or tolerance than the \
+                     landscape it should be part of: compute it with the same n, kappa and \
+                     options"
+                        .into(),
+                ));
+            }
+            for r in sample.rows {
+                kept[r.kappa_index] = Some((r.cost, r.status));
+            }
+            newtonian = Some(sample.newtonian);
+        }
+        let walk = RowWalk::new(self, ns, kappas, options, newtonian)?;
+        let already = kept.iter().flatten().count() * ns.len();
+        let done = AtomicUsize::new(already);
+        if already > 0 {
+            progress(already);
+        }
         let progress = Mutex::new(&mut progress);
         // rows are independent: each starts from the Newtonian solution; one objective (solver
         // workspace) per worker
         let rows: Vec<(Vec<f64>, Vec<PointStatus>)> = kappas
             .par_iter()
+            .zip(kept)
             .map_init(
-                || self.objective([1.0, kappas[0]], &opts).ok(),
-                |obj, &k| {
-                    let mut row = vec![f64::NAN; ns.len()];
-                    let mut status = vec![PointStatus::Failed; ns.len()];
-                    if cancel.load(Ordering::Relaxed) {
-                        status.fill(PointStatus::NotReached);
-                        return (row, status);
+                || walk.objective(self),
+                |obj, (&k, kept)| {
+                    if let Some(row) = kept {
+                        return row;
                     }
-                    if let Some(obj) = obj.as_mut() {
-                        obj.set_solutions(&newtonian);
-                        // the last two accepted points of the row: (n, solutions)
-                        let mut last: (f64, Vec<Solution>) = (1.0, newtonian.clone());
-                        let mut before: Option<(f64, Vec<Solution>)> = None;
-                        for (pos, &i) in order.iter().enumerate() {
-                            if cancel.load(Ordering::Relaxed) {
-                                for &rest in &order[pos..] {
-                                    status[rest] = PointStatus::NotReached;
-                                }
-                                break;
-                            }
-                            let n = ns[i];
-                            let predicted: Option<Vec<Guess>> =
-                                before.as_ref().and_then(|(nb, sb)| {
-                                    let t = (n - last.0) / (last.0 - nb);
-                                    (t.is_finite() && t.abs() <= 2.0).then(|| {
-                                        last.1
-                                            .iter()
-                                            .zip(sb)
-                                            .map(|(a, b)| secant_guess(a, b, t))
-                                            .collect()
-                                    })
-                                });
-                            let first = match &predicted {
-                                Some(guesses) => obj.try_cost_from(n, k, guesses),
-                                None => obj.try_cost_at(n, k),
-                            };
-                            // on failure the warm starts are still the neighbour's solutions:
-                            // retry from them, bisecting the step (giving up early once
-                            // `cancel` is set)
-                            let r = first.or_else(|_| {
-                                bisect_step(
-                                    last.0,
-                                    n,
-                                    retry_bisections(n - last.0),
-                                    &mut |to| obj.try_cost_at(to, k),
-                                    &|| {
-                                        cancel.load(Ordering::Relaxed).then(|| {
-                                            RheometerError::Data(
-                                                "the landscape was cancelled".into(),
-                                            )
-                                        })
-                                    },
-                                )
-                            });
-                            match r {
-                                Ok(c) => {
-                                    row[i] = c;
-                                    status[i] = PointStatus::Computed;
-                                    let sols = obj.solutions();
-                                    before = Some(std::mem::replace(&mut last, (n, sols)));
-                                }
-                                Err(_) => {
-                                    // a retry given up because of the cancellation: the point
-                                    // and the rest of the row were not reached, not failed
-                                    if cancel.load(Ordering::Relaxed) {
-                                        for &rest in &order[pos..] {
-                                            status[rest] = PointStatus::NotReached;
-                                        }
-                                    }
-                                    break;
-                                }
-                            }
-                        }
-                    }
+                    let row = walk.row(obj.as_mut(), k, cancel);
                     let d = done.fetch_add(ns.len(), Ordering::Relaxed) + ns.len();
                     if let Ok(mut p) = progress.lock() {
                         (*p)(d);
                     }
-                    (row, status)
+                    row
                 },
             )
             .collect();
@@ -256,5 +267,172 @@ impl Rheometer {
             status,
             cancelled,
         })
+    }
+}
+
+/// Rows of a landscape computed ahead of the rest ([`Rheometer::landscape_sample`]), with the
+/// time each took: the estimate of the run, and rows the run keeps.
+#[derive(Debug, Clone)]
+pub struct LandscapeSample {
+    n: Vec<f64>,
+    kappa: Vec<f64>,
+    tol: f64,
+    newtonian: Vec<Solution>,
+    rows: Vec<SampledRow>,
+}
+
+/// One row of a [`LandscapeSample`].
+#[derive(Debug, Clone)]
+struct SampledRow {
+    kappa_index: usize,
+    cost: Vec<f64>,
+    status: Vec<PointStatus>,
+    seconds: f64,
+}
+
+impl LandscapeSample {
+    /// Rows computed.
+    pub fn rows(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Mean wall time of a sampled row \[s\] (the rows ran side by side on the worker threads,
+    /// as the run's rows do).
+    pub fn row_s(&self) -> f64 {
+        self.rows.iter().map(|r| r.seconds).sum::<f64>() / self.rows.len().max(1) as f64
+    }
+
+    /// Estimated wall time \[s\] of the rows not yet computed, spread over `threads` workers.
+    pub fn remaining_s(&self, threads: usize) -> f64 {
+        let left = self.kappa.len().saturating_sub(self.rows.len());
+        self.row_s() * left.div_ceil(threads.max(1)) as f64
+    }
+}
+
+/// What every row of one landscape shares: the options of its solves, the order of its `n`
+/// values (Newtonian end first) and the Newtonian solutions it starts from (`n = 1` does not
+/// depend on κ; given, e.g. a sample's, or solved at the first κ).
+struct RowWalk<'a> {
+    ns: &'a [f64],
+    opts: IdentifyOptions,
+    order: Vec<usize>,
+    newtonian: Vec<Solution>,
+    kappa0: f64,
+}
+
+impl<'a> RowWalk<'a> {
+    fn new(
+        rh: &Rheometer,
+        ns: &'a [f64],
+        kappas: &[f64],
+        options: &IdentifyOptions,
+        newtonian: Option<Vec<Solution>>,
+    ) -> Result<Self, RheometerError> {
+        let mut opts = options.clone();
+        opts.simulate.factor_at_solution = false;
+        // a solve that diverges must fail fast, not refine towards 20 000 nodes
+        opts.simulate.max_nodes = opts.simulate.max_nodes.min(LANDSCAPE_MAX_NODES);
+        let mut order: Vec<usize> = (0..ns.len()).collect();
+        order.sort_by(|&a, &b| ns[b].total_cmp(&ns[a]));
+        let newtonian = match newtonian {
+            Some(s) => s,
+            None => rh.objective([1.0, kappas[0]], &opts)?.solutions(),
+        };
+        Ok(RowWalk {
+            ns,
+            opts,
+            order,
+            newtonian,
+            kappa0: kappas[0],
+        })
+    }
+
+    /// A worker's objective (its solver workspace); `None` if it cannot be built (its rows
+    /// are then marked failed).
+    fn objective<'r>(&self, rh: &'r Rheometer) -> Option<super::objective::Objective<'r>> {
+        rh.objective([1.0, self.kappa0], &self.opts).ok()
+    }
+
+    /// The row at `k`: walked from the Newtonian end towards smaller `n`, each point
+    /// warm-started from the secant predictor of the last two, a failed step bisected, and the
+    /// rest of the row marked failed after a failure that bisection does not mend.
+    fn row(
+        &self,
+        obj: Option<&mut super::objective::Objective<'_>>,
+        k: f64,
+        cancel: &AtomicBool,
+    ) -> (Vec<f64>, Vec<PointStatus>) {
+        let ns = self.ns;
+        let order = &self.order;
+        let mut row = vec![f64::NAN; ns.len()];
+        let mut status = vec![PointStatus::Failed; ns.len()];
+        if cancel.load(Ordering::Relaxed) {
+            status.fill(PointStatus::NotReached);
+            return (row, status);
+        }
+        let Some(obj) = obj else {
+            return (row, status);
+        };
+        obj.set_solutions(&self.newtonian);
+        // the last two accepted points of the row: (n, solutions)
+        let mut last: (f64, Vec<Solution>) = (1.0, self.newtonian.clone());
+        let mut before: Option<(f64, Vec<Solution>)> = None;
+        for (pos, &i) in order.iter().enumerate() {
+            if cancel.load(Ordering::Relaxed) {
+                for &rest in &order[pos..] {
+                    status[rest] = PointStatus::NotReached;
+                }
+                break;
+            }
+            let n = ns[i];
+            let predicted: Option<Vec<Guess>> = before.as_ref().and_then(|(nb, sb)| {
+                let t = (n - last.0) / (last.0 - nb);
+                (t.is_finite() && t.abs() <= 2.0).then(|| {
+                    last.1
+                        .iter()
+                        .zip(sb)
+                        .map(|(a, b)| secant_guess(a, b, t))
+                        .collect()
+                })
+            });
+            let first = match &predicted {
+                Some(guesses) => obj.try_cost_from(n, k, guesses),
+                None => obj.try_cost_at(n, k),
+            };
+            // on failure the warm starts are still the neighbour's solutions: retry from
+            // them, bisecting the step (giving up early once `cancel` is set)
+            let r = first.or_else(|_| {
+                bisect_step(
+                    last.0,
+                    n,
+                    retry_bisections(n - last.0),
+                    &mut |to| obj.try_cost_at(to, k),
+                    &|| {
+                        cancel
+                            .load(Ordering::Relaxed)
+                            .then(|| RheometerError::Data("the landscape was cancelled".into()))
+                    },
+                )
+            });
+            match r {
+                Ok(c) => {
+                    row[i] = c;
+                    status[i] = PointStatus::Computed;
+                    let sols = obj.solutions();
+                    before = Some(std::mem::replace(&mut last, (n, sols)));
+                }
+                Err(_) => {
+                    // a retry given up because of the cancellation: the point and the rest
+                    // of the row were not reached, not failed
+                    if cancel.load(Ordering::Relaxed) {
+                        for &rest in &order[pos..] {
+                            status[rest] = PointStatus::NotReached;
+                        }
+                    }
+                    break;
+                }
+            }
+        }
+        (row, status)
     }
 }
