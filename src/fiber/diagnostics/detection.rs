@@ -104,6 +104,11 @@ pub struct DetectionLimits {
     /// can be detected, e.g. `strain_thinning` in a Carreau-type fit).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub invisible: Vec<String>,
+    /// Why the shifts of the law are not given (`null`: they are): the user's `n` or `κ` at a
+    /// bound of its range, where the fit's linearisation does not hold and its standard errors
+    /// are not valid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shifts_withheld: Option<String>,
 }
 
 /// What the limits need beyond the candidates' signatures.
@@ -124,6 +129,9 @@ pub struct DetectionContext {
     pub stderr_n: f64,
     /// Statistical standard error of `κ`.
     pub stderr_kappa: f64,
+    /// Why the shifts of the law are withheld (`None`: they are computed), see
+    /// [`DetectionLimits::shifts_withheld`].
+    pub shifts_withheld: Option<&'static str>,
 }
 
 /// `ΔJ*`: the cost a candidate must remove to bring `ΔBIC = N ln(J_after/J_before) + Δk ln N`
@@ -162,6 +170,7 @@ pub fn detection_limits(
         earn_threshold: ctx.threshold,
         limits: Vec::new(),
         invisible: Vec::new(),
+        shifts_withheld: ctx.shifts_withheld.map(str::to_string),
     };
     for (i, e) in effects.iter().enumerate() {
         let (Some(l), Some(&k)) = (scores.get(i), extra.get(i)) else {
@@ -178,7 +187,8 @@ pub fn detection_limits(
         }
         // the bias of leaving out strength +1 is −dθ/ds
         let per = |c: Option<usize>| {
-            c.and_then(|c| dtheta.get(i).and_then(|d| d.get(c)))
+            c.filter(|_| ctx.shifts_withheld.is_none())
+                .and_then(|c| dtheta.get(i).and_then(|d| d.get(c)))
                 .map(|v| -v)
         };
         let (dn, dk) = (per(cols.0), per(cols.1));
@@ -240,17 +250,17 @@ impl DetectionLimits {
             self.earn_threshold
         );
         s.push_str(&format!(
-            "    {:<22} {:<9} {:>13} {:>13}  {:<17} {}\n",
+            "    {:<23} {:<10} {:>13} {:>13}  {:<17} {}\n",
             "effect", "category", "detected 50 %", "detected 95 %", "shift n at s95", "shift kappa"
         ));
         let shift = |v: Option<f64>, se: Option<f64>| match (v, se) {
-            (Some(v), Some(se)) => format!("{:+.4} ({se:.1} se)", v),
-            (Some(v), None) => format!("{v:+.4}"),
+            (Some(v), Some(se)) => format!("{} ({se:.1} se)", signed(v)),
+            (Some(v), None) => signed(v),
             _ => "-".into(),
         };
         for l in &self.limits {
             s.push_str(&format!(
-                "    {:<22} {:<9} {:>13} {:>13}  {:<17} {}\n",
+                "    {:<23} {:<10} {:>13} {:>13}  {:<17} {}\n",
                 l.effect,
                 l.category,
                 l.strength_words(l.s50),
@@ -264,6 +274,9 @@ impl DetectionLimits {
                 "    not detectable at all (the fitted parameters absorb them): {}\n",
                 self.invisible.join(", ")
             ));
+        }
+        if let Some(why) = &self.shifts_withheld {
+            s.push_str(&format!("    no shifts of the law: {why}\n"));
         }
         s.push_str(
             "(detected 50 %/95 %: the strength at which the candidate's own refit earns its \
@@ -324,6 +337,16 @@ impl DetectionLimits {
             s.push_str(&format!(" {capital}."));
         }
         Some(s)
+    }
+}
+
+/// A shift with its sign: four decimals where that is readable (`+0.0123`), else three
+/// significant digits in scientific notation (`+2.960e13`).
+fn signed(v: f64) -> String {
+    if v.abs() < 1e3 {
+        format!("{v:+.4}")
+    } else {
+        format!("{v:+.3e}")
     }
 }
 
@@ -432,6 +455,7 @@ mod tests {
             threshold: -10.0,
             stderr_n: 0.01,
             stderr_kappa: 0.1,
+            shifts_withheld: None,
         };
         let d = detection_limits(
             &effects,
@@ -457,5 +481,30 @@ mod tests {
         assert_eq!(mf.strength_words(0.0412), "4.12 %");
         assert_eq!(die.strength_words(3.216), "3.22 K");
         assert!((mf.s95 / die.s95 - 4.0 / 100.0).abs() < 1e-12);
+        // a user's law at a bound: the limits stand, the shifts of the law are withheld
+        let why = "n at a bound";
+        let held = detection_limits(
+            &effects,
+            &[1, 1, 2],
+            &scores,
+            &dtheta,
+            (Some(0), Some(1)),
+            &DetectionContext {
+                shifts_withheld: Some(why),
+                ..ctx
+            },
+        );
+        assert_eq!(held.limits[0].s95, die.s95);
+        assert!(held.limits.iter().all(|l| l.shift_n_at_s95.is_none()
+            && l.shift_kappa_se.is_none()
+            && l.worst_shift_se() == 0.0));
+        let text = held.to_text();
+        assert!(
+            text.contains("no shifts of the law: n at a bound"),
+            "{text}"
+        );
+        assert!(!text.contains("se)"), "{text}");
+        assert_eq!(signed(0.01234), "+0.0123");
+        assert_eq!(signed(-2.96e13), "-2.960e13");
     }
 }

@@ -203,6 +203,11 @@ fn limits(
             threshold: ctx.options.earn_threshold,
             stderr_n: se(&s.n),
             stderr_kappa: se(&s.kappa),
+            shifts_withheld: (s.bound_of("n").is_some() || s.bound_of("kappa").is_some())
+                .then_some(
+                    "your fit's n or kappa is at a bound of its range, where the fit's \
+                     linearisation does not hold and its standard errors are not valid",
+                ),
         },
     )
 }
