@@ -630,10 +630,17 @@ class Diagnosis(Result):
 
     @property
     def law_is_a_result(self) -> bool:
-        """Whether the verdict leaves the final fit's law (n, kappa) a result: the model is
-        adequate or the misfit is explained. False when it is "ambiguous" or "none of the
-        candidates": then no law of this diagnosis is a result, whatever its interval."""
-        return self.verdict.get("kind") in ("adequate", "explained")
+        """Whether the final fit's law (n, kappa) may be used as a result: the model is
+        adequate or the misfit is explained, and neither n nor kappa of that fit (the final
+        fit, else the user's) is at a bound of its range (no valid interval there). False when
+        the verdict is "ambiguous" or "none of the candidates": then no law of this diagnosis
+        is a result, whatever its interval. The library's ``Diagnosis::law_is_a_result`` rule."""
+        if self.verdict.get("kind") not in ("adequate", "explained"):
+            return False
+        fit = self._data.get("final_fit") or self._data.get("base_fit") or {}
+        return not any(
+            b.get("parameter") in ("n", "kappa") for b in fit.get("at_bound", [])
+        )
 
     @property
     def found(self) -> List[str]:

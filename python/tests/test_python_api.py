@@ -136,6 +136,11 @@ def test_a_robust_loss_weights_the_diagnosis_and_outliers_are_no_missing_physics
     assert w is not None and w["loss"] == "huber" and w["down_weighted"] >= 7, w
     assert d.verdict["kind"] == "adequate" and d.law_is_a_result, d.verdict
     assert d.found == [] and "Loss huber: the points are weighted" in d.text
+    # the same verdict with the law's kappa at a bound: no result (the library's rule)
+    data = json.loads(json.dumps(d.diagnosis))
+    fit = data.get("final_fit") or data["base_fit"]
+    fit["at_bound"] = [{"parameter": "kappa", "side": "lower", "bound": 7.0}]
+    assert not diffbvp.Diagnosis(data).law_is_a_result
     for run in (diffbvp.diagnose, diffbvp.fit):
         with pytest.raises(diffbvp.InputError, match="f_scale: a soft margin needs a robust loss"):
             run(ds, f_scale=0.02)

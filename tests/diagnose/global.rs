@@ -334,7 +334,7 @@ fn radiation_and_warm_air_never_a_wrong_law() {
         "{n_range:?} {n:?}"
     );
     assert!(kappa_range[0] <= k[0] && k[1] <= kappa_range[1]);
-    assert!(!d.verdict.law_is_a_result());
+    assert!(!d.law_is_a_result());
     // the report says so (its lines wrapped at 100 characters)
     let text = d.to_text().split_whitespace().collect::<Vec<_>>().join(" ");
     assert!(text.contains("neither law is a result"), "{text}");
@@ -400,7 +400,7 @@ fn strain_hardening_is_none_of_the_candidates() {
         "{:?}",
         d.consistency
     );
-    assert!(!d.verdict.law_is_a_result());
+    assert!(!d.law_is_a_result());
     // nothing named that removes less than half the excess misfit
     for c in d.candidates.iter().filter(|c| d.found.contains(&c.effect)) {
         assert!(
@@ -444,7 +444,7 @@ fn a_further_step_starts_from_the_weights_of_the_step_before() {
         matches!(d.verdict, Verdict::NoneOfTheCandidates { .. }),
         "{text}"
     );
-    assert!(!d.verdict.law_is_a_result());
+    assert!(!d.law_is_a_result());
     assert_eq!(d.stopped, None, "{text}");
     assert!(!d.further_steps.is_empty(), "{text}");
 }
@@ -529,7 +529,7 @@ fn law_outcome(r: &DiagnosisRun, sc: &Scenario) -> (&'static str, f64) {
     let z =
         |e: &diffbvp::fiber::rheometer::Estimate, truth: f64| (e.value - truth).abs() / e.stderr;
     let worst = z(&fit.n, sc.law.n).max(z(&fit.kappa, sc.law.kappa));
-    let flagged = !d.verdict.law_is_a_result()
+    let flagged = !d.law_is_a_result()
         || fit
             .warnings
             .iter()

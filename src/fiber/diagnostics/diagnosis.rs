@@ -157,6 +157,29 @@ impl Diagnosis {
             .and_then(|n| self.candidate(n))
     }
 
+    /// The fit whose law the diagnosis reports: the final fit (with the found effects) where
+    /// there is one, else the user's.
+    pub fn law_fit(&self) -> &FitSummary {
+        self.final_fit.as_ref().unwrap_or(&self.base_fit)
+    }
+
+    /// The law parameter (`n` or `kappa`) of [`law_fit`](Self::law_fit) at a bound of its
+    /// range, if any: such a law has no valid interval and is no material result, whatever
+    /// the verdict (a 300 m/s aspirator's co-flow "explained" the data with `κ` at its lower
+    /// bound 7, `K` a hundred times below the truth).
+    pub fn law_at_bound(&self) -> Option<&crate::fiber::rheometer::AtBound> {
+        let f = self.law_fit();
+        f.bound_of("n").or_else(|| f.bound_of("kappa"))
+    }
+
+    /// Whether the reported law `(n, κ)` may be used as a result: the verdict leaves it one
+    /// ([`Verdict::law_is_a_result`](super::diagnose::verdict::Verdict::law_is_a_result):
+    /// adequate or explained) and neither parameter is at a bound ([`law_at_bound`](Self::law_at_bound)).
+    /// Python's `Diagnosis.law_is_a_result` applies the same rule to the JSON.
+    pub fn law_is_a_result(&self) -> bool {
+        self.verdict.law_is_a_result() && self.law_at_bound().is_none()
+    }
+
     /// The noise level the judgement used \[-\] (the base fit's).
     pub fn noise_level(&self) -> f64 {
         self.base_fit.noise.level

@@ -203,21 +203,30 @@ impl Diagnosis {
         ));
     }
 
-    /// Why the final law is not a result, if the verdict says it is not: the misfit is not
-    /// explained, or another explanation as good disagrees on the law.
-    fn law_not_a_result(&self) -> Option<&'static str> {
-        match self.verdict {
-            Verdict::NoneOfTheCandidates { ref stand_ins, .. } if !stand_ins.is_empty() => Some(
-                "the effect's strength differs between the experiments: a stand-in, see the verdict",
-            ),
-            Verdict::NoneOfTheCandidates { .. } => {
-                Some("the misfit is not explained, see the verdict")
+    /// Why the final law is not a result, if it is not: the misfit is not explained, another
+    /// explanation as good disagrees on the law, or its `n` or `κ` is at a bound of its range
+    /// ([`Diagnosis::law_is_a_result`]).
+    fn law_not_a_result(&self) -> Option<String> {
+        let why = match self.verdict {
+            Verdict::NoneOfTheCandidates { ref stand_ins, .. } if !stand_ins.is_empty() => {
+                "the effect's strength differs between the experiments: a stand-in, see the verdict"
             }
+            Verdict::NoneOfTheCandidates { .. } => "the misfit is not explained, see the verdict",
             Verdict::Ambiguous { .. } => {
-                Some("another explanation as good disagrees on the law, see the verdict")
+                "another explanation as good disagrees on the law, see the verdict"
             }
-            Verdict::Adequate | Verdict::Explained { .. } => None,
-        }
+            Verdict::Adequate | Verdict::Explained { .. } => {
+                return self.law_at_bound().map(|b| {
+                    format!(
+                        "{} is at its {} bound {}, where the fit has no valid interval",
+                        b.parameter,
+                        b.side.name(),
+                        fmt_g(b.bound)
+                    )
+                })
+            }
+        };
+        Some(why.to_string())
     }
 
     /// The pair named by the joint search of pairs, with its strengths.
