@@ -250,7 +250,7 @@ impl DetectionLimits {
             self.earn_threshold
         );
         s.push_str(&format!(
-            "    {:<23} {:<10} {:>13} {:>13}  {:<17} {}\n",
+            "    {:<22} {:<9} {:>13} {:>13}  {:<17} {}\n",
             "effect", "category", "detected 50 %", "detected 95 %", "shift n at s95", "shift kappa"
         ));
         let shift = |v: Option<f64>, se: Option<f64>| match (v, se) {
@@ -260,7 +260,7 @@ impl DetectionLimits {
         };
         for l in &self.limits {
             s.push_str(&format!(
-                "    {:<23} {:<10} {:>13} {:>13}  {:<17} {}\n",
+                "    {:<22} {:<9} {:>13} {:>13}  {:<17} {}\n",
                 l.effect,
                 l.category,
                 l.strength_words(l.s50),
