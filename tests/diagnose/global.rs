@@ -76,7 +76,7 @@ fn local_from_truth(set: &ExperimentSet, r: &DiagnosisRun, sc: &Scenario, e: &Ex
 fn check(sc: &Scenario, e: &Expect) -> (ExperimentSet, DiagnosisRun) {
     let (set, r, t) = run(sc);
     let d = &r.diagnosis;
-    let fit = d.final_fit.as_ref().unwrap_or(&d.base_fit);
+    let fit = d.law_fit();
     let verdict = d.verdict.kind();
     let local = if d.found.is_empty() {
         f64::NAN
@@ -288,7 +288,7 @@ fn radiation_and_warm_air_never_a_wrong_law() {
     let sc = radiation_and_warm_air();
     let (_, r, t) = run(&sc);
     let d = &r.diagnosis;
-    let fit = d.final_fit.as_ref().unwrap_or(&d.base_fit);
+    let fit = d.law_fit();
     let holds = |ci: [f64; 2], v: f64| ci[0] <= v && v <= ci[1];
     let flagged = fit.warnings.iter().any(|w| {
         w.message.contains("not a result") || w.message.contains("neither law is a result")
@@ -525,7 +525,7 @@ fn control_with_a_noisy_take_up_names_nothing() {
 /// distances in standard errors.
 fn law_outcome(r: &DiagnosisRun, sc: &Scenario) -> (&'static str, f64) {
     let d = &r.diagnosis;
-    let fit = d.final_fit.as_ref().unwrap_or(&d.base_fit);
+    let fit = d.law_fit();
     let z =
         |e: &diffbvp::fiber::rheometer::Estimate, truth: f64| (e.value - truth).abs() / e.stderr;
     let worst = z(&fit.n, sc.law.n).max(z(&fit.kappa, sc.law.kappa));

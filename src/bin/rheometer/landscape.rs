@@ -85,14 +85,7 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         b.set_message("landscape");
         b
     };
-    let run = rh.landscape_from(
-        &ns,
-        &ks,
-        &opts,
-        Some(sample),
-        |d| bar.set_position(d as u64),
-        &INTERRUPTED,
-    )?;
+    let run = rh.landscape_from(sample, |d| bar.set_position(d as u64), &INTERRUPTED)?;
     bar.finish_and_clear();
     let mut dir = outputs::DirWriter::begin(&outputs, &out, "rheometer landscape", "files", names)?;
     let path = dir.path("landscape.csv");

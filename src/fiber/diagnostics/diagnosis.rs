@@ -204,9 +204,7 @@ impl Diagnosis {
     /// where there is one, else of the user's fit: a point that only looks wrong to a model
     /// missing an effect is no outlier.
     pub fn outliers(&self) -> &[crate::fiber::noise_model::Outlier] {
-        self.final_fit
-            .as_ref()
-            .unwrap_or(&self.base_fit)
+        self.law_fit()
             .noise
             .model
             .as_ref()

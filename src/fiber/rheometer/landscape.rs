@@ -142,15 +142,16 @@ impl Rheometer {
         progress: impl FnMut(usize) + Send,
         cancel: &AtomicBool,
     ) -> Result<LandscapeRun, RheometerError> {
-        self.landscape_from(ns, kappas, options, None, progress, cancel)
+        let walk = RowWalk::new(self, ns, kappas, options, None)?;
+        Ok(self.walk_rows(&walk, kappas, vec![None; kappas.len()], progress, cancel))
     }
 
     /// Walks a few rows of the landscape `ns × kappas` (the smallest, middle and largest `κ`:
     /// the smallest has the largest region without solution, where failing solves cost most)
     /// exactly as [`Rheometer::landscape_with`] does, in parallel, and times them: the
     /// estimate of the whole run ([`LandscapeSample::remaining_s`]) comes from the real
-    /// computation, and [`Rheometer::landscape_from`] keeps these rows instead of computing
-    /// them again.
+    /// computation, and [`Rheometer::landscape_from`] continues from these rows instead of
+    /// computing them again.
     pub fn landscape_sample(
         &self,
         ns: &[f64],
@@ -158,9 +159,6 @@ impl Rheometer {
         options: &IdentifyOptions,
         cancel: &AtomicBool,
     ) -> Result<LandscapeSample, RheometerError> {
-        if ns.is_empty() || kappas.is_empty() {
-            return Err(RheometerError::Data("the landscape grid is empty".into()));
-        }
         let walk = RowWalk::new(self, ns, kappas, options, None)?;
         let mut picked = vec![0, kappas.len() / 2, kappas.len() - 1];
         picked.dedup();
@@ -183,56 +181,55 @@ impl Rheometer {
         Ok(LandscapeSample {
             n: ns.to_vec(),
             kappa: kappas.to_vec(),
-            tol: options.simulate.tol,
+            options: options.clone(),
             newtonian: walk.newtonian,
             rows,
         })
     }
 
-    /// [`Rheometer::landscape_with`] that keeps the rows of `sample` (from
-    /// [`Rheometer::landscape_sample`] on the same grid and tolerance; an error otherwise)
-    /// instead of computing them again; `progress` counts them as done from the start.
+    /// The whole landscape of `sample` (from [`Rheometer::landscape_sample`] of this
+    /// rheometer: its grid, options and Newtonian solutions), keeping the sample's rows
+    /// instead of computing them again; otherwise as [`Rheometer::landscape_with`], with
+    /// `progress` counting the sample's rows as done from the start.
     pub fn landscape_from(
         &self,
-        ns: &[f64],
-        kappas: &[f64],
-        options: &IdentifyOptions,
-        sample: Option<LandscapeSample>,
+        sample: LandscapeSample,
         mut progress: impl FnMut(usize) + Send,
         cancel: &AtomicBool,
     ) -> Result<LandscapeRun, RheometerError> {
-        if ns.is_empty() || kappas.is_empty() {
-            return Err(RheometerError::Data("the landscape grid is empty".into()));
+        let LandscapeSample {
+            n,
+            kappa,
+            options,
+            newtonian,
+            rows,
+        } = sample;
+        let mut kept: Vec<Option<(Vec<f64>, Vec<PointStatus>)>> = vec![None; kappa.len()];
+        for r in rows {
+            kept[r.kappa_index] = Some((r.cost, r.status));
         }
-        let mut kept: Vec<Option<(Vec<f64>, Vec<PointStatus>)>> = vec![None; kappas.len()];
-        let mut newtonian = None;
-        if let Some(sample) = sample {
-            let same = sample.n == ns
-                && sample.kappa == kappas
-                && sample.tol == options.simulate.tol
-                && sample.rows.iter().all(|r| r.kappa_index < kappas.len());
-            if !same {
-                return Err(RheometerError::Data(
-                    "the landscape sample was computed on another grid or tolerance than the \
-                     landscape it should be part of: compute it with the same n, kappa and \
-                     options"
-                        .into(),
-                ));
-            }
-            for r in sample.rows {
-                kept[r.kappa_index] = Some((r.cost, r.status));
-            }
-            newtonian = Some(sample.newtonian);
-        }
-        let walk = RowWalk::new(self, ns, kappas, options, newtonian)?;
-        let already = kept.iter().flatten().count() * ns.len();
-        let done = AtomicUsize::new(already);
+        let already = kept.iter().flatten().count() * n.len();
         if already > 0 {
             progress(already);
         }
+        let walk = RowWalk::new(self, &n, &kappa, &options, Some(newtonian))?;
+        Ok(self.walk_rows(&walk, &kappa, kept, progress, cancel))
+    }
+
+    /// Every row of `kappas` not in `kept` walked in parallel (one objective, i.e. solver
+    /// workspace, per worker; rows are independent, each starts from the Newtonian solution),
+    /// the kept ones as they are; `progress` after every computed row with the points done.
+    fn walk_rows(
+        &self,
+        walk: &RowWalk<'_>,
+        kappas: &[f64],
+        kept: Vec<Option<(Vec<f64>, Vec<PointStatus>)>>,
+        mut progress: impl FnMut(usize) + Send,
+        cancel: &AtomicBool,
+    ) -> LandscapeRun {
+        let ns = walk.ns;
+        let done = AtomicUsize::new(kept.iter().flatten().count() * ns.len());
         let progress = Mutex::new(&mut progress);
-        // rows are independent: each starts from the Newtonian solution; one objective (solver
-        // workspace) per worker
         let rows: Vec<(Vec<f64>, Vec<PointStatus>)> = kappas
             .par_iter()
             .zip(kept)
@@ -258,7 +255,7 @@ impl Rheometer {
             status.extend(st);
         }
         let cancelled = status.contains(&PointStatus::NotReached);
-        Ok(LandscapeRun {
+        LandscapeRun {
             landscape: Landscape {
                 n: ns.to_vec(),
                 kappa: kappas.to_vec(),
@@ -266,17 +263,18 @@ impl Rheometer {
             },
             status,
             cancelled,
-        })
+        }
     }
 }
 
 /// Rows of a landscape computed ahead of the rest ([`Rheometer::landscape_sample`]), with the
-/// time each took: the estimate of the run, and rows the run keeps.
+/// time each took, and the grid, options and Newtonian solutions the rest continues from
+/// ([`Rheometer::landscape_from`]): the estimate of the run, and rows the run keeps.
 #[derive(Debug, Clone)]
 pub struct LandscapeSample {
     n: Vec<f64>,
     kappa: Vec<f64>,
-    tol: f64,
+    options: IdentifyOptions,
     newtonian: Vec<Solution>,
     rows: Vec<SampledRow>,
 }
@@ -328,6 +326,9 @@ impl<'a> RowWalk<'a> {
         options: &IdentifyOptions,
         newtonian: Option<Vec<Solution>>,
     ) -> Result<Self, RheometerError> {
+        if ns.is_empty() || kappas.is_empty() {
+            return Err(RheometerError::Data("the landscape grid is empty".into()));
+        }
         let mut opts = options.clone();
         opts.simulate.factor_at_solution = false;
         // a solve that diverges must fail fast, not refine towards 20 000 nodes
