@@ -142,12 +142,16 @@ fn verdict(page: &mut HtmlPage, s: &FitSummary) {
     if !finding.is_empty() {
         details.push(sentence(&finding));
     }
-    let (tone, headline) = match s.warnings.len() {
-        0 => (
+    let (tone, headline) = match (s.law_not_a_result(), s.warnings.len()) {
+        (Some(why), _) => (
+            Tone::Bad,
+            format!("NOT A RESULT: {why}; this law is no material property"),
+        ),
+        (None, 0) => (
             Tone::Good,
             "The model fits the data: no warnings".to_string(),
         ),
-        n => (
+        (None, n) => (
             Tone::Caution,
             format!("{n} warning(s): check them (below) before using the estimates"),
         ),
@@ -474,7 +478,9 @@ fn inputs_section(page: &mut HtmlPage, input: &FitReportInput<'_>) {
 mod tests {
     use super::*;
     use crate::fiber::rheometer::summary::tests::example;
-    use crate::fiber::rheometer::{FitWarning, FlowCurve, FlowPoint, WarningCode};
+    use crate::fiber::rheometer::{
+        AtBound, BoundSide, FitWarning, FlowCurve, FlowPoint, WarningCode,
+    };
 
     /// A flow curve of five points, the middle three covered by the data.
     fn curve() -> FlowCurve {
@@ -503,6 +509,7 @@ mod tests {
             points,
             isotherms: Vec::new(),
             finding: String::new(),
+            not_a_result: None,
         }
     }
 
@@ -568,5 +575,51 @@ mod tests {
         let h = page_of(&s, "a", "a.csv", Path::new("e.toml"));
         assert!(h.contains("class=\"verdict caution\""));
         assert!(h.contains("Warnings (1)") && h.contains("misfit &lt;here&gt; &amp; there"));
+    }
+
+    #[test]
+    fn a_law_that_is_not_a_result_is_said_so_in_the_text_the_page_and_the_flow_curve() {
+        let mut s = example();
+        assert_eq!(s.law_not_a_result(), None);
+        assert!(!s.to_text().contains("NOT A RESULT"));
+        let plain = flow_curve_figure_svg(&curve()).expect("svg");
+        assert!(plain.contains("identified law") && !plain.contains("NOT A RESULT"));
+        // an implausible n: the warning's finding is the reason, everywhere the law is shown
+        s.warnings.push(FitWarning::new(
+            WarningCode::Implausible,
+            "n = 0.0027 is implausible for a polymer melt (expected 0.2 to 1): the fit \
+             compensates a model error"
+                .into(),
+        ));
+        let why = s.law_not_a_result().expect("not a result");
+        assert_eq!(
+            why,
+            "n = 0.0027 is implausible for a polymer melt (expected 0.2 to 1)"
+        );
+        assert!(s.to_text().contains(&format!("NOT A RESULT: {why}")));
+        let h = page_of(&s, "a", "a.csv", Path::new("e.toml"));
+        assert!(h.contains("class=\"verdict bad\"") && h.contains("NOT A RESULT"));
+        let flagged = FlowCurve {
+            not_a_result: Some(why.clone()),
+            ..curve()
+        };
+        let svg = flow_curve_figure_svg(&flagged).expect("svg");
+        assert!(svg.contains("NOT A RESULT") && !svg.contains("identified law"));
+        // a warning of another kind does not make the law "not a result"; a bound does
+        s.warnings.clear();
+        s.warnings
+            .push(FitWarning::new(WarningCode::Misfit, "misfit".into()));
+        assert_eq!(s.law_not_a_result(), None);
+        s.at_bound.push(AtBound {
+            parameter: "kappa".into(),
+            side: BoundSide::Lower,
+            bound: 7.0,
+            value: 7.0,
+        });
+        let why = s.law_not_a_result().expect("at a bound");
+        assert!(why.starts_with("kappa is at its lower bound 7"), "{why}");
+        // a fit that did not fit the law has no law to judge
+        s.fitted.retain(|p| p != "n" && p != "kappa");
+        assert_eq!(s.law_not_a_result(), None);
     }
 }

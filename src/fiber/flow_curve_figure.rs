@@ -23,6 +23,8 @@ struct Drawn {
     plateau: String,
     statistical_label: &'static str,
     isotherms: Vec<(String, Vec<f64>)>,
+    title: String,
+    curve_label: String,
 }
 
 impl Drawn {
@@ -49,6 +51,19 @@ impl Drawn {
                     )
                 })
                 .collect(),
+            // a law that is not a result is never drawn as "the identified law"
+            title: match &curve.not_a_result {
+                Some(_) => "Elongational viscosity: NOT A RESULT".to_string(),
+                None => "Elongational viscosity".to_string(),
+            },
+            curve_label: match &curve.not_a_result {
+                // the reason's head ("n is at its upper bound 1"), the rest in the report
+                Some(why) => format!(
+                    "fitted law, NOT A RESULT: {}",
+                    why.split([',', '(']).next().unwrap_or(why).trim()
+                ),
+                None => "identified law".to_string(),
+            },
         }
     }
 
@@ -66,7 +81,7 @@ impl Drawn {
             .collect();
         let [lo, hi] = curve.covered_per_s;
         let plot = FlowCurvePlot {
-            title: "Elongational viscosity",
+            title: &self.title,
             temperature_k: Some(curve.temperature_k),
             statistical: (curve.band != BandMethod::None).then_some((&self.stat[0], &self.stat[1])),
             statistical_label: self.statistical_label,
@@ -75,7 +90,7 @@ impl Drawn {
             plateau: Some((curve.plateau_pa_s, &self.plateau)),
             data_range: (lo.is_finite() && hi.is_finite() && lo > 0.0 && lo < hi)
                 .then_some((lo, hi)),
-            curve_label: "identified law",
+            curve_label: &self.curve_label,
             points: &points,
             size: SIZE,
             ..FlowCurvePlot::new(&self.rates, &self.eta)

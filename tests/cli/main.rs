@@ -16,4 +16,5 @@ mod input_loading;
 mod input_messages;
 mod input_plausibility;
 mod input_units;
+mod law_not_a_result;
 mod reader_fuzz;

@@ -168,8 +168,7 @@ impl Diagnosis {
     /// the verdict (a 300 m/s aspirator's co-flow "explained" the data with `κ` at its lower
     /// bound 7, `K` a hundred times below the truth).
     pub fn law_at_bound(&self) -> Option<&crate::fiber::rheometer::AtBound> {
-        let f = self.law_fit();
-        f.bound_of("n").or_else(|| f.bound_of("kappa"))
+        self.law_fit().law_at_bound()
     }
 
     /// Whether the reported law `(n, κ)` may be used as a result: the verdict leaves it one

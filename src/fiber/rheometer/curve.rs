@@ -71,6 +71,12 @@ pub struct FlowCurve {
     /// What the data support, in one sentence (e.g. "no strain thinning detected ...").
     #[serde(default)]
     pub finding: String,
+    /// Why the fit's law is not a result, if it is not ([`FitSummary::law_not_a_result`]
+    /// of the fit the curve is drawn from): the figure then says so in its title and legend.
+    ///
+    /// [`FitSummary::law_not_a_result`]: super::FitSummary::law_not_a_result
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub not_a_result: Option<String>,
 }
 
 impl FlowCurve {

@@ -277,6 +277,7 @@ impl FlowCurve {
             points,
             isotherms,
             finding: summary.law_finding(),
+            not_a_result: summary.law_not_a_result(),
         })
     }
 }

@@ -426,6 +426,46 @@ impl FitSummary {
     pub fn bound_of(&self, parameter: &str) -> Option<&AtBound> {
         self.at_bound.iter().find(|b| b.parameter == parameter)
     }
+
+    /// The law parameter (`n` or `kappa`) at a bound of its range, if any: such a law has no
+    /// valid interval and is no material result.
+    pub fn law_at_bound(&self) -> Option<&AtBound> {
+        self.bound_of("n").or_else(|| self.bound_of("kappa"))
+    }
+
+    /// Why this fit's material law is not a result, if it is not: `n` or `κ` at a bound of
+    /// its range (no valid interval there), or an `implausible` warning (an `n` no polymer
+    /// melt has, a law that jumped far from the plain fit for no gain, a stand-in effect, two
+    /// explanations that disagree on the law): the warning's finding up to its first colon.
+    /// `None` where the law was not fitted or is a result. The one rule for the fit's text,
+    /// figures, flow curve and HTML page.
+    pub fn law_not_a_result(&self) -> Option<String> {
+        if !self.law_fitted() {
+            return None;
+        }
+        if let Some(b) = self.law_at_bound() {
+            let newtonian = b.parameter == "n" && b.side == BoundSide::Upper && b.bound == 1.0;
+            return Some(format!(
+                "{} is at its {} bound {}, where the fit has no valid interval{}",
+                b.parameter,
+                b.side.name(),
+                crate::fiber::format::fmt_g(b.bound),
+                if newtonian {
+                    " (the Carreau-type law is Newtonian there and kappa is not determined; \
+                     whether the Newtonian law fits is said below)"
+                } else {
+                    ""
+                }
+            ));
+        }
+        self.warnings
+            .iter()
+            .find(|w| w.code == WarningCode::Implausible)
+            .map(|w| match w.message.split_once(':') {
+                Some((head, _)) => head.trim().to_string(),
+                None => w.message.trim().to_string(),
+            })
+    }
 }
 
 #[cfg(test)]

@@ -115,6 +115,11 @@ impl FitSummary {
             self.experiments.len().max(self.take_up_factors.len())
         );
         s.push_str(&self.law_text());
+        if let Some(why) = self.law_not_a_result() {
+            s.push_str(&format!(
+                "    NOT A RESULT: {why}; this law is no material property (warnings below)\n"
+            ));
+        }
         let finding = self.law_finding();
         if !finding.is_empty() {
             s.push_str(&format!("    {finding}\n"));
