@@ -130,6 +130,33 @@ fn bench_rhs(c: &mut Criterion) {
             fd[3].re
         })
     });
+    // the linearisation's pass: the four states and the four parameters (c, n, kappa, take-up
+    // factor) seeded at once, one 8-wide pass as `Collocation::dual_pass` makes at a solution
+    let seeds = 8;
+    let yd8: Vec<DualSVec64<8>> = y
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| DualSVec64::from_re(v).derivative(i))
+        .collect();
+    let pd8: Vec<DualSVec64<8>> = p
+        .iter()
+        .enumerate()
+        .map(|(j, &v)| {
+            let d = DualSVec64::from_re(v);
+            if y.len() + j < seeds {
+                d.derivative(y.len() + j)
+            } else {
+                d
+            }
+        })
+        .collect();
+    let mut fd8 = [DualSVec64::<8>::from_re(0.0); 4];
+    c.bench_function("fiber_rhs_dual8", |b| {
+        b.iter(|| {
+            m.rhs(black_box(0.3), black_box(&yd8), &pd8, &mut fd8);
+            fd8[3].re
+        })
+    });
 }
 
 criterion_group!(benches, bench, bench_rhs);
