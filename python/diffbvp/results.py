@@ -215,6 +215,30 @@ class Estimate:
         return f"Estimate({self.name}={self})"
 
 
+def law_not_a_result(fit: Mapping[str, Any]) -> Optional[str]:
+    """Why the law of ``fit`` (a fit's dict, as ``rheometer fit --json`` writes it) is not a
+    result, or None: n or kappa at a bound of its range (no valid interval there), or an
+    ``implausible`` warning (its finding up to the first colon). None where the law was not
+    fitted. The library's ``FitSummary::law_not_a_result`` rule and words (the text report's
+    ``NOT A RESULT:`` line, ``flow_curve.not_a_result``)."""
+    if not any(p in ("n", "kappa") for p in fit.get("fitted", [])):
+        return None
+    bounds = fit.get("at_bound", []) or []
+    for name in ("n", "kappa"):
+        for b in bounds:
+            if b.get("parameter") != name:
+                continue
+            side, bound = b.get("side"), _num(b.get("bound"))
+            newtonian = name == "n" and side == "upper" and bound == 1.0
+            return (f"{name} is at its {side} bound {bound:.6g}, where the fit has no valid interval"
+                    + (" (the Carreau-type law is Newtonian there and kappa is not determined; "
+                       "whether the Newtonian law fits is said below)" if newtonian else ""))
+    for w in fit.get("warnings", []) or []:
+        if w.get("code") == "implausible":
+            return str(w.get("message", "")).split(":", 1)[0].strip()
+    return None
+
+
 class FitResult(Result):
     """The outcome of :func:`diffbvp.fit`: the library's ``FitSummary`` as a dict (exactly the
     JSON ``rheometer fit --json`` writes) plus arrays.
@@ -224,6 +248,7 @@ class FitResult(Result):
     :meth:`estimates`. ``fit.noise_level`` [-] is the one noise level the misfit is judged
     against (``fit.noise``: where it comes from, the noise model); ``fit.rms`` [-] the RMS
     relative residual; ``fit.warnings`` everything that makes the fit doubtful;
+    ``fit.law_not_a_result`` why the law (n, κ) is no result (None where it is one);
     ``fit.covariance`` the covariance of the fitted shared parameters
     (``fit.covariance_names``) in their reported units; ``fit.error_budget`` the systematic
     uncertainty from what the data cannot identify. Every other key of the summary reads as an
@@ -285,6 +310,18 @@ class FitResult(Result):
     def rms(self) -> float:
         """RMS relative residual over all measurements [-] (0.016 = 1.6 %)."""
         return _num(self._data["rms_relative_residual"])
+
+    @property
+    def law_not_a_result(self) -> Optional[str]:
+        """Why this fit's law (n, kappa) is not a result, or None (:func:`law_not_a_result`:
+        n or kappa at a bound, or an ``implausible`` warning)."""
+        return law_not_a_result(self._data)
+
+    @property
+    def law_is_a_result(self) -> bool:
+        """Whether this fit's law may be used as a result (no reason in
+        :attr:`law_not_a_result`; a fit without a fitted law has none either)."""
+        return law_not_a_result(self._data) is None
 
     @property
     def warnings(self) -> List[Dict[str, str]]:
@@ -631,16 +668,15 @@ class Diagnosis(Result):
     @property
     def law_is_a_result(self) -> bool:
         """Whether the final fit's law (n, kappa) may be used as a result: the model is
-        adequate or the misfit is explained, and neither n nor kappa of that fit (the final
-        fit, else the user's) is at a bound of its range (no valid interval there). False when
-        the verdict is "ambiguous" or "none of the candidates": then no law of this diagnosis
-        is a result, whatever its interval. The library's ``Diagnosis::law_is_a_result`` rule."""
+        adequate or the misfit is explained, and that fit (the final fit, else the user's)
+        passes the fit's own rule (:func:`law_not_a_result`: neither n nor kappa at a bound of
+        its range, no ``implausible`` warning). False when the verdict is "ambiguous" or "none
+        of the candidates": then no law of this diagnosis is a result, whatever its interval.
+        The library's ``Diagnosis::law_is_a_result`` rule."""
         if self.verdict.get("kind") not in ("adequate", "explained"):
             return False
         fit = self._data.get("final_fit") or self._data.get("base_fit") or {}
-        return not any(
-            b.get("parameter") in ("n", "kappa") for b in fit.get("at_bound", [])
-        )
+        return law_not_a_result(fit) is None
 
     @property
     def found(self) -> List[str]:

@@ -203,3 +203,22 @@ def test_a_fit_and_a_diagnosis_continue_from_a_previous_result(radiation_diagnos
     d = diffbvp.diagnose(ds, start_from=fit, refit_top=2)
     assert "radiation" in d.base_fit.summary["fitted"]
     assert all(c.effect != "radiation" for c in d.candidates)
+
+
+def test_a_law_at_its_bound_is_no_result_in_python_as_in_the_report(pmma, pmma_fit):
+    """300 K of warm air fixed where there is none: n runs to its upper bound 1. The fit's
+    ``law_not_a_result`` is the text report's ``NOT A RESULT:`` reason and the flow curve's
+    ``not_a_result``, word for word; the shipped fit's law is a result. An ``implausible``
+    warning alone makes a law no result too (the library's rule)."""
+    assert pmma_fit.law_is_a_result and pmma_fit.law_not_a_result is None
+    assert "not_a_result" not in (pmma_fit.summary.get("flow_curve") or {})
+    f = diffbvp.fit(pmma, effects="air_temperature_profile=300", error_budget=False)
+    why = f.law_not_a_result
+    assert why is not None and not f.law_is_a_result, f.summary["at_bound"]
+    assert why.startswith("n is at its upper bound 1"), why
+    flat = " ".join(f.text.split())
+    assert f"NOT A RESULT: {why}" in flat, f.text
+    assert f.summary["flow_curve"]["not_a_result"] == why
+    data = json.loads(json.dumps(pmma_fit.summary))
+    data["warnings"] = [{"code": "implausible", "message": "n = 0.01 is implausible here: biased"}]
+    assert diffbvp.results.law_not_a_result(data) == "n = 0.01 is implausible here"

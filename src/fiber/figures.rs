@@ -347,14 +347,15 @@ pub fn identification_figures(
     let identified = profiles(&id.solutions);
     let newtonian = profiles(newtonian);
     // a law that is not a result (FitSummary::law_not_a_result) is not labelled "identified"
-    let label = match id.summary.law_not_a_result() {
-        Some(_) => format!(
-            "fitted n = {:.3}, κ = {:.2}: NOT A RESULT (see the report)",
-            id.law()[0],
-            id.law()[1]
-        ),
-        None => format!("identified n = {:.3}, κ = {:.2}", id.law()[0], id.law()[1]),
+    let (word, note) = match id.summary.law_not_a_result() {
+        Some(_) => ("fitted", ": NOT A RESULT (see the report)"),
+        None => ("identified", ""),
     };
+    let label = format!(
+        "{word} n = {:.3}, κ = {:.2}{note}",
+        id.law()[0],
+        id.law()[1]
+    );
     let fitted = ModelCurves {
         label: &label,
         profiles: &identified,

@@ -173,10 +173,12 @@ impl Diagnosis {
 
     /// Whether the reported law `(n, κ)` may be used as a result: the verdict leaves it one
     /// ([`Verdict::law_is_a_result`](super::diagnose::verdict::Verdict::law_is_a_result):
-    /// adequate or explained) and neither parameter is at a bound ([`law_at_bound`](Self::law_at_bound)).
-    /// Python's `Diagnosis.law_is_a_result` applies the same rule to the JSON.
+    /// adequate or explained) and [`law_fit`](Self::law_fit)'s own rule does too
+    /// ([`FitSummary::law_not_a_result`]: neither parameter at a bound
+    /// ([`law_at_bound`](Self::law_at_bound)), no implausible law, e.g. an "adequate" plain fit
+    /// with `n` near 0). Python's `Diagnosis.law_is_a_result` applies the same rule to the JSON.
     pub fn law_is_a_result(&self) -> bool {
-        self.verdict.law_is_a_result() && self.law_at_bound().is_none()
+        self.verdict.law_is_a_result() && self.law_fit().law_not_a_result().is_none()
     }
 
     /// The noise level the judgement used \[-\] (the base fit's).

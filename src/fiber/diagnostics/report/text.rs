@@ -204,8 +204,9 @@ impl Diagnosis {
     }
 
     /// Why the final law is not a result, if it is not: the misfit is not explained, another
-    /// explanation as good disagrees on the law, or its `n` or `κ` is at a bound of its range
-    /// ([`Diagnosis::law_is_a_result`]).
+    /// explanation as good disagrees on the law, or the fit's own rule
+    /// ([`FitSummary::law_not_a_result`](crate::fiber::rheometer::FitSummary::law_not_a_result):
+    /// `n` or `κ` at a bound, an implausible law) ([`Diagnosis::law_is_a_result`]).
     fn law_not_a_result(&self) -> Option<String> {
         let why = match self.verdict {
             Verdict::NoneOfTheCandidates { ref stand_ins, .. } if !stand_ins.is_empty() => {
@@ -215,15 +216,10 @@ impl Diagnosis {
             Verdict::Ambiguous { .. } => {
                 "another explanation as good disagrees on the law, see the verdict"
             }
+            // the fit's own rule (a bound, an implausible warning): the one the fit's report,
+            // figures and page apply
             Verdict::Adequate | Verdict::Explained { .. } => {
-                return self.law_at_bound().map(|b| {
-                    format!(
-                        "{} is at its {} bound {}, where the fit has no valid interval",
-                        b.parameter,
-                        b.side.name(),
-                        fmt_g(b.bound)
-                    )
-                })
+                return self.law_fit().law_not_a_result();
             }
         };
         Some(why.to_string())
