@@ -217,8 +217,9 @@ class Estimate:
 
 def law_not_a_result(fit: Mapping[str, Any]) -> Optional[str]:
     """Why the law of ``fit`` (a fit's dict, as ``rheometer fit --json`` writes it) is not a
-    result, or None: n or kappa at a bound of its range (no valid interval there), or an
-    ``implausible`` warning (its finding up to the first colon). None where the law was not
+    result, or None: n or kappa at a bound of its range (no valid interval there), an
+    ``implausible`` warning, or a ``misfit`` warning (the model misses the data by several
+    times the noise) (the warning's finding up to the first colon). None where the law was not
     fitted. The library's ``FitSummary::law_not_a_result`` rule and words (the text report's
     ``NOT A RESULT:`` line, ``flow_curve.not_a_result``)."""
     if not any(p in ("n", "kappa") for p in fit.get("fitted", [])):
@@ -233,9 +234,11 @@ def law_not_a_result(fit: Mapping[str, Any]) -> Optional[str]:
             return (f"{name} is at its {side} bound {bound:.6g}, where the fit has no valid interval"
                     + (" (the Carreau-type law is Newtonian there and kappa is not determined; "
                        "whether the Newtonian law fits is said below)" if newtonian else ""))
-    for w in fit.get("warnings", []) or []:
-        if w.get("code") == "implausible":
-            return str(w.get("message", "")).split(":", 1)[0].strip()
+    warnings = fit.get("warnings", []) or []
+    for code in ("implausible", "misfit"):
+        for w in warnings:
+            if w.get("code") == code:
+                return str(w.get("message", "")).split(":", 1)[0].strip()
     return None
 
 

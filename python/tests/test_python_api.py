@@ -222,3 +222,8 @@ def test_a_law_at_its_bound_is_no_result_in_python_as_in_the_report(pmma, pmma_f
     data = json.loads(json.dumps(pmma_fit.summary))
     data["warnings"] = [{"code": "implausible", "message": "n = 0.01 is implausible here: biased"}]
     assert diffbvp.results.law_not_a_result(data) == "n = 0.01 is implausible here"
+    data["warnings"] = [{"code": "misfit", "message": "misfit far above the noise: the RMS ..."},
+                        {"code": "large_uncertainty", "message": "kappa: wide"}]
+    assert diffbvp.results.law_not_a_result(data) == "misfit far above the noise"
+    data["warnings"] = [{"code": "large_uncertainty", "message": "kappa: wide"}]
+    assert diffbvp.results.law_not_a_result(data) is None

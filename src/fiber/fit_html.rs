@@ -568,8 +568,9 @@ mod tests {
         assert!(h.contains("No flow curve"), "a missing curve is said");
         // the one noise level, as the text report gives it
         assert!(text.contains("the noise level 1.500 %") && h.contains("the noise level 1.500 %"));
+        // (a warning that leaves the law a result: a misfit makes it none, see below)
         s.warnings.push(FitWarning::new(
-            WarningCode::Misfit,
+            WarningCode::LargeUncertainty,
             "misfit <here> & there".into(),
         ));
         let h = page_of(&s, "a", "a.csv", Path::new("e.toml"));
@@ -605,10 +606,22 @@ mod tests {
         };
         let svg = flow_curve_figure_svg(&flagged).expect("svg");
         assert!(svg.contains("NOT A RESULT") && !svg.contains("identified law"));
-        // a warning of another kind does not make the law "not a result"; a bound does
+        // a misfit far above the noise makes it no result too (the law compensates what the
+        // model lacks); a warning of another kind does not; a bound does
         s.warnings.clear();
-        s.warnings
-            .push(FitWarning::new(WarningCode::Misfit, "misfit".into()));
+        s.warnings.push(FitWarning::new(
+            WarningCode::Misfit,
+            "misfit far above the noise: the RMS relative residual is 4.2 times the noise".into(),
+        ));
+        assert_eq!(
+            s.law_not_a_result().as_deref(),
+            Some("misfit far above the noise")
+        );
+        s.warnings.clear();
+        s.warnings.push(FitWarning::new(
+            WarningCode::LargeUncertainty,
+            "kappa: wide".into(),
+        ));
         assert_eq!(s.law_not_a_result(), None);
         s.at_bound.push(AtBound {
             parameter: "kappa".into(),

@@ -434,9 +434,11 @@ impl FitSummary {
     }
 
     /// Why this fit's material law is not a result, if it is not: `n` or `κ` at a bound of
-    /// its range (no valid interval there), or an `implausible` warning (an `n` no polymer
-    /// melt has, a law that jumped far from the plain fit for no gain, a stand-in effect, two
-    /// explanations that disagree on the law): the warning's finding up to its first colon.
+    /// its range (no valid interval there), an `implausible` warning (an `n` no polymer melt
+    /// has, a law that jumped far from the plain fit for no gain, a stand-in effect, two
+    /// explanations that disagree on the law), or a `misfit` warning (the model misses the
+    /// data by several times the noise: the law compensates what the model lacks): the
+    /// warning's finding up to its first colon.
     /// `None` where the law was not fitted or is a result. The one rule for the fit's text,
     /// figures, flow curve and HTML page.
     pub fn law_not_a_result(&self) -> Option<String> {
@@ -458,9 +460,11 @@ impl FitSummary {
                 }
             ));
         }
-        self.warnings
+        // an implausible law first, then a misfit (RMS beyond MISFIT_RATIO times the noise:
+        // the model does not describe the data, and the law compensates what it lacks)
+        [WarningCode::Implausible, WarningCode::Misfit]
             .iter()
-            .find(|w| w.code == WarningCode::Implausible)
+            .find_map(|code| self.warnings.iter().find(|w| w.code == *code))
             .map(|w| match w.message.split_once(':') {
                 Some((head, _)) => head.trim().to_string(),
                 None => w.message.trim().to_string(),
