@@ -606,6 +606,18 @@ mod tests {
         };
         let svg = flow_curve_figure_svg(&flagged).expect("svg");
         assert!(svg.contains("NOT A RESULT") && !svg.contains("identified law"));
+        // the CSV a spreadsheet reads: a 0/1 column on every row
+        let last_column = |c: &FlowCurve| -> Vec<String> {
+            let csv = c.to_csv();
+            let mut rows = csv
+                .lines()
+                .map(|l| l.rsplit(',').next().unwrap_or("").to_string());
+            assert_eq!(rows.next().as_deref(), Some("law_is_a_result"));
+            rows.collect()
+        };
+        assert!(last_column(&curve()).iter().all(|v| v == "1"));
+        let flagged_rows = last_column(&flagged);
+        assert!(!flagged_rows.is_empty() && flagged_rows.iter().all(|v| v == "0"));
         // a misfit far above the noise makes it no result too (the law compensates what the
         // model lacks); a warning of another kind does not; a bound does
         s.warnings.clear();

@@ -1,5 +1,5 @@
 //! A law that is not a result (issue 26, item 3) is said so wherever `rheometer fit` shows
-//! it: the text report, the HTML page's verdict, the flow curve's JSON and its figure's
+//! it: the text report, the HTML page's verdict, the flow curve's JSON, CSV and its figure's
 //! legend; a plausible law is shown as the identified law in all of them.
 
 use std::fs;
@@ -12,8 +12,8 @@ const LIMIT: Duration = Duration::from_secs(240);
 
 /// `rheometer fit TOML ARGS... --out OUT` on a scratch copy of the shipped data: (the text
 /// report `fit_report.txt`, whose result section stdout prints too, the HTML page,
-/// `flow_curve.json` parsed).
-fn fit_out(name: &str, args: &[&str]) -> (String, String, serde_json::Value) {
+/// `flow_curve.json` parsed, the `law_is_a_result` column of `flow_curve.csv`).
+fn fit_out(name: &str, args: &[&str]) -> (String, String, serde_json::Value, Vec<String>) {
     let (dir, toml, data) = shipped_copy(name);
     let out = dir.join("out");
     let mut all = vec!["fit", s(&toml)];
@@ -35,14 +35,24 @@ fn fit_out(name: &str, args: &[&str]) -> (String, String, serde_json::Value) {
         "stdout and the report"
     );
     let page = read("fit_report.html");
+    let csv = read("flow_curve.csv");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| *h == "law_is_a_result")
+        .unwrap_or_else(|| panic!("no law_is_a_result column: {header:?}"));
+    let flags = lines
+        .map(|l| l.split(',').nth(col).unwrap_or("").to_string())
+        .collect();
     let _ = fs::remove_dir_all(&dir);
-    (report, page, curve)
+    (report, page, curve, flags)
 }
 
 #[test]
 fn a_law_at_its_bound_is_not_a_result_in_the_text_the_page_and_the_flow_curve() {
     // 300 K of warm air fixed where there is none: the law runs to n = 1, kappa undetermined
-    let (text, page, curve) = fit_out(
+    let (text, page, curve, flags) = fit_out(
         "law_not_a_result_warm_air",
         &["--with", "air_temperature_profile=300"],
     );
@@ -56,12 +66,20 @@ fn a_law_at_its_bound_is_not_a_result_in_the_text_the_page_and_the_flow_curve() 
         .as_str()
         .expect("flow_curve.json: not_a_result");
     assert!(
+        !flags.is_empty() && flags.iter().all(|f| f == "0"),
+        "{flags:?}"
+    );
+    assert!(
         line.contains(why.split(" (").next().unwrap_or(why)),
         "{why} / {line}"
     );
 
     // the control: the shipped data with the paper's model, a plausible law
-    let (text, page, curve) = fit_out("law_not_a_result_control", &[]);
+    let (text, page, curve, flags) = fit_out("law_not_a_result_control", &[]);
+    assert!(
+        !flags.is_empty() && flags.iter().all(|f| f == "1"),
+        "{flags:?}"
+    );
     assert!(!text.contains("NOT A RESULT"), "{text}");
     assert!(!page.contains("class=\"verdict bad\""));
     assert!(curve.get("not_a_result").is_none(), "{curve}");

@@ -89,13 +89,15 @@ impl FlowCurve {
     }
 
     /// The curve as CSV, units in the header: `strain_rate_per_s, eta_E_Pa_s`, the three bands
-    /// (`stat95_low_Pa_s`, ...), `plateau_Pa_s` (Trouton), `extrapolated` (0/1), and one
-    /// `eta_E_at_<T>K_Pa_s` column per isotherm; the curve's temperature in `temperature_K`.
+    /// (`stat95_low_Pa_s`, ...), `plateau_Pa_s` (Trouton), `extrapolated` (0/1),
+    /// `law_is_a_result` (0 where the fit's law is no result, [`FlowCurve::not_a_result`]; the
+    /// reason is in the JSON and the report), and one `eta_E_at_<T>K_Pa_s` column per
+    /// isotherm; the curve's temperature in `temperature_K`.
     pub fn to_csv(&self) -> String {
         let mut s = String::from(
             "strain_rate_per_s,eta_E_Pa_s,stat95_low_Pa_s,stat95_high_Pa_s,sys95_low_Pa_s,\
              sys95_high_Pa_s,total95_low_Pa_s,total95_high_Pa_s,plateau_Pa_s,temperature_K,\
-             extrapolated",
+             extrapolated,law_is_a_result",
         );
         for iso in &self.isotherms {
             s.push_str(&format!(",eta_E_at_{:.2}K_Pa_s", iso.temperature_k));
@@ -103,7 +105,7 @@ impl FlowCurve {
         s.push('\n');
         for (i, p) in self.points.iter().enumerate() {
             s.push_str(&format!(
-                "{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{}",
+                "{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}",
                 p.strain_rate_per_s,
                 p.eta_pa_s,
                 p.stat95_pa_s[0],
@@ -114,7 +116,9 @@ impl FlowCurve {
                 p.total95_pa_s[1],
                 self.plateau_pa_s,
                 self.temperature_k,
-                u8::from(p.extrapolated)
+                u8::from(p.extrapolated),
+                // on every row, so a spreadsheet that keeps a few columns keeps it too
+                u8::from(self.not_a_result.is_none())
             ));
             for iso in &self.isotherms {
                 s.push_str(&format!(
