@@ -453,6 +453,8 @@ class FitResult(Result):
             parts.append(f"noise={100 * self.noise_level:.2g} %")
         if self.warnings:
             parts.append(f"{len(self.warnings)} warning{'s' if len(self.warnings) > 1 else ''}")
+        if self.law_not_a_result is not None:
+            parts.append("NOT A RESULT")
         return f"FitResult({', '.join(parts)})"
 
     def __str__(self) -> str:

@@ -215,6 +215,7 @@ def test_a_law_at_its_bound_is_no_result_in_python_as_in_the_report(pmma, pmma_f
     f = diffbvp.fit(pmma, effects="air_temperature_profile=300", error_budget=False)
     why = f.law_not_a_result
     assert why is not None and not f.law_is_a_result, f.summary["at_bound"]
+    assert repr(f).endswith("NOT A RESULT)") and "NOT A RESULT" not in repr(pmma_fit), repr(f)
     assert why.startswith("n is at its upper bound 1"), why
     flat = " ".join(f.text.split())
     assert f"NOT A RESULT: {why}" in flat, f.text
