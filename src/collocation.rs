@@ -12,7 +12,7 @@
 //! exact dual-number Jacobians of `f` at the nodes and midpoints and of `g`, combined by the chain
 //! rule (Ascher, Mattheij & Russell; Kierzenka & Shampine 2001).
 
-use crate::dual_jacobian::{BcFn, DualJacobian, RhsFn};
+use crate::dual_jacobian::{BcFn, DualJacobian, RhsFn, Seeds};
 use crate::error::BvpError;
 use crate::problem::Bvp;
 
@@ -36,13 +36,18 @@ pub(crate) struct Collocation {
     pub f_mid: Vec<f64>,
     /// Residual vector: `(m-1) n` collocation residuals, then `n + k` boundary residuals.
     pub res: Vec<f64>,
-    /// Width of the stored Jacobians' parameter part (`k` for Newton, `k + q` for sensitivities).
+    /// Width of the stored Jacobians' parameter part (`k` for Newton, `k + q` for sensitivities
+    /// in all model parameters, `k + model_seeds.len()` in general).
     pub seeded_params: usize,
-    /// Node Jacobians `∂f/∂(y, p[..seeded])`, `m × n × (n + seeded)`.
+    /// The model parameters (indices into the `q` model parameters, increasing) whose columns
+    /// follow the `k` unknowns' in the Jacobians' parameter part: column `k + s` is model
+    /// parameter `model_seeds[s]` (empty for Newton, `0..q` for a full linearisation).
+    pub model_seeds: Vec<usize>,
+    /// Node Jacobians `∂f/∂(y, p_seeded)`, `m × n × (n + seeded)`.
     pub jn: Vec<f64>,
     /// Midpoint Jacobians, `(m-1) × n × (n + seeded)`.
     pub jm: Vec<f64>,
-    /// Boundary Jacobian `∂g/∂(ya, yb, p[..seeded])`, `(n+k) × (2n + seeded)`.
+    /// Boundary Jacobian `∂g/∂(ya, yb, p_seeded)`, `(n+k) × (2n + seeded)`.
     pub jbc: Vec<f64>,
     /// Right-hand-side evaluations in `f64` (one per point).
     pub rhs_evals: usize,
@@ -50,6 +55,10 @@ pub(crate) struct Collocation {
     pub jac_evals: usize,
     input: Vec<f64>,
     fbuf: Vec<f64>,
+    /// Input indices seeded at a node or midpoint (`[y, p]`) and at the boundary
+    /// (`[ya, yb, p]`) for a linearisation in a subset of the model parameters.
+    seed_list: Vec<usize>,
+    bc_seed_list: Vec<usize>,
     engine: DualJacobian,
 }
 
@@ -66,6 +75,7 @@ impl Collocation {
             f_mid: Vec::new(),
             res: Vec::new(),
             seeded_params: 0,
+            model_seeds: Vec::new(),
             jn: Vec::new(),
             jm: Vec::new(),
             jbc: Vec::new(),
@@ -73,6 +83,8 @@ impl Collocation {
             jac_evals: 0,
             input: Vec::new(),
             fbuf: Vec::new(),
+            seed_list: Vec::new(),
+            bc_seed_list: Vec::new(),
             engine: DualJacobian::default(),
         }
     }
@@ -134,6 +146,7 @@ impl Collocation {
         c.x.extend_from_slice(&self.x);
         c.h.extend_from_slice(&self.h);
         c.seeded_params = self.seeded_params;
+        c.model_seeds.clone_from(&self.model_seeds);
         c.jn.extend_from_slice(&self.jn);
         c.jm.extend_from_slice(&self.jm);
         c.jbc.extend_from_slice(&self.jbc);
@@ -229,7 +242,7 @@ impl Collocation {
         p: &[f64],
         seeded: usize,
     ) -> Result<(), BvpError> {
-        self.dual_pass(problem, y, p, seeded, true)?;
+        self.dual_pass(problem, y, p, seeded, None, true)?;
         self.finish_residual(problem, y, p)
     }
 
@@ -243,11 +256,33 @@ impl Collocation {
         p: &[f64],
         seeded: usize,
     ) -> Result<(), BvpError> {
-        self.dual_pass(problem, y, p, seeded, false)
+        self.dual_pass(problem, y, p, seeded, None, false)
     }
 
-    /// The dual-number pass of [`jacobians`](Self::jacobians); with `values`, the real parts
-    /// also set the node slopes `f`, the midpoint states and `f_mid` (checked finite, as
+    /// [`jacobians`](Self::jacobians) with respect to `y`, the `k` unknowns and the model
+    /// parameters `model` only (indices into the `q` model parameters, strictly increasing):
+    /// the other model parameters are constants of the dual pass, which then needs
+    /// `ceil((n + k + model.len()) / 8)` evaluations per point instead of
+    /// `ceil((n + k + q) / 8)`. Column `k + s` of the parameter part is `model[s]`.
+    pub(crate) fn jacobians_in<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        model: &[usize],
+    ) -> Result<(), BvpError> {
+        debug_assert!(model.windows(2).all(|w| w[0] < w[1]));
+        debug_assert!(model.last().is_none_or(|&j| j < self.q));
+        if model.len() == self.q {
+            // all of them: the plain prefix seeding
+            return self.dual_pass(problem, y, p, self.k + self.q, None, false);
+        }
+        self.dual_pass(problem, y, p, self.k + model.len(), Some(model), false)
+    }
+
+    /// The dual-number pass of [`jacobians`](Self::jacobians) (with `model`, of
+    /// [`jacobians_in`](Self::jacobians_in)); with `values`, the real parts also set the node
+    /// slopes `f`, the midpoint states and `f_mid` (checked finite, as
     /// [`residual`](Self::residual) checks them).
     fn dual_pass<P: Bvp>(
         &mut self,
@@ -255,15 +290,84 @@ impl Collocation {
         y: &[f64],
         p: &[f64],
         seeded: usize,
+        model: Option<&[usize]>,
+        values: bool,
+    ) -> Result<(), BvpError> {
+        let (n, k) = (self.n, self.k);
+        self.seeded_params = seeded;
+        self.model_seeds.clear();
+        let mut seed_list = std::mem::take(&mut self.seed_list);
+        let mut bc_seed_list = std::mem::take(&mut self.bc_seed_list);
+        seed_list.clear();
+        bc_seed_list.clear();
+        match model {
+            Some(list) => {
+                self.model_seeds.extend_from_slice(list);
+                seed_list.extend(0..n + k);
+                seed_list.extend(list.iter().map(|j| n + k + j));
+                bc_seed_list.extend(0..2 * n + k);
+                bc_seed_list.extend(list.iter().map(|j| 2 * n + k + j));
+            }
+            None => self.model_seeds.extend(0..seeded.saturating_sub(k)),
+        }
+        let seeds = match model {
+            Some(_) => (Seeds::These(&seed_list), Seeds::These(&bc_seed_list)),
+            None => (Seeds::First(n + seeded), Seeds::First(2 * n + seeded)),
+        };
+        let result = self.dual_pass_seeded(problem, y, p, seeds, values);
+        self.seed_list = seed_list;
+        self.bc_seed_list = bc_seed_list;
+        result
+    }
+
+    /// The derivatives of `f` (at the nodes and midpoints) and of `g` with respect to the model
+    /// parameters `model` only, nothing in the states: `jn`, `jm` are `… × n × s` and `jbc` is
+    /// `(n + k) × s` for `s = model.len()`, column `j` model parameter `model[j]`. A
+    /// linearisation seeded in other parameters combines them with its own state Jacobians
+    /// ([`param_column_with`](Self::param_column_with)); nothing else may read this
+    /// collocation's Jacobians. Requires the midpoint states of `y` (as
+    /// [`jacobians`](Self::jacobians)).
+    pub(crate) fn param_jacobians_only<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        model: &[usize],
+    ) -> Result<(), BvpError> {
+        let (n, k) = (self.n, self.k);
+        self.seeded_params = model.len();
+        self.model_seeds.clear();
+        self.model_seeds.extend_from_slice(model);
+        let nodes: Vec<usize> = model.iter().map(|j| n + k + j).collect();
+        let bc: Vec<usize> = model.iter().map(|j| 2 * n + k + j).collect();
+        self.dual_pass_seeded(
+            problem,
+            y,
+            p,
+            (Seeds::These(&nodes), Seeds::These(&bc)),
+            false,
+        )
+    }
+
+    /// [`dual_pass`](Self::dual_pass) with the seeds of the nodes and midpoints and of the
+    /// boundary conditions.
+    fn dual_pass_seeded<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        (node_seeds, bc_seeds): (Seeds<'_>, Seeds<'_>),
         values: bool,
     ) -> Result<(), BvpError> {
         let (n, m) = (self.n, self.m());
-        let w = n + seeded;
-        self.seeded_params = seeded;
+        // the widths of the node and the boundary Jacobians' rows: `n + seeded` and
+        // `2 n + seeded` but for `param_jacobians_only`
+        let w = node_seeds.len();
+        let wb = bc_seeds.len();
         self.jn.resize(m * n * w, 0.0);
         self.jm.resize((m - 1) * n * w, 0.0);
         let nb = n + self.k;
-        self.jbc.resize(nb * (2 * n + seeded), 0.0);
+        self.jbc.resize(nb * wb, 0.0);
         let mut fbuf = std::mem::take(&mut self.fbuf);
         fbuf.resize(n.max(nb), 0.0);
         for i in 0..m {
@@ -280,10 +384,10 @@ impl Collocation {
             } else {
                 &mut fbuf[..n]
             };
-            self.engine.jacobian(
+            self.engine.jacobian_in(
                 &rf,
                 &self.input,
-                w,
+                node_seeds,
                 out,
                 &mut self.jn[i * n * w..(i + 1) * n * w],
             );
@@ -310,10 +414,10 @@ impl Collocation {
             } else {
                 &mut fbuf[..n]
             };
-            self.engine.jacobian(
+            self.engine.jacobian_in(
                 &rf,
                 &self.input,
-                w,
+                node_seeds,
                 out,
                 &mut self.jm[i * n * w..(i + 1) * n * w],
             );
@@ -344,19 +448,14 @@ impl Collocation {
         self.input.extend_from_slice(&y[(m - 1) * n..]);
         self.input.extend_from_slice(p);
         let bf = BcFn { problem, n };
-        self.engine.jacobian(
-            &bf,
-            &self.input,
-            2 * n + seeded,
-            &mut fbuf[..nb],
-            &mut self.jbc,
-        );
+        self.engine
+            .jacobian_in(&bf, &self.input, bc_seeds, &mut fbuf[..nb], &mut self.jbc);
         self.fbuf = fbuf;
         for (c, v) in self.jbc.iter().enumerate() {
             if !v.is_finite() {
                 return Err(BvpError::NonFinite {
                     what: "boundary-condition Jacobian",
-                    component: c / (2 * n + seeded),
+                    component: c / wb.max(1),
                     x: self.x[0],
                 });
             }
@@ -446,31 +545,80 @@ impl Collocation {
         }
     }
 
-    /// Column `col` (index into `p`, `< seeded_params`) of `∂r/∂p`: writes the collocation part
+    /// The column of the Jacobians' parameter part holding `p_col` (`col` an index into
+    /// `p = (unknowns, model parameters)`), if it was seeded: `col` itself for an unknown, `k + s`
+    /// for model parameter `model_seeds[s]`.
+    pub(crate) fn param_slot(&self, col: usize) -> Option<usize> {
+        if col < self.k {
+            return (col < self.seeded_params).then_some(col);
+        }
+        self.model_seeds
+            .binary_search(&(col - self.k))
+            .ok()
+            .map(|s| self.k + s)
+    }
+
+    /// Column `col` (a column of the parameter part, `< seeded_params`: see
+    /// [`param_slot`](Self::param_slot)) of `∂r/∂p`: writes the collocation part
     /// (`(m-1) n` rows) and the boundary part (`n + k` rows) into `out` (length `m n + k`).
     pub(crate) fn param_column(&self, col: usize, out: &mut [f64]) {
+        let n = self.n;
+        let w = n + self.seeded_params;
+        let parts = ParamParts {
+            jn: &self.jn,
+            jm: &self.jm,
+            jbc: &self.jbc,
+            width: w,
+            column: n + col,
+            bc_width: 2 * n + self.seeded_params,
+            bc_column: 2 * n + col,
+        };
+        self.param_column_from(&parts, out);
+    }
+
+    /// [`param_column`](Self::param_column) for column `s` of `extra`, computed by
+    /// [`param_jacobians_only`](Self::param_jacobians_only) on this mesh at this solution:
+    /// its parameter derivatives with this linearisation's state Jacobians.
+    pub(crate) fn param_column_with(&self, extra: &Collocation, s: usize, out: &mut [f64]) {
+        let parts = ParamParts {
+            jn: &extra.jn,
+            jm: &extra.jm,
+            jbc: &extra.jbc,
+            width: extra.seeded_params,
+            column: s,
+            bc_width: extra.seeded_params,
+            bc_column: s,
+        };
+        self.param_column_from(&parts, out);
+    }
+
+    /// `∂r/∂p` for one parameter whose derivatives of `f` and `g` are in `parts`, with the
+    /// state Jacobians of this collocation.
+    fn param_column_from(&self, parts: &ParamParts<'_>, out: &mut [f64]) {
         let (n, m) = (self.n, self.m());
         let w = n + self.seeded_params;
-        let pc = n + col;
+        let (pw, pc) = (parts.width, parts.column);
+        let fp = |j: &[f64], i: usize, r: usize| j[(i * n + r) * pw + pc];
         for i in 0..m - 1 {
             let h = self.h[i];
-            let ji = &self.jn[i * n * w..(i + 1) * n * w];
-            let jj = &self.jn[(i + 1) * n * w..(i + 2) * n * w];
             let jm = &self.jm[i * n * w..(i + 1) * n * w];
             for r in 0..n {
                 // d y_mid / dp = -h/8 (fp_j - fp_i)
                 let mut s = 0.0;
                 for l in 0..n {
-                    s += jm[r * w + l] * (-0.125 * h) * (jj[l * w + pc] - ji[l * w + pc]);
+                    s += jm[r * w + l]
+                        * (-0.125 * h)
+                        * (fp(parts.jn, i + 1, l) - fp(parts.jn, i, l));
                 }
-                out[i * n + r] =
-                    -h / 6.0 * (ji[r * w + pc] + 4.0 * (jm[r * w + pc] + s) + jj[r * w + pc]);
+                out[i * n + r] = -h / 6.0
+                    * (fp(parts.jn, i, r)
+                        + 4.0 * (fp(parts.jm, i, r) + s)
+                        + fp(parts.jn, i + 1, r));
             }
         }
-        let wb = 2 * n + self.seeded_params;
         let off = (m - 1) * n;
         for r in 0..n + self.k {
-            out[off + r] = self.jbc[r * wb + 2 * n + col];
+            out[off + r] = parts.jbc[r * parts.bc_width + parts.bc_column];
         }
     }
 
@@ -480,6 +628,18 @@ impl Collocation {
         let wb = 2 * self.n + self.seeded_params;
         self.jbc[r * wb + end * self.n + c]
     }
+}
+
+/// Where one parameter's derivatives of `f` (nodes `jn`, midpoints `jm`, rows of `width`, at
+/// `column`) and of `g` (`jbc`, rows of `bc_width`, at `bc_column`) are stored.
+struct ParamParts<'a> {
+    jn: &'a [f64],
+    jm: &'a [f64],
+    jbc: &'a [f64],
+    width: usize,
+    column: usize,
+    bc_width: usize,
+    bc_column: usize,
 }
 
 fn check_finite(

@@ -2,8 +2,8 @@
 //!
 //! A function `out = F(input)` written generically over [`DualNum`] is evaluated with static
 //! vector duals (`DualSVec64<W>`) that carry `W` directional derivatives at once. Derivatives
-//! with respect to the first `n_seeds` inputs are computed in `ceil(n_seeds / W)` passes; the
-//! remaining inputs are constants. The width `W ∈ {1, 2, 4, 8}` is chosen from `n_seeds`, so a
+//! with respect to the seeded inputs ([`Seeds`]: the first `n_seeds`, or a list) are computed
+//! in `ceil(n_seeds / W)` passes; the remaining inputs are constants. The width `W ∈ {1, 2, 4, 8}` is chosen from `n_seeds`, so a
 //! 4-state right-hand side needs one pass. Buffers are kept between calls: no allocation once
 //! warmed up.
 
@@ -46,13 +46,65 @@ impl<P: Bvp> DualFn for BcFn<'_, P> {
     }
 }
 
+/// The inputs a Jacobian is taken in: its columns, in order.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Seeds<'a> {
+    /// The first `n` inputs.
+    First(usize),
+    /// The inputs at these indices (strictly increasing).
+    These(&'a [usize]),
+}
+
+impl Seeds<'_> {
+    /// Number of seeded inputs (= Jacobian columns).
+    #[inline]
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            Seeds::First(n) => *n,
+            Seeds::These(l) => l.len(),
+        }
+    }
+
+    /// Input index of column `j`.
+    #[inline]
+    fn input(&self, j: usize) -> usize {
+        match self {
+            Seeds::First(_) => j,
+            Seeds::These(l) => l[j],
+        }
+    }
+
+    /// Whether these seeds are those recorded in `first`/`list` by [`Seeds::record`].
+    fn same_as(&self, first: usize, list: &[usize]) -> bool {
+        match self {
+            Seeds::First(n) => list.is_empty() && *n == first,
+            Seeds::These(l) => first == usize::MAX && *l == list,
+        }
+    }
+
+    /// Records these seeds (for [`Seeds::same_as`]).
+    fn record(&self, first: &mut usize, list: &mut Vec<usize>) {
+        list.clear();
+        match self {
+            Seeds::First(n) => *first = *n,
+            Seeds::These(l) => {
+                *first = usize::MAX;
+                list.extend_from_slice(l);
+            }
+        }
+    }
+}
+
 #[derive(Default)]
 struct Buffers<const W: usize> {
     input: Vec<DualSVec64<W>>,
     out: Vec<DualSVec64<W>>,
-    /// `(n_seeds, input length)` for which `input` holds the seeds of a single pass: the next
-    /// call with the same shape only replaces the values.
-    seeded_for: Option<(usize, usize)>,
+    /// Input length for which `input` holds the seeds of a single pass (those recorded in
+    /// `seeded_first` and `seeded_list`): the next call with the same seeds only replaces the
+    /// values.
+    seeded_for: Option<usize>,
+    seeded_first: usize,
+    seeded_list: Vec<usize>,
 }
 
 impl<const W: usize> Buffers<W> {
@@ -60,13 +112,16 @@ impl<const W: usize> Buffers<W> {
         &mut self,
         f: &F,
         input: &[f64],
-        n_seeds: usize,
+        seeds: Seeds<'_>,
         out: &mut [f64],
         jac: &mut [f64],
     ) {
+        let n_seeds = seeds.len();
         let n_out = out.len();
         let single = n_seeds <= W;
-        let seeded = single && self.seeded_for == Some((n_seeds, input.len()));
+        let seeded = single
+            && self.seeded_for == Some(input.len())
+            && seeds.same_as(self.seeded_first, &self.seeded_list);
         if seeded {
             for (v, &x) in self.input.iter_mut().zip(input) {
                 v.re = x;
@@ -83,12 +138,12 @@ impl<const W: usize> Buffers<W> {
         while start < n_seeds.max(1) {
             let end = (start + W).min(n_seeds);
             if !seeded {
-                for (j, v) in self.input.iter_mut().enumerate() {
-                    v.eps = if j >= start && j < end {
-                        Derivative::derivative_generic(Const::<W>, U1, j - start)
-                    } else {
-                        Derivative::none()
-                    };
+                for v in self.input.iter_mut() {
+                    v.eps = Derivative::none();
+                }
+                for j in start..end {
+                    self.input[seeds.input(j)].eps =
+                        Derivative::derivative_generic(Const::<W>, U1, j - start);
                 }
             }
             for o in self.out.iter_mut() {
@@ -119,7 +174,8 @@ impl<const W: usize> Buffers<W> {
             start = end;
         }
         if single {
-            self.seeded_for = Some((n_seeds, input.len()));
+            self.seeded_for = Some(input.len());
+            seeds.record(&mut self.seeded_first, &mut self.seeded_list);
         }
     }
 }
@@ -144,13 +200,27 @@ impl DualJacobian {
         out: &mut [f64],
         jac: &mut [f64],
     ) {
-        debug_assert!(n_seeds <= input.len());
+        self.jacobian_in(f, input, Seeds::First(n_seeds), out, jac)
+    }
+
+    /// Evaluates `out = F(input)` and the row-major Jacobian `jac[i * s + j] =
+    /// ∂out_i/∂input_{seed j}` for the `s = seeds.len()` seeded inputs.
+    pub(crate) fn jacobian_in<F: DualFn>(
+        &mut self,
+        f: &F,
+        input: &[f64],
+        seeds: Seeds<'_>,
+        out: &mut [f64],
+        jac: &mut [f64],
+    ) {
+        let n_seeds = seeds.len();
+        debug_assert!(n_seeds == 0 || seeds.input(n_seeds - 1) < input.len());
         debug_assert!(jac.len() >= out.len() * n_seeds);
         match n_seeds {
-            0 | 1 => self.w1.jacobian(f, input, n_seeds, out, jac),
-            2 => self.w2.jacobian(f, input, n_seeds, out, jac),
-            3 | 4 => self.w4.jacobian(f, input, n_seeds, out, jac),
-            _ => self.w8.jacobian(f, input, n_seeds, out, jac),
+            0 | 1 => self.w1.jacobian(f, input, seeds, out, jac),
+            2 => self.w2.jacobian(f, input, seeds, out, jac),
+            3 | 4 => self.w4.jacobian(f, input, seeds, out, jac),
+            _ => self.w8.jacobian(f, input, seeds, out, jac),
         }
     }
 }
@@ -199,6 +269,44 @@ mod tests {
                     }
                     assert!((jac[i * n + j] - exact).abs() < 1e-13, "n={n} i={i} j={j}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn listed_seeds_are_the_columns_of_the_full_jacobian() {
+        let x: Vec<f64> = (0..13).map(|i| 0.2 + 0.07 * i as f64).collect();
+        let mut full = vec![0.0; 13 * 13];
+        let mut out = vec![0.0; 13];
+        let mut engine = DualJacobian::default();
+        engine.jacobian(&Poly, &x, 13, &mut out, &mut full);
+        // one pass (4 seeds), two passes (9 seeds); the same list twice (cached seeds), then a
+        // prefix of the same length (the cache must not mistake one for the other)
+        for list in [
+            vec![0, 3, 7, 12],
+            vec![0, 1, 2, 3, 5, 6, 9, 11, 12],
+            vec![0, 3, 7, 12],
+        ] {
+            let s = list.len();
+            let mut jac = vec![0.0; 13 * s];
+            let mut o = vec![0.0; 13];
+            engine.jacobian_in(&Poly, &x, Seeds::These(&list), &mut o, &mut jac);
+            assert_eq!(o, out);
+            for i in 0..13 {
+                for (j, &c) in list.iter().enumerate() {
+                    assert_eq!(jac[i * s + j], full[i * 13 + c], "row {i}, input {c}");
+                }
+            }
+        }
+        let mut jac = vec![0.0; 13 * 4];
+        engine.jacobian(&Poly, &x, 4, &mut out, &mut jac);
+        for i in 0..13 {
+            for c in 0..4 {
+                assert_eq!(
+                    jac[i * 4 + c],
+                    full[i * 13 + c],
+                    "prefix row {i}, input {c}"
+                );
             }
         }
     }

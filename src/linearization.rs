@@ -15,10 +15,12 @@ use crate::linear::{Factorization, LinearSystem, Pattern};
 use crate::problem::Bvp;
 use std::sync::Arc;
 
-/// Jacobians seeded in all parameters and the factorised Newton matrix at one solution.
+/// Jacobians seeded in the parameters and the factorised Newton matrix at one solution.
 pub(crate) struct Linearization {
-    /// Mesh, interval lengths and the Jacobians `jn`, `jm`, `jbc` seeded in `k + q` parameters
-    /// (the value buffers are empty).
+    /// Mesh, interval lengths and the Jacobians `jn`, `jm`, `jbc` seeded in the `k` unknowns and
+    /// the model parameters `col.model_seeds` (all `q` of them unless the solve was told which
+    /// ones a caller will differentiate in: [`SolveOptions::linearization_params`](crate::SolveOptions::linearization_params));
+    /// the value buffers are empty.
     pub col: Collocation,
     /// The factorisation of `∂_Y S` at the solution.
     pub factorization: Factorization,
@@ -28,9 +30,11 @@ impl std::fmt::Debug for Linearization {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "Linearization {{ nodes: {}, seeded parameters: {}, factorization: {:?} }}",
+            "Linearization {{ nodes: {}, seeded parameters: {} (model parameters {:?}), \
+             factorization: {:?} }}",
             self.col.m(),
             self.col.seeded_params,
+            self.col.model_seeds,
             self.factorization
         )
     }
@@ -47,16 +51,21 @@ impl Linearization {
     /// Computes the linearisation at the node values `y` with all parameters
     /// `p = (unknowns, model parameters)` in `col` and `lin` (a solver's workspace or fresh ones),
     /// which must hold this mesh and the midpoint states of `y` (after a residual evaluation at
-    /// `y`, or [`Collocation::set_midpoints_from_slopes`]): one dual pass seeded in the states
-    /// and all `k + q` parameters, one factorisation.
+    /// `y`, or [`Collocation::set_midpoints_from_slopes`]): one dual pass seeded in the states,
+    /// the `k` unknowns and the model parameters `model` (all `q` if `None`), one
+    /// factorisation.
     pub(crate) fn compute<P: Bvp>(
         problem: &P,
         col: &mut Collocation,
         lin: &mut LinearSystem,
         y: &[f64],
         p: &[f64],
+        model: Option<&[usize]>,
     ) -> Result<Self, BvpError> {
-        col.jacobians(problem, y, p, col.k + col.q)?;
+        match model {
+            Some(list) => col.jacobians_in(problem, y, p, list)?,
+            None => col.jacobians(problem, y, p, col.k + col.q)?,
+        }
         lin.factor(col)?;
         Ok(Linearization {
             col: col.jacobian_copy(),
@@ -65,7 +74,8 @@ impl Linearization {
     }
 
     /// The linearisation at a solution (`x`, `y`, slopes `yp`, parameters `p`) with a fresh
-    /// workspace: what a derivative request computes when the solve did not. No right-hand-side
+    /// workspace, seeded in the model parameters `model` (all if `None`): what a derivative
+    /// request computes when the solve did not. No right-hand-side
     /// evaluation in `f64`: the midpoint states follow from the stored slopes.
     pub(crate) fn with_fresh_workspace<P: Bvp>(
         problem: &P,
@@ -73,13 +83,63 @@ impl Linearization {
         y: &[f64],
         yp: &[f64],
         p: &[f64],
+        model: Option<&[usize]>,
     ) -> Result<Self, BvpError> {
         let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
         let mut col = Collocation::new(n, k, q);
         col.set_mesh(x);
         let mut lin = LinearSystem::new(Arc::new(Pattern::new(n, k, x.len())?));
         col.set_midpoints_from_slopes(y, yp);
-        Self::compute(problem, &mut col, &mut lin, y, p)
+        Self::compute(problem, &mut col, &mut lin, y, p, model)
+    }
+
+    /// The derivatives of `f` and `g` in the model parameters `model` at a solution (`x`, `y`,
+    /// slopes `yp`, parameters `p`), nothing in the states: a dual pass `n + k` inputs narrower
+    /// than a linearisation's and no factorisation, for the columns of parameters a cached
+    /// linearisation was not seeded in ([`Collocation::param_column_with`]).
+    pub(crate) fn extra_columns<P: Bvp>(
+        problem: &P,
+        (x, y, yp): (&[f64], &[f64], &[f64]),
+        p: &[f64],
+        model: &[usize],
+    ) -> Result<Collocation, BvpError> {
+        let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
+        let mut col = Collocation::new(n, k, q);
+        col.set_mesh(x);
+        col.set_midpoints_from_slopes(y, yp);
+        col.param_jacobians_only(problem, y, p, model)?;
+        Ok(col)
+    }
+
+    /// Whether the Jacobians hold the columns of all model parameters `model` (indices into
+    /// the `q` model parameters).
+    pub(crate) fn covers(&self, model: impl IntoIterator<Item = usize>) -> bool {
+        let c = &self.col;
+        c.model_seeds.len() == c.q || model.into_iter().all(|j| c.param_slot(c.k + j).is_some())
+    }
+
+    /// The column of `∂r/∂p` for model parameter `j`, which must be covered
+    /// ([`covers`](Self::covers)).
+    pub(crate) fn model_column(&self, j: usize, out: &mut [f64]) -> Result<(), BvpError> {
+        let c = &self.col;
+        match c.param_slot(c.k + j) {
+            Some(slot) => {
+                c.param_column(slot, out);
+                Ok(())
+            }
+            None => Err(BvpError::InvalidInput(format!(
+                "the linearisation at this solution is not seeded in model parameter {j} \
+                 (seeded in {:?})",
+                c.model_seeds
+            ))),
+        }
+    }
+
+    /// Column of the node Jacobian `jn` holding model parameter `j` (`n + slot`), which must be
+    /// covered.
+    pub(crate) fn model_jn_column(&self, j: usize) -> Option<usize> {
+        let c = &self.col;
+        c.param_slot(c.k + j).map(|s| c.n + s)
     }
 
     /// Solves `∂_Y S · X = B` (or its transpose) for `ncols` right-hand sides stored column after

@@ -52,21 +52,40 @@ fn linearization<'s, P: Bvp>(
     problem: &P,
     sol: &'s Solution,
 ) -> Result<&'s Linearization, BvpError> {
+    linearization_covering(problem, sol, 0..sol.params.len())
+}
+
+/// [`linearization`] seeded at least in the model parameters `model`.
+fn linearization_covering<'s, P: Bvp>(
+    problem: &P,
+    sol: &'s Solution,
+    model: impl IntoIterator<Item = usize>,
+) -> Result<&'s Linearization, BvpError> {
+    check_belongs(problem, sol)?;
+    sol.linearization_covering(problem, model)
+}
+
+/// Errors unless `sol` has the dimensions of `problem`'s solutions.
+fn check_belongs<P: Bvp>(problem: &P, sol: &Solution) -> Result<(), BvpError> {
     let (n, k, q) = (problem.dim(), problem.num_unknowns(), problem.num_params());
     if sol.n != n || sol.unknowns.len() != k || sol.params.len() != q {
         return Err(BvpError::InvalidInput(
             "the solution does not belong to this problem (dimensions differ)".into(),
         ));
     }
-    sol.linearization(problem)
+    Ok(())
 }
 
-/// Forward sensitivities `dy/dp` of a solution with respect to the fixed model parameters.
+/// Forward sensitivities `dy/dp` of a solution with respect to the fixed model parameters (all
+/// of them, or the subset of [`Sensitivities::compute_for`]: column `j` then belongs to model
+/// parameter [`columns`](Self::columns)`[j]`).
 #[derive(Debug, Clone)]
 pub struct Sensitivities {
     n: usize,
     q: usize,
     x: Vec<f64>,
+    /// The model parameter of each column (`0..q` for all of them).
+    columns: Vec<usize>,
     /// `∂y_{i,c}/∂p_j` at the nodes, index `(i n + c) q + j`.
     pub dy: Vec<f64>,
     /// Derivative of the node slopes `f(x_i, y_i, p)` (total), same layout.
@@ -86,7 +105,29 @@ impl Sensitivities {
     /// elimination agree to round-off even on badly scaled systems (fiber model: 1e-15; 3.5e-11
     /// without the step). [`Sensitivities::compute_unrefined`] skips the step.
     pub fn compute<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
-        Self::compute_with(problem, sol, true)
+        Self::compute_with(problem, sol, true, None)
+    }
+
+    /// The sensitivities with respect to the model parameters `columns` only (indices into the
+    /// model parameters, strictly increasing; column `j` of the result is `columns[j]`), one
+    /// solve with `columns.len()` right-hand sides, without the refinement step (as
+    /// [`compute_unrefined`](Self::compute_unrefined)). What a fit that frees a few of a
+    /// model's parameters needs; with [`SolveOptions::linearization_params`](crate::SolveOptions::linearization_params)
+    /// covering `columns`, the cached linearisation serves (otherwise the full one is computed
+    /// once).
+    pub fn compute_for<P: Bvp>(
+        problem: &P,
+        sol: &Solution,
+        columns: &[usize],
+    ) -> Result<Self, BvpError> {
+        let q = problem.num_params();
+        if !columns.windows(2).all(|w| w[0] < w[1]) || columns.last().is_some_and(|&j| j >= q) {
+            return Err(BvpError::InvalidInput(format!(
+                "Sensitivities::compute_for: columns must be strictly increasing indices of the \
+                 {q} model parameters, got {columns:?}"
+            )));
+        }
+        Self::compute_with(problem, sol, false, Some(columns))
     }
 
     /// [`Sensitivities::compute`] without the refinement step: one solve with the cached factors,
@@ -94,17 +135,28 @@ impl Sensitivities {
     /// model), about 60 % cheaper on the solver benchmarks. What a Gauss–Newton Jacobian needs
     /// ([`BvpResiduals`](crate::least_squares::BvpResiduals) uses it).
     pub fn compute_unrefined<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
-        Self::compute_with(problem, sol, false)
+        Self::compute_with(problem, sol, false, None)
     }
 
-    fn compute_with<P: Bvp>(problem: &P, sol: &Solution, refine: bool) -> Result<Self, BvpError> {
-        let lz = linearization(problem, sol)?;
-        let (n, k, q, m) = (lz.col.n, lz.col.k, lz.col.q, lz.col.m());
+    fn compute_with<P: Bvp>(
+        problem: &P,
+        sol: &Solution,
+        refine: bool,
+        columns: Option<&[usize]>,
+    ) -> Result<Self, BvpError> {
+        let columns: Vec<usize> = match columns {
+            Some(c) => c.to_vec(),
+            None => (0..sol.params.len()).collect(),
+        };
+        let lz = linearization_covering(problem, sol, columns.iter().copied())?;
+        let (n, k, m) = (lz.col.n, lz.col.k, lz.col.m());
+        let q = columns.len();
         let size = m * n + k;
         let mut rhs = vec![0.0; size * q];
-        for j in 0..q {
-            lz.col
-                .param_column(k + j, &mut rhs[j * size..(j + 1) * size]);
+        let mut jn_cols = Vec::with_capacity(q);
+        for (j, &c) in columns.iter().enumerate() {
+            lz.model_column(c, &mut rhs[j * size..(j + 1) * size])?;
+            jn_cols.push(lz.model_jn_column(c).unwrap_or(usize::MAX));
         }
         for v in rhs.iter_mut() {
             *v = -*v;
@@ -132,8 +184,8 @@ impl Sensitivities {
         let mut dyp = vec![0.0; m * n * q];
         for i in 0..m {
             for c in 0..n {
-                for j in 0..q {
-                    let mut v = lz.jn(i, c, n + k + j);
+                for (j, &jc) in jn_cols.iter().enumerate() {
+                    let mut v = lz.jn(i, c, jc);
                     for l in 0..n {
                         v += lz.jn(i, c, l) * dy[(i * n + l) * q + j];
                     }
@@ -148,15 +200,22 @@ impl Sensitivities {
             n,
             q,
             x: sol.x.clone(),
+            columns,
             dy,
             dyp,
             d_unknowns,
         })
     }
 
-    /// Number of model parameters.
+    /// Number of columns: the model parameters differentiated in (all of them unless computed
+    /// by [`compute_for`](Self::compute_for)).
     pub fn num_params(&self) -> usize {
         self.q
+    }
+
+    /// The model parameter (index into the model parameters) of each column.
+    pub fn columns(&self) -> &[usize] {
+        &self.columns
     }
 
     /// `∂y_c(x)/∂p_j` of the interpolated solution at `x`, written into `dy` (`n × q`, row-major),
@@ -204,9 +263,10 @@ fn check_points(xs: &[f64]) -> Result<(), BvpError> {
     }
 }
 
-/// Values and exact Jacobian `dr/dp` (`len × q`, row-major) of a residual vector
-/// `r_j = g(j, x_j, y(x_j), p)` at the points `xs`, from forward sensitivities (one solve with
-/// `q` right-hand sides). This is what a Gauss–Newton fit calls.
+/// Values and exact Jacobian `dr/dp` (`len × s`, row-major, `s = sens.num_params()`: column `j`
+/// is model parameter `sens.columns()[j]`, all `q` of them for [`Sensitivities::compute`]) of a
+/// residual vector `r_j = g(j, x_j, y(x_j), p)` at the points `xs`, from forward sensitivities
+/// (one solve with `s` right-hand sides). This is what a Gauss–Newton fit calls.
 pub fn residual_jacobian<P: Bvp, G: PointFunction>(
     problem: &P,
     sol: &Solution,
@@ -220,7 +280,7 @@ pub fn residual_jacobian<P: Bvp, G: PointFunction>(
             "the solution does not belong to this problem (dimensions differ)".into(),
         ));
     }
-    if sens.q != q || sens.x.len() != sol.x.len() {
+    if sens.columns.last().is_some_and(|&j| j >= q) || sens.x != sol.x {
         return Err(BvpError::InvalidInput(
             "the sensitivities were computed for a different solution".into(),
         ));
@@ -232,10 +292,11 @@ pub fn residual_jacobian<P: Bvp, G: PointFunction>(
     let mut grad = vec![0.0; n + k + q];
     let mut y = vec![0.0; n];
     let mut yp = vec![0.0; n];
-    let mut dy = vec![0.0; n * q];
-    let mut dyp = vec![0.0; n * q];
+    let s = sens.q;
+    let mut dy = vec![0.0; n * s];
+    let mut dyp = vec![0.0; n * s];
     let mut values = Vec::with_capacity(xs.len());
-    let mut jac = vec![0.0; xs.len() * q];
+    let mut jac = vec![0.0; xs.len() * s];
     for (idx, &x) in xs.iter().enumerate() {
         sol.eval_into(x, &mut y, &mut yp);
         sens.at_into(x, &mut dy, &mut dyp);
@@ -257,15 +318,15 @@ pub fn residual_jacobian<P: Bvp, G: PointFunction>(
             });
         }
         values.push(out[0]);
-        for j in 0..q {
-            let mut v = grad[n + k + j];
+        for (j, &pj) in sens.columns.iter().enumerate() {
+            let mut v = grad[n + k + pj];
             for c in 0..n {
-                v += grad[c] * dy[c * q + j];
+                v += grad[c] * dy[c * s + j];
             }
             for l in 0..k {
-                v += grad[n + l] * sens.d_unknowns[l * q + j];
+                v += grad[n + l] * sens.d_unknowns[l * s + j];
             }
-            jac[idx * q + j] = v;
+            jac[idx * s + j] = v;
         }
     }
     Ok((values, jac))
@@ -401,17 +462,43 @@ pub fn tangent_guess<P: Bvp>(
             "tangent_guess: model parameter {j} is not finite"
         )));
     }
-    let lz = linearization(problem, sol)?;
+    check_belongs(problem, sol)?;
+    let changed: Vec<usize> = (0..q).filter(|&j| params[j] != sol.params[j]).collect();
+    // the cached linearisation, whatever it is seeded in (its factorisation and state
+    // Jacobians serve any parameter), or one seeded in the changed parameters
+    let lz = match sol.linearization.get() {
+        Some(l) => l,
+        None => sol.linearization_covering(problem, changed.iter().copied())?,
+    };
     let (n, k, m) = (lz.col.n, lz.col.k, lz.col.m());
+    // the changed parameters it was not seeded in: their derivatives of f and g alone
+    let missing: Vec<usize> = changed
+        .iter()
+        .copied()
+        .filter(|&j| lz.col.param_slot(k + j).is_none())
+        .collect();
+    let extra = match missing.is_empty() {
+        true => None,
+        false => Some(Linearization::extra_columns(
+            problem,
+            (&sol.x, &sol.y, &sol.yp),
+            &sol.full_params(),
+            &missing,
+        )?),
+    };
     let size = m * n + k;
     let mut rhs = vec![0.0; size];
     let mut column = vec![0.0; size];
-    for (j, (new, old)) in params.iter().zip(&sol.params).enumerate() {
-        let dp = new - old;
-        if dp == 0.0 {
-            continue;
+    for &j in &changed {
+        let dp = params[j] - sol.params[j];
+        match (lz.col.param_slot(k + j), &extra) {
+            (Some(slot), _) => lz.col.param_column(slot, &mut column),
+            (None, Some(e)) => {
+                let s = missing.partition_point(|&i| i < j);
+                lz.col.param_column_with(e, s, &mut column);
+            }
+            (None, None) => lz.model_column(j, &mut column)?,
         }
-        lz.col.param_column(k + j, &mut column);
         for (r, c) in rhs.iter_mut().zip(&column) {
             *r -= dp * c;
         }

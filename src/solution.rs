@@ -61,9 +61,14 @@ pub struct Solution {
     pub residual_scale: Vec<f64>,
     /// Statistics.
     pub stats: SolveStats,
-    /// The linearisation at this solution (Jacobians seeded in all parameters, factorised Newton
-    /// matrix), computed at most once: by the solve or by the first derivative request.
+    /// The linearisation at this solution (Jacobians seeded in the parameters, factorised Newton
+    /// matrix), computed at most once: by the solve (seeded in the model parameters of
+    /// [`SolveOptions::linearization_params`](crate::SolveOptions::linearization_params)) or by
+    /// the first derivative request.
     pub(crate) linearization: OnceLock<Arc<Linearization>>,
+    /// The linearisation seeded in all parameters, when the solve's was seeded in fewer and a
+    /// request needed all (computed at most once).
+    pub(crate) full_linearization: OnceLock<Arc<Linearization>>,
 }
 
 impl Solution {
@@ -205,13 +210,29 @@ impl Solution {
             + self.params.len()
             + self.rms_residuals.len()
             + self.residual_scale.len();
-        8 * v + self.linearization.get().map_or(0, |l| l.heap_bytes())
+        8 * v
+            + self.linearization.get().map_or(0, |l| l.heap_bytes())
+            + self.full_linearization.get().map_or(0, |l| l.heap_bytes())
     }
 
-    /// The linearisation at this solution: the cached one, or computed now (once) with a fresh
-    /// workspace and cached. Assumes the public fields are those the solve returned.
-    pub(crate) fn linearization<P: Bvp>(&self, problem: &P) -> Result<&Linearization, BvpError> {
-        if let Some(l) = self.linearization.get() {
+    /// A linearisation at this solution seeded (at least) in the model parameters `model`
+    /// (strictly increasing): the cached one if it covers them, else the full one (cached in
+    /// its own slot, computed now if need be, once); with nothing cached, one seeded in `model`
+    /// is computed and cached. Assumes the public fields are those the solve returned.
+    pub(crate) fn linearization_covering<P: Bvp>(
+        &self,
+        problem: &P,
+        model: impl IntoIterator<Item = usize>,
+    ) -> Result<&Linearization, BvpError> {
+        let model: Vec<usize> = model.into_iter().collect();
+        let (slot, seeds) = match self.linearization.get() {
+            Some(l) if l.covers(model.iter().copied()) => return Ok(l),
+            Some(_) => (&self.full_linearization, None),
+            // nothing cached: the parameters asked for (all of them in the usual request)
+            None if model.len() < self.params.len() => (&self.linearization, Some(&model[..])),
+            None => (&self.linearization, None),
+        };
+        if let Some(l) = slot.get() {
             return Ok(l);
         }
         let l = Linearization::with_fresh_workspace(
@@ -220,10 +241,11 @@ impl Solution {
             &self.y,
             &self.yp,
             &self.full_params(),
+            seeds,
         )?;
         // another thread may have set it meanwhile: either value is the same linearisation
-        let _ = self.linearization.set(Arc::new(l));
-        self.linearization.get().map(|l| &**l).ok_or_else(|| {
+        let _ = slot.set(Arc::new(l));
+        slot.get().map(|l| &**l).ok_or_else(|| {
             BvpError::InvalidInput("the solution's linearisation could not be cached".into())
         })
     }

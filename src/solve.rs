@@ -66,6 +66,14 @@ pub struct SolveOptions {
     /// the solution for every later request. Set it when derivatives will follow every solve
     /// (a fit): the solver's workspace is then reused.
     pub factor_at_solution: bool,
+    /// The model parameters (indices into the `q` model parameters, strictly increasing) the
+    /// linearisation at the solution is seeded in, besides the states and the unknowns
+    /// (default `None`: all of them). A fit that frees 3 of a model's 7 parameters needs only
+    /// their columns: the dual pass then takes one evaluation per point where all 7 take two
+    /// (the right-hand side with 4 states is evaluated 8 derivatives at a time). Derivative
+    /// requests for other parameters stay exact: they compute the full linearisation once,
+    /// with a fresh workspace, and cache it beside this one.
+    pub linearization_params: Option<Arc<[usize]>>,
     /// Progress on stderr: 0 silent (default), 1 one line per mesh, 2 also Newton iterations.
     pub verbose: u8,
     /// Linear solver for the Newton matrix (default [`LinearSolverKind::Auto`]: structured
@@ -119,6 +127,7 @@ impl Default for SolveOptions {
             max_newton_iterations_per_mesh: 8,
             newton_step_tol: None,
             factor_at_solution: false,
+            linearization_params: None,
             verbose: 0,
             linear_solver: LinearSolverKind::Auto,
             mesh: mesh::MeshOptions::default(),
@@ -212,6 +221,14 @@ impl SolveOptions {
                      allow at least 2 nodes, got factor {} and at_least {}; typical values are \
                      factor 16 and at_least 1000, or None for no limit",
                     g.factor, g.at_least
+                )));
+            }
+        }
+        if let Some(l) = &self.linearization_params {
+            if !l.windows(2).all(|w| w[0] < w[1]) {
+                return Err(BvpError::InvalidInput(format!(
+                    "SolveOptions::linearization_params must be strictly increasing indices of \
+                     model parameters, got {l:?}"
                 )));
             }
         }
@@ -595,6 +612,16 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 "parameter {i} of p = (unknowns, model parameters) is not finite"
             )));
         }
+        if let Some(&j) = options
+            .linearization_params
+            .as_ref()
+            .and_then(|l| l.iter().find(|&&j| j >= q))
+        {
+            return Err(BvpError::InvalidInput(format!(
+                "SolveOptions::linearization_params names model parameter {j}, but the problem \
+                 has {q} (indices 0..{q})"
+            )));
+        }
         if guess.x.len() > options.max_nodes {
             return Err(BvpError::InvalidInput(format!(
                 "the initial mesh has {} nodes, more than max_nodes = {}",
@@ -845,7 +872,14 @@ impl<'a, P: Bvp> Solver<'a, P> {
         // midpoint states the Jacobians need
         let linearization = OnceLock::new();
         if opts.factor_at_solution {
-            let lz = Linearization::compute(problem, &mut self.ws.col, &mut lin, &y, &p);
+            let lz = Linearization::compute(
+                problem,
+                &mut self.ws.col,
+                &mut lin,
+                &y,
+                &p,
+                opts.linearization_params.as_deref(),
+            );
             stats.jacobian_factorizations += 1;
             self.keep_system(lin);
             let _ = linearization.set(Arc::new(lz?));
@@ -865,6 +899,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
             residual_scale: scale,
             stats,
             linearization,
+            full_linearization: OnceLock::new(),
         })
     }
 }

@@ -28,6 +28,7 @@ use crate::mesh::{linspace, MeshOptions};
 use crate::sensitivity::tangent_guess;
 use crate::solution::Solution;
 use crate::solve::{GrowthLimit, Guess, ResidualScale, SolveOptions, Solver};
+use std::sync::Arc;
 
 /// Options of [`simulate`].
 #[derive(Debug, Clone)]
@@ -67,6 +68,10 @@ pub struct SimulateOptions {
     /// a trial point beyond the region where the fiber has a solution then fails in
     /// milliseconds instead of refining towards `max_nodes`.
     pub growth_limit: Option<GrowthLimit>,
+    /// The model parameters (indices, strictly increasing) the linearisation at the solution
+    /// is seeded in, with [`factor_at_solution`](Self::factor_at_solution) (default `None`: all;
+    /// see [`SolveOptions::linearization_params`]). A fit's start solves set those it frees.
+    pub linearization_params: Option<Arc<[usize]>>,
 }
 
 impl Default for SimulateOptions {
@@ -83,6 +88,7 @@ impl Default for SimulateOptions {
             mesh: MeshOptions::default(),
             smooth_cold_final: true,
             growth_limit: None,
+            linearization_params: None,
         }
     }
 }
@@ -116,6 +122,7 @@ impl SimulateOptions {
             max_nodes: self.max_nodes,
             scale: ResidualScale::PerComponent(self.scale.to_vec()),
             factor_at_solution: self.factor_at_solution,
+            linearization_params: self.linearization_params.clone(),
             mesh: self.mesh.clone(),
             growth_limit: self.growth_limit,
             ..Default::default()

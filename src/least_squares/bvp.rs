@@ -50,6 +50,15 @@ impl ParamMap {
         }
     }
 
+    /// The model parameters with a link, increasing (each once): the columns a fit through this
+    /// map differentiates in.
+    pub fn linked_models(&self) -> Vec<usize> {
+        let mut m: Vec<usize> = self.links.iter().map(|l| l.model).collect();
+        m.sort_unstable();
+        m.dedup();
+        m
+    }
+
     /// Adds the identity link `q[model] = p[fit]`.
     pub fn link(self, model: usize, fit: usize) -> Self {
         self.link_affine(model, fit, 1.0, 0.0)
@@ -153,6 +162,13 @@ pub struct BvpRun<'a, P: Bvp, G> {
     // the calibration's loose solve at the accepted solution's parameters and its tolerance
     // (the first loose evaluation, at the same point, reuses it)
     calibration: Option<(f64, Solution)>,
+    // the model parameters each solve's linearisation is seeded in (those the map links to fit
+    // parameters, and any unlinked one whose base value has changed since: the tangent
+    // predictor needs its column), the position in them of each link's model parameter (the
+    // column of the run's `dr/dq`), and the unlinked ones seen changing
+    seeds: Arc<[usize]>,
+    link_slots: Vec<usize>,
+    varied: Vec<usize>,
 }
 
 impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
@@ -197,7 +213,39 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
             accepted_loose: false,
             pending_loose: false,
             calibration: None,
+            seeds: Arc::from([]),
+            link_slots: Vec::new(),
+            varied: Vec::new(),
         })
+    }
+
+    /// Brings the seeds and the links' columns up to date with the map (whose links may change
+    /// through [`map_mut`](Self::map_mut)) and with the unlinked model parameters whose values
+    /// in `self.q` differ from the accepted solution's.
+    fn update_seeds(&mut self) {
+        let links = &self.map.links;
+        let linked = |j: usize| links.iter().any(|l| l.model == j);
+        for (j, (a, b)) in self.q.iter().zip(&self.accepted.params).enumerate() {
+            if a != b && !linked(j) && !self.varied.contains(&j) {
+                self.varied.push(j);
+            }
+        }
+        let varied = &self.varied;
+        let mut wanted = (0..self.q.len()).filter(|&j| linked(j) || varied.contains(&j));
+        let same = self.seeds.iter().all(|&j| wanted.next() == Some(j)) && wanted.next().is_none();
+        if !same {
+            let seeds: Vec<usize> = (0..self.q.len())
+                .filter(|&j| linked(j) || varied.contains(&j))
+                .collect();
+            self.seeds = Arc::from(seeds);
+        }
+        let seeds = &self.seeds;
+        self.link_slots.clear();
+        self.link_slots.extend(
+            links
+                .iter()
+                .map(|l| seeds.partition_point(|&j| j < l.model)),
+        );
     }
 
     /// Supplies a solve at the start solution's own parameters with tolerance `tol`, e.g. the
@@ -289,6 +337,7 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         tol: Option<f64>,
     ) -> Result<(Vec<f64>, Vec<f64>), BvpError> {
         self.map.model_params_into(p, &mut self.q);
+        self.update_seeds();
         let own;
         let mut predicted = false;
         let guess = match start {
@@ -328,6 +377,9 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
                     Some(t) => self.loose_options(t),
                     None => self.solver.options.clone(),
                 };
+                if opts.linearization_params.is_none() {
+                    opts.linearization_params = Some(self.seeds.clone());
+                }
                 if self.q == self.accepted.params {
                     // a re-solve at the accepted solution's own parameters (at another
                     // tolerance): its mesh grows with the tolerance, not because the start is far
@@ -356,7 +408,7 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         }
         let problem = self.solver.problem();
         let out = if jacobian {
-            let sens = Sensitivities::compute_unrefined(problem, &sol)?;
+            let sens = Sensitivities::compute_for(problem, &sol, &self.seeds)?;
             residual_jacobian(problem, &sol, &sens, &self.points, &self.residual)?
         } else {
             (self.residuals_of(&sol), Vec::new())
@@ -731,15 +783,15 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
         };
         for (run, (rk, jk)) in self.runs.iter().zip(parts) {
             if jacobian {
-                let q = run.q.len();
+                let q = run.seeds.len();
                 let off = r.len();
                 for i in 0..rk.len() {
                     let row = &mut jac[(off + i) * np..(off + i + 1) * np];
-                    for l in &run.map.links {
+                    for (l, &c) in run.map.links.iter().zip(&run.link_slots) {
                         row[l.fit] += if l.scale == 1.0 {
-                            jk[i * q + l.model]
+                            jk[i * q + c]
                         } else {
-                            l.scale * jk[i * q + l.model]
+                            l.scale * jk[i * q + c]
                         };
                     }
                 }
@@ -789,15 +841,15 @@ impl<'a, P: Bvp + Sync, G: PointFunction + Send> BvpResiduals<'a, P, G> {
             .zip(jac.blocks_mut())
             .enumerate()
         {
-            let q = run.q.len();
+            let q = run.seeds.len();
             let own = structure.locals(k);
             let nl = own.len();
             for i in 0..rk.len() {
-                for l in &run.map.links {
+                for (l, &c) in run.map.links.iter().zip(&run.link_slots) {
                     let v = if l.scale == 1.0 {
-                        jk[i * q + l.model]
+                        jk[i * q + c]
                     } else {
-                        l.scale * jk[i * q + l.model]
+                        l.scale * jk[i * q + c]
                     };
                     if l.fit < ns {
                         sh[i * ns + l.fit] += v;

@@ -16,6 +16,7 @@ mod library_edges;
 mod linear_solvers;
 mod mesh_passes;
 mod oscillatory_mesh;
+mod partial_linearisation;
 mod plot;
 mod relative_offset;
 mod scipy_problems;

@@ -10,7 +10,7 @@ use super::layout::{FitStart, Layout};
 use super::options::{CarreauFiber, FitProgress, IdentifyOptions, RheometerError};
 use crate::fiber::error::FiberError;
 use crate::fiber::in_order::CollectInOrder;
-use crate::fiber::simulate::{simulate_params, Simulator};
+use crate::fiber::simulate::{simulate_params, SimulateOptions, Simulator};
 use crate::least_squares::{
     BvpResiduals, BvpRun, Jacobian, LeastSquaresProblem, ParamMap, RunError,
 };
@@ -142,9 +142,15 @@ impl<'a> Objective<'a> {
                     kappa: start[1],
                     source,
                 };
+                let map = Self::param_map(&layout, estimator, ns, k, phi_idx);
+                // the start solution linearised in the parameters this fit frees only (the
+                // run's solves are, too: `BvpRun`)
+                let sim = &SimulateOptions {
+                    linearization_params: Some(map.linked_models().into()),
+                    ..options.simulate.clone()
+                };
                 // a fit with loose inner iterations at the continuation's own loose tolerance:
                 // the cold start's loose end point is the calibration's loose solve
-                let sim = &options.simulate;
                 let loose_start = options.loose_tolerance.filter(|&t| {
                     warm.is_none()
                         && t == sim.continuation.intermediate_tol
@@ -202,7 +208,6 @@ impl<'a> Objective<'a> {
                         )
                     }
                 };
-                let map = Self::param_map(&layout, estimator, ns, k, phi_idx);
                 let run = BvpRun::new(
                     Solver::new(model, options.simulate.solve_options()),
                     sol.solution,
