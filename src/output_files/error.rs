@@ -144,13 +144,14 @@ pub enum OutputError {
     /// Nobody opened the FIFO for reading.
     #[error(
         "cannot write {path}: no process opened this FIFO for reading within {waited_s} s; \
-         start the reader first (e.g. cat {path} &)"
+         start the reader first (e.g. cat {path} &), or let the writer wait longer \
+         (DIFFBVP_FIFO_WAIT_S=60)"
     )]
     FifoWithoutReader {
         /// The FIFO.
         path: PathBuf,
         /// How long the writer waited \[s\].
-        waited_s: u64,
+        waited_s: f64,
     },
     /// Two outputs of one run are the same file: one would replace the other.
     #[error(

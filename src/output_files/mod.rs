@@ -34,5 +34,6 @@ pub use temporaries::{
     TEMPORARY_PREFIX,
 };
 pub use write::{
-    ensure_not_input, same_file, write_bytes, write_file, write_target, FIFO_READER_WAIT,
+    ensure_not_input, fifo_reader_wait, same_file, write_bytes, write_file, write_target,
+    FIFO_READER_WAIT, FIFO_WAIT_VARIABLE,
 };

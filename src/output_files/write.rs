@@ -9,8 +9,28 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-/// How long a write into a FIFO waits for a reader to open it.
+/// How long a write into a FIFO waits for a reader to open it, unless the environment
+/// variable [`FIFO_WAIT_VARIABLE`] says otherwise ([`fifo_reader_wait`]).
 pub const FIFO_READER_WAIT: Duration = Duration::from_secs(10);
+
+/// The environment variable that sets the FIFO reader wait in seconds (a number in
+/// `[0.1, 3600]`, e.g. `DIFFBVP_FIFO_WAIT_S=60` for a reader that starts late; anything else
+/// leaves the default [`FIFO_READER_WAIT`]).
+pub const FIFO_WAIT_VARIABLE: &str = "DIFFBVP_FIFO_WAIT_S";
+
+/// How long a write into a FIFO waits for a reader: [`FIFO_WAIT_VARIABLE`] if it holds a number
+/// of seconds in `[0.1, 3600]`, else [`FIFO_READER_WAIT`].
+pub fn fifo_reader_wait() -> Duration {
+    fifo_wait_from(std::env::var(FIFO_WAIT_VARIABLE).ok().as_deref())
+}
+
+/// The wait a value of [`FIFO_WAIT_VARIABLE`] gives (`None`: unset).
+fn fifo_wait_from(value: Option<&str>) -> Duration {
+    value
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|s| (0.1..=3600.0).contains(s))
+        .map_or(FIFO_READER_WAIT, Duration::from_secs_f64)
+}
 
 /// Whether `a` and `b` are the same file: same device and inode on Unix (hard and symbolic
 /// links included), same canonical path elsewhere. False if either does not exist.
@@ -174,7 +194,7 @@ fn duplicate(_fd: i32) -> io::Result<fs::File> {
 
 /// Opens a character device or FIFO for writing, in place (no creation, no truncation). A
 /// FIFO is opened without blocking, retried until a reader opens it (up to
-/// [`FIFO_READER_WAIT`]), and then switched back to blocking writes.
+/// [`fifo_reader_wait`]), and then switched back to blocking writes.
 fn open_special(path: &Path, fifo: bool) -> Result<fs::File, OutputError> {
     let mut opts = fs::OpenOptions::new();
     opts.write(true);
@@ -187,6 +207,7 @@ fn open_special(path: &Path, fifo: bool) -> Result<fs::File, OutputError> {
         use std::os::unix::fs::OpenOptionsExt;
         opts.custom_flags(libc::O_NONBLOCK);
         let t0 = Instant::now();
+        let wait = fifo_reader_wait();
         loop {
             match opts.open(path) {
                 Ok(f) => {
@@ -200,10 +221,10 @@ fn open_special(path: &Path, fifo: bool) -> Result<fs::File, OutputError> {
                     return Ok(f);
                 }
                 Err(e) if e.raw_os_error() == Some(libc::ENXIO) => {
-                    if t0.elapsed() >= FIFO_READER_WAIT {
+                    if t0.elapsed() >= wait {
                         return Err(OutputError::FifoWithoutReader {
                             path: path.to_path_buf(),
-                            waited_s: FIFO_READER_WAIT.as_secs(),
+                            waited_s: wait.as_secs_f64(),
                         });
                     }
                     std::thread::sleep(Duration::from_millis(20));
@@ -231,6 +252,17 @@ mod tests {
         let _ = fs::remove_dir_all(&d);
         fs::create_dir_all(&d).unwrap();
         d
+    }
+
+    #[test]
+    fn the_fifo_wait_is_ten_seconds_unless_the_variable_gives_a_sane_one() {
+        assert_eq!(fifo_wait_from(None), Duration::from_secs(10));
+        assert_eq!(fifo_wait_from(Some("60")), Duration::from_secs(60));
+        assert_eq!(fifo_wait_from(Some(" 0.5 ")), Duration::from_millis(500));
+        // not a number, not finite, too short to be meant, longer than an hour: the default
+        for v in ["", "ten", "NaN", "inf", "-1", "0", "0.05", "3601"] {
+            assert_eq!(fifo_wait_from(Some(v)), FIFO_READER_WAIT, "{v:?}");
+        }
     }
 
     fn names(d: &Path) -> Vec<String> {

@@ -296,13 +296,22 @@ fn a24_a_fifo_without_reader_is_an_error_after_a_wait_not_a_hang() {
         .status()
         .unwrap()
         .success());
-    let p = rheometer(
+    // the wait set by the environment (the default, 10 s, is the unit test's): the failure
+    // comes after it, not before and not never
+    let p = run_with(
         &["--quiet", "fit", s(&toml), "--json", s(&fifo)],
         &[&data],
         LIMIT,
+        |c| c.env("DIFFBVP_FIFO_WAIT_S", "1.5"),
     );
-    p.assert_clean_failure(&["fifo", "no process opened this FIFO for reading", "cat"]);
+    p.assert_clean_failure(&[
+        "fifo",
+        "no process opened this FIFO for reading within 1.5 s",
+        "cat",
+        "DIFFBVP_FIFO_WAIT_S",
+    ]);
     assert_eq!(kind(&fifo), "fifo");
+    assert!(p.elapsed >= Duration::from_millis(1500), "{:?}", p.elapsed);
     assert!(p.elapsed < Duration::from_secs(60), "{:?}", p.elapsed);
 }
 
