@@ -159,6 +159,9 @@ pub struct BvpRun<'a, P: Bvp, G> {
     tight_mesh: Vec<f64>,
     accepted_loose: bool,
     pending_loose: bool,
+    // the last tight accepted solution while the accepted one is loose: a tight solve from
+    // the loose one that fails is retried from it
+    last_tight: Option<Solution>,
     // the calibration's loose solve at the accepted solution's parameters and its tolerance
     // (the first loose evaluation, at the same point, reuses it)
     calibration: Option<(f64, Solution)>,
@@ -212,6 +215,7 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
             tight_mesh,
             accepted_loose: false,
             pending_loose: false,
+            last_tight: None,
             calibration: None,
             seeds: Arc::from([]),
             link_slots: Vec::new(),
@@ -285,13 +289,19 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
         self.calibration = None;
         self.accepted = solution;
         self.accepted_loose = false;
+        self.last_tight = None;
         self.pending = None;
     }
 
     /// Promotes the pending solution, if any.
     fn accept_pending(&mut self) {
         if let Some(s) = self.pending.take() {
-            self.accepted = s;
+            let old = std::mem::replace(&mut self.accepted, s);
+            if !self.pending_loose {
+                self.last_tight = None;
+            } else if !self.accepted_loose {
+                self.last_tight = Some(old);
+            }
             self.accepted_loose = self.pending_loose;
         }
     }
@@ -398,7 +408,21 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
                         }
                     }
                 } else {
-                    self.solver.solve_with(&self.q, guess, &opts)?
+                    match self.solver.solve_with(&self.q, guess, &opts) {
+                        Ok(sol) => sol,
+                        // a tight solve from the loose solution's values that fails (the loose
+                        // phase may end where a tight solve from them does not converge): once
+                        // more from the last tight solution
+                        Err(e) => match (&self.last_tight, start, tol) {
+                            (Some(t), None, None) if self.accepted_loose => {
+                                let from = Guess::from(t);
+                                self.solver
+                                    .solve_with(&self.q, &from, &opts)
+                                    .map_err(|_| e)?
+                            }
+                            _ => return Err(e),
+                        },
+                    }
                 }
             }
         };

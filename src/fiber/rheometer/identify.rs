@@ -82,18 +82,22 @@ impl Rheometer {
         // checked before any simulation: the layout's size is known only with the objective,
         // the tolerance's range is not
         options.relative_offset(1)?;
-        let mut obj = self.objective_from(start, options)?;
+        // the experiments solved where the fit starts: at the warm take-up factors (clamped to
+        // their bounds) if given, so that the first evaluation re-solves nothing
+        let take_up: Vec<f64> =
+            if options.estimator == Estimator::Principled && warm.take_up.len() == self.len() {
+                let [lo, hi] = options.take_up_bounds;
+                warm.take_up.iter().map(|t| t.clamp(lo, hi)).collect()
+            } else {
+                Vec::new()
+            };
+        let mut obj = self.objective_at_take_up(start, options, &take_up)?;
         let mut p0 = obj.initial_parameters();
         let (lower, upper) = obj.bounds();
         // within `optimum_tolerance` standard errors of the optimum
         let relative_offset = options.relative_offset(lower.len())?;
         let ns = obj.layout.num_shared();
-        if options.estimator == Estimator::Principled && warm.take_up.len() == self.len() {
-            let [lo, hi] = options.take_up_bounds;
-            for (p, t) in p0[ns..].iter_mut().zip(&warm.take_up) {
-                *p = t.clamp(lo, hi);
-            }
-        }
+        p0[ns..ns + take_up.len()].copy_from_slice(&take_up);
         let (f_scale, f_scale_source) = self.robust_margin(options)?;
         let sigma = options
             .relative_uncertainty

@@ -85,7 +85,7 @@ impl Rheometer {
         start: [f64; 2],
         options: &IdentifyOptions,
     ) -> Result<Objective<'_>, RheometerError> {
-        Objective::new(self, &FitStart::at(start), options)
+        Objective::new(self, &FitStart::at(start), options, &[])
     }
 
     /// An objective for a general start (free candidates, start strengths, warm starts).
@@ -94,7 +94,19 @@ impl Rheometer {
         start: &FitStart,
         options: &IdentifyOptions,
     ) -> Result<Objective<'_>, RheometerError> {
-        Objective::new(self, start, options)
+        Objective::new(self, start, options, &[])
+    }
+
+    /// [`objective_from`](Self::objective_from) with the experiments solved at the take-up
+    /// factors `take_up` (one per experiment, principled estimator; empty: all 1): the fit's
+    /// start point when it starts there, so that its first evaluation re-solves nothing.
+    pub(crate) fn objective_at_take_up(
+        &self,
+        start: &FitStart,
+        options: &IdentifyOptions,
+        take_up: &[f64],
+    ) -> Result<Objective<'_>, RheometerError> {
+        Objective::new(self, start, options, take_up)
     }
 }
 
@@ -103,7 +115,17 @@ impl<'a> Objective<'a> {
         rheo: &'a Rheometer,
         fit_start: &FitStart,
         options: &IdentifyOptions,
+        take_up: &[f64],
     ) -> Result<Self, RheometerError> {
+        if !take_up.is_empty()
+            && (take_up.len() != rheo.len() || options.estimator != Estimator::Principled)
+        {
+            return Err(RheometerError::Data(format!(
+                "{} start take-up factors for {} experiments (principled estimator only)",
+                take_up.len(),
+                rheo.len()
+            )));
+        }
         let start = fit_start.law;
         let layout = Layout::new(&rheo.models[0], &rheo.spec, fit_start, options)?;
         if let Some(w) = &fit_start.warm {
@@ -134,7 +156,7 @@ impl<'a> Objective<'a> {
             .enumerate()
             .map(|(k, model)| {
                 let phi_idx = model.take_up_factor_index();
-                let p = layout.local(&shared0, 1.0, phi_idx);
+                let p = layout.local(&shared0, take_up.get(k).copied().unwrap_or(1.0), phi_idx);
                 let warm = fit_start.warm.as_ref().map(|w| &w[k]);
                 let sim_err = |source: FiberError| RheometerError::Simulation {
                     experiment: rheo.experiments[k].name.clone(),
@@ -143,10 +165,11 @@ impl<'a> Objective<'a> {
                     source,
                 };
                 let map = Self::param_map(&layout, estimator, ns, k, phi_idx);
-                // the start solution linearised in the parameters this fit frees only (the
-                // run's solves are, too: `BvpRun`)
+                // the start solution is not linearised: the fit's first evaluation is at these
+                // parameters (its take-up factors included), re-solves this solution without a
+                // Newton step and linearises it then, in the parameters the fit frees
                 let sim = &SimulateOptions {
-                    linearization_params: Some(map.linked_models().into()),
+                    factor_at_solution: false,
                     ..options.simulate.clone()
                 };
                 // a fit with loose inner iterations at the continuation's own loose tolerance:
@@ -176,38 +199,8 @@ impl<'a> Objective<'a> {
                         total: rheo.len(),
                     });
                 }
-                let lo = model.scaling.reference.length;
-                let dd = model.scaling.diameter();
-                let length = rheo.experiments[k].spinline_length;
-                let (points, residual) = match estimator {
-                    Estimator::Paper => {
-                        let no = options.n_opt_points;
-                        let delta = length / no as f64;
-                        let s: Vec<f64> = (1..=no).map(|i| i as f64 * delta).collect();
-                        (
-                            s.iter().map(|v| v / lo).collect(),
-                            FiberResidual::Paper {
-                                model,
-                                sqrt_delta: vec![(delta / lo).sqrt(); no],
-                                d_fit: s
-                                    .iter()
-                                    .map(|&v| rheo.smoothing[k].diameter(v) / dd)
-                                    .collect(),
-                            },
-                        )
-                    }
-                    Estimator::Principled => {
-                        let m = &rheo.measurements[k];
-                        (
-                            m.positions.iter().map(|v| v / lo).collect(),
-                            FiberResidual::Relative {
-                                model,
-                                d_meas: m.diameters.iter().map(|v| v / dd).collect(),
-                                sigma: options.point_sigmas(k, m.diameters.len(), sigma),
-                            },
-                        )
-                    }
-                };
+                let (points, residual) =
+                    Self::observations(rheo, k, model, estimator, options, sigma);
                 let run = BvpRun::new(
                     Solver::new(model, options.simulate.solve_options()),
                     sol.solution,
@@ -246,6 +239,51 @@ impl<'a> Objective<'a> {
             options: options.clone(),
             layout,
         })
+    }
+
+    /// Experiment `k`'s observation points (dimensionless positions) and residual for the
+    /// estimator: the paper's `n_opt_points` evaluation points of the smoothed diameter, or the
+    /// measurements with their noise levels (`sigma` the relative uncertainty).
+    fn observations(
+        rheo: &'a Rheometer,
+        k: usize,
+        model: &'a CarreauFiber,
+        estimator: Estimator,
+        options: &IdentifyOptions,
+        sigma: f64,
+    ) -> (Vec<f64>, FiberResidual<'a>) {
+        let lo = model.scaling.reference.length;
+        let dd = model.scaling.diameter();
+        let length = rheo.experiments[k].spinline_length;
+        match estimator {
+            Estimator::Paper => {
+                let no = options.n_opt_points;
+                let delta = length / no as f64;
+                let s: Vec<f64> = (1..=no).map(|i| i as f64 * delta).collect();
+                (
+                    s.iter().map(|v| v / lo).collect(),
+                    FiberResidual::Paper {
+                        model,
+                        sqrt_delta: vec![(delta / lo).sqrt(); no],
+                        d_fit: s
+                            .iter()
+                            .map(|&v| rheo.smoothing[k].diameter(v) / dd)
+                            .collect(),
+                    },
+                )
+            }
+            Estimator::Principled => {
+                let m = &rheo.measurements[k];
+                (
+                    m.positions.iter().map(|v| v / lo).collect(),
+                    FiberResidual::Relative {
+                        model,
+                        d_meas: m.diameters.iter().map(|v| v / dd).collect(),
+                        sigma: options.point_sigmas(k, m.diameters.len(), sigma),
+                    },
+                )
+            }
+        }
     }
 
     /// Experiment `k`'s local parameters `[c, n, κ, strengths..., φ]` as a map of the fit
