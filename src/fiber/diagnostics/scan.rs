@@ -420,6 +420,7 @@ fn fit_warm(
     let warm = WarmFit {
         take_up: take_up.to_vec(),
         stop_tolerance: loose.then_some(GRID_TOLERANCE),
+        solve_at_take_up: true,
     };
     rh.identify_warm(start, &options, &warm)
 }

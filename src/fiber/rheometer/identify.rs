@@ -91,7 +91,7 @@ impl Rheometer {
             } else {
                 Vec::new()
             };
-        let mut obj = self.objective_at_take_up(start, options, &take_up)?;
+        let mut obj = self.objective_at_take_up(start, options, &take_up, warm.solve_at_take_up)?;
         let mut p0 = obj.initial_parameters();
         let (lower, upper) = obj.bounds();
         // within `optimum_tolerance` standard errors of the optimum

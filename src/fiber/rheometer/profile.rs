@@ -185,6 +185,7 @@ impl Profiler<'_> {
         let wf = WarmFit {
             take_up: warm.take_up.clone(),
             stop_tolerance: None,
+            solve_at_take_up: false,
         };
         self.rh.identify_unchecked(&start, &opts, &wf)
     }

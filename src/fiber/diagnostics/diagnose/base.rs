@@ -133,6 +133,7 @@ impl<'a> Context<'a> {
         let fit = WarmFit {
             take_up: w.take_up_factors().to_vec(),
             stop_tolerance: None,
+            solve_at_take_up: true,
         };
         self.rh.identify_warm(&start, &checked, &fit)
     }
@@ -229,6 +230,7 @@ impl<'a> Context<'a> {
         let warm = WarmFit {
             take_up: base.take_up_factors().to_vec(),
             stop_tolerance: None,
+            solve_at_take_up: true,
         };
         let mut weighted = self.rh.identify_warm(&start, &self.opts, &warm)?;
         // the one noise level of these data and this model is the plain fit's, and the misfit
