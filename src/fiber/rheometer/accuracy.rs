@@ -118,7 +118,7 @@ pub(crate) fn matched(
         let warm = WarmFit {
             take_up: id.take_up_factors().to_vec(),
             stop_tolerance: None,
-            solve_at_take_up: false,
+            solve_at_take_up: true,
         };
         let wall = id.summary.solver.wall_time_s;
         let Ok(mut refined) = rh.identify_unchecked(&next, &opts, &warm) else {

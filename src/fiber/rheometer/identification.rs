@@ -86,9 +86,9 @@ pub(crate) struct WarmFit {
     pub stop_tolerance: Option<f64>,
     /// Solve the start solutions at the take-up factors `take_up` (where the warm solutions
     /// were solved at them), so that the fit's first evaluation re-solves nothing. The
-    /// diagnosis' scans and refits set it (their warm starts come from the fit they continue;
-    /// 11 % of a diagnosis). Off elsewhere: on a fit at its bound (the air hotter than the
-    /// melt, `n = 1`) the profile walk's warm solves at the take-up factors failed more often
-    /// and fell back to cold starts (3.8 s became 8.9 s).
+    /// diagnosis' scans, refits and step fits set it, and the nested and accuracy fits (their
+    /// warm starts come from the fit they continue; 11 % of a diagnosis). Off for the profile
+    /// walk: on a fit at its bound (the air hotter than the melt, `n = 1`) its warm solves at
+    /// the take-up factors failed more often and fell back to cold starts (3.8 s became 8.9 s).
     pub solve_at_take_up: bool,
 }

@@ -91,7 +91,7 @@ impl Rheometer {
                 let warm = WarmFit {
                     take_up: plain.take_up_factors().to_vec(),
                     stop_tolerance: None,
-                    solve_at_take_up: false,
+                    solve_at_take_up: true,
                 };
                 self.identify_warm(&warm_start, options, &warm)
                     .map(|fit| (plain, fit))
