@@ -293,30 +293,52 @@ impl Collocation {
         model: Option<&[usize]>,
         values: bool,
     ) -> Result<(), BvpError> {
-        let (n, k) = (self.n, self.k);
-        self.seeded_params = seeded;
-        self.model_seeds.clear();
-        let mut seed_list = std::mem::take(&mut self.seed_list);
-        let mut bc_seed_list = std::mem::take(&mut self.bc_seed_list);
-        seed_list.clear();
-        bc_seed_list.clear();
-        match model {
-            Some(list) => {
-                self.model_seeds.extend_from_slice(list);
-                seed_list.extend(0..n + k);
-                seed_list.extend(list.iter().map(|j| n + k + j));
-                bc_seed_list.extend(0..2 * n + k);
-                bc_seed_list.extend(list.iter().map(|j| 2 * n + k + j));
-            }
-            None => self.model_seeds.extend(0..seeded.saturating_sub(k)),
-        }
-        let seeds = match model {
-            Some(_) => (Seeds::These(&seed_list), Seeds::These(&bc_seed_list)),
-            None => (Seeds::First(n + seeded), Seeds::First(2 * n + seeded)),
+        let Some(list) = model else {
+            let n = self.n;
+            self.seeded_params = seeded;
+            self.model_seeds.clear();
+            self.model_seeds.extend(0..seeded.saturating_sub(self.k));
+            let seeds = (Seeds::First(n + seeded), Seeds::First(2 * n + seeded));
+            return self.dual_pass_seeded(problem, y, p, seeds, values);
         };
+        self.set_seed_lists(list, true);
+        self.dual_pass_listed(problem, y, p, values)
+    }
+
+    /// Sets the seeds of a pass in the model parameters `model`: `model_seeds`, and the input
+    /// indices at the nodes and midpoints (`[y, p]`) and at the boundary (`[ya, yb, p]`), with
+    /// the states and the `k` unknowns in front if `states`.
+    fn set_seed_lists(&mut self, model: &[usize], states: bool) {
+        let (n, k) = (self.n, self.k);
+        self.seeded_params = if states { k + model.len() } else { model.len() };
+        self.model_seeds.clear();
+        self.model_seeds.extend_from_slice(model);
+        self.seed_list.clear();
+        self.bc_seed_list.clear();
+        if states {
+            self.seed_list.extend(0..n + k);
+            self.bc_seed_list.extend(0..2 * n + k);
+        }
+        self.seed_list.extend(model.iter().map(|j| n + k + j));
+        self.bc_seed_list
+            .extend(model.iter().map(|j| 2 * n + k + j));
+    }
+
+    /// [`dual_pass_seeded`](Self::dual_pass_seeded) with the seeds of
+    /// [`set_seed_lists`](Self::set_seed_lists).
+    fn dual_pass_listed<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        values: bool,
+    ) -> Result<(), BvpError> {
+        let nodes = std::mem::take(&mut self.seed_list);
+        let bc = std::mem::take(&mut self.bc_seed_list);
+        let seeds = (Seeds::These(&nodes), Seeds::These(&bc));
         let result = self.dual_pass_seeded(problem, y, p, seeds, values);
-        self.seed_list = seed_list;
-        self.bc_seed_list = bc_seed_list;
+        self.seed_list = nodes;
+        self.bc_seed_list = bc;
         result
     }
 
@@ -334,19 +356,8 @@ impl Collocation {
         p: &[f64],
         model: &[usize],
     ) -> Result<(), BvpError> {
-        let (n, k) = (self.n, self.k);
-        self.seeded_params = model.len();
-        self.model_seeds.clear();
-        self.model_seeds.extend_from_slice(model);
-        let nodes: Vec<usize> = model.iter().map(|j| n + k + j).collect();
-        let bc: Vec<usize> = model.iter().map(|j| 2 * n + k + j).collect();
-        self.dual_pass_seeded(
-            problem,
-            y,
-            p,
-            (Seeds::These(&nodes), Seeds::These(&bc)),
-            false,
-        )
+        self.set_seed_lists(model, false);
+        self.dual_pass_listed(problem, y, p, false)
     }
 
     /// [`dual_pass`](Self::dual_pass) with the seeds of the nodes and midpoints and of the

@@ -119,13 +119,14 @@ impl Linearization {
     }
 
     /// The column of `∂r/∂p` for model parameter `j`, which must be covered
-    /// ([`covers`](Self::covers)).
-    pub(crate) fn model_column(&self, j: usize, out: &mut [f64]) -> Result<(), BvpError> {
+    /// ([`covers`](Self::covers)), into `out`; returns the column of the node Jacobian
+    /// ([`jn`](Self::jn)) holding `∂f/∂p_j`.
+    pub(crate) fn model_column(&self, j: usize, out: &mut [f64]) -> Result<usize, BvpError> {
         let c = &self.col;
         match c.param_slot(c.k + j) {
             Some(slot) => {
                 c.param_column(slot, out);
-                Ok(())
+                Ok(c.n + slot)
             }
             None => Err(BvpError::InvalidInput(format!(
                 "the linearisation at this solution is not seeded in model parameter {j} \
@@ -133,13 +134,6 @@ impl Linearization {
                 c.model_seeds
             ))),
         }
-    }
-
-    /// Column of the node Jacobian `jn` holding model parameter `j` (`n + slot`), which must be
-    /// covered.
-    pub(crate) fn model_jn_column(&self, j: usize) -> Option<usize> {
-        let c = &self.col;
-        c.param_slot(c.k + j).map(|s| c.n + s)
     }
 
     /// Solves `∂_Y S · X = B` (or its transpose) for `ncols` right-hand sides stored column after

@@ -155,8 +155,7 @@ impl Sensitivities {
         let mut rhs = vec![0.0; size * q];
         let mut jn_cols = Vec::with_capacity(q);
         for (j, &c) in columns.iter().enumerate() {
-            lz.model_column(c, &mut rhs[j * size..(j + 1) * size])?;
-            jn_cols.push(lz.model_jn_column(c).unwrap_or(usize::MAX));
+            jn_cols.push(lz.model_column(c, &mut rhs[j * size..(j + 1) * size])?);
         }
         for v in rhs.iter_mut() {
             *v = -*v;
@@ -497,7 +496,9 @@ pub fn tangent_guess<P: Bvp>(
                 let s = missing.partition_point(|&i| i < j);
                 lz.col.param_column_with(e, s, &mut column);
             }
-            (None, None) => lz.model_column(j, &mut column)?,
+            (None, None) => {
+                lz.model_column(j, &mut column)?;
+            }
         }
         for (r, c) in rhs.iter_mut().zip(&column) {
             *r -= dp * c;

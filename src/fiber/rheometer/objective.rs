@@ -85,7 +85,7 @@ impl Rheometer {
         start: [f64; 2],
         options: &IdentifyOptions,
     ) -> Result<Objective<'_>, RheometerError> {
-        Objective::new(self, &FitStart::at(start), options, (&[], false))
+        Objective::new(self, &FitStart::at(start), options, &[])
     }
 
     /// An objective for a general start (free candidates, start strengths, warm starts).
@@ -94,7 +94,7 @@ impl Rheometer {
         start: &FitStart,
         options: &IdentifyOptions,
     ) -> Result<Objective<'_>, RheometerError> {
-        Objective::new(self, start, options, (&[], false))
+        Objective::new(self, start, options, &[])
     }
 
     /// [`objective_from`](Self::objective_from) for a fit that starts at the take-up factors
@@ -111,17 +111,25 @@ impl Rheometer {
         // not solving there: the start as a plain fit's, at take-up factors 1 and not
         // linearised (measured: on a fit at its bound the profile walk took 1.7 times as long
         // with the start solutions linearised for a tangent towards the take-up factors)
-        let take_up = if solve_there { take_up } else { &[] };
-        Objective::new(self, start, options, (take_up, solve_there))
+        Objective::new(
+            self,
+            start,
+            options,
+            if solve_there { take_up } else { &[] },
+        )
     }
 }
 
 impl<'a> Objective<'a> {
+    /// The objective of a fit from `fit_start`, every experiment solved at the start law and
+    /// strengths and at its take-up factor in `take_up` where its warm start was solved at that
+    /// factor (the fit then starts there and its first evaluation re-solves nothing), else at 1
+    /// (`take_up` empty: all at 1).
     pub(super) fn new(
         rheo: &'a Rheometer,
         fit_start: &FitStart,
         options: &IdentifyOptions,
-        (take_up, solve_there): (&[f64], bool),
+        take_up: &[f64],
     ) -> Result<Self, RheometerError> {
         if !take_up.is_empty()
             && (take_up.len() != rheo.len() || options.estimator != Estimator::Principled)
@@ -166,7 +174,7 @@ impl<'a> Objective<'a> {
                 // at the fit's start take-up factor where the warm start was solved at it (a
                 // warm fit continuing the fit it comes from); else at 1, as a cold start is
                 let phi = match (take_up.get(k), warm) {
-                    (Some(&t), Some(w)) if solve_there && w.params.get(phi_idx) == Some(&t) => t,
+                    (Some(&t), Some(w)) if w.params.get(phi_idx) == Some(&t) => t,
                     _ => 1.0,
                 };
                 let p = layout.local(&shared0, phi, phi_idx);
