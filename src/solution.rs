@@ -69,6 +69,10 @@ pub struct Solution {
     /// The linearisation seeded in all parameters, when the solve's was seeded in fewer and a
     /// request needed all (computed at most once).
     pub(crate) full_linearization: OnceLock<Arc<Linearization>>,
+    /// The factorised Newton matrix of the solve's last Newton step, with
+    /// [`SolveOptions::keep_newton_matrix`](crate::SolveOptions::keep_newton_matrix): a
+    /// start for simplified Newton nearby, not a linearisation at this solution.
+    pub(crate) newton_matrix: Option<Arc<Factorization>>,
 }
 
 impl Solution {
@@ -198,9 +202,16 @@ impl Solution {
         self.linearization.get().map(|l| &l.factorization)
     }
 
+    /// Whether the solve kept its last Newton matrix
+    /// ([`SolveOptions::keep_newton_matrix`](crate::SolveOptions::keep_newton_matrix)): a solve
+    /// nearby on this mesh ([`Solver::solve_near`](crate::Solver::solve_near)) starts from it.
+    pub fn has_newton_matrix(&self) -> bool {
+        self.newton_matrix.is_some()
+    }
+
     /// Bytes this solution holds on the heap: its vectors and, once computed, its cached
     /// linearisation (Jacobians seeded in all parameters and the factorised Newton matrix; a
-    /// sparse LU's factors estimated). What a fit keeps per run and solution, for planning the
+    /// sparse LU's factors estimated) and a kept Newton matrix. What a fit keeps per run and solution, for planning the
     /// memory of a large fit.
     pub fn heap_bytes(&self) -> usize {
         let v = self.x.len()
@@ -213,6 +224,7 @@ impl Solution {
         8 * v
             + self.linearization.get().map_or(0, |l| l.heap_bytes())
             + self.full_linearization.get().map_or(0, |l| l.heap_bytes())
+            + self.newton_matrix.as_ref().map_or(0, |f| f.heap_bytes())
     }
 
     /// A linearisation at this solution seeded (at least) in the model parameters `model`

@@ -74,6 +74,15 @@ pub struct SolveOptions {
     /// requests for other parameters stay exact: they compute the full linearisation once,
     /// with a fresh workspace, and cache it beside this one.
     pub linearization_params: Option<Arc<[usize]>>,
+    /// Keep the factorised Newton matrix of the last Newton step in the [`Solution`] (default
+    /// `false`; ignored with [`factor_at_solution`](Self::factor_at_solution), whose exact
+    /// linearisation serves the same purpose). That matrix is the Jacobian at an iterate near
+    /// the solution, not at it: it gives no sensitivities, but a solve nearby on the same mesh
+    /// ([`Solver::solve_near`]) starts simplified Newton from it, with no Jacobian evaluation
+    /// and no factorisation until the contraction test asks for one. A walk over many nearby
+    /// parameter values that needs only the solutions (a cost landscape) saves most of its
+    /// dual-number passes; the copy costs one allocation per solve.
+    pub keep_newton_matrix: bool,
     /// Progress on stderr: 0 silent (default), 1 one line per mesh, 2 also Newton iterations.
     pub verbose: u8,
     /// Linear solver for the Newton matrix (default [`LinearSolverKind::Auto`]: structured
@@ -128,6 +137,7 @@ impl Default for SolveOptions {
             newton_step_tol: None,
             factor_at_solution: false,
             linearization_params: None,
+            keep_newton_matrix: false,
             verbose: 0,
             linear_solver: LinearSolverKind::Auto,
             mesh: mesh::MeshOptions::default(),
@@ -670,9 +680,10 @@ impl<'a, P: Bvp> Solver<'a, P> {
     /// [`solve_with`](Self::solve_with) from a guess on the mesh of a nearby solution `near`
     /// (e.g. [`tangent_guess`](crate::sensitivity::tangent_guess) or `Guess::from(near)`),
     /// starting with simplified Newton on the factorised Newton matrix of `near` when `near`
-    /// has its linearisation cached ([`Solution::factorization`]): no Jacobian evaluation and
+    /// has its linearisation cached ([`Solution::factorization`]) or kept its last Newton
+    /// matrix ([`SolveOptions::keep_newton_matrix`]): no Jacobian evaluation and
     /// no factorisation until the affine-invariant contraction test asks for a fresh one. The
-    /// result meets the same tolerances as any solve. Without a cached linearisation, or on
+    /// result meets the same tolerances as any solve. Without either, or on
     /// another mesh, this is `solve_with`.
     pub fn solve_near(
         &mut self,
@@ -681,7 +692,14 @@ impl<'a, P: Bvp> Solver<'a, P> {
         near: &Solution,
         opts: &SolveOptions,
     ) -> Result<Solution, BvpError> {
-        let initial = near.factorization().filter(|_| guess.x == near.x);
+        if guess.x != near.x {
+            return self.solve_impl(params, guess, opts, None);
+        }
+        let initial = match (near.factorization(), &near.newton_matrix) {
+            (Some(f), _) => Some(Initial::Borrowed(f)),
+            (None, Some(kept)) => Some(Initial::Kept(kept)),
+            (None, None) => None,
+        };
         self.solve_impl(params, guess, opts, initial)
     }
 
@@ -692,7 +710,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
         params: &[f64],
         guess: &Guess,
         opts: &SolveOptions,
-        initial: Option<&Factorization>,
+        initial: Option<Initial<'_>>,
     ) -> Result<Solution, BvpError> {
         if !self.thread_workspace {
             return self.solve_inner(params, guess, opts, initial);
@@ -716,9 +734,16 @@ impl<'a, P: Bvp> Solver<'a, P> {
         params: &[f64],
         guess: &Guess,
         opts: &SolveOptions,
-        mut initial: Option<&Factorization>,
+        initial: Option<Initial<'_>>,
     ) -> Result<Solution, BvpError> {
         self.validate(params, guess, opts)?;
+        // a kept Newton matrix carries over to this solution while no newer one is factored on
+        // the guess's mesh
+        let carried = match initial {
+            Some(Initial::Kept(k)) => Some(k.clone()),
+            _ => None,
+        };
+        let mut initial = initial.map(|i| i.factorization());
         let problem = self.problem;
         let n = self.ws.col.n;
         let bc_tol = opts.bc_tol.unwrap_or(opts.tol);
@@ -769,6 +794,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
             };
             stats.newton_iterations += report.iterations;
             stats.jacobian_factorizations += lin.factorizations - factorizations_before;
+            let factored = lin.factorizations > factorizations_before;
             let max_bc_res = max_bc(&self.ws.col);
             rms_residuals(
                 problem,
@@ -785,7 +811,8 @@ impl<'a, P: Bvp> Solver<'a, P> {
 
             if !opts.adapt {
                 if report.converged {
-                    return self.finish(problem, lin, x, y, p, scale, stats, opts);
+                    let kept = kept_matrix(opts, &lin, factored, x == guess.x, &carried);
+                    return self.finish(problem, lin, x, y, p, scale, stats, opts, kept);
                 }
                 self.keep_system(lin);
                 return Err(BvpError::NewtonFailed {
@@ -845,7 +872,8 @@ impl<'a, P: Bvp> Solver<'a, P> {
                         continue;
                     }
                 }
-                return self.finish(problem, lin, x, y, p, scale, stats, opts);
+                let kept = kept_matrix(opts, &lin, factored, x == guess.x, &carried);
+                return self.finish(problem, lin, x, y, p, scale, stats, opts, kept);
             } else {
                 self.keep_system(lin);
             }
@@ -866,6 +894,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
         scale: Vec<f64>,
         mut stats: SolveStats,
         opts: &SolveOptions,
+        newton_matrix: Option<Arc<Factorization>>,
     ) -> Result<Solution, BvpError> {
         let k = self.ws.col.k;
         // `col` holds values at the final iterate (the error estimate used them), among them the
@@ -900,7 +929,47 @@ impl<'a, P: Bvp> Solver<'a, P> {
             stats,
             linearization,
             full_linearization: OnceLock::new(),
+            newton_matrix,
         })
+    }
+}
+
+/// The factorisation a solve nearby may start from ([`Solver::solve_near`]).
+#[derive(Clone, Copy)]
+pub(crate) enum Initial<'f> {
+    /// The exact linearisation's factorisation at a nearby solution.
+    Borrowed(&'f Factorization),
+    /// A nearby solve's last Newton matrix ([`SolveOptions::keep_newton_matrix`]).
+    Kept(&'f Arc<Factorization>),
+}
+
+impl<'f> Initial<'f> {
+    fn factorization(self) -> &'f Factorization {
+        match self {
+            Initial::Borrowed(f) => f,
+            Initial::Kept(k) => k,
+        }
+    }
+}
+
+/// The Newton matrix a solution keeps with [`SolveOptions::keep_newton_matrix`] (and without
+/// an exact linearisation): the one its last Newton run factored, or else, on the guess's own
+/// mesh, the kept matrix the solve started from (`carried`); none on another mesh.
+fn kept_matrix(
+    opts: &SolveOptions,
+    lin: &LinearSystem,
+    factored: bool,
+    on_guess_mesh: bool,
+    carried: &Option<Arc<Factorization>>,
+) -> Option<Arc<Factorization>> {
+    if !opts.keep_newton_matrix || opts.factor_at_solution {
+        None
+    } else if factored {
+        Some(Arc::new(lin.snapshot()))
+    } else if on_guess_mesh {
+        carried.clone()
+    } else {
+        None
     }
 }
 

@@ -72,6 +72,10 @@ pub struct SimulateOptions {
     /// is seeded in, with [`factor_at_solution`](Self::factor_at_solution) (default `None`: all;
     /// see [`SolveOptions::linearization_params`]). A fit's start solves set those it frees.
     pub linearization_params: Option<Arc<[usize]>>,
+    /// Keep every solve's last Newton matrix for the next solve nearby (default `false`; see
+    /// [`SolveOptions::keep_newton_matrix`]): a walk that needs only solutions and costs (the
+    /// landscape) warm-starts simplified Newton from it.
+    pub keep_newton_matrix: bool,
 }
 
 impl Default for SimulateOptions {
@@ -89,6 +93,7 @@ impl Default for SimulateOptions {
             smooth_cold_final: true,
             growth_limit: None,
             linearization_params: None,
+            keep_newton_matrix: false,
         }
     }
 }
@@ -123,6 +128,7 @@ impl SimulateOptions {
             scale: ResidualScale::PerComponent(self.scale.to_vec()),
             factor_at_solution: self.factor_at_solution,
             linearization_params: self.linearization_params.clone(),
+            keep_newton_matrix: self.keep_newton_matrix,
             mesh: self.mesh.clone(),
             growth_limit: self.growth_limit,
             ..Default::default()

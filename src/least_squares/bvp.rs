@@ -395,7 +395,18 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
                     // tolerance): its mesh grows with the tolerance, not because the start is far
                     opts.growth_limit = None;
                 }
-                if predicted {
+                if !predicted && self.accepted.has_newton_matrix() && guess.x == self.accepted.x {
+                    // simplified Newton from the accepted solve's last Newton matrix
+                    // (SolveOptions::keep_newton_matrix); where that does not converge, Newton
+                    // with fresh Jacobians from the same start
+                    match self
+                        .solver
+                        .solve_near(&self.q, guess, &self.accepted, &opts)
+                    {
+                        Ok(sol) => sol,
+                        Err(_) => self.solver.solve_with(&self.q, guess, &opts)?,
+                    }
+                } else if predicted {
                     match self
                         .solver
                         .solve_near(&self.q, guess, &self.accepted, &opts)

@@ -10,6 +10,7 @@ mod core_accuracy;
 mod decay_model;
 mod growth_limit;
 mod html_page;
+mod kept_newton_matrix;
 mod least_squares;
 mod library_contracts;
 mod library_edges;

