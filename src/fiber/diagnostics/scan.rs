@@ -45,6 +45,15 @@ pub const REFINE_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
     at_least: 1000,
 };
 
+/// The largest mesh of a refinement's BVP solves ([`ScanOptions::refine_max_nodes`]) \[nodes\].
+/// A fit's solutions need 25–300 nodes per experiment (tol 1e-4); near the edge of the region
+/// where the fiber has a solution one experiment's mesh grows without bound (its strain rate
+/// explodes at the take-up). A co-flow refit from another material law crept along that edge
+/// for its last 14 steps with one experiment at 15 968 nodes (the others at 60–95): 4.7 s of
+/// its 6.2 s, at a cost no better than the candidate's best refit. Such a point fails instead,
+/// and the trust region takes a shorter step.
+pub const REFINE_MAX_NODES: usize = 2000;
+
 /// The growth limit of the grid points' BVP solves ([`ScanOptions::grid_growth_limit`]): 16
 /// times the start's mesh, always 5000 nodes (the floor is what binds: about 100–250 times the
 /// mesh a grid point needs at its tolerance 1e-3, 20–50 nodes per experiment). A grid fit's trial step towards `n → 0` (a co-flow or a strain-thinning branch
@@ -94,6 +103,9 @@ pub struct ScanOptions {
     /// region where the fiber has a solution then fails in milliseconds instead of refining
     /// towards 20 000 nodes, and the trust region takes a shorter one.
     pub refine_growth_limit: Option<GrowthLimit>,
+    /// The largest mesh of a refinement's (and a pair's joint fit's) BVP solves (default
+    /// [`REFINE_MAX_NODES`]; the fit's own `max_nodes` if smaller).
+    pub refine_max_nodes: usize,
     /// How far the grid points' BVP solves may refine beyond the mesh they start from (default
     /// [`GRID_GROWTH_LIMIT`]; `None`: up to `max_nodes`). Looser than
     /// [`refine_growth_limit`](Self::refine_growth_limit): with at most
@@ -131,6 +143,7 @@ impl Default for ScanOptions {
             stop_above: 20.0,
             grid_tol: 1e-3,
             refine_growth_limit: Some(REFINE_GROWTH_LIMIT),
+            refine_max_nodes: REFINE_MAX_NODES,
             grid_growth_limit: Some(GRID_GROWTH_LIMIT),
             refine_within: 0.05,
             bracket_rounds: 2,
@@ -462,6 +475,8 @@ pub struct ProfileScan {
     pub candidate: Effect,
     /// The mesh-growth limit of the refinements ([`ScanOptions::refine_growth_limit`]).
     pub growth_limit: Option<GrowthLimit>,
+    /// The largest mesh of the refinements ([`ScanOptions::refine_max_nodes`]).
+    pub max_nodes: usize,
 }
 
 /// Scans the candidate variant `effect` (with shape `shape`, for the report) on the rheometer
@@ -597,6 +612,7 @@ pub fn scan_profile(
         rheometer: vrh,
         candidate: candidate.clone(),
         growth_limit: scan.refine_growth_limit,
+        max_nodes: scan.refine_max_nodes,
     })
 }
 
@@ -778,6 +794,7 @@ pub fn refine(
     };
     let mut limited = options.clone();
     limited.simulate.growth_limit = scan.growth_limit;
+    limited.simulate.max_nodes = limited.simulate.max_nodes.min(scan.max_nodes);
     let id = fit_warm(rh, &fs, &start.take_up, &limited, false)?;
     Ok(Refit {
         start_strength: start.strength,

@@ -244,27 +244,34 @@ pub(crate) fn check_fixed_effects(s: &FitSummary, w: &mut Vec<FitWarning>) {
     }
 }
 
-/// An implausible material law (`n` below [`PLAUSIBLE_N`]: not a result), or a 95 % interval
-/// of `n` reaching beyond `[0, 1]` (the law's own range: the linearised interval is not
-/// reliable there; a large-uncertainty warning).
+/// An implausible material law (`n` below [`PLAUSIBLE_N`], at a bound of its range or not:
+/// not a result), or a 95 % interval of `n` reaching beyond `[0, 1]` (the law's own range: the
+/// linearised interval is not reliable there; a large-uncertainty warning). An `n` at its
+/// upper bound 1 is the Newtonian limit, a law a melt can have: the at-bound warning says it.
 pub(crate) fn check_law(s: &FitSummary, w: &mut Vec<FitWarning>) {
     let n = &s.n;
-    if !n.fitted || s.bound_of("n").is_some() {
+    if !n.fitted {
         return;
     }
+    let at_bound = s.bound_of("n").is_some();
     if n.value < PLAUSIBLE_N[0] {
         w.push(FitWarning::new(
             WarningCode::Implausible,
             format!(
-                "n = {} is implausible for a polymer melt (expected {} to {}): the fit \
+                "n = {}{} is implausible for a polymer melt (expected {} to {}): the fit \
                  compensates a model error with the viscosity law; this is not a material \
                  result",
                 fmt_g(n.value),
+                if at_bound {
+                    " (at the lower bound of its range)"
+                } else {
+                    ""
+                },
                 PLAUSIBLE_N[0],
                 PLAUSIBLE_N[1]
             ),
         ));
-    } else if n.has_interval() && (n.ci95[0] < 0.0 || n.ci95[1] > 1.0) {
+    } else if !at_bound && n.has_interval() && (n.ci95[0] < 0.0 || n.ci95[1] > 1.0) {
         w.push(FitWarning::new(
             WarningCode::LargeUncertainty,
             format!(
@@ -477,5 +484,52 @@ mod tests {
         low.cost = refit.cost;
         let (jump, _) = law_jump(&with_base(0.10, 0.002), &low).expect("a jump below 0.2");
         assert!((jump - 30.0).abs() < 1e-6, "{jump}");
+    }
+}
+
+#[cfg(test)]
+mod law_tests {
+    use super::*;
+    use crate::fiber::rheometer::summary::tests::refit_summary;
+    use crate::fiber::rheometer::summary::{AtBound, BoundSide};
+
+    fn at_bound(n: f64, bound: f64, side: BoundSide) -> FitSummary {
+        let mut s = refit_summary("a", (0.5, 0.1), (n, 0.0), (15.0, 0.3));
+        s.at_bound.push(AtBound {
+            parameter: "n".into(),
+            side,
+            bound,
+            value: n,
+        });
+        s
+    }
+
+    /// An `n` that the fit drove to the lower bound of its range (1e-4 at the bound 0: a
+    /// strongly hardening melt, a candidate's refit buying the misfit with the law) is as
+    /// implausible as one inside the range; the Newtonian limit `n = 1` at the upper bound is
+    /// not; a plausible `n` whose interval leaves `[0, 1]` is a large uncertainty.
+    #[test]
+    fn an_n_below_the_plausible_range_is_implausible_at_its_bound_too() {
+        let codes = |s: &FitSummary| {
+            let mut w = Vec::new();
+            check_law(s, &mut w);
+            w.iter().map(|w| w.code).collect::<Vec<_>>()
+        };
+        let low = at_bound(1.2e-4, 0.0, BoundSide::Lower);
+        assert_eq!(codes(&low), vec![WarningCode::Implausible]);
+        let mut w = Vec::new();
+        check_law(&low, &mut w);
+        assert!(
+            w[0].message.contains("at the lower bound"),
+            "{}",
+            w[0].message
+        );
+        assert!(codes(&at_bound(1.0, 1.0, BoundSide::Upper)).is_empty());
+        let inside = refit_summary("a", (0.5, 0.1), (0.1, 0.02), (15.0, 0.3));
+        assert_eq!(codes(&inside), vec![WarningCode::Implausible]);
+        let wide = refit_summary("a", (0.5, 0.1), (0.9, 0.1), (15.0, 0.3));
+        assert_eq!(codes(&wide), vec![WarningCode::LargeUncertainty]);
+        let fine = refit_summary("a", (0.5, 0.1), (0.6, 0.05), (15.0, 0.3));
+        assert!(codes(&fine).is_empty());
     }
 }

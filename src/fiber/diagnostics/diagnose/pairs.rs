@@ -107,8 +107,11 @@ pub(crate) fn search(
         }
     }
     let tried = pairs.len();
-    // the joint fits are refits like the single ones: the same mesh-growth limit
-    let limit = options.scan.refine_growth_limit;
+    // the joint fits are refits like the single ones: the same mesh limits
+    let limit = (
+        options.scan.refine_growth_limit,
+        options.scan.refine_max_nodes,
+    );
     let fits: Vec<(usize, usize, Identification, usize, usize)> = pairs
         .into_par_iter()
         .filter_map(|(i, j)| {
@@ -250,14 +253,14 @@ fn member<'a>(c: &'a Candidate, options: &DiagnoseOptions) -> Option<Member<'a>>
 
 /// The joint fit of `a` and `b` from each of `starts` (start strengths and shapes by name; the
 /// law of the user's fit, its solutions as warm starts, one model for all starts, BVP solves
-/// with the mesh-growth limit `limit`): the fits that converged.
+/// with the mesh-growth limit and the largest mesh of `limit`): the fits that converged.
 fn fit_pair(
     set: &ExperimentSet,
     base_spec: &ModelSpec,
     first: &Step,
     (a, b): (&Member<'_>, &Member<'_>),
     starts: &[Vec<(String, f64)>],
-    limit: Option<GrowthLimit>,
+    limit: (Option<GrowthLimit>, usize),
 ) -> Result<Vec<Identification>, RheometerError> {
     let mut spec = base_spec.clone();
     spec.candidates.clear();
@@ -271,7 +274,8 @@ fn fit_pair(
         loss: Loss::Linear,
         ..first.opts.clone()
     };
-    opts.simulate.growth_limit = limit;
+    opts.simulate.growth_limit = limit.0;
+    opts.simulate.max_nodes = opts.simulate.max_nodes.min(limit.1);
     let mut fits = Vec::new();
     for st in starts {
         let start = FitStart {

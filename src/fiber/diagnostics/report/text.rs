@@ -20,10 +20,7 @@ impl Diagnosis {
         match (&self.most_likely_missing, self.named()) {
             (Some(name), Some(c)) => self.named_paragraph(&mut s, name, c),
             _ => {
-                s.push_str(
-                    "No candidate earns its place: no effect lowers BIC by more than the threshold; \
-                     the model is adequate for these data (or the missing effect is not among the candidates).\n",
-                );
+                s.push_str(&self.nothing_named_text());
                 if let Some(w) = self.detection.words() {
                     s.push_str(&format!("{w}\n"));
                 }
@@ -349,6 +346,32 @@ impl Diagnosis {
     }
 
     /// The refits that lower BIC but are not named (outside the physical range, at a bound).
+    /// Why nothing is named: no effect lowers BIC enough, or those that do are not credible
+    /// estimates (listed under NOT NAMED); the model is called adequate only where its
+    /// residuals are noise.
+    fn nothing_named_text(&self) -> String {
+        let not_credible = self
+            .candidates
+            .iter()
+            .filter(|c| c.refitted() && c.status != StrengthStatus::Physical && c.delta_bic < 0.0)
+            .count();
+        let why = if not_credible > 0 {
+            format!(
+                "{not_credible} lower{} BIC but none is a credible estimate (see NOT NAMED below)",
+                if not_credible == 1 { "s" } else { "" }
+            )
+        } else {
+            "no effect lowers BIC by more than the threshold".to_string()
+        };
+        let adequate = if self.systematic {
+            "the residuals are systematic: the missing effect is not among the candidates"
+        } else {
+            "the model is adequate for these data (or the missing effect is not among the \
+             candidates)"
+        };
+        format!("No candidate earns its place: {why}; {adequate}.\n")
+    }
+
     fn not_named_paragraph(&self, s: &mut String) {
         for c in self
             .candidates
