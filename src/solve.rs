@@ -739,11 +739,8 @@ impl<'a, P: Bvp> Solver<'a, P> {
         self.validate(params, guess, opts)?;
         // a kept Newton matrix carries over to this solution while no newer one is factored on
         // the guess's mesh
-        let carried = match initial {
-            Some(Initial::Kept(k)) => Some(k.clone()),
-            _ => None,
-        };
-        let mut initial = initial.map(|i| i.factorization());
+        let carried = initial.and_then(Initial::kept);
+        let mut initial = initial.map(Initial::factorization);
         let problem = self.problem;
         let n = self.ws.col.n;
         let bc_tol = opts.bc_tol.unwrap_or(opts.tol);
@@ -948,6 +945,14 @@ impl<'f> Initial<'f> {
         match self {
             Initial::Borrowed(f) => f,
             Initial::Kept(k) => k,
+        }
+    }
+
+    /// The kept matrix (a new reference to it), if this is one.
+    fn kept(self) -> Option<Arc<Factorization>> {
+        match self {
+            Initial::Borrowed(_) => None,
+            Initial::Kept(k) => Some(k.clone()),
         }
     }
 }
