@@ -346,30 +346,51 @@ impl Diagnosis {
     }
 
     /// The refits that lower BIC but are not named (outside the physical range, at a bound).
-    /// Why nothing is named: no effect lowers BIC enough, or those that do are not credible
-    /// estimates (listed under NOT NAMED); the model is called adequate only where its
-    /// residuals are noise.
+    /// Why nothing is named: no effect lowers BIC, or those that do are not credible
+    /// estimates (listed under NOT NAMED) or not by enough (the threshold, the look-elsewhere
+    /// test, the share of the excess misfit: the candidates table); the model is called
+    /// adequate only where its residuals are noise.
     fn nothing_named_text(&self) -> String {
-        let not_credible = self
-            .candidates
-            .iter()
-            .filter(|c| c.refitted() && c.status != StrengthStatus::Physical && c.delta_bic < 0.0)
-            .count();
-        let why = if not_credible > 0 {
-            format!(
-                "{not_credible} lower{} BIC but none is a credible estimate (see NOT NAMED below)",
-                if not_credible == 1 { "s" } else { "" }
-            )
-        } else {
-            "no effect lowers BIC by more than the threshold".to_string()
+        let lowering = |physical: bool| {
+            self.candidates
+                .iter()
+                .filter(|c| {
+                    c.refitted()
+                        && (c.status == StrengthStatus::Physical) == physical
+                        && c.delta_bic < 0.0
+                })
+                .count()
         };
+        let (credible, not_credible) = (lowering(true), lowering(false));
+        let mut why = Vec::new();
+        if not_credible > 0 {
+            why.push(format!(
+                "{not_credible} lower{} BIC without a credible estimate (see NOT NAMED below)",
+                if not_credible == 1 { "s" } else { "" }
+            ));
+        }
+        if credible > 0 {
+            why.push(format!(
+                "{credible} credible refit{} lower{} BIC, but not by enough to be named (the \
+                 threshold, the false-alarm probability, the share of the excess misfit: see the \
+                 candidates table)",
+                if credible == 1 { "" } else { "s" },
+                if credible == 1 { "s" } else { "" }
+            ));
+        }
+        if why.is_empty() {
+            why.push("no effect lowers BIC".to_string());
+        }
         let adequate = if self.systematic {
             "the residuals are systematic: the missing effect is not among the candidates"
         } else {
             "the model is adequate for these data (or the missing effect is not among the \
              candidates)"
         };
-        format!("No candidate earns its place: {why}; {adequate}.\n")
+        format!(
+            "No candidate earns its place: {}; {adequate}.\n",
+            why.join("; ")
+        )
     }
 
     fn not_named_paragraph(&self, s: &mut String) {
