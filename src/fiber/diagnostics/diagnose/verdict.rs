@@ -180,8 +180,14 @@ pub(crate) fn at_noise(fit: &FitSummary, noise: &NoiseSummary) -> (f64, f64) {
 /// Whether `fit` leaves residuals at the noise (see the module documentation; the noise level
 /// of `noise_for`).
 pub(crate) fn explained(fit: &FitSummary, noise: &NoiseSummary) -> bool {
+    explained_within(fit, noise, 1.0)
+}
+
+/// [`explained`] with both limits `slack` times as wide (a screening fit solved less
+/// accurately: `slack` ≥ 1).
+pub(crate) fn explained_within(fit: &FitSummary, noise: &NoiseSummary, slack: f64) -> bool {
     let (ratio, z) = at_noise(fit, &noise_for(fit, noise));
-    ratio <= EXPLAINED_RMS_OVER_NOISE && z < STRUCTURE_Z
+    ratio <= slack * EXPLAINED_RMS_OVER_NOISE && z < slack * STRUCTURE_Z
 }
 
 /// Where the residuals of `profiles` (positions and relative residuals per experiment, named
