@@ -689,6 +689,14 @@ class Diagnosis(Result):
         return list(self._data.get("found", []))
 
     @property
+    def stage_times(self) -> Dict[str, float]:
+        """Where the diagnosis' wall time went [s]: ``fits_s``, ``linearised_s`` (linearisation,
+        detection limits, false-alarm calibration), ``scans_s``, ``refits_s``, ``pairs_s``,
+        ``rest_s``; they add up to the wall time (empty for a report written before they were
+        kept)."""
+        return dict(self._data.get("stage_times", {}))
+
+    @property
     def most_likely_missing(self) -> Optional[str]:
         """The best single candidate that may be named (the forward search's first step), or
         None. A pair that explains the data better replaces it in ``found`` (see ``pair``)."""

@@ -57,6 +57,12 @@ def test_repr_and_to_dict(pmma_fit, radiation_diagnosis):
     r = repr(radiation_diagnosis)
     assert "radiation" in r and radiation_diagnosis.verdict["kind"] in r
     assert "radiation" in repr(radiation_diagnosis.candidate("radiation"))
+    # where the diagnosis' time went: the stages add up to its wall time
+    times = radiation_diagnosis.stage_times
+    assert set(times) == {"fits_s", "linearised_s", "scans_s", "refits_s", "pairs_s", "rest_s"}
+    assert times["scans_s"] > 0 and all(v >= 0 for v in times.values())
+    wall = radiation_diagnosis.to_dict()["wall_time_s"]
+    assert sum(times.values()) == pytest.approx(wall, rel=1e-6)
     pd = pytest.importorskip("pandas")
     df = pd.DataFrame(pmma_fit.residuals_table())
     assert len(df) == pmma_fit.summary["residuals"]

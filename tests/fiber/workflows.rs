@@ -259,6 +259,32 @@ fn diagnose_reproduces_the_program_with_the_fits_noise_level() {
     let text = d.to_text();
     let level = format!("{:.3} %", 100.0 * d.noise_level());
     assert!(text.contains(&level), "{text}");
+    // where the time went: every stage timed, the stages add up to the wall time, and the
+    // CLI's JSON carries them
+    let t = &d.stage_times;
+    let stages = [
+        t.fits_s,
+        t.linearised_s,
+        t.scans_s,
+        t.refits_s,
+        t.pairs_s,
+        t.rest_s,
+    ];
+    assert!(stages.iter().all(|v| v.is_finite() && *v >= 0.0), "{t:?}");
+    assert!(
+        t.fits_s > 0.0 && t.scans_s > 0.0 && t.refits_s > 0.0,
+        "{t:?}"
+    );
+    let sum: f64 = stages.iter().sum();
+    assert!(
+        (sum - d.wall_time_s).abs() <= 1e-6 * d.wall_time_s.max(1.0),
+        "stages {sum} s, wall {} s",
+        d.wall_time_s
+    );
+    assert!(text.contains(" s (fits "), "{text}");
+    assert!(cli["stage_times"]["scans_s"]
+        .as_f64()
+        .is_some_and(|v| v > 0.0));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

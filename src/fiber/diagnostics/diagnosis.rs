@@ -128,6 +128,45 @@ pub struct Diagnosis {
     pub verdict: Verdict,
     /// Wall time \[s\].
     pub wall_time_s: f64,
+    /// Where the wall time went, stage by stage (reports written before it was kept: zeros).
+    #[serde(default)]
+    pub stage_times: StageTimes,
+}
+
+/// Where a diagnosis spent its wall time \[s\], stage by stage, the steps of the forward search
+/// summed: what to look at when a diagnosis is slow (the stages run their candidates, shapes
+/// and starts in parallel, so these are wall times, not CPU times).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct StageTimes {
+    /// The fits each step starts from (the user's model, then with the effects found), with
+    /// the noise model's weights \[s\].
+    pub fits_s: f64,
+    /// The linearisation at those fits, the detection limits and the look-elsewhere
+    /// calibration \[s\].
+    pub linearised_s: f64,
+    /// The profile scans of the candidates' strengths \[s\].
+    pub scans_s: f64,
+    /// The refits of the scans' best points, from several laws \[s\].
+    pub refits_s: f64,
+    /// The pairs of candidates fitted jointly \[s\].
+    pub pairs_s: f64,
+    /// Everything else: judging, ties, the final fit's checks, the report's parts \[s\].
+    pub rest_s: f64,
+}
+
+impl StageTimes {
+    /// The sum of the stages the steps timed (all but the pairs and the rest) \[s\].
+    pub(crate) fn steps_s(&self) -> f64 {
+        self.fits_s + self.linearised_s + self.scans_s + self.refits_s
+    }
+
+    /// Adds the stage times of a step.
+    pub(crate) fn add(&mut self, o: &StageTimes) {
+        self.fits_s += o.fits_s;
+        self.linearised_s += o.linearised_s;
+        self.scans_s += o.scans_s;
+        self.refits_s += o.refits_s;
+    }
 }
 
 /// A step of the forward search after the first: the model with the effects found so far,

@@ -89,7 +89,9 @@ pub use super::candidate::{
     earns_its_place, rank_order, strength_status, Candidate, Indistinguishable, ShapeAlternative,
     StrengthStatus, PHYSICAL_RANGE_SE,
 };
-pub use super::diagnosis::{Diagnosis, DiagnosisRun, ForwardStep, ResidualProfiles, RobustWeights};
+pub use super::diagnosis::{
+    Diagnosis, DiagnosisRun, ForwardStep, ResidualProfiles, RobustWeights, StageTimes,
+};
 pub use step::MAX_FALSE_ALARM;
 
 /// Options of [`diagnose`].
@@ -212,6 +214,11 @@ pub fn diagnose(
     }
     // two effects that hide each other: every pair fitted jointly, as a challenge to what the
     // steps found, wherever there is something to explain
+    let mut times = StageTimes::default();
+    for s in &steps {
+        times.add(&s.times);
+    }
+    let t_pairs = Instant::now();
     let pair = if options.max_effects >= 2 && something_to_explain(&steps) {
         let (dbic, fit) = steps_result(&steps);
         let noise = &steps[0].base.summary.noise;
@@ -235,8 +242,11 @@ pub fn diagnose(
     } else {
         None
     };
+    times.pairs_s = t_pairs.elapsed().as_secs_f64();
     let mut run = assemble(set, steps, pair, options, t0);
     run.diagnosis.stopped = stopped;
+    times.rest_s = (run.diagnosis.wall_time_s - times.steps_s() - times.pairs_s).max(0.0);
+    run.diagnosis.stage_times = times;
     Ok(run)
 }
 
@@ -411,6 +421,7 @@ fn assemble(
             stopped: None,
             verdict,
             wall_time_s: t0.elapsed().as_secs_f64(),
+            stage_times: StageTimes::default(),
         },
         residuals_before,
         residuals_after,

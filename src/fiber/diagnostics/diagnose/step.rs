@@ -13,7 +13,7 @@ use crate::fiber::diagnostics::candidate::{
     earns_its_place, rank_order, Candidate, Indistinguishable,
 };
 use crate::fiber::diagnostics::detection::{detection_limits, DetectionContext, DetectionLimits};
-use crate::fiber::diagnostics::diagnosis::RobustWeights;
+use crate::fiber::diagnostics::diagnosis::{RobustWeights, StageTimes};
 use crate::fiber::diagnostics::scores::cosine;
 use crate::fiber::diagnostics::ties::{alternatives_among, Alternative};
 use crate::fiber::effects::{Effect, ModelSpec};
@@ -21,6 +21,7 @@ use crate::fiber::rheometer::{
     Estimate, Identification, IdentifyOptions, ParameterShift, RheometerError,
 };
 use crate::fiber::setup::ExperimentSet;
+use std::time::Instant;
 
 /// Largest false-alarm probability of the search at which an effect may be named.
 pub const MAX_FALSE_ALARM: f64 = 0.05;
@@ -51,6 +52,8 @@ pub(crate) struct Step {
     pub opts: IdentifyOptions,
     /// How the robust loss weighted the points at this step (`None`: least squares).
     pub weights: Option<RobustWeights>,
+    /// The step's stage times (fits, linearisation, scans, refits).
+    pub times: StageTimes,
 }
 
 impl Step {
@@ -68,10 +71,14 @@ pub(crate) fn run(
     options: &DiagnoseOptions,
     warm: Option<&Identification>,
 ) -> Result<Step, RheometerError> {
+    let mut times = StageTimes::default();
+    let t0 = Instant::now();
     let mut ctx = Context::new(set, spec, options)?;
     let base = ctx.fit_base(warm)?;
     let base = ctx.weighted_base(base)?;
     let ctx = ctx;
+    times.fits_s = t0.elapsed().as_secs_f64();
+    let t0 = Instant::now();
     let lin = linearise::linearise(&ctx, &base)?;
     let systematic = residuals_systematic(&base);
     let mut records = linearise::linear_candidates(&ctx, &lin);
@@ -92,7 +99,8 @@ pub(crate) fn run(
         options.calibration_replicates,
         0x5EED_D1A6,
     );
-    let mut refits = search_and_judge(&ctx, &lin, &base, &mut records);
+    times.linearised_s = t0.elapsed().as_secs_f64();
+    let mut refits = search_and_judge(&ctx, &lin, &base, &mut records, &mut times);
     for r in records.iter_mut() {
         r.false_alarm = calibration.false_alarm(r.delta_bic);
         r.share_of_excess = share_of_excess(lin.cost_before, r.cost_after, j_noise);
@@ -127,6 +135,7 @@ pub(crate) fn run(
         systematic,
         opts: ctx.opts.clone(),
         weights: ctx.weights.clone(),
+        times,
     })
 }
 
@@ -219,10 +228,15 @@ fn search_and_judge(
     lin: &Linearisation,
     base: &Identification,
     records: &mut [Candidate],
+    times: &mut StageTimes,
 ) -> Vec<(usize, Effect, Identification)> {
+    let t0 = Instant::now();
     let searched = search::searched(ctx, lin);
     let scans = search::scan_all(ctx, base, lin, &searched, records);
+    times.scans_s = t0.elapsed().as_secs_f64();
+    let t0 = Instant::now();
     let refined = search::refine_all(ctx, base, lin, &scans, &searched, records);
+    times.refits_s = t0.elapsed().as_secs_f64();
     count_starts(&refined, records);
     let extra: Vec<usize> = records.iter().map(|c| c.extra_parameters).collect();
     let choices = shapes::choose_shapes(ctx, lin, &scans, refined, &extra);

@@ -34,8 +34,22 @@ impl Diagnosis {
         self.profiles_paragraph(&mut s);
         self.indistinguishable_paragraph(&mut s);
         s.push_str(&self.detection.to_text());
-        s.push_str(&format!("wall time {:.2} s\n", self.wall_time_s));
+        s.push_str(&self.wall_time_text());
         wrap_long_lines(&s)
+    }
+
+    /// The wall time and where it went (see [`StageTimes`](super::super::diagnosis::StageTimes);
+    /// a report read from a JSON file written before the stages were timed: the total alone).
+    fn wall_time_text(&self) -> String {
+        let t = &self.stage_times;
+        if t.steps_s() + t.pairs_s + t.rest_s <= 0.0 {
+            return format!("wall time {:.2} s\n", self.wall_time_s);
+        }
+        format!(
+            "wall time {:.2} s (fits {:.2} s, linearisation and calibration {:.2} s, scans {:.2} \
+             s, refits {:.2} s, pairs {:.2} s, the rest {:.2} s)\n",
+            self.wall_time_s, t.fits_s, t.linearised_s, t.scans_s, t.refits_s, t.pairs_s, t.rest_s
+        )
     }
 
     /// The heading, the base fit (its warnings) and whether its residuals are noise.
