@@ -24,6 +24,7 @@ use diffbvp::fiber::diagnostics::diagnose::{
 };
 use diffbvp::fiber::effects::{LawChoice, ModelSpec};
 use diffbvp::fiber::input::load_experiments;
+use diffbvp::fiber::rheometer::FitSummary;
 use independent::dataset::{Expected, Faults, Scenario};
 use independent::scenarios;
 use std::sync::OnceLock;
@@ -54,6 +55,22 @@ fn run(sc: &Scenario) -> Diagnosis {
         top.delta_bic
     );
     d
+}
+
+/// Generates, loads and fits `sc` as a diagnosis fits the user's model (its base fit, the
+/// noise model's weights included), without searching any candidate: the same fit, bit for
+/// bit, at 0.03 s instead of a whole diagnosis' 0.75 s.
+fn base_fit(sc: &Scenario) -> FitSummary {
+    let generated = sc.generate().unwrap();
+    let set = load_experiments(&generated.toml).unwrap();
+    let options = DiagnoseOptions {
+        candidates: Vec::new(),
+        ..DiagnoseOptions::default()
+    };
+    diagnose(&set, &ModelSpec::new(LawChoice::Carreau), &options)
+        .unwrap()
+        .diagnosis
+        .base_fit
 }
 
 /// The control's diagnosis (computed once).
@@ -243,10 +260,10 @@ fn the_predicted_bias_of_an_undetected_fault_is_the_fits() {
         (gauge_offset(3e-6, seed), "gauge_offset", 3.0),
         (die_offset(-5.0, seed), "die_temperature_offset", -5.0),
     ] {
-        let d = run(&sc);
+        let fit = base_fit(&sc);
         let l = limit(c, effect);
-        let dk = d.base_fit.kappa.value - c.base_fit.kappa.value;
-        let dn = d.base_fit.n.value - c.base_fit.n.value;
+        let dk = fit.kappa.value - c.base_fit.kappa.value;
+        let dn = fit.n.value - c.base_fit.n.value;
         let pk = l.dkappa_per_unit.unwrap() * strength;
         let pn = l.dn_per_unit.unwrap() * strength;
         println!(
