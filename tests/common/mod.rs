@@ -40,6 +40,26 @@ impl Bvp for Bratu {
         r[1] = yb[0];
     }
 }
+/// Bratu's problem y'' + k e^y = 0, y(0) = y(1) = 0, with `k` the model parameter `p[0]`
+/// (for solvers, paths and fits that vary it).
+pub struct BratuInK;
+impl Bvp for BratuInK {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        1
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = -y[0].exp() * p[0];
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[0];
+        r[1] = yb[0];
+    }
+}
+
 /// Exact Bratu solution for the branch parameter θ (θ = √(2k) cosh(θ/4)).
 pub fn bratu_exact(theta: f64, x: f64) -> f64 {
     -2.0 * (((x - 0.5) * theta / 2.0).cosh() / (theta / 4.0).cosh()).ln()

@@ -3,27 +3,9 @@
 //! result meets the same tolerance as a solve with fresh Jacobians, with fewer dual-number
 //! passes; the kept matrix is never mistaken for a linearisation at the solution.
 
+use crate::common::BratuInK;
 use diffbvp::mesh::linspace;
-use diffbvp::{Bvp, DualNum, Guess, Solution, SolveOptions, Solver};
-
-/// `y'' = −a e^{y}`, `y(0) = y(1) = 0` (Bratu), `a = p[0]`.
-struct Bratu;
-impl Bvp for Bratu {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_params(&self) -> usize {
-        1
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -p[0] * y[0].exp();
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0];
-    }
-}
+use diffbvp::{Guess, Solution, SolveOptions, Solver};
 
 fn options(keep: bool) -> SolveOptions {
     SolveOptions {
@@ -48,9 +30,9 @@ fn max_diff(a: &Solution, b: &Solution) -> f64 {
 
 #[test]
 fn a_walk_from_kept_newton_matrices_matches_fresh_solves_with_fewer_dual_passes() {
-    let mut kept = Solver::new(&Bratu, options(true));
-    let mut fresh = Solver::new(&Bratu, options(false));
-    let first = kept.solve(&[1.0], &start()).expect("Bratu at a = 1");
+    let mut kept = Solver::new(&BratuInK, options(true));
+    let mut fresh = Solver::new(&BratuInK, options(false));
+    let first = kept.solve(&[1.0], &start()).expect("BratuInK at a = 1");
     assert!(first.has_newton_matrix(), "the option keeps the matrix");
     assert!(
         first.factorization().is_none(),
@@ -87,20 +69,20 @@ fn a_walk_from_kept_newton_matrices_matches_fresh_solves_with_fewer_dual_passes(
 
 #[test]
 fn a_kept_matrix_is_neither_kept_by_default_nor_used_on_another_mesh() {
-    let mut solver = Solver::new(&Bratu, options(false));
-    let plain = solver.solve(&[1.0], &start()).expect("Bratu");
+    let mut solver = Solver::new(&BratuInK, options(false));
+    let plain = solver.solve(&[1.0], &start()).expect("BratuInK");
     assert!(!plain.has_newton_matrix(), "off by default");
-    let mut keeper = Solver::new(&Bratu, options(true));
-    let near = keeper.solve(&[1.0], &start()).expect("Bratu");
+    let mut keeper = Solver::new(&BratuInK, options(true));
+    let near = keeper.solve(&[1.0], &start()).expect("BratuInK");
     // a guess on another mesh: solve_near is solve_with, and nothing is carried over
     let other = Guess::constant(linspace(0.0, 1.0, 31), &[0.0, 0.0]);
     let far = keeper
         .solve_near(&[1.05], &other, &near, &options(true))
-        .expect("Bratu on 31 nodes");
+        .expect("BratuInK on 31 nodes");
     assert_eq!(far.nodes(), 31);
     let again = solver
         .solve_with(&[1.05], &other, &options(false))
-        .expect("Bratu on 31 nodes, fresh");
+        .expect("BratuInK on 31 nodes, fresh");
     assert!(max_diff(&far, &again) < 1e-12);
     assert!(
         far.stats.rhs_dual_evaluations > 0,
@@ -111,6 +93,8 @@ fn a_kept_matrix_is_neither_kept_by_default_nor_used_on_another_mesh() {
         factor_at_solution: true,
         ..options(true)
     };
-    let lin = keeper.solve_with(&[1.0], &start(), &exact).expect("Bratu");
+    let lin = keeper
+        .solve_with(&[1.0], &start(), &exact)
+        .expect("BratuInK");
     assert!(lin.factorization().is_some() && !lin.has_newton_matrix());
 }

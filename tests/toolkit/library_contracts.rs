@@ -5,6 +5,7 @@
 //! and never an `Ok` with a NaN cost or zero standard errors. The last tests cover the
 //! non-panicking alternatives of the documented panics.
 
+use crate::common::BratuInK;
 use diffbvp::continuation::{
     secant_guess, solve_by_continuation, try_secant_guess, PathOptions, SimpleSteps, StepControl,
 };
@@ -13,25 +14,6 @@ use diffbvp::mesh::{
     linspace, try_apply, try_coarsen, try_linspace, try_refine, validate, MeshOptions,
 };
 use diffbvp::{solve, Bvp, BvpError, DualNum, Guess, Solution, SolveOptions, Solver};
-
-/// Bratu's problem y'' + k e^y = 0, y(0) = y(1) = 0, with `k` the model parameter.
-struct Bratu;
-impl Bvp for Bratu {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_params(&self) -> usize {
-        1
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -y[0].exp() * p[0];
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0];
-    }
-}
 
 /// y''' = 0 with y(0) = 1, y'(0) = 0, y(1) = 2: a 3-state problem.
 struct Cubic;
@@ -56,7 +38,13 @@ fn bratu_guess() -> Guess {
 }
 
 fn bratu(k: f64) -> Solution {
-    solve(&Bratu, &[k], &bratu_guess(), &SolveOptions::with_tol(1e-6)).unwrap()
+    solve(
+        &BratuInK,
+        &[k],
+        &bratu_guess(),
+        &SolveOptions::with_tol(1e-6),
+    )
+    .unwrap()
 }
 
 fn invalid_input(e: BvpError) -> String {
@@ -281,7 +269,13 @@ fn secant_mismatch_is_an_error_naming_both_dimensions() {
 #[test]
 fn tol_huge_is_refused_naming_the_option() {
     for tol in [1e300, 1.0] {
-        let e = solve(&Bratu, &[1.0], &bratu_guess(), &SolveOptions::with_tol(tol)).unwrap_err();
+        let e = solve(
+            &BratuInK,
+            &[1.0],
+            &bratu_guess(),
+            &SolveOptions::with_tol(tol),
+        )
+        .unwrap_err();
         let m = invalid_input(e);
         assert!(m.contains("SolveOptions::tol must be below 1"), "{m}");
         assert!(m.contains("relative residual"), "{m}");
@@ -296,13 +290,19 @@ fn tol_huge_is_refused_naming_the_option() {
         "{m}"
     );
     // the largest tolerance allowed still solves
-    assert!(solve(&Bratu, &[1.0], &bratu_guess(), &SolveOptions::with_tol(0.5)).is_ok());
+    assert!(solve(
+        &BratuInK,
+        &[1.0],
+        &bratu_guess(),
+        &SolveOptions::with_tol(0.5)
+    )
+    .is_ok());
     // a path's intermediate tolerance alike
     let path = PathOptions {
         intermediate_tol: 3.0,
         ..PathOptions::default()
     };
-    let mut solver = Solver::new(&Bratu, SolveOptions::with_tol(1e-6));
+    let mut solver = Solver::new(&BratuInK, SolveOptions::with_tol(1e-6));
     let e = solve_by_continuation(
         &mut solver,
         &[0.5],
@@ -376,7 +376,7 @@ fn linspace_nan_is_an_error_from_try_linspace() {
     assert!(m.contains("the end b = NaN"), "{m}");
     // a solve on such nodes names the node
     let e = solve(
-        &Bratu,
+        &BratuInK,
         &[1.0],
         &Guess::constant(linspace(f64::NAN, 1.0, 3), &[0.0, 0.0]),
         &SolveOptions::default(),
@@ -388,7 +388,7 @@ fn linspace_nan_is_an_error_from_try_linspace() {
 #[test]
 fn mesh_huge_span_is_a_degenerate_mesh_error() {
     let e = solve(
-        &Bratu,
+        &BratuInK,
         &[1.0],
         &Guess::constant(vec![-1e308, 1e308], &[0.0, 0.0]),
         &SolveOptions::default(),
@@ -404,7 +404,7 @@ fn mesh_huge_span_is_a_degenerate_mesh_error() {
 #[test]
 fn mesh_tiny_span_is_a_degenerate_mesh_error() {
     let e = solve(
-        &Bratu,
+        &BratuInK,
         &[1.0],
         &Guess::constant(vec![0.0, 5e-324], &[0.0, 0.0]),
         &SolveOptions::default(),

@@ -6,37 +6,19 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::{Duration, Instant};
 
+use crate::common::BratuInK;
 use diffbvp::continuation::{continuation, sweep, ContinuationOptions};
 use diffbvp::least_squares::{fit, FitError, FitOptions, LeastSquaresProblem};
 use diffbvp::mesh::{coarsen, linspace, refine, validate};
 use diffbvp::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
-use diffbvp::{solve, Bvp, BvpError, DualNum, Guess, Solution, SolveOptions, Solver};
-
-/// Bratu's problem y'' + k e^y = 0, y(0) = y(1) = 0, with `k` the model parameter.
-struct Bratu;
-impl Bvp for Bratu {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_params(&self) -> usize {
-        1
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -y[0].exp() * p[0];
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[0];
-        r[1] = yb[0];
-    }
-}
+use diffbvp::{solve, BvpError, DualNum, Guess, Solution, SolveOptions, Solver};
 
 fn guess() -> Guess {
     Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0])
 }
 
 fn bratu() -> Solution {
-    solve(&Bratu, &[1.0], &guess(), &SolveOptions::with_tol(1e-6)).unwrap()
+    solve(&BratuInK, &[1.0], &guess(), &SolveOptions::with_tol(1e-6)).unwrap()
 }
 
 fn invalid_input(e: BvpError) -> String {
@@ -139,7 +121,7 @@ fn refine_and_coarsen_of_degenerate_meshes_return_them_unchanged() {
 #[test]
 fn solve_on_an_empty_or_non_finite_mesh_is_an_error() {
     let e = solve(
-        &Bratu,
+        &BratuInK,
         &[1.0],
         &Guess::constant(linspace(0.0, 1.0, 0), &[0.0, 0.0]),
         &SolveOptions::default(),
@@ -149,14 +131,15 @@ fn solve_on_an_empty_or_non_finite_mesh_is_an_error() {
     assert!(m.contains("at least 2 nodes, got 0"), "{m}");
     let mut g = guess();
     g.x[2] = f64::NAN;
-    let m = invalid_input(solve(&Bratu, &[1.0], &g, &SolveOptions::default()).unwrap_err());
+    let m = invalid_input(solve(&BratuInK, &[1.0], &g, &SolveOptions::default()).unwrap_err());
     assert!(m.contains("mesh node 2 is not finite"), "{m}");
     let mut g = guess();
     g.y.pop();
-    let m = invalid_input(solve(&Bratu, &[1.0], &g, &SolveOptions::default()).unwrap_err());
+    let m = invalid_input(solve(&BratuInK, &[1.0], &g, &SolveOptions::default()).unwrap_err());
     assert!(m.contains("the guess has 9 values"), "{m}");
-    let m =
-        invalid_input(solve(&Bratu, &[f64::NAN], &guess(), &SolveOptions::default()).unwrap_err());
+    let m = invalid_input(
+        solve(&BratuInK, &[f64::NAN], &guess(), &SolveOptions::default()).unwrap_err(),
+    );
     assert!(m.contains("not finite"), "{m}");
 }
 
@@ -181,7 +164,7 @@ fn at_node_and_component_out_of_range() {
 }
 
 fn continuation_error(options: ContinuationOptions) -> (String, Duration) {
-    let mut solver = Solver::new(&Bratu, SolveOptions::with_tol(1e-6));
+    let mut solver = Solver::new(&BratuInK, SolveOptions::with_tol(1e-6));
     let start = solver.solve(&[0.5], &guess()).unwrap();
     let t0 = Instant::now();
     // the target 10 lies beyond Bratu's fold (k ≈ 3.51): a path with valid options would fail
@@ -345,7 +328,7 @@ fn solve_options_are_validated_with_names_and_values() {
         ),
     ];
     for (options, needle) in cases {
-        let m = invalid_input(solve(&Bratu, &[1.0], &guess(), &options).unwrap_err());
+        let m = invalid_input(solve(&BratuInK, &[1.0], &guess(), &options).unwrap_err());
         assert!(m.contains(needle), "expected {needle:?} in {m}");
         assert!(options.validate(2).is_err());
     }
@@ -354,7 +337,7 @@ fn solve_options_are_validated_with_names_and_values() {
 
 #[test]
 fn sweep_with_an_index_out_of_range_reports_every_value() {
-    let mut solver = Solver::new(&Bratu, SolveOptions::default());
+    let mut solver = Solver::new(&BratuInK, SolveOptions::default());
     let r = sweep(&mut solver, &[1.0], 3, &[0.1, 0.2], &guess());
     assert_eq!(r.len(), 2);
     for e in r {
@@ -374,15 +357,15 @@ impl PointFunction for FirstState {
 #[test]
 fn sensitivities_at_nan_and_residual_jacobian_at_nan_points() {
     let s = bratu();
-    let sens = Sensitivities::compute(&Bratu, &s).unwrap();
+    let sens = Sensitivities::compute(&BratuInK, &s).unwrap();
     let at = catch_unwind(AssertUnwindSafe(|| sens.at(f64::NAN))).expect("no panic");
     assert!(at.iter().all(|v| v.is_nan()), "{at:?}");
     let finite = sens.at(0.5);
     assert!(finite.iter().all(|v| v.is_finite()), "{finite:?}");
-    let e = residual_jacobian(&Bratu, &s, &sens, &[0.25, f64::NAN], &FirstState).unwrap_err();
+    let e = residual_jacobian(&BratuInK, &s, &sens, &[0.25, f64::NAN], &FirstState).unwrap_err();
     let m = invalid_input(e);
     assert!(m.contains("evaluation point 1 is not finite"), "{m}");
-    let e = diffbvp::sensitivity::adjoint_gradient(&Bratu, &s, &[0.5], &[f64::NAN], &FirstState)
+    let e = diffbvp::sensitivity::adjoint_gradient(&BratuInK, &s, &[0.5], &[f64::NAN], &FirstState)
         .unwrap_err();
     assert!(invalid_input(e).contains("weight 0 is not finite"));
 }
@@ -451,13 +434,13 @@ fn fit_options_are_validated_with_names_and_values() {
 #[test]
 fn discrete_system_refuses_a_dense_jacobian_beyond_its_limit() {
     use diffbvp::inspect::{discrete_system, MAX_DENSE_ENTRIES};
-    let small = discrete_system(&Bratu, &[1.0], &guess()).unwrap();
+    let small = discrete_system(&BratuInK, &[1.0], &guess()).unwrap();
     assert_eq!(small.size, 10);
     assert_eq!(small.jacobian.len(), 100);
     // 20 000 nodes x 2 states: 1.6e9 dense entries (12.8 GB) — an error, not an abort
     let big = Guess::constant(linspace(0.0, 1.0, 20_000), &[0.0, 0.0]);
     let t0 = Instant::now();
-    let m = invalid_input(discrete_system(&Bratu, &[1.0], &big).unwrap_err());
+    let m = invalid_input(discrete_system(&BratuInK, &[1.0], &big).unwrap_err());
     assert!(
         m.contains("20000 nodes x 2 states") && m.contains(&MAX_DENSE_ENTRIES.to_string()),
         "{m}"
