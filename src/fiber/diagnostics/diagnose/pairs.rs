@@ -17,7 +17,7 @@
 //!   member alone below [`DiagnoseOptions::earn_threshold`]).
 //!
 //! Every pair is first fitted with its BVPs solved at the scans' tolerance and judged with
-//! margins ([`SCREEN_SLACK`]); only the pairs that pass are fitted again at full accuracy from
+//! margins (`Margins::SCREEN`); only the pairs that pass are fitted again at full accuracy from
 //! that optimum and judged as above (most pairs fail the screen: on a gauge-offset set the
 //! diagnosis took 0.78 of the time, on the shipped data and `data/two_effects` the same).
 //!
@@ -43,17 +43,32 @@ use rayon::prelude::*;
 /// Relative `J` within which two starts reached the same optimum \[-\].
 const SAME_OPTIMUM: f64 = 1e-4;
 
-/// The screening's slack ([`judge_with`]): "explained" 10 % wider, a member's place 5 looser
-/// in `ΔBIC` (the screening's BVP tolerance moves a refit's `ΔBIC` by under 2 on 234 points).
-const SCREEN_SLACK: f64 = 1.1;
+/// How strictly a pair is judged ([`judge`]): the limits of "explained" `explained` times as
+/// wide, and each member's place beside the other `bic` looser in `ΔBIC`.
+#[derive(Clone, Copy)]
+struct Margins {
+    explained: f64,
+    bic: f64,
+}
 
-/// `ΔBIC` margin per unit of slack above 1 (`SCREEN_SLACK` 1.1: 5).
-const SCREEN_BIC_MARGIN_PER_SLACK: f64 = 50.0;
+impl Margins {
+    /// As the module documentation says.
+    const NONE: Margins = Margins {
+        explained: 1.0,
+        bic: 0.0,
+    };
+    /// For the screening fit at the scans' BVP tolerance (which moves a refit's `ΔBIC` by under
+    /// 2 on 234 points): "explained" 10 % wider, a member's place 5 looser.
+    const SCREEN: Margins = Margins {
+        explained: 1.1,
+        bic: 5.0,
+    };
+}
 
 /// How a pair's joint fits solve their BVPs: at the fit's tolerance (`tol` `None`) or at
 /// `tol`, with the refinements' mesh limits.
 #[derive(Clone, Copy)]
-struct Accuracy {
+struct Solves {
     tol: Option<f64>,
     limit: (Option<GrowthLimit>, usize),
 }
@@ -133,52 +148,46 @@ pub(crate) fn search(
         options.scan.refine_max_nodes,
     );
     // screening: every pair fitted with its BVPs solved at the scans' tolerance (1e-3 for the
-    // fit's 1e-4: the ranking's ΔBIC moves by under 2 on 234 points) and judged with margins;
-    // the pairs that pass are fitted again at full accuracy from the screening's optimum and
-    // judged as they stand
-    let screen = Accuracy {
+    // fit's 1e-4) and judged with margins; a pair that passes is fitted again at full accuracy
+    // from the screening's optimum and judged as it stands
+    let screen = Solves {
         tol: Some(options.scan.grid_tol),
         limit,
     };
-    let full = Accuracy { tol: None, limit };
-    let screened: Vec<(usize, usize, Identification)> = pairs
+    let full = Solves { tol: None, limit };
+    let fits: Vec<(usize, usize, Identification, usize, usize)> = pairs
         .into_par_iter()
         .filter_map(|(i, j)| {
             let (a, b) = (&members[i], &members[j]);
-            let from = &first.base;
-            let (id, _) = best_of(
-                fit_pair(set, base_spec, first, (a, b), from, &[a.start(b)], screen).ok()?,
+            let fit = |from: &Identification, start: Vec<(String, f64)>, solves: Solves| {
+                fit_pair(set, base_spec, first, (a, b), from, &[start], solves)
+                    .ok()
+                    .and_then(best_of)
+            };
+            let (loose, _) = fit(&first.base, a.start(b), screen)?;
+            judge(
+                first,
+                options,
+                (a, b),
+                &loose,
+                (1, 1, tried),
+                Margins::SCREEN,
             )?;
-            judge_with(first, options, a, b, &id, (1, 1, tried), SCREEN_SLACK)?;
-            Some((i, j, id))
-        })
-        .collect();
-    let fits: Vec<(usize, usize, Identification, usize, usize)> = screened
-        .into_par_iter()
-        .filter_map(|(i, j, loose)| {
-            let (a, b) = (&members[i], &members[j]);
-            let starts = [a
-                .scaled(&loose.summary, 1.0)
-                .into_iter()
-                .chain(b.scaled(&loose.summary, 1.0))
-                .collect()];
-            let (id, at) =
-                best_of(fit_pair(set, base_spec, first, (a, b), &loose, &starts, full).ok()?)?;
-            Some((i, j, id, starts.len(), at))
+            let (id, at) = fit(&loose, pair_start(a, b, &loose.summary, 1.0), full)?;
+            Some((i, j, id, 1, at))
         })
         .collect();
     let best = fits
         .into_iter()
         .filter_map(|(i, j, id, starts, at)| {
+            let (a, b) = (&members[i], &members[j]);
             let p = judge(
                 first,
                 options,
-                &members[i],
-                &members[j],
+                (a, b),
                 &id,
-                starts,
-                at,
-                tried,
+                (starts, at, tried),
+                Margins::NONE,
             )?;
             Some((i, j, p, id))
         })
@@ -189,49 +198,42 @@ pub(crate) fn search(
     let (a, b) = (&members[i], &members[j]);
     let more: Vec<Vec<(String, f64)>> = [2.0, 0.5]
         .iter()
-        .map(|&scale| {
-            a.scaled(&id.summary, scale)
-                .into_iter()
-                .chain(b.scaled(&id.summary, scale))
-                .collect()
-        })
+        .map(|&scale| pair_start(a, b, &id.summary, scale))
         .collect();
     let mut fits =
         fit_pair(set, base_spec, first, (a, b), &first.base, &more, full).unwrap_or_default();
     fits.push(id);
     let starts = p.starts + more.len();
     let (id, at) = best_of(fits)?;
-    let p = judge(first, options, a, b, &id, starts, at, tried)?;
+    let p = judge(
+        first,
+        options,
+        (a, b),
+        &id,
+        (starts, at, tried),
+        Margins::NONE,
+    )?;
     Some((p, id))
 }
 
+/// The start of the pair `a + b` at `scale` times the distance from neutral of the strengths
+/// fitted in `fit` (its fitted shapes as fitted; see [`Member::scaled`]).
+fn pair_start(a: &Member<'_>, b: &Member<'_>, fit: &FitSummary, scale: f64) -> Vec<(String, f64)> {
+    a.scaled(fit, scale)
+        .into_iter()
+        .chain(b.scaled(fit, scale))
+        .collect()
+}
+
 /// The pair `a + b` fitted as `id` (from `starts` starts, `at` of them at its optimum, `tried`
-/// pairs in all), if it qualifies (module documentation).
-#[allow(clippy::too_many_arguments)]
+/// pairs in all), if it qualifies (module documentation) with `margins`.
 fn judge(
     first: &Step,
     options: &DiagnoseOptions,
-    a: &Member<'_>,
-    b: &Member<'_>,
-    id: &Identification,
-    starts: usize,
-    at: usize,
-    tried: usize,
-) -> Option<PairFound> {
-    judge_with(first, options, a, b, id, (starts, at, tried), 1.0)
-}
-
-/// [`judge`] with margins for a screening fit (`slack` > 1): the limits of "explained"
-/// `slack` times as wide, and each member's place beside the other
-/// `(slack − 1) ×` [`SCREEN_BIC_MARGIN_PER_SLACK`] looser in `ΔBIC`.
-fn judge_with(
-    first: &Step,
-    options: &DiagnoseOptions,
-    a: &Member<'_>,
-    b: &Member<'_>,
+    (a, b): (&Member<'_>, &Member<'_>),
     id: &Identification,
     (starts, at, tried): (usize, usize, usize),
-    slack: f64,
+    margins: Margins,
 ) -> Option<PairFound> {
     let n = first.base.fit.num_residuals() as f64;
     let j0 = first.base.summary.cost;
@@ -262,9 +264,8 @@ fn judge_with(
         })
     });
     let law_free = s.bound_of("n").is_none() && s.bound_of("kappa").is_none();
-    let margin = (slack - 1.0) * SCREEN_BIC_MARGIN_PER_SLACK;
-    let earns = vs.iter().all(|v| *v < options.earn_threshold + margin);
-    let explained = super::verdict::explained_within(s, noise, slack);
+    let earns = vs.iter().all(|v| *v < options.earn_threshold + margins.bic);
+    let explained = super::verdict::explained_within(s, noise, margins.explained);
     (credible && law_free && earns && explained).then(|| PairFound {
         effects: [a.candidate.effect.clone(), b.candidate.effect.clone()],
         delta_bic: dbic,
@@ -317,7 +318,7 @@ fn member<'a>(c: &'a Candidate, options: &DiagnoseOptions) -> Option<Member<'a>>
 
 /// The joint fit of `a` and `b` from each of `starts` (start strengths and shapes by name; the
 /// law of the fit `from` and its solutions as warm starts, one model for all starts, BVP
-/// solves as `accuracy` says): the fits that converged.
+/// solves as `solves` says): the fits that converged.
 fn fit_pair(
     set: &ExperimentSet,
     base_spec: &ModelSpec,
@@ -325,7 +326,7 @@ fn fit_pair(
     (a, b): (&Member<'_>, &Member<'_>),
     from: &Identification,
     starts: &[Vec<(String, f64)>],
-    accuracy: Accuracy,
+    solves: Solves,
 ) -> Result<Vec<Identification>, RheometerError> {
     let mut spec = base_spec.clone();
     spec.candidates.clear();
@@ -339,9 +340,9 @@ fn fit_pair(
         loss: Loss::Linear,
         ..first.opts.clone()
     };
-    opts.simulate.growth_limit = accuracy.limit.0;
-    opts.simulate.max_nodes = opts.simulate.max_nodes.min(accuracy.limit.1);
-    if let Some(t) = accuracy.tol {
+    opts.simulate.growth_limit = solves.limit.0;
+    opts.simulate.max_nodes = opts.simulate.max_nodes.min(solves.limit.1);
+    if let Some(t) = solves.tol {
         opts.simulate.tol = opts.simulate.tol.max(t);
         opts.loose_tolerance = None;
     }
