@@ -395,28 +395,24 @@ impl<'a, P: Bvp, G: PointFunction> BvpRun<'a, P, G> {
                     // tolerance): its mesh grows with the tolerance, not because the start is far
                     opts.growth_limit = None;
                 }
-                if !predicted && self.accepted.has_newton_matrix() && guess.x == self.accepted.x {
-                    // simplified Newton from the accepted solve's last Newton matrix
-                    // (SolveOptions::keep_newton_matrix); where that does not converge, Newton
-                    // with fresh Jacobians from the same start
+                // simplified Newton from the accepted solution's factorisation: its exact one
+                // with the tangent predictor, or its last Newton matrix
+                // (SolveOptions::keep_newton_matrix) for a start on its mesh
+                let near =
+                    predicted || (self.accepted.has_newton_matrix() && guess.x == self.accepted.x);
+                if near {
                     match self
                         .solver
                         .solve_near(&self.q, guess, &self.accepted, &opts)
                     {
                         Ok(sol) => sol,
-                        Err(_) => self.solver.solve_with(&self.q, guess, &opts)?,
-                    }
-                } else if predicted {
-                    match self
-                        .solver
-                        .solve_near(&self.q, guess, &self.accepted, &opts)
-                    {
-                        Ok(sol) => sol,
-                        // a predictor that led Newton astray: the accepted solution itself
-                        Err(_) => {
+                        // a predictor that led Newton astray: the accepted solution itself; a
+                        // start the kept matrix did not converge from: fresh Jacobians
+                        Err(_) if predicted => {
                             let plain = Guess::from(&self.accepted);
                             self.solver.solve_with(&self.q, &plain, &opts)?
                         }
+                        Err(_) => self.solver.solve_with(&self.q, guess, &opts)?,
                     }
                 } else {
                     match self.solver.solve_with(&self.q, guess, &opts) {
