@@ -155,7 +155,7 @@ pub(crate) fn search(
         limit,
     };
     let full = Solves { tol: None, limit };
-    let fits: Vec<(usize, usize, Identification, usize, usize)> = pairs
+    let best = pairs
         .into_par_iter()
         .filter_map(|(i, j)| {
             let (a, b) = (&members[i], &members[j]);
@@ -174,21 +174,7 @@ pub(crate) fn search(
                 Margins::SCREEN,
             )?;
             let (id, at) = fit(&loose, pair_start(a, b, &loose.summary, 1.0), full)?;
-            Some((i, j, id, 1, at))
-        })
-        .collect();
-    let best = fits
-        .into_iter()
-        .filter_map(|(i, j, id, starts, at)| {
-            let (a, b) = (&members[i], &members[j]);
-            let p = judge(
-                first,
-                options,
-                (a, b),
-                &id,
-                (starts, at, tried),
-                Margins::NONE,
-            )?;
+            let p = judge(first, options, (a, b), &id, (1, at, tried), Margins::NONE)?;
             Some((i, j, p, id))
         })
         .min_by(|x, y| x.2.delta_bic.total_cmp(&y.2.delta_bic))?;
