@@ -529,6 +529,18 @@ pub fn try_coarsen(x: &[f64], rms: &[f64], threshold: f64) -> Result<Vec<f64>, B
     Ok(coarsen(x, rms, threshold))
 }
 
+/// The mesh `x` with every interval halved: `2 m - 1` nodes for `m` (the same nodes and the
+/// midpoint of every interval).
+pub fn halved(x: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(2 * x.len());
+    for w in x.windows(2) {
+        out.push(w[0]);
+        out.push(0.5 * (w[0] + w[1]));
+    }
+    out.extend(x.last());
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -735,5 +747,12 @@ mod tests {
         assert_eq!(linspace(0.0, 1.0, 5), vec![0.0, 0.25, 0.5, 0.75, 1.0]);
         assert_eq!(linspace(0.0, 1.0, 0), Vec::<f64>::new());
         assert_eq!(linspace(2.0, 1.0, 1), vec![2.0]);
+    }
+
+    #[test]
+    fn halving_keeps_the_nodes_and_adds_every_midpoint() {
+        assert_eq!(halved(&[0.0, 1.0, 3.0]), vec![0.0, 0.5, 1.0, 2.0, 3.0]);
+        assert_eq!(halved(&[2.0]), vec![2.0]);
+        assert!(halved(&[]).is_empty());
     }
 }

@@ -84,8 +84,9 @@ pub struct IdentifyOptions {
     /// and its covariance at `simulate.tol`. `None`: every solve at `simulate.tol`.
     pub loose_tolerance: Option<f64>,
     /// The largest shift of an estimate \[standard errors\] the BVPs' discretisation may cause
-    /// (default `Some(0.01)`): the fit is checked with every BVP solved 100 times more
-    /// accurately at the optimum and refined at tighter tolerances until it holds (see
+    /// (default `Some(0.01)`): the fit is checked at the optimum with every BVP re-solved on its
+    /// mesh with every interval halved (Richardson) and refined at tighter tolerances until it
+    /// holds (see
     /// [`accuracy`](super::accuracy)). `None`: no check, `simulate.tol` as given.
     pub max_discretisation_shift: Option<f64>,
     /// How close \[standard errors\] to the optimum of the discretised model the fit must

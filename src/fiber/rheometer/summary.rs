@@ -238,13 +238,15 @@ pub struct SolverRecord {
     /// Mesh nodes of each experiment's final solution.
     #[serde(default)]
     pub nodes: Vec<usize>,
-    /// The largest shift of a fitted shared parameter, in its standard errors, when every
-    /// BVP is solved `check_tolerance` accurately at the optimum (`NaN`: not checked).
+    /// The largest shift of a fitted shared parameter, in its standard errors, by the
+    /// discretisation error of the BVPs, estimated at the optimum by re-solving every
+    /// experiment on its mesh with every interval halved (Richardson; `NaN`: not checked).
     #[serde(default = "serde_nan::nan", deserialize_with = "serde_nan::f64")]
     pub discretisation_shift_se: f64,
-    /// BVP tolerance of the discretisation check \[-\] (`NaN`: not checked).
-    #[serde(default = "serde_nan::nan", deserialize_with = "serde_nan::f64")]
-    pub check_tolerance: f64,
+    /// Mesh nodes of each experiment's halved mesh in the discretisation check (empty: not
+    /// checked).
+    #[serde(default)]
+    pub check_nodes: Vec<usize>,
 }
 
 /// The outcome of an identification (the JSON of `rheometer fit --json`).
@@ -356,7 +358,7 @@ impl Default for SolverRecord {
             bvp_tolerance: f64::NAN,
             nodes: Vec::new(),
             discretisation_shift_se: f64::NAN,
-            check_tolerance: f64::NAN,
+            check_nodes: Vec::new(),
         }
     }
 }
@@ -530,7 +532,7 @@ pub(crate) mod tests {
                 bvp_tolerance: 1e-6,
                 nodes: vec![100],
                 discretisation_shift_se: f64::NAN,
-                check_tolerance: f64::NAN,
+                check_nodes: Vec::new(),
             },
             at_bound: Vec::new(),
             warnings: Vec::new(),

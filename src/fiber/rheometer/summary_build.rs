@@ -208,7 +208,7 @@ impl FitSummary {
                 bvp_tolerance: input.bvp_tolerance,
                 nodes: input.nodes,
                 discretisation_shift_se: f64::NAN,
-                check_tolerance: f64::NAN,
+                check_nodes: Vec::new(),
             },
             at_bound,
             warnings: Vec::new(),

@@ -221,8 +221,9 @@ impl FitSummary {
         };
         let check = if sv.discretisation_shift_se.is_finite() {
             format!(
-                "; at {:.0e} the estimates move by at most {:.1e} standard errors",
-                sv.check_tolerance, sv.discretisation_shift_se
+                "; on meshes with every interval halved the estimates move by at most {:.1e} \
+                 standard errors",
+                sv.discretisation_shift_se
             )
         } else {
             String::new()
