@@ -40,10 +40,11 @@ use serde::{Deserialize, Serialize};
 /// about tenfold. Where the fiber has no solution (strong strain thinning, the strain rate
 /// exploding at the take-up) the mesh instead grows towards 20 000 nodes: on a strongly
 /// hardening data set, 158 such solves took 53 s of a diagnosis' 127 s of CPU time. A co-flow
-/// refit crawling along the edge of the solvable region (83 trial steps, 28 of them failing
-/// near 2000 nodes from starts of about 250) took 1.7 s with the factor 16; with 4 its
-/// diagnosis takes 3.7 s instead of 4.5, and the `diagnose` text is unchanged on 21 data sets
-/// (the 6 shipped ones with an effect or none, 15 made by the test-only model).
+/// refit crawling along the edge of the solvable region (one experiment's mesh at 875 nodes, the
+/// others at 60–95) took 1.7 s with the factor 16: 83 trial steps, 28 of them failing only after
+/// refining towards 2000 nodes. With 4 they fail at the growth limit: 78 steps, the same cost,
+/// 0.9 s; that diagnosis takes 3.7 s instead of 4.5, and the `diagnose` text is unchanged on 21
+/// data sets (the 6 shipped ones with an effect or none, 15 made by the test-only model).
 pub const REFINE_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
     factor: 4.0,
     at_least: 1000,
