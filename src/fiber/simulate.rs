@@ -80,7 +80,8 @@ pub struct SimulateOptions {
     /// (no adaptation; Newton to `tol`) (default `false`):
     /// the discretisation check of a fit ([`accuracy`](crate::fiber::rheometer::accuracy)),
     /// whose difference from the start is the start's discretisation error to first order
-    /// ([`Guess::on_halved_mesh`]). A cold start is solved as usual.
+    /// ([`Guess::on_halved_mesh`]). Every solve of these options is then on a fixed mesh:
+    /// without a start solution (a cold start) it is an error.
     pub halve_start_mesh: bool,
 }
 
@@ -349,6 +350,11 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
                 "cold_with_loose does not insert required positions; use solve".into(),
             ));
         }
+        if self.options.halve_start_mesh {
+            return Err(FiberError::InvalidInput(
+                "halve_start_mesh needs a start solution; a cold start has none".into(),
+            ));
+        }
         let guess = self.stress_free_guess(p);
         let (path_opts, final_opts) = (
             self.options.solve_options(),
@@ -412,18 +418,27 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
             .map(|s| s / l_si * model.length())
             .collect();
         let solve_opts = options.solve_options();
+        if options.halve_start_mesh {
+            // the discretisation check's solve on the halved mesh, on that fixed mesh (no
+            // fallback: a failure is the check's to report)
+            return match start {
+                Some(prev) if prev.n == 4 && prev.nodes() >= 2 => {
+                    let guess = Guess::on_halved_mesh(prev);
+                    let sol = self.solver.solve_with(p, &guess, &solve_opts)?;
+                    Ok(FiberSolution { solution: sol })
+                }
+                _ => Err(FiberError::InvalidInput(
+                    "halve_start_mesh needs a start solution of the fiber (4 states, at least \
+                     2 nodes) to halve; solve without it first"
+                        .into(),
+                )),
+            };
+        }
         if let Some(prev) = start {
             if prev.n == 4 && prev.nodes() >= 2 {
                 // the tangent predictor when the start's linearisation is at hand (a fit computed
                 // its sensitivities), and simplified Newton on the start's factorisation: two
                 // iterations instead of four, and no Jacobian evaluation
-                // the discretisation check's solve on the halved mesh (no fallback: a failure
-                // is the check's to report)
-                if options.halve_start_mesh {
-                    let guess = Guess::on_halved_mesh(prev);
-                    let sol = self.solver.solve_with(p, &guess, &solve_opts)?;
-                    return Ok(FiberSolution { solution: sol });
-                }
                 if required.is_empty() && prev.factorization().is_some() {
                     if let Ok(guess) = tangent_guess(model, prev, p) {
                         if let Ok(sol) = self.solver.solve_near(p, &guess, prev, &solve_opts) {

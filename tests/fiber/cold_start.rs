@@ -4,7 +4,9 @@
 use diffbvp::continuation::ContinuationOptions as AdapterOptions;
 use diffbvp::fiber::cold_start::StepControl;
 use diffbvp::fiber::setup::{Air, Experiment, Material};
-use diffbvp::fiber::{simulate, CarreauLike, FiberError, FiberModel, Physics, SimulateOptions};
+use diffbvp::fiber::{
+    simulate, CarreauLike, FiberError, FiberModel, Physics, SimulateOptions, Simulator,
+};
 use diffbvp::BvpError;
 
 fn model() -> FiberModel<CarreauLike> {
@@ -76,4 +78,59 @@ fn adapter_cold_start_reports_a_stalled_path() {
             s.nodes()
         ),
     }
+}
+
+/// The discretisation check's solve (`SimulateOptions::halve_start_mesh`): from a solution at
+/// tol 1e-4, the same parameters on its mesh with every interval halved (2m − 1 nodes, no
+/// adaptation), whose diameter moves from the start's by about 15/16 of the start's error (a
+/// solve at 1e-9, 40 times the nodes, measures it): the Richardson estimate within 10 % at the
+/// position of the largest error. Without a start there is nothing to halve: an error.
+#[test]
+fn the_halved_mesh_solve_measures_the_start_s_discretisation_error() {
+    let m = model();
+    let p = [0.8, 11.71];
+    let coarse = simulate(&m, &p, &SimulateOptions::with_tol(1e-4)).unwrap();
+    let exact = simulate(&m, &p, &SimulateOptions::with_tol(1e-9)).unwrap();
+    let mut o = SimulateOptions::with_tol(1e-6);
+    o.halve_start_mesh = true;
+    let mut sim = Simulator::new(&m, o.clone());
+    let half = sim
+        .solve(&coarse.solution.params, Some(&coarse.solution))
+        .unwrap();
+    let (mc, mh) = (coarse.solution.nodes(), half.solution.nodes());
+    assert_eq!(mh, 2 * mc - 1, "{mc} nodes halved gave {mh}");
+    assert!(exact.solution.nodes() > 10 * mc);
+    let l = m.experiment.spinline_length;
+    let positions: Vec<f64> = (0..=200).map(|i| l * i as f64 / 200.0).collect();
+    let (dc, dh, de) = (
+        coarse.profiles(&m, &positions).diameter,
+        half.profiles(&m, &positions).diameter,
+        exact.profiles(&m, &positions).diameter,
+    );
+    let (i, err) = dc
+        .iter()
+        .zip(&de)
+        .map(|(c, e)| c - e)
+        .enumerate()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .unwrap();
+    let estimate = (dc[i] - dh[i]) * 16.0 / 15.0;
+    eprintln!(
+        "HALVED | {mc} -> {mh} nodes (1e-9: {}); at s = {:.3} m: error {err:.3e} m, estimate \
+         {estimate:.3e} m",
+        exact.solution.nodes(),
+        positions[i]
+    );
+    assert!(err.abs() > 1e-9 * de[i], "no error to measure: {err:e}");
+    assert!(
+        (estimate - err).abs() <= 0.1 * err.abs(),
+        "at s = {} m: error {err:e} m, Richardson estimate {estimate:e} m",
+        positions[i]
+    );
+    // a cold start has no mesh to halve
+    let cold = Simulator::new(&m, o).solve(&coarse.solution.params, None);
+    assert!(
+        matches!(&cold, Err(FiberError::InvalidInput(msg)) if msg.contains("halve_start_mesh")),
+        "{cold:?}"
+    );
 }
