@@ -153,6 +153,16 @@ impl SimulateOptions {
     }
 }
 
+/// The error of a solve with [`SimulateOptions::halve_start_mesh`] but no start solution to
+/// halve (a cold start).
+fn no_mesh_to_halve() -> FiberError {
+    FiberError::InvalidInput(
+        "halve_start_mesh needs a start solution of the fiber (4 states, at least 2 nodes) to \
+         halve; a cold start has none: solve without it first"
+            .into(),
+    )
+}
+
 /// A converged fiber solution (dimensionless states inside) with SI accessors.
 #[derive(Debug, Clone)]
 pub struct FiberSolution {
@@ -351,9 +361,7 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
             ));
         }
         if self.options.halve_start_mesh {
-            return Err(FiberError::InvalidInput(
-                "halve_start_mesh needs a start solution; a cold start has none".into(),
-            ));
+            return Err(no_mesh_to_halve());
         }
         let guess = self.stress_free_guess(p);
         let (path_opts, final_opts) = (
@@ -427,11 +435,7 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
                     let sol = self.solver.solve_with(p, &guess, &solve_opts)?;
                     Ok(FiberSolution { solution: sol })
                 }
-                _ => Err(FiberError::InvalidInput(
-                    "halve_start_mesh needs a start solution of the fiber (4 states, at least \
-                     2 nodes) to halve; solve without it first"
-                        .into(),
-                )),
+                _ => Err(no_mesh_to_halve()),
             };
         }
         if let Some(prev) = start {

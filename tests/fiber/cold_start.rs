@@ -83,8 +83,8 @@ fn adapter_cold_start_reports_a_stalled_path() {
 /// The discretisation check's solve (`SimulateOptions::halve_start_mesh`): from a solution at
 /// tol 1e-4, the same parameters on its mesh with every interval halved (2m − 1 nodes, no
 /// adaptation), whose diameter moves from the start's by about 15/16 of the start's error (a
-/// solve at 1e-9, 40 times the nodes, measures it): the Richardson estimate within 10 % at the
-/// position of the largest error. Without a start there is nothing to halve: an error.
+/// solve at 1e-9, 40 times the nodes, measures it): the Richardson estimate within 6 % at the
+/// position of the largest error (measured: 3.8 %). Without a start there is nothing to halve: an error.
 #[test]
 fn the_halved_mesh_solve_measures_the_start_s_discretisation_error() {
     let m = model();
@@ -123,7 +123,7 @@ fn the_halved_mesh_solve_measures_the_start_s_discretisation_error() {
     );
     assert!(err.abs() > 1e-9 * de[i], "no error to measure: {err:e}");
     assert!(
-        (estimate - err).abs() <= 0.1 * err.abs(),
+        (estimate - err).abs() <= 0.06 * err.abs(),
         "at s = {} m: error {err:e} m, Richardson estimate {estimate:e} m",
         positions[i]
     );

@@ -19,7 +19,8 @@ pub struct LandscapeArgs {
     /// The estimator whose cost is mapped (default: the paper's, as in its Fig. 4).
     #[arg(long, value_enum, default_value_t = EstimatorArg::Paper)]
     pub estimator: EstimatorArg,
-    /// BVP tolerance of the landscape solves (1e-12 to 0.1; a picture: fits solve at 1e-4 and check the discretisation).
+    /// BVP tolerance of the landscape solves (1e-12 to 0.1; a picture: fits solve at 1e-4 and
+    /// check the discretisation).
     #[arg(long, default_value_t = 1e-4, allow_hyphen_values = true, value_parser = checks::parse_tol)]
     pub tol: f64,
     /// Output directory.

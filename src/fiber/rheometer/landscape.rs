@@ -365,7 +365,7 @@ impl<'a> RowWalk<'a> {
             Some(s) => s,
             None => rh.objective([1.0, kappas[0]], &opts)?.solutions(),
         };
-        // a solve at the edge of the solvable region fails at 4 times its start's mesh
+        // a solve at the edge of the solvable region fails at 8 times its start's mesh
         opts.simulate.growth_limit = opts.simulate.growth_limit.or(Some(LANDSCAPE_GROWTH_LIMIT));
         Ok(RowWalk {
             ns,

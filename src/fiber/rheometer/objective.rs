@@ -505,6 +505,15 @@ impl<'a> Objective<'a> {
         self.runs.solutions()
     }
 
+    /// The mesh nodes of each experiment's current warm-start solution (no copies).
+    pub fn nodes(&self) -> Vec<usize> {
+        self.runs
+            .runs()
+            .iter()
+            .map(|r| r.accepted().nodes())
+            .collect()
+    }
+
     /// Replaces the warm-start solutions (same order as [`solutions`](Self::solutions)).
     pub fn set_solutions(&mut self, sols: &[Solution]) {
         self.runs.set_solutions(sols);
