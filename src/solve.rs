@@ -253,6 +253,12 @@ impl SolveOptions {
     }
 }
 
+/// Richardson's factor of the collocation (Lobatto IIIA, order 4) on a mesh with every
+/// interval halved: the discretisation error of a solution `y` is `(y_half − y) · 16/15` to
+/// first order, `y_half` solved on the halved mesh ([`Guess::on_halved_mesh`]), since halving
+/// every interval divides the error by 16.
+pub const RICHARDSON_FACTOR: f64 = 16.0 / 15.0;
+
 /// An initial guess: mesh, states at the nodes and unknown parameters. It is also the warm-start
 /// type: [`Guess::from`] a previous [`Solution`], or a predicted one such as the secant
 /// predictor [`secant_guess`](crate::continuation::secant_guess), carries exactly what a solve
@@ -294,9 +300,8 @@ impl Guess {
     /// `s` on its mesh with every interval halved ([`mesh::halved`]): the nodes kept, the
     /// midpoints from the solution's collocation interpolant (accurate to the method's order),
     /// its unknowns. The start of a solve on a fixed mesh
-    /// ([`SolveOptions::fixed_mesh`]) whose difference from `s` estimates the discretisation
-    /// error of `s` (Richardson: the collocation is of order 4, halving every interval divides
-    /// the error by 16).
+    /// ([`SolveOptions::fixed_mesh`]) whose difference from `s`, times
+    /// [`RICHARDSON_FACTOR`], estimates the discretisation error of `s`.
     pub fn on_halved_mesh(s: &Solution) -> Self {
         let x = mesh::halved(&s.x);
         let mut yp = vec![0.0; s.n];

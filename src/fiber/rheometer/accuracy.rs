@@ -30,9 +30,7 @@ use crate::fiber::simulate::SimulateOptions;
 /// The tightest tolerance the refinement goes to \[-\].
 pub const TIGHTEST_TOLERANCE: f64 = 1e-9;
 
-/// Richardson's factor of a method of order 4 on a mesh with every interval halved: the
-/// error of the coarse solution is `(y_half − y) · 16/15` to first order.
-pub const RICHARDSON_FACTOR: f64 = 16.0 / 15.0;
+pub use crate::solve::RICHARDSON_FACTOR;
 
 /// The largest shift \[standard errors\] of a fitted shared parameter (`n`, `κ`, strengths,
 /// shapes) by the discretisation error of the fit's BVPs (Richardson, see the
