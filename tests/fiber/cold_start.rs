@@ -114,7 +114,7 @@ fn the_halved_mesh_solve_measures_the_start_s_discretisation_error() {
         .enumerate()
         .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
         .unwrap();
-    let estimate = (dc[i] - dh[i]) * 16.0 / 15.0;
+    let estimate = (dc[i] - dh[i]) * diffbvp::solve::RICHARDSON_FACTOR;
     eprintln!(
         "HALVED | {mc} -> {mh} nodes (1e-9: {}); at s = {:.3} m: error {err:.3e} m, estimate \
          {estimate:.3e} m",

@@ -329,3 +329,44 @@ fn coarsening_removes_needless_nodes() {
     assert!(s.stats.mesh_coarsenings > 0);
     assert!(s.rms_residuals.iter().all(|&r| r < 1e-6));
 }
+
+/// Richardson extrapolation with the toolkit's pieces: a Bratu solution on an adaptive mesh at
+/// tol 1e-4, re-solved on that mesh with every interval halved (`Guess::on_halved_mesh`, fixed
+/// mesh), estimates its error against the exact solution as `(y_half − y) · RICHARDSON_FACTOR`.
+/// At the nodes (where Lobatto IIIA's error is a smooth function of position, `C(x) h⁴`) the
+/// estimate matches the error to 0.2 % of the largest error (measured: 0.02 % on 7 nodes);
+/// without the factor 16/15 it would be 6.7 % off.
+#[test]
+fn the_halved_mesh_estimates_the_discretisation_error() {
+    let theta = 1.517164599050754;
+    let p = Bratu { k: 1.0 };
+    let g = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
+    let coarse = solve(&p, &[], &g, &SolveOptions::with_tol(1e-4)).unwrap();
+    let half = solve(
+        &p,
+        &[],
+        &Guess::on_halved_mesh(&coarse),
+        &SolveOptions::fixed_mesh(),
+    )
+    .unwrap();
+    assert_eq!(half.nodes(), 2 * coarse.nodes() - 1);
+    let (mut worst, mut largest) = (0.0f64, 0.0f64);
+    for (i, &x) in coarse.x.iter().enumerate() {
+        let err = coarse.at_node(i, 0) - bratu_exact(theta, x);
+        let estimate =
+            (coarse.at_node(i, 0) - half.at_node(2 * i, 0)) * diffbvp::solve::RICHARDSON_FACTOR;
+        worst = worst.max((estimate - err).abs());
+        largest = largest.max(err.abs());
+    }
+    assert!(largest > 1e-12, "no error to estimate: {largest:e}");
+    assert!(
+        worst <= 0.002 * largest,
+        "Richardson off by {worst:e} against a largest error of {largest:e} ({} nodes)",
+        coarse.nodes()
+    );
+    eprintln!(
+        "RICHARDSON | {} nodes: largest error {largest:.3e}, estimate off by {worst:.3e} ({:.2} %)",
+        coarse.nodes(),
+        100.0 * worst / largest
+    );
+}
