@@ -70,7 +70,8 @@ impl Margins {
 #[derive(Clone, Copy)]
 struct Solves {
     tol: Option<f64>,
-    limit: (Option<GrowthLimit>, usize),
+    growth_limit: Option<GrowthLimit>,
+    max_nodes: usize,
 }
 
 /// One member of a pair: the effect with its discrete shapes fixed at its refit's, and its
@@ -143,18 +144,18 @@ pub(crate) fn search(
     }
     let tried = pairs.len();
     // the joint fits are refits like the single ones: the same mesh limits
-    let limit = (
-        options.scan.refine_growth_limit,
-        options.scan.refine_max_nodes,
-    );
+    let full = Solves {
+        tol: None,
+        growth_limit: options.scan.refine_growth_limit,
+        max_nodes: options.scan.refine_max_nodes,
+    };
     // screening: every pair fitted with its BVPs solved at the scans' tolerance (1e-3 for the
     // fit's 1e-4) and judged with margins; a pair that passes is fitted again at full accuracy
     // from the screening's optimum and judged as it stands
     let screen = Solves {
         tol: Some(options.scan.grid_tol),
-        limit,
+        ..full
     };
-    let full = Solves { tol: None, limit };
     let best = pairs
         .into_par_iter()
         .filter_map(|(i, j)| {
@@ -326,8 +327,8 @@ fn fit_pair(
         loss: Loss::Linear,
         ..first.opts.clone()
     };
-    opts.simulate.growth_limit = solves.limit.0;
-    opts.simulate.max_nodes = opts.simulate.max_nodes.min(solves.limit.1);
+    opts.simulate.growth_limit = solves.growth_limit;
+    opts.simulate.max_nodes = opts.simulate.max_nodes.min(solves.max_nodes);
     if let Some(t) = solves.tol {
         opts.simulate.tol = opts.simulate.tol.max(t);
         opts.loose_tolerance = None;
