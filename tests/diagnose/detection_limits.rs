@@ -17,6 +17,7 @@
 //! Each run prints one `DETECTION` line (run with `--nocapture`).
 
 use crate::independent;
+use crate::shared;
 
 use diffbvp::fiber::diagnostics::detection::DetectionLimit;
 use diffbvp::fiber::diagnostics::diagnose::{
@@ -30,16 +31,10 @@ use independent::scenarios;
 use std::sync::OnceLock;
 
 /// Generates, loads and diagnoses `sc`.
+/// (Made once per test binary and shared by the tests that ask for the same scenario,
+/// [`shared::diagnosed`].)
 fn run(sc: &Scenario) -> Diagnosis {
-    let generated = sc.generate().unwrap();
-    let set = load_experiments(&generated.toml).unwrap();
-    let d = diagnose(
-        &set,
-        &ModelSpec::new(LawChoice::Carreau),
-        &DiagnoseOptions::default(),
-    )
-    .unwrap()
-    .diagnosis;
+    let d = shared::diagnosed(sc).run.diagnosis.clone();
     let top = &d.candidates[0];
     println!(
         "DETECTION | {} seed {} | base n {:.4} κ {:.4} | named {:?} | top {} = {:.4} ± {:.4} {} ΔBIC {:.1}",

@@ -11,6 +11,7 @@
 //! `BASELINE` line (run with `--nocapture`).
 
 use crate::independent;
+use crate::shared;
 
 use diffbvp::fiber::diagnostics::diagnose::verdict::Verdict;
 use diffbvp::fiber::diagnostics::diagnose::{diagnose, Candidate, DiagnoseOptions, DiagnosisRun};
@@ -22,26 +23,33 @@ use independent::model::AirHeat;
 use independent::scenarios::{self, NOISE_SD};
 use std::time::Instant;
 
-/// Generates, loads and diagnoses `sc`, printing the baseline line.
+/// The diagnosis of `sc` with the default options (made once per test binary and shared by
+/// the tests that ask for the same scenario, [`shared::diagnosed`]), printing the baseline line.
 fn run(sc: &Scenario) -> DiagnosisRun {
-    run_with(sc, &DiagnoseOptions::default())
+    let d = shared::diagnosed(sc);
+    print_baseline(sc, &d.run, d.seconds);
+    d.run.clone()
 }
 
-/// [`run`] with the diagnosis' `options`.
+/// [`run`] with the diagnosis' `options` (not shared).
 fn run_with(sc: &Scenario, options: &DiagnoseOptions) -> DiagnosisRun {
-    let t0 = Instant::now();
     let generated = sc.generate().unwrap();
-    let t_gen = t0.elapsed().as_secs_f64();
     let set = load_experiments(&generated.toml).unwrap();
     let t1 = Instant::now();
     let r = diagnose(&set, &ModelSpec::new(LawChoice::Carreau), options).unwrap();
-    let t_diag = t1.elapsed().as_secs_f64();
+    print_baseline(sc, &r, t1.elapsed().as_secs_f64());
+    r
+}
+
+/// Prints the diagnosis `r` of `sc` (made in `t_diag` seconds) and its `BASELINE` and
+/// `ALTERNATIVES` lines.
+fn print_baseline(sc: &Scenario, r: &DiagnosisRun, t_diag: f64) {
     let d = &r.diagnosis;
     println!("{}", d.to_text());
     let b = &d.base_fit;
     let top = d.candidates.first();
     println!(
-        "BASELINE | {} | base n {:.3} κ {:.3} RMS {:.2} % noise {:.2} % ({}) sys {} | named {:?} | top {} = {:.4} ± {:.4} {} at_bound {:?} ΔBIC {:.1} RMS after {:.2} % n {:.3} κ {:.3} | gen {:.1} s diagnose {:.1} s",
+        "BASELINE | {} | base n {:.3} κ {:.3} RMS {:.2} % noise {:.2} % ({}) sys {} | named {:?} | top {} = {:.4} ± {:.4} {} at_bound {:?} ΔBIC {:.1} RMS after {:.2} % n {:.3} κ {:.3} | diagnose {:.1} s",
         sc.name,
         b.n.value,
         b.kappa.value,
@@ -59,7 +67,6 @@ fn run_with(sc: &Scenario, options: &DiagnoseOptions) -> DiagnosisRun {
         100.0 * top.map_or(f64::NAN, |c| c.rms_relative_residual_after()),
         top.map_or(f64::NAN, |c| c.n()),
         top.map_or(f64::NAN, |c| c.kappa()),
-        t_gen,
         t_diag
     );
     println!(
@@ -88,7 +95,6 @@ fn run_with(sc: &Scenario, options: &DiagnoseOptions) -> DiagnosisRun {
                 .join("; ")
         }
     );
-    r
 }
 
 /// A named effect is never one whose strength sits at a bound or outside the physical range,
@@ -287,10 +293,10 @@ fn control_names_nothing() {
 
 /// Also: the exponential and the inverse-square tail fit these data about equally well (the
 /// truth's decay is neither); the report keeps the exponential and gives the other's estimate
-/// as the shape's systematic uncertainty.
+/// as the shape's systematic uncertainty (ignored from the global refits until stop 52, when the
+/// other tail was no longer within the tie margin; measured at stop 53: 42.96 ± 8.14 m/s,
+/// ΔBIC −865.4, RMS after 1.45 %, the inverse-square tail as the shape alternative).
 #[test]
-#[ignore = "known shortfall (issue 26): since the global refits, the exponential and the \
-            inverse-square tail no longer come out as a shape alternative within the tie margin"]
 fn strong_aspirator_coflow_is_found() {
     let sc = scenarios::aspirator_strong();
     let r = run(&sc);
@@ -502,21 +508,17 @@ fn other_material_with_radiation() {
 // own seed: found where the data carry the effect above its detection limit, covered by the
 // reported detection limits where they do not.
 
+/// A 300 m/s aspirator over 0.3 m: air_coflow is named and the verdict is "explained" (RMS/noise
+/// 1.08), but the data hardly bound the jet's speed (measured: 600 ± 3100 m/s at its search
+/// bound, 0.4 standard errors beyond the physical limit 400 m/s, which the report notes) and the
+/// law is wide (n = 0.63 ± 0.24, κ = 10 ± 40). It meets the acceptance criteria: the strength
+/// within 3 standard errors of the truth, RMS after within 20 % of the noise, the truth inside
+/// the intervals. And what the diagnosis must never do while the refit's `κ` may end at a bound
+/// (until stop 51 it ended at its lower bound 7 with the verdict "explained"): print that law as
+/// a result. Its law either holds the truth in its intervals, or is at a bound and marked "NOT A
+/// RESULT" (text, and `Diagnosis::law_is_a_result` false). One diagnosis for both checks.
 #[test]
-#[ignore = "known shortfall (issue 26): air_coflow is named and the verdict is explained, but the \
-            refit's kappa ends at its lower bound 7 (no interval; n = 0.61 +/- 0.23)"]
-fn aspirator_300_m_s_long_is_found() {
-    let sc = scenarios::aspirator(300.0, 0.3, 121);
-    assert_found(&sc, &run(&sc));
-}
-
-/// The same 300 m/s aspirator over 0.3 m, for what the diagnosis must never do while the
-/// refit's `κ` may end at a bound: print that law as a result. Its law either holds the truth
-/// in its intervals, or is at a bound and marked "NOT A RESULT" (text, and
-/// `Diagnosis::law_is_a_result` false; measured: `κ` at its lower bound 7 with the verdict
-/// "explained", which before this check left the law a result).
-#[test]
-fn aspirator_300_m_s_long_never_gives_a_law_at_a_bound_as_a_result() {
+fn aspirator_300_m_s_long_is_found_and_never_gives_a_law_at_a_bound_as_a_result() {
     let sc = scenarios::aspirator(300.0, 0.3, 121);
     let r = run(&sc);
     let d = &r.diagnosis;
@@ -534,6 +536,7 @@ fn aspirator_300_m_s_long_never_gives_a_law_at_a_bound_as_a_result() {
         None if d.law_is_a_result() => assert_truth_in_ci(&sc, &d.candidates[0]),
         None => {}
     }
+    assert_found(&sc, &r);
 }
 
 #[test]

@@ -8,6 +8,7 @@
 //! Each prints one `GLOBAL` line (run with `--nocapture`).
 
 use crate::independent;
+use crate::shared;
 
 use diffbvp::fiber::diagnostics::candidate::earns_its_place;
 use diffbvp::fiber::diagnostics::diagnose::verdict::Verdict;
@@ -46,12 +47,13 @@ fn diagnosed(sc: &Scenario) -> (ExperimentSet, DiagnosisRun) {
     (set, r)
 }
 
+/// The scenario's diagnosis with the default options, made once per test binary and shared by
+/// the tests that ask for the same scenario ([`shared::diagnosed`]; the studies, which diagnose
+/// hundreds of sets once each, call [`diagnosed`]), with its wall time \[s\].
 fn run(sc: &Scenario) -> (ExperimentSet, DiagnosisRun, f64) {
-    let t0 = Instant::now();
-    let (set, r) = diagnosed(sc);
-    let t = t0.elapsed().as_secs_f64();
-    println!("{}", r.diagnosis.to_text());
-    (set, r, t)
+    let d = shared::diagnosed(sc);
+    println!("{}", d.run.diagnosis.to_text());
+    (d.set.clone(), d.run.clone(), d.seconds)
 }
 
 /// `J` of the model with the found effects, refitted locally from the truth.

@@ -12,4 +12,5 @@ mod diagnose_realistic;
 mod diagnose_scan;
 mod diagnose_separability;
 mod global;
+mod shared;
 mod user_effect_descriptor;

@@ -1,0 +1,58 @@
+//! One diagnosis per data set for the whole test binary: tests that look at the same scenario
+//! (the same truth, seed, noise and faults: the scenario's `Debug` text is the key) with the
+//! default options share its data set and diagnosis instead of each making and diagnosing it
+//! again (issue 27: nothing in the suite repeats a full diagnosis it could reuse). Tests running
+//! in parallel that ask for the same scenario wait for the one diagnosis.
+
+use crate::independent;
+
+use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
+use diffbvp::fiber::effects::{LawChoice, ModelSpec};
+use diffbvp::fiber::input::load_experiments;
+use diffbvp::fiber::setup::ExperimentSet;
+use independent::dataset::Scenario;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
+
+/// A scenario's data set and its diagnosis with the default options.
+pub struct Diagnosed {
+    /// The data set as loaded from the generated TOML + CSV.
+    pub set: ExperimentSet,
+    /// The diagnosis (Carreau-type law, `DiagnoseOptions::default()`).
+    pub run: DiagnosisRun,
+    /// Wall time of the diagnosis \[s\] (of the first test that asked for it).
+    pub seconds: f64,
+}
+
+type Cell = Arc<OnceLock<Arc<Diagnosed>>>;
+
+/// The scenario's data set, generated, loaded and diagnosed once per test binary.
+pub fn diagnosed(sc: &Scenario) -> Arc<Diagnosed> {
+    static CACHE: OnceLock<Mutex<HashMap<String, Cell>>> = OnceLock::new();
+    let key = format!("{sc:?}");
+    let cell: Cell = {
+        let mut map = CACHE
+            .get_or_init(|| Mutex::new(HashMap::new()))
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        map.entry(key).or_default().clone()
+    };
+    cell.get_or_init(|| {
+        let generated = sc.generate().unwrap();
+        let set = load_experiments(&generated.toml).unwrap();
+        let t0 = Instant::now();
+        let run = diagnose(
+            &set,
+            &ModelSpec::new(LawChoice::Carreau),
+            &DiagnoseOptions::default(),
+        )
+        .unwrap();
+        Arc::new(Diagnosed {
+            set,
+            run,
+            seconds: t0.elapsed().as_secs_f64(),
+        })
+    })
+    .clone()
+}
