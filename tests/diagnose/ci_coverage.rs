@@ -13,10 +13,10 @@
 //! binomial tail allows, and a mean standardised error within ±3.3/√N.
 
 use crate::independent;
+use crate::shared;
 
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
-use diffbvp::fiber::effects::{Effect, LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
+use diffbvp::fiber::diagnostics::diagnose::DiagnoseOptions;
+use diffbvp::fiber::effects::Effect;
 use independent::dataset::Scenario;
 use independent::model::AirFlow;
 use independent::scenarios;
@@ -50,16 +50,12 @@ fn coverage(sc: &Scenario, effect: Effect, base: bool) {
     for k in 0..seeds() {
         let mut s = sc.clone();
         s.seed = sc.seed + 1000 * k;
-        let generated = s.generate().unwrap();
-        let set = load_experiments(&generated.toml).unwrap();
         let options = DiagnoseOptions {
             candidates: vec![effect.clone()],
             ..DiagnoseOptions::default()
         };
-        let t1 = Instant::now();
-        let d = diagnose(&set, &ModelSpec::new(LawChoice::Carreau), &options)
-            .unwrap()
-            .diagnosis;
+        let diagnosed = shared::diagnose_with(&s, &options);
+        let d = diagnosed.run.diagnosis;
         let c = &d.candidates[0];
         let (n, kappa, ci_n, ci_k) = if base {
             let b = &d.base_fit;
@@ -94,7 +90,7 @@ fn coverage(sc: &Scenario, effect: Effect, base: bool) {
             c.unit,
             c.shape().iter().map(|sh| (sh.name.clone(), sh.value)).collect::<Vec<_>>(),
             100.0 * c.rms_relative_residual_after(),
-            t1.elapsed().as_secs_f64()
+            diagnosed.seconds
         );
         rows.push(row);
     }

@@ -20,11 +20,7 @@ use crate::independent;
 use crate::shared;
 
 use diffbvp::fiber::diagnostics::detection::DetectionLimit;
-use diffbvp::fiber::diagnostics::diagnose::{
-    diagnose, earns_its_place, DiagnoseOptions, Diagnosis,
-};
-use diffbvp::fiber::effects::{LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
+use diffbvp::fiber::diagnostics::diagnose::{earns_its_place, DiagnoseOptions, Diagnosis};
 use diffbvp::fiber::rheometer::FitSummary;
 use independent::dataset::{Expected, Faults, Scenario};
 use independent::scenarios;
@@ -56,19 +52,15 @@ fn run(sc: &Scenario) -> Diagnosis {
 /// noise model's weights included), without searching any candidate: the same fit, bit for
 /// bit, at 0.03 s instead of a whole diagnosis' 0.75 s.
 fn base_fit(sc: &Scenario) -> FitSummary {
-    let generated = sc.generate().unwrap();
-    let set = load_experiments(&generated.toml).unwrap();
     let options = DiagnoseOptions {
         candidates: Vec::new(),
         ..DiagnoseOptions::default()
     };
-    diagnose(&set, &ModelSpec::new(LawChoice::Carreau), &options)
-        .unwrap()
-        .diagnosis
-        .base_fit
+    shared::diagnose_with(sc, &options).run.diagnosis.base_fit
 }
 
-/// The control's diagnosis (computed once).
+/// The control's diagnosis (the shared one, [`shared::diagnosed`], held here as a `'static`
+/// borrow for the limit lookups; its detection limits printed once).
 fn control() -> &'static Diagnosis {
     static C: OnceLock<Diagnosis> = OnceLock::new();
     C.get_or_init(|| {

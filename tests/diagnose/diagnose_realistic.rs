@@ -14,14 +14,11 @@ use crate::independent;
 use crate::shared;
 
 use diffbvp::fiber::diagnostics::diagnose::verdict::Verdict;
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, Candidate, DiagnoseOptions, DiagnosisRun};
-use diffbvp::fiber::effects::{LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
+use diffbvp::fiber::diagnostics::diagnose::{Candidate, DiagnoseOptions, DiagnosisRun};
 use diffbvp::least_squares::Loss;
 use independent::dataset::{Faults, Scenario};
 use independent::model::AirHeat;
 use independent::scenarios::{self, NOISE_SD};
-use std::time::Instant;
 
 /// The diagnosis of `sc` with the default options (made once per test binary and shared by
 /// the tests that ask for the same scenario, [`shared::diagnosed`]), printing the baseline line.
@@ -33,12 +30,9 @@ fn run(sc: &Scenario) -> DiagnosisRun {
 
 /// [`run`] with the diagnosis' `options` (not shared).
 fn run_with(sc: &Scenario, options: &DiagnoseOptions) -> DiagnosisRun {
-    let generated = sc.generate().unwrap();
-    let set = load_experiments(&generated.toml).unwrap();
-    let t1 = Instant::now();
-    let r = diagnose(&set, &ModelSpec::new(LawChoice::Carreau), options).unwrap();
-    print_baseline(sc, &r, t1.elapsed().as_secs_f64());
-    r
+    let d = shared::diagnose_with(sc, options);
+    print_baseline(sc, &d.run, d.seconds);
+    d.run
 }
 
 /// Prints the diagnosis `r` of `sc` (made in `t_diag` seconds) and its `BASELINE` and

@@ -19,24 +19,20 @@
 //! Run: `cargo test --release --test diagnose_separability -- --ignored --nocapture`.
 
 use crate::independent;
+use crate::shared;
 
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
-use diffbvp::fiber::effects::{Effect, LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
+use diffbvp::fiber::diagnostics::diagnose::{DiagnoseOptions, Diagnosis};
+use diffbvp::fiber::effects::Effect;
 use independent::dataset::Scenario;
 use independent::scenarios::{self, NOISE_SD};
 
 /// Diagnoses `sc` with the two rival candidates only.
 fn rivals(sc: &Scenario) -> Diagnosis {
-    let generated = sc.generate().unwrap();
-    let set = load_experiments(&generated.toml).unwrap();
     let options = DiagnoseOptions {
         candidates: vec![Effect::InletDiameter, Effect::GaugeScale],
         ..DiagnoseOptions::default()
     };
-    diagnose(&set, &ModelSpec::new(LawChoice::Carreau), &options)
-        .unwrap()
-        .diagnosis
+    shared::diagnose_with(sc, &options).run.diagnosis
 }
 
 /// `(J after, strength)` of candidate `name`.

@@ -12,9 +12,8 @@ use crate::shared;
 
 use diffbvp::fiber::diagnostics::candidate::earns_its_place;
 use diffbvp::fiber::diagnostics::diagnose::verdict::Verdict;
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
+use diffbvp::fiber::diagnostics::diagnose::{DiagnoseOptions, DiagnosisRun};
 use diffbvp::fiber::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
 use diffbvp::fiber::rheometer::{FitStart, Rheometer};
 use diffbvp::fiber::setup::ExperimentSet;
 use independent::dataset::{Faults, Scenario};
@@ -34,17 +33,10 @@ struct Expect {
     truth_strengths: Vec<(&'static str, f64)>,
 }
 
-/// The scenario's data set, diagnosed with the default options.
+/// The scenario's data set, diagnosed with the default options, not cached (the studies).
 fn diagnosed(sc: &Scenario) -> (ExperimentSet, DiagnosisRun) {
-    let generated = sc.generate().unwrap();
-    let set = load_experiments(&generated.toml).unwrap();
-    let r = diagnose(
-        &set,
-        &ModelSpec::new(LawChoice::Carreau),
-        &DiagnoseOptions::default(),
-    )
-    .unwrap();
-    (set, r)
+    let d = shared::diagnose_with(sc, &DiagnoseOptions::default());
+    (d.set, d.run)
 }
 
 /// The scenario's diagnosis with the default options, made once per test binary and shared by

@@ -25,9 +25,25 @@ pub struct Diagnosed {
     pub seconds: f64,
 }
 
+/// Generates and loads `sc` and diagnoses it with `options` (the Carreau-type law), every
+/// call anew: the tests with options of their own and the studies, which diagnose hundreds of
+/// sets once each, so that the cache of [`diagnosed`] does not hold them.
+pub fn diagnose_with(sc: &Scenario, options: &DiagnoseOptions) -> Diagnosed {
+    let generated = sc.generate().unwrap();
+    let set = load_experiments(&generated.toml).unwrap();
+    let t0 = Instant::now();
+    let run = diagnose(&set, &ModelSpec::new(LawChoice::Carreau), options).unwrap();
+    Diagnosed {
+        set,
+        run,
+        seconds: t0.elapsed().as_secs_f64(),
+    }
+}
+
 type Cell = Arc<OnceLock<Arc<Diagnosed>>>;
 
-/// The scenario's data set, generated, loaded and diagnosed once per test binary.
+/// The scenario's data set, generated, loaded and diagnosed with the default options once per
+/// test binary.
 pub fn diagnosed(sc: &Scenario) -> Arc<Diagnosed> {
     static CACHE: OnceLock<Mutex<HashMap<String, Cell>>> = OnceLock::new();
     let key = format!("{sc:?}");
@@ -38,21 +54,6 @@ pub fn diagnosed(sc: &Scenario) -> Arc<Diagnosed> {
             .unwrap_or_else(|poisoned| poisoned.into_inner());
         map.entry(key).or_default().clone()
     };
-    cell.get_or_init(|| {
-        let generated = sc.generate().unwrap();
-        let set = load_experiments(&generated.toml).unwrap();
-        let t0 = Instant::now();
-        let run = diagnose(
-            &set,
-            &ModelSpec::new(LawChoice::Carreau),
-            &DiagnoseOptions::default(),
-        )
-        .unwrap();
-        Arc::new(Diagnosed {
-            set,
-            run,
-            seconds: t0.elapsed().as_secs_f64(),
-        })
-    })
-    .clone()
+    cell.get_or_init(|| Arc::new(diagnose_with(sc, &DiagnoseOptions::default())))
+        .clone()
 }
