@@ -677,11 +677,15 @@ fn false_alarm_rate_on_effect_free_sets() {
 /// then `N` data sets of the independent model with the effect at `2 s95`
 /// (`DIFFBVP_POWER_SETS`, default 20; seeds varied, the control's noise level;
 /// `DIFFBVP_POWER_EFFECTS`, a comma-separated subset; `DIFFBVP_POWER_TEXT` prints the report
-/// of each miss and wrong law; `DIFFBVP_POWER_FIRST` starts at that set). Counts the sets where
+/// of each miss and wrong law; `DIFFBVP_POWER_FIRST` starts at that set;
+/// `DIFFBVP_POWER_TIMES` another multiple of `s95`; radiation is capped at its physical
+/// limit 1). Counts the sets where
 /// the effect is found, and those where it is reported in a tie with the named cause (an
 /// alternative as consistent with the data, within the tie margin, with the measurement that
 /// decides: a mass-flow error and a Nusselt scale have signatures with cosine −0.997 on these
-/// data, and issue 26 asks for ties to be reported as ties, with no "first"); 80 % of the two
+/// data, and issue 26 asks for ties to be reported as ties, with no "first"; or an explanation
+/// the ambiguous verdict puts beside the result, with its decisive measurement, as a gauge
+/// offset beyond its physical range of ±20 µm); 80 % of the two
 /// together is the issue's target, both counts are printed. In every set, found or missed, the law the diagnosis
 /// reports is checked against the truth ([`law_outcome`]): a law more than 3 standard errors
 /// off and not marked as no result is a wrong law printed with confidence, allowed only as
@@ -702,7 +706,10 @@ fn false_alarm_rate_on_effect_free_sets() {
             (DIFFBVP_POWER_SETS=100, 46 min beside other work): radiation 96 + 4 tied, \
             die_temperature_offset 100 + 0, mass_flow_scale 60 + 39, gauge_scale 79 + 20, \
             gauge_offset 35 + 0 (the misses name air_temperature_profile in 33; its law no \
-            result in 71), WRONG 0 of 500, the true effect a stand-in 0 times"]
+            result in 71), WRONG 0 of 500, the true effect a stand-in 0 times; stop 54, the \
+            gauge offset with the ambiguous verdict's explanations counted as reported ties: \
+            35 + 46 of 100 at 2 x s95 (26.9 um; the 19 misses all with the law no result), \
+            98 + 1 at its physical limit 20 um (1.49 x s95; DIFFBVP_POWER_TIMES=1.489), WRONG 0"]
 fn power_at_twice_the_detection_limit() {
     let sets: usize = std::env::var("DIFFBVP_POWER_SETS")
         .ok()
@@ -720,6 +727,12 @@ fn power_at_twice_the_detection_limit() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(0);
+    // the strength as a multiple of s95 (2: the issue's target; e.g. 1.49 puts the gauge
+    // offset at its physical limit 20 µm)
+    let times: f64 = std::env::var("DIFFBVP_POWER_TIMES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(2.0);
     let chosen: Vec<String> = std::env::var("DIFFBVP_POWER_EFFECTS")
         .map(|v| v.split(',').map(|s| s.trim().to_string()).collect())
         .unwrap_or_else(|_| all.iter().map(|s| s.to_string()).collect());
@@ -741,7 +754,7 @@ fn power_at_twice_the_detection_limit() {
             "µm" | "um" | "μm" => 1e-6,
             _ => 1.0,
         };
-        let s = 2.0 * limit.s95 * per_unit;
+        let s = times * limit.s95 * per_unit;
         let scenario = |seed: u64| match *effect {
             "radiation" => scenarios::radiating(s.min(1.0), seed),
             "die_temperature_offset" => scenarios::with_faults(
@@ -789,7 +802,16 @@ fn power_at_twice_the_detection_limit() {
             }
             // named in a tie: an alternative the report lists beside the named cause, as about
             // as consistent with the data, with the measurement that decides between them
-            let tie = !hit && r.diagnosis.alternatives.iter().any(|a| a.effect == *effect);
+            // (a tied candidate, or an explanation the ambiguous verdict puts beside the
+            // result: e.g. a gauge offset whose strength lies beyond its physical range)
+            let in_verdict = match &r.diagnosis.verdict {
+                Verdict::Ambiguous { alternatives, .. } => {
+                    alternatives.iter().any(|a| a.iter().any(|e| e == effect))
+                }
+                _ => false,
+            };
+            let tie = !hit
+                && (in_verdict || r.diagnosis.alternatives.iter().any(|a| a.effect == *effect));
             if tie {
                 tied += 1;
             }
@@ -836,7 +858,7 @@ fn power_at_twice_the_detection_limit() {
             }
         }
         println!(
-            "POWER | {effect} at 2 x s95 = 2 x {:.4} {}: found in {found} of {sets} sets, in a \
+            "POWER | {effect} at {times} x s95 = {times} x {:.4} {}: found in {found} of {sets} sets, in a \
              reported tie with the named cause in {tied} more | law holds {} flagged {} (range \
              misses the truth {}) WRONG {} | the true effect called a stand-in {stand_ins} | \
              {:.0} s",
