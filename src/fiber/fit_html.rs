@@ -317,7 +317,7 @@ fn flow_curve_section(page: &mut HtmlPage, s: &FitSummary) {
         match c.band {
             BandMethod::Delta => "its statistical 95 % band (delta method)",
             BandMethod::Profile => "its statistical 95 % band (along the likelihood profile)",
-            BandMethod::None => "no statistical band (no fitted law parameter)",
+            BandMethod::None => crate::fiber::rheometer::summary_text::NO_BAND,
         },
         if c.systematic {
             " and the band with the systematic uncertainty of the error budget"

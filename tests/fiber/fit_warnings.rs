@@ -304,6 +304,35 @@ fn air_hotter_than_the_melt_is_not_relabelled_newtonian() {
         assert_eq!(at_bound(&v, "n").map(|b| b.0), Some("upper".to_string()));
         assert!(line(&p.stdout, "n:").contains("AT UPPER BOUND 1"));
     }
+    // a model 50 times the noise off the data: no likelihood intervals nor test of it (they
+    // took 3.7 s of refits of that model), and the report says why
+    assert!(v.get("intervals").is_none(), "{}", v["intervals"]);
+    assert!(v.get("newtonian_test").is_none(), "{}", v["newtonian_test"]);
+    assert!(
+        p.stdout.contains(
+            "[[Profile-likelihood intervals and likelihood-ratio test]]\n    not computed: the \
+             model misses the data by"
+        ),
+        "{}",
+        p.stdout
+    );
+    assert!(!p.stdout.contains("said below"), "{}", p.stdout);
+    assert!(!p.stdout.contains("likelihood-ratio p ="), "{}", p.stdout);
+}
+
+#[test]
+fn a_fit_at_the_noise_has_its_likelihood_intervals_and_test() {
+    let (dir, toml, data) = probe::shipped_copy("fw_at_noise");
+    let (p, v) = fit_cli(&toml, &data, &dir);
+    assert!(!p.stdout.contains("not computed"), "{}", p.stdout);
+    let names: Vec<&str> = v["intervals"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i["parameter"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["n", "kappa"]);
+    assert!(v["newtonian_test"]["p_value"].as_f64().unwrap() < 0.05);
 }
 
 #[test]

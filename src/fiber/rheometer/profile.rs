@@ -497,9 +497,11 @@ pub fn intervals(
     mode: ProfileMode,
 ) -> Result<(Vec<ProfileInterval>, Option<NewtonianTest>), RheometerError> {
     // the paper's cost is a weighted distance to smoothed data, not a likelihood
+    // nor a model that misses the data by several times the noise
     if mode == ProfileMode::Never
         || id.names.is_empty()
         || options.estimator != super::estimator::Estimator::Principled
+        || id.summary.likelihood_skipped().is_some()
     {
         return Ok((Vec::new(), None));
     }

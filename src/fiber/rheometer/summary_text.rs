@@ -332,6 +332,11 @@ impl FitSummary {
     /// The profile intervals and the likelihood-ratio test.
     fn intervals_text(&self) -> String {
         let mut s = String::new();
+        if let Some(why) = self.likelihood_skipped() {
+            s.push_str("[[Profile-likelihood intervals and likelihood-ratio test]]\n");
+            s.push_str(&format!("    not computed: {why}\n"));
+            return s;
+        }
         if !self.intervals.is_empty() {
             s.push_str("[[Profile-likelihood intervals (95 %: deviance 3.84; one-sided 2.71)]]\n");
         }
@@ -415,15 +420,15 @@ impl FitSummary {
         ));
         if let Some(p) = c.nearest(c.median_per_s) {
             let band = |b: [f64; 2]| format!("[{}, {}]", fmt_sig(b[0], 3), fmt_sig(b[1], 3));
+            let how = |m: &str| format!(", 95 % band {} Pa s ({m})", band(p.stat95_pa_s));
             s.push_str(&format!(
-                "    at {} 1/s: eta_E = {} Pa s, 95 % band {} Pa s ({}){}\n",
+                "    at {} 1/s: eta_E = {} Pa s{}{}\n",
                 fmt_sig(p.strain_rate_per_s, 2),
                 fmt_sig(p.eta_pa_s, 3),
-                band(p.stat95_pa_s),
                 match c.band {
-                    super::flow_curve::BandMethod::Delta => "delta method",
-                    super::flow_curve::BandMethod::Profile => "along the profile",
-                    super::flow_curve::BandMethod::None => "no fitted law parameter",
+                    super::flow_curve::BandMethod::Delta => how("delta method"),
+                    super::flow_curve::BandMethod::Profile => how("along the profile"),
+                    super::flow_curve::BandMethod::None => format!(" ({NO_BAND})"),
                 },
                 if c.systematic {
                     format!(", with systematic {} Pa s", band(p.total95_pa_s))
@@ -435,6 +440,10 @@ impl FitSummary {
         s
     }
 }
+
+/// Why a flow curve has no statistical band ([`BandMethod::None`](super::flow_curve::BandMethod::None)).
+pub(crate) const NO_BAND: &str =
+    "no statistical band: no fitted law parameter, or no covariance of the fitted ones";
 
 /// A p-value in words: `p = 0.41`, `p = 2.3e-5`, `p < 1e-15`.
 pub(crate) fn fmt_p(p: f64) -> String {
