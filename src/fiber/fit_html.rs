@@ -283,6 +283,12 @@ fn law_section(page: &mut HtmlPage, s: &FitSummary) {
             ));
         }
     }
+    if let Some(why) = s.likelihood_skipped() {
+        notes.push(format!(
+            "Profile-likelihood intervals and the likelihood-ratio test against the Newtonian \
+             law not computed: {why}."
+        ));
+    }
     for i in &s.intervals {
         notes.push(format!(
             "Profile likelihood of {}: {}{}.",
@@ -629,7 +635,17 @@ mod tests {
             s.law_not_a_result().as_deref(),
             Some("misfit far above the noise")
         );
+        // and no likelihood intervals nor test of that model, in the text and on the page
+        let why = s.likelihood_skipped().expect("skipped under a misfit");
+        assert!(why.starts_with("the model misses the data by"), "{why}");
+        let flat = |t: &str| t.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(flat(&s.to_text()).contains(&format!("not computed: {why}")));
+        let h = page_of(&s, "a", "a.csv", Path::new("e.toml"));
+        assert!(flat(&h).contains(&format!(
+            "test against the Newtonian law not computed: {why}"
+        )));
         s.warnings.clear();
+        assert_eq!(s.likelihood_skipped(), None);
         s.warnings.push(FitWarning::new(
             WarningCode::LargeUncertainty,
             "kappa: wide".into(),
