@@ -334,6 +334,18 @@ fn radiation_and_warm_air_never_a_wrong_law() {
     let text = d.to_text().split_whitespace().collect::<Vec<_>>().join(" ");
     assert!(text.contains("neither law is a result"), "{text}");
     assert!(text.contains("VERDICT: AMBIGUOUS"), "{text}");
+    // with what decides between them: a measurement for each (the air along the line, the
+    // fiber's temperature), and no explanation called the most likely one
+    let decides = text
+        .split("What decides: ")
+        .nth(1)
+        .and_then(|t| t.split(". ").next())
+        .unwrap_or_else(|| panic!("no 'What decides' in {text}"));
+    for e in ["air_temperature_profile", "radiation"] {
+        assert!(decides.contains(&format!("(for {e}")), "{decides}");
+    }
+    assert!(decides.contains("pyrometer"), "{decides}");
+    assert!(!text.contains("Most likely missing"), "{text}");
 }
 
 /// Two effects that hide each other: warm air heats where radiation cools. Alone, radiation

@@ -268,7 +268,9 @@ pub struct EffectDescriptor {
     /// thinning 2: `n` and `κ`, which is undetermined in the model without it).
     pub fit_parameters: usize,
     /// A measurement outside these diameter data that tells this cause apart from another one
-    /// with the same signature (`None`: for physics, data at other conditions decide).
+    /// with the same signature: calibrate the gauge, weigh the throughput, measure the air
+    /// speed or temperature or the fiber temperature along the line (`None`: the material law
+    /// itself, or a user effect without one; data at other conditions decide).
     pub independent_check: Option<&'static str>,
     /// The error-budget source it represents (`None`: not a budget source).
     pub budget: Option<BudgetSource>,

@@ -31,9 +31,10 @@
 //! | `vft_b_offset` | `ΔB` (K) | VFT `B + ΔB`, zero-rate viscosity at `T_o` held (not a default candidate) | – | material | [-400, 400] | [-1000, 1000] | `vft_B_K` |
 //! | `vft_t_vf_offset` | `ΔT_VF` (K) | VFT `T_VF + ΔT_VF`, level at `T_o` held (not a default candidate) | – | material | [-30, 15] | [-60, 15] | `vft_T_VF_K` |
 //!
-//! Every strength is neutral at 0. Process conditions and instrument errors carry an
+//! Every strength is neutral at 0. Every effect but strain thinning carries an
 //! [independent check](EffectDescriptor::independent_check) (calibrate the gauge on a wire,
-//! photograph the die swell, weigh the extrudate, measure the melt temperature at the die); the
+//! photograph the die swell, weigh the extrudate, measure the melt temperature at the die, the
+//! air speed or temperature next to the fiber, the fiber temperature with a pyrometer); the
 //! error budget's sources are the descriptors' [`budget`](EffectDescriptor::budget) fields.
 //!
 //! **Adding a built-in effect**: its descriptor in its family's file and in [`BUILTIN`], its
@@ -125,10 +126,10 @@ mod tests {
             for s in d.shapes {
                 assert_eq!(s.scanned, s.scan != ShapeScan::Default, "{}", s.model_param);
             }
-            // process, instrument and material conditions have an independent check
+            // every effect but the material law itself has an independent check
             assert_eq!(
                 d.independent_check.is_some(),
-                d.category != Category::Physics,
+                d.name != "strain_thinning",
                 "{}",
                 d.name
             );

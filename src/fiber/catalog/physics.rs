@@ -17,6 +17,12 @@ pub const DEFAULT_COFLOW_LINE_ONSET: f64 = 0.2;
 /// Default (start) ramp width `w` \[m\] of the co-flow along the line.
 pub const DEFAULT_COFLOW_LINE_RAMP_WIDTH: f64 = 0.02;
 
+/// What decides radiation and the convective heat transfer (the Nusselt law's scale): the
+/// fiber's temperature along the line, which both set.
+pub const FIBER_TEMPERATURE_CHECK: &str = "measure the fiber temperature along the line (an \
+                                           infrared pyrometer): radiation and the heat \
+                                           transfer set how fast it cools";
+
 /// `κ = ln(K / 1 Pa)` \[-\] at which the strain-thinning direction of a Newtonian model is taken
 /// (the middle of the default κ range (7, 20)).
 pub const STRAIN_THINNING_REFERENCE_KAPPA: f64 = 13.5;
@@ -52,6 +58,7 @@ pub const RADIATION: EffectDescriptor = EffectDescriptor {
     describe: "thermal radiation, strength = emissivity",
     search_range: (-0.5, 2.0),
     physical_range: (0.0, 1.0),
+    independent_check: Some(FIBER_TEMPERATURE_CHECK),
     ..EffectDescriptor::builtin("radiation", Category::Physics)
 };
 
@@ -94,6 +101,9 @@ pub const AIR_COFLOW: EffectDescriptor = EffectDescriptor {
     search_range: (-100.0, 600.0),
     physical_range: (-50.0, 400.0),
     shapes: &[COFLOW_DECAY, COFLOW_TAIL],
+    independent_check: Some(
+        "measure the air speed next to the fiber near the take-up (a hot-wire anemometer)",
+    ),
     ..EffectDescriptor::builtin("air_coflow", Category::Physics)
 };
 
@@ -134,6 +144,9 @@ pub const AIR_COFLOW_LINE: EffectDescriptor = EffectDescriptor {
     search_range: (-100.0, 600.0),
     physical_range: (-50.0, 400.0),
     shapes: &[COFLOW_LINE_ONSET, COFLOW_LINE_RAMP],
+    independent_check: Some(
+        "measure the air speed next to the fiber along the line (a hot-wire anemometer)",
+    ),
     ..EffectDescriptor::builtin("air_coflow_line", Category::Physics)
 };
 
@@ -160,6 +173,9 @@ pub const AIR_TEMPERATURE_PROFILE: EffectDescriptor = EffectDescriptor {
     search_range: (-60.0, 600.0),
     physical_range: (-50.0, 400.0),
     shapes: &[WARM_AIR_DECAY],
+    independent_check: Some(
+        "measure the air temperature next to the fiber below the die (a thermocouple moved along the line)",
+    ),
     ..EffectDescriptor::builtin("air_temperature_profile", Category::Physics)
 };
 
@@ -171,5 +187,6 @@ pub const NUSSELT_SCALE: EffectDescriptor = EffectDescriptor {
     search_range: (-0.9, 3.0),
     physical_range: (-0.5, 1.0),
     map: StrengthMap::OnePlus,
+    independent_check: Some(FIBER_TEMPERATURE_CHECK),
     ..EffectDescriptor::builtin("nusselt_scale", Category::Physics)
 };

@@ -35,23 +35,27 @@ fn probability(p: f64) -> String {
     }
 }
 
-/// " What decides: ..." — the independent checks of `effects` (each once; empty where none has
-/// one, as for physics, which data at other conditions decide).
+/// " What decides: ..." — the independent checks of `effects`, each once with the effects it
+/// decides (one measurement, e.g. the fiber temperature, can decide two); effects without one
+/// (strain thinning, a user effect) are left to data at other conditions. Empty for no effects.
 fn what_decides<'a>(effects: impl Iterator<Item = &'a String>) -> String {
-    let mut checks: Vec<String> = Vec::new();
+    let mut checks: Vec<(&str, Vec<&str>)> = Vec::new();
     for e in effects {
-        if let Some(c) = super::ties::independent_check(e) {
-            let line = format!("{c} (for {e})");
-            if !checks.contains(&line) {
-                checks.push(line);
-            }
+        let c = super::ties::independent_check(e).unwrap_or(super::ties::OTHER_CONDITIONS);
+        match checks.iter_mut().find(|(k, _)| *k == c) {
+            Some((_, for_)) if !for_.contains(&e.as_str()) => for_.push(e),
+            Some(_) => {}
+            None => checks.push((c, vec![e])),
         }
     }
     if checks.is_empty() {
-        String::new()
-    } else {
-        format!(" What decides: {}.", checks.join("; "))
+        return String::new();
     }
+    let lines: Vec<String> = checks
+        .iter()
+        .map(|(c, for_)| format!("{c} (for {})", for_.join(", ")))
+        .collect();
+    format!(" What decides: {}.", lines.join("; "))
 }
 
 impl Diagnosis {
@@ -469,9 +473,25 @@ mod tests {
         assert!(t.contains("reference wire (for gauge_offset)"), "{t}");
         assert!(t.contains("(for mass_flow_scale)"), "{t}");
         assert_eq!(t.matches("gauge_offset").count(), 1, "{t}");
-        // physics has no independent check here: data at other conditions decide
-        assert!(!t.contains("air_temperature_profile"), "{t}");
-        let physics = ["radiation".to_string()];
-        assert_eq!(what_decides(physics.iter()), "");
+        // missing physics is decided by a measurement along the line too
+        assert!(
+            t.contains("a thermocouple moved along the line) (for air_temperature_profile)"),
+            "{t}"
+        );
+        // one measurement that decides two effects is named once, for both
+        let heat = ["radiation".to_string(), "nusselt_scale".to_string()];
+        let t = what_decides(heat.iter());
+        assert_eq!(t.matches("pyrometer").count(), 1, "{t}");
+        assert!(t.ends_with("cools (for radiation, nusselt_scale)."), "{t}");
+        let same = ["air_coflow_line".to_string(), "user_pull".to_string()];
+        let t = what_decides(same.iter());
+        assert!(
+            t.contains("hot-wire anemometer) (for air_coflow_line)"),
+            "{t}"
+        );
+        // an effect without a check: data at other conditions
+        assert!(t.contains("another take-up speed"), "{t}");
+        assert!(t.ends_with("differently (for user_pull)."), "{t}");
+        assert_eq!(what_decides(std::iter::empty()), "");
     }
 }

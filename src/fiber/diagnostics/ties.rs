@@ -55,7 +55,8 @@ pub struct Alternative {
     /// material result does not depend on which of the two causes is chosen.
     pub material_robust: bool,
     /// The measurement outside these data that decides whether the alternative is the cause
-    /// (its descriptor's independent check; absent for physics).
+    /// (its descriptor's independent check; absent for strain thinning and user effects
+    /// without one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub independent_check: Option<String>,
     /// The same for the named cause.
@@ -186,13 +187,20 @@ pub fn alternatives_among(
         .collect()
 }
 
-/// An independent check (outside these diameter data) that decides whether a process condition
-/// or the instrument is off, for the built-in effects (their descriptors'
-/// [`independent_check`](EffectDescriptor::independent_check); `None` for physics and unknown
-/// names).
+/// An independent check (outside these diameter data) that decides whether the effect is
+/// there: a process condition or the instrument off, the air's speed or temperature, the
+/// fiber's cooling, for the built-in effects (their descriptors'
+/// [`independent_check`](EffectDescriptor::independent_check); `None` for strain thinning and
+/// unknown names).
 pub fn independent_check(effect: &str) -> Option<&'static str> {
     crate::fiber::catalog::builtin(effect).and_then(|d| d.independent_check)
 }
+
+/// What else tells explanations apart that no measurement along the line decides: data at
+/// other conditions.
+pub const OTHER_CONDITIONS: &str = "data at other conditions (another take-up speed, air \
+                                    condition or mass flow), which change their signatures \
+                                    differently";
 
 /// The category in words (`"missing physics"`, `"a process condition"`, `"an instrument
 /// error"`, `"material data"`).
@@ -299,8 +307,8 @@ pub(super) fn ties_paragraph(
                 .join(", ")
         ));
     }
-    // what decides: an independent check of each process condition / instrument in the tie
-    // (the records' checks; a record without them, e.g. read from older JSON, the built-in's)
+    // what decides: an independent check of each effect in the tie (the records' checks; a
+    // record without them, e.g. read from older JSON, the built-in's)
     let members: Vec<(&str, Category)> = std::iter::once((named, first.named_category))
         .chain(alts.iter().map(|a| (a.effect.as_str(), a.category)))
         .collect();
@@ -322,11 +330,10 @@ pub(super) fn ties_paragraph(
             members.iter().map(words).collect::<Vec<_>>().join(", ")
         ));
     } else if members.iter().all(|m| m.1 == Category::Physics) {
-        s.push_str(
-            "All are missing physics: data at other conditions (another take-up speed, air \
-             condition or mass flow), which change their signatures differently, can tell them \
-             apart.\n",
-        );
+        s.push_str(&format!(
+            "All are missing physics: a measurement along the line, or {OTHER_CONDITIONS}, can \
+             tell them apart"
+        ));
     } else {
         s.push_str(&format!(
             "{}: an independent check decides",
@@ -519,11 +526,11 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn process_and_instrument_effects_have_an_independent_check() {
+    fn every_effect_but_the_law_has_an_independent_check() {
         for e in crate::fiber::effects::Effect::all() {
             assert_eq!(
                 independent_check(e.name()).is_some(),
-                e.category() != Category::Physics,
+                e.name() != "strain_thinning",
                 "{}",
                 e.name()
             );

@@ -145,8 +145,12 @@ impl Diagnosis {
             .map(|a| a.effect.as_str())
             .collect();
         let replaced = self.pair.as_ref().is_some_and(|p| p.replaces);
+        let ambiguous = matches!(self.verdict, Verdict::Ambiguous { .. });
         let lead = if replaced {
             "Best single candidate (a pair explains the data better, below):".to_string()
+        } else if ambiguous && exact.is_empty() {
+            "One of the explanations the verdict cannot tell apart (the forward search's):"
+                .to_string()
         } else if exact.is_empty() {
             "Most likely missing:".to_string()
         } else {
