@@ -316,7 +316,7 @@ impl Effect {
     }
 
     /// A measurement outside the diameter data that tells this cause apart from another one
-    /// with the same signature (`None` for physics).
+    /// with the same signature (`None` for strain thinning and user effects without one).
     pub fn independent_check(&self) -> Option<&'static str> {
         self.descriptor().independent_check
     }

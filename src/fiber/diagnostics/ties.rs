@@ -11,8 +11,9 @@
 //! strong). For each alternative the diagnosis lists its gap, the cosine of its orthogonalised
 //! signature with the named one's, its refit's `(n, κ)` with 95% CIs, and how far `n` and `κ`
 //! move from the named refit's, in units of the named refit's standard errors: whether the
-//! material result is robust to the choice. A process condition or an instrument error in a tie
-//! can be checked independently of these data: the check is its descriptor's
+//! material result is robust to the choice. Every effect in a tie but strain thinning can be
+//! checked independently of these data (a process condition, the instrument, the air's speed
+//! or temperature, the fiber's temperature): the check is its descriptor's
 //! [`independent_check`](crate::fiber::effects::EffectDescriptor::independent_check), a
 //! user-written candidate's included.
 
