@@ -327,7 +327,7 @@ pub(super) fn ties_paragraph(
     if alts.iter().any(Alternative::mixes_physics_and_conditions) {
         s.push_str(&format!(
             "The tie mixes missing physics with process conditions or the instrument ({}): an \
-             independent check of the process condition or instrument decides",
+             independent check decides",
             members.iter().map(words).collect::<Vec<_>>().join(", ")
         ));
     } else if members.iter().all(|m| m.1 == Category::Physics) {
@@ -522,6 +522,30 @@ pub(crate) mod tests {
             "{t}"
         );
         assert!(t.contains("(inlet_diameter: measure the die swell"), "{t}");
+        assert!(
+            t.contains("radiation: measure the fiber temperature"),
+            "{t}"
+        );
+        // missing physics only: a measurement along the line for each, or other conditions
+        let warm = cand("air_temperature_profile", Physical, -37.0, 0.81, 11.7);
+        let c = Alternative::new(&rad, &warm, Category::Physics, Category::Physics, 0.95);
+        let t = ties_paragraph(&rad, &[c], &[rad.clone(), warm.clone()]);
+        assert!(
+            t.contains(
+                "All are missing physics: a measurement along the line, or data at other \
+                 conditions"
+            ),
+            "{t}"
+        );
+        assert!(
+            t.contains("(radiation: measure the fiber temperature"),
+            "{t}"
+        );
+        assert!(
+            t.contains("air_temperature_profile: measure the air temperature"),
+            "{t}"
+        );
+        assert!(t.trim_end().ends_with(")."), "{t}");
         assert!(ties_paragraph(&named, &[], &[]).is_empty());
         assert!(or_alternatives(&[]).is_empty());
     }
