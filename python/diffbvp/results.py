@@ -232,13 +232,12 @@ def law_not_a_result(fit: Mapping[str, Any]) -> Optional[str]:
             side, bound = b.get("side"), _num(b.get("bound"))
             newtonian = name == "n" and side == "upper" and bound == 1.0
             # under a misfit warning the likelihood-ratio test is not computed
-            # (FitSummary::likelihood_skipped)
+            # (FitSummary::likelihood_skipped), so the reason points to nothing below
             skipped = any(w.get("code") == "misfit" for w in fit.get("warnings", []) or [])
+            below = "" if skipped else "; whether the Newtonian law fits is said below"
             return (f"{name} is at its {side} bound {bound:.6g}, where the fit has no valid interval"
-                    + ((" (the Carreau-type law is Newtonian there and kappa is not determined)"
-                        if skipped else
-                        " (the Carreau-type law is Newtonian there and kappa is not determined; "
-                        "whether the Newtonian law fits is said below)") if newtonian else ""))
+                    + (" (the Carreau-type law is Newtonian there and kappa is not determined"
+                       f"{below})" if newtonian else ""))
     warnings = fit.get("warnings", []) or []
     for code in ("implausible", "misfit"):
         for w in warnings:

@@ -234,3 +234,14 @@ def test_a_law_at_its_bound_is_no_result_in_python_as_in_the_report(pmma, pmma_f
     assert diffbvp.results.law_not_a_result(data) == "misfit far above the noise"
     data["warnings"] = [{"code": "large_uncertainty", "message": "kappa: wide"}]
     assert diffbvp.results.law_not_a_result(data) is None
+    # n at its upper bound 1 with a misfit: no likelihood-ratio test "below" to point to
+    # (the library's words for the shipped data with the air at 600 K)
+    data["at_bound"] = [{"parameter": "n", "side": "upper", "bound": 1.0, "value": 1.0}]
+    assert diffbvp.results.law_not_a_result(data) == (
+        "n is at its upper bound 1, where the fit has no valid interval (the Carreau-type law "
+        "is Newtonian there and kappa is not determined; whether the Newtonian law fits is said "
+        "below)")
+    data["warnings"] = [{"code": "misfit", "message": "misfit far above the noise: ..."}]
+    assert diffbvp.results.law_not_a_result(data) == (
+        "n is at its upper bound 1, where the fit has no valid interval (the Carreau-type law "
+        "is Newtonian there and kappa is not determined)")

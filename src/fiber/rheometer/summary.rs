@@ -456,15 +456,13 @@ impl FitSummary {
                 b.parameter,
                 b.side.name(),
                 crate::fiber::format::fmt_g(b.bound),
-                match (newtonian, self.likelihood_skipped().is_some()) {
-                    (true, false) => {
-                        " (the Carreau-type law is Newtonian there and kappa is not determined; \
-                         whether the Newtonian law fits is said below)"
-                    }
-                    (true, true) => {
-                        " (the Carreau-type law is Newtonian there and kappa is not determined)"
-                    }
-                    _ => "",
+                if !newtonian {
+                    ""
+                } else if self.misfit_warned() {
+                    " (the Carreau-type law is Newtonian there and kappa is not determined)"
+                } else {
+                    " (the Carreau-type law is Newtonian there and kappa is not determined; \
+                     whether the Newtonian law fits is said below)"
                 }
             ));
         }
@@ -488,25 +486,25 @@ impl FitSummary {
     /// and their refits of such a model are slow (the shipped data with the air at 600 K:
     /// 3.7 s of profiles and test after a fit of 0.02 s). `None`: they are computed.
     pub fn likelihood_skipped(&self) -> Option<String> {
-        if !self.law_fitted() {
-            return None;
-        }
-        self.warnings
-            .iter()
-            .any(|w| w.code == WarningCode::Misfit)
-            .then(|| {
-                let noise = self.noise.level;
-                let times = if noise.is_finite() && noise > 0.0 {
-                    format!("{:.1} times the noise", self.rms_relative_residual / noise)
-                } else {
-                    "far more than the noise".to_string()
-                };
-                format!(
-                    "the model misses the data by {times} (warning misfit): likelihood \
+        self.misfit_warned().then(|| {
+            let noise = self.noise.level;
+            let times = if noise.is_finite() && noise > 0.0 {
+                format!("{:.1} times the noise", self.rms_relative_residual / noise)
+            } else {
+                "far more than the noise".to_string()
+            };
+            format!(
+                "the model misses the data by {times} (warning misfit): likelihood \
                      intervals and tests of a model that does not describe the data would be no \
                      result"
-                )
-            })
+            )
+        })
+    }
+
+    /// Whether the law was fitted and the fit carries a `misfit` warning (the one condition
+    /// of [`likelihood_skipped`](Self::likelihood_skipped)).
+    fn misfit_warned(&self) -> bool {
+        self.law_fitted() && self.warnings.iter().any(|w| w.code == WarningCode::Misfit)
     }
 }
 
