@@ -265,26 +265,31 @@ class FitResult(Result):
     ``profiles`` (name → fitted profiles on uniform positions, SI units in the keys).
     """
 
-    __slots__ = ("text", "notes")
+    __slots__ = ("text", "notes", "context")
 
     def __init__(self, summary: Dict[str, Any], arrays: Optional[Dict[str, Any]] = None, text: str = "",
-                 notes: Optional[List[str]] = None):
+                 notes: Optional[List[str]] = None, context: Optional[str] = None):
         super().__init__(summary, arrays)
         object.__setattr__(self, "text", text)
         object.__setattr__(self, "notes", list(notes or []))
+        # why the diagnosis this fit belongs to says its law is no result (None: no diagnosis,
+        # or the diagnosis leaves it one)
+        object.__setattr__(self, "context", context)
 
     @classmethod
     def _from_native(cls, d: Dict[str, Any]) -> "FitResult":
         return cls(d["summary"], d["arrays"], d.get("text", ""), d.get("notes", []))
 
     def __getstate__(self):  # type: ignore[override]
-        return (self._data, self._arrays, self.text, self.notes)
+        return (self._data, self._arrays, self.text, self.notes, self.context)
 
     def __setstate__(self, state):  # type: ignore[override]
         object.__setattr__(self, "_data", state[0])
         object.__setattr__(self, "_arrays", state[1])
         object.__setattr__(self, "text", state[2])
         object.__setattr__(self, "notes", state[3])
+        # a state pickled before the context was kept has four parts
+        object.__setattr__(self, "context", state[4] if len(state) > 4 else None)
 
     @property
     def summary(self) -> Dict[str, Any]:
@@ -320,15 +325,18 @@ class FitResult(Result):
 
     @property
     def law_not_a_result(self) -> Optional[str]:
-        """Why this fit's law (n, kappa) is not a result, or None (:func:`law_not_a_result`:
-        n or kappa at a bound, or an ``implausible`` warning)."""
-        return law_not_a_result(self._data)
+        """Why this fit's law (n, kappa) is not a result, or None: the fit's own rule
+        (:func:`law_not_a_result`: n or kappa at a bound, an ``implausible`` or ``misfit``
+        warning), else, for a fit of a diagnosis (``Diagnosis.base_fit``, ``final_fit``), the
+        diagnosis' reason (``Diagnosis.law_not_a_result``: an ambiguous verdict, a misfit no
+        candidate explains; for the user's model, the effects the diagnosis found missing)."""
+        return law_not_a_result(self._data) or self.context
 
     @property
     def law_is_a_result(self) -> bool:
         """Whether this fit's law may be used as a result (no reason in
         :attr:`law_not_a_result`; a fit without a fitted law has none either)."""
-        return law_not_a_result(self._data) is None
+        return self.law_not_a_result is None
 
     @property
     def warnings(self) -> List[Dict[str, str]]:
@@ -675,17 +683,38 @@ class Diagnosis(Result):
         return self._data.get("robust")
 
     @property
-    def law_is_a_result(self) -> bool:
-        """Whether the final fit's law (n, kappa) may be used as a result: the model is
-        adequate or the misfit is explained, and that fit (the final fit, else the user's)
-        passes the fit's own rule (:func:`law_not_a_result`: neither n nor kappa at a bound of
-        its range, no ``implausible`` warning). False when the verdict is "ambiguous" or "none
-        of the candidates": then no law of this diagnosis is a result, whatever its interval.
-        The library's ``Diagnosis::law_is_a_result`` rule."""
-        if self.verdict.get("kind") not in ("adequate", "explained"):
-            return False
+    def law_not_a_result(self) -> Optional[str]:
+        """Why the reported law (n, kappa) (the final fit's, else the user's) is not a result,
+        or None: the verdict is "ambiguous" or "none of the candidates" (then no law of this
+        diagnosis is a result, whatever its interval), or that fit fails the fit's own rule
+        (:func:`law_not_a_result`: n or kappa at a bound of its range, an ``implausible`` or
+        ``misfit`` warning). The library writes the reason into the JSON
+        (``Diagnosis::law_not_a_result``, the text report's "NOT A RESULT" words); for a JSON
+        written before it did, the same rule is applied here."""
+        if "law_not_a_result" in self._data:
+            return self._data["law_not_a_result"]
+        kind = self.verdict.get("kind")
+        if kind not in ("adequate", "explained"):
+            return f"the verdict is {kind}, see the verdict"
         fit = self._data.get("final_fit") or self._data.get("base_fit") or {}
-        return law_not_a_result(fit) is None
+        return law_not_a_result(fit)
+
+    @property
+    def law_is_a_result(self) -> bool:
+        """Whether the reported law (n, kappa) may be used as a result: no reason in
+        :attr:`law_not_a_result` (the library's ``Diagnosis::law_is_a_result`` rule)."""
+        return self.law_not_a_result is None
+
+    def _base_law_not_a_result(self) -> Optional[str]:
+        """Why the user's model's law is not a result (the library's
+        ``Diagnosis::base_law_not_a_result``, from the JSON; for a JSON written before it was
+        there: the effects found, else the reported law's reason)."""
+        if "base_law_not_a_result" in self._data:
+            return self._data["base_law_not_a_result"]
+        if self._data.get("final_fit") is not None:
+            return (f"your model lacks the effects the diagnosis found ({' + '.join(self.found)}); "
+                    "the law with them is the final fit's")
+        return self.law_not_a_result
 
     @property
     def found(self) -> List[str]:
@@ -723,16 +752,22 @@ class Diagnosis(Result):
 
     @property
     def base_fit(self) -> FitResult:
-        """The user's model fitted (principled estimator), with its one noise level."""
-        return FitResult(self._data["base_fit"], {"residual_profiles": self._arrays.get("residuals_before") or {}})
+        """The user's model fitted (principled estimator), with its one noise level; its
+        ``law_not_a_result`` says why its law is no result where the diagnosis found effects
+        missing from it or leaves no law a result."""
+        return FitResult(self._data["base_fit"], {"residual_profiles": self._arrays.get("residuals_before") or {}},
+                         context=self._base_law_not_a_result())
 
     @property
     def final_fit(self) -> Optional[FitResult]:
-        """The fit with all found effects (fitted jointly), None if nothing was found."""
+        """The fit with all found effects (fitted jointly), None if nothing was found; its
+        ``law_not_a_result`` carries the diagnosis' reason (:attr:`law_not_a_result`), e.g.
+        under an ambiguous verdict, where its interval alone would look like a result."""
         f = self._data.get("final_fit")
         if f is None:
             return None
-        return FitResult(f, {"residual_profiles": self._arrays.get("residuals_after") or {}})
+        return FitResult(f, {"residual_profiles": self._arrays.get("residuals_after") or {}},
+                         context=self.law_not_a_result)
 
     @property
     def noise_level(self) -> float:

@@ -95,7 +95,7 @@ pub fn diagnose<'py>(
     })?;
     let run = out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), None))?;
     let d = PyDict::new(py);
-    d.set_item("diagnosis", serde_to_py(py, &run.diagnosis)?)?;
+    d.set_item("diagnosis", serde_to_py(py, &run.diagnosis.json())?)?;
     d.set_item("text", run.diagnosis.to_text())?;
     d.set_item("base_arrays", identification_arrays(py, &run.base, None)?)?;
     match &run.best {

@@ -70,6 +70,12 @@ def test_diagnosis_equals_cli_diagnose_json(rheometer, scratch, radiation_diagno
     assert 0.0 <= named.false_alarm <= 1.0
     assert d.final_fit is not None and d.final_fit.effects[0]["effect"] == "radiation"
     assert_same(ref["base_fit"], d.base_fit.summary)
+    # the library's reasons, in the CLI's JSON as in Python's: the law with radiation is a
+    # result (explained), the user's model without it is not
+    assert ref["law_not_a_result"] is None and d.law_is_a_result and d.final_fit.law_is_a_result
+    assert "radiation" in ref["base_law_not_a_result"]
+    assert d.base_fit.law_not_a_result == ref["base_law_not_a_result"]
+    assert not d.base_fit.law_is_a_result and "NOT A RESULT" in repr(d.base_fit)
     # the residual arrays belong to the base and the final fit
     base_rms = np.sqrt(np.mean(d.base_fit.residuals_table()["relative_residual"] ** 2))
     assert base_rms == pytest.approx(d.base_fit.rms, rel=1e-12)

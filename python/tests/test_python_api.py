@@ -142,8 +142,11 @@ def test_a_robust_loss_weights_the_diagnosis_and_outliers_are_no_missing_physics
     assert w is not None and w["loss"] == "huber" and w["down_weighted"] >= 7, w
     assert d.verdict["kind"] == "adequate" and d.law_is_a_result, d.verdict
     assert d.found == [] and "Loss huber: the points are weighted" in d.text
-    # the same verdict with the law's kappa at a bound: no result (the library's rule)
+    assert d.law_not_a_result is None and d.base_fit.law_is_a_result
+    # the same verdict with the law's kappa at a bound, in a JSON written before the library
+    # wrote its reason: no result (the library's rule, applied to the fit)
     data = json.loads(json.dumps(d.diagnosis))
+    data.pop("law_not_a_result")
     fit = data.get("final_fit") or data["base_fit"]
     fit["at_bound"] = [{"parameter": "kappa", "side": "lower", "bound": 7.0}]
     assert not diffbvp.Diagnosis(data).law_is_a_result
@@ -168,6 +171,12 @@ def test_a_pair_as_good_with_another_law_makes_the_law_no_result():
     assert any("neither law is a result" in w["message"] for w in d.final_fit.warnings)
     # the verdict's own kind says so: a notebook that checks it never takes this law
     assert d.verdict["kind"] == "ambiguous" and not d.law_is_a_result, d.verdict
+    # nor one that takes a fit alone: the diagnosis' reason is the text report's words, the
+    # final fit is no result (its own warning), and the user's model lacks the effect found
+    assert f"NOT A RESULT: {d.law_not_a_result})" in " ".join(d.text.split()), d.law_not_a_result
+    assert not d.final_fit.law_is_a_result and "NOT A RESULT" in repr(d.final_fit)
+    assert d.found[0] in d.base_fit.law_not_a_result and not d.base_fit.law_is_a_result
+    assert pickle.loads(pickle.dumps(d.base_fit)).law_not_a_result == d.base_fit.law_not_a_result
     assert ["air_temperature_profile", "radiation"] in [sorted(a) for a in d.verdict["alternatives"]]
     assert d.verdict["n_range"][0] <= 0.8 <= d.verdict["n_range"][1], d.verdict
     # the two explanations' envelope holds the truth

@@ -196,10 +196,15 @@ fn the_control_says_which_faults_it_could_miss() {
             && text.contains("What these data could have missed"),
         "{text}"
     );
-    // JSON round trip keeps the limits
-    let js = serde_json::to_string(d).unwrap();
+    // JSON round trip (as written, with its derived reasons) keeps the limits and the rule
+    let js = serde_json::to_string(&d.json()).unwrap();
     let back: Diagnosis = serde_json::from_str(&js).unwrap();
     assert_eq!(back.detection.limits.len(), d.detection.limits.len());
+    assert_eq!(back.law_not_a_result(), d.law_not_a_result());
+    // nothing named: the user's fit is the reported one, and both reasons are the same
+    let v: serde_json::Value = serde_json::from_str(&js).unwrap();
+    assert_eq!(v["law_not_a_result"], v["base_law_not_a_result"]);
+    assert_eq!(v["law_not_a_result"].is_null(), d.law_is_a_result());
 }
 
 /// A mass-flow error of 1.5 × `s95` (−14.5 %) is detected; `nusselt_scale`, whose signature is

@@ -330,6 +330,16 @@ fn radiation_and_warm_air_never_a_wrong_law() {
     );
     assert!(kappa_range[0] <= k[0] && k[1] <= kappa_range[1]);
     assert!(!d.law_is_a_result());
+    // and so does the JSON, for the law with the found effects and for the user's model
+    let js: serde_json::Value = serde_json::to_value(d.json()).unwrap();
+    let why = js["law_not_a_result"]
+        .as_str()
+        .expect("a reason in the JSON");
+    assert!(why.contains("disagrees on the law"), "{why}");
+    let base = js["base_law_not_a_result"]
+        .as_str()
+        .expect("a reason for the base fit");
+    assert!(d.found.iter().all(|e| base.contains(e.as_str())), "{base}");
     // the report says so (its lines wrapped at 100 characters)
     let text = d.to_text().split_whitespace().collect::<Vec<_>>().join(" ");
     assert!(text.contains("neither law is a result"), "{text}");

@@ -124,7 +124,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let run = run?;
     let text = run.diagnosis.to_text();
     outln!("{text}");
-    let js = serde_json::to_string_pretty(&run.diagnosis)?;
+    let js = serde_json::to_string_pretty(&run.diagnosis.json())?;
     if let Some(path) = json {
         outputs.write_text(&path, &js)?;
         g.say(format!("wrote {}", path.display()));

@@ -210,14 +210,67 @@ impl Diagnosis {
         self.law_fit().law_at_bound()
     }
 
-    /// Whether the reported law `(n, κ)` may be used as a result: the verdict leaves it one
-    /// ([`Verdict::law_is_a_result`](super::diagnose::verdict::Verdict::law_is_a_result):
-    /// adequate or explained) and [`law_fit`](Self::law_fit)'s own rule does too
-    /// ([`FitSummary::law_not_a_result`]: neither parameter at a bound
-    /// ([`law_at_bound`](Self::law_at_bound)), no implausible law, e.g. an "adequate" plain fit
-    /// with `n` near 0). Python's `Diagnosis.law_is_a_result` applies the same rule to the JSON.
+    /// Whether the reported law `(n, κ)` may be used as a result: no reason in
+    /// [`law_not_a_result`](Self::law_not_a_result). Python's `Diagnosis.law_is_a_result`
+    /// reads that reason from the JSON.
     pub fn law_is_a_result(&self) -> bool {
-        self.verdict.law_is_a_result() && self.law_fit().law_not_a_result().is_none()
+        self.law_not_a_result().is_none()
+    }
+
+    /// Why the reported law (that of [`law_fit`](Self::law_fit)) is not a result, if it is
+    /// not: the verdict leaves none (the misfit is not explained, or is explained only by an
+    /// effect whose strength differs between the experiments, or another explanation as good
+    /// disagrees on the law: [`Verdict::law_is_a_result`](super::diagnose::verdict::Verdict::law_is_a_result)),
+    /// or the fit's own rule ([`FitSummary::law_not_a_result`]: `n` or `κ` at a bound of its
+    /// range, e.g. a 300 m/s aspirator's co-flow "explaining" the data with `κ` at its lower
+    /// bound 7, `K` a hundred times below the truth; an implausible law, e.g. an "adequate"
+    /// plain fit with `n` near 0). The text report's "NOT A RESULT" words; the JSON
+    /// ([`Diagnosis::json`]) writes them as `law_not_a_result`.
+    pub fn law_not_a_result(&self) -> Option<String> {
+        let why = match self.verdict {
+            Verdict::NoneOfTheCandidates { ref stand_ins, .. } if !stand_ins.is_empty() => {
+                "the effect's strength differs between the experiments: a stand-in, see the verdict"
+            }
+            Verdict::NoneOfTheCandidates { .. } => "the misfit is not explained, see the verdict",
+            Verdict::Ambiguous { .. } => {
+                "another explanation as good disagrees on the law, see the verdict"
+            }
+            // the fit's own rule (a bound, an implausible warning): the one the fit's report,
+            // figures and page apply
+            Verdict::Adequate | Verdict::Explained { .. } => {
+                return self.law_fit().law_not_a_result();
+            }
+        };
+        Some(why.to_string())
+    }
+
+    /// Why the law of the user's model ([`base_fit`](Self::base_fit)) is not a result, if it
+    /// is not: where the diagnosis found effects, the model lacks them (the law with them is
+    /// the final fit's, see [`law_not_a_result`](Self::law_not_a_result)); else the reported
+    /// law's reason, the user's fit being the reported one. The JSON writes it as
+    /// `base_law_not_a_result`.
+    pub fn base_law_not_a_result(&self) -> Option<String> {
+        if self.final_fit.is_none() {
+            return self.law_not_a_result();
+        }
+        Some(format!(
+            "your model lacks the effects the diagnosis found ({}); the law with them is the \
+             final fit's",
+            self.found.join(" + ")
+        ))
+    }
+
+    /// The diagnosis as its JSON is written (`rheometer diagnose --json`, `diagnosis.json`,
+    /// Python's `Diagnosis.diagnosis`): every field of [`Diagnosis`] and, derived at writing,
+    /// `law_not_a_result` and `base_law_not_a_result` (the reasons above, `null` where the law
+    /// is a result), so that a reader of the JSON applies the library's rule without
+    /// repeating it. Reading the JSON back ignores the two.
+    pub fn json(&self) -> DiagnosisJson<'_> {
+        DiagnosisJson {
+            diagnosis: self,
+            law_not_a_result: self.law_not_a_result(),
+            base_law_not_a_result: self.base_law_not_a_result(),
+        }
     }
 
     /// The noise level the judgement used \[-\] (the base fit's).
@@ -250,6 +303,16 @@ impl Diagnosis {
             .as_ref()
             .map_or(&[], |m| &m.outliers)
     }
+}
+
+/// What a diagnosis' JSON holds ([`Diagnosis::json`]): the diagnosis and the reasons derived
+/// from it.
+#[derive(Debug, Serialize)]
+pub struct DiagnosisJson<'a> {
+    #[serde(flatten)]
+    diagnosis: &'a Diagnosis,
+    law_not_a_result: Option<String>,
+    base_law_not_a_result: Option<String>,
 }
 
 /// A diagnosis with the data for figures.

@@ -218,28 +218,6 @@ impl Diagnosis {
         ));
     }
 
-    /// Why the final law is not a result, if it is not: the misfit is not explained, another
-    /// explanation as good disagrees on the law, or the fit's own rule
-    /// ([`FitSummary::law_not_a_result`](crate::fiber::rheometer::FitSummary::law_not_a_result):
-    /// `n` or `κ` at a bound, an implausible law) ([`Diagnosis::law_is_a_result`]).
-    fn law_not_a_result(&self) -> Option<String> {
-        let why = match self.verdict {
-            Verdict::NoneOfTheCandidates { ref stand_ins, .. } if !stand_ins.is_empty() => {
-                "the effect's strength differs between the experiments: a stand-in, see the verdict"
-            }
-            Verdict::NoneOfTheCandidates { .. } => "the misfit is not explained, see the verdict",
-            Verdict::Ambiguous { .. } => {
-                "another explanation as good disagrees on the law, see the verdict"
-            }
-            // the fit's own rule (a bound, an implausible warning): the one the fit's report,
-            // figures and page apply
-            Verdict::Adequate | Verdict::Explained { .. } => {
-                return self.law_fit().law_not_a_result();
-            }
-        };
-        Some(why.to_string())
-    }
-
     /// The pair named by the joint search of pairs, with its strengths.
     fn pair_paragraph(&self, s: &mut String) {
         let Some(p) = &self.pair else { return };
