@@ -732,7 +732,9 @@ class Diagnosis(Result):
     @property
     def most_likely_missing(self) -> Optional[str]:
         """The best single candidate that may be named (the forward search's first step), or
-        None. A pair that explains the data better replaces it in ``found`` (see ``pair``)."""
+        None. A pair that explains the data better replaces it in ``found`` (see ``pair``).
+        Under an "ambiguous" verdict it is one of the explanations the data cannot tell apart
+        (the report's words), not the cause: the verdict's ``alternatives`` are as good."""
         return self._data.get("most_likely_missing")
 
     @property
