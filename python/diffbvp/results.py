@@ -706,15 +706,10 @@ class Diagnosis(Result):
         return self.law_not_a_result is None
 
     def _base_law_not_a_result(self) -> Optional[str]:
-        """Why the user's model's law is not a result (the library's
-        ``Diagnosis::base_law_not_a_result``, from the JSON; for a JSON written before it was
-        there: the effects found, else the reported law's reason)."""
-        if "base_law_not_a_result" in self._data:
-            return self._data["base_law_not_a_result"]
-        if self._data.get("final_fit") is not None:
-            return (f"your model lacks the effects the diagnosis found ({' + '.join(self.found)}); "
-                    "the law with them is the final fit's")
-        return self.law_not_a_result
+        """Why the user's model's law is not a result: the library's
+        ``Diagnosis::base_law_not_a_result``, from the JSON (its words are not repeated here:
+        a JSON written before the library wrote it gives the fit no reason beyond its own)."""
+        return self._data.get("base_law_not_a_result")
 
     @property
     def found(self) -> List[str]:
