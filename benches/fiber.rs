@@ -157,6 +157,45 @@ fn bench_rhs(c: &mut Criterion) {
             fd8[3].re
         })
     });
+    // the same two passes with the solver's number type (slopes always stored)
+    use diffbvp::dense_dual::DenseDual64;
+    let yq: Vec<DenseDual64<4>> = y
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| DenseDual64::from_re(v).derivative(i))
+        .collect();
+    let pq: Vec<DenseDual64<4>> = p.iter().map(|&v| DenseDual64::from_re(v)).collect();
+    let mut fq = [DenseDual64::<4>::from_re(0.0); 4];
+    c.bench_function("fiber_rhs_dense4", |b| {
+        b.iter(|| {
+            m.rhs(black_box(0.3), black_box(&yq), &pq, &mut fq);
+            fq[3].re
+        })
+    });
+    let yq8: Vec<DenseDual64<8>> = y
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| DenseDual64::from_re(v).derivative(i))
+        .collect();
+    let pq8: Vec<DenseDual64<8>> = p
+        .iter()
+        .enumerate()
+        .map(|(j, &v)| {
+            let d = DenseDual64::from_re(v);
+            if y.len() + j < seeds {
+                d.derivative(y.len() + j)
+            } else {
+                d
+            }
+        })
+        .collect();
+    let mut fq8 = [DenseDual64::<8>::from_re(0.0); 4];
+    c.bench_function("fiber_rhs_dense8", |b| {
+        b.iter(|| {
+            m.rhs(black_box(0.3), black_box(&yq8), &pq8, &mut fq8);
+            fq8[3].re
+        })
+    });
 }
 
 criterion_group!(benches, bench, bench_rhs);

@@ -7,7 +7,8 @@
 //!
 //! 1. the user implements [`DualScalarFn`] (one generic method);
 //! 2. a blanket impl makes every such type a [`DynDualScalarFn`], an object-safe trait with one
-//!    method per concrete number type the toolkit uses (`f64`, [`Dual64`], `DualSVec64<1|2|4|8>`);
+//!    method per concrete number type the toolkit uses (`f64`, [`Dual64`], `DualSVec64<1|2|4|8>`,
+//!    [`DenseDual64<1|2|4|8>`](crate::dense_dual::DenseDual64));
 //! 3. inside generic code, [`eval_dyn`] calls a `&dyn DynDualScalarFn` with the number type `D`
 //!    at hand, selecting the matching method by `TypeId` (via [`std::any::Any`] downcasts; no
 //!    `unsafe`).
@@ -30,6 +31,7 @@
 //! assert_eq!((v.re, v.eps), (9.0, 6.0));
 //! ```
 
+use crate::dense_dual::DenseDual64;
 use num_dual::{Dual64, DualNum, DualSVec64};
 use std::any::Any;
 
@@ -58,6 +60,14 @@ pub trait DynDualScalarFn: Send + Sync {
     fn eval_dual4(&self, x: f64, args: &[DualSVec64<4>]) -> DualSVec64<4>;
     /// Eight directional derivatives.
     fn eval_dual8(&self, x: f64, args: &[DualSVec64<8>]) -> DualSVec64<8>;
+    /// One directional derivative, always stored (the solver's Jacobians).
+    fn eval_dense1(&self, x: f64, args: &[DenseDual64<1>]) -> DenseDual64<1>;
+    /// Two directional derivatives, always stored.
+    fn eval_dense2(&self, x: f64, args: &[DenseDual64<2>]) -> DenseDual64<2>;
+    /// Four directional derivatives, always stored.
+    fn eval_dense4(&self, x: f64, args: &[DenseDual64<4>]) -> DenseDual64<4>;
+    /// Eight directional derivatives, always stored.
+    fn eval_dense8(&self, x: f64, args: &[DenseDual64<8>]) -> DenseDual64<8>;
 }
 
 impl<T: DualScalarFn + Send + Sync> DynDualScalarFn for T {
@@ -79,10 +89,22 @@ impl<T: DualScalarFn + Send + Sync> DynDualScalarFn for T {
     fn eval_dual8(&self, x: f64, args: &[DualSVec64<8>]) -> DualSVec64<8> {
         self.eval(x, args)
     }
+    fn eval_dense1(&self, x: f64, args: &[DenseDual64<1>]) -> DenseDual64<1> {
+        self.eval(x, args)
+    }
+    fn eval_dense2(&self, x: f64, args: &[DenseDual64<2>]) -> DenseDual64<2> {
+        self.eval(x, args)
+    }
+    fn eval_dense4(&self, x: f64, args: &[DenseDual64<4>]) -> DenseDual64<4> {
+        self.eval(x, args)
+    }
+    fn eval_dense8(&self, x: f64, args: &[DenseDual64<8>]) -> DenseDual64<8> {
+        self.eval(x, args)
+    }
 }
 
 /// Calls `f` with the number type `D` of the caller. Supported: `f64`, [`Dual64`],
-/// `DualSVec64<1|2|4|8>`; any other type, or more than [`MAX_ARGS`] arguments, gives `NaN`.
+/// `DualSVec64<1|2|4|8>`, [`DenseDual64<1|2|4|8>`](DenseDual64) (the solver's); any other type, or more than [`MAX_ARGS`] arguments, gives `NaN`.
 pub fn eval_dyn<D: DualNum<Primitive = f64> + Copy>(
     f: &dyn DynDualScalarFn,
     x: f64,
@@ -106,6 +128,10 @@ pub fn eval_dyn<D: DualNum<Primitive = f64> + Copy>(
         };
     }
     dispatch!(f64, eval_f64);
+    dispatch!(DenseDual64<4>, eval_dense4);
+    dispatch!(DenseDual64<8>, eval_dense8);
+    dispatch!(DenseDual64<1>, eval_dense1);
+    dispatch!(DenseDual64<2>, eval_dense2);
     dispatch!(DualSVec64<4>, eval_dual4);
     dispatch!(DualSVec64<8>, eval_dual8);
     dispatch!(DualSVec64<1>, eval_dual1);
@@ -141,6 +167,18 @@ mod tests {
             &[Dual64::from_re(3.0).derivative(), Dual64::from_re(4.0)],
         );
         assert_eq!((r.re, r.eps), (24.0, 8.0));
+        // the solver's number types reach the function, not the NaN fallback
+        let a = DenseDual64::<4>::from_re(3.0).derivative(0);
+        let b = DenseDual64::<4>::from_re(4.0).derivative(3);
+        let r = eval_dyn(f, 2.0, &[a, b]);
+        assert_eq!((r.re, r.slopes()), (24.0, [8.0, 0.0, 0.0, 6.0]));
+        let a = DenseDual64::<8>::from_re(3.0).derivative(7);
+        let r = eval_dyn(f, 2.0, &[a, a]);
+        assert_eq!(r.slopes()[7], 12.0);
+        let r = eval_dyn(f, 2.0, &[DenseDual64::<1>::from_re(3.0).derivative(0); 2]);
+        assert_eq!(r.slopes(), [12.0]);
+        let r = eval_dyn(f, 2.0, &[DenseDual64::<2>::from_re(3.0).derivative(1); 2]);
+        assert_eq!(r.slopes(), [0.0, 12.0]);
     }
 
     #[test]

@@ -102,6 +102,7 @@
 #![allow(clippy::needless_range_loop)]
 mod collocation;
 pub mod continuation;
+pub mod dense_dual;
 mod dual_jacobian;
 pub mod dyn_dual;
 pub mod error;

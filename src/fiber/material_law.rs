@@ -7,7 +7,7 @@
 //! derivatives with respect to them are exact). It returns `μ̃_e = μ_e/μ_o`.
 //!
 //! The strain-rate formulation needs `∂_T μ_e` and `∂_ε̇ μ_e`; [`viscosity_with_partials`] gets
-//! them by nested dual numbers (one pass with `num_dual::DualSVec<D, 2>` over the caller's `D`,
+//! them by nested dual numbers (one pass with [`DenseDual<D, Const<2>>`](crate::dense_dual::DenseDual) over the caller's `D`,
 //! seeded in `T` and `ε̇`), so a law is written once, without hand-coded derivatives, and the
 //! derivatives of the right-hand side with respect to the states and the law parameters stay
 //! exact. Laws must be strictly monotone in the strain rate
@@ -19,8 +19,9 @@
 //! `mu_e` out of line on `#[inline]` alone, and the warm re-solve of the fiber benchmark was
 //! 1.25× slower than under the default profile.
 
-use nalgebra::{Const, U1};
-use num_dual::{DualNum, DualSVec};
+use crate::dense_dual::DenseDual;
+use nalgebra::Const;
+use num_dual::DualNum;
 
 /// Largest number of law parameters supported by [`viscosity_with_partials`].
 pub const MAX_LAW_PARAMS: usize = 8;
@@ -262,22 +263,21 @@ pub fn viscosity_with_partials_shifted<L: ViscosityLaw, D: DualNum<Primitive = f
     p: &[D],
 ) -> (D, D, D) {
     let k = p.len().min(MAX_LAW_PARAMS);
-    let mut pl = [DualSVec::<D, 2>::from_re(D::zero()); MAX_LAW_PARAMS];
+    let mut pl = [DenseDual::<D, Const<2>>::from_re(D::zero()); MAX_LAW_PARAMS];
     for (l, &v) in pl.iter_mut().zip(&p[..k]) {
-        *l = DualSVec::from_re(v);
+        *l = DenseDual::from_re(v);
     }
     let pl = &pl[..k];
-    let tt = DualSVec::<D, 2>::from_re(t).derivative(0);
-    let mu0 = zero.eval_with(tt, shift.map(|d| d.map(DualSVec::from_re)));
+    let tt = DenseDual::<D, Const<2>>::from_re(t).derivative(0);
+    let mu0 = zero.eval_with(tt, shift.map(|d| d.map(DenseDual::from_re)));
     let x = LawInputs {
         t: tt,
         mu0,
-        rate: DualSVec::from_re(rate).derivative(1),
+        rate: DenseDual::from_re(rate).derivative(1),
         de,
     };
     let m = law.mu_e(&x, pl);
-    let e = m.eps.unwrap_generic(Const::<2>, U1);
-    (m.re, e[0], e[1])
+    (m.re, m.slope(0), m.slope(1))
 }
 
 /// `μ̃_e` alone (no derivatives).

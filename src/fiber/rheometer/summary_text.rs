@@ -25,6 +25,17 @@ pub(crate) fn fmt_interval(ci: [f64; 2], u: f64) -> String {
 }
 
 impl FitSummary {
+    /// Whether the linearised 95 % interval of a fitted estimate says nothing: a standard
+    /// error of 1e5 or more, or an interval wider than the estimate's whole search range (a
+    /// nearly singular covariance, e.g. two effects of the same physics fitted together).
+    fn not_determined(&self, e: &Estimate) -> bool {
+        let wider_than_range = self.interval(&e.name).is_some_and(|i| {
+            let [lo, hi] = i.search_range;
+            (e.ci95[1] - e.ci95[0]).abs() > (hi - lo).abs()
+        });
+        e.stderr >= 1e5 || wider_than_range
+    }
+
     /// The line of a fitted or fixed estimate: `label value ± se  95% CI [lo, hi]`, or its
     /// bound, or why it has no interval.
     fn estimate_line(&self, label: &str, e: &Estimate) -> String {
@@ -53,7 +64,11 @@ impl FitSummary {
                 fmt_sig(value, 5)
             )
         } else {
-            let undetermined = if se >= 1e5 { " (not determined)" } else { "" };
+            let undetermined = if self.not_determined(e) {
+                " (not determined)"
+            } else {
+                ""
+            };
             format!(
                 "    {label} {}{unit}  95% CI {}{unit}{undetermined}",
                 fmt_pm(value, se),
