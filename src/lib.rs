@@ -49,7 +49,8 @@
 //! it (checked by `python3 .ci/import-graph.py`, which reads this list). The toolkit, bottom to
 //! top:
 //!
-//! 1. [`error`], [`problem`], [`mesh`], [`dense_dual`] (dual numbers with every slope stored), [`dyn_dual`];
+//! 1. [`error`], [`problem`], [`mesh`], [`dense_dual`] (dual numbers with every slope stored),
+//!    [`dyn_dual`];
 //! 2. `dual_jacobian`, `collocation`, [`linear`] (sparse LU and block elimination),
 //!    `error_control`, `newton`, `linearization`, [`solution`],
 //!    `mesh_cycle` (the watch for a mesh that does not settle);
