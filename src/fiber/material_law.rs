@@ -33,6 +33,12 @@ pub struct LawInputs<D> {
     pub t: D,
     /// Zero-rate elongational viscosity `μ̃_e0(T̃)` \[-\].
     pub mu0: D,
+    /// `μ̃_e0 = mu0_factor · exp(mu0_exponent)` \[-\]: the exponent of the VFT law, for laws
+    /// that multiply `μ̃_e0` by exponentials and can fold them into one (one `exp` fewer per
+    /// point, see [`CarreauLike`]).
+    pub mu0_exponent: D,
+    /// The constant factor of `μ̃_e0 = mu0_factor · exp(mu0_exponent)` \[-\].
+    pub mu0_factor: f64,
     /// Strain rate `ε̇̃` \[-\].
     pub rate: D,
     /// Deborah number `De` \[-\].
@@ -85,7 +91,13 @@ impl ZeroRateViscosity {
     /// Evaluates `μ̃_e0(T̃)`.
     #[inline(always)]
     pub fn eval<D: DualNum<Primitive = f64> + Copy>(&self, t: D) -> D {
-        ((t - self.t_vf).recip() * self.b).exp() * self.a
+        self.exponent(t).exp() * self.a
+    }
+
+    /// The exponent `b/(T̃ − t_VF)` of `μ̃_e0(T̃) = a exp(b/(T̃ − t_VF))` \[-\].
+    #[inline(always)]
+    pub fn exponent<D: DualNum<Primitive = f64> + Copy>(&self, t: D) -> D {
+        (t - self.t_vf).recip() * self.b
     }
 
     /// `μ̃_e0(T̃)` with the VFT parameters shifted, `b' = b + db` (`db = ΔB/T_o`) and
@@ -98,10 +110,26 @@ impl ZeroRateViscosity {
     /// rounding.
     #[inline(always)]
     pub fn eval_shifted<D: DualNum<Primitive = f64> + Copy>(&self, t: D, db: D, dt_vf: D) -> D {
+        self.exponent_shifted(t, db, dt_vf).exp() * self.a
+    }
+
+    /// The exponent of [`eval_shifted`](Self::eval_shifted):
+    /// `b/(1 − t_VF) + b'/(T̃ − t'_VF) − b'/(1 − t'_VF)` \[-\] (times `a` after `exp`).
+    #[inline(always)]
+    pub fn exponent_shifted<D: DualNum<Primitive = f64> + Copy>(&self, t: D, db: D, dt_vf: D) -> D {
         let b = db + self.b;
         let t_vf = dt_vf + self.t_vf;
         let level = self.b / (1.0 - self.t_vf);
-        ((t - t_vf).recip() * b - (-t_vf + 1.0).recip() * b + level).exp() * self.a
+        (t - t_vf).recip() * b - (-t_vf + 1.0).recip() * b + level
+    }
+
+    /// The exponent of [`eval_with`](Self::eval_with) (`μ̃_e0 = a exp(·)`) \[-\].
+    #[inline(always)]
+    pub fn exponent_with<D: DualNum<Primitive = f64> + Copy>(&self, t: D, shift: VftShift<D>) -> D {
+        match shift {
+            None => self.exponent(t),
+            Some([db, dt_vf]) => self.exponent_shifted(t, db, dt_vf),
+        }
     }
 }
 
@@ -114,9 +142,27 @@ impl ZeroRateViscosity {
     /// ([`eval`](Self::eval) or [`eval_shifted`](Self::eval_shifted)).
     #[inline(always)]
     pub fn eval_with<D: DualNum<Primitive = f64> + Copy>(&self, t: D, shift: VftShift<D>) -> D {
-        match shift {
-            None => self.eval(t),
-            Some([db, dt_vf]) => self.eval_shifted(t, db, dt_vf),
+        self.exponent_with(t, shift).exp() * self.a
+    }
+
+    /// The [`LawInputs`] at `t` (VFT shifted by `shift`), strain rate `rate` and Deborah number
+    /// `de`: `μ̃_e0` and its exponent from one evaluation.
+    #[inline(always)]
+    pub fn law_inputs<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        t: D,
+        shift: VftShift<D>,
+        rate: D,
+        de: f64,
+    ) -> LawInputs<D> {
+        let mu0_exponent = self.exponent_with(t, shift);
+        LawInputs {
+            t,
+            mu0: mu0_exponent.exp() * self.a,
+            rate,
+            de,
+            mu0_exponent,
+            mu0_factor: self.a,
         }
     }
 }
@@ -182,10 +228,12 @@ impl ViscosityLaw for CarreauLike {
     #[inline(always)]
     fn mu_e<D: DualNum<Primitive = f64> + Copy>(&self, x: &LawInputs<D>, p: &[D]) -> D {
         let (n, kappa) = (p[0], p[1]);
-        // λ ε̇ De = De μ0 ε̇ / K̃, K̃ = exp(κ)/K_o
-        let w = x.mu0 * x.rate * (-kappa).exp() * (x.de * self.stress_scale);
+        // λ ε̇ De = De μ0 ε̇ / K̃, K̃ = exp(κ)/K_o; μ0 = f exp(e): μ0 exp(−κ) = f exp(e − κ), and
+        // μ0 (1 + w²)^((n−1)/2) = f exp(e + (n−1)/2 ln(1 + w²)) (two exp instead of three)
+        let f = x.mu0_factor;
+        let w = (x.mu0_exponent - kappa).exp() * x.rate * (f * x.de * self.stress_scale);
         let ln1p = (w * w).ln_1p();
-        x.mu0 * ((n - 1.0) * 0.5 * ln1p).exp()
+        (x.mu0_exponent + (n - 1.0) * 0.5 * ln1p).exp() * f
     }
 }
 
@@ -269,13 +317,8 @@ pub fn viscosity_with_partials_shifted<L: ViscosityLaw, D: DualNum<Primitive = f
     }
     let pl = &pl[..k];
     let tt = DenseDual::<D, Const<2>>::from_re(t).derivative(0);
-    let mu0 = zero.eval_with(tt, shift.map(|d| d.map(DenseDual::from_re)));
-    let x = LawInputs {
-        t: tt,
-        mu0,
-        rate: DenseDual::from_re(rate).derivative(1),
-        de,
-    };
+    let shift = shift.map(|d| d.map(DenseDual::from_re));
+    let x = zero.law_inputs(tt, shift, DenseDual::from_re(rate).derivative(1), de);
     let m = law.mu_e(&x, pl);
     (m.re, m.slope(0), m.slope(1))
 }
@@ -304,8 +347,7 @@ pub fn viscosity_shifted<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
     rate: D,
     p: &[D],
 ) -> D {
-    let mu0 = zero.eval_with(t, shift);
-    law.mu_e(&LawInputs { t, mu0, rate, de }, p)
+    law.mu_e(&zero.law_inputs(t, shift, rate, de), p)
 }
 
 #[cfg(test)]

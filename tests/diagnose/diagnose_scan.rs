@@ -203,11 +203,12 @@ fn the_grid_tolerance_moves_no_refit() {
 }
 
 /// The grid points' mesh-growth limit (`ScanOptions::grid_growth_limit`) on
-/// `data/hidden_radiation`, co-flow with a 0.25 m decay and no tail: on the positive side the
-/// grid fits' law runs towards `n → 0`, where a trial solve refines towards 20 000 nodes
-/// before it fails. The limit binds there (the profile changes where `J` is many times the
-/// user's), and moves no grid point that can start a refit (`J` within 1.2 times the user's)
-/// and not the best refit.
+/// `data/hidden_radiation`, co-flow with a 0.25 m decay and no tail, the walk continued to
+/// 1000 times the user's `J`: on the positive side the grid fits' law runs towards `n → 0`,
+/// where a trial solve may refine towards 20 000 nodes before it fails. Neither the default
+/// limit nor one 8 times tighter (which must bind: the profile changes where `J` is many
+/// times the user's) moves a grid point that can start a refit (`J` within 1.2 times the
+/// user's) or the best refit.
 #[test]
 fn the_grid_growth_limit_moves_no_refit() {
     use diffbvp::fiber::diagnostics::scan::{
@@ -227,8 +228,13 @@ fn the_grid_growth_limit_moves_no_refit() {
         .with_shape("tail", 0.0)
         .unwrap();
     let scan = |limit: Option<GrowthLimit>| -> CandidateScan {
+        // the walk goes on into the region where the solves need the most nodes (the default
+        // stops at 20 times the user's J, where on this set the limit may or may not bind:
+        // it did, until a change of rounding in the right-hand side moved the side's last
+        // point below 20 times)
         let so = ScanOptions {
             grid_growth_limit: limit,
+            stop_above: 1e3,
             ..ScanOptions::default()
         };
         scan_candidate(&rh, &coflow, Vec::new(), &base, cost_base, &opts, &so).unwrap()
@@ -237,7 +243,6 @@ fn the_grid_growth_limit_moves_no_refit() {
         ScanOptions::default().grid_growth_limit,
         Some(GRID_GROWTH_LIMIT)
     );
-    let limited = scan(Some(GRID_GROWTH_LIMIT));
     let free = scan(None);
     let at = |s: &CandidateScan, v: f64| {
         s.profile
@@ -246,32 +251,53 @@ fn the_grid_growth_limit_moves_no_refit() {
             .find(|p| p.strength == v)
             .map(|p| p.cost / cost_base)
     };
-    let mut strengths: Vec<f64> = limited
-        .profile
-        .points
-        .iter()
-        .chain(&free.profile.points)
-        .map(|p| p.strength)
-        .collect();
-    strengths.sort_by(f64::total_cmp);
-    strengths.dedup();
-    let mut differ = 0;
-    let mut near = 0;
-    for v in strengths {
-        let (a, b) = (at(&limited, v), at(&free, v));
-        println!("{v:9.3} m/s: J/J_user {a:?} (limit) {b:?} (none)");
-        if a != b {
-            differ += 1;
+    // the grid points where a limited scan's profile differs from the free one's; none within
+    // 1.2 times the user's J may, nor the best refit
+    let differing = |limited: &CandidateScan, name: &str| -> usize {
+        let mut strengths: Vec<f64> = limited
+            .profile
+            .points
+            .iter()
+            .chain(&free.profile.points)
+            .map(|p| p.strength)
+            .collect();
+        strengths.sort_by(f64::total_cmp);
+        strengths.dedup();
+        let (mut differ, mut near) = (0, 0);
+        for v in strengths {
+            let (a, b) = (at(limited, v), at(&free, v));
+            println!("{v:9.3} m/s: J/J_user {a:?} ({name}) {b:?} (none)");
+            if a != b {
+                differ += 1;
+            }
+            if b.is_some_and(|b| b <= 1.2) {
+                near += 1;
+                assert_eq!(
+                    a, b,
+                    "{name}: a grid point near the user's J moved at {v} m/s"
+                );
+            }
         }
-        if b.is_some_and(|b| b <= 1.2) {
-            near += 1;
-            assert_eq!(a, b, "a grid point near the user's J moved at {v} m/s");
-        }
-    }
-    // the limit did bind (a side's walk or a grid value changed), far from the user's J
-    assert!(differ > 0, "the grid growth limit never bound");
-    assert!(near >= 3, "{near} grid points near the user's J");
-    let (a, b) = (&limited.refits[0], &free.refits[0]);
-    println!("refits: J {:.8e} / {:.8e}", a.cost, b.cost);
-    assert_eq!(a.cost, b.cost);
+        assert!(near >= 3, "{near} grid points near the user's J");
+        let (a, b) = (&limited.refits[0], &free.refits[0]);
+        println!(
+            "{name}: {differ} grid points differ; refits: J {:.8e} / {:.8e}",
+            a.cost, b.cost
+        );
+        assert_eq!(a.cost, b.cost, "{name}: the best refit moved");
+        differ
+    };
+    // the default: whether it binds on this set depends on rounding (it did at stop 56, it
+    // does not since the right-hand side's exponentials were folded)
+    differing(&scan(Some(GRID_GROWTH_LIMIT)), "default limit");
+    // a limit 8 times tighter binds for sure (the test would see a limit that moves a
+    // point that matters) and still moves none
+    let tight = GrowthLimit {
+        factor: 2.0,
+        at_least: 600,
+    };
+    assert!(
+        differing(&scan(Some(tight)), "tight limit") > 0,
+        "the tight limit never bound"
+    );
 }
