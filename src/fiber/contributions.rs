@@ -173,8 +173,8 @@ impl NusseltLaw for InclinedChurchillBernstein {
         let inc2 =
             re_sq + self.inclination_regularisation * self.inclination_regularisation + extra_sq;
         let inclination = -(re_tau * re_tau / inc2) * 0.5 + 1.0;
-        let sqrt_re = re_eps2.sqrt().sqrt(); // Re_ε^½, Re_ε² > 0
-                                             // (Re_ε/282000)^(5/8) = Re_ε^½ Re_ε^⅛ / 282000^(5/8), by square roots only
+        // Re_ε^½ (Re_ε² > 0); (Re_ε/282000)^(5/8) = Re_ε^½ Re_ε^⅛ / 282000^(5/8), by square roots
+        let sqrt_re = re_eps2.sqrt().sqrt();
         let re_58 = sqrt_re * sqrt_re.sqrt().sqrt() * CB_REYNOLDS_SCALE_POW;
         // [1 + (Re_ε/282000)^(5/8)]^(4/5)
         inclination * (sqrt_re * pr_arg * one_plus_pow_four_fifths(re_58) + 0.3)
@@ -1373,8 +1373,7 @@ mod tests {
     /// the closed form (`exp(⅘ log1p x)`, slope `⅘ (1 + x)^(−1/5)`) over the series' range and
     /// across its limit, where the two branches meet: values to 4e-16 relative, slopes to
     /// 2e-15 (the truncated slope series' remainder `9 C(⅘, 9) x⁸` is 1e-15 of `⅘` at the
-    /// limit); the literal
-    /// `282000^(−5/8)` is `powf`'s value to the last bit but one.
+    /// limit). The literal `282000^(−5/8)` equals `powf`'s value to one unit in the last place.
     #[test]
     fn the_four_fifths_power_series_equals_the_closed_form() {
         use num_dual::Dual64;
