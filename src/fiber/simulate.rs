@@ -83,6 +83,13 @@ pub struct SimulateOptions {
     /// ([`Guess::on_halved_mesh`]). Every solve of these options is then on a fixed mesh:
     /// without a start solution (a cold start) it is an error.
     pub halve_start_mesh: bool,
+    /// Where a warm start fails, solve again by continuation from the stress-free fiber (a cold
+    /// start; default `true`). `false`: the failed warm start is the error. The scans' grid
+    /// fits whose law is deep in the implausible range set it
+    /// ([`COLD_FALLBACK_MIN_N`](crate::fiber::diagnostics::scan::COLD_FALLBACK_MIN_N)): there
+    /// the continuation towards a nearly rate-independent, strongly thinning fiber takes
+    /// 0.1–0.5 s per experiment, often to fail at its end.
+    pub cold_fallback: bool,
 }
 
 impl Default for SimulateOptions {
@@ -102,6 +109,7 @@ impl Default for SimulateOptions {
             linearization_params: None,
             keep_newton_matrix: false,
             halve_start_mesh: false,
+            cold_fallback: true,
         }
     }
 }
@@ -456,8 +464,10 @@ impl<'a, L: ViscosityLaw, H: NusseltLaw> Simulator<'a, L, H> {
                     let x = insert_required(&prev.x, &required);
                     Guess::from_fn(x, 4, |x, y| prev.eval_into(x, y, &mut [0.0; 4]))
                 };
-                if let Ok(sol) = self.solver.solve_with(p, &guess, &solve_opts) {
-                    return Ok(FiberSolution { solution: sol });
+                match self.solver.solve_with(p, &guess, &solve_opts) {
+                    Ok(sol) => return Ok(FiberSolution { solution: sol }),
+                    Err(e) if !options.cold_fallback => return Err(e.into()),
+                    Err(_) => {}
                 }
             }
         }

@@ -134,3 +134,32 @@ fn the_halved_mesh_solve_measures_the_start_s_discretisation_error() {
         "{cold:?}"
     );
 }
+
+#[test]
+fn a_failed_warm_start_falls_back_to_a_cold_start_unless_told_not_to() {
+    let m = model();
+    let o = SimulateOptions::with_tol(1e-4);
+    let good = simulate(&m, &[0.8, 11.71], &o).unwrap();
+    // a start no Newton iteration can use: its states are not numbers
+    let mut broken = good.solution.clone();
+    broken.y.fill(f64::NAN);
+    let p = m.parameters(1.0, &[0.8, 11.71]).unwrap();
+    let fallback = Simulator::new(&m, o.clone())
+        .solve(&p, Some(&broken))
+        .expect("the cold start after the failed warm start");
+    assert_eq!(
+        fallback.nodes(),
+        good.nodes(),
+        "the fallback is the cold start"
+    );
+    assert_eq!(fallback.solution.y, good.solution.y);
+    let no_fallback = SimulateOptions {
+        cold_fallback: false,
+        ..o
+    };
+    match Simulator::new(&m, no_fallback).solve(&p, Some(&broken)) {
+        Err(FiberError::Solver(_)) => {}
+        Err(other) => panic!("expected the warm start's solver error, got {other}"),
+        Ok(s) => panic!("expected the warm start to fail, got {} nodes", s.nodes()),
+    }
+}
