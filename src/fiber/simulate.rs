@@ -84,7 +84,8 @@ pub struct SimulateOptions {
     /// without a start solution (a cold start) it is an error.
     pub halve_start_mesh: bool,
     /// Where a warm start fails, solve again by continuation from the stress-free fiber (a cold
-    /// start; default `true`). `false`: the failed warm start is the error. The scans' grid
+    /// start; default `true`). `false`: the failed warm start is the error (a start that is not
+    /// a solution of the fiber's 4 states is no warm start: it is cold-started either way). The scans' grid
     /// fits whose law is deep in the implausible range set it
     /// ([`COLD_FALLBACK_MIN_N`](crate::fiber::diagnostics::scan::COLD_FALLBACK_MIN_N)): there
     /// the continuation towards a nearly rate-independent, strongly thinning fiber takes

@@ -644,7 +644,8 @@ pub fn scan_profile(
 /// at strength `v`, from the material law `law` and the warm start `from` (its solutions,
 /// take-up factors and the other effects' strengths), stopped at [`GRID_TOLERANCE`]. From a
 /// law below [`COLD_FALLBACK_MIN_N`] a failed warm start is not followed by a cold start: the
-/// point is fitted from the plausible law `restart` instead (where given).
+/// point is fitted from the plausible law `restart` instead (where given; other errors, such
+/// as a cancellation, are returned as they are).
 fn grid_fit(
     vrh: &mut Rheometer,
     slot: usize,
@@ -670,13 +671,17 @@ fn grid_fit(
                 },
                 ..options.clone()
             };
-            fit_warm(vrh, &start, &from.take_up, &no_cold, true).or_else(|_| {
-                let start = FitStart {
-                    law: plausible,
-                    ..start.clone()
-                };
-                fit_warm(vrh, &start, &from.take_up, options, true)
-            })
+            match fit_warm(vrh, &start, &from.take_up, &no_cold, true) {
+                // a start solve failed (not, e.g., a cancellation): from the plausible law
+                Err(RheometerError::Simulation { .. }) => {
+                    let start = FitStart {
+                        law: plausible,
+                        ..start
+                    };
+                    fit_warm(vrh, &start, &from.take_up, options, true)
+                }
+                other => other,
+            }
         }
         _ => fit_warm(vrh, &start, &from.take_up, options, true),
     };
