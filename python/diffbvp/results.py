@@ -729,7 +729,9 @@ class Diagnosis(Result):
         """The best single candidate that may be named (the forward search's first step), or
         None. A pair that explains the data better replaces it in ``found`` (see ``pair``).
         Under an "ambiguous" verdict it is one of the explanations the data cannot tell apart
-        (the report's words), not the cause: the verdict's ``alternatives`` are as good."""
+        (the report's words), not the cause: the verdict's ``alternatives`` are as good; under
+        "none_of_the_candidates" it is a stand-in or helps only in part (the report says which),
+        not the cause either."""
         return self._data.get("most_likely_missing")
 
     @property

@@ -104,6 +104,24 @@ fn check(sc: &Scenario, e: &Expect) -> (ExperimentSet, DiagnosisRun) {
             sc.name
         );
     }
+    // the named candidate's refit is global: several starts, the report says how many reached
+    // the kept optimum
+    if let Some(c) = d.named() {
+        let [ran, reached] = c.refit_starts;
+        assert!(
+            ran >= 2 && (1..=ran).contains(&reached),
+            "{}: {:?}",
+            sc.name,
+            c.refit_starts
+        );
+        let flat = d.to_text().split_whitespace().collect::<Vec<_>>().join(" ");
+        let words = format!("({reached} of {ran} refit starts reached this optimum)");
+        assert!(
+            flat.contains(&words),
+            "{}: no '{words}' in the report",
+            sc.name
+        );
+    }
     // one noise level: a warning of the user's fit that names the noise names the fit's own
     let level = d.base_fit.noise.describe();
     for w in &d.base_fit.warnings {
@@ -430,6 +448,14 @@ fn strain_hardening_is_none_of_the_candidates() {
     let text = d.to_text();
     assert!(text.contains("NONE OF THE CANDIDATES"), "{text}");
     assert!(!text.contains("With it: n ="), "{text}");
+    // the named candidate is a stand-in, not the cause: the report does not call it the most
+    // likely missing effect
+    let flat = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(!flat.contains("Most likely missing"), "{text}");
+    assert!(
+        flat.contains("Best candidate, a stand-in (not the cause"),
+        "{text}"
+    );
 }
 
 /// Strong hardening (β = 0.3, seed 12002 of `hardening_study`): the Nusselt factor's refit

@@ -84,7 +84,8 @@ pub struct Diagnosis {
     /// The best single candidate that may be named (the first step's, best by `ΔBIC`), if one
     /// earns its place. A pair that explains the data better ([`pair`](Self::pair)) replaces
     /// it in [`found`](Self::found). Under an ambiguous verdict it is one of the explanations
-    /// the data cannot tell apart (the report says so), not the cause.
+    /// the data cannot tell apart, and under "none of the candidates" a stand-in or a partial
+    /// explanation (the report says which), not the cause.
     pub most_likely_missing: Option<String>,
     /// Other candidates about as consistent with the data as the named one: they earn their
     /// place too, with a `ΔBIC` less than the tie margin above the named one's (best first;

@@ -151,6 +151,19 @@ impl Diagnosis {
         } else if ambiguous && exact.is_empty() {
             "One of the explanations the verdict cannot tell apart (the forward search's):"
                 .to_string()
+        } else if let (true, Verdict::NoneOfTheCandidates { stand_ins, .. }) =
+            (exact.is_empty(), &self.verdict)
+        {
+            // the verdict says that something else is missing: the named candidate is no cause
+            if stand_ins.iter().any(|c| c.effect == name) {
+                "Best candidate, a stand-in (not the cause: its strength differs between the \
+                 experiments, see the verdict):"
+                    .to_string()
+            } else {
+                "Helps most, but does not explain the data (something none of the candidates \
+                 describes is missing, see the verdict):"
+                    .to_string()
+            }
         } else if exact.is_empty() {
             "Most likely missing:".to_string()
         } else {
@@ -165,7 +178,7 @@ impl Diagnosis {
             "{lead} {name}{}. Its signature lies along s = {} (strongest at {:.2} m). \
              Adding it removes {:.1} % of the misfit ({:.0} % of the excess over the noise; \
              false-alarm probability of the search {}) (J {:.4e} -> {:.4e}), RMS {:.3} % -> {:.3} %, \
-             delta BIC = {:.1}, delta AIC = {:.1}; fitted strength {}.\n",
+             delta BIC = {:.1}, delta AIC = {:.1}; fitted strength {}{}.\n",
             super::super::ties::or_alternatives(&self.alternatives),
             fmt_range(c.signature_range_m),
             c.signature_peak_m,
@@ -178,7 +191,8 @@ impl Diagnosis {
             100.0 * c.rms_relative_residual_after(),
             c.delta_bic,
             c.delta_aic,
-            pm_unit(c.strength(), c.stderr_strength(), &c.unit)
+            pm_unit(c.strength(), c.stderr_strength(), &c.unit),
+            starts_reached(c.refit_starts)
         ));
         if let Some(b) = c.at_bound().iter().find(|b| b.parameter == c.effect) {
             s.push_str(&format!(
@@ -525,4 +539,16 @@ fn law_line(effects: &str, note: &str, f: &FitSummary) -> String {
         estimate_with_ci_bounds(&f.at_bound, "kappa", f.kappa.value, f.kappa.ci95),
         100.0 * f.rms_relative_residual
     )
+}
+
+/// How many of a candidate's refit starts reached its best cost, in words (`refit_starts` =
+/// `[ran, reached]`; empty without refit): a best reached from one start of many is a sign of a
+/// rugged landscape.
+fn starts_reached(refit_starts: [usize; 2]) -> String {
+    let [ran, reached] = refit_starts;
+    if ran == 0 {
+        String::new()
+    } else {
+        format!(" ({reached} of {ran} refit starts reached this optimum)")
+    }
 }
