@@ -1221,7 +1221,12 @@ impl<H: NusseltLaw> Physics<H> {
 
     /// Unscaled dimensionless value of one term (force per length in units of `f_o` or heat
     /// per length in units of `h_o`).
-    #[inline]
+    ///
+    /// Out of line on purpose: inlined into the right-hand side's loop over the terms (as
+    /// `#[inline]` asked), the `f64` right-hand side took 66 ns per point; called, 53 ns, and the
+    /// dense dual passes 4–6 % less (criterion, `fiber_rhs_*`); the 101×101 landscape 0.83 and
+    /// `diagnose` 0.92 of the time. A fat-LTO build had found this by itself.
+    #[inline(never)]
     pub fn term_value<D: DualNum<Primitive = f64> + Copy>(
         &self,
         term: &Term,
@@ -1253,27 +1258,40 @@ impl<H: NusseltLaw> Physics<H> {
                 let ta2 = st.t_air * st.t_air;
                 -st.d * (t2 * t2 - ta2 * ta2) * (co.radiation * emissivity)
             }
-            TermKind::Custom(f) => {
-                let si = &co.si;
-                let args = [
-                    st.u * si.velocity,
-                    st.n * si.force,
-                    st.t * si.temperature,
-                    st.rate * si.strain_rate,
-                    st.d * si.diameter,
-                    st.rho * si.density,
-                    st.cp * si.heat_capacity,
-                    st.t_air * si.temperature,
-                    st.v_air * si.velocity,
-                ];
-                let v = eval_dyn(f.as_ref(), st.s * si.length, &args[..SI_ARGS]);
-                let scale = match term.balance {
-                    Balance::Momentum => co.force_per_length,
-                    Balance::Energy => co.heat_per_length,
-                };
-                v * (1.0 / scale)
-            }
+            TermKind::Custom(f) => Self::custom_term_value(f.as_ref(), term.balance, st, co),
         }
+    }
+
+    /// The value of a user-written term (dimensionless, as [`term_value`](Self::term_value)):
+    /// its SI arguments, [`eval_dyn`], scaled back. Out of line: inlined into the right-hand
+    /// side, its argument array made the right-hand side of every model (with or without user
+    /// terms) slower.
+    #[cold]
+    #[inline(never)]
+    fn custom_term_value<D: DualNum<Primitive = f64> + Copy>(
+        f: &dyn DynDualScalarFn,
+        balance: Balance,
+        st: &LocalState<D>,
+        co: &Coefficients,
+    ) -> D {
+        let si = &co.si;
+        let args = [
+            st.u * si.velocity,
+            st.n * si.force,
+            st.t * si.temperature,
+            st.rate * si.strain_rate,
+            st.d * si.diameter,
+            st.rho * si.density,
+            st.cp * si.heat_capacity,
+            st.t_air * si.temperature,
+            st.v_air * si.velocity,
+        ];
+        let v = eval_dyn(f, st.s * si.length, &args[..SI_ARGS]);
+        let scale = match balance {
+            Balance::Momentum => co.force_per_length,
+            Balance::Energy => co.heat_per_length,
+        };
+        v * (1.0 / scale)
     }
 
     /// `(Σ F_k, Σ H_k)`: total dimensionless force and heat gain per length with strength
