@@ -373,12 +373,17 @@ def _previous(start_from: Union[None, FitResult, Diagnosis, Mapping[str, Any], P
 def landscape(dataset: Union[Dataset, PathLike], *, grid: Tuple[int, int] = (41, 41),
               n_range: Tuple[float, float] = (0.0, 1.0),
               kappa_range: Tuple[float, float] = (9.0, 16.0), estimator: str = "paper",
-              tol: float = 1e-4, max_nodes: Optional[int] = None) -> Landscape:
+              tol: float = 1e-4, max_nodes: Optional[int] = None,
+              uniform_tol: bool = False) -> Landscape:
     """The cost J(n, κ) on a grid (paper Fig. 4), as ``rheometer landscape``: ``grid`` =
-    (number of n values, number of κ values); ``tol``: BVP tolerance (a picture; fits use
-    1e-6). Ctrl-C stops it between grid points (``KeyboardInterrupt``)."""
+    (number of n values, number of κ values); ``tol``: BVP tolerance (a picture: fits check
+    their own discretisation). Points whose row neighbour's cost is more than twice their row's
+    lowest are solved at ten times ``tol`` (at most 1e-3; their costs to a few 1e-4 relative),
+    unless ``uniform_tol``; the result's ``point_tol`` array says which. Ctrl-C stops it between grid
+    points (``KeyboardInterrupt``)."""
     d = _native.landscape(_ds(dataset), grid=(int(grid[0]), int(grid[1])),
                           n_range=(float(n_range[0]), float(n_range[1])),
                           kappa_range=(float(kappa_range[0]), float(kappa_range[1])),
-                          estimator=estimator, tol=tol, max_nodes=max_nodes)
+                          estimator=estimator, tol=tol, max_nodes=max_nodes,
+                          uniform_tol=bool(uniform_tol))
     return Landscape(d)

@@ -806,7 +806,8 @@ class Diagnosis(Result):
 class Landscape(Result):
     """The outcome of :func:`diffbvp.landscape`: grid vectors ``n`` and ``kappa``, ``cost``
     J(n, κ) as a (len(kappa) × len(n)) array (nan where no solution), ``status`` (0 computed, 1
-    failed, 2 not computed), ``minimum`` (n, κ, J) of the grid."""
+    failed, 2 not computed), ``point_tol`` (the BVP tolerance of each cost, nan where none;
+    ``tol`` is the landscape's own), ``minimum`` (n, κ, J) of the grid."""
 
     __slots__ = ()
 
@@ -819,11 +820,15 @@ class Landscape(Result):
         )
 
     def table(self) -> Dict[str, np.ndarray]:
-        """Long table: ``n``, ``kappa``, ``cost``, ``status`` (n varying fastest)."""
+        """Long table: ``n``, ``kappa``, ``cost``, ``status``, ``tol`` (each cost's BVP
+        tolerance; the CSV's columns, n varying fastest)."""
         n, k = np.meshgrid(self._data["n"], self._data["kappa"])
         return {
             "n": n.ravel(),
             "kappa": k.ravel(),
             "cost": np.asarray(self._data["cost"]).ravel(),
             "status": np.asarray(self._data["status"]).ravel(),
+            "tol": np.asarray(
+                self._data.get("point_tol", np.full(np.shape(self._data["cost"]), np.nan))
+            ).ravel(),
         }

@@ -8,7 +8,7 @@ use crate::errors::{input_error, to_py_err};
 use crate::options;
 use crate::run::interruptible;
 use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;
-use diffbvp::fiber::rheometer::{IdentifyOptions, PointStatus};
+use diffbvp::fiber::rheometer::{FarRule, IdentifyOptions, PointStatus};
 use diffbvp::fiber::workflow::{self, LandscapeRequest};
 use diffbvp::mesh::linspace;
 use pyo3::prelude::*;
@@ -21,10 +21,12 @@ const MAX_GRID_POINTS: usize = 100_000;
 
 /// Computes `J(n, κ)` on a `grid = (number of n values, number of κ values)` grid. Returns
 /// `{"n", "kappa", "cost": (κ × n) array, "status": (κ × n) array of 0 ok / 1 failed / 2 not
-/// computed, "estimator", "minimum": (n, κ, J) | None}`.
+/// computed, "point_tol": (κ × n) array of each cost's BVP tolerance (NaN where none),
+/// "estimator", "tol", "minimum": (n, κ, J) | None, "cancelled"}`. `uniform_tol`: every point at `tol` (default: points far from
+/// their row's minimum at ten times `tol`, at most 1e-3, as `rheometer landscape`).
 #[pyfunction]
 #[pyo3(signature = (dataset, *, grid=(41, 41), n_range=(0.0, 1.0), kappa_range=(9.0, 16.0),
-    estimator="paper", tol=1e-4, max_nodes=None))]
+    estimator="paper", tol=1e-4, max_nodes=None, uniform_tol=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn landscape<'py>(
     py: Python<'py>,
@@ -35,6 +37,7 @@ pub fn landscape<'py>(
     estimator: &str,
     tol: f64,
     max_nodes: Option<usize>,
+    uniform_tol: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut opts = IdentifyOptions::with_estimator(options::estimator(estimator)?);
     options::check_range("n_range", "n", n_range, [opts.lower[0], opts.upper[0]])?;
@@ -73,6 +76,7 @@ pub fn landscape<'py>(
         n: linspace(n_range.0, n_range.1, a),
         kappa: linspace(kappa_range.0, kappa_range.1, b),
         identify: opts,
+        far: uniform_tol.then(FarRule::uniform),
     };
     let (loaded, path) = dataset.data();
     let out = interruptible(py, |cancel| {
@@ -97,6 +101,7 @@ pub fn landscape<'py>(
         "status",
         array2(py, &status, l.kappa.len(), l.n.len())?.call_method1("astype", ("int8",))?,
     )?;
+    d.set_item("point_tol", array2(py, &run.tol, l.kappa.len(), l.n.len())?)?;
     d.set_item("estimator", estimator)?;
     d.set_item("tol", tol)?;
     d.set_item("minimum", l.minimum())?;

@@ -106,13 +106,19 @@ def test_compare_equals_cli_compare_json(rheometer, scratch, pmma_fit):
 
 def test_landscape_equals_cli_csv(rheometer, scratch):
     out = scratch / "land"
-    p = run_cli(rheometer, "landscape", str(PMMA), "--grid", "4x3", "--n-range", "0.6,1",
+    p = run_cli(rheometer, "landscape", str(PMMA), "--grid", "5x3", "--n-range", "0.2,1",
                 "--kappa-range", "10,13", "--out", str(out))
     assert p.returncode == 0, p.stderr
-    rows = [l.split(",") for l in (out / "landscape.csv").read_text().splitlines()[1:]]
-    got = diffbvp.landscape(PMMA, grid=(4, 3), n_range=(0.6, 1.0), kappa_range=(10.0, 13.0))
+    lines = (out / "landscape.csv").read_text().splitlines()
+    assert lines[0] == "n,kappa,cost,status,tol"
+    rows = [l.split(",") for l in lines[1:]]
+    got = diffbvp.landscape(PMMA, grid=(5, 3), n_range=(0.2, 1.0), kappa_range=(10.0, 13.0))
     t = got.table()
-    assert len(rows) == 12 == len(t["cost"])
-    for r, n, k, c in zip(rows, t["n"], t["kappa"], t["cost"]):
+    assert len(rows) == 15 == len(t["cost"]) == len(t["tol"])
+    assert got.tol == 1e-4 and got.point_tol.shape == (3, 5)
+    for r, n, k, c, tol in zip(rows, t["n"], t["kappa"], t["cost"], t["tol"]):
         assert float(r[0]) == n and float(r[1]) == k
         assert float(r[2]) == pytest.approx(c, rel=1e-12)
+        assert float(r[4]) == tol or (np.isnan(tol) and r[4] == "NaN")
+    # the minimum's neighbourhood at --tol, points far from it (n = 0.2) at ten times --tol
+    assert set(float(r[4]) for r in rows if r[3] == "ok") == {1e-4, 1e-3}

@@ -3,7 +3,7 @@
 //! truth of the synthetic data, and the strongly strain-thinning corner is marked missing.
 
 use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{Estimator, IdentifyOptions, Rheometer};
+use diffbvp::fiber::rheometer::{Estimator, FarRule, IdentifyOptions, Rheometer};
 use std::path::Path;
 
 #[test]
@@ -70,8 +70,10 @@ fn a_landscape_keeps_its_sample_rows_unchanged() {
     let ns = [1.0, 0.8, 0.6, 0.4, 0.0];
     let ks = [10.0, 11.0, 11.71, 12.5, 13.0];
     let never = AtomicBool::new(false);
+    let bits = |c: &[f64]| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     let plain = rh.landscape_with(&ns, &ks, &o, |_| {}, &never).unwrap();
-    let sample = rh.landscape_sample(&ns, &ks, &o, &never).unwrap();
+    let far = FarRule::for_tol(o.simulate.tol);
+    let sample = rh.landscape_sample(&ns, &ks, &o, far, &never).unwrap();
     assert_eq!(sample.rows(), 3, "the smallest, middle and largest kappa");
     assert!(sample.row_s() > 0.0 && sample.remaining_s(2) > 0.0);
     let mut progress = Vec::new();
@@ -81,8 +83,63 @@ fn a_landscape_keeps_its_sample_rows_unchanged() {
     assert_eq!(progress.first(), Some(&(3 * ns.len())));
     assert_eq!(progress.last(), Some(&(ks.len() * ns.len())));
     assert_eq!(kept.status, plain.status);
+    assert_eq!(bits(&kept.tol), bits(&plain.tol));
     assert!(kept.status.contains(&PointStatus::Failed));
-    let bits = |c: &[f64]| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&kept.landscape.cost), bits(&plain.landscape.cost));
     assert_eq!(kept.landscape.kappa, ks);
+}
+
+/// Points far from their row's minimum (the cost before them more than twice the row's lowest
+/// so far) are solved at ten times the tolerance, and say so; every point before the first far
+/// one of its row is computed exactly as with one tolerance for all, and the far costs move by
+/// less than 1e-3 relative.
+#[test]
+fn far_points_are_solved_looser_and_the_rest_as_with_one_tolerance() {
+    use diffbvp::fiber::rheometer::PointStatus;
+    use std::sync::atomic::AtomicBool;
+    assert_eq!(FarRule::for_tol(1e-4).tol, 1e-3);
+    assert_eq!(FarRule::for_tol(1e-6).tol, 1e-5);
+    assert_eq!(
+        FarRule::for_tol(1e-2).tol,
+        1e-2,
+        "never tighter than the landscape's"
+    );
+    let set = load_experiments(Path::new("data/pmma7n_synthetic/experiments.toml")).unwrap();
+    let rh = Rheometer::new(&set).unwrap();
+    let mut o = IdentifyOptions::with_estimator(Estimator::Paper);
+    o.simulate.tol = 1e-4;
+    let ns = [1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2];
+    let ks = [11.0, 12.5];
+    let never = AtomicBool::new(false);
+    let ruled = rh.landscape_with(&ns, &ks, &o, |_| {}, &never).unwrap();
+    let uniform = rh
+        .landscape_ruled(&ns, &ks, &o, FarRule::uniform(), |_| {}, &never)
+        .unwrap();
+    assert!(uniform.tol.iter().all(|&t| t == 1e-4), "{:?}", uniform.tol);
+    let (mut near, mut far) = (0, 0);
+    for j in 0..ks.len() {
+        let row = |v: &[f64]| v[j * ns.len()..(j + 1) * ns.len()].to_vec();
+        let (cost, tol, plain) = (
+            row(&ruled.landscape.cost),
+            row(&ruled.tol),
+            row(&uniform.landscape.cost),
+        );
+        let (mut row_min, mut last, mut far_yet) = (f64::INFINITY, f64::NAN, false);
+        for i in 0..ns.len() {
+            assert_eq!(ruled.status[j * ns.len() + i], PointStatus::Computed);
+            let expected = if last > 2.0 * row_min { 1e-3 } else { 1e-4 };
+            assert_eq!(tol[i], expected, "n = {}, kappa = {}", ns[i], ks[j]);
+            far_yet |= expected == 1e-3;
+            if far_yet {
+                far += 1;
+                let rel = (cost[i] - plain[i]).abs() / plain[i];
+                assert!(rel < 1e-3, "n = {}: {} vs {}", ns[i], cost[i], plain[i]);
+            } else {
+                near += 1;
+                assert_eq!(cost[i].to_bits(), plain[i].to_bits(), "n = {}", ns[i]);
+            }
+            (last, row_min) = (cost[i], row_min.min(cost[i]));
+        }
+    }
+    assert!(near >= 6 && far >= 4, "near {near}, far {far}");
 }

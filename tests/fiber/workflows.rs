@@ -203,6 +203,7 @@ fn landscape_reproduces_the_program() {
         n: vec![0.6, 0.75, 0.9],
         kappa: vec![11.0, 12.0],
         identify,
+        far: None,
     };
     let lib = workflow::landscape(&data, &request, |_| {}, &AtomicBool::new(false)).unwrap();
     // both in the order n fastest

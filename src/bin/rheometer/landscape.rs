@@ -23,6 +23,12 @@ pub struct LandscapeArgs {
     /// check the discretisation).
     #[arg(long, default_value_t = 1e-4, allow_hyphen_values = true, value_parser = checks::parse_tol)]
     pub tol: f64,
+    /// Solve every point at --tol. Default: a point whose row neighbour's cost is more than
+    /// twice its row's lowest is solved at ten times --tol (at most 1e-3; its cost to a few
+    /// 1e-4 relative), the minimum and the costs near it at --tol; the CSV's column tol says
+    /// which.
+    #[arg(long)]
+    pub uniform_tol: bool,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
@@ -37,6 +43,7 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         kappa_range,
         estimator: est,
         tol,
+        uniform_tol,
         out,
     } = args;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
@@ -67,7 +74,12 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let ks = linspace(kappa_range.0, kappa_range.1, grid.1);
     let t0 = std::time::Instant::now();
     // a few rows first, timed: the estimate comes from the real work, and the run keeps them
-    let sample = rh.landscape_sample(&ns, &ks, &opts, &INTERRUPTED)?;
+    let far = if uniform_tol {
+        FarRule::uniform()
+    } else {
+        FarRule::for_tol(tol)
+    };
+    let sample = rh.landscape_sample(&ns, &ks, &opts, far, &INTERRUPTED)?;
     if !g.quiet {
         g.say(checks::landscape_estimate(
             &sample,
@@ -143,11 +155,12 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     Ok(())
 }
 
-/// Writes the landscape as CSV `n,kappa,cost,status`, one row per grid point (`n` varying
-/// fastest); status is `ok`, `failed` (cost NaN: no solution) or `not_computed` (interrupted).
+/// Writes the landscape as CSV `n,kappa,cost,status,tol`, one row per grid point (`n` varying
+/// fastest); status is `ok`, `failed` (cost NaN: no solution) or `not_computed` (interrupted),
+/// `tol` the BVP tolerance of the point's cost (NaN where none was computed).
 fn write_landscape_csv(w: &mut dyn std::io::Write, run: &LandscapeRun) -> std::io::Result<()> {
     let l = &run.landscape;
-    writeln!(w, "n,kappa,cost,status")?;
+    writeln!(w, "n,kappa,cost,status,tol")?;
     for (j, k) in l.kappa.iter().enumerate() {
         for (i, n) in l.n.iter().enumerate() {
             let idx = j * l.n.len() + i;
@@ -158,10 +171,11 @@ fn write_landscape_csv(w: &mut dyn std::io::Write, run: &LandscapeRun) -> std::i
             };
             writeln!(
                 w,
-                "{},{},{:e},{status}",
+                "{},{},{:e},{status},{:e}",
                 checks::show(*n),
                 checks::show(*k),
-                l.cost[idx]
+                l.cost[idx],
+                run.tol[idx]
             )?;
         }
     }

@@ -14,7 +14,7 @@ use diffbvp::fiber::input::{
 };
 use diffbvp::fiber::output::write_profiles_csv;
 use diffbvp::fiber::rheometer::{
-    Estimator, FitSummary, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
+    Estimator, FarRule, FitSummary, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
 };
 use diffbvp::fiber::workflow::{self, CompareRequest, FitRequest, FitRun};
 use diffbvp::fiber::{FiberSolution, SimulateOptions};
@@ -160,8 +160,8 @@ rheometer fit data/pmma7n_synthetic/experiments.toml --newtonian")]
 rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 41x41 --out target/landscape\n  \
 rheometer landscape data/pmma7n_synthetic/experiments.toml --grid 11x11 --n-range 0.6,1 \
 --kappa-range 10,14 --estimator principled --out target/landscape_zoom\n\n\
-Writes DIR/landscape.csv with the columns n,kappa,cost,status (ok, failed or not_computed) \
-and the heat map DIR/landscape.png. Ctrl-C stops it, keeping the finished points (exit code 130).")]
+Writes DIR/landscape.csv with the columns n,kappa,cost,status (ok, failed or not_computed),tol \
+(the BVP tolerance of the point) and the heat map DIR/landscape.png. Ctrl-C stops it, keeping the finished points (exit code 130).")]
     Landscape(landscape::LandscapeArgs),
     /// Compare the model with the measurements: residuals along the spin line, noise level,
     /// chi2/dof, whiteness and where the misfit is systematic; text, JSON, CSV and figures.

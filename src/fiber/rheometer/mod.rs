@@ -71,7 +71,7 @@ pub use estimator::Estimator;
 pub use flow_curve::FlowCurveOptions;
 pub use identification::Identification;
 pub use identify::{StartPoint, PAPER_TABLE3_STARTS};
-pub use landscape::{Landscape, LandscapeRun, LandscapeSample, PointStatus};
+pub use landscape::{FarRule, Landscape, LandscapeRun, LandscapeSample, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
 pub use likelihood::{NewtonianTest, OneSidedBound, ProfileInterval, ProfilePoint, ThinningBound};
 pub use nested::{NestedFit, NestedStart};

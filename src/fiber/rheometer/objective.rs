@@ -16,7 +16,7 @@ use crate::least_squares::{
 };
 use crate::sensitivity::PointFunction;
 use crate::solution::Solution;
-use crate::solve::{Guess, Solver};
+use crate::solve::{GrowthLimit, Guess, Solver};
 use num_dual::DualNum;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -473,6 +473,19 @@ impl<'a> Objective<'a> {
         };
         self.runs.accept_pending();
         Ok(r.iter().map(|v| v * v).sum())
+    }
+
+    /// Sets the BVP tolerance and the mesh growth limit of the next solves of every experiment
+    /// (a landscape's far points, its first attempt at a point); a boundary tolerance of the
+    /// options is kept unless looser than `tol`.
+    pub fn set_solve_accuracy(&mut self, tol: f64, growth_limit: Option<GrowthLimit>) {
+        let bc_tol = self.options.simulate.bc_tol.map(|b| b.max(tol));
+        for r in self.runs.runs_mut() {
+            let o = &mut r.solver_mut().options;
+            o.tol = tol;
+            o.bc_tol = bc_tol;
+            o.growth_limit = growth_limit;
+        }
     }
 
     /// Cost at `(n, κ)` from the current warm starts only (no cold-start fallback); on success

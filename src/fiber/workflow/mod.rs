@@ -37,7 +37,7 @@ use crate::fiber::diagnostics::diagnose::{diagnose as run_diagnosis, DiagnoseOpt
 use crate::fiber::diagnostics::diagnosis::DiagnosisRun;
 use crate::fiber::effects::ModelSpec;
 use crate::fiber::input::LoadedExperiments;
-use crate::fiber::rheometer::{IdentifyOptions, LandscapeRun, Rheometer, RheometerError};
+use crate::fiber::rheometer::{FarRule, IdentifyOptions, LandscapeRun, Rheometer, RheometerError};
 use std::sync::atomic::AtomicBool;
 
 /// Diagnoses which candidate effect is missing from `model` on `data` (see
@@ -60,6 +60,10 @@ pub struct LandscapeRequest {
     pub kappa: Vec<f64>,
     /// The estimator whose cost is mapped, and the BVP settings.
     pub identify: IdentifyOptions,
+    /// The accuracy of the points far from their row's minimum (`None`:
+    /// [`FarRule::for_tol`] of `identify`'s tolerance; [`FarRule::uniform`]: every point at
+    /// that tolerance).
+    pub far: Option<FarRule>,
 }
 
 /// The cost `J(n, κ)` of the paper's model on `request`'s grid; `progress(points done)` is
@@ -72,10 +76,14 @@ pub fn landscape(
     cancel: &AtomicBool,
 ) -> Result<LandscapeRun, RheometerError> {
     let rh = Rheometer::new(&data.set)?;
-    rh.landscape_with(
+    let far = request
+        .far
+        .unwrap_or_else(|| FarRule::for_tol(request.identify.simulate.tol));
+    rh.landscape_ruled(
         &request.n,
         &request.kappa,
         &request.identify,
+        far,
         progress,
         cancel,
     )
