@@ -52,8 +52,10 @@ use std::time::Instant;
 /// nodes except right at the edge of the region where the BVP has a solution).
 pub const LANDSCAPE_MAX_NODES: usize = 1000;
 
-/// How far a landscape solve may refine beyond the mesh it starts from (a neighbour's solution,
-/// or its secant prediction): 8 times its nodes, always 300. A step of the grid changes the
+/// How far a landscape solve may refine beyond the mesh it starts from when a point is retried
+/// by halving its step (from the neighbour's solution; a point's first attempt, from the secant
+/// prediction, has [`LANDSCAPE_FIRST_GROWTH_LIMIT`]): 8 times its nodes, always 300. Until stop
+/// 59 it held for every attempt; the figures below are of that time. A step of the grid changes the
 /// solution's mesh by a few tens of percent except at the edge of the region where the BVP has a
 /// solution, where a failing solve otherwise refines to [`LANDSCAPE_MAX_NODES`] before it fails,
 /// once per row and again in each bisection of the step. On the shipped data's 101×101 grid the

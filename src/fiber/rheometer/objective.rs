@@ -476,8 +476,9 @@ impl<'a> Objective<'a> {
     }
 
     /// Sets the BVP tolerance and the mesh growth limit of the next solves of every experiment
-    /// (a landscape's far points, its first attempt at a point); a boundary tolerance of the
-    /// options is kept unless looser than `tol`.
+    /// (a landscape's far points, its first attempt at a point). A boundary tolerance of the
+    /// objective's options is kept where it is looser than `tol` and raised to `tol` where it
+    /// is tighter; without one the boundary conditions are held to `tol`.
     pub fn set_solve_accuracy(&mut self, tol: f64, growth_limit: Option<GrowthLimit>) {
         let bc_tol = self.options.simulate.bc_tol.map(|b| b.max(tol));
         for r in self.runs.runs_mut() {
