@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""The import graph of src/: every `crate::`, `super::` and `self::` path in the code (use
-statements and paths in expressions, comments and strings left out), resolved to the file it
-names, checked against the Layers section of src/lib.rs.
+"""The import graph of each library crate of the workspace (crates/diffbvp, crates/rheometer):
+every `crate::`, `super::` and `self::` path in the code (use statements and paths in
+expressions, comments and strings left out), resolved to the file it names, checked against
+the Layers section of that crate's src/lib.rs. (That the toolkit never imports the rheometer
+the compiler keeps: `diffbvp` does not depend on `rheometer`.)
 
 Checks:
-  1. the Layers section lists every module of the toolkit and of `fiber` (no module missing,
-     none listed that does not exist);
+  1. the Layers section lists every top-level module of the crate (no module missing, none
+     listed that does not exist);
   2. no upward arrow: a module imports only from its own layer or the layers below it;
   3. no circle: no two files import each other, directly or through others;
   4. (report) the import circles between modules of the same layer.
@@ -18,19 +20,17 @@ import re
 import sys
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-SRC = os.path.join(ROOT, "src")
+CRATES = ["crates/diffbvp", "crates/rheometer"]
 
 
-def module_files():
-    """{module path tuple: file} for the library (src/bin is a separate crate)."""
+def module_files(src):
+    """{module path tuple: file} for the library crate whose sources are in `src`."""
     mods = {}
-    for dirpath, _, files in os.walk(SRC):
-        if os.path.relpath(dirpath, SRC).split(os.sep)[0] == "bin":
-            continue
+    for dirpath, _, files in os.walk(src):
         for f in files:
             if not f.endswith(".rs"):
                 continue
-            rel = os.path.relpath(os.path.join(dirpath, f), SRC)[:-3].split(os.sep)
+            rel = os.path.relpath(os.path.join(dirpath, f), src)[:-3].split(os.sep)
             if rel == ["lib"]:
                 path = ()
             elif rel[-1] == "mod":
@@ -118,51 +118,42 @@ def resolve(path, here, mods):
     return best
 
 
-def layers():
-    """{unit: layer} from the Layers section of src/lib.rs: toolkit units are top-level
-    module names, fiber units `fiber::NAME` (layer numbers of the fiber list offset by 100)."""
-    text = open(os.path.join(SRC, "lib.rs"), encoding="utf-8").read()
+def layers(src):
+    """{unit: layer} from the Layers section of the crate's src/lib.rs (units are top-level
+    module names)."""
+    text = open(os.path.join(src, "lib.rs"), encoding="utf-8").read()
     doc = "\n".join(l[4:] if l.startswith("//! ") else l[3:] for l in text.splitlines() if l.startswith("//!"))
     sec = doc.split("## Layers", 1)[1].split("\n## ", 1)[0]
-    toolkit, fiber = sec.split("The fiber model and rheometer", 1)
     out = {}
-    for part, offset, prefix in ((toolkit, 0, ()), (fiber, 100, ("fiber",))):
-        for m in re.finditer(r"^(\d+)\.\s+(.*?)(?=^\d+\.|\Z)", part, flags=re.S | re.M):
-            layer = offset + int(m.group(1))
-            # the names outside parentheses ("`rheometer` (inside: ...)" explains, links
-            # "[`solve`](mod@solve)" point): nested parentheses removed innermost first
-            body = m.group(2).split("\n\n", 1)[0]
-            while True:
-                stripped = re.sub(r"\([^()]*\)", "", body)
-                if stripped == body:
-                    break
-                body = stripped
-            names = re.findall(r"`([\w:]+)`", body)
-            for n in names:
-                out[prefix + tuple(n.split("::"))] = layer
-    # `plot` and `atomic_write` stand apart (no solver imports): a layer of their own, 0
-    for sentence in re.findall(r"[^.]*stand apart", toolkit):
-        for n in re.findall(r"`(\w+)`", sentence):
-            out[(n,)] = 0
+    for m in re.finditer(r"^(\d+)\.\s+(.*?)(?=^\d+\.|\Z)", sec, flags=re.S | re.M):
+        layer = int(m.group(1))
+        # the names outside parentheses ("`fit` (inside: ...)" explains, links
+        # "[`solve`](mod@solve)" point): nested parentheses removed innermost first
+        body = m.group(2).split("\n\n", 1)[0]
+        while True:
+            stripped = re.sub(r"\([^()]*\)", "", body)
+            if stripped == body:
+                break
+            body = stripped
+        for n in re.findall(r"`([\w:]+)`", body):
+            out[tuple(n.split("::"))] = layer
     return out
 
 
 def unit_of(mod):
-    if not mod:
-        return None
-    if mod[0] == "fiber":
-        return mod[:2] if len(mod) >= 2 else None
-    return mod[:1]
+    return mod[:1] if mod else None
 
 
-def main():
-    mods = module_files()
-    lay = layers()
+def check(crate):
+    """The findings of one crate, printed; 0 when clean, 1 otherwise."""
+    src = os.path.join(ROOT, crate, "src")
+    mods = module_files(src)
+    lay = layers(src)
     problems = []
     units = {unit_of(m) for m in mods if unit_of(m)}
     for u in sorted(units):
         if u not in lay:
-            problems.append(f"module {'::'.join(u)} is not in the Layers section of src/lib.rs")
+            problems.append(f"module {'::'.join(u)} is not in the Layers section of {crate}/src/lib.rs")
     for u in sorted(lay):
         if u not in units:
             problems.append(f"the Layers section lists {'::'.join(u)}, which does not exist")
@@ -186,9 +177,7 @@ def main():
             la, lb = lay.get(ua), lay.get(ub)
             if la is None or lb is None:
                 continue
-            if (la >= 100) != (lb >= 100) and lb >= 100:
-                problems.append(f"the toolkit module {'::'.join(a)} imports fiber's {'::'.join(b)}")
-            elif lb > la and not (la == 0 and lb == 0):
+            if lb > la:
                 problems.append(
                     f"upward arrow: {'::'.join(a)} (layer {la}) imports {'::'.join(b)} (layer {lb})"
                 )
@@ -232,13 +221,17 @@ def main():
         return 0
     n_edges = sum(len(t) for t in edges.values())
     if problems:
-        print(f"import graph: {len(mods)} modules, {n_edges} arrows; {len(problems)} problems:")
+        print(f"import graph of {crate}: {len(mods)} modules, {n_edges} arrows; {len(problems)} problems:")
         for p in problems:
             print("  - " + p)
         return 1
-    print(f"import graph: {len(mods)} modules, {n_edges} arrows; no circle, no upward arrow, "
-          f"the Layers section of src/lib.rs lists all {len(units)} units")
+    print(f"import graph of {crate}: {len(mods)} modules, {n_edges} arrows; no circle, no upward "
+          f"arrow, the Layers section of its src/lib.rs lists all {len(units)} units")
     return 0
+
+
+def main():
+    return max(check(c) for c in CRATES)
 
 
 if __name__ == "__main__":

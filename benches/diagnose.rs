@@ -3,9 +3,9 @@
 //! the best grid points)) on the 9 shipped experiments. Target: < 10 s median on 2 cores.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
-use diffbvp::fiber::effects::ModelSpec;
-use diffbvp::fiber::input::load_experiments;
+use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions};
+use rheometer::effects::ModelSpec;
+use rheometer::input::load_experiments;
 use std::hint::black_box;
 use std::path::Path;
 

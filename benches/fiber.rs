@@ -4,10 +4,10 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use diffbvp::continuation::ContinuationOptions as AdapterOptions;
-use diffbvp::fiber::cold_start::StepControl;
-use diffbvp::fiber::setup::{Air, Experiment, Material};
-use diffbvp::fiber::simulate::simulate_from;
-use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions, Simulator};
+use rheometer::cold_start::StepControl;
+use rheometer::setup::{Air, Experiment, Material};
+use rheometer::simulate::simulate_from;
+use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions, Simulator};
 use std::hint::black_box;
 
 fn model() -> FiberModel<CarreauLike> {

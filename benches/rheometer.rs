@@ -3,9 +3,9 @@
 //! an 11×11 cost landscape (paper's estimator, n ∈ [0, 1], κ ∈ [9, 16], tol 1e-4 as the CLI).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{Estimator, IdentifyOptions, Rheometer};
 use diffbvp::mesh::linspace;
+use rheometer::input::load_experiments;
+use rheometer::rheometer::{Estimator, IdentifyOptions, Rheometer};
 use std::hint::black_box;
 use std::path::Path;
 

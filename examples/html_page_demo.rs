@@ -11,8 +11,8 @@
 
 use std::path::PathBuf;
 
-use diffbvp::html_page::{HtmlPage, Table, Tone};
-use diffbvp::plot::{
+use rheometer::html_page::{HtmlPage, Table, Tone};
+use rheometer::plot::{
     flow_curve_svg, panels_svg, save_flow_curve, save_panels, FlowCurvePlot, Panel,
     ReferencePoints, Series,
 };

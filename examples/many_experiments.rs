@@ -13,10 +13,10 @@
 //! from a SplitMix64 stream seeded with `seed` (default 1). Prints the planned cost, the
 //! progress on stderr, then the estimate with its standard errors and the time of each phase.
 
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{FitProgress, IdentifyOptions, ProgressHook, Rheometer};
-use diffbvp::fiber::setup::{ExperimentSet, Measurements};
-use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
+use rheometer::input::load_experiments;
+use rheometer::rheometer::{FitProgress, IdentifyOptions, ProgressHook, Rheometer};
+use rheometer::setup::{ExperimentSet, Measurements};
+use rheometer::synthetic::{NoiseModel, SplitMix64};
 use std::error::Error;
 use std::path::Path;
 use std::time::Instant;

@@ -11,12 +11,12 @@
 //!
 //! `cargo run --release --example missing_physics [-- OUT_DIR]`
 
-use diffbvp::fiber::diagnostics::compare::FigureFormat;
-use diffbvp::fiber::diagnostics::diagnose::DiagnoseOptions;
-use diffbvp::fiber::effects::{EffectSetting, ModelSpec};
-use diffbvp::fiber::input::load_experiments_with;
-use diffbvp::fiber::rheometer::IdentifyOptions;
-use diffbvp::fiber::workflow::{self, CompareRequest, FitRequest};
+use rheometer::diagnostics::compare::FigureFormat;
+use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::effects::{EffectSetting, ModelSpec};
+use rheometer::input::load_experiments_with;
+use rheometer::rheometer::IdentifyOptions;
+use rheometer::workflow::{self, CompareRequest, FitRequest};
 use std::error::Error;
 use std::path::{Path, PathBuf};
 

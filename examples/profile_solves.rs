@@ -7,16 +7,16 @@
 //! what a fit does), `fiber_candidates` the fiber with every built-in candidate effect carried
 //! at neutral strength, as `diagnose` solves it.
 
-use diffbvp::fiber::effects::{Effect, ModelSpec};
-use diffbvp::fiber::setup::{Air, Experiment, Material};
-use diffbvp::fiber::simulate::simulate_from;
-use diffbvp::fiber::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use diffbvp::mesh::linspace;
 use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{solve, Guess, Solution, SolveOptions};
+use rheometer::effects::{Effect, ModelSpec};
+use rheometer::setup::{Air, Experiment, Material};
+use rheometer::simulate::simulate_from;
+use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use std::hint::black_box;
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../crates/diffbvp/tests/common/mod.rs"]
 mod common;
 use common::{Bratu, CoupledTroesch, Shock};
 

@@ -10,13 +10,13 @@
 // `tests/book_examples.rs` includes this file as a module and checks `run()`'s numbers.
 #![allow(dead_code)]
 
-use diffbvp::fiber::contributions::STEFAN_BOLTZMANN;
-use diffbvp::fiber::setup::{Air, Experiment, Inlet, Material, TakeUp};
-use diffbvp::fiber::{
+use diffbvp::DualNum;
+use rheometer::contributions::STEFAN_BOLTZMANN;
+use rheometer::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use rheometer::{
     simulate, Balance, CarreauLike, FiberError, FiberModel, FiberTerm, Physics, Profiles, SiState,
     SimulateOptions,
 };
-use diffbvp::DualNum;
 use std::f64::consts::PI;
 
 // ANCHOR: term

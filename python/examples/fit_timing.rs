@@ -4,10 +4,10 @@
 //! `cargo run --release -p diffbvp-python --example fit_timing -- [RUNS] [EXPERIMENTS.toml]`
 //! prints one wall time per run (s) and the median, then `n kappa` of the last fit.
 
-use diffbvp::fiber::input::load_experiments_with;
-use diffbvp::fiber::rheometer::IdentifyOptions;
-use diffbvp::fiber::workflow::{fit, FitRequest};
-use diffbvp::fiber::FiberSolution;
+use rheometer::input::load_experiments_with;
+use rheometer::rheometer::IdentifyOptions;
+use rheometer::workflow::{fit, FitRequest};
+use rheometer::FiberSolution;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

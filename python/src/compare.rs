@@ -7,11 +7,11 @@ use crate::dataset::Dataset;
 use crate::errors::{input_error, to_py_err};
 use crate::options;
 use crate::run::interruptible;
-use diffbvp::fiber::diagnostics::compare::MissingTakeUp;
-use diffbvp::fiber::rheometer::FitSummary;
-use diffbvp::fiber::workflow::{self, CompareRequest};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rheometer::diagnostics::compare::MissingTakeUp;
+use rheometer::rheometer::FitSummary;
+use rheometer::workflow::{self, CompareRequest};
 
 /// How a fit given from Python is named in messages.
 const FIT_SOURCE: &str = "the fit";

@@ -4,12 +4,12 @@
 
 use crate::convert::{array1, from_py, vec_f64};
 use crate::errors::{input_error, to_py_err};
-use diffbvp::fiber::input::{
-    load_experiments_with, parse_experiments, parse_measurements, InputError, LoadedExperiments,
-};
-use diffbvp::fiber::setup::{Inlet, TakeUp};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
+use rheometer::input::{
+    load_experiments_with, parse_experiments, parse_measurements, InputError, LoadedExperiments,
+};
+use rheometer::setup::{Inlet, TakeUp};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -117,14 +117,14 @@ fn build(
             }
             None => match &loaded.details[k].data {
                 Some(file) => Some(
-                    diffbvp::fiber::input::load_measurements(file, e.spinline_length, MIN_POINTS)
+                    rheometer::input::load_measurements(file, e.spinline_length, MIN_POINTS)
                         .map_err(|err| {
-                        input_error(format!(
-                            "{}: experiment \"{}\": {err}",
-                            path.display(),
-                            e.name
-                        ))
-                    })?,
+                            input_error(format!(
+                                "{}: experiment \"{}\": {err}",
+                                path.display(),
+                                e.name
+                            ))
+                        })?,
                 ),
                 None => None,
             },

@@ -3,7 +3,7 @@
 //! calibration) goes to Python through its serde JSON form, with the residual arrays of the
 //! base and the final fit besides.
 //!
-//! [`Diagnosis`]: diffbvp::fiber::diagnostics::diagnosis::Diagnosis
+//! [`Diagnosis`]: rheometer::diagnostics::diagnosis::Diagnosis
 
 use crate::convert::serde_to_py;
 use crate::dataset::Dataset;
@@ -11,11 +11,11 @@ use crate::errors::{input_error, to_py_err};
 use crate::fit::identification_arrays;
 use crate::options;
 use crate::run::interruptible;
-use diffbvp::fiber::diagnostics::diagnose::DiagnoseOptions;
-use diffbvp::fiber::effects::{Effect, ModelSpec};
-use diffbvp::fiber::workflow;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::effects::{Effect, ModelSpec};
+use rheometer::workflow;
 
 /// Searches the candidate effects for what the model misses, as `rheometer diagnose`.
 /// Returns `{"diagnosis": Diagnosis as dict, "text": the report, "base_arrays": {...},

@@ -2,14 +2,14 @@
 //! `InputError`, `SimulationError`, `FitError`), with the CLI's text: the message, its causes
 //! (`caused by: ...`) and the hints of a failed simulation (`hint: ...`), each on its own line.
 
-use diffbvp::fiber::diagnostics::compare::CompareError;
-use diffbvp::fiber::failure_hints::{failed_experiment, name_experiment, ExperimentFailure};
-use diffbvp::fiber::input::{InputError, LoadedExperiments};
-use diffbvp::fiber::rheometer::RheometerError;
 use diffbvp::least_squares::FitError;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::types::PyType;
+use rheometer::diagnostics::compare::CompareError;
+use rheometer::failure_hints::{failed_experiment, name_experiment, ExperimentFailure};
+use rheometer::input::{InputError, LoadedExperiments};
+use rheometer::rheometer::RheometerError;
 use std::error::Error;
 use std::path::Path;
 
@@ -94,7 +94,7 @@ fn kind_of(e: &(dyn Error + 'static)) -> &'static str {
             _ => "SimulationError",
         };
     }
-    if e.downcast_ref::<diffbvp::fiber::FiberError>().is_some() {
+    if e.downcast_ref::<rheometer::FiberError>().is_some() {
         return "SimulationError";
     }
     if e.downcast_ref::<FitError>().is_some() {

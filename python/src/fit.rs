@@ -7,12 +7,12 @@ use crate::dataset::Dataset;
 use crate::errors::{input_error, to_py_err};
 use crate::options;
 use crate::run::interruptible;
-use diffbvp::fiber::effects::{LawChoice, ModelSpec};
-use diffbvp::fiber::rheometer::{Identification, IdentifyOptions, Rheometer};
-use diffbvp::fiber::workflow::{self, FitRequest};
-use diffbvp::fiber::{FiberSolution, Profiles};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rheometer::effects::{LawChoice, ModelSpec};
+use rheometer::rheometer::{Identification, IdentifyOptions, Rheometer};
+use rheometer::workflow::{self, FitRequest};
+use rheometer::{FiberSolution, Profiles};
 
 /// Profiles as a dict of numpy arrays (SI units in the key names), the named terms under
 /// `terms`.
@@ -28,8 +28,8 @@ pub fn profiles_dict<'py>(py: Python<'py>, p: &Profiles) -> PyResult<Bound<'py, 
     let terms = PyDict::new(py);
     for (name, balance, v) in &p.terms {
         let unit = match balance {
-            diffbvp::fiber::Balance::Momentum => "N_m",
-            diffbvp::fiber::Balance::Energy => "W_m",
+            rheometer::Balance::Momentum => "N_m",
+            rheometer::Balance::Energy => "W_m",
         };
         terms.set_item(format!("{name}_{unit}"), array1(py, v))?;
     }

@@ -7,12 +7,12 @@ use crate::dataset::Dataset;
 use crate::errors::{input_error, to_py_err};
 use crate::options;
 use crate::run::interruptible;
-use diffbvp::fiber::rheometer::landscape::LANDSCAPE_MAX_NODES;
-use diffbvp::fiber::rheometer::{FarRule, IdentifyOptions, PointStatus};
-use diffbvp::fiber::workflow::{self, LandscapeRequest};
 use diffbvp::mesh::linspace;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rheometer::rheometer::landscape::LANDSCAPE_MAX_NODES;
+use rheometer::rheometer::{FarRule, IdentifyOptions, PointStatus};
+use rheometer::workflow::{self, LandscapeRequest};
 
 /// Largest number of values per direction.
 const MAX_GRID_SIDE: usize = 1000;

@@ -1,7 +1,7 @@
 //! `diffbvp._native`: the thin Rust layer of the Python package `diffbvp`.
 //!
 //! Each function checks its arguments as the `rheometer` program checks its flags, calls the
-//! library's workflow ([`diffbvp::fiber::workflow`]: fit, simulate, compare, diagnose,
+//! library's workflow ([`rheometer::workflow`]: fit, simulate, compare, diagnose,
 //! landscape) and hands its result to Python through the result's serde JSON form (one path:
 //! [`convert::serde_to_py`]; dicts, lists, floats) plus numpy arrays for array-valued data;
 //! the Python result classes in `python/diffbvp/` wrap those dicts. Long calls run with the GIL released and stop

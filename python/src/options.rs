@@ -2,10 +2,10 @@
 //! words in the messages).
 
 use crate::errors::input_error;
-use diffbvp::fiber::effects::{EffectSetting, LawChoice};
-use diffbvp::fiber::rheometer::{Estimator, FitSummary, IdentifyOptions};
 use diffbvp::least_squares::Loss;
 use pyo3::prelude::*;
+use rheometer::effects::{EffectSetting, LawChoice};
+use rheometer::rheometer::{Estimator, FitSummary, IdentifyOptions};
 
 /// Smallest `max_nodes` (the cold start begins on a mesh of 21 nodes).
 pub const MIN_MAX_NODES: usize = 50;

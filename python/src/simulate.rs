@@ -8,12 +8,12 @@ use crate::errors::{input_error, CapturedError};
 use crate::fit::profiles_dict;
 use crate::options;
 use crate::run::interruptible;
-use diffbvp::fiber::effects::physics_with;
-use diffbvp::fiber::profile_sensitivities::ProfileSensitivities;
-use diffbvp::fiber::take_up::MissingTakeUp;
-use diffbvp::fiber::workflow::{self, SimulateError, SimulateRequest};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use rheometer::effects::physics_with;
+use rheometer::profile_sensitivities::ProfileSensitivities;
+use rheometer::take_up::MissingTakeUp;
+use rheometer::workflow::{self, SimulateError, SimulateRequest};
 use std::ops::ControlFlow;
 use std::sync::atomic::Ordering;
 

@@ -3,10 +3,10 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use diffbvp::fiber::input::{
+use rheometer::input::{
     load_experiments, load_experiments_with, load_measurements, parse_experiments, InputError,
 };
-use diffbvp::fiber::setup::{Air, ExperimentSet, Inlet, Material, TakeUp};
+use rheometer::setup::{Air, ExperimentSet, Inlet, Material, TakeUp};
 
 const SHIPPED: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

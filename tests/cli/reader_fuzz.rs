@@ -10,9 +10,9 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use diffbvp::fiber::input::{load_experiments_with, parse_experiments, parse_measurements};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
+use rheometer::input::{load_experiments_with, parse_experiments, parse_measurements};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/pmma7n_synthetic");
 
@@ -407,7 +407,7 @@ fn loader_survives_mutated_toml_and_csv_files() {
                 Ok(Err(e)) => {
                     let msg = e.to_string();
                     prop_assert!(msg.starts_with(&toml_path.display().to_string()), "{msg:?}");
-                    if let diffbvp::fiber::input::InputError::Data { cause, .. } = &*e {
+                    if let rheometer::input::InputError::Data { cause, .. } = &*e {
                         let cause = cause.to_string();
                         prop_assert!(cause.contains(".csv"), "{cause:?}");
                     }

@@ -15,11 +15,11 @@
 use crate::independent;
 use crate::shared;
 
-use diffbvp::fiber::diagnostics::diagnose::DiagnoseOptions;
-use diffbvp::fiber::effects::Effect;
 use independent::dataset::Scenario;
 use independent::model::AirFlow;
 use independent::scenarios;
+use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::effects::Effect;
 use std::time::Instant;
 
 /// Seeds per scenario (the scenario's own seed first): 16, or `COVERAGE_SEEDS` from the

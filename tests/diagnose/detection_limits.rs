@@ -19,11 +19,11 @@
 use crate::independent;
 use crate::shared;
 
-use diffbvp::fiber::diagnostics::detection::DetectionLimit;
-use diffbvp::fiber::diagnostics::diagnose::{earns_its_place, DiagnoseOptions, Diagnosis};
-use diffbvp::fiber::rheometer::FitSummary;
 use independent::dataset::{Expected, Faults, Scenario};
 use independent::scenarios;
+use rheometer::diagnostics::detection::DetectionLimit;
+use rheometer::diagnostics::diagnose::{earns_its_place, DiagnoseOptions, Diagnosis};
+use rheometer::rheometer::FitSummary;
 use std::sync::OnceLock;
 
 /// Generates, loads and diagnoses `sc`.

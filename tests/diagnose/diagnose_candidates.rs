@@ -1,14 +1,14 @@
 //! Candidate effects: neutral strengths reproduce the base model exactly, dual-number
 //! derivatives with respect to a strength agree with finite differences, CLI parsing.
 
-use diffbvp::fiber::effects::{
-    Category, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
-};
-use diffbvp::fiber::setup::{Air, Experiment, Material};
-use diffbvp::fiber::simulate::simulate_params;
-use diffbvp::fiber::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
 use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{DualNum, Guess, SolveOptions, Solver};
+use rheometer::effects::{
+    Category, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
+};
+use rheometer::setup::{Air, Experiment, Material};
+use rheometer::simulate::simulate_params;
+use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
 
 fn experiment() -> Experiment {
     Experiment::pmma7n_v0p53_p2()
@@ -163,7 +163,7 @@ fn strength_derivatives_match_finite_differences() {
 
 #[test]
 fn settings_parse_names_and_values() {
-    for name in diffbvp::fiber::effects::BUILTIN_NAMES {
+    for name in rheometer::effects::BUILTIN_NAMES {
         let s: EffectSetting = name.parse().unwrap();
         assert_eq!(s.effect.name(), name);
         assert!(s.value.is_none());

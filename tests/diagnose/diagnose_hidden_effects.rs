@@ -5,13 +5,13 @@
 //! RMS relative residual to within 20% of the noise level and cover the true (n, κ) by the
 //! reported 95% CIs. On data without a hidden effect no candidate may earn its place.
 
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
-use diffbvp::fiber::effects::{Effect, LawChoice, ModelSpec};
-use diffbvp::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
-use diffbvp::fiber::simulate::simulate_params;
-use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
-use diffbvp::fiber::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
 use diffbvp::DualNum;
+use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
+use rheometer::effects::{Effect, LawChoice, ModelSpec};
+use rheometer::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
+use rheometer::simulate::simulate_params;
+use rheometer::synthetic::{NoiseModel, SplitMix64};
+use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
 
 /// 1.5% white noise plus up to 3% extra near the take-up (aspirator disturbance): 3% at
 /// s = 0.50 m.

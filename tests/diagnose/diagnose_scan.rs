@@ -4,16 +4,16 @@
 //! must be reported as not physical and never named as the missing effect; its profile of `J`
 //! must be in the diagnosis.
 
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, StrengthStatus};
-use diffbvp::fiber::effects::{LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
-use diffbvp::fiber::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
-use diffbvp::fiber::simulate::simulate_params;
-use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
-use diffbvp::fiber::SimulateOptions;
-use diffbvp::fiber::{Balance, CarreauLike, FiberModel, FiberTerm, Physics, SiState};
 use diffbvp::DualNum;
+use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, StrengthStatus};
+use rheometer::effects::{LawChoice, ModelSpec};
+use rheometer::input::load_experiments;
+use rheometer::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
+use rheometer::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
+use rheometer::simulate::simulate_params;
+use rheometer::synthetic::{NoiseModel, SplitMix64};
+use rheometer::SimulateOptions;
+use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, Physics, SiState};
 
 /// Grey-body radiation `−π d ε σ (T⁴ − T_air⁴)` \[W/m\] with ε = 1.7, written here, not taken
 /// from the radiation candidate.
@@ -146,8 +146,8 @@ fn hidden_radiation_fit() -> (ExperimentSet, Rheometer, Identification) {
 /// distance, the bound of their noise floor) and its ΔBIC within 0.1.
 #[test]
 fn the_grid_tolerance_moves_no_refit() {
-    use diffbvp::fiber::diagnostics::scan::{scan_candidate, CandidateScan, ScanOptions};
-    use diffbvp::fiber::effects::Effect;
+    use rheometer::diagnostics::scan::{scan_candidate, CandidateScan, ScanOptions};
+    use rheometer::effects::Effect;
 
     let (set, rh, base) = hidden_radiation_fit();
     let opts = IdentifyOptions::default();
@@ -185,7 +185,7 @@ fn the_grid_tolerance_moves_no_refit() {
     }
     assert!(compared >= 3, "{compared} grid points near the user's J");
     let (a, b) = (&loose.refits[0], &tight.refits[0]);
-    let strength = |r: &diffbvp::fiber::diagnostics::scan::Refit| {
+    let strength = |r: &rheometer::diagnostics::scan::Refit| {
         r.identification
             .summary
             .effect("radiation")
@@ -211,11 +211,11 @@ fn the_grid_tolerance_moves_no_refit() {
 /// user's) or the best refit.
 #[test]
 fn the_grid_growth_limit_moves_no_refit() {
-    use diffbvp::fiber::diagnostics::scan::{
+    use diffbvp::GrowthLimit;
+    use rheometer::diagnostics::scan::{
         scan_candidate, CandidateScan, ScanOptions, GRID_GROWTH_LIMIT,
     };
-    use diffbvp::fiber::effects::Effect;
-    use diffbvp::GrowthLimit;
+    use rheometer::effects::Effect;
 
     let (_, rh, base) = hidden_radiation_fit();
     let opts = IdentifyOptions::default();

@@ -21,10 +21,10 @@
 use crate::independent;
 use crate::shared;
 
-use diffbvp::fiber::diagnostics::diagnose::{DiagnoseOptions, Diagnosis};
-use diffbvp::fiber::effects::Effect;
 use independent::dataset::Scenario;
 use independent::scenarios::{self, NOISE_SD};
+use rheometer::diagnostics::diagnose::{DiagnoseOptions, Diagnosis};
+use rheometer::effects::Effect;
 
 /// Diagnoses `sc` with the two rival candidates only.
 fn rivals(sc: &Scenario) -> Diagnosis {

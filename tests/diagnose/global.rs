@@ -10,15 +10,15 @@
 use crate::independent;
 use crate::shared;
 
-use diffbvp::fiber::diagnostics::candidate::earns_its_place;
-use diffbvp::fiber::diagnostics::diagnose::verdict::Verdict;
-use diffbvp::fiber::diagnostics::diagnose::{DiagnoseOptions, DiagnosisRun};
-use diffbvp::fiber::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
-use diffbvp::fiber::rheometer::{FitStart, Rheometer};
-use diffbvp::fiber::setup::ExperimentSet;
 use independent::dataset::{Faults, Scenario};
 use independent::model::AirHeat;
 use independent::scenarios;
+use rheometer::diagnostics::candidate::earns_its_place;
+use rheometer::diagnostics::diagnose::verdict::Verdict;
+use rheometer::diagnostics::diagnose::{DiagnoseOptions, DiagnosisRun};
+use rheometer::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::rheometer::{FitStart, Rheometer};
+use rheometer::setup::ExperimentSet;
 use std::time::Instant;
 
 /// What a scenario must give.
@@ -322,7 +322,7 @@ fn radiation_and_warm_air_never_a_wrong_law() {
     assert!(flagged, "a wrong law printed as a result: {:?}", fit.n);
     let pair = d.pair.as_ref().expect("the disagreeing explanation");
     let pf = pair.fit.as_ref().expect("the pair's fit beside the result");
-    let [n, k] = diffbvp::fiber::diagnostics::pair::law_envelope_of([pf, fit]);
+    let [n, k] = rheometer::diagnostics::pair::law_envelope_of([pf, fit]);
     assert!(holds(n, sc.law.n) && holds(k, sc.law.kappa), "{n:?} {k:?}");
     // the pair beside the result is the truth's
     let mut effects = pair.effects.to_vec();
@@ -594,14 +594,13 @@ fn control_with_a_noisy_take_up_names_nothing() {
 fn law_outcome(r: &DiagnosisRun, sc: &Scenario) -> (&'static str, f64) {
     let d = &r.diagnosis;
     let fit = d.law_fit();
-    let z =
-        |e: &diffbvp::fiber::rheometer::Estimate, truth: f64| (e.value - truth).abs() / e.stderr;
+    let z = |e: &rheometer::rheometer::Estimate, truth: f64| (e.value - truth).abs() / e.stderr;
     let worst = z(&fit.n, sc.law.n).max(z(&fit.kappa, sc.law.kappa));
     let flagged = !d.law_is_a_result()
         || fit
             .warnings
             .iter()
-            .any(|w| w.code == diffbvp::fiber::rheometer::WarningCode::Implausible);
+            .any(|w| w.code == rheometer::rheometer::WarningCode::Implausible);
     if let Verdict::Ambiguous {
         n_range,
         kappa_range,

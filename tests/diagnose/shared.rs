@@ -6,11 +6,11 @@
 
 use crate::independent;
 
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
-use diffbvp::fiber::effects::{LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::setup::ExperimentSet;
 use independent::dataset::Scenario;
+use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
+use rheometer::effects::{LawChoice, ModelSpec};
+use rheometer::input::load_experiments;
+use rheometer::setup::ExperimentSet;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;

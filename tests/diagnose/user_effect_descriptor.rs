@@ -12,11 +12,11 @@
 
 use crate::independent::line_force::LineForce;
 use crate::independent::scenarios::{self, NOISE_SD};
-use diffbvp::fiber::diagnostics::diagnose::{diagnose, DiagnoseOptions};
-use diffbvp::fiber::effects::{Category, Effect, EffectDescriptor, LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::{Balance, FiberTerm, SiState};
 use diffbvp::DualNum;
+use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions};
+use rheometer::effects::{Category, Effect, EffectDescriptor, LawChoice, ModelSpec};
+use rheometer::input::load_experiments;
+use rheometer::{Balance, FiberTerm, SiState};
 use std::f64::consts::PI;
 
 /// Where the guide sits \[m\] and the width of its contact \[m\].

@@ -2,12 +2,12 @@
 //! the same solution at `c = 1`, and the Adapter's failure names how far it got.
 
 use diffbvp::continuation::ContinuationOptions as AdapterOptions;
-use diffbvp::fiber::cold_start::StepControl;
-use diffbvp::fiber::setup::{Air, Experiment, Material};
-use diffbvp::fiber::{
+use diffbvp::BvpError;
+use rheometer::cold_start::StepControl;
+use rheometer::setup::{Air, Experiment, Material};
+use rheometer::{
     simulate, CarreauLike, FiberError, FiberModel, Physics, SimulateOptions, Simulator,
 };
-use diffbvp::BvpError;
 
 fn model() -> FiberModel<CarreauLike> {
     let exp = Experiment::pmma7n_v0p53_p2();

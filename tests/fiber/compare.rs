@@ -1,13 +1,13 @@
 //! Model vs measurement comparison: residual statistics, systematic segments, the CLI's error
 //! paths and the shipped hidden-effect data set.
 
-use diffbvp::fiber::diagnostics::compare::{
+use rheometer::diagnostics::compare::{
     compare, compare_set, simulate_experiments, CompareOptions, Comparison, ModelSetup,
     NoiseSource, RunsTest, SimulatedExperiment,
 };
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::setup::{ExperimentSet, TakeUp};
-use diffbvp::fiber::{Physics, SimulateOptions};
+use rheometer::input::load_experiments;
+use rheometer::setup::{ExperimentSet, TakeUp};
+use rheometer::{Physics, SimulateOptions};
 use std::path::Path;
 use std::process::Command;
 use std::sync::OnceLock;

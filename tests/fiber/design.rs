@@ -11,14 +11,14 @@ use crate::independent::rng::Rng;
 use crate::independent::scenarios::control;
 use crate::independent::solve::diameters;
 use crate::noisy_data::noisy_set;
-use diffbvp::fiber::design::{
+use rayon::prelude::*;
+use rheometer::design::{
     design_for_estimation, CandidateGrid, CandidateOutcome, Criterion, Design, DesignRequest,
     TakeUpAxis,
 };
-use diffbvp::fiber::input::load_experiments_with;
-use diffbvp::fiber::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
-use diffbvp::fiber::setup::{Experiment, ExperimentSet};
-use rayon::prelude::*;
+use rheometer::input::load_experiments_with;
+use rheometer::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
+use rheometer::setup::{Experiment, ExperimentSet};
 use std::time::Instant;
 
 /// Replicates of each simulated design (≥ 200 for the criterion; `DESIGN_REPLICATES`

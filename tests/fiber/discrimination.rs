@@ -21,16 +21,16 @@ use crate::independent::rng::Rng;
 use crate::independent::scenarios::with_faults;
 use crate::independent::solve::diameters;
 use crate::noisy_data::noisy_set;
-use diffbvp::fiber::design::{
+use rayon::prelude::*;
+use rheometer::design::{
     design_for_discrimination, CandidateGrid, Discrimination, DiscriminationRequest, Rival,
     TakeUpAxis,
 };
-use diffbvp::fiber::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments_with;
-use diffbvp::fiber::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
-use diffbvp::fiber::setup::{Experiment, ExperimentSet};
-use diffbvp::fiber::simulate::{simulate_params, SimulateOptions};
-use rayon::prelude::*;
+use rheometer::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::input::load_experiments_with;
+use rheometer::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
+use rheometer::setup::{Experiment, ExperimentSet};
+use rheometer::simulate::{simulate_params, SimulateOptions};
 use std::time::Instant;
 
 /// True mass flow over the nominal one.

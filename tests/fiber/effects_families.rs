@@ -7,17 +7,15 @@
 //! `vft_b_offset` and `vft_t_vf_offset` are the model built from changed VFT data (with `μ_c`
 //! rescaled so that the zero-rate viscosity at `T_o` stays), with exact derivatives.
 
-use diffbvp::fiber::effects::{
-    Category, Effect, EffectSetting, ModelSpec, ALL_NAMES, BUILTIN_NAMES,
-};
-use diffbvp::fiber::rheometer::estimator::RelativeResidual;
-use diffbvp::fiber::rheometer::{FitStart, FitSummary, IdentifyOptions, Layout, Rheometer};
-use diffbvp::fiber::setup::{Air, Experiment, ExperimentSet, Inlet, Material, Measurements};
-use diffbvp::fiber::simulate::simulate_params;
-use diffbvp::fiber::synthetic::{NoiseModel, SplitMix64};
-use diffbvp::fiber::{Balance, CarreauLike, FiberModel, Physics, SimulateOptions};
 use diffbvp::sensitivity::{residual_jacobian, Sensitivities};
 use diffbvp::{Guess, SolveOptions, Solver};
+use rheometer::effects::{Category, Effect, EffectSetting, ModelSpec, ALL_NAMES, BUILTIN_NAMES};
+use rheometer::rheometer::estimator::RelativeResidual;
+use rheometer::rheometer::{FitStart, FitSummary, IdentifyOptions, Layout, Rheometer};
+use rheometer::setup::{Air, Experiment, ExperimentSet, Inlet, Material, Measurements};
+use rheometer::simulate::simulate_params;
+use rheometer::synthetic::{NoiseModel, SplitMix64};
+use rheometer::{Balance, CarreauLike, FiberModel, Physics, SimulateOptions};
 
 const TRUTH: [f64; 2] = [0.8, 11.71];
 

@@ -1,9 +1,9 @@
 //! Agreement with the noise-free reference profiles of an independent scipy implementation
 //! (`tests/data/reference_profiles/`, solve_bvp tol 1e-8 with every output point a node).
 
-use diffbvp::fiber::setup::{Air, Experiment, Material};
-use diffbvp::fiber::simulate::simulate_from;
-use diffbvp::fiber::{
+use rheometer::setup::{Air, Experiment, Material};
+use rheometer::simulate::simulate_from;
+use rheometer::{
     simulate, CarreauLike, FiberModel, Newtonian, Physics, SimulateOptions, ViscosityLaw,
 };
 use std::time::Instant;

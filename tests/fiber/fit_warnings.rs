@@ -10,8 +10,8 @@
 
 use crate::probe;
 
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{
+use rheometer::input::load_experiments;
+use rheometer::rheometer::{
     BoundSide, Estimator, FitSummary, IdentifyOptions, Rheometer, WarningCode,
 };
 use serde_json::Value;
@@ -681,7 +681,7 @@ fn diagnose_marks_a_candidate_refit_at_its_bound() {
     }
     let coflow = cands.iter().find(|c| c["effect"] == "air_coflow").unwrap();
     let (lo, hi) = "air_coflow"
-        .parse::<diffbvp::fiber::effects::Effect>()
+        .parse::<rheometer::effects::Effect>()
         .unwrap()
         .bounds();
     let s = coflow["refit"]["effects"]

@@ -8,12 +8,12 @@
 
 use crate::independent::rng::Rng;
 use crate::independent::scenarios;
-use diffbvp::fiber::effects::LawChoice;
-use diffbvp::fiber::flow_curve_figure::save_flow_curve_figure;
-use diffbvp::fiber::format::{fmt_pm, LINE_WIDTH};
-use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
-use diffbvp::fiber::rheometer::{BandMethod, FitSummary, IdentifyOptions};
-use diffbvp::fiber::workflow::{fit, FitRequest, FitRun};
+use rheometer::effects::LawChoice;
+use rheometer::flow_curve_figure::save_flow_curve_figure;
+use rheometer::format::{fmt_pm, LINE_WIDTH};
+use rheometer::input::{load_experiments_with, LoadedExperiments};
+use rheometer::rheometer::{BandMethod, FitSummary, IdentifyOptions};
+use rheometer::workflow::{fit, FitRequest, FitRun};
 use std::path::Path;
 use std::time::Duration;
 

@@ -5,10 +5,10 @@
 //! refinements' limit and with a limit so tight that it binds on ordinary steps reach the same
 //! optimum.
 
-use diffbvp::fiber::diagnostics::scan::{ScanOptions, REFINE_GROWTH_LIMIT};
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{Identification, IdentifyOptions, Rheometer};
 use diffbvp::GrowthLimit;
+use rheometer::diagnostics::scan::{ScanOptions, REFINE_GROWTH_LIMIT};
+use rheometer::input::load_experiments;
+use rheometer::rheometer::{Identification, IdentifyOptions, Rheometer};
 use std::path::Path;
 
 fn fit(rh: &Rheometer, limit: Option<GrowthLimit>) -> Identification {

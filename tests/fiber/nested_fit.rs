@@ -7,10 +7,10 @@
 
 use crate::independent;
 
-use diffbvp::fiber::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::{Estimator, IdentifyOptions, NestedStart, Rheometer};
 use independent::scenarios;
+use rheometer::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::input::load_experiments;
+use rheometer::rheometer::{Estimator, IdentifyOptions, NestedStart, Rheometer};
 
 #[test]
 fn a_fitted_effect_never_leaves_the_fit_worse_than_without_it() {

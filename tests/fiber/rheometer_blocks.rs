@@ -2,10 +2,10 @@
 //! complement (block-arrow normal equations); on the 9 shipped experiments it lands where the
 //! dense driver lands, for the linear and a robust loss.
 
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::rheometer::objective::Objective;
-use diffbvp::fiber::rheometer::{Estimator, FitStart, IdentifyOptions, Rheometer, RheometerError};
 use diffbvp::least_squares::{fit, Accuracy, FitOptions, FitResult, LeastSquaresProblem, Loss};
+use rheometer::input::load_experiments;
+use rheometer::rheometer::objective::Objective;
+use rheometer::rheometer::{Estimator, FitStart, IdentifyOptions, Rheometer, RheometerError};
 use std::path::Path;
 
 fn rheometer() -> Rheometer {
@@ -107,7 +107,7 @@ fn block_fit_of_the_shipped_experiments_is_the_dense_fit() {
 
 #[test]
 fn progress_is_reported_and_the_plan_is_the_fit_size() {
-    use diffbvp::fiber::rheometer::{FitProgress, ProgressHook};
+    use rheometer::rheometer::{FitProgress, ProgressHook};
     use std::sync::{Arc, Mutex};
     let rh = rheometer();
     let start = [0.5, 11.51];

@@ -5,14 +5,14 @@
 //! outliers of +15…+35 % (measured diameter too large) at chosen positions, three of them near
 //! the take-up.
 
-use diffbvp::fiber::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
-use diffbvp::fiber::rheometer::{FitSummary, IdentifyOptions, Rheometer};
-use diffbvp::fiber::setup::{ExperimentSet, TakeUp};
-use diffbvp::fiber::synthetic::{NoiseModel as SyntheticNoise, SplitMix64};
-use diffbvp::fiber::Physics;
 use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem, Loss};
+use rheometer::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
+use rheometer::input::load_experiments;
+use rheometer::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
+use rheometer::rheometer::{FitSummary, IdentifyOptions, Rheometer};
+use rheometer::setup::{ExperimentSet, TakeUp};
+use rheometer::synthetic::{NoiseModel as SyntheticNoise, SplitMix64};
+use rheometer::Physics;
 use std::path::Path;
 
 const TRUTH: [f64; 2] = [0.8, 11.71];
@@ -406,7 +406,7 @@ fn a_robust_loss_with_the_paper_estimator_or_a_bad_margin_is_refused() {
     let rh = Rheometer::new(&shipped()).unwrap();
     let paper = IdentifyOptions {
         loss: Loss::Huber,
-        ..IdentifyOptions::with_estimator(diffbvp::fiber::rheometer::Estimator::Paper)
+        ..IdentifyOptions::with_estimator(rheometer::rheometer::Estimator::Paper)
     };
     let e = rh.identify(TRUTH, &paper).unwrap_err().to_string();
     assert!(e.contains("principled"), "{e}");
@@ -474,7 +474,7 @@ fn the_correct_model_stays_consistent_with_noise_and_outliers_are_reported() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("diffbvp-robust-{}", std::process::id()));
     let written = cmp
-        .write(&dir, diffbvp::plot::FigureFormat::Svg, &[])
+        .write(&dir, rheometer::plot::FigureFormat::Svg, &[])
         .unwrap();
     let svg = std::fs::read_to_string(dir.join("compare_residuals.svg")).unwrap();
     assert!(svg.contains("outliers (") && svg.contains("pooled trend"));

@@ -1,7 +1,7 @@
 //! Ansatz smoothing (paper eq. 5) on the shipped synthetic data set.
 
-use diffbvp::fiber::input::load_experiments;
-use diffbvp::fiber::smoothing::smooth;
+use rheometer::input::load_experiments;
+use rheometer::smoothing::smooth;
 use std::path::Path;
 
 #[test]

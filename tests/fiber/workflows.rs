@@ -4,15 +4,13 @@
 
 use crate::probe;
 
-use diffbvp::fiber::diagnostics::compare::MissingTakeUp;
-use diffbvp::fiber::diagnostics::diagnose::DiagnoseOptions;
-use diffbvp::fiber::effects::ModelSpec;
-use diffbvp::fiber::input::{load_experiments_with, LoadedExperiments};
-use diffbvp::fiber::rheometer::{Estimator, FitSummary, IdentifyOptions};
-use diffbvp::fiber::workflow::{
-    self, CompareRequest, FitRequest, LandscapeRequest, SimulateRequest,
-};
-use diffbvp::fiber::SimulateOptions;
+use rheometer::diagnostics::compare::MissingTakeUp;
+use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::effects::ModelSpec;
+use rheometer::input::{load_experiments_with, LoadedExperiments};
+use rheometer::rheometer::{Estimator, FitSummary, IdentifyOptions};
+use rheometer::workflow::{self, CompareRequest, FitRequest, LandscapeRequest, SimulateRequest};
+use rheometer::SimulateOptions;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;

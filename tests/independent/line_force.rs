@@ -2,7 +2,7 @@
 //! fiber, an air knife): the force per length `F/(w √(2π)) exp(−(s − s_c)²/(2 w²))` \[N/m\]
 //! along the spinning direction (negative `F`: against the motion, as a guide's friction), added
 //! to the momentum balance of a [`Line`] as an external force like gravity. Written here, apart
-//! from the crate's `FiberTerm`s; nothing here calls `diffbvp::fiber`.
+//! from the crate's `FiberTerm`s; nothing here calls `rheometer`.
 
 use super::model::Line;
 use super::solve::TOLERANCE;

@@ -3,7 +3,7 @@
 //! directly into the balances ([`model`]), solved with the crate's generic collocation solver
 //! ([`solve`]), its own noise ([`rng`]) and data sets written in the project's TOML + CSV
 //! input format ([`dataset`], [`scenarios`]); a concentrated line force ([`line_force`]) as a
-//! hidden effect no candidate has. Nothing here calls `diffbvp::fiber`.
+//! hidden effect no candidate has. Nothing here calls `rheometer`.
 #![allow(dead_code)]
 
 pub mod dataset;

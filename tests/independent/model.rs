@@ -1,5 +1,5 @@
 //! The stationary fiber-spinning model of the paper (Sec. 2, App. A) and `model-closure.md`,
-//! written independently of `src/fiber/**`, dimensional (SI) on the scaled arc length
+//! written independently of `crates/rheometer/src/**`, dimensional (SI) on the scaled arc length
 //! `x = s/L ∈ [0, 1]`, with hidden effects written directly into the balances.
 //!
 //! States `y = (w, N/N_ref, T/T_ref)` with `u = u_in e^w` [m/s], `N` the tension [N]

@@ -1,0 +1,166 @@
+//! The candidate experiments of a design: a grid over the mass flow (the extruder's stencil
+//! velocity) and the take-up condition (diameter or speed), each a copy of a template
+//! experiment of the data set measured at the template's positions.
+
+use crate::setup::{Experiment, TakeUp};
+use serde::Serialize;
+
+/// The take-up axis of the grid.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "kind", content = "values")]
+pub enum TakeUpAxis {
+    /// Take-up diameters \[m\].
+    Diameter(Vec<f64>),
+    /// Take-up speeds \[m/s\].
+    Velocity(Vec<f64>),
+}
+
+impl TakeUpAxis {
+    /// The values (diameters \[m\] or speeds \[m/s\]).
+    pub fn values(&self) -> &[f64] {
+        match self {
+            TakeUpAxis::Diameter(v) | TakeUpAxis::Velocity(v) => v,
+        }
+    }
+
+    /// The take-up condition of value `v`.
+    pub fn condition(&self, v: f64) -> TakeUp {
+        match self {
+            TakeUpAxis::Diameter(_) => TakeUp::Diameter(v),
+            TakeUpAxis::Velocity(_) => TakeUp::Velocity(v),
+        }
+    }
+
+    /// `"take-up diameter"` or `"take-up speed"`.
+    pub fn label(&self) -> &'static str {
+        match self {
+            TakeUpAxis::Diameter(_) => "take-up diameter",
+            TakeUpAxis::Velocity(_) => "take-up speed",
+        }
+    }
+
+    /// The unit of the values.
+    pub fn unit(&self) -> &'static str {
+        match self {
+            TakeUpAxis::Diameter(_) => "m",
+            TakeUpAxis::Velocity(_) => "m/s",
+        }
+    }
+}
+
+/// The grid of candidate experiments.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CandidateGrid {
+    /// Index of the template experiment in the data set (material, inlet, temperatures,
+    /// spin-line length and measurement positions are the template's).
+    pub template: usize,
+    /// Mass flows \[kg/s\] (first axis).
+    pub mass_flows: Vec<f64>,
+    /// Take-up conditions (second axis).
+    pub take_up: TakeUpAxis,
+    /// Measurement positions \[m\] of a candidate (`None`: the template's).
+    pub positions: Option<Vec<f64>>,
+}
+
+/// One candidate experiment: its place in the grid and its process conditions.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Candidate {
+    /// Index along the mass-flow axis.
+    pub i: usize,
+    /// Index along the take-up axis.
+    pub j: usize,
+    /// Mass flow \[kg/s\].
+    pub mass_flow: f64,
+    /// Take-up value (diameter \[m\] or speed \[m/s\], as the axis).
+    pub take_up: f64,
+}
+
+impl CandidateGrid {
+    /// Checks the axes: non-empty, finite and positive values.
+    pub fn validate(&self) -> Result<(), String> {
+        let check = |what: &str, unit: &str, v: &[f64]| {
+            if v.is_empty() {
+                return Err(format!("the candidate grid has no {what} values"));
+            }
+            match v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+                Some(x) => Err(format!(
+                    "candidate {what} {x} {unit} is not a positive finite value"
+                )),
+                None => Ok(()),
+            }
+        };
+        check("mass flow", "kg/s", &self.mass_flows)?;
+        check(
+            self.take_up.label(),
+            self.take_up.unit(),
+            self.take_up.values(),
+        )?;
+        if let Some(p) = &self.positions {
+            if p.is_empty() || p.iter().any(|s| !(s.is_finite() && *s >= 0.0)) {
+                return Err(
+                    "candidate measurement positions must be finite and non-negative (m)".into(),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The candidates, mass flow varying slowest.
+    pub fn candidates(&self) -> Vec<Candidate> {
+        let mut out = Vec::with_capacity(self.mass_flows.len() * self.take_up.values().len());
+        for (i, &q) in self.mass_flows.iter().enumerate() {
+            for (j, &t) in self.take_up.values().iter().enumerate() {
+                out.push(Candidate {
+                    i,
+                    j,
+                    mass_flow: q,
+                    take_up: t,
+                });
+            }
+        }
+        out
+    }
+
+    /// The experiment of candidate `c` made from `template` (named after its conditions).
+    pub fn experiment(&self, template: &Experiment, c: &Candidate) -> Experiment {
+        let name = match self.take_up {
+            TakeUpAxis::Diameter(_) => {
+                format!("Q{:.3e}_d{:.1}um", c.mass_flow, c.take_up * 1e6)
+            }
+            TakeUpAxis::Velocity(_) => format!("Q{:.3e}_u{:.3}m_s", c.mass_flow, c.take_up),
+        };
+        Experiment {
+            name,
+            mass_flow: c.mass_flow,
+            take_up: Some(self.take_up.condition(c.take_up)),
+            ..template.clone()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_lists_every_pair_and_refuses_bad_axes() {
+        let g = CandidateGrid {
+            template: 0,
+            mass_flows: vec![1e-5, 2e-5],
+            take_up: TakeUpAxis::Diameter(vec![5e-5, 8e-5, 1e-4]),
+            positions: None,
+        };
+        g.validate().unwrap();
+        let c = g.candidates();
+        assert_eq!(c.len(), 6);
+        assert_eq!((c[4].i, c[4].j, c[4].take_up), (1, 1, 8e-5));
+        let e = g.experiment(&Experiment::pmma7n_v0p53_p2(), &c[4]);
+        assert_eq!(e.take_up, Some(TakeUp::Diameter(8e-5)));
+        assert_eq!(e.mass_flow, 2e-5);
+        let bad = CandidateGrid {
+            take_up: TakeUpAxis::Velocity(vec![1.0, -2.0]),
+            ..g
+        };
+        assert!(bad.validate().unwrap_err().contains("take-up speed -2"));
+    }
+}

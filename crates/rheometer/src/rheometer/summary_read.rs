@@ -1,0 +1,575 @@
+//! Reading a [`FitSummary`] back from its JSON (`rheometer fit --json`): the next step
+//! (`compare --fit`, `fit --from`) starts from it. Every field the next
+//! step needs is checked, and errors name the file and the field.
+
+use super::estimator::Estimator;
+use super::summary::{FitSummary, WarningCode};
+use crate::effects::{Effect, EffectSetting};
+use crate::error::Readable;
+use serde_json::Value;
+
+/// The range of `n` accepted from a fit file (the rheometer's search range) \[-\].
+pub const FIT_FILE_N_RANGE: [f64; 2] = [0.0, 1.0];
+/// The range of `κ = ln(K / 1 Pa)` accepted from a fit file (`K` from 1 Pa to about
+/// `5·10²¹` Pa) \[-\].
+pub const FIT_FILE_KAPPA_RANGE: [f64; 2] = [0.0, 50.0];
+/// The range of take-up factors accepted from a fit file: the rheometer's default search range
+/// (`IdentifyOptions::take_up_bounds`), which every fit of the `rheometer` program uses \[-\].
+pub const FIT_FILE_TAKE_UP_RANGE: [f64; 2] = [0.5, 1.5];
+
+/// A previous fit's effects as the model of a next fit
+/// ([`FitSummary::continued_effects`]).
+#[derive(Debug, Clone)]
+pub struct ContinuedEffects {
+    /// The effects, strengths fitted or fixed as in the previous fit, fitted shapes free.
+    pub effects: Vec<EffectSetting>,
+    /// Start values of the fitted strengths (by effect name) and shapes (by model-parameter
+    /// name).
+    pub starts: Vec<(String, f64)>,
+}
+
+fn kind(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
+/// A number, or an estimate object with a numeric `value`.
+fn is_estimate(v: &Value) -> bool {
+    v.is_number() || v.get("value").is_some_and(Value::is_number)
+}
+
+/// Checks the shape of the fields the next step needs, one by one so that errors name them.
+fn check_fields(obj: &serde_json::Map<String, Value>) -> Result<(), String> {
+    for key in ["estimator", "n", "kappa"] {
+        if !obj.contains_key(key) {
+            return Err(format!(
+                "field \"{key}\": missing (a fit report from `rheometer fit --json` has it)"
+            ));
+        }
+    }
+    for key in ["n", "kappa"] {
+        if let Some(v) = obj.get(key).filter(|v| !is_estimate(v)) {
+            return Err(format!(
+                "field \"{key}\": expected a number or an estimate {{\"value\": ...}}, found {} \
+                 ({v})",
+                kind(v)
+            ));
+        }
+    }
+    if let Some(v) = obj.get("take_up_factors") {
+        let arr = v.as_array().ok_or_else(|| {
+            format!(
+                "field \"take_up_factors\": expected an array of numbers, found {}",
+                kind(v)
+            )
+        })?;
+        if let Some((i, x)) = arr.iter().enumerate().find(|(_, x)| !x.is_number()) {
+            return Err(format!(
+                "field \"take_up_factors\"[{i}]: expected a number, found {} ({x})",
+                kind(x)
+            ));
+        }
+    }
+    if let Some(v) = obj.get("effects") {
+        let arr = v.as_array().ok_or_else(|| {
+            format!(
+                "field \"effects\": expected an array of effects, found {}",
+                kind(v)
+            )
+        })?;
+        for (i, e) in arr.iter().enumerate() {
+            let f = format!("\"effects\"[{i}]");
+            match e.get("effect") {
+                Some(Value::String(_)) => {}
+                Some(x) => {
+                    return Err(format!(
+                        "field {f}.effect: expected an effect name, found {} ({x})",
+                        kind(x)
+                    ))
+                }
+                None => return Err(format!("field {f}.effect: missing")),
+            }
+            match e.get("strength") {
+                Some(x) if is_estimate(x) => {}
+                Some(x) => {
+                    return Err(format!(
+                        "field {f}.strength: expected a number or an estimate, found {} ({x})",
+                        kind(x)
+                    ))
+                }
+                None => return Err(format!("field {f}.strength: missing")),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `{"value": v, "stderr": se, "ci95": ci, "fitted": fitted}` from the flat fields of a report
+/// written before estimates were objects.
+fn estimate_object(
+    name: &str,
+    v: &Value,
+    se: Option<&Value>,
+    ci: Option<&Value>,
+    fitted: bool,
+) -> Value {
+    let mut e = serde_json::json!({"name": name, "value": v, "unit": "-", "fitted": fitted});
+    if let Some(se) = se {
+        e["stderr"] = se.clone();
+    }
+    if let Some(ci) = ci {
+        e["ci95"] = ci.clone();
+    }
+    e
+}
+
+/// A report written before [`FitSummary`] existed (flat `n`, `stderr_n`, `ci95_n`, ...,
+/// `noise_level`, `iterations`) in today's form; today's reports pass unchanged.
+fn upgrade_legacy(mut v: Value) -> Value {
+    let Some(obj) = v.as_object_mut() else {
+        return v;
+    };
+    let fitted_list: Option<Vec<String>> = obj.get("fitted").and_then(|f| {
+        f.as_array().map(|a| {
+            a.iter()
+                .filter_map(|x| x.as_str().map(String::from))
+                .collect()
+        })
+    });
+    let is_fitted = |k: &str| {
+        fitted_list
+            .as_ref()
+            .is_none_or(|l| l.iter().any(|x| x == k))
+    };
+    if fitted_list.is_none() && obj.get("n").is_some_and(Value::is_number) {
+        // before the list existed every fit fitted (n, κ) and the effects marked fitted
+        let mut names = vec![Value::from("n"), Value::from("kappa")];
+        if let Some(Value::Array(effects)) = obj.get("effects") {
+            for e in effects {
+                if e.get("fitted").and_then(Value::as_bool) == Some(true) {
+                    if let Some(n) = e.get("effect") {
+                        names.push(n.clone());
+                    }
+                }
+            }
+        }
+        obj.insert("fitted".into(), Value::Array(names));
+    }
+    for key in ["n", "kappa"] {
+        if let Some(x) = obj.get(key).filter(|x| x.is_number()).cloned() {
+            let e = estimate_object(
+                key,
+                &x,
+                obj.get(&format!("stderr_{key}")),
+                obj.get(&format!("ci95_{key}")),
+                is_fitted(key),
+            );
+            obj.insert(key.into(), e);
+        }
+    }
+    if let Some(x) = obj.get("K_Pa").filter(|x| x.is_number()).cloned() {
+        let mut e = estimate_object("K", &x, None, obj.get("ci95_K_Pa"), is_fitted("kappa"));
+        e["unit"] = "Pa".into();
+        obj.insert("K_Pa".into(), e);
+    }
+    if let Some(Value::Array(effects)) = obj.get_mut("effects") {
+        for e in effects.iter_mut() {
+            let name = e
+                .get("effect")
+                .and_then(Value::as_str)
+                .unwrap_or("")
+                .to_string();
+            if let Some(x) = e.get("strength").filter(|x| x.is_number()).cloned() {
+                let fitted = e.get("fitted").and_then(Value::as_bool).unwrap_or(false);
+                let mut est = estimate_object(
+                    &name,
+                    &x,
+                    e.get("stderr_strength"),
+                    e.get("ci95_strength"),
+                    fitted,
+                );
+                est["unit"] = e.get("unit").cloned().unwrap_or_else(|| "-".into());
+                e["strength"] = est;
+            }
+        }
+    }
+    if !obj.contains_key("noise") {
+        if let Some(level) = obj.get("noise_level").cloned() {
+            let declared = obj
+                .get("noise_source")
+                .and_then(Value::as_str)
+                .is_some_and(|s| s.starts_with("declared"));
+            obj.insert(
+                "noise".into(),
+                serde_json::json!({
+                    "level": level,
+                    "source": if declared { "declared" } else { "estimated" },
+                    "estimator": obj.get("noise_source").cloned().unwrap_or_else(|| "".into()),
+                    "rms_over_noise": null,
+                }),
+            );
+        }
+    }
+    if !obj.contains_key("solver") {
+        let mut solver = serde_json::Map::new();
+        for key in [
+            "iterations",
+            "failed_evaluations",
+            "termination",
+            "wall_time_s",
+        ] {
+            if let Some(x) = obj.get(key) {
+                solver.insert(key.into(), x.clone());
+            }
+        }
+        obj.insert("solver".into(), Value::Object(solver));
+    }
+    v
+}
+
+impl FitSummary {
+    /// Reports written before the error budget became a table warned for every source that
+    /// shifted an estimate by more than its statistical error; their budget's warnings are
+    /// recomputed by today's rule ([`ErrorBudget::warnings`](super::ErrorBudget::warnings)).
+    fn upgrade_systematic_warnings(&mut self) {
+        let Some(b) = &self.error_budget else { return };
+        let now = b.warnings();
+        self.warnings.retain(|w| w.code != WarningCode::Systematic);
+        self.warnings.extend(now);
+    }
+
+    /// Parses the JSON text of a fit summary; `source` names it in errors. Reports written by
+    /// earlier versions (bare numbers for `n`, `κ` and strengths) read too.
+    pub fn from_json(text: &str, source: &str) -> Result<Self, String> {
+        let not_report = |what: String| {
+            format!("{source} is not a fit report as written by `rheometer fit --json`: {what}")
+        };
+        let value: Value =
+            serde_json::from_str(text).map_err(|e| not_report(format!("not valid JSON: {e}")))?;
+        let obj = value
+            .as_object()
+            .ok_or_else(|| not_report("expected a JSON object {...}".into()))?;
+        check_fields(obj).map_err(|e| format!("{source}: {e}"))?;
+        let value = upgrade_legacy(value);
+        let mut s: FitSummary =
+            serde_json::from_value(value).map_err(|e| not_report(e.to_string()))?;
+        s.validate(source)?;
+        s.upgrade_systematic_warnings();
+        Ok(s)
+    }
+
+    /// A fit to continue from: the JSON text of a fit report (`rheometer fit --json`) or of a
+    /// diagnosis (`rheometer diagnose --json`: its final fit, the model with the effects it
+    /// found, or without one its base fit); `source` names the file in errors.
+    pub fn from_fit_or_diagnosis_json(text: &str, source: &str) -> Result<Self, String> {
+        let value: Value =
+            serde_json::from_str(text).map_err(|e| format!("{source} is not valid JSON: {e}"))?;
+        let diagnosis = value
+            .as_object()
+            .filter(|o| o.contains_key("verdict") && o.contains_key("base_fit"));
+        let Some(obj) = diagnosis else {
+            return Self::from_json(text, source);
+        };
+        let (field, fit) = match obj.get("final_fit").filter(|v| !v.is_null()) {
+            Some(f) => ("final_fit", f),
+            None => ("base_fit", &obj["base_fit"]),
+        };
+        Self::from_json(
+            &fit.to_string(),
+            &format!("{source} (the diagnosis' field \"{field}\")"),
+        )
+    }
+
+    /// The effects of this fit as the model of a next fit, and where its fitted parameters
+    /// start: each effect with the strength fitted where it was fitted (else fixed at its
+    /// value), its fitted shapes free again and the others fixed at their values; the start
+    /// values of the fitted strengths (by effect name) and shapes (by model-parameter name),
+    /// as [`FitStart::strengths`](super::FitStart::strengths) takes them.
+    pub fn continued_effects(&self) -> Result<ContinuedEffects, String> {
+        let mut effects = Vec::new();
+        let mut starts = Vec::new();
+        for e in &self.effects {
+            let mut effect: Effect = e.effect.parse()?;
+            let settings = effect.shape_settings();
+            for sh in &e.shapes {
+                let Some((sp, _)) = settings.iter().find(|(sp, _)| sp.name == sh.name) else {
+                    return Err(format!(
+                        "{} has no shape parameter \"{}\"",
+                        e.effect, sh.name
+                    ));
+                };
+                if sh.fitted {
+                    starts.push((sp.model_param.to_string(), sh.value));
+                } else {
+                    effect = effect.with_shape(&sh.name, sh.value)?;
+                }
+            }
+            if e.strength.fitted {
+                starts.push((effect.name().to_string(), e.strength.value));
+                effects.push(EffectSetting::fitted(effect));
+            } else {
+                effects.push(EffectSetting::fixed(effect, e.strength.value));
+            }
+        }
+        Ok(ContinuedEffects { effects, starts })
+    }
+
+    /// [`continued_effects`](Self::continued_effects) joined with further effects `with`
+    /// (each effect once): the model of a next fit that continues from this one. `with_label`
+    /// names where `with` came from (`"--with"`, `"effects"`) and `source` this fit (`"--from
+    /// fit.json"`) in errors.
+    pub fn continued_with(
+        &self,
+        with: Vec<EffectSetting>,
+        with_label: &str,
+        source: &str,
+    ) -> Result<ContinuedEffects, String> {
+        let c = self
+            .continued_effects()
+            .map_err(|e| format!("{source}: {e}"))?;
+        let mut effects = c.effects;
+        for w in with {
+            let name = w.effect.name();
+            if effects.iter().any(|e| e.effect.name() == name) {
+                return Err(format!(
+                    "{with_label} {name}: {name} is in the model of {source} already (its \
+                     strength is fitted from that fit's value); give it once: drop it from \
+                     {with_label}, or start without {source} to give {name} yourself"
+                ));
+            }
+            effects.push(w);
+        }
+        Ok(ContinuedEffects {
+            effects,
+            starts: c.starts,
+        })
+    }
+
+    /// Checks the values (as read from a file `source`): `n` in [`FIT_FILE_N_RANGE`], `κ` in
+    /// [`FIT_FILE_KAPPA_RANGE`], take-up factors in [`FIT_FILE_TAKE_UP_RANGE`], effects known,
+    /// once each, with finite strengths inside their search ranges, and as many experiment
+    /// names (if given) as take-up factors. Errors name the file and the field.
+    pub fn validate(&self, source: &str) -> Result<(), String> {
+        let bad = |field: String, msg: String| Err(format!("{source}: field {field}: {msg}"));
+        let in_range = |v: f64, r: [f64; 2]| v.is_finite() && v >= r[0] && v <= r[1];
+        let (n, kappa) = (self.n.value, self.kappa.value);
+        if !in_range(n, FIT_FILE_N_RANGE) {
+            return bad(
+                "\"n\"".into(),
+                format!(
+                    "n = {} must be a finite power index in [{}, {}]",
+                    Readable(n),
+                    FIT_FILE_N_RANGE[0],
+                    FIT_FILE_N_RANGE[1]
+                ),
+            );
+        }
+        if !in_range(kappa, FIT_FILE_KAPPA_RANGE) {
+            return bad(
+                "\"kappa\"".into(),
+                format!(
+                    "kappa = ln(K / 1 Pa) = {} must be finite and in [{}, {}]",
+                    Readable(kappa),
+                    FIT_FILE_KAPPA_RANGE[0],
+                    FIT_FILE_KAPPA_RANGE[1]
+                ),
+            );
+        }
+        for (i, &f) in self.take_up_factors.iter().enumerate() {
+            if !in_range(f, FIT_FILE_TAKE_UP_RANGE) {
+                return bad(
+                    format!("\"take_up_factors\"[{i}]"),
+                    format!(
+                        "take-up factor {} must be finite and in [{}, {}]",
+                        Readable(f),
+                        FIT_FILE_TAKE_UP_RANGE[0],
+                        FIT_FILE_TAKE_UP_RANGE[1]
+                    ),
+                );
+            }
+        }
+        if !self.experiments.is_empty() && self.experiments.len() != self.take_up_factors.len() {
+            return bad(
+                "\"experiments\"".into(),
+                format!(
+                    "{} experiment names but {} take-up factors",
+                    self.experiments.len(),
+                    self.take_up_factors.len()
+                ),
+            );
+        }
+        for (i, e) in self.effects.iter().enumerate() {
+            let field = format!("\"effects\"[{i}]");
+            if self.effects[..i].iter().any(|o| o.effect == e.effect) {
+                return bad(
+                    format!("{field}.effect"),
+                    format!("effect \"{}\" appears twice", e.effect),
+                );
+            }
+            if let Err(msg) = self.effect_of(i) {
+                return bad(format!("{field}.effect"), msg);
+            }
+        }
+        for (i, (effect, strength)) in self.model_effects()?.iter().enumerate() {
+            let (lo, hi) = effect.bounds();
+            if !(strength.is_finite() && *strength >= lo && *strength <= hi) {
+                return bad(
+                    format!("\"effects\"[{i}].strength"),
+                    format!(
+                        "{} strength {} must be finite and in [{lo}, {hi}] {}",
+                        effect.name(),
+                        strength,
+                        effect.unit()
+                    ),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The `i`-th effect with its shape parameters fixed at the fitted values.
+    fn effect_of(&self, i: usize) -> Result<Effect, String> {
+        let e = &self.effects[i];
+        let mut effect: Effect = e.effect.parse()?;
+        for sh in &e.shapes {
+            effect = effect.with_shape(&sh.name, sh.value)?;
+        }
+        Ok(effect)
+    }
+
+    /// The fitted model's effects with their strengths (the effects' units), the shapes fixed
+    /// at their fitted values: the model to simulate or compare.
+    pub fn model_effects(&self) -> Result<Vec<(Effect, f64)>, String> {
+        (0..self.effects.len())
+            .map(|i| Ok((self.effect_of(i)?, self.effects[i].strength.value)))
+            .collect()
+    }
+
+    /// Checks the fit's experiment names (where the file has them) against the data set's
+    /// `names`, in order; `source` names the fit file in errors.
+    pub fn check_experiments(&self, names: &[String], source: &str) -> Result<(), String> {
+        if self.experiments.is_empty() {
+            return Ok(());
+        }
+        if self.experiments.len() != names.len() {
+            return Err(format!(
+                "{source}: field \"experiments\": the fit has {} experiments, the data set {}; \
+                 was the fit made on this data set?",
+                self.experiments.len(),
+                names.len()
+            ));
+        }
+        for (i, (a, b)) in self.experiments.iter().zip(names).enumerate() {
+            if a != b {
+                return Err(format!(
+                    "{source}: field \"experiments\"[{i}]: the fit's experiment \"{a}\" is \
+                     \"{b}\" in the data set; was the fit made on this data set (same order)?"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The take-up factors to simulate the `experiments` experiments of the fit's data set
+    /// with: the fitted ones (principled estimator; their number checked), else `None` (all 1).
+    pub fn take_up_for(
+        &self,
+        experiments: usize,
+        source: &str,
+    ) -> Result<Option<Vec<f64>>, String> {
+        if self.estimator != Estimator::Principled {
+            return Ok(None);
+        }
+        if self.take_up_factors.len() != experiments {
+            return Err(format!(
+                "{source}: field \"take_up_factors\": {} take-up factors for {experiments} \
+                 experiments; was the fit made on this data set?",
+                self.take_up_factors.len()
+            ));
+        }
+        Ok(Some(self.take_up_factors.clone()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rheometer::summary::tests::refit_summary;
+    use crate::rheometer::Estimate;
+
+    /// A fit with a co-flow: strength 27 ± 3 m/s, decay length fitted, tail fixed at 0.5.
+    fn coflow_fit(n: f64) -> FitSummary {
+        let mut f = refit_summary("air_coflow", (27.0, 3.0), (n, 0.02), (11.6, 0.2));
+        f.effects[0].shapes = vec![
+            Estimate::fitted("decay_length", 0.19, "m", 0.012, None),
+            Estimate {
+                fitted: false,
+                ..Estimate::fitted("tail", 0.5, "-", 0.0, None)
+            },
+        ];
+        f
+    }
+
+    #[test]
+    fn a_previous_fit_continues_with_its_fitted_shapes_free_and_its_values_as_starts() {
+        let c = coflow_fit(0.8).continued_effects().unwrap();
+        assert_eq!(c.effects.len(), 1);
+        assert!(c.effects[0].value.is_none(), "the strength is fitted again");
+        match &c.effects[0].effect {
+            Effect::AirCoflow { decay_length, tail } => {
+                assert_eq!((*decay_length, *tail), (None, Some(0.5)));
+            }
+            e => panic!("{e:?}"),
+        }
+        assert_eq!(
+            c.starts,
+            vec![
+                ("air_coflow.decay_length".to_string(), 0.19),
+                ("air_coflow".to_string(), 27.0)
+            ]
+        );
+        // a fixed strength stays fixed, and starts nothing
+        let mut fixed = coflow_fit(0.8);
+        fixed.effects[0].strength.fitted = false;
+        let c = fixed.continued_effects().unwrap();
+        assert_eq!(c.effects[0].value, Some(27.0));
+        assert_eq!(c.starts.len(), 1);
+    }
+
+    #[test]
+    fn a_diagnosis_file_gives_its_final_fit_or_else_its_base_fit() {
+        let base = serde_json::to_value(coflow_fit(0.3)).unwrap();
+        let last = serde_json::to_value(coflow_fit(0.8)).unwrap();
+        let doc = |final_fit: Value| {
+            serde_json::json!({
+                "verdict": {"kind": "explained"},
+                "base_fit": base.clone(),
+                "final_fit": final_fit,
+            })
+            .to_string()
+        };
+        let f = FitSummary::from_fit_or_diagnosis_json(&doc(last.clone()), "d.json").unwrap();
+        assert_eq!(f.n.value, 0.8);
+        let f = FitSummary::from_fit_or_diagnosis_json(&doc(Value::Null), "d.json").unwrap();
+        assert_eq!(f.n.value, 0.3);
+        // a fit report reads as itself
+        let f = FitSummary::from_fit_or_diagnosis_json(&last.to_string(), "f.json").unwrap();
+        assert_eq!(f.n.value, 0.8);
+        // errors name the file and the diagnosis' field
+        let mut broken = last.clone();
+        broken["n"] = serde_json::json!("high");
+        let e = FitSummary::from_fit_or_diagnosis_json(&doc(broken), "d.json").unwrap_err();
+        assert!(
+            e.contains("d.json") && e.contains("final_fit") && e.contains("\"n\""),
+            "{e}"
+        );
+        let e = FitSummary::from_fit_or_diagnosis_json("{", "d.json").unwrap_err();
+        assert!(e.contains("d.json") && e.contains("JSON"), "{e}");
+    }
+}

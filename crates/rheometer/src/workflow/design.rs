@@ -1,0 +1,102 @@
+//! The `design` workflow: fit the model to the data (no error budget, no profile intervals:
+//! the design needs the estimate, its solutions and its noise level), then predict, for every
+//! candidate experiment, the uncertainty after adding it ([`design_for_estimation`]).
+
+use super::fit::{fit, FitRequest, FitRun};
+use crate::design::{
+    design_for_discrimination, design_for_estimation, Design, DesignRequest, Discrimination,
+    DiscriminationRequest, Rival,
+};
+use crate::effects::{Effect, EffectSetting};
+use crate::input::LoadedExperiments;
+use crate::rheometer::profile::ProfileMode;
+use crate::rheometer::RheometerError;
+
+/// The outcome of the `design` workflow.
+#[derive(Debug)]
+pub struct DesignRun {
+    /// The fit the design starts from.
+    pub fit: FitRun,
+    /// The ranked candidates.
+    pub design: Design,
+}
+
+/// Fits `fit_request`'s model to `data` (error budget and profile intervals off) and designs
+/// the next experiment by `request`.
+pub fn design(
+    data: &LoadedExperiments,
+    fit_request: &FitRequest,
+    request: &DesignRequest,
+) -> Result<DesignRun, RheometerError> {
+    request.grid.validate().map_err(RheometerError::Data)?;
+    let mut fr = fit_request.clone();
+    fr.error_budget = false;
+    fr.profile = ProfileMode::Never;
+    fr.baseline = false;
+    fr.newtonian_reference = false;
+    let run = fit(data, &fr)?;
+    let design = design_for_estimation(&run.rheometer, &run.identification, request)?;
+    Ok(DesignRun { fit: run, design })
+}
+
+/// The outcome of the discrimination workflow.
+#[derive(Debug)]
+pub struct DiscriminationRun {
+    /// The rivals' fits: the request's model plus each effect, in the order given.
+    pub fits: Vec<FitRun>,
+    /// The candidates ranked by how well they tell the rivals apart.
+    pub design: Discrimination,
+}
+
+/// Fits the rivals — `fit_request`'s model plus each of `effects` (strength fitted) — to
+/// `data` (error budget and profile intervals off) and ranks the candidates of `request` by
+/// how well they tell them apart ([`design_for_discrimination`]).
+///
+/// Errors: fewer than two effects, an effect given twice or already in the model, a fit that
+/// fails, and the design's errors.
+pub fn discriminate(
+    data: &LoadedExperiments,
+    fit_request: &FitRequest,
+    effects: &[Effect],
+    request: &DiscriminationRequest,
+) -> Result<DiscriminationRun, RheometerError> {
+    request.grid.validate().map_err(RheometerError::Data)?;
+    if effects.len() < 2 {
+        return Err(RheometerError::Data(
+            "give at least two rival effects to tell apart".into(),
+        ));
+    }
+    // every rival is checked before the first fit
+    let mut requests = Vec::with_capacity(effects.len());
+    for e in effects {
+        if fit_request.model.contains(e.name()) {
+            return Err(RheometerError::Data(format!(
+                "{} is already in the model: a rival adds an effect the model lacks",
+                e.name()
+            )));
+        }
+        let mut fr = fit_request.clone();
+        fr.error_budget = false;
+        fr.profile = ProfileMode::Never;
+        fr.baseline = false;
+        fr.newtonian_reference = false;
+        fr.model = fr.model.with(EffectSetting::fitted(e.clone()));
+        fr.model.validate().map_err(RheometerError::Data)?;
+        requests.push(fr);
+    }
+    let fits = requests
+        .iter()
+        .map(|fr| fit(data, fr))
+        .collect::<Result<Vec<_>, _>>()?;
+    let rivals: Vec<Rival> = effects
+        .iter()
+        .zip(&fits)
+        .map(|(e, f)| Rival {
+            name: e.name(),
+            rheometer: &f.rheometer,
+            fit: &f.identification,
+        })
+        .collect();
+    let design = design_for_discrimination(&rivals, request)?;
+    Ok(DiscriminationRun { fits, design })
+}
