@@ -15,6 +15,9 @@
 //! Values between nodes go through the C1 interpolant, whose node slopes `f(x_i, y_i, p)` depend
 //! on `p` too; the derivatives here are those of the interpolated discrete solution, consistent
 //! with it to round-off.
+//!
+//! Integral functionals `∫ g(x, y, p) dx + φ(y(a), y(b), p)` have their own entry points
+//! ([`IntegralFunction`], [`integral_value`], [`integral_adjoint`], [`integral_forward`]).
 
 use crate::dual_jacobian::{DualFn, DualJacobian};
 use crate::error::BvpError;
@@ -22,6 +25,9 @@ use crate::linearization::Linearization;
 use crate::problem::Bvp;
 use crate::solution::{hermite_weights, interval_of, Solution};
 use num_dual::DualNum;
+
+mod integral;
+pub use integral::{integral_adjoint, integral_forward, integral_value, IntegralFunction};
 
 /// A scalar function `g(x, y, p)` of a point, the state there and all parameters
 /// `p = (unknowns, model parameters)`, written generically over dual numbers. `index` numbers

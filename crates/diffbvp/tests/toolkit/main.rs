@@ -9,6 +9,7 @@ mod continuation;
 mod core_accuracy;
 mod decay_model;
 mod growth_limit;
+mod integral_functionals;
 mod kept_newton_matrix;
 mod least_squares;
 mod library_contracts;
