@@ -4,19 +4,17 @@
 //! towards smaller `n`; the row starts from the Newtonian solution (`n = 1` does not depend on
 //! κ). Every point is warm-started from the toolkit's secant predictor
 //! ([`secant_guess`]): the last two solutions of the row, extrapolated linearly in `n` onto the
-//! newest mesh (about a third fewer Newton iterations than starting from the neighbour itself).
+//! newest mesh (it needs fewer Newton iterations than a start from the neighbour itself).
 //! Only costs are evaluated (no sensitivities); every solve keeps its last Newton matrix
 //! ([`SolveOptions::keep_newton_matrix`](diffbvp::SolveOptions::keep_newton_matrix)) and the next
-//! point on the same mesh starts simplified Newton from it (on the shipped data's 41×41 grid,
-//! 1.0 factorisations per solve instead of 1.5 and 178 dual-number evaluations instead of 226;
-//! the 101×101 landscape takes 0.86 of the time, its costs move by at most 8e-6 relative,
-//! within the solves' tolerance).
+//! point on the same mesh starts simplified Newton from it: that saves factorisations and
+//! dual-number evaluations and moves the costs only within the solves' tolerance.
 //!
 //! Where a point fails, the step from the last good point is halved recursively
 //! ([`bisect_step`]; once on fine grids, up to three times on coarse ones), starting with the
-//! first half (on the shipped data's 101×101 grid, a retry of the point itself from its
-//! neighbour's solution rescued 11 of 156 failed points, the halved step 44, and every row's
-//! final failure paid for that retry with one more failing solve); if that fails too, the rest
+//! first half, not with a retry of the point itself from its neighbour's solution: the halved
+//! step rescues more failed points, and a retry would cost every row's final failure one more
+//! failing solve; if that fails too, the rest
 //! of the row
 //! (smaller `n`, i.e. stronger strain thinning) is marked `NaN`: there the BVP has no solution,
 //! the strain rate explodes at the take-up, as the paper notes. Approaching that edge the
@@ -31,8 +29,8 @@
 //! 1e-3): its cost moves by a few 1e-4 relative, while the minimum and every cost near it are
 //! computed at the landscape's tolerance. Each point's tolerance is in [`LandscapeRun::tol`].
 //! Most of a landscape's work lies at those far points, near the edge of the region where the
-//! BVP has a solution (on the shipped data's 101×101 grid, 64 % of the time went to the 16 % of
-//! the points with `n < 0.2`, where `J` is 16–860 times its minimum).
+//! BVP has a solution, where `J` is many times its minimum, so that is where the looser
+//! tolerance saves time.
 //!
 //! [`Rheometer::landscape_with`] can be stopped early (a cancellation flag, checked before
 //! every grid point) and says for every point whether it was computed, failed, or not reached
@@ -54,17 +52,13 @@ pub const LANDSCAPE_MAX_NODES: usize = 1000;
 
 /// How far a landscape solve may refine beyond the mesh it starts from when a point is retried
 /// by halving its step (from the neighbour's solution; a point's first attempt, from the secant
-/// prediction, has [`LANDSCAPE_FIRST_GROWTH_LIMIT`]): 8 times its nodes, always 300. Until stop
-/// 59 it held for every attempt; the figures below are of that time. A step of the grid changes the
-/// solution's mesh by a few tens of percent except at the edge of the region where the BVP has a
-/// solution, where a failing solve otherwise refines to [`LANDSCAPE_MAX_NODES`] before it fails,
-/// once per row and again in each bisection of the step. On the shipped data's 101×101 grid the
-/// landscape takes 0.90 of the time (9.89 s against 10.95 s, medians of 3), on 61×61 grids
-/// 0.77 (shipped data and `data/two_effects`); 3 of the 10 201 points (at n ≤ 0.03, `J` 32–37
-/// times the minimum's) are marked failed instead of computed, 3 of 3721 on each 61×61 grid
-/// (one of them on `data/two_effects`, whose user fit sits at n = 0.18, at 1.07 times the
-/// minimum's `J`), and the other costs move by at most 2.3e-6 relative. 4 times and 200 nodes
-/// took 0.78 of the time on the 101×101 grid but marked 15–19 points failed per grid. The
+/// prediction, has [`LANDSCAPE_FIRST_GROWTH_LIMIT`]): 8 times its nodes, always 300. A step of
+/// the grid changes the solution's mesh by a few tens of percent except at the edge of the
+/// region where the BVP has a solution, where a failing solve otherwise refines to
+/// [`LANDSCAPE_MAX_NODES`] before it fails, once per row and again in each bisection of the
+/// step. The limit makes such a solve fail early, at the price of a few points near the edge
+/// marked failed instead of computed, and leaves the other costs well within the solves'
+/// tolerance; a tighter limit would mark many more points failed. The
 /// Newtonian solutions the rows start from are solved without it; options that set a growth
 /// limit of their own keep it.
 pub const LANDSCAPE_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
@@ -77,11 +71,9 @@ pub const LANDSCAPE_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
 /// the edge of the region where the BVP has a solution), the step is halved and solved with
 /// [`LANDSCAPE_GROWTH_LIMIT`]; a first attempt that would have needed more than 3 times its
 /// nodes is rare away from the edge, and at the edge it usually fails anyway, after refining
-/// 8 times as far. On the shipped data's 101×101 grid the landscape took 0.89 of the time
-/// (with the far points' tolerance and the halved retries); against the landscape of the full
-/// limit at every attempt and no far tolerance, 11 rows ended one grid step further and 8 one
-/// step earlier (18 and 4 with the full limit at the first attempt too): at the edge, which
-/// points a walk reaches depends on its path.
+/// 8 times as far, so the tighter first limit saves that refinement. At the edge, which points
+/// a walk reaches depends on its path, so a row may end a grid step earlier or later than with
+/// other limits.
 pub const LANDSCAPE_FIRST_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
     factor: 3.0,
     at_least: 300,
@@ -95,8 +87,8 @@ pub const LANDSCAPE_FAR_COST: f64 = 2.0;
 /// ([`FarRule::for_tol`]), at most [`LANDSCAPE_FAR_TOL_MAX`].
 pub const LANDSCAPE_FAR_TOL_FACTOR: f64 = 10.0;
 
-/// The loosest tolerance of far points \[-\]: their costs then move by about 3e-4 relative
-/// (measured on the shipped data's 101×101 grid).
+/// The loosest tolerance of far points \[-\]: it keeps their costs to a few 1e-4 relative,
+/// which is all the picture needs.
 pub const LANDSCAPE_FAR_TOL_MAX: f64 = 1e-3;
 
 /// The accuracy of a landscape's far points: where the picture needs its costs to a few 1e-4
@@ -112,9 +104,8 @@ pub const LANDSCAPE_FAR_TOL_MAX: f64 = 1e-3;
 /// about 6 `σ²` over its minimum `J_min ≈ dof · σ²`, a relative growth of 6/dof (a few percent
 /// for the shipped data's 234 points). A point at twice `J_min` lies about √dof standard
 /// errors away, and a relative error `ε` of its cost moves its contour by about
-/// `ε · J / (2 √dof σ²)`: at `ε = 3e-4`, 0.005 standard errors (measured on the shipped data's
-/// 101×101 grid: at most 0.007 where `J ≤ 10 J_min`, 0.036 at the edge, where `J` is 700 times
-/// `J_min`, hundreds of standard errors from the minimum).
+/// `ε · J / (2 √dof σ²)`: at `ε = 3e-4`, 0.005 standard errors, and more only at the edge,
+/// hundreds of standard errors from the minimum.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FarRule {
     /// A point is far when the cost of the point before it in its row exceeds this multiple of
