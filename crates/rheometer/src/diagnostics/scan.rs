@@ -39,13 +39,11 @@ use serde::{Deserialize, Serialize};
 /// nodes (the landscape's cap). Warm-started solves need 1–3 refinements of a few tens of
 /// percent; a cold start's final solve, which is exempt, refines its loose continuation mesh
 /// about tenfold. Where the fiber has no solution (strong strain thinning, the strain rate
-/// exploding at the take-up) the mesh instead grows towards 20 000 nodes: on a strongly
-/// hardening data set, 158 such solves took 53 s of a diagnosis' 127 s of CPU time. A co-flow
-/// refit crawling along the edge of the solvable region (one experiment's mesh at 875 nodes, the
-/// others at 60–95) took 1.7 s with the factor 16: 83 trial steps, 28 of them failing only after
-/// refining towards 2000 nodes. With 4 they fail at the growth limit: 78 steps, the same cost,
-/// 0.9 s; that diagnosis takes 3.7 s instead of 4.5, and the `diagnose` text is unchanged on 21
-/// data sets (the 6 shipped ones with an effect or none, 15 made by the test-only model).
+/// exploding at the take-up) the mesh instead grows towards 20 000 nodes, and such solves
+/// would dominate a diagnosis' time. With the factor 4 a trial step along the edge of the
+/// solvable region fails at the growth limit, early and cheaply, and the trust region reaches
+/// the same cost in about as many steps; a looser factor lets such steps fail only after
+/// refining towards the node cap.
 pub const REFINE_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
     factor: 4.0,
     at_least: 1000,
@@ -54,21 +52,18 @@ pub const REFINE_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
 /// The largest mesh of a refinement's BVP solves ([`ScanOptions::refine_max_nodes`]) \[nodes\].
 /// A fit's solutions need 25–300 nodes per experiment (tol 1e-4); near the edge of the region
 /// where the fiber has a solution one experiment's mesh grows without bound (its strain rate
-/// explodes at the take-up). A co-flow refit from another material law crept along that edge
-/// for its last 14 steps with one experiment at 15 968 nodes (the others at 60–95): 4.7 s of
-/// its 6.2 s, at a cost no better than the candidate's best refit. Such a point fails instead,
-/// and the trust region takes a shorter step.
+/// explodes at the take-up). A refit creeping along that edge on such a mesh spends most of its
+/// time there without reaching a lower cost, so such a point fails instead, and the trust
+/// region takes a shorter step.
 pub const REFINE_MAX_NODES: usize = 2000;
 
 /// The growth limit of the grid points' BVP solves ([`ScanOptions::grid_growth_limit`]): 16
 /// times the start's mesh, always 5000 nodes (the floor is what binds: about 100–250 times the
 /// mesh a grid point needs at its tolerance 1e-3, 20–50 nodes per experiment). A grid fit's trial step towards `n → 0` (a co-flow or a strain-thinning branch
-/// the law follows) makes the mesh grow towards `max_nodes` (20 000) before the solve fails:
-/// 15 of a strong co-flow set's 200 grid fits took 62 % of its grid time that way, 0.3–0.9 s
-/// each. With this limit such a solve fails at a quarter of that mesh; the few grid solves
-/// that succeed beyond it (up to 9 700 nodes seen on 12 data sets) fail instead, which changed
-/// 9 of about 2 400 grid points on those sets, all at `J` above 1.15 times the user's, and no refit,
-/// ranking or verdict.
+/// the law follows) makes the mesh grow towards `max_nodes` (20 000) before the solve fails,
+/// which would take most of a grid's time. With this limit such a solve fails at a quarter of
+/// that mesh; the rare grid solves that would succeed beyond it fail instead: they lie well
+/// above the user's `J`, where no refit, ranking or verdict depends on them.
 pub const GRID_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
     factor: 16.0,
     at_least: 5000,
@@ -79,13 +74,8 @@ pub const GRID_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
 /// it is fitted again from the plausible law [`ScanOptions::restart_law`] instead (cold
 /// starts there take milliseconds), and without one it fails and ends its side's walk. Half
 /// the lower end of [`PLAUSIBLE_N`]: such a law is nearly rate-independent and compensates a
-/// missing effect. On `data/two_effects` the cold starts of grid fits from laws at `n` = 0.0005
-/// to 0.05 took 1.3 s of the diagnosis' 7.6 s of CPU time, the longest (0.53 s, a 400 m/s
-/// co-flow at `n = 0.0016`) to fail at its end, while those from laws above 0.07 took 1–6 ms
-/// each. Refitted from the plausible law instead, those grid points end lower (`J` 0.835 →
-/// 0.732 and 1.561 → 1.105 times the user's at 18.6 m/s; the failed 400 m/s point at 0.865), the
-/// verdict, strengths and `J` of the diagnosis are the same (`n` 0.771 → 0.772) and it takes
-/// 3.20 s instead of 3.88 s; the 6 other shipped data sets' reports are unchanged.
+/// missing effect. Cold starts from such laws are slow and often fail at the end of their
+/// continuation, while a refit from the plausible law is quick and ends at a lower `J`.
 ///
 /// [`SimulateOptions::cold_fallback`]: crate::simulate::SimulateOptions::cold_fallback
 pub const COLD_FALLBACK_MIN_N: f64 = 0.5 * PLAUSIBLE_N[0];
@@ -111,11 +101,8 @@ pub struct ScanOptions {
     pub refine_within: f64,
     /// BVP tolerance of the grid points' solves (default 1e-3; the fit's own tolerance if that
     /// is looser). A grid point's `J` is a profile value that chooses where the refinements
-    /// start, and the refinements solve at the fit's tolerance (1e-4 by default). Against
-    /// grid points solved at 1e-4, the points with `J` within 1.2 times the user's moved by at
-    /// most 2e-4, 4e-4, 3e-4 and 7e-3 of their `J` on the shipped, hidden-radiation,
-    /// two-effects and a strong co-flow set (under 2 in `ΔBIC` on 234 points), and every
-    /// refinement, ranking and verdict stayed the same (the test
+    /// start, and the refinements solve at the fit's tolerance (1e-4 by default), so the grid's
+    /// looser tolerance changes no refinement, ranking or verdict (the test
     /// `diagnose_scan::the_grid_tolerance_moves_no_refit` checks this on radiation; the time
     /// saved is in the book's performance chapter).
     pub grid_tol: f64,
@@ -133,8 +120,7 @@ pub struct ScanOptions {
     /// [`refine_growth_limit`](Self::refine_growth_limit): with at most
     /// [`inner_max_iterations`](Self::inner_max_iterations) steps, a step that fails instead
     /// of succeeding on a fine mesh changes the profile value, and with it which points are
-    /// refined (with the refinements' limit on the grid fits too, a co-flow with outliers was
-    /// refined from another grid point and ended 1.8 % above the global optimum).
+    /// refined, and a refinement from the wrong grid point can end above the global optimum.
     pub grid_growth_limit: Option<GrowthLimit>,
     /// A side's walk ends once a point's `J` exceeds this multiple of the user's `J`
     /// (default 20: far from any useful fit, and the fits there are the expensive ones).
@@ -697,11 +683,10 @@ fn grid_fit(
 /// Whether a side's outward walk `done` started from an implausible material law (the
 /// user's fit `base` with `n` below [`PLAUSIBLE_N`]: it compensates a missing effect) and is
 /// walked inwards again from a plausible one. The walk then follows the law's branch towards
-/// `n → 0` and can pass a basin whose law is plausible: on warm air and a co-flow together
-/// (`data/two_effects`) every co-flow grid point above the neutral value ended above the
-/// user's `J` while the co-flow alone, with `n = 0.77`, removes 94 % of the excess misfit.
-/// From a plausible user's fit the walks are left as they are (tried on 12 data sets: sides
-/// whose law drifts below 0.2 gained nothing by an inward walk and cost up to 70 % more time).
+/// `n → 0` and can pass a basin whose law is plausible, so a side's points can all end above
+/// the user's `J` though the effect explains most of the misfit. From a plausible user's fit
+/// the walks are left as they are: there an inward walk finds no lower basin and only costs
+/// time.
 fn needs_inward_walk(done: &[(f64, GridStart)], base: &GridStart) -> bool {
     !done.is_empty() && base.law[0] < PLAUSIBLE_N[0]
 }
