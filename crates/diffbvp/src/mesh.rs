@@ -259,9 +259,8 @@ pub struct MeshOptions {
     /// between interval midpoints instead of holding it constant over each old interval
     /// (default `false`). When one pass cuts intervals into many pieces, the residual of the new
     /// pieces follows the error constant's variation inside the old interval, which a constant
-    /// misses: on the fiber model's final cold-start pass (24 → ~224 nodes) the largest new
-    /// residual per old interval was up to 2.2 times the constant prediction, forcing a second
-    /// full pass for two intervals.
+    /// misses, and an interval whose new residual exceeds the constant prediction forces a
+    /// second full pass.
     pub smooth: bool,
     /// Switch to scipy's rule ([`RefineRule::Scipy`]) for the rest of a solve when the
     /// equidistributed mesh does not settle (default `true`): over three refinement passes the

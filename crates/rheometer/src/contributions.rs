@@ -111,9 +111,8 @@ pub trait NusseltLaw: Send + Sync {
 /// speed changes sign: the unregularised inclination factor jumps from ½ to 1 and back within
 /// `|Re| ≲ 1e-3`, and `Nu_CB ∝ Re_ε^½` has a cusp there of width `ε_r` = 1e-3. Both are layers
 /// of ~1e-5 m the collocation cannot resolve cheaply: with the cusp at `ε_r`, a solve whose
-/// crossing point moved refined its mesh 4–10 times, down to intervals of 6e-6 m (on the
-/// shipped data's diagnosis, 1398 such solves took 3.5 s of 7 s of solving; with `ε_c` on the
-/// Reynolds number too, 442 took 0.9 s). `ε_c` widens both layers. In still air (`v_air = 0`,
+/// crossing point moved refined its mesh many times, down to intervals of a few µm. `ε_c`
+/// widens both layers, so that such solves stay cheap. In still air (`v_air = 0`,
 /// also a co-flow of strength 0) the term vanishes identically, with zero derivative, so the
 /// base model is reproduced exactly. Elsewhere it changes the inclination factor (½ for the
 /// tangential flow along the fiber) by `≲ ε_c²/Re²` relative (0.25% at `Re = 1`) and `Re_ε^½`
@@ -1222,10 +1221,8 @@ impl<H: NusseltLaw> Physics<H> {
     /// Unscaled dimensionless value of one term (force per length in units of `f_o` or heat
     /// per length in units of `h_o`).
     ///
-    /// Out of line on purpose: inlined into the right-hand side's loop over the terms (as
-    /// `#[inline]` asked), the `f64` right-hand side took 66 ns per point; called, 53 ns, and the
-    /// dense dual passes 4–6 % less (criterion, `fiber_rhs_*`); the 101×101 landscape 0.83 and
-    /// `diagnose` 0.92 of the time. A fat-LTO build had found this by itself.
+    /// Out of line on purpose: inlined into the right-hand side's loop over the terms, it makes
+    /// that loop slower, in `f64` and in the dense dual passes alike (criterion, `fiber_rhs_*`).
     #[inline(never)]
     pub fn term_value<D: DualNum<Primitive = f64> + Copy>(
         &self,

@@ -88,8 +88,8 @@ pub struct SimulateOptions {
     /// a solution of the fiber's 4 states is no warm start: it is cold-started either way). The scans' grid
     /// fits whose law is deep in the implausible range set it
     /// ([`COLD_FALLBACK_MIN_N`](crate::diagnostics::scan::COLD_FALLBACK_MIN_N)): there
-    /// the continuation towards a nearly rate-independent, strongly thinning fiber takes
-    /// 0.1–0.5 s per experiment, often to fail at its end.
+    /// the continuation towards a nearly rate-independent, strongly thinning fiber is slow and
+    /// often fails at its end.
     pub cold_fallback: bool,
 }
 

@@ -87,8 +87,8 @@ pub(crate) struct WarmFit {
     /// Solve the start solutions at the take-up factors `take_up` (where the warm solutions
     /// were solved at them), so that the fit's first evaluation re-solves nothing. The
     /// diagnosis' scans, refits and step fits set it, and the nested and accuracy fits (their
-    /// warm starts come from the fit they continue; 11 % of a diagnosis). Off for the profile
-    /// walk: on a fit at its bound (the air hotter than the melt, `n = 1`) its warm solves at
-    /// the take-up factors failed more often and fell back to cold starts (3.8 s became 8.9 s).
+    /// warm starts come from the fit they continue). Off for the profile walk: on a fit at its
+    /// bound (the air hotter than the melt, `n = 1`) its warm solves at the take-up factors fail
+    /// more often and fall back to slow cold starts.
     pub solve_at_take_up: bool,
 }

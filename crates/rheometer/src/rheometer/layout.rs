@@ -82,9 +82,9 @@ fn drop_column(c: &mut Option<usize>, i: usize) {
 }
 
 /// Fraction of an effect parameter's search range that is one unit of the fit's trust region
-/// ([`Layout::x_scale`]): a co-flow searched over −100…600 m/s moves up to 70 m/s per iteration
-/// instead of 1 m/s (with a unit scale, a refit that had to travel 100 m/s ran out of its 100
-/// iterations on the way).
+/// ([`Layout::x_scale`]): a co-flow searched over −100…600 m/s moves up to 70 m/s per iteration,
+/// not 1 m/s as with a unit scale, so that a refit that must travel far reaches its optimum
+/// within its iteration limit.
 pub const EFFECT_SCALE_FRACTION: f64 = 0.1;
 
 /// The parameter layout of one fit.

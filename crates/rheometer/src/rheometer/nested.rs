@@ -99,7 +99,8 @@ impl Rheometer {
         match (given, from_plain) {
             (Ok(g), Ok((plain, p))) => {
                 let given_cost = Some(g.summary.cost);
-                // ties keep the fit from the given start (as before this check)
+                // ties keep the fit from the given start: the plain optimum replaces it only
+                // where it is strictly better
                 let (fit, start) = if p.summary.cost < g.summary.cost {
                     (p, NestedStart::PlainOptimum)
                 } else {

@@ -18,8 +18,7 @@
 //!
 //! Every pair is first fitted with its BVPs solved at the scans' tolerance and judged with
 //! margins (`Margins::SCREEN`); only the pairs that pass are fitted again at full accuracy from
-//! that optimum and judged as above (most pairs fail the screen: on a gauge-offset set the
-//! diagnosis took 0.78 of the time, on the shipped data and `data/two_effects` the same).
+//! that optimum and judged as above (most pairs fail the screen, so few pay for full accuracy).
 //!
 //! The kept pair with the lowest `ΔBIC` (against the user's model) is judged against the
 //! forward search's result by [`against_steps`](crate::diagnostics::pair): it replaces
