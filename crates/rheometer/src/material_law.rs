@@ -15,9 +15,9 @@
 //! `1 + x²` as `exp(a ln(1 + x²))`, never `powf`/`sqrt` of a quantity that can be 0.
 //!
 //! The laws and the viscosity helpers are `#[inline(always)]`: they must fuse with the
-//! model's right-hand side in every dual-number instance. With `codegen-units = 1` LLVM kept
-//! `mu_e` out of line on `#[inline]` alone, and the warm re-solve of the fiber benchmark was
-//! 1.25× slower than under the default profile.
+//! model's right-hand side in every dual-number instance; `#[inline]` alone is not enough,
+//! because with `codegen-units = 1` LLVM may keep `mu_e` out of line and slow the fiber's
+//! solves.
 
 use diffbvp::dense_dual::DenseDual;
 use nalgebra::Const;

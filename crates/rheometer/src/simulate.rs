@@ -56,11 +56,10 @@ pub struct SimulateOptions {
     /// Mesh adaptation of every solve (default [`MeshOptions::default`]).
     pub mesh: MeshOptions,
     /// The final solve of a cold start with [`smooth`](MeshOptions::smooth) error constants
-    /// (default `true`). That solve refines the loose continuation mesh about tenfold
-    /// (24 → ~224 nodes on v0p53_p2); with the error constant held constant per old interval
-    /// the prediction missed `tol` on two intervals and a second full pass followed on 5 of
-    /// the 9 shipped experiments; with the smooth constant one pass reaches `tol` on all 9
-    /// (1–2 % more nodes).
+    /// (default `true`). That solve refines the loose continuation mesh about tenfold; with the
+    /// error constant held constant per old interval the prediction can miss `tol` on a few
+    /// intervals and cost a second full pass, while the smooth constant reaches `tol` in one
+    /// pass for a few more nodes.
     pub smooth_cold_final: bool,
     /// How far a solve may refine beyond the mesh it starts from (default `None`: up to
     /// `max_nodes`; see [`SolveOptions::growth_limit`]). The refinements of the diagnosis set it
@@ -149,8 +148,8 @@ impl SimulateOptions {
             mesh: self.mesh.clone(),
             growth_limit: self.growth_limit,
             ..if self.halve_start_mesh {
-                // Newton to `tol` (without `fixed_mesh`'s step test: a correction test at
-                // 1e-10 changed no estimated shift in its fourth digit, at 6 % of a fit's time)
+                // Newton to `tol` (without `fixed_mesh`'s step test: it costs time and does not
+                // change the estimated shift to the digits reported)
                 SolveOptions {
                     newton_step_tol: None,
                     ..SolveOptions::fixed_mesh()

@@ -16,8 +16,8 @@
 //! | [`lag1_autocorrelation_about_zero`] | the diagnosis | about zero, i.e. an offset counts as correlation (`0` without spread) |
 //!
 //! The diagnosis's "systematic" test `rms/noise > 1.2` is calibrated on the RMS estimate: the
-//! robust estimate is smaller where the residual has kinks, and on the shipped correct-model
-//! control (RMS 1.682 %, robust noise 1.36 %) it would call the noise systematic.
+//! robust estimate is smaller where the residual has kinks, so that it would call the noise of
+//! a correct model systematic.
 
 pub mod distributions;
 

@@ -7,7 +7,7 @@
 //! pivoting, applied in the natural block order of the unknowns. That order is already a good
 //! elimination order for this block-bidiagonal matrix (fill stays within the bandwidth plus the
 //! `n + k` boundary rows and the parameter columns), so no fill-reducing analysis (COLAMD) is run:
-//! profiling showed COLAMD and the symbolic analysis at ~20% of a solve. The pattern and the
+//! it would cost a sizeable share of a solve and reduce no fill. The pattern and the
 //! (identity) column permutation are built once per mesh (on first use) and reused for every numeric
 //! factorisation; the factor storage and scratch are reused across Newton iterations.
 //!

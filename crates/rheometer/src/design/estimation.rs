@@ -145,9 +145,9 @@ pub fn shared_columns(model: &CarreauFiber, id: &Identification) -> Result<Vec<u
 /// level, else the fit's residual level `σ̂ = √(Σ r²/(N − P))` over the relative residuals
 /// (`P` fitted parameters, take-up factors included) — the level the fit's own standard errors
 /// use, so that the design's prediction for the current data is the fit's. The noise model's
-/// level (second differences, robust to a smooth misfit) is what a misfit is judged against;
-/// on three experiments of 26 points with 1.5 % noise it read 1.18 %, and standard errors
-/// predicted from it came out 25 % low.
+/// level (second differences, robust to a smooth misfit) is what a misfit is judged against,
+/// not what a design predicts with: it can read well below the noise on a few short
+/// experiments, and standard errors predicted from it would then come out too low.
 pub fn noise_level(id: &Identification, given: Option<f64>) -> f64 {
     if let Some(s) = given.or(id.summary.noise.declared_level()) {
         return s;

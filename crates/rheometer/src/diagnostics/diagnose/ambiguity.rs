@@ -46,9 +46,9 @@ pub(crate) struct Rival<'a> {
 /// candidate of the first step (`candidates`) not in the result whose `ΔBIC` is below the
 /// earn threshold and within the tie margin of the result's — a credible one (a tie), or one
 /// whose best strength lies outside its physical range or at a search bound: such a fit
-/// explains the data as well, and only the range's prior excludes it (a gauge offset of 27 µm,
-/// beyond the ±20 µm range, was refused and its data "explained" by air 34 K cooler with `n`
-/// 7.9 standard errors off). A refit whose law is itself implausible is no rival.
+/// explains the data as well, and only the range's prior excludes it (without it, a strength
+/// just beyond its range is refused and its data "explained" by another candidate with a law
+/// many standard errors off). A refit whose law is itself implausible is no rival.
 pub(crate) fn disagreeing_rivals<'a>(
     candidates: &'a [Candidate],
     found: &[String],
