@@ -137,8 +137,8 @@ impl Sensitivities {
     }
 
     /// [`Sensitivities::compute`] without the refinement step: one solve with the cached factors,
-    /// accurate to about the system's condition number times `ε` (3.5e-11 relative on the fiber
-    /// model), about 60 % cheaper on the solver benchmarks. What a Gauss–Newton Jacobian needs
+    /// accurate to about the system's condition number times `ε` and much cheaper than with the
+    /// refinement step. What a Gauss–Newton Jacobian needs
     /// ([`BvpResiduals`](crate::least_squares::BvpResiduals) uses it).
     pub fn compute_unrefined<P: Bvp>(problem: &P, sol: &Solution) -> Result<Self, BvpError> {
         Self::compute_with(problem, sol, false, None)
@@ -444,8 +444,8 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
 /// mesh of `sol`, unknown parameters included. `D_p Y · Δp` costs one linear solve with the
 /// factorisation of the solution's linearisation (cached in `sol`; computed once and cached if
 /// it is not there yet). Newton started from it converges in fewer iterations than from `sol`
-/// itself when the step is small (on the fiber model: 1 iteration instead of 4 for a step of
-/// 0.01 in `n` and `κ`); far from `sol` it is no better than `sol` and may be worse, so a caller
+/// itself when the step is small, because it is first-order accurate in the step; far from
+/// `sol` it is no better than `sol` and may be worse, so a caller
 /// should keep `Guess::from(sol)` as the fallback.
 ///
 /// Errors if `params` does not have `num_params()` finite values or `sol` does not belong to
