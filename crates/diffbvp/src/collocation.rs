@@ -15,6 +15,7 @@
 use crate::dual_jacobian::{BcFn, DualJacobian, RhsFn, Seeds};
 use crate::error::BvpError;
 use crate::problem::Bvp;
+use crate::singular::Singular;
 
 /// Values, residuals and Jacobians of the collocation system on one mesh.
 pub(crate) struct Collocation {
@@ -53,6 +54,8 @@ pub(crate) struct Collocation {
     pub rhs_evals: usize,
     /// Right-hand-side evaluations with dual numbers (one per point and pass).
     pub jac_evals: usize,
+    /// The problem's singular term ([`Bvp::singular_term`]), refreshed by every evaluation.
+    pub singular: Option<Singular>,
     input: Vec<f64>,
     fbuf: Vec<f64>,
     /// Input indices seeded at a node or midpoint (`[y, p]`) and at the boundary
@@ -81,12 +84,29 @@ impl Collocation {
             jbc: Vec::new(),
             rhs_evals: 0,
             jac_evals: 0,
+            singular: None,
             input: Vec::new(),
             fbuf: Vec::new(),
             seed_list: Vec::new(),
             bc_seed_list: Vec::new(),
             engine: DualJacobian::default(),
         }
+    }
+
+    /// Reads the problem's singular term ([`Bvp::singular_term`]) and checks it and the mesh's
+    /// start `a = 0`; `D` and `B` are recomputed only when `S` changed.
+    pub(crate) fn refresh_singular<P: Bvp>(&mut self, problem: &P) -> Result<(), BvpError> {
+        match problem.singular_term() {
+            None => self.singular = None,
+            Some(s) => {
+                let a = self.x.first().copied().unwrap_or(0.0);
+                match &self.singular {
+                    Some(cached) if cached.is_of(&s) => Singular::check_start(a)?,
+                    _ => self.singular = Some(Singular::new(s, self.n, a)?),
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Number of mesh nodes.
@@ -160,25 +180,28 @@ impl Collocation {
         y: &[f64],
         p: &[f64],
     ) -> Result<(), BvpError> {
+        self.refresh_singular(problem)?;
         let (n, m) = (self.n, self.m());
         for i in 0..m {
-            problem.rhs(
-                self.x[i],
-                &y[i * n..(i + 1) * n],
-                p,
-                &mut self.f[i * n..(i + 1) * n],
-            );
+            let (yi, fi) = (&y[i * n..(i + 1) * n], &mut self.f[i * n..(i + 1) * n]);
+            problem.rhs(self.x[i], yi, p, fi);
+            if let Some(s) = &self.singular {
+                s.apply(self.x[i], yi, fi);
+            }
         }
         self.rhs_evals += m;
         check_finite(&self.f, n, 1, |i| self.x[i], "right-hand side")?;
         self.midpoint_states(y);
         for i in 0..m - 1 {
-            problem.rhs(
-                self.x[i] + 0.5 * self.h[i],
+            let xm = self.x[i] + 0.5 * self.h[i];
+            let (ym, fm) = (
                 &self.y_mid[i * n..(i + 1) * n],
-                p,
                 &mut self.f_mid[i * n..(i + 1) * n],
             );
+            problem.rhs(xm, ym, p, fm);
+            if let Some(s) = &self.singular {
+                s.apply(xm, ym, fm);
+            }
         }
         self.rhs_evals += m - 1;
         check_finite(
@@ -370,6 +393,7 @@ impl Collocation {
         (node_seeds, bc_seeds): (Seeds<'_>, Seeds<'_>),
         values: bool,
     ) -> Result<(), BvpError> {
+        self.refresh_singular(problem)?;
         let (n, m) = (self.n, self.m());
         // the widths of the node and the boundary Jacobians' rows: `n + seeded` and
         // `2 n + seeded` but for `param_jacobians_only`
@@ -389,6 +413,7 @@ impl Collocation {
                 problem,
                 x: self.x[i],
                 n,
+                singular: self.singular.as_ref(),
             };
             let out = if values {
                 &mut self.f[i * n..(i + 1) * n]
@@ -419,6 +444,7 @@ impl Collocation {
                 problem,
                 x: self.x[i] + 0.5 * self.h[i],
                 n,
+                singular: self.singular.as_ref(),
             };
             let out = if values {
                 &mut self.f_mid[i * n..(i + 1) * n]

@@ -11,6 +11,7 @@
 
 use crate::dense_dual::DenseDual64;
 use crate::problem::Bvp;
+use crate::singular::Singular;
 use num_dual::DualNum;
 
 /// A vector function of a slice of inputs, generic over the number type.
@@ -23,6 +24,8 @@ pub(crate) struct RhsFn<'a, P> {
     pub problem: &'a P,
     pub x: f64,
     pub n: usize,
+    /// The problem's singular term, added to `f` (exact: it is linear in `y`).
+    pub singular: Option<&'a Singular>,
 }
 
 impl<P: Bvp> DualFn for RhsFn<'_, P> {
@@ -30,6 +33,9 @@ impl<P: Bvp> DualFn for RhsFn<'_, P> {
     fn eval<D: DualNum<Primitive = f64> + Copy>(&self, input: &[D], out: &mut [D]) {
         let (y, p) = input.split_at(self.n);
         self.problem.rhs(self.x, y, p, out);
+        if let Some(s) = self.singular {
+            s.apply(self.x, y, out);
+        }
     }
 }
 

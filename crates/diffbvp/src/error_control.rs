@@ -52,6 +52,9 @@ pub(crate) fn rms_residuals<P: Bvp>(
                 d1[c] = d[0] * yi[c] + d[1] * fi[c] + d[2] * yj[c] + d[3] * fj[c];
             }
             problem.rhs(col.x[i] + t * h, s1, p, f1);
+            if let Some(s) = &col.singular {
+                s.apply(col.x[i] + t * h, s1, f1);
+            }
             for ((d, f), sc) in d1.iter().zip(f1.iter()).zip(scale) {
                 let s = (d - f) / (sc + f.abs());
                 r_12 += s * s;

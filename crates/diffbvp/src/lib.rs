@@ -51,7 +51,7 @@
 //! top:
 //!
 //! 1. [`error`], [`problem`], [`mesh`], [`dense_dual`] (dual numbers with every slope stored),
-//!    [`dyn_dual`];
+//!    [`dyn_dual`], `singular` (the singular term `S y / x`);
 //! 2. `dual_jacobian`, `collocation`, [`linear`] (sparse LU and block elimination),
 //!    `error_control`, `newton`, `linearization`, [`solution`],
 //!    `mesh_cycle` (the watch for a mesh that does not settle);
@@ -88,6 +88,7 @@ mod mesh_cycle;
 mod newton;
 pub mod problem;
 pub mod sensitivity;
+mod singular;
 pub mod solution;
 pub mod solve;
 pub use error::BvpError;

@@ -58,4 +58,52 @@ pub trait Bvp {
 
     /// Boundary residuals `g(y(a), y(b), p)`, written into `r` (length `n + k`).
     fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]);
+
+    /// A constant singular term `S` (`n × n`, row-major; default `None`): the equations become
+    ///
+    /// ```text
+    /// y'(x) = S y / x + f(x, y, p),   0 <= x <= b,
+    /// ```
+    ///
+    /// on an interval that must start at `a = 0`, as bvp4c's and scipy's `solve_bvp(S=...)`. A
+    /// solution is smooth at 0 only if `S y(0) = 0` (the regularity condition); the boundary
+    /// conditions must impose it (for `y'' + (2/x) y' = …` written as `y = (u, u')`,
+    /// `S = [[0, 0], [0, -2]]` and the condition is `u'(0) = 0`). The solver then takes
+    /// `y'(0) = (I − S)⁻¹ f(0, y(0), p)` at `x = 0`, projects the guess's `y(0)` onto the null
+    /// space of `S` and checks `S y(0) = 0` at the solution; `I − S` must be nonsingular. The term
+    /// is linear in `y`: it enters every Jacobian exactly, and forward and adjoint sensitivities,
+    /// continuation and the mesh control work unchanged.
+    ///
+    /// ```
+    /// use diffbvp::mesh::linspace;
+    /// use diffbvp::{solve, Bvp, DualNum, Guess, SolveOptions};
+    ///
+    /// /// Emden's equation y'' + (2/x) y' + y^5 = 0, y'(0) = 0, y(1) = sqrt(3/4).
+    /// struct Emden;
+    /// impl Bvp for Emden {
+    ///     fn dim(&self) -> usize { 2 }
+    ///     fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
+    ///         f[0] = y[1];
+    ///         f[1] = -y[0].powi(5);
+    ///     }
+    ///     fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+    ///         r[0] = ya[1];
+    ///         r[1] = yb[0] - 0.75f64.sqrt();
+    ///     }
+    ///     // the (2/x) y' term: row 1 of S y / x is -2 y[1] / x
+    ///     fn singular_term(&self) -> Option<Vec<f64>> {
+    ///         Some(vec![0.0, 0.0, 0.0, -2.0])
+    ///     }
+    /// }
+    ///
+    /// let guess = Guess::constant(linspace(0.0, 1.0, 5), &[1.0, 0.0]);
+    /// let sol = solve(&Emden, &[], &guess, &SolveOptions::with_tol(1e-6))?;
+    /// let exact = |x: f64| (1.0 + x * x / 3.0).powf(-0.5);
+    /// assert!((sol.eval(0.0)[0] - exact(0.0)).abs() < 1e-6);
+    /// assert!((sol.eval(0.5)[0] - exact(0.5)).abs() < 1e-6);
+    /// # Ok::<(), diffbvp::BvpError>(())
+    /// ```
+    fn singular_term(&self) -> Option<Vec<f64>> {
+        None
+    }
 }

@@ -11,6 +11,7 @@ use crate::mesh;
 use crate::mesh_cycle::MeshControl;
 use crate::newton::{max_bc, newton, NewtonReport, NewtonSettings, NewtonWork, Start};
 use crate::problem::Bvp;
+use crate::singular::Singular;
 use crate::solution::{resample, Solution, SolveStats};
 use std::cell::RefCell;
 use std::sync::{Arc, OnceLock};
@@ -764,6 +765,11 @@ impl<'a, P: Bvp> Solver<'a, P> {
         let settings = newton_settings(opts);
         let mut x = guess.x.clone();
         let mut y = guess.y.clone();
+        if let Some(s) = problem.singular_term() {
+            // the guess's y(0) onto the null space of S (scipy's projection): the start then
+            // satisfies the regularity condition S y(0) = 0
+            Singular::new(s, n, x[0])?.project(&mut y[..n]);
+        }
         let mut p: Vec<f64> = guess.unknowns.iter().chain(params).copied().collect();
         let mut stats = SolveStats::default();
         self.ws.col.rhs_evals = 0;
@@ -806,6 +812,16 @@ impl<'a, P: Bvp> Solver<'a, P> {
                     return Err(e);
                 }
             };
+            if report.converged {
+                if let Some(s) = &self.ws.col.singular {
+                    // the boundary conditions hold here: if they do not impose S y(0) = 0, no
+                    // refinement will (the solution is not smooth at 0)
+                    if let Err(e) = s.check_regular(&y, bc_tol) {
+                        self.keep_system(lin);
+                        return Err(e);
+                    }
+                }
+            }
             stats.newton_iterations += report.iterations;
             stats.jacobian_factorizations += lin.factorizations - factorizations_before;
             let factored = lin.factorizations > factorizations_before;
@@ -911,6 +927,9 @@ impl<'a, P: Bvp> Solver<'a, P> {
         newton_matrix: Option<Arc<Factorization>>,
     ) -> Result<Solution, BvpError> {
         let k = self.ws.col.k;
+        if let Some(s) = &self.ws.col.singular {
+            s.check_regular(&y, opts.bc_tol.unwrap_or(opts.tol))?;
+        }
         // `col` holds values at the final iterate (the error estimate used them), among them the
         // midpoint states the Jacobians need
         let linearization = OnceLock::new();

@@ -18,6 +18,7 @@ mod linear_solvers;
 mod mesh_passes;
 mod oscillatory_mesh;
 mod partial_linearisation;
+mod problem_classes;
 mod relative_offset;
 mod scipy_problems;
 mod sensitivities;
