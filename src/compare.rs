@@ -81,7 +81,8 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let outputs = outputs::check(&plan, g)?;
     let mut request = match &fit {
         Some(path) => {
-            let rep = read_fit(path)?;
+            let rep = read_fit_file(g, path, "--fit")?;
+            warn_other_data(g, &rep, &loaded, &format!("--fit {}", path.display()));
             for w in &rep.warnings {
                 g.warn(format!(
                     "the fit in {} carries a warning: [{}] {}",

@@ -56,7 +56,10 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         json,
         out,
     } = args;
-    let previous = from.as_deref().map(previous::read_previous).transpose()?;
+    let previous = from
+        .as_deref()
+        .map(|p| previous::read_previous(p, g))
+        .transpose()?;
     let law = previous::law(model, previous.as_ref());
     let mut opts = DiagnoseOptions::default();
     let effects = match &previous {
@@ -70,7 +73,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     };
     let loaded = load_input(g, &experiments, true, true)?;
     if let Some(p) = &previous {
-        p.check_experiments(&loaded)?;
+        p.check_experiments(&loaded, g)?;
     }
     let spec = ModelSpec {
         law,
@@ -124,7 +127,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let run = run?;
     let text = run.diagnosis.to_text();
     outln!("{text}");
-    let js = serde_json::to_string_pretty(&run.diagnosis.json())?;
+    let js = to_report_json(ReportKind::Diagnosis, &run.diagnosis.json())?;
     if let Some(path) = json {
         outputs.write_text(&path, &js)?;
         g.say(format!("wrote {}", path.display()));

@@ -72,7 +72,10 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         html,
         out,
     } = args;
-    let previous = from.as_deref().map(previous::read_previous).transpose()?;
+    let previous = from
+        .as_deref()
+        .map(|p| previous::read_previous(p, g))
+        .transpose()?;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
     if let Some(t) = tol {
         opts.simulate.tol = t;
@@ -112,7 +115,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     spec.validate()?;
     let loaded = load_input(g, &experiments, true, true)?;
     if let Some(p) = &previous {
-        p.check_experiments(&loaded)?;
+        p.check_experiments(&loaded, g)?;
     }
     // every output is checked before the fit
     let mut plan = outputs::plan_for(&experiments, &loaded);
@@ -168,7 +171,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             rep.warnings.len()
         ));
     }
-    let text = serde_json::to_string_pretty(rep)?;
+    let text = to_report_json(ReportKind::Fit, rep)?;
     if let Some(path) = json {
         outputs.write_text(&path, &text)?;
         g.say(format!("wrote {}", path.display()));
@@ -258,7 +261,10 @@ fn write_fit_outputs(
     }
     if let Some(curve) = &run.summary().flow_curve {
         w.text("flow_curve.csv", &curve.to_csv())?;
-        w.text("flow_curve.json", &serde_json::to_string_pretty(curve)?)?;
+        w.text(
+            "flow_curve.json",
+            &to_report_json(ReportKind::FlowCurve, curve)?,
+        )?;
         let fig = w.path(&format!("flow_curve.{}", g.format.ext()));
         w.files(|_| save_flow_curve_figure(&fig, curve).map(|()| vec![fig.clone()]))?;
     }

@@ -10,11 +10,16 @@ use rheometer::effects::{EffectSetting, LawChoice, ModelSpec};
 use rheometer::failure_hints::ExperimentFailure;
 use rheometer::figures::{self, ExperimentView, ModelCurves, View};
 use rheometer::flow_curve_figure::save_flow_curve_figure;
-use rheometer::input::{load_experiments_with_options, InputError, LoadOptions, LoadedExperiments};
+use rheometer::input::{
+    load_experiments_with_options, InputError, LoadOptions, LoadedExperiments,
+    DEFAULT_MAX_JSON_BYTES,
+};
 use rheometer::output::write_profiles_csv;
 use rheometer::output_files::{CheckedOutputs, PARTIAL_NAME};
+use rheometer::report_json::{to_report_json, ReportKind};
 use rheometer::rheometer::{
-    Estimator, FarRule, FitSummary, IdentifyOptions, LandscapeRun, PointStatus, Rheometer,
+    DataCheck, Estimator, FarRule, FitSummary, IdentifyOptions, LandscapeRun, PointStatus,
+    Rheometer,
 };
 use rheometer::workflow::{self, CompareRequest, FitRequest, FitRun};
 use rheometer::{FiberSolution, SimulateOptions};
@@ -270,10 +275,36 @@ fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {
     diffbvp::mesh::linspace(a, b, m)
 }
 
-fn read_fit(path: &Path) -> Result<FitSummary, Box<dyn Error>> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read the fit file {}: {e}", path.display()))?;
-    Ok(FitSummary::from_json(&text, &path.display().to_string())?)
+/// Reads the fit of a report file given by `flag` (`--from`, `--fit`; `-` is standard
+/// input): a fit report or a diagnosis' final fit, through the library's one bounded, strict
+/// reader, capped at [`DEFAULT_MAX_JSON_BYTES`] unless `--allow-large-inputs`.
+pub fn read_fit_file(g: &Global, path: &Path, flag: &str) -> Result<FitSummary, Box<dyn Error>> {
+    let max = if g.allow_large_inputs {
+        u64::MAX
+    } else {
+        DEFAULT_MAX_JSON_BYTES
+    };
+    Ok(FitSummary::read_file(
+        path,
+        max,
+        flag,
+        &[ReportKind::Fit, ReportKind::Diagnosis],
+    )?)
+}
+
+/// Warns when the fit read from `flag FILE` was not made on the data of `loaded`: other
+/// numbers under the same experiment names (its data digest differs). A warning, not a
+/// refusal: a fit is legitimately compared with new data, or continued on edited data.
+pub fn warn_other_data(g: &Global, fit: &FitSummary, loaded: &LoadedExperiments, source: &str) {
+    let data = loaded
+        .set
+        .experiments
+        .iter()
+        .zip(&loaded.set.measurements)
+        .filter_map(|(e, m)| m.as_ref().map(|m| (e, m)));
+    if let DataCheck::Differs(message) = fit.check_data(data, source) {
+        g.warn(message);
+    }
 }
 
 fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
@@ -323,6 +354,10 @@ fn main() -> ExitCode {
             };
         }
     };
+    if let Err(e) = bounded_environment() {
+        err_line(&format!("error: {e}"));
+        return ExitCode::FAILURE;
+    }
     // `simulate` and `landscape` stop cleanly after SIGINT (they check the flag between
     // experiments or grid points); the other commands, and every command after SIGTERM or
     // SIGHUP, end at once, without leaving a temporary of a write in progress behind
@@ -338,13 +373,69 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::FAILURE,
         Err(e) => {
             if let Some(i) = e.downcast_ref::<Interrupted>() {
-                err_line(&format!("interrupted: {i}"));
-                return ExitCode::from(EXIT_INTERRUPTED);
+                err_line(&format!("{}: {i}", signals::stopped_by()));
+                return ExitCode::from(signals::exit_code());
             }
             report_error(e.as_ref());
             ExitCode::FAILURE
         }
     }
+}
+
+/// Checks the environment before any work: every `DIFFBVP_*` variable valid (else an error
+/// naming it and its range), and the thread pool built with the size `RAYON_NUM_THREADS`
+/// asks for, clamped to a number this machine can run (with a warning); a pool that cannot be
+/// built (threads refused by a memory or process limit) is an error, not a panic.
+fn bounded_environment() -> Result<(), String> {
+    rheometer::environment::check_diffbvp_variables(std::env::vars_os())?;
+    if let Some(w) = memory_limit_note() {
+        err_line(&format!("warning: {w}"));
+    }
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let value = std::env::var_os("RAYON_NUM_THREADS").map(|v| v.to_string_lossy().into_owned());
+    let (threads, warning) = rheometer::environment::thread_count(value.as_deref(), cores);
+    if let Some(w) = warning {
+        err_line(&format!("warning: {w}"));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global()
+        .map_err(|e| {
+            format!(
+                "cannot start {threads} worker threads ({e}): a limit on memory or processes \
+                 (ulimit -v, ulimit -u, a container's limit) is too tight; lower \
+                 RAYON_NUM_THREADS (e.g. RAYON_NUM_THREADS=1) or raise the limit"
+            )
+        })
+}
+
+/// Below this address-space limit (`ulimit -v`) the program warns at start: a fit of the
+/// shipped data sets needs several hundred MB of address space (thread stacks included).
+const LOW_ADDRESS_SPACE_BYTES: u64 = 1 << 30;
+
+/// A warning when the address space is limited below [`LOW_ADDRESS_SPACE_BYTES`]: the program
+/// may then end with "memory allocation failed" (an abort the program cannot turn into a
+/// message), so the limit is named before the work.
+fn memory_limit_note() -> Option<String> {
+    #[cfg(unix)]
+    {
+        let mut lim = libc::rlimit {
+            rlim_cur: 0,
+            rlim_max: 0,
+        };
+        // SAFETY: getrlimit writes the struct it is given and nothing else
+        let ok = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } == 0;
+        let cur = u64::try_from(lim.rlim_cur).unwrap_or(u64::MAX);
+        if ok && lim.rlim_cur != libc::RLIM_INFINITY && cur < LOW_ADDRESS_SPACE_BYTES {
+            return Some(format!(
+                "the address space of this process is limited to {} MB (ulimit -v); a fit may \
+                 need more and would then end with \"memory allocation failed\"; raise the \
+                 limit (ulimit -v unlimited) if it does",
+                cur >> 20
+            ));
+        }
+    }
+    None
 }
 
 /// A note for `--n -- -0.1` (clap reads `--` as the value and `-0.1` as flags): negative

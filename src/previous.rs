@@ -39,10 +39,18 @@ impl Previous {
         Ok(Some(s))
     }
 
-    /// Checks that the file is a fit of the experiments of `loaded`, in their order.
-    pub fn check_experiments(&self, loaded: &LoadedExperiments) -> Result<(), String> {
+    /// Checks that the file is a fit of the experiments of `loaded`, in their order, and
+    /// warns when its data digest says it was made on other numbers.
+    pub fn check_experiments(&self, loaded: &LoadedExperiments, g: &Global) -> Result<(), String> {
         self.fit
-            .check_experiments(&loaded.set.names(), &self.path.display().to_string())
+            .check_experiments(&loaded.set.names(), &self.path.display().to_string())?;
+        warn_other_data(
+            g,
+            &self.fit,
+            loaded,
+            &format!("--from {}", self.path.display()),
+        );
+        Ok(())
     }
 
     /// The model's effects: the file's (continued) and then `with`, each effect once; the
@@ -53,11 +61,9 @@ impl Previous {
     }
 }
 
-/// Reads the file of `--from`: a fit report or a diagnosis.
-pub fn read_previous(path: &Path) -> Result<Previous, Box<dyn Error>> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("--from: cannot read {}: {e}", path.display()))?;
-    let fit = FitSummary::from_fit_or_diagnosis_json(&text, &path.display().to_string())?;
+/// Reads the file of `--from`: a fit report or a diagnosis (`-`: standard input).
+pub fn read_previous(path: &Path, g: &Global) -> Result<Previous, Box<dyn Error>> {
+    let fit = read_fit_file(g, path, "--from")?;
     Ok(Previous {
         path: path.to_path_buf(),
         fit,

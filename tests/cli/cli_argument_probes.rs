@@ -522,8 +522,15 @@ fn fit_json(dir: &Path, n: f64, kappa: f64, factor: f64) -> PathBuf {
         .map(|v| format!("{v}"))
         .collect();
     let text = format!(
-        "{{\"estimator\": \"Principled\", \"n\": {n}, \"kappa\": {kappa}, \
-         \"take_up_factors\": [{}]}}",
+        "{{\"schema_version\": 1, \"report\": \"fit\", \"written_by\": \"rheometer\", \
+         \"estimator\": \"Principled\", \"n\": {n}, \"kappa\": {kappa}, \
+         \"experiments\": [{}], \"take_up_factors\": [{}]}}",
+        [
+            "v0p27_p1", "v0p27_p2", "v0p27_p3", "v0p53_p1", "v0p53_p2", "v0p53_p3", "v1p06_p1",
+            "v1p06_p2", "v1p06_p3"
+        ]
+        .map(|n| format!("\"{n}\""))
+        .join(", "),
         factors.join(", ")
     );
     let path = dir.join(format!("fit_{n}_{kappa}_{factor}.json"));

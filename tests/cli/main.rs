@@ -4,6 +4,7 @@
 #[path = "../probe/mod.rs"]
 mod probe;
 
+mod bad_input_t4;
 mod cli_argument_probes;
 mod cli_output_layer;
 mod cli_output_safety;

@@ -286,7 +286,7 @@ fn cli_errors_are_clear() {
     ]);
     assert!(!ok);
     assert!(
-        err.contains("cannot read the fit file") && err.contains("missing.json"),
+        err.contains("--fit") && err.contains("cannot read file") && err.contains("missing.json"),
         "{err}"
     );
 
@@ -302,14 +302,16 @@ fn cli_errors_are_clear() {
     ]);
     assert!(!ok);
     assert!(
-        err.contains("bad.json") && err.contains("is not a fit report"),
+        err.contains("bad.json") && err.contains("the file ends early (truncated?)"),
         "{err}"
     );
 
     let short = dir.join("short.json");
     std::fs::write(
         &short,
-        r#"{"estimator": "Principled", "n": 0.8, "kappa": 11.7, "take_up_factors": [1.0, 1.0]}"#,
+        r#"{"schema_version": 1, "report": "fit", "written_by": "rheometer",
+            "estimator": "Principled", "n": 0.8, "kappa": 11.7, "experiments": [],
+            "take_up_factors": [1.0, 1.0]}"#,
     )
     .unwrap();
     let (ok, err) = rheometer(&[
@@ -345,11 +347,14 @@ fn cli_writes_summary_json_and_figures() {
         .join(format!("diffbvp-compare-run-{}", std::process::id()));
     let fit = dir.join("fit.json");
     std::fs::create_dir_all(&dir).unwrap();
-    // a fit report as `rheometer fit --json` writes it (NaN standard errors become null)
+    // a fit report with the fields `compare` reads, stamped as this version writes it (NaN
+    // standard errors become null)
     std::fs::write(
         &fit,
-        r#"{"estimator": "Paper", "start": [0.5, 12.0], "n": 0.8, "kappa": 11.71,
-            "stderr_n": null, "take_up_factors": [1,1,1,1,1,1,1,1,1]}"#,
+        r#"{"schema_version": 1, "report": "fit", "written_by": "rheometer",
+            "estimator": "Paper", "start": [0.5, 12.0],
+            "n": 0.8, "kappa": 11.71, "experiments": [],
+            "take_up_factors": [1,1,1,1,1,1,1,1,1]}"#,
     )
     .unwrap();
     let out = dir.join("cmp");

@@ -406,9 +406,13 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
 pub use crate::plot::FigureFormat;
 
 impl Comparison {
-    /// The JSON summary (all numbers, per point).
+    /// The JSON summary (all numbers, per point), stamped as a
+    /// [`ReportKind::Comparison`](crate::report_json::ReportKind::Comparison) report.
     pub fn to_json(&self) -> Result<String, CompareError> {
-        Ok(serde_json::to_string_pretty(self)?)
+        Ok(crate::report_json::to_report_json(
+            crate::report_json::ReportKind::Comparison,
+            self,
+        )?)
     }
 
     /// The per-point table as CSV.

@@ -83,6 +83,17 @@ pub enum InputError {
         /// What it looks like and what to pass instead.
         message: String,
     },
+    /// A JSON report read back is malformed: truncated, a duplicate key, `NaN`, a number out
+    /// of range, a syntax error; the message names the field (`n.value`).
+    #[error("{at}{}: {message}", column.map(|c| format!(":{c}")).unwrap_or_default())]
+    Json {
+        /// File and line.
+        at: Location,
+        /// 1-based column, if known.
+        column: Option<usize>,
+        /// What is wrong, at which field, and what to do.
+        message: String,
+    },
     /// The file is not valid TOML.
     #[error("{at}{}: malformed TOML: {message}", column.map(|c| format!(":{c}")).unwrap_or_default())]
     Toml {

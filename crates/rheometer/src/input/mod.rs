@@ -126,6 +126,9 @@
 //! * `options`: [`LoadOptions`] (the caps) and the fit-memory estimate;
 //! * `error`: [`Location`], [`InputError`] and [`InputWarning`], the messages of every failure;
 //! * `source`: opening regular files only, bounded reading, encoding checks;
+//! * `json`: reading a JSON report back (`fit --from`, `compare --fit`), bounded and strict
+//!   ([`read_json`]: the file checks of `source`, `-` for standard input, duplicate keys,
+//!   `NaN`, numbers out of range and truncation named with the field's path);
 //! * `syntax`: messages for duplicate keys and for files that are not experiments files;
 //! * `schema`: the keys of each table, the rules their values obey, plausible ranges, and
 //!   hints for misspelt or misplaced keys;
@@ -146,6 +149,7 @@ mod cross_checks;
 mod error;
 mod experiment;
 mod experiments;
+mod json;
 mod loaded;
 mod measurements;
 mod options;
@@ -162,6 +166,7 @@ pub use experiments::{
     load_experiments, load_experiments_with, load_experiments_with_options, parse_experiments,
     parse_experiments_with,
 };
+pub use json::{parse_json, read_json, show_json_path, JsonSource, DEFAULT_MAX_JSON_BYTES};
 pub use loaded::{ExperimentDetails, LoadedExperiments};
 pub use measurements::{
     load_measurements, load_measurements_with, parse_measurements, CSV_HEADER, DEFAULT_MIN_POINTS,

@@ -151,6 +151,8 @@ pub enum Limit {
     Experiments,
     /// [`LoadOptions::max_fit_memory_bytes`].
     FitMemory,
+    /// [`JsonSource::max_bytes`](super::JsonSource::max_bytes): a JSON report read back.
+    JsonBytes,
 }
 
 impl Limit {
@@ -163,6 +165,7 @@ impl Limit {
             Limit::RowsPerFile => "max_rows_per_file",
             Limit::Experiments => "max_experiments",
             Limit::FitMemory => "max_fit_memory_bytes",
+            Limit::JsonBytes => "max_json_bytes",
         }
     }
 }

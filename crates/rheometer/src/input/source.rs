@@ -157,7 +157,7 @@ pub(super) fn read_toml(path: &Path, max_bytes: u64) -> Result<String, InputErro
 }
 
 /// Refuses byte-order marks of UTF-16/UTF-32 and the signatures of spreadsheets.
-fn check_start(path: &Path, bytes: &[u8]) -> Result<(), InputError> {
+pub(super) fn check_start(path: &Path, bytes: &[u8]) -> Result<(), InputError> {
     let encoding = if bytes.starts_with(b"\xFF\xFE\0\0") || bytes.starts_with(b"\0\0\xFE\xFF") {
         Some("UTF-32")
     } else if bytes.starts_with(b"\xFF\xFE") || bytes.starts_with(b"\xFE\xFF") {
@@ -203,7 +203,12 @@ fn check_start(path: &Path, bytes: &[u8]) -> Result<(), InputError> {
 
 /// Checks that `bytes` (starting at byte `offset` and line `line` of the file) are UTF-8 text
 /// without NUL bytes.
-fn check_text(path: &Path, bytes: &[u8], offset: u64, line: usize) -> Result<(), InputError> {
+pub(super) fn check_text(
+    path: &Path,
+    bytes: &[u8],
+    offset: u64,
+    line: usize,
+) -> Result<(), InputError> {
     if let Some(nul) = bytes.iter().position(|&b| b == 0) {
         return Err(encoding_error(path, bytes, offset, line, nul));
     }

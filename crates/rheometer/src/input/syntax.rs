@@ -101,10 +101,15 @@ pub(super) fn not_experiments(path: &Path, text: &str) -> Option<InputError> {
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
         .find(|(_, l)| !l.is_empty() && !l.starts_with('#'))?;
+    // a JSON array: `[` alone (pretty-printed), or followed by a value; TOML's table headers
+    // `[name]` and `[[name]]` hold neither a lone bracket nor a comma-separated list
+    let after = first.get(1..).unwrap_or("").trim_start();
     let json = first.starts_with('{')
+        || first == "["
         || (first.starts_with('[')
-            && first[1..].trim_start().starts_with(['{', '"', '[', ']'])
-            && !first.starts_with("[["));
+            && !first.starts_with("[[")
+            && (after.starts_with(['{', '"', '[', ']'])
+                || (after.contains(',') && !first.contains('='))));
     let csv = !json
         && !first.starts_with('[')
         && !first.contains('=')
@@ -172,5 +177,10 @@ mod tests {
         assert!(not_experiments(p, "[material]\na = 1").is_none());
         assert!(not_experiments(p, "[[experiment]]\n").is_none());
         assert!(not_experiments(p, "a = 1, 2").is_none());
+        for array in ["[\n  {\"a\": 1}\n]", "[1, 2]", "[ -1.5, 2 ]", "[]"] {
+            let e = not_experiments(p, array).unwrap();
+            assert!(e.to_string().contains("JSON"), "{array}: {e}");
+        }
+        assert!(not_experiments(p, "[1]\na = 1").is_none());
     }
 }

@@ -30,7 +30,8 @@ pub enum OutputError {
     },
     /// The output directory, or one of its parents, exists and is not a directory.
     #[error(
-        "cannot create the output directory {path}: {file} exists and is a file, not a directory"
+        "cannot create the output directory {path}: {file} exists and is {}, not a directory",
+        kind_of(file)
     )]
     NotADirectory {
         /// The requested directory.
@@ -58,6 +59,18 @@ pub enum OutputError {
         mode: u32,
         /// Whether another user owns it.
         others: bool,
+    },
+    /// The existing file is immutable or append-only (`chattr +i`, `+a`): not even root may
+    /// replace it, so it is refused before the work.
+    #[error(
+        "refusing to replace {path}: the file is immutable or append-only (chattr +i or +a: \
+         {source}); remove the attribute (`chattr -i {path}` as root) or choose another name"
+    )]
+    Immutable {
+        /// The path.
+        path: PathBuf,
+        /// The error of opening it for writing.
+        source: std::io::Error,
     },
     /// The existing file belongs to another user in a directory with the sticky bit (as
     /// `/tmp`): it cannot be replaced.
@@ -182,8 +195,8 @@ pub enum OutputError {
         #[source]
         source: Box<OutputError>,
     },
-    /// I/O failure while writing.
-    #[error("cannot write {path}: {source}")]
+    /// I/O failure while writing (the temporary of the write removed).
+    #[error("cannot write {path}: {source}{}", io_hint(source))]
     Io {
         /// The path.
         path: PathBuf,
@@ -226,6 +239,54 @@ fn alias_note(path: &Path, input: &Path) -> String {
             input.display()
         )
     }
+}
+
+/// What to do after a failed write: for a file beyond the size limit (`ulimit -f`) or a full
+/// disk or quota, what limits it; nothing otherwise.
+fn io_hint(e: &std::io::Error) -> &'static str {
+    #[cfg(unix)]
+    {
+        match e.raw_os_error() {
+            Some(libc::EFBIG) => {
+                return "; the file would exceed the file-size limit of this process (`ulimit \
+                        -f`, a batch system's limit): raise the limit, or write where larger \
+                        files are allowed; nothing was left behind"
+            }
+            Some(libc::ENOSPC) | Some(libc::EDQUOT) => {
+                return "; the disk or your quota is full: free space, or write elsewhere; \
+                        nothing was left behind"
+            }
+            _ => {}
+        }
+    }
+    let _ = e;
+    ""
+}
+
+/// What the existing `file` is, for messages: `a file`, `a character device`, `a FIFO (named
+/// pipe)`, `a socket`, `a block device`.
+fn kind_of(file: &Path) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if let Ok(m) = std::fs::metadata(file) {
+            let t = m.file_type();
+            if t.is_char_device() {
+                return "a character device";
+            }
+            if t.is_block_device() {
+                return "a block device";
+            }
+            if t.is_fifo() {
+                return "a FIFO (named pipe)";
+            }
+            if t.is_socket() {
+                return "a socket";
+            }
+        }
+    }
+    let _ = file;
+    "a file"
 }
 
 fn same_path_note(path: &Path) -> String {

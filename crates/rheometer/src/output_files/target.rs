@@ -286,6 +286,18 @@ pub fn check_replaceable(path: &Path) -> Result<(), OutputError> {
         if mode & 0o222 == 0 {
             return Err(protected());
         }
+        // an immutable or append-only file refuses writing with EPERM (EACCES is the mode),
+        // for root too; opening for writing without truncation changes nothing
+        if meta.is_file() {
+            if let Err(e) = fs::OpenOptions::new().write(true).open(path) {
+                if e.raw_os_error() == Some(libc::EPERM) {
+                    return Err(OutputError::Immutable {
+                        path: path.to_path_buf(),
+                        source: e,
+                    });
+                }
+            }
+        }
         if euid != 0 {
             // another user's file in a sticky directory first: the rename would fail whatever
             // the file's mode

@@ -102,7 +102,12 @@ pub fn write_target(
     match target {
         Target::Stdout => {
             let mut out = io::stdout().lock();
-            write(&mut out).and_then(|()| out.flush()).map_err(io_err)
+            match write(&mut out).and_then(|()| out.flush()) {
+                // a reader that closed the pipe (`| head`) wanted no more: success, as for the
+                // report on stdout
+                Err(e) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
+                r => r.map_err(io_err),
+            }
         }
         Target::Descriptor(fd) => {
             let file = duplicate(*fd).map_err(io_err)?;

@@ -185,6 +185,7 @@ impl Rheometer {
             wall_time_s: t0.elapsed().as_secs_f64(),
         });
         summary.strain_rates = self.strain_rate_coverage(&solutions);
+        summary.data_digest = super::data_digest(self.experiments.iter().zip(&self.measurements));
         Ok(Identification {
             summary,
             names: obj.layout.names.clone(),

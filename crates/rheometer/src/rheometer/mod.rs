@@ -86,5 +86,6 @@ pub use summary::{
     WarningCode,
 };
 pub use summary_read::{
-    ContinuedEffects, FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE, FIT_FILE_TAKE_UP_RANGE,
+    data_digest, ContinuedEffects, DataCheck, FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE,
+    FIT_FILE_TAKE_UP_RANGE,
 };

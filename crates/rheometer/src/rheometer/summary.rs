@@ -270,6 +270,11 @@ pub struct FitSummary {
     /// Experiment names, in the order of `take_up_factors`.
     #[serde(default)]
     pub experiments: Vec<String>,
+    /// A digest of the data the fit was made on ([`data_digest`](super::data_digest): the
+    /// experiments' names, conditions and measurements), so that a reader can tell this
+    /// fit's data from other data with the same experiment names (empty: not recorded).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub data_digest: String,
     /// Start point `(n, κ)`.
     #[serde(default = "nan_pair", deserialize_with = "serde_nan::pair")]
     pub start: [f64; 2],
@@ -522,6 +527,7 @@ pub(crate) mod tests {
     ) -> FitSummary {
         let kp = Estimate::fitted("kappa", kappa.0, "-", kappa.1, None);
         FitSummary {
+            data_digest: String::new(),
             estimator: Estimator::Principled,
             law: LawChoice::Carreau,
             fitted: vec!["n".into(), "kappa".into(), effect.into()],

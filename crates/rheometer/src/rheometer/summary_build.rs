@@ -187,6 +187,7 @@ impl FitSummary {
             law: input.law,
             fitted: input.names.to_vec(),
             experiments: input.experiments,
+            data_digest: String::new(),
             start: input.start,
             n,
             kappa,

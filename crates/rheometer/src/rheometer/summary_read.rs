@@ -1,12 +1,18 @@
-//! Reading a [`FitSummary`] back from its JSON (`rheometer fit --json`): the next step
-//! (`compare --fit`, `fit --from`) starts from it. Every field the next
-//! step needs is checked, and errors name the file and the field.
+//! Reading a [`FitSummary`] back from its JSON (`rheometer fit --json`, or a diagnosis'
+//! final fit): the next step (`compare --fit`, `fit --from`, `diagnose --from`) starts from
+//! it. A file is read by [`FitSummary::read_file`], the one door of every such file (the
+//! bounded, strict reader [`read_json`], the report's stamp [`check_report`], the field types
+//! with their paths, the values' ranges); every error names the file and the field.
 
 use super::estimator::Estimator;
 use super::summary::{FitSummary, WarningCode};
 use crate::effects::{Effect, EffectSetting};
 use crate::error::Readable;
+use crate::input::{parse_json, read_json, show_json_path, JsonSource};
+use crate::report_json::{check_report, ReportKind};
+use crate::setup::{Experiment, Measurements};
 use serde_json::Value;
+use std::path::Path;
 
 /// The range of `n` accepted from a fit file (the rheometer's search range) \[-\].
 pub const FIT_FILE_N_RANGE: [f64; 2] = [0.0, 1.0];
@@ -44,6 +50,34 @@ fn is_estimate(v: &Value) -> bool {
     v.is_number() || v.get("value").is_some_and(Value::is_number)
 }
 
+/// The error of an estimate field `key` whose value `v` is neither a number nor an object with
+/// a numeric `value`: names the inner field where the object is there but its value is not.
+fn estimate_type_error(key: &str, v: &Value) -> String {
+    match v.get("value") {
+        Some(inner) => format!(
+            "field `{key}.value` is {} ({}); it should be a number",
+            kind(inner),
+            short_json(inner)
+        ),
+        None if v.is_object() => format!("field `{key}.value`: missing (an estimate has a value)"),
+        None => format!(
+            "field `{key}` is {} ({}); it should be an estimate {{\"value\": number, ...}}",
+            kind(v),
+            short_json(v)
+        ),
+    }
+}
+
+/// `v` as JSON, cut to 60 characters for messages.
+fn short_json(v: &Value) -> String {
+    let s = v.to_string();
+    if s.chars().count() > 60 {
+        format!("{}…", s.chars().take(59).collect::<String>())
+    } else {
+        s
+    }
+}
+
 /// Checks the shape of the fields the next step needs, one by one so that errors name them.
 fn check_fields(obj: &serde_json::Map<String, Value>) -> Result<(), String> {
     for key in ["estimator", "n", "kappa"] {
@@ -55,11 +89,7 @@ fn check_fields(obj: &serde_json::Map<String, Value>) -> Result<(), String> {
     }
     for key in ["n", "kappa"] {
         if let Some(v) = obj.get(key).filter(|v| !is_estimate(v)) {
-            return Err(format!(
-                "field \"{key}\": expected a number or an estimate {{\"value\": ...}}, found {} \
-                 ({v})",
-                kind(v)
-            ));
+            return Err(estimate_type_error(key, v));
         }
     }
     if let Some(v) = obj.get("take_up_factors") {
@@ -97,12 +127,7 @@ fn check_fields(obj: &serde_json::Map<String, Value>) -> Result<(), String> {
             }
             match e.get("strength") {
                 Some(x) if is_estimate(x) => {}
-                Some(x) => {
-                    return Err(format!(
-                        "field {f}.strength: expected a number or an estimate, found {} ({x})",
-                        kind(x)
-                    ))
-                }
+                Some(x) => return Err(estimate_type_error(&format!("effects[{i}].strength"), x)),
                 None => return Err(format!("field {f}.strength: missing")),
             }
         }
@@ -233,7 +258,150 @@ fn upgrade_legacy(mut v: Value) -> Value {
     v
 }
 
+/// A digest of the data a fit is made on: FNV-1a (64 bit) over each experiment's name, mass
+/// flow, inlet and air temperatures, spin-line length and measured positions and diameters
+/// (their bit patterns), as 16 hex digits. It tells a fit's data from other data that merely
+/// share the experiment names; it is no protection against deliberate forgery.
+pub fn data_digest<'a>(
+    data: impl IntoIterator<Item = (&'a Experiment, &'a Measurements)>,
+) -> String {
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(PRIME);
+        }
+    };
+    for (e, m) in data {
+        eat(&(e.name.len() as u64).to_le_bytes());
+        eat(e.name.as_bytes());
+        for x in [
+            e.mass_flow,
+            e.inlet_temperature,
+            e.air_temperature,
+            e.spinline_length,
+        ] {
+            eat(&x.to_bits().to_le_bytes());
+        }
+        eat(&(m.positions.len() as u64).to_le_bytes());
+        for (s, d) in m.positions.iter().zip(&m.diameters) {
+            eat(&s.to_bits().to_le_bytes());
+            eat(&d.to_bits().to_le_bytes());
+        }
+    }
+    format!("{h:016x}")
+}
+
+/// How a fit read back relates to the data it is used with ([`FitSummary::check_data`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum DataCheck {
+    /// The digests agree: the fit was made on these data.
+    Same,
+    /// The same experiment names, other numbers: the message says so.
+    Differs(String),
+    /// The fit records no digest (a diagnosis' base fit made without one, or a report built
+    /// in memory): nothing can be said.
+    Unknown,
+}
+
 impl FitSummary {
+    /// Reads the fit of a report file `path` (`-`: standard input): a fit report or, where
+    /// `wanted` has [`ReportKind::Diagnosis`], a diagnosis' final fit (its base fit if it has
+    /// none). The file is read bounded (at most `max_bytes`) and strictly ([`read_json`]),
+    /// its stamp checked ([`check_report`]: the current schema version, a wanted kind), then
+    /// its fields' types (errors name the path, `n.value`) and values
+    /// ([`validate`](Self::validate)); `flag` names the option that gave the file.
+    pub fn read_file(
+        path: &Path,
+        max_bytes: u64,
+        flag: &str,
+        wanted: &[ReportKind],
+    ) -> Result<Self, String> {
+        let source = show_json_path(path);
+        let remedy = format!(
+            "{} FILE",
+            wanted
+                .first()
+                .map_or("rheometer fit --json", |k| k.command())
+        );
+        let value = read_json(
+            path,
+            JsonSource {
+                max_bytes,
+                remedy: &remedy,
+            },
+        )
+        .map_err(|e| {
+            let limit = matches!(e, crate::input::InputError::Limit { .. });
+            format!(
+                "{flag}: {e}{}",
+                if limit {
+                    " (on the command line: --allow-large-inputs)"
+                } else {
+                    ""
+                }
+            )
+        })?;
+        let kind = check_report(&value, wanted, &source, flag)?;
+        if kind != ReportKind::Diagnosis {
+            return Self::from_report_value(value, &source);
+        }
+        let Value::Object(mut obj) = value else {
+            return Err(format!("{source}: a diagnosis is a JSON object"));
+        };
+        let (field, fit) = match obj.remove("final_fit").filter(|v| !v.is_null()) {
+            Some(f) => ("final_fit", f),
+            None => (
+                "base_fit",
+                obj.remove("base_fit")
+                    .ok_or_else(|| format!("{source}: field `base_fit`: missing"))?,
+            ),
+        };
+        Self::from_report_value(fit, &format!("{source} (the diagnosis' field `{field}`)"))
+    }
+
+    /// A fit from the JSON value of a report as this version writes it (no older forms):
+    /// the fields the next step needs checked one by one, then every field's type (an error
+    /// names its path, `experiments[2]`), then the values ([`validate`](Self::validate)).
+    pub fn from_report_value(value: Value, source: &str) -> Result<Self, String> {
+        let obj = value
+            .as_object()
+            .ok_or_else(|| format!("{source}: a fit report is a JSON object"))?;
+        for key in ["experiments", "take_up_factors"] {
+            if !obj.contains_key(key) {
+                return Err(format!(
+                    "{source}: field `{key}`: missing (a fit report of `rheometer fit --json` \
+                     has it: it ties the fit to its data)"
+                ));
+            }
+        }
+        Self::from_value(value, source, false)
+    }
+
+    /// Whether this fit (read from `source`) was made on the data `data` (the experiments and
+    /// their measurements, in order), by [`data_digest`].
+    pub fn check_data<'a>(
+        &self,
+        data: impl IntoIterator<Item = (&'a Experiment, &'a Measurements)>,
+        source: &str,
+    ) -> DataCheck {
+        if self.data_digest.is_empty() {
+            return DataCheck::Unknown;
+        }
+        let now = data_digest(data);
+        if now == self.data_digest {
+            DataCheck::Same
+        } else {
+            DataCheck::Differs(format!(
+                "{source} was fitted on other data than these (data digest {} there, {now} \
+                 here): the experiment names agree, but conditions or measurements differ \
+                 (another data set with the same names, or edited CSV files)",
+                self.data_digest
+            ))
+        }
+    }
+
     /// Reports written before the error budget became a table warned for every source that
     /// shifted an estimate by more than its statistical error; their budget's warnings are
     /// recomputed by today's rule ([`ErrorBudget::warnings`](super::ErrorBudget::warnings)).
@@ -244,46 +412,65 @@ impl FitSummary {
         self.warnings.extend(now);
     }
 
-    /// Parses the JSON text of a fit summary; `source` names it in errors. Reports written by
-    /// earlier versions (bare numbers for `n`, `κ` and strengths) read too.
+    /// Parses the JSON text of a fit summary held in memory (a Python dict, a test's text);
+    /// `source` names it in errors. The text is parsed as strictly as a file
+    /// ([`parse_json`]: duplicate keys, `NaN`, numbers out of range refused, naming the
+    /// field), but needs no stamp, and reports of earlier layouts (bare numbers for `n`, `κ`
+    /// and strengths) read too; files are read by [`read_file`](Self::read_file), which
+    /// takes the current layout only.
     pub fn from_json(text: &str, source: &str) -> Result<Self, String> {
-        let not_report = |what: String| {
-            format!("{source} is not a fit report as written by `rheometer fit --json`: {what}")
-        };
-        let value: Value =
-            serde_json::from_str(text).map_err(|e| not_report(format!("not valid JSON: {e}")))?;
-        let obj = value
-            .as_object()
-            .ok_or_else(|| not_report("expected a JSON object {...}".into()))?;
-        check_fields(obj).map_err(|e| format!("{source}: {e}"))?;
-        let value = upgrade_legacy(value);
-        let mut s: FitSummary =
-            serde_json::from_value(value).map_err(|e| not_report(e.to_string()))?;
-        s.validate(source)?;
-        s.upgrade_systematic_warnings();
-        Ok(s)
+        let value = parse_json(text, Path::new(source), "rheometer fit --json FILE")
+            .map_err(|e| e.to_string())?;
+        Self::from_value(value, source, true)
     }
 
     /// A fit to continue from: the JSON text of a fit report (`rheometer fit --json`) or of a
     /// diagnosis (`rheometer diagnose --json`: its final fit, the model with the effects it
-    /// found, or without one its base fit); `source` names the file in errors.
+    /// found, or without one its base fit), held in memory as [`from_json`](Self::from_json)
+    /// takes it; `source` names it in errors.
     pub fn from_fit_or_diagnosis_json(text: &str, source: &str) -> Result<Self, String> {
-        let value: Value =
-            serde_json::from_str(text).map_err(|e| format!("{source} is not valid JSON: {e}"))?;
+        let value = parse_json(text, Path::new(source), "rheometer fit --json FILE")
+            .map_err(|e| e.to_string())?;
         let diagnosis = value
             .as_object()
-            .filter(|o| o.contains_key("verdict") && o.contains_key("base_fit"));
-        let Some(obj) = diagnosis else {
-            return Self::from_json(text, source);
+            .is_some_and(|o| o.contains_key("verdict") && o.contains_key("base_fit"));
+        if !diagnosis {
+            return Self::from_value(value, source, true);
+        }
+        let Value::Object(mut obj) = value else {
+            return Err(format!("{source}: a diagnosis is a JSON object"));
         };
-        let (field, fit) = match obj.get("final_fit").filter(|v| !v.is_null()) {
+        let (field, fit) = match obj.remove("final_fit").filter(|v| !v.is_null()) {
             Some(f) => ("final_fit", f),
-            None => ("base_fit", &obj["base_fit"]),
+            None => ("base_fit", obj.remove("base_fit").unwrap_or(Value::Null)),
         };
-        Self::from_json(
-            &fit.to_string(),
+        Self::from_value(
+            fit,
             &format!("{source} (the diagnosis' field \"{field}\")"),
+            true,
         )
+    }
+
+    /// A fit from a parsed report: the fields the next step needs checked one by one, then
+    /// (with `legacy`) earlier layouts brought to today's, then every field's type (an error
+    /// names its path, `experiments[2]`), then the values ([`validate`](Self::validate)).
+    fn from_value(value: Value, source: &str, legacy: bool) -> Result<Self, String> {
+        let obj = value.as_object().ok_or_else(|| {
+            format!(
+                "{source}: the JSON is {}, not a report: a fit report is a JSON object {{...}}",
+                kind(&value)
+            )
+        })?;
+        check_fields(obj).map_err(|e| format!("{source}: {e}"))?;
+        let value = if legacy { upgrade_legacy(value) } else { value };
+        let mut s: FitSummary = serde_path_to_error::deserialize(value).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner().to_string();
+            format!("{source}: field `{path}`: {}", readable_type_error(&inner))
+        })?;
+        s.validate(source)?;
+        s.upgrade_systematic_warnings();
+        Ok(s)
     }
 
     /// The effects of this fit as the model of a next fit, and where its fitted parameters
@@ -494,6 +681,18 @@ impl FitSummary {
             ));
         }
         Ok(Some(self.take_up_factors.clone()))
+    }
+}
+
+/// serde's `invalid type: string "x", expected a sequence` as `is a string ("x"); it should
+/// be a sequence`; other messages unchanged.
+fn readable_type_error(msg: &str) -> String {
+    let Some(rest) = msg.strip_prefix("invalid type: ") else {
+        return msg.to_string();
+    };
+    match rest.rsplit_once(", expected ") {
+        Some((found, expected)) => format!("is {found}; it should be {expected}"),
+        None => msg.to_string(),
     }
 }
 
