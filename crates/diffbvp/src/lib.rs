@@ -56,7 +56,7 @@
 //!    `error_control`, `newton`, `linearization`, [`solution`],
 //!    `mesh_cycle` (the watch for a mesh that does not settle);
 //! 3. [`solve`](mod@solve) (the adaptive loop);
-//! 4. [`continuation`], [`sensitivity`], [`inspect`];
+//! 4. [`continuation`], [`sensitivity`], [`inspect`], `expr` (feature `expr`: problems as text);
 //! 5. [`least_squares`] (the bounded driver; its [`BvpResiduals`](least_squares::BvpResiduals)
 //!    adaptor solves BVPs and takes their sensitivities).
 //!
@@ -66,6 +66,7 @@
 //! |---|---|---|
 //! | `parallel` | no | [`least_squares::BvpResiduals`] solves its runs in parallel (rayon; faer's own rayon too) |
 //! | `serde` | no | `Serialize`/`Deserialize` for the toolkit's records (options, statistics, termination) |
+//! | `expr` | no | `expr::ExprBvp`: a problem given as text expressions (parsed, evaluated over dual numbers; no extra dependencies) |
 //!
 //! Without features the crate depends on num-dual, faer, nalgebra, num-traits and thiserror
 //! only.
@@ -79,6 +80,8 @@ mod dual_jacobian;
 pub mod dyn_dual;
 pub mod error;
 mod error_control;
+#[cfg(feature = "expr")]
+pub mod expr;
 pub mod inspect;
 pub mod least_squares;
 pub mod linear;
