@@ -137,8 +137,9 @@ pub fn param_jacobian<P: Bvp>(problem: &P, sol: &Solution) -> Result<CsMat<f64>,
 /// moves the whole solution); stored in compressed columns without the exact zeros.
 pub fn sensitivity_matrix(sens: &Sensitivities) -> CsMat<f64> {
     let s = sens.num_params();
-    let states = if s == 0 { 0 } else { sens.dy.len() / s };
-    let k = if s == 0 { 0 } else { sens.d_unknowns.len() / s };
+    // rows per column: the layouts are `row * s + column` (no rows without columns)
+    let states = sens.dy.len().checked_div(s).unwrap_or(0);
+    let k = sens.d_unknowns.len().checked_div(s).unwrap_or(0);
     let mut tri = TriMat::new((states + k, s));
     for r in 0..states {
         for j in 0..s {
