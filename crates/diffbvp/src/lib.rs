@@ -58,7 +58,8 @@
 //! 3. [`solve`](mod@solve) (the adaptive loop);
 //! 4. [`continuation`], [`sensitivity`], [`inspect`], `expr` (feature `expr`: problems as text);
 //! 5. [`least_squares`] (the bounded driver; its [`BvpResiduals`](least_squares::BvpResiduals)
-//!    adaptor solves BVPs and takes their sensitivities).
+//!    adaptor solves BVPs and takes their sensitivities), `sparse` (feature `sprs`: the
+//!    Jacobians as `sprs` matrices).
 //!
 //! ## Cargo features
 //!
@@ -66,6 +67,7 @@
 //! |---|---|---|
 //! | `parallel` | no | [`least_squares::BvpResiduals`] solves its runs in parallel (rayon; faer's own rayon too) |
 //! | `serde` | no | `Serialize`/`Deserialize` for the toolkit's records (options, statistics, termination) |
+//! | `sprs` | no | `sparse`: the collocation, parameter, sensitivity and fit Jacobians as `sprs::CsMat<f64>` |
 //! | `expr` | no | `expr::ExprBvp`: a problem given as text expressions (parsed, evaluated over dual numbers; no extra dependencies) |
 //!
 //! Without features the crate depends on num-dual, faer, nalgebra, num-traits and thiserror
@@ -94,6 +96,8 @@ pub mod sensitivity;
 mod singular;
 pub mod solution;
 pub mod solve;
+#[cfg(feature = "sprs")]
+pub mod sparse;
 pub use error::BvpError;
 pub use linear::{Factorization, LinearSolverKind};
 pub use num_dual::DualNum;
