@@ -29,7 +29,8 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from . import _native
-from .errors import DiffbvpError, FitError, InputError, SimulationError
+from .bvp import BvpFitResult, BvpResult, CubicInterpolant, fit_bvp, solve_bvp, to_expression
+from .errors import DiffbvpError, EvaluationError, FitError, InputError, SimulationError
 from .results import (Candidate, Comparison, Diagnosis, Estimate, FitResult, Landscape, Result,
                       SimulationResult)
 
@@ -55,6 +56,13 @@ __all__ = [
     "Diagnosis",
     "Landscape",
     "Result",
+    "solve_bvp",
+    "fit_bvp",
+    "to_expression",
+    "BvpResult",
+    "BvpFitResult",
+    "CubicInterpolant",
+    "EvaluationError",
 ]
 
 __version__ = _native.library_version()

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import List, Optional
 
-__all__ = ["DiffbvpError", "InputError", "SimulationError", "FitError"]
+__all__ = ["DiffbvpError", "InputError", "SimulationError", "FitError", "EvaluationError"]
 
 
 class DiffbvpError(Exception):
@@ -45,3 +45,10 @@ class SimulationError(DiffbvpError):
 class FitError(DiffbvpError):
     """A fit that could not run or finish (e.g. the model cannot be evaluated at the start
     point)."""
+
+
+class EvaluationError(DiffbvpError, ArithmeticError):
+    """A problem's right-hand side or boundary condition (an expression or a Python callable
+    of :func:`diffbvp.solve_bvp`) that gave a non-finite value, raised, or returned the wrong
+    shape during a solve. The message names the component (``fun[1] = "..."``), the position
+    ``x`` and what to check."""

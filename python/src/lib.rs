@@ -8,6 +8,7 @@
 //! on Ctrl-C ([`run`]). Errors become `diffbvp.errors` exceptions with the CLI's messages
 //! ([`errors`]).
 
+mod bvp;
 mod compare;
 mod convert;
 mod dataset;
@@ -31,6 +32,8 @@ fn library_version() -> &'static str {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<dataset::Dataset>()?;
+    m.add_class::<bvp::ExprProblem>()?;
+    m.add_class::<bvp::BvpSolution>()?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
