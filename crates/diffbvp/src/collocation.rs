@@ -12,7 +12,7 @@
 //! exact dual-number Jacobians of `f` at the nodes and midpoints and of `g`, combined by the chain
 //! rule (Ascher, Mattheij & Russell; Kierzenka & Shampine 2001).
 
-use crate::dual_jacobian::{BcFn, DualJacobian, RhsFn, Seeds};
+use crate::dual_jacobian::{BcFn, DualJacobian, InterfaceFn, RhsFn, Seeds};
 use crate::error::BvpError;
 use crate::problem::Bvp;
 use crate::singular::Singular;
@@ -56,6 +56,12 @@ pub(crate) struct Collocation {
     pub jac_evals: usize,
     /// The problem's singular term ([`Bvp::singular_term`]), refreshed by every evaluation.
     pub singular: Option<Singular>,
+    /// Region of every node of a multipoint mesh ([`Bvp::interfaces`]; all 0 otherwise): the
+    /// number of zero-width intervals (interfaces) before it.
+    pub region: Vec<usize>,
+    /// Interface Jacobians `∂h_j/∂(left, right, p_seeded)`, `interfaces × n × wb` with the
+    /// boundary Jacobian's row width `wb` (and its column layout).
+    pub jif: Vec<f64>,
     input: Vec<f64>,
     fbuf: Vec<f64>,
     /// Input indices seeded at a node or midpoint (`[y, p]`) and at the boundary
@@ -85,6 +91,8 @@ impl Collocation {
             rhs_evals: 0,
             jac_evals: 0,
             singular: None,
+            region: Vec::new(),
+            jif: Vec::new(),
             input: Vec::new(),
             fbuf: Vec::new(),
             seed_list: Vec::new(),
@@ -109,6 +117,27 @@ impl Collocation {
         Ok(())
     }
 
+    /// The region of every node from the zero-width intervals of the mesh (a multipoint mesh
+    /// holds each interface twice).
+    fn set_regions(&mut self) {
+        self.region.clear();
+        let mut r = 0;
+        self.region.push(0);
+        for &h in &self.h {
+            if h == 0.0 {
+                r += 1;
+            }
+            self.region.push(r);
+        }
+    }
+
+    /// Whether interval `i` is an interface (zero width: its rows are the interface
+    /// conditions, not collocation equations).
+    #[inline]
+    pub(crate) fn is_interface(&self, i: usize) -> bool {
+        self.h[i] == 0.0
+    }
+
     /// Number of mesh nodes.
     pub(crate) fn m(&self) -> usize {
         self.x.len()
@@ -121,6 +150,7 @@ impl Collocation {
         self.x.extend_from_slice(x);
         self.h.clear();
         self.h.extend(x.windows(2).map(|w| w[1] - w[0]));
+        self.set_regions();
         self.f.resize(m * n, 0.0);
         self.y_mid.resize((m - 1) * n, 0.0);
         self.f_mid.resize((m - 1) * n, 0.0);
@@ -165,6 +195,8 @@ impl Collocation {
         let mut c = Collocation::new(self.n, self.k, self.q);
         c.x.extend_from_slice(&self.x);
         c.h.extend_from_slice(&self.h);
+        c.region.extend_from_slice(&self.region);
+        c.jif.extend_from_slice(&self.jif);
         c.seeded_params = self.seeded_params;
         c.model_seeds.clone_from(&self.model_seeds);
         c.jn.extend_from_slice(&self.jn);
@@ -184,7 +216,7 @@ impl Collocation {
         let (n, m) = (self.n, self.m());
         for i in 0..m {
             let (yi, fi) = (&y[i * n..(i + 1) * n], &mut self.f[i * n..(i + 1) * n]);
-            problem.rhs(self.x[i], yi, p, fi);
+            problem.rhs_in_region(self.region[i], self.x[i], yi, p, fi);
             if let Some(s) = &self.singular {
                 s.apply(self.x[i], yi, fi);
             }
@@ -198,7 +230,12 @@ impl Collocation {
                 &self.y_mid[i * n..(i + 1) * n],
                 &mut self.f_mid[i * n..(i + 1) * n],
             );
-            problem.rhs(xm, ym, p, fm);
+            if self.h[i] == 0.0 {
+                // an interface: no collocation equation, no midpoint
+                fm.fill(0.0);
+                continue;
+            }
+            problem.rhs_in_region(self.region[i], xm, ym, p, fm);
             if let Some(s) = &self.singular {
                 s.apply(xm, ym, fm);
             }
@@ -241,7 +278,20 @@ impl Collocation {
         }
         let off = len;
         let (res_col, res_bc) = self.res.split_at_mut(off);
-        let _ = res_col;
+        for i in 0..m - 1 {
+            if self.h[i] == 0.0 {
+                let r = &mut res_col[i * n..(i + 1) * n];
+                let (left, right) = (&y[i * n..(i + 1) * n], &y[(i + 1) * n..(i + 2) * n]);
+                problem.interface_conditions(self.region[i], left, right, p, r);
+                if let Some(c) = r.iter().position(|v| !v.is_finite()) {
+                    return Err(BvpError::NonFinite {
+                        what: "interface condition",
+                        component: c,
+                        x: self.x[i],
+                    });
+                }
+            }
+        }
         problem.bc(&y[..n], &y[(m - 1) * n..], p, res_bc);
         for (c, v) in res_bc.iter().enumerate() {
             if !v.is_finite() {
@@ -414,6 +464,7 @@ impl Collocation {
                 x: self.x[i],
                 n,
                 singular: self.singular.as_ref(),
+                region: self.region[i],
             };
             let out = if values {
                 &mut self.f[i * n..(i + 1) * n]
@@ -436,6 +487,14 @@ impl Collocation {
             self.midpoint_states(y);
         }
         for i in 0..m - 1 {
+            if self.h[i] == 0.0 {
+                // an interface: its rows come from `jif`
+                self.jm[i * n * w..(i + 1) * n * w].fill(0.0);
+                if values {
+                    self.f_mid[i * n..(i + 1) * n].fill(0.0);
+                }
+                continue;
+            }
             self.input.clear();
             self.input
                 .extend_from_slice(&self.y_mid[i * n..(i + 1) * n]);
@@ -445,6 +504,7 @@ impl Collocation {
                 x: self.x[i] + 0.5 * self.h[i],
                 n,
                 singular: self.singular.as_ref(),
+                region: self.region[i],
             };
             let out = if values {
                 &mut self.f_mid[i * n..(i + 1) * n]
@@ -487,6 +547,38 @@ impl Collocation {
         let bf = BcFn { problem, n };
         self.engine
             .jacobian_in(&bf, &self.input, bc_seeds, &mut fbuf[..nb], &mut self.jbc);
+        // the interface conditions, seeded as the boundary conditions ([left, right, p])
+        let interfaces = self.region.last().copied().unwrap_or(0);
+        self.jif.resize(interfaces * n * wb, 0.0);
+        for i in 0..m - 1 {
+            if self.h[i] != 0.0 {
+                continue;
+            }
+            let j = self.region[i];
+            self.input.clear();
+            self.input.extend_from_slice(&y[i * n..(i + 2) * n]);
+            self.input.extend_from_slice(p);
+            let hf = InterfaceFn {
+                problem,
+                index: j,
+                n,
+            };
+            self.engine.jacobian_in(
+                &hf,
+                &self.input,
+                bc_seeds,
+                &mut fbuf[..n],
+                &mut self.jif[j * n * wb..(j + 1) * n * wb],
+            );
+        }
+        if let Some(c) = self.jif.iter().position(|v| !v.is_finite()) {
+            self.fbuf = fbuf;
+            return Err(BvpError::NonFinite {
+                what: "interface-condition Jacobian",
+                component: (c / wb.max(1)) % n,
+                x: self.x[0],
+            });
+        }
         self.fbuf = fbuf;
         for (c, v) in self.jbc.iter().enumerate() {
             if !v.is_finite() {
@@ -503,6 +595,17 @@ impl Collocation {
     /// The `n × n` blocks `A_i = ∂r_i/∂y_i` and `B_i = ∂r_i/∂y_{i+1}` side by side: row `r`
     /// of `[A_i B_i]` is written to `out[r ld..r ld + 2n]` (`ld >= 2n`).
     pub(crate) fn interval_rows(&self, i: usize, out: &mut [f64], ld: usize) {
+        if self.h[i] == 0.0 {
+            // an interface: `[∂h_j/∂left ∂h_j/∂right]`
+            let n = self.n;
+            let wb = 2 * n + self.seeded_params;
+            let j = self.region[i];
+            for r in 0..n {
+                let row = &self.jif[(j * n + r) * wb..(j * n + r) * wb + 2 * n];
+                out[r * ld..r * ld + 2 * n].copy_from_slice(row);
+            }
+            return;
+        }
         // small systems with the sizes known at compile time (the same operations in the same
         // order: bit-identical to the general loop)
         match self.n {
@@ -609,6 +712,7 @@ impl Collocation {
             column: n + col,
             bc_width: 2 * n + self.seeded_params,
             bc_column: 2 * n + col,
+            jif: &self.jif,
         };
         self.param_column_from(&parts, out);
     }
@@ -625,6 +729,7 @@ impl Collocation {
             column: s,
             bc_width: extra.seeded_params,
             bc_column: s,
+            jif: &extra.jif,
         };
         self.param_column_from(&parts, out);
     }
@@ -638,6 +743,13 @@ impl Collocation {
         let fp = |j: &[f64], i: usize, r: usize| j[(i * n + r) * pw + pc];
         for i in 0..m - 1 {
             let h = self.h[i];
+            if h == 0.0 {
+                let j = self.region[i];
+                for r in 0..n {
+                    out[i * n + r] = parts.jif[(j * n + r) * parts.bc_width + parts.bc_column];
+                }
+                continue;
+            }
             let jm = &self.jm[i * n * w..(i + 1) * n * w];
             for r in 0..n {
                 // d y_mid / dp = -h/8 (fp_j - fp_i)
@@ -677,6 +789,8 @@ struct ParamParts<'a> {
     column: usize,
     bc_width: usize,
     bc_column: usize,
+    /// The interface conditions' derivatives (rows of `bc_width`, at `bc_column`).
+    jif: &'a [f64],
 }
 
 fn check_finite(

@@ -668,6 +668,18 @@ pub fn try_secant_guess(a: &Solution, b: &Solution, t: f64) -> Result<Guess, Bvp
         )));
     }
     let mut y = a.y.clone();
+    if crate::mesh::regions(&a.x).len() > 1 {
+        // a multipoint mesh: the left limit at an interface from b's left region
+        let yb = crate::solve::resample_regions(&b.x, &b.y, &b.yp, n, &a.x);
+        for ((v, &va), &vb) in y.iter_mut().zip(&a.y).zip(&yb) {
+            *v = va + t * (va - vb);
+        }
+        return Ok(Guess {
+            x: a.x.clone(),
+            y,
+            unknowns: secant_unknowns(a, b, t),
+        });
+    }
     let (mut yb, mut ypb) = (vec![0.0; n], vec![0.0; n]);
     for (i, &x) in a.x.iter().enumerate() {
         b.eval_into(x, &mut yb, &mut ypb);
@@ -676,7 +688,16 @@ pub fn try_secant_guess(a: &Solution, b: &Solution, t: f64) -> Result<Guess, Bvp
             y[k] = a.y[k] + t * (a.y[k] - yb[c]);
         }
     }
-    let unknowns = if a.unknowns.len() == b.unknowns.len() {
+    Ok(Guess {
+        x: a.x.clone(),
+        y,
+        unknowns: secant_unknowns(a, b, t),
+    })
+}
+
+/// The secant predictor's unknowns: extrapolated when `a` and `b` have as many, else `a`'s.
+fn secant_unknowns(a: &Solution, b: &Solution, t: f64) -> Vec<f64> {
+    if a.unknowns.len() == b.unknowns.len() {
         a.unknowns
             .iter()
             .zip(&b.unknowns)
@@ -684,12 +705,7 @@ pub fn try_secant_guess(a: &Solution, b: &Solution, t: f64) -> Result<Guess, Bvp
             .collect()
     } else {
         a.unknowns.clone()
-    };
-    Ok(Guess {
-        x: a.x.clone(),
-        y,
-        unknowns,
-    })
+    }
 }
 
 /// Reaches `to` from `from` with a solve at `to` and, if it fails, by recursively halving the

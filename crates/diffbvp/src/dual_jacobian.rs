@@ -26,13 +26,15 @@ pub(crate) struct RhsFn<'a, P> {
     pub n: usize,
     /// The problem's singular term, added to `f` (exact: it is linear in `y`).
     pub singular: Option<&'a Singular>,
+    /// The region of a multipoint problem ([`Bvp::rhs_in_region`]).
+    pub region: usize,
 }
 
 impl<P: Bvp> DualFn for RhsFn<'_, P> {
     #[inline]
     fn eval<D: DualNum<Primitive = f64> + Copy>(&self, input: &[D], out: &mut [D]) {
         let (y, p) = input.split_at(self.n);
-        self.problem.rhs(self.x, y, p, out);
+        self.problem.rhs_in_region(self.region, self.x, y, p, out);
         if let Some(s) = self.singular {
             s.apply(self.x, y, out);
         }
@@ -51,6 +53,24 @@ impl<P: Bvp> DualFn for BcFn<'_, P> {
         let (ya, rest) = input.split_at(self.n);
         let (yb, p) = rest.split_at(self.n);
         self.problem.bc(ya, yb, p, out);
+    }
+}
+
+/// The interface conditions `h_j(left, right, p)` with input `[left, right, p]` (the layout
+/// of [`BcFn`]'s input).
+pub(crate) struct InterfaceFn<'a, P> {
+    pub problem: &'a P,
+    pub index: usize,
+    pub n: usize,
+}
+
+impl<P: Bvp> DualFn for InterfaceFn<'_, P> {
+    #[inline]
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, input: &[D], out: &mut [D]) {
+        let (left, rest) = input.split_at(self.n);
+        let (right, p) = rest.split_at(self.n);
+        self.problem
+            .interface_conditions(self.index, left, right, p, out);
     }
 }
 

@@ -529,15 +529,65 @@ pub fn try_coarsen(x: &[f64], rms: &[f64], threshold: f64) -> Result<Vec<f64>, B
 }
 
 /// The mesh `x` with every interval halved: `2 m - 1` nodes for `m` (the same nodes and the
-/// midpoint of every interval).
+/// midpoint of every interval; a multipoint mesh's interfaces, held twice, stay as they are).
 pub fn halved(x: &[f64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(2 * x.len());
     for w in x.windows(2) {
         out.push(w[0]);
-        out.push(0.5 * (w[0] + w[1]));
+        if w[1] != w[0] {
+            out.push(0.5 * (w[0] + w[1]));
+        }
     }
     out.extend(x.last());
     out
+}
+
+/// A multipoint mesh ([`Bvp::interfaces`](crate::Bvp::interfaces)) on the points
+/// `x_0 < x_1 < … < x_R`: `nodes_per_region` equally spaced nodes (at least 2) on every region
+/// `[x_{r-1}, x_r]`, each interior point held twice (the left and the right limit).
+pub fn multipoint_linspace(points: &[f64], nodes_per_region: usize) -> Vec<f64> {
+    let mut out = Vec::new();
+    for w in points.windows(2) {
+        out.extend(linspace(w[0], w[1], nodes_per_region.max(2)));
+    }
+    out
+}
+
+/// The node ranges of the regions of a mesh (a multipoint mesh holds each interface twice:
+/// a region ends at a node whose successor has the same `x`); one range for an ordinary mesh.
+pub fn regions(x: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for i in 0..x.len().saturating_sub(1) {
+        if x[i + 1] == x[i] {
+            out.push(start..i + 1);
+            start = i + 1;
+        }
+    }
+    out.push(start..x.len());
+    out
+}
+
+/// [`validate`] for a multipoint mesh with the interfaces `interfaces`: each region's mesh
+/// must be valid and the repeated nodes must be exactly the interfaces, in order.
+pub fn validate_multipoint(x: &[f64], interfaces: &[f64]) -> Result<(), BvpError> {
+    let ranges = regions(x);
+    let found: Vec<f64> = ranges[1..].iter().map(|r| x[r.start]).collect();
+    if found != interfaces {
+        return Err(BvpError::InvalidInput(format!(
+            "the mesh holds the points {found:?} twice but the problem's interfaces              (Bvp::interfaces) are {interfaces:?}: a multipoint mesh holds every interface              twice (left and right limit) and no other point (mesh::multipoint_linspace builds              one)"
+        )));
+    }
+    for (r, range) in ranges.iter().enumerate() {
+        validate(&x[range.clone()]).map_err(|e| match e {
+            BvpError::InvalidInput(m) => BvpError::InvalidInput(format!(
+                "region {r} (nodes {}..{}) of the multipoint mesh: {m}",
+                range.start, range.end
+            )),
+            other => other,
+        })?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -357,6 +357,10 @@ impl NewtonWork {
 fn residuals_small(col: &Collocation, scale: &[f64], tol: f64) -> bool {
     let n = col.n;
     for i in 0..col.m() - 1 {
+        if col.is_interface(i) {
+            // interface conditions are measured with the boundary conditions (`max_bc`)
+            continue;
+        }
         let tol_r = 2.0 / 3.0 * col.h[i] * 5e-2 * tol;
         let res_i = &col.res[i * n..(i + 1) * n];
         let fm_i = &col.f_mid[i * n..(i + 1) * n];
@@ -374,9 +378,15 @@ pub(crate) fn bc_small(col: &Collocation, bc_tol: f64) -> bool {
     max_bc(col) < bc_tol
 }
 
+/// The largest boundary and interface residual.
 pub(crate) fn max_bc(col: &Collocation) -> f64 {
-    let off = (col.m() - 1) * col.n;
-    col.res[off..].iter().fold(0.0, |a: f64, v| a.max(v.abs()))
+    let (n, m) = (col.n, col.m());
+    let off = (m - 1) * n;
+    let ends = col.res[off..].iter().fold(0.0, |a: f64, v| a.max(v.abs()));
+    (0..m - 1)
+        .filter(|&i| col.is_interface(i))
+        .flat_map(|i| &col.res[i * n..(i + 1) * n])
+        .fold(ends, |a, v| a.max(v.abs()))
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {

@@ -305,8 +305,12 @@ impl Guess {
     /// [`RICHARDSON_FACTOR`], estimates the discretisation error of `s`.
     pub fn on_halved_mesh(s: &Solution) -> Self {
         let x = mesh::halved(&s.x);
-        let mut yp = vec![0.0; s.n];
-        Guess::from_fn(x, s.n, |x, y| s.eval_into(x, y, &mut yp)).with_unknowns(&s.unknowns)
+        let y = resample_regions(&s.x, &s.y, &s.yp, s.n, &x);
+        Guess {
+            x,
+            y,
+            unknowns: s.unknowns.clone(),
+        }
     }
 
     /// Sets the unknown-parameter guess.
@@ -601,7 +605,12 @@ impl<'a, P: Bvp> Solver<'a, P> {
             ));
         }
         options.validate(n)?;
-        mesh::validate(&guess.x)?;
+        let interfaces = self.problem.interfaces();
+        if interfaces.is_empty() {
+            mesh::validate(&guess.x)?;
+        } else {
+            mesh::validate_multipoint(&guess.x, interfaces)?;
+        }
         if guess.y.len() != guess.x.len() * n {
             return Err(BvpError::InvalidInput(format!(
                 "the guess has {} values, expected {} nodes x {} states = {}",
@@ -864,14 +873,19 @@ impl<'a, P: Bvp> Solver<'a, P> {
             );
             stats.mesh_rule_switched_at = control.switched_at;
             let refined = if above > 0 {
-                Some(mesh::apply(
-                    &x,
-                    &self.ws.rms,
-                    &self.ws.marks,
-                    opts.tol,
-                    &control.options,
-                    opts.max_nodes,
-                ))
+                let (rms, marks) = (&self.ws.rms, &self.ws.marks);
+                Some(per_region(&x, |xr, r| {
+                    let ints = r.start..r.end - 1;
+                    let marks = marks.get(ints.clone()).unwrap_or(&[]);
+                    mesh::apply(
+                        xr,
+                        &rms[ints],
+                        marks,
+                        opts.tol,
+                        &control.options,
+                        opts.max_nodes,
+                    )
+                }))
             } else {
                 None
             };
@@ -882,7 +896,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
             if let Some(new_x) = refined {
                 self.keep_system(lin);
                 allowed_size(new_x.len(), guess.x.len(), growth_limit, max_res, opts)?;
-                y = resample(&x, &y, &self.ws.col.f, n, &new_x);
+                y = resample_regions(&x, &y, &self.ws.col.f, n, &new_x);
                 x = new_x;
                 stats.mesh_refinements += 1;
                 start = Start::WithJacobian;
@@ -890,11 +904,14 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 // coarsen only if the coarser mesh can still be solved and checked: the solution
                 // returned must belong to the mesh it was computed on
                 if coarsenings_left > 0 && m > 8 && iteration < opts.max_mesh_iterations {
-                    let new_x = mesh::coarsen(&x, &self.ws.rms, opts.tol / 20.0);
+                    let rms = &self.ws.rms;
+                    let new_x = per_region(&x, |xr, r| {
+                        mesh::coarsen(xr, &rms[r.start..r.end - 1], opts.tol / 20.0)
+                    });
                     if (m - new_x.len()) * 10 >= m {
                         self.keep_system(lin);
                         coarsenings_left -= 1;
-                        y = resample(&x, &y, &self.ws.col.f, n, &new_x);
+                        y = resample_regions(&x, &y, &self.ws.col.f, n, &new_x);
                         x = new_x;
                         stats.mesh_refinements += 1;
                         stats.mesh_coarsenings += 1;
@@ -965,6 +982,50 @@ impl<'a, P: Bvp> Solver<'a, P> {
             newton_matrix,
         })
     }
+}
+
+/// `op(region's nodes, their range)` on every region of the (multipoint) mesh `x`, the new
+/// meshes concatenated: the mesh control acts on each region alone and keeps the interfaces.
+fn per_region(
+    x: &[f64],
+    mut op: impl FnMut(&[f64], std::ops::Range<usize>) -> Vec<f64>,
+) -> Vec<f64> {
+    let ranges = mesh::regions(x);
+    if ranges.len() == 1 {
+        return op(x, 0..x.len());
+    }
+    let mut out = Vec::with_capacity(x.len());
+    for r in ranges {
+        out.extend(op(&x[r.clone()], r));
+    }
+    out
+}
+
+/// [`resample`] region by region: the left limit at an interface from the region on its left,
+/// the right limit from the one on its right (`xs` and `new_x` have the same interfaces).
+pub(crate) fn resample_regions(
+    xs: &[f64],
+    ys: &[f64],
+    fs: &[f64],
+    n: usize,
+    new_x: &[f64],
+) -> Vec<f64> {
+    let (old, new) = (mesh::regions(xs), mesh::regions(new_x));
+    if old.len() == 1 || old.len() != new.len() {
+        return resample(xs, ys, fs, n, new_x);
+    }
+    let mut out = Vec::with_capacity(new_x.len() * n);
+    for (o, w) in old.into_iter().zip(new) {
+        let nodes = o.start * n..o.end * n;
+        out.extend(resample(
+            &xs[o],
+            &ys[nodes.clone()],
+            &fs[nodes],
+            n,
+            &new_x[w],
+        ));
+    }
+    out
 }
 
 /// The factorisation a solve nearby may start from ([`Solver::solve_near`]).

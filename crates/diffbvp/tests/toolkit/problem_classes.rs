@@ -251,3 +251,274 @@ fn violated_regularity_conditions_are_named() {
         .to_string();
     assert!(msg.contains("I - S is singular"), "{msg}");
 }
+
+// ---------------------------------------------------------------- multipoint problems
+
+/// Steady conduction with a uniform source g = 1 through two layers [0, ξ] and [ξ, 1] of
+/// conductivities k1, k2 (model parameters 0 and 1) with a contact resistance Rc (parameter 2):
+/// T' = −q / k_r, q' = g; T(0) = 1, T(1) = 0; at ξ the flux is continuous and the temperature
+/// jumps, T(ξ⁺) = T(ξ⁻) − Rc q(ξ).
+struct Layers;
+
+const XI: f64 = 0.4;
+const SOURCE: f64 = 1.0;
+
+impl Bvp for Layers {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        3
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        self.rhs_in_region(usize::from(x > XI), x, y, p, f);
+    }
+    fn rhs_in_region<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        region: usize,
+        _x: f64,
+        y: &[D],
+        p: &[D],
+        f: &mut [D],
+    ) {
+        f[0] = -y[1] / p[region];
+        f[1] = D::from(SOURCE);
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[0] - 1.0;
+        r[1] = yb[0];
+    }
+    fn interfaces(&self) -> &[f64] {
+        &[XI]
+    }
+    fn interface_conditions<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        _index: usize,
+        left: &[D],
+        right: &[D],
+        p: &[D],
+        r: &mut [D],
+    ) {
+        r[0] = right[0] - left[0] + p[2] * left[1];
+        r[1] = right[1] - left[1];
+    }
+}
+
+/// The closed form of [`Layers`]: (T, q) at x (the right limit at ξ), generic so that dual
+/// numbers give its exact parameter derivatives.
+fn layers_exact<D: DualNum<Primitive = f64> + Copy>(x: f64, p: [D; 3]) -> [D; 2] {
+    layers_side(x, p, false)
+}
+
+/// [`layers_exact`] with the left limit at ξ if `left`.
+fn layers_side<D: DualNum<Primitive = f64> + Copy>(x: f64, p: [D; 3], left: bool) -> [D; 2] {
+    let [k1, k2, rc] = p;
+    let g = SOURCE;
+    let q0 = (-(k1.recip() * (g * XI * XI / 2.0))
+        - k2.recip() * (g * (1.0 - XI * XI) / 2.0)
+        - rc * (g * XI)
+        + 1.0)
+        / (k1.recip() * XI + k2.recip() * (1.0 - XI) + rc);
+    let q = q0 + g * x;
+    if x < XI || (left && x == XI) {
+        [-(q0 * x + g * x * x / 2.0) / k1 + 1.0, q]
+    } else {
+        let t_xi = -(q0 * XI + g * XI * XI / 2.0) / k1 + 1.0 - rc * (q0 + g * XI);
+        [t_xi - (q0 * (x - XI) + g * (x * x - XI * XI) / 2.0) / k2, q]
+    }
+}
+
+#[test]
+fn two_layers_with_a_contact_jump_match_the_closed_form_and_its_derivatives() {
+    use diffbvp::mesh::{multipoint_linspace, regions};
+    use num_dual::Dual64;
+    let p = [1.0, 3.0, 0.5];
+    let guess = Guess::constant(multipoint_linspace(&[0.0, XI, 1.0], 4), &[0.5, 0.0]);
+    let mut o = tight(1e-6);
+    o.factor_at_solution = true;
+    let s = solve(&Layers, &p, &guess, &o).unwrap();
+    // the Newton matrix stays almost block diagonal: the structured elimination factors it
+    assert_eq!(
+        s.factorization().map(|f| f.kind()),
+        Some(diffbvp::LinearSolverKind::Structured)
+    );
+    let r = regions(&s.x);
+    assert_eq!(r.len(), 2);
+    // the left limit at ξ is the last node of region 0
+    let left = r[0].end - 1;
+    let exact_left = layers_side(XI, p, true);
+    assert!((s.at_node(left, 0) - exact_left[0]).abs() < 1e-12);
+    let sens = Sensitivities::compute(&Layers, &s).unwrap();
+    for x in [0.1, 0.3, XI, 0.7, 0.95] {
+        let v = layers_exact(x, p);
+        let got = s.eval(x);
+        assert!(
+            (got[0] - v[0]).abs() < 1e-12 && (got[1] - v[1]).abs() < 1e-12,
+            "x {x}"
+        );
+        let d = sens.at(x);
+        for j in 0..3 {
+            let mut pd = p.map(Dual64::from);
+            pd[j] = Dual64::new(p[j], 1.0);
+            let e = layers_exact(x, pd);
+            for c in 0..2 {
+                let want = e[c].eps;
+                assert!(
+                    (d[c * 3 + j] - want).abs() < 1e-10 * (1.0 + want.abs()),
+                    "d y{c}/d p{j} at {x}: {} vs {want}",
+                    d[c * 3 + j]
+                );
+            }
+        }
+    }
+    // the adjoint gradient of T at the jump's left limit plus q(1)
+    struct Probe;
+    impl PointFunction for Probe {
+        fn eval<D: DualNum<Primitive = f64> + Copy>(
+            &self,
+            i: usize,
+            _x: f64,
+            y: &[D],
+            _p: &[D],
+        ) -> D {
+            y[i]
+        }
+    }
+    let (value, grad) = adjoint_gradient(&Layers, &s, &[0.2, 1.0], &[1.0, 1.0], &Probe).unwrap();
+    let want_v = layers_exact(0.2, p)[0] + layers_exact(1.0, p)[1];
+    assert!((value - want_v).abs() < 1e-12);
+    for j in 0..3 {
+        let mut pd = p.map(Dual64::from);
+        pd[j] = Dual64::new(p[j], 1.0);
+        let want = layers_exact(0.2, pd)[0].eps + layers_exact(1.0, pd)[1].eps;
+        assert!(
+            (grad[j] - want).abs() < 1e-10 * (1.0 + want.abs()),
+            "dG/dp{j}"
+        );
+    }
+}
+
+/// A reacting layer [0, ξ] (u'' = φ² u) behind an inert diffusion layer [ξ, 1] (u'' = 0),
+/// u'(0) = 0, u(1) = 1, u and u' continuous at ξ; φ is the model parameter.
+struct ReactingLayer;
+
+impl Bvp for ReactingLayer {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        1
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        self.rhs_in_region(usize::from(x > XI), x, y, p, f);
+    }
+    fn rhs_in_region<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        region: usize,
+        _x: f64,
+        y: &[D],
+        p: &[D],
+        f: &mut [D],
+    ) {
+        f[0] = y[1];
+        f[1] = if region == 0 {
+            p[0] * p[0] * y[0]
+        } else {
+            D::zero()
+        };
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[1];
+        r[1] = yb[0] - 1.0;
+    }
+    fn interfaces(&self) -> &[f64] {
+        &[XI]
+    }
+}
+
+/// u(x) of [`ReactingLayer`]: A cosh(φx) in the reacting layer, linear beyond it.
+fn reacting_exact<D: DualNum<Primitive = f64> + Copy>(x: f64, phi: D) -> D {
+    let (c, s) = ((phi * XI).cosh(), (phi * XI).sinh());
+    let a = (c + phi * s * (1.0 - XI)).recip();
+    if x <= XI {
+        a * (phi * x).cosh()
+    } else {
+        a * (c + phi * s * (x - XI))
+    }
+}
+
+#[test]
+fn a_reacting_layer_refines_its_own_region_and_matches_the_closed_form() {
+    use diffbvp::mesh::{multipoint_linspace, regions};
+    use num_dual::Dual64;
+    let phi = 30.0;
+    let guess = Guess::constant(multipoint_linspace(&[0.0, XI, 1.0], 5), &[0.5, 0.0]);
+    let s = solve(&ReactingLayer, &[phi], &guess, &tight(1e-8)).unwrap();
+    let r = regions(&s.x);
+    // the steep layer is refined, the linear region keeps its few nodes
+    assert!(r[0].len() > 4 * r[1].len(), "{:?}", r);
+    assert!(r[1].len() <= 5, "{:?}", r);
+    let sens = Sensitivities::compute(&ReactingLayer, &s).unwrap();
+    for x in [0.0, 0.2, 0.38, XI, 0.6, 1.0] {
+        let want = reacting_exact(x, phi);
+        assert!((s.eval(x)[0] - want).abs() < 1e-7, "u({x})");
+        let dwant = reacting_exact(x, Dual64::new(phi, 1.0)).eps;
+        let got = sens.at(x)[0];
+        assert!(
+            (got - dwant).abs() < 1e-6 * dwant.abs().max(1e-3),
+            "du/dphi({x}): {got} vs {dwant}"
+        );
+    }
+}
+
+#[test]
+fn multipoint_meshes_must_hold_the_interfaces_twice() {
+    let msg = solve(
+        &ReactingLayer,
+        &[2.0],
+        &Guess::constant(linspace(0.0, 1.0, 5), &[0.5, 0.0]),
+        &tight(1e-4),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(msg.contains("twice") && msg.contains("0.4"), "{msg}");
+}
+
+/// Errors and node counts per tolerance (run with --nocapture for the table of the report).
+#[test]
+fn errors_shrink_with_the_tolerance() {
+    use diffbvp::mesh::multipoint_linspace;
+    for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
+        let grid = |f: &dyn Fn(f64) -> f64| {
+            (0..=200)
+                .map(|j| j as f64 / 200.0)
+                .map(f)
+                .fold(0.0f64, f64::max)
+        };
+        let g = Guess::constant(linspace(0.0, 1.0, 5), &[1.0, 0.0]);
+        let e = solve(&Emden { regular_bc: true }, &[], &g, &tight(tol)).unwrap();
+        let err_e = grid(&|x| (e.eval(x)[0] - emden_exact(x)).abs());
+        let g = Guess::constant(linspace(0.0, 1.0, 5), &[0.5, 0.0]);
+        let pl = solve(&Pellet, &[3.0], &g, &tight(tol)).unwrap();
+        let err_p = grid(&|x| {
+            let y = if x == 0.0 {
+                3.0 / 3.0f64.sinh()
+            } else {
+                pellet_exact(x, 3.0).0
+            };
+            (pl.eval(x)[0] - y).abs()
+        });
+        let g = Guess::constant(multipoint_linspace(&[0.0, XI, 1.0], 5), &[0.5, 0.0]);
+        let rl = solve(&ReactingLayer, &[30.0], &g, &tight(tol)).unwrap();
+        let err_r = grid(&|x| (rl.eval(x)[0] - reacting_exact(x, 30.0)).abs());
+        eprintln!(
+            "| {tol:.0e} | {err_e:.1e} | {} | {err_p:.1e} | {} | {err_r:.1e} | {} |",
+            e.nodes(),
+            pl.nodes(),
+            rl.nodes()
+        );
+        for err in [err_e, err_p, err_r] {
+            assert!(err < tol, "tol {tol:e}: error {err:e}");
+        }
+    }
+}
