@@ -4,40 +4,22 @@
 
 use rheometer::effects::Effect;
 use rheometer::failure_hints::ExperimentFailure;
-use rheometer::input::{parse_experiments, Location, MAX_PLAUSIBLE_DIAMETER_M};
-use rheometer::rheometer::landscape::LANDSCAPE_MAX_NODES;
+use rheometer::input::{parse_experiments, Location};
 use rheometer::rheometer::{IdentifyOptions, LandscapeSample};
 use std::error::Error;
 use std::path::Path;
 
-/// Largest `--points` of `simulate` (rows per profile CSV; 1e6 rows took 1.8 GB of memory and
-/// 86 MB per CSV for the 9 shipped experiments, 1e5 a tenth).
-pub const MAX_POINTS: usize = 100_000;
-/// Largest number of values per direction of `landscape --grid`.
-pub const MAX_GRID_SIDE: usize = 1000;
-/// Largest number of points of `landscape --grid` (N x M).
-pub const MAX_GRID_POINTS: usize = 100_000;
-/// Smallest `--max-nodes` (the cold start begins on a mesh of 21 nodes).
-pub const MIN_MAX_NODES: usize = 50;
-/// Largest `--max-nodes`.
-pub const MAX_MAX_NODES: usize = 1_000_000;
-/// Default `--max-nodes` of the solves of `simulate`, `fit`, `diagnose` and `compare`.
-pub const DEFAULT_MAX_NODES: usize = 20_000;
-/// Smallest take-up diameter accepted from `--take-up-diameter` \[m\].
-pub const MIN_TAKE_UP_DIAMETER_M: f64 = 1e-7;
-/// Largest |κ| (K = e^κ Pa stays a finite positive number).
-pub const MAX_ABS_KAPPA: f64 = 700.0;
-/// Tolerance range of `landscape --tol`.
-pub const TOL_RANGE: (f64, f64) = (1e-12, 0.1);
+use rheometer::workflow::request::{self, Arg, Door, Refusal, MAX_GRID_POINTS};
+pub use rheometer::workflow::request::{show, DEFAULT_MAX_NODES};
 
-/// A number as people read it: the shortest form that reads back exactly, in exponent
-/// notation below 1e-4 and from 1e6 on (`1e308`, not 309 digits).
-pub fn show(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&v.abs()) {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
-    }
+/// A refusal as clap shows it after the flag and the value it names: the reason alone.
+fn reason(r: Refusal) -> String {
+    r.reason(Door::Cli)
+}
+
+/// A refusal with the flag and value named, for a check after parsing.
+fn message(r: Refusal) -> String {
+    r.message(Door::Cli)
 }
 
 /// A value as given, for a message: trimmed and, if very long, cut to its first 40
@@ -68,20 +50,15 @@ fn number(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
-/// A whole number within `range` (inclusive); `what` says what is counted, as in "give
-/// 2 to 100000 {what}". Negative and non-integer values get the same range message.
-fn count_in(s: &str, range: std::ops::RangeInclusive<usize>, what: &str) -> Result<usize, String> {
+/// A whole number of the flag's text `s`: the number, or why it is none (`range` and `what`
+/// for the words: "give 2 to 100000 {what}").
+fn whole(s: &str, range: std::ops::RangeInclusive<usize>, what: &str) -> Result<i128, String> {
     let (lo, hi) = (*range.start(), *range.end());
-    let out_of_range = |got: &str| format!("give {lo} to {hi} {what} (got {got})");
     match s.trim().parse::<i128>() {
-        Ok(v) => usize::try_from(v)
-            .ok()
-            .filter(|v| range.contains(v))
-            .ok_or_else(|| out_of_range(&given(s))),
+        Ok(v) => Ok(v),
         Err(_) if number(s).is_ok() => Err(format!(
-            "{}: {}",
-            out_of_range(&given(s)),
-            "a whole number is needed"
+            "give {lo} to {hi} {what} (got {}): a whole number is needed",
+            given(s)
         )),
         Err(_) => Err(format!(
             "\"{}\" is not a whole number; give {lo} to {hi} {what}",
@@ -90,52 +67,34 @@ fn count_in(s: &str, range: std::ops::RangeInclusive<usize>, what: &str) -> Resu
     }
 }
 
-/// `--points`: 2 to [`MAX_POINTS`].
+/// `--points`: 2 to [`request::MAX_POINTS`].
 pub fn parse_points(s: &str) -> Result<usize, String> {
-    count_in(s, 2..=MAX_POINTS, "output positions per profile")
+    let what = "output positions per profile";
+    request::points(whole(s, 2..=request::MAX_POINTS, what)?).map_err(reason)
 }
 
-/// `--max-nodes`: [`MIN_MAX_NODES`] to [`MAX_MAX_NODES`].
+/// `--max-nodes`: [`request::MIN_MAX_NODES`] to [`request::MAX_MAX_NODES`].
 pub fn parse_max_nodes(s: &str) -> Result<usize, String> {
-    let v = count_in(s, 0..=usize::MAX, "nodes").map_err(|_| {
-        format!(
-            "the mesh limit must lie in {MIN_MAX_NODES}..={MAX_MAX_NODES} nodes (got {}; \
-             default {DEFAULT_MAX_NODES})",
+    let range = request::MIN_MAX_NODES..=request::MAX_MAX_NODES;
+    match whole(s, range, "nodes") {
+        Ok(v) => request::max_nodes(v).map_err(reason),
+        Err(_) => Err(format!(
+            "the mesh limit must lie in {}..={} nodes (got {}; default {DEFAULT_MAX_NODES})",
+            request::MIN_MAX_NODES,
+            request::MAX_MAX_NODES,
             given(s)
-        )
-    })?;
-    if !(MIN_MAX_NODES..=MAX_MAX_NODES).contains(&v) {
-        return Err(format!(
-            "the mesh limit must lie in {MIN_MAX_NODES}..={MAX_MAX_NODES} nodes (got {v}; \
-             default {DEFAULT_MAX_NODES})"
-        ));
+        )),
     }
-    Ok(v)
 }
 
 /// `--relative-uncertainty`: in (0, 1), like the TOML key `relative_uncertainty`.
 pub fn parse_fraction(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if !(v > 0.0 && v < 1.0) {
-        return Err(format!(
-            "a relative uncertainty must lie in (0, 1) like the TOML key relative_uncertainty \
-             (got {}; 0.01 is 1 %)",
-            show(v)
-        ));
-    }
-    Ok(v)
+    request::relative_uncertainty(number(s)?).map_err(reason)
 }
 
 /// `--f-scale`: a positive, finite relative residual below 1.
 pub fn parse_f_scale(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if !(v > 0.0 && v < 1.0) {
-        return Err(format!(
-            "f_scale is a relative residual in (0, 1) (got {}; 0.02 is 2 %)",
-            show(v)
-        ));
-    }
-    Ok(v)
+    request::f_scale(number(s)?).map_err(reason)
 }
 
 /// `--loss` and `--f-scale` of `fit` and `diagnose`.
@@ -154,139 +113,57 @@ pub struct LossArgs {
 impl LossArgs {
     /// Sets the loss and its soft margin of `opts`. Error: a soft margin without a robust loss.
     pub fn apply(&self, opts: &mut IdentifyOptions) -> Result<(), String> {
-        if let Some(c) = self.f_scale {
-            if self.loss.is_linear() {
-                return Err(format!(
-                    "--f-scale {}: a soft margin needs a robust loss, but the loss is linear \
-                     (least squares, the default of --loss); add --loss soft_l1 (or huber, \
-                     cauchy), or drop --f-scale",
-                    show(c)
-                ));
-            }
-        }
-        opts.loss = self.loss;
-        opts.f_scale = self.f_scale;
+        let (loss, margin) = request::robust_loss(self.loss, self.f_scale).map_err(message)?;
+        opts.loss = loss;
+        opts.f_scale = margin;
         Ok(())
     }
 }
 
-/// `--tol`: in [`TOL_RANGE`].
+/// `--tol`: in [`request::TOL_RANGE`].
 pub fn parse_tol(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if !(TOL_RANGE.0..=TOL_RANGE.1).contains(&v) {
-        return Err(format!(
-            "the tolerance must lie in [{:e}, {}] (got {})",
-            TOL_RANGE.0,
-            TOL_RANGE.1,
-            show(v)
-        ));
-    }
-    Ok(v)
+    request::tol(number(s)?).map_err(reason)
 }
 
 /// `--refit-top`: 1 to the number of built-in candidate effects.
 pub fn parse_refit_top(s: &str) -> Result<usize, String> {
     let most = Effect::builtin().len();
-    count_in(
-        s,
-        1..=most,
-        "candidates to refit (the number of candidate effects is the most)",
-    )
+    let what = "candidates to refit (the number of candidate effects is the most)";
+    request::refit_top(whole(s, 1..=most, what)?).map_err(reason)
 }
 
 /// `--n`: the Carreau-type law's domain, a finite n >= 0.
 pub fn parse_n(s: &str) -> Result<f64, String> {
-    check_n(number(s)?)
+    request::n(number(s)?).map_err(reason)
 }
 
-/// Checks that `v` lies in the Carreau-type law's domain of n (finite, >= 0).
-pub fn check_n(v: f64) -> Result<f64, String> {
-    if !(v >= 0.0 && v.is_finite()) {
-        return Err(format!(
-            "the power index n must be >= 0 (the Carreau-type law's domain; 1 is Newtonian), \
-             got {}",
-            show(v)
-        ));
-    }
-    Ok(v)
-}
-
-/// `--kappa`: a finite κ with |κ| <= [`MAX_ABS_KAPPA`].
+/// `--kappa`: a finite κ with |κ| <= [`request::MAX_ABS_KAPPA`].
 pub fn parse_kappa(s: &str) -> Result<f64, String> {
-    check_kappa(number(s)?)
+    request::kappa(number(s)?).map_err(reason)
 }
 
-/// Checks that `v` is a usable κ (finite, |κ| <= [`MAX_ABS_KAPPA`]).
-pub fn check_kappa(v: f64) -> Result<f64, String> {
-    if v.is_nan() || v.abs() > MAX_ABS_KAPPA {
-        return Err(format!(
-            "kappa = ln(K / 1 Pa) must lie in [-{MAX_ABS_KAPPA}, {MAX_ABS_KAPPA}] (K = e^kappa \
-             overflows beyond; the fit searches [7, 20]), got {}",
-            show(v)
-        ));
-    }
-    Ok(v)
-}
-
-/// `--take-up-diameter`: in [[`MIN_TAKE_UP_DIAMETER_M`], `MAX_PLAUSIBLE_DIAMETER_M`] m.
+/// `--take-up-diameter`: in [[`request::MIN_TAKE_UP_DIAMETER_M`], the largest plausible
+/// diameter] m.
 pub fn parse_take_up_diameter(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if !(MIN_TAKE_UP_DIAMETER_M..=MAX_PLAUSIBLE_DIAMETER_M).contains(&v) {
-        return Err(format!(
-            "a take-up diameter must lie in [{MIN_TAKE_UP_DIAMETER_M:e}, \
-             {MAX_PLAUSIBLE_DIAMETER_M}] m (got {} m; the unit is metres)",
-            show(v)
-        ));
-    }
-    Ok(v)
+    request::take_up_diameter(number(s)?).map_err(reason)
 }
 
-/// Checks that `(lo, hi)` given with `flag` is increasing and within `[min, max]`, the fit's
-/// bounds of the parameter `name`.
+/// Checks that `(lo, hi)` given with the flag of `arg` is increasing and within `[min, max]`,
+/// the fit's bounds of the parameter `name`.
 pub fn check_range(
-    flag: &str,
+    arg: Arg,
     name: &str,
-    (lo, hi): (f64, f64),
-    [min, max]: [f64; 2],
+    range: (f64, f64),
+    bounds: [f64; 2],
 ) -> Result<(), String> {
-    let given = format!("{flag} {},{}", show(lo), show(hi));
-    if lo == hi {
-        return Err(format!(
-            "{given}: the range is a single value; give MIN,MAX with MIN < MAX, within the \
-             fit's bounds [{min}, {max}] of {name}"
-        ));
-    }
-    if lo > hi {
-        return Err(format!(
-            "{given}: give MIN,MAX with MIN < MAX (did you mean {},{}?)",
-            show(hi),
-            show(lo)
-        ));
-    }
-    if lo < min || hi > max {
-        return Err(format!(
-            "{given}: {name} must lie within the fit's bounds [{min}, {max}]"
-        ));
-    }
-    Ok(())
+    request::range(arg, name, range, bounds)
+        .map(|_| ())
+        .map_err(message)
 }
 
 /// Checks `--start N,KAPPA` against the fit's bounds.
-pub fn check_start((n, kappa): (f64, f64), opts: &IdentifyOptions) -> Result<(), String> {
-    let inside = |v: f64, i: usize| v >= opts.lower[i] && v <= opts.upper[i];
-    if !inside(n, 0) || !inside(kappa, 1) {
-        return Err(format!(
-            "--start {},{}: the start must lie within the fit's bounds n in [{}, {}] and \
-             kappa in [{}, {}]",
-            show(n),
-            show(kappa),
-            opts.lower[0],
-            opts.upper[0],
-            opts.lower[1],
-            opts.upper[1]
-        ));
-    }
-    Ok(())
+pub fn check_start(start: (f64, f64), opts: &IdentifyOptions) -> Result<(), String> {
+    request::start(start, opts).map(|_| ()).map_err(message)
 }
 
 /// Two values separated by one of `separators` ("0.5,11" or "41x41"); `form` and `what` name
@@ -318,21 +195,11 @@ pub fn parse_pair(s: &str) -> Result<(f64, f64), String> {
     Ok((a, b))
 }
 
-/// The `--grid` size "NxM": 2 to [`MAX_GRID_SIDE`] values per direction, at most
+/// The `--grid` size "NxM": 2 to [`request::MAX_GRID_SIDE`] values per direction, at most
 /// [`MAX_GRID_POINTS`] points.
 pub fn parse_grid(s: &str) -> Result<(usize, usize), String> {
-    let (a, b) = parse_two::<usize>(s, &['x', 'X'], "\"NxM\"", "a count")?;
-    if a < 2 || b < 2 {
-        return Err("the grid needs at least 2 points per direction".into());
-    }
-    if a > MAX_GRID_SIDE || b > MAX_GRID_SIDE || a.saturating_mul(b) > MAX_GRID_POINTS {
-        return Err(format!(
-            "{a}x{b} is too large: at most {MAX_GRID_SIDE} values per direction and \
-             {MAX_GRID_POINTS} points (a 41x41 grid of the shipped data takes seconds; zoom in \
-             with --n-range and --kappa-range instead)"
-        ));
-    }
-    Ok((a, b))
+    let (a, b) = parse_two::<i128>(s, &['x', 'X'], "\"NxM\"", "a count")?;
+    request::grid(a, b, MAX_GRID_POINTS).map_err(reason)
 }
 
 /// The failure `e` prefixed with the experiment's name and its line in the experiments file
@@ -361,17 +228,10 @@ pub fn name_experiment(e: Box<dyn Error>, toml: &Path, law: Option<[f64; 2]>) ->
     }
 }
 
-/// The mesh limit of a landscape: `--max-nodes` (at most [`LANDSCAPE_MAX_NODES`], the cap of
-/// the landscape's solves) or that cap.
+/// The mesh limit of a landscape: `--max-nodes` (at most the cap of the landscape's solves)
+/// or that cap.
 pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, String> {
-    match max_nodes {
-        None => Ok(LANDSCAPE_MAX_NODES),
-        Some(m) if m <= LANDSCAPE_MAX_NODES => Ok(m),
-        Some(m) => Err(format!(
-            "--max-nodes {m}: the landscape caps its meshes at {LANDSCAPE_MAX_NODES} nodes \
-             (points that need more are marked missing); give at most {LANDSCAPE_MAX_NODES}"
-        )),
-    }
+    request::landscape_max_nodes(max_nodes.map(|m| m as i128)).map_err(message)
 }
 
 /// The estimate of a landscape's run time, from its sample rows (computed and timed exactly as

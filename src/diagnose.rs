@@ -1,6 +1,7 @@
 //! `rheometer diagnose`.
 
 use crate::*;
+use rheometer::workflow::request::{self, Door};
 
 /// Arguments of `rheometer diagnose`.
 #[derive(clap::Args)]
@@ -109,10 +110,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     }
     robust.apply(&mut opts.identify)?;
     opts.identify.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
-    if let Some(t) = tol {
-        opts.identify.simulate.tol = t;
-        opts.identify.max_discretisation_shift = Some(f64::INFINITY);
-    }
+    request::given_tol(&mut opts.identify, tol).map_err(|r| r.message(Door::Cli))?;
     // a spinner on a terminal (indicatif draws nothing when stderr is not a terminal)
     let spinner = if g.quiet {
         ProgressBar::hidden()

@@ -2,6 +2,7 @@
 
 use crate::*;
 use rheometer::fit_html::FIT_REPORT_HTML;
+use rheometer::workflow::request::{self, Door};
 
 /// Arguments of `rheometer fit`.
 #[derive(clap::Args)]
@@ -77,10 +78,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         .map(|p| previous::read_previous(p, g))
         .transpose()?;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
-    if let Some(t) = tol {
-        opts.simulate.tol = t;
-        opts.max_discretisation_shift = Some(f64::INFINITY);
-    }
+    request::given_tol(&mut opts, tol).map_err(|r| r.message(Door::Cli))?;
     robust.apply(&mut opts)?;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     let model = if newtonian {
@@ -97,14 +95,9 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         }
         None => (with, start, Vec::new()),
     };
+    request::newtonian_start(law == LawChoice::Newtonian, start)
+        .map_err(|r| r.message(Door::Cli))?;
     if let Some(s) = start {
-        if law == LawChoice::Newtonian {
-            return Err(
-                "--start with --model newtonian: the Newtonian model (n = 1) has no (n, kappa) \
-                 to start from; drop --start or fit the Carreau-type law (--model carreau)"
-                    .into(),
-            );
-        }
         checks::check_start(s, &opts)?;
     }
     let spec = ModelSpec {

@@ -1,6 +1,7 @@
 //! `rheometer landscape`.
 
 use crate::*;
+use rheometer::workflow::request::Arg;
 
 /// Arguments of `rheometer landscape`.
 #[derive(clap::Args)]
@@ -48,9 +49,9 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     } = args;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
     // sizes and ranges before any work
-    checks::check_range("--n-range", "n", n_range, [opts.lower[0], opts.upper[0]])?;
+    checks::check_range(Arg::NRange, "n", n_range, [opts.lower[0], opts.upper[0]])?;
     checks::check_range(
-        "--kappa-range",
+        Arg::KappaRange,
         "kappa",
         kappa_range,
         [opts.lower[1], opts.upper[1]],

@@ -23,6 +23,7 @@ __all__ = [
     "Comparison",
     "Diagnosis",
     "Landscape",
+    "DesignResult",
 ]
 
 
@@ -832,3 +833,42 @@ class Landscape(Result):
                 self._data.get("point_tol", np.full(np.shape(self._data["cost"]), np.nan))
             ).ravel(),
         }
+
+
+class DesignResult(Result):
+    """The outcome of :func:`diffbvp.design`: the dict ``rheometer design --json`` writes (for a
+    design for estimation: ``current`` uncertainty, ranked ``candidates`` with their predicted
+    standard errors, the criterion; with ``discriminate``: the rivals' separations), plus
+    ``text`` (the report) and ``csv`` (every candidate, as ``design.csv``)."""
+
+    __slots__ = ("text", "csv")
+
+    def __init__(self, data: Dict[str, Any], text: str = "", csv: str = ""):
+        super().__init__(data, {})
+        object.__setattr__(self, "text", text)
+        object.__setattr__(self, "csv", csv)
+
+    def __getstate__(self):  # type: ignore[override]
+        return (self._data, self.text, self.csv)
+
+    def __setstate__(self, state):  # type: ignore[override]
+        if not (isinstance(state, tuple) and len(state) == 3 and isinstance(state[0], dict)):
+            raise TypeError("DesignResult: the pickled state is not (dict, text, csv)")
+        object.__setattr__(self, "_data", state[0])
+        object.__setattr__(self, "_arrays", {})
+        object.__setattr__(self, "text", state[1])
+        object.__setattr__(self, "csv", state[2])
+
+    @property
+    def ranked(self) -> List[Dict[str, Any]]:
+        """The feasible candidates, best first."""
+        cands = [c for c in self._data.get("candidates", []) if c.get("rank") is not None]
+        return sorted(cands, key=lambda c: c["rank"])
+
+    def __repr__(self) -> str:
+        n = len(self._data.get("candidates", []))
+        return f"DesignResult({n} candidates, {len(self.ranked)} feasible)"
+
+    def __str__(self) -> str:
+        return self.text
+

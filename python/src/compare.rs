@@ -36,7 +36,7 @@ pub fn compare<'py>(
     effects: Vec<String>,
     relative_uncertainty: Option<f64>,
     tol: Option<f64>,
-    max_nodes: Option<usize>,
+    max_nodes: Option<i128>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut request = match fit {
         Some(f) => {
@@ -75,7 +75,7 @@ pub fn compare<'py>(
         }
     };
     request.with = options::effects(&effects)?;
-    request.relative_uncertainty = options::fraction("relative_uncertainty", relative_uncertainty)?;
+    request.relative_uncertainty = options::fraction(relative_uncertainty)?;
     request.simulate.max_nodes = options::max_nodes(max_nodes)?;
     if let Some(t) = options::tol(tol)? {
         request.simulate.tol = t;

@@ -15,7 +15,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::diagnostics::diagnose::DiagnoseOptions;
 use rheometer::effects::{Effect, ModelSpec};
-use rheometer::workflow;
+use rheometer::workflow::{
+    self,
+    request::{self, Arg},
+};
 
 /// Searches the candidate effects for what the model misses, as `rheometer diagnose`.
 /// Returns `{"diagnosis": Diagnosis as dict, "text": the report, "base_arrays": {...},
@@ -31,12 +34,12 @@ pub fn diagnose<'py>(
     model: Option<&str>,
     effects: Vec<String>,
     candidates: Option<Vec<String>>,
-    refit_top: Option<usize>,
+    refit_top: Option<i128>,
     start: Option<(f64, f64)>,
     loss: &str,
     f_scale: Option<f64>,
     tol: Option<f64>,
-    max_nodes: Option<usize>,
+    max_nodes: Option<i128>,
     start_from: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (loaded, path) = dataset.data();
@@ -70,13 +73,13 @@ pub fn diagnose<'py>(
     }
     if let Some(k) = refit_top {
         let most = opts.candidates.len().max(1);
-        if !(1..=most).contains(&k) {
-            return Err(input_error(format!(
-                "refit_top: give 1 to {most} (the number of candidate effects) candidates to \
-                 refit (got {k})"
-            )));
-        }
-        opts.refit_top = k;
+        opts.refit_top = options::count(
+            Arg::RefitTop,
+            k,
+            1,
+            most,
+            "candidates to refit (the number of candidate effects is the most)",
+        )?;
     }
     if let Some(s) = start {
         options::check_start(s, &opts.identify)?;
@@ -84,10 +87,7 @@ pub fn diagnose<'py>(
     }
     options::robust_loss(&mut opts.identify, loss, f_scale)?;
     opts.identify.simulate.max_nodes = options::max_nodes(max_nodes)?;
-    if let Some(t) = options::tol(tol)? {
-        opts.identify.simulate.tol = t;
-        opts.identify.max_discretisation_shift = Some(f64::INFINITY);
-    }
+    request::given_tol(&mut opts.identify, tol).map_err(options::refused)?;
     let out = interruptible(py, |cancel| {
         let mut opts = opts;
         opts.identify.cancel = Some(cancel);

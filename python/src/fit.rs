@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::effects::{LawChoice, ModelSpec};
 use rheometer::rheometer::{Identification, IdentifyOptions, Rheometer};
+use rheometer::workflow::request::{self, Arg};
 use rheometer::workflow::{self, FitRequest};
 use rheometer::{FiberSolution, Profiles};
 
@@ -91,28 +92,25 @@ pub fn fit<'py>(
     relative_uncertainty: Option<f64>,
     error_budget: bool,
     tol: Option<f64>,
-    max_nodes: Option<usize>,
-    profile_points: usize,
+    max_nodes: Option<i128>,
+    profile_points: i128,
     start_from: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut opts = IdentifyOptions::with_estimator(options::estimator(estimator)?);
     options::robust_loss(&mut opts, loss, f_scale)?;
-    opts.relative_uncertainty = options::fraction("relative_uncertainty", relative_uncertainty)?;
+    opts.relative_uncertainty = options::fraction(relative_uncertainty)?;
     opts.simulate.max_nodes = options::max_nodes(max_nodes)?;
-    if let Some(t) = options::tol(tol)? {
-        // a given tolerance is kept (the discretisation shift is only reported), as `--tol`
-        opts.simulate.tol = t;
-        opts.max_discretisation_shift = Some(f64::INFINITY);
-    }
+    request::given_tol(&mut opts, tol).map_err(options::refused)?;
     if let Some(s) = start {
         options::check_start(s, &opts)?;
     }
-    if !(2..=options::MAX_POINTS).contains(&profile_points) {
-        return Err(input_error(format!(
-            "profile_points: give 2 to {} positions per profile (got {profile_points})",
-            options::MAX_POINTS
-        )));
-    }
+    let profile_points = options::count(
+        Arg::ProfilePoints,
+        profile_points,
+        2,
+        options::MAX_POINTS,
+        "positions per profile",
+    )?;
     let (loaded, path) = dataset.data();
     let continued = options::continued(
         start_from.as_deref(),
@@ -129,13 +127,7 @@ pub fn fit<'py>(
         effects: continued.effects,
         candidates: Vec::new(),
     };
-    if spec.law == LawChoice::Newtonian && start.is_some() {
-        return Err(input_error(
-            "start: the Newtonian model (n = 1) has no (n, kappa) to start from; drop start or \
-             fit the Carreau-type law (model=\"carreau\")"
-                .into(),
-        ));
-    }
+    request::newtonian_start(spec.law == LawChoice::Newtonian, start).map_err(options::refused)?;
     let request = FitRequest {
         model: spec,
         start: start.map(|(n, k)| [n, k]),

@@ -10,14 +10,9 @@ use crate::run::interruptible;
 use diffbvp::mesh::linspace;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rheometer::rheometer::landscape::LANDSCAPE_MAX_NODES;
 use rheometer::rheometer::{FarRule, IdentifyOptions, PointStatus};
+use rheometer::workflow::request::{self, Arg};
 use rheometer::workflow::{self, LandscapeRequest};
-
-/// Largest number of values per direction.
-const MAX_GRID_SIDE: usize = 1000;
-/// Largest number of grid points.
-const MAX_GRID_POINTS: usize = 100_000;
 
 /// Computes `J(n, κ)` on a `grid = (number of n values, number of κ values)` grid. Returns
 /// `{"n", "kappa", "cost": (κ × n) array, "status": (κ × n) array of 0 ok / 1 failed / 2 not
@@ -31,47 +26,27 @@ const MAX_GRID_POINTS: usize = 100_000;
 pub fn landscape<'py>(
     py: Python<'py>,
     dataset: &Dataset,
-    grid: (usize, usize),
+    grid: (i128, i128),
     n_range: (f64, f64),
     kappa_range: (f64, f64),
     estimator: &str,
     tol: f64,
-    max_nodes: Option<usize>,
+    max_nodes: Option<i128>,
     uniform_tol: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut opts = IdentifyOptions::with_estimator(options::estimator(estimator)?);
-    options::check_range("n_range", "n", n_range, [opts.lower[0], opts.upper[0]])?;
+    options::check_range(Arg::NRange, "n", n_range, [opts.lower[0], opts.upper[0]])?;
     options::check_range(
-        "kappa_range",
+        Arg::KappaRange,
         "kappa",
         kappa_range,
         [opts.lower[1], opts.upper[1]],
     )?;
-    let (a, b) = grid;
-    if a < 2 || b < 2 {
-        return Err(input_error(
-            "grid: the grid needs at least 2 points per direction".into(),
-        ));
-    }
-    if a > MAX_GRID_SIDE || b > MAX_GRID_SIDE || a.saturating_mul(b) > MAX_GRID_POINTS {
-        return Err(input_error(format!(
-            "grid = ({a}, {b}) is too large: at most {MAX_GRID_SIDE} values per direction and \
-             {MAX_GRID_POINTS} points (zoom in with n_range and kappa_range instead)"
-        )));
-    }
+    let (a, b) =
+        request::grid(grid.0, grid.1, request::MAX_GRID_POINTS).map_err(options::refused)?;
     options::tol(Some(tol))?;
     opts.simulate.tol = tol;
-    opts.simulate.max_nodes = match max_nodes {
-        None => LANDSCAPE_MAX_NODES,
-        Some(m) if (options::MIN_MAX_NODES..=LANDSCAPE_MAX_NODES).contains(&m) => m,
-        Some(m) => {
-            return Err(input_error(format!(
-                "max_nodes = {m}: the landscape caps its meshes at {LANDSCAPE_MAX_NODES} nodes; \
-                 give {} to {LANDSCAPE_MAX_NODES}",
-                options::MIN_MAX_NODES
-            )))
-        }
-    };
+    opts.simulate.max_nodes = request::landscape_max_nodes(max_nodes).map_err(options::refused)?;
     let request = LandscapeRequest {
         n: linspace(n_range.0, n_range.1, a),
         kappa: linspace(kappa_range.0, kappa_range.1, b),

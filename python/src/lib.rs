@@ -1,7 +1,7 @@
 //! `diffbvp._native`: the thin Rust layer of the Python package `diffbvp`.
 //!
 //! Each function checks its arguments as the `rheometer` program checks its flags, calls the
-//! library's workflow ([`rheometer::workflow`]: fit, simulate, compare, diagnose,
+//! library's workflow ([`rheometer::workflow`]: fit, simulate, compare, diagnose, design,
 //! landscape) and hands its result to Python through the result's serde JSON form (one path:
 //! [`convert::serde_to_py`]; dicts, lists, floats) plus numpy arrays for array-valued data;
 //! the Python result classes in `python/diffbvp/` wrap those dicts. Long calls run with the GIL released and stop
@@ -12,6 +12,7 @@ mod bvp;
 mod compare;
 mod convert;
 mod dataset;
+mod design;
 mod diagnose;
 mod errors;
 mod fit;
@@ -39,6 +40,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(landscape::landscape, m)?)?;
+    m.add_function(wrap_pyfunction!(design::design, m)?)?;
     m.add_function(wrap_pyfunction!(library_version, m)?)?;
     m.add_function(wrap_pyfunction!(run::set_threads, m)?)?;
     m.add_function(wrap_pyfunction!(run::threads, m)?)?;

@@ -7,51 +7,38 @@ use pyo3::prelude::*;
 use rheometer::effects::{EffectSetting, LawChoice};
 use rheometer::rheometer::{Estimator, FitSummary, IdentifyOptions};
 
-/// Smallest `max_nodes` (the cold start begins on a mesh of 21 nodes).
-pub const MIN_MAX_NODES: usize = 50;
-/// Largest `max_nodes`.
-pub const MAX_MAX_NODES: usize = 1_000_000;
-/// Default mesh limit of the solves of `simulate`, `fit`, `diagnose` and `compare`.
-pub const DEFAULT_MAX_NODES: usize = 20_000;
-/// Largest |κ| (K = e^κ Pa stays a finite positive number).
-pub const MAX_ABS_KAPPA: f64 = 700.0;
-/// Largest number of output positions per profile.
-pub const MAX_POINTS: usize = 100_000;
-/// Range of a BVP tolerance \[-\].
-pub const TOL_RANGE: (f64, f64) = (1e-12, 0.1);
+pub use rheometer::workflow::request::MAX_POINTS;
+use rheometer::workflow::request::{self, Arg, Door, Refusal};
 
-/// A BVP tolerance `tol` in [`TOL_RANGE`] (or none).
+/// A refusal of the library's request rules in Python's words (argument names, not flags).
+pub fn refused(r: Refusal) -> PyErr {
+    input_error(r.message(Door::Python))
+}
+
+/// A BVP tolerance `tol` in the request's range (or none).
 pub fn tol(v: Option<f64>) -> PyResult<Option<f64>> {
+    v.map(request::tol).transpose().map_err(refused)
+}
+
+/// The relative uncertainty (or none) in (0, 1), like the TOML key.
+pub fn fraction(v: Option<f64>) -> PyResult<Option<f64>> {
+    v.map(request::relative_uncertainty)
+        .transpose()
+        .map_err(refused)
+}
+
+/// `max_nodes` (a Python int, any sign): the request's range, default
+/// [`request::DEFAULT_MAX_NODES`].
+pub fn max_nodes(v: Option<i128>) -> PyResult<usize> {
     match v {
-        Some(t) if !(TOL_RANGE.0..=TOL_RANGE.1).contains(&t) => Err(input_error(format!(
-            "tol: the tolerance must lie in [{:e}, {}] (got {t})",
-            TOL_RANGE.0, TOL_RANGE.1
-        ))),
-        other => Ok(other),
+        None => Ok(request::DEFAULT_MAX_NODES),
+        Some(v) => request::max_nodes(v).map_err(refused),
     }
 }
 
-/// A relative uncertainty `name` in (0, 1) like the TOML key (or none).
-pub fn fraction(name: &str, v: Option<f64>) -> PyResult<Option<f64>> {
-    match v {
-        Some(v) if !(v > 0.0 && v < 1.0) => Err(input_error(format!(
-            "{name} must lie in (0, 1) like the TOML key relative_uncertainty (got {v}; 0.01 is \
-             1 %)"
-        ))),
-        other => Ok(other),
-    }
-}
-
-/// `max_nodes`: `MIN_MAX_NODES..=MAX_MAX_NODES`, default [`DEFAULT_MAX_NODES`].
-pub fn max_nodes(v: Option<usize>) -> PyResult<usize> {
-    match v {
-        None => Ok(DEFAULT_MAX_NODES),
-        Some(v) if (MIN_MAX_NODES..=MAX_MAX_NODES).contains(&v) => Ok(v),
-        Some(v) => Err(input_error(format!(
-            "max_nodes: the mesh limit must lie in {MIN_MAX_NODES}..={MAX_MAX_NODES} nodes \
-             (got {v}; default {DEFAULT_MAX_NODES})"
-        ))),
-    }
+/// A count `v` of `arg` in `lo..=hi` (a Python int, any sign); `what` says what is counted.
+pub fn count(arg: Arg, v: i128, lo: usize, hi: usize, what: &str) -> PyResult<usize> {
+    request::count_in(arg, v, lo, hi, what).map_err(refused)
 }
 
 /// The estimator by name: `"principled"` or `"paper"`.
@@ -93,83 +80,32 @@ fn loss(name: &str) -> PyResult<Loss> {
 /// take them. Errors: an unknown loss, a margin outside (0, 1), a margin without a robust
 /// loss.
 pub fn robust_loss(opts: &mut IdentifyOptions, name: &str, margin: Option<f64>) -> PyResult<()> {
-    let l = loss(name)?;
-    let c = f_scale(margin)?;
-    if c.is_some() && l.is_linear() {
-        return Err(input_error(
-            "f_scale: a soft margin needs a robust loss, but loss is \"linear\" (least \
-             squares); give loss=\"soft_l1\" (or \"huber\", \"cauchy\"), or drop f_scale"
-                .to_string(),
-        ));
-    }
+    let (l, c) = request::robust_loss(loss(name)?, margin).map_err(refused)?;
     opts.loss = l;
     opts.f_scale = c;
     Ok(())
 }
 
-/// `f_scale`: a relative residual in (0, 1).
-fn f_scale(v: Option<f64>) -> PyResult<Option<f64>> {
-    match v {
-        Some(v) if !(v > 0.0 && v < 1.0) => Err(input_error(format!(
-            "f_scale is a relative residual in (0, 1) (got {v}; 0.02 is 2 %)"
-        ))),
-        other => Ok(other),
-    }
-}
-
 /// `n`: the Carreau-type law's domain (finite, >= 0).
 pub fn check_n(v: f64) -> PyResult<f64> {
-    if !(v >= 0.0 && v.is_finite()) {
-        return Err(input_error(format!(
-            "the power index n must be >= 0 (the Carreau-type law's domain; 1 is Newtonian), \
-             got {v}"
-        )));
-    }
-    Ok(v)
+    request::n(v).map_err(refused)
 }
 
-/// `kappa`: finite with |κ| <= [`MAX_ABS_KAPPA`].
+/// `kappa`: finite with |κ| within the request's bound.
 pub fn check_kappa(v: f64) -> PyResult<f64> {
-    if v.is_nan() || v.abs() > MAX_ABS_KAPPA {
-        return Err(input_error(format!(
-            "kappa = ln(K / 1 Pa) must lie in [-{MAX_ABS_KAPPA}, {MAX_ABS_KAPPA}] (K = e^kappa \
-             overflows beyond; the fit searches [7, 20]), got {v}"
-        )));
-    }
-    Ok(v)
+    request::kappa(v).map_err(refused)
 }
 
 /// `start = (n, κ)` within the fit's bounds.
-pub fn check_start((n, kappa): (f64, f64), opts: &IdentifyOptions) -> PyResult<()> {
-    let inside = |v: f64, i: usize| v >= opts.lower[i] && v <= opts.upper[i];
-    if !inside(n, 0) || !inside(kappa, 1) {
-        return Err(input_error(format!(
-            "start = ({n}, {kappa}): the start must lie within the fit's bounds n in [{}, {}] \
-             and kappa in [{}, {}]",
-            opts.lower[0], opts.upper[0], opts.lower[1], opts.upper[1]
-        )));
-    }
-    Ok(())
+pub fn check_start(s: (f64, f64), opts: &IdentifyOptions) -> PyResult<()> {
+    request::start(s, opts).map(|_| ()).map_err(refused)
 }
 
-/// `(lo, hi)` increasing and within `[min, max]` (the fit's bounds of `name`).
-pub fn check_range(
-    arg: &str,
-    name: &str,
-    (lo, hi): (f64, f64),
-    [min, max]: [f64; 2],
-) -> PyResult<()> {
-    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
-        return Err(input_error(format!(
-            "{arg} = ({lo}, {hi}): give (MIN, MAX) with MIN < MAX"
-        )));
-    }
-    if lo < min || hi > max {
-        return Err(input_error(format!(
-            "{arg} = ({lo}, {hi}): {name} must lie within the fit's bounds [{min}, {max}]"
-        )));
-    }
-    Ok(())
+/// `(lo, hi)` of `arg` increasing and within `[min, max]` (the fit's bounds of `name`).
+pub fn check_range(arg: Arg, name: &str, range: (f64, f64), bounds: [f64; 2]) -> PyResult<()> {
+    request::range(arg, name, range, bounds)
+        .map(|_| ())
+        .map_err(refused)
 }
 
 /// A fit or diagnosis to continue from (`start_from`): the model's law and effects and where

@@ -13,6 +13,7 @@ use pyo3::types::{PyDict, PyList};
 use rheometer::effects::physics_with;
 use rheometer::profile_sensitivities::ProfileSensitivities;
 use rheometer::take_up::MissingTakeUp;
+use rheometer::workflow::request;
 use rheometer::workflow::{self, SimulateError, SimulateRequest};
 use std::ops::ControlFlow;
 use std::sync::atomic::Ordering;
@@ -40,7 +41,7 @@ fn sensitivities_dict<'py>(
 /// Simulates every experiment at `(n, κ)`. Returns `{"law", "effects", "experiments": [{"name",
 /// "nodes", "take_up_from_data_m", "profiles": {...}, "sensitivities": {...} | None}]}`.
 #[pyfunction]
-#[pyo3(signature = (dataset, n=0.8, kappa=11.71, *, effects=Vec::new(), take_up_diameter=None,
+#[pyo3(signature = (dataset, n, kappa, *, effects=Vec::new(), take_up_diameter=None,
     take_up_from_data=false, points=101, positions=None, sensitivities=false, tol=None,
     max_nodes=None))]
 #[allow(clippy::too_many_arguments)]
@@ -52,11 +53,11 @@ pub fn simulate<'py>(
     effects: Vec<String>,
     take_up_diameter: Option<f64>,
     take_up_from_data: bool,
-    points: usize,
+    points: i128,
     positions: Option<Vec<f64>>,
     sensitivities: bool,
     tol: Option<f64>,
-    max_nodes: Option<usize>,
+    max_nodes: Option<i128>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = [options::check_n(n)?, options::check_kappa(kappa)?];
     let mut fixed = Vec::new();
@@ -80,22 +81,13 @@ pub fn simulate<'py>(
         (None, true) => MissingTakeUp::FromData,
         (None, false) => MissingTakeUp::Error,
     };
-    if !(2..=options::MAX_POINTS).contains(&points) {
-        return Err(input_error(format!(
-            "points: give 2 to {} output positions per profile (got {points})",
-            options::MAX_POINTS
-        )));
-    }
-    if let Some(p) = &positions {
-        if p.is_empty() || p.len() > options::MAX_POINTS || p.iter().any(|x| !x.is_finite()) {
-            return Err(input_error(format!(
-                "positions: give 1 to {} finite positions along the spin line (m)",
-                options::MAX_POINTS
-            )));
-        }
-    }
+    let points = request::points(points).map_err(options::refused)?;
     let (loaded, path) = dataset.data();
+    if let Some(p) = &positions {
+        request::positions(p, loaded).map_err(options::refused)?;
+    }
     let mut request = SimulateRequest::new(law, path.to_path_buf());
+    request.door = request::Door::Python;
     request.missing_take_up = missing;
     request.points = points;
     request.positions = positions;

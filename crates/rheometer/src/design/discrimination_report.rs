@@ -139,3 +139,45 @@ fn num(v: f64) -> String {
         format!("{v:.3}")
     }
 }
+
+impl Discrimination {
+    /// Every candidate of a design for discrimination as CSV: grid indices, conditions, `λ` and
+    /// expected `ΔBIC` of every ordered pair of rivals, rank, and why it is infeasible.
+    pub fn to_csv(&self) -> String {
+        let d = self;
+        let mut s = String::from("i,j,mass_flow_kg_s,take_up,");
+        for p in &d.current {
+            s.push_str(&format!(
+                "lambda_{t}_vs_{r},dbic_{t}_vs_{r},",
+                t = p.truth,
+                r = p.refitted
+            ));
+        }
+        s.push_str("min_lambda,rank,infeasible\n");
+        for c in &d.candidates {
+            s.push_str(&format!(
+                "{},{},{:e},{:e},",
+                c.candidate.i, c.candidate.j, c.candidate.mass_flow, c.candidate.take_up
+            ));
+            if c.separations.is_empty() {
+                s.push_str(&",".repeat(2 * d.current.len() + 2));
+            } else {
+                for p in &c.separations {
+                    s.push_str(&format!("{},{},", p.lambda, p.expected_delta_bic));
+                }
+                s.push_str(&format!(
+                    "{},{},",
+                    c.min_lambda,
+                    c.rank.map_or(String::new(), |r| r.to_string())
+                ));
+            }
+            let why = c.infeasible.as_deref().unwrap_or("");
+            if why.is_empty() {
+                s.push('\n');
+            } else {
+                s.push_str(&format!("\"{}\"\n", why.replace('"', "'")));
+            }
+        }
+        s
+    }
+}

@@ -23,6 +23,7 @@ impl Design {
             self.template,
             self.criterion.name()
         );
+        let _ = writeln!(t, "Noise of the predictions: {}", self.noise_model);
         let _ = writeln!(
             t,
             "\nNow (predicted from the fit's sensitivities; the fit's own in brackets):"
@@ -134,5 +135,46 @@ pub(super) fn infeasible_paragraph<'a>(
             "\n{} candidates infeasible (no solution of {model}), e.g. {name}: {reason}",
             bad.len()
         );
+    }
+}
+
+impl Design {
+    /// Every candidate as CSV: grid indices, conditions, predicted standard errors, correlation,
+    /// criteria, rank, and why it is infeasible.
+    pub fn to_csv(&self) -> String {
+        let d = self;
+        let mut s = String::from("i,j,mass_flow_kg_s,take_up,");
+        for p in &d.parameters {
+            s.push_str(&format!("se_{p},"));
+        }
+        s.push_str("corr_n_kappa,d_gain,a_ratio,e_ratio,gain,rank,infeasible\n");
+        for c in &d.candidates {
+            s.push_str(&format!(
+                "{},{},{:e},{:e},",
+                c.candidate.i, c.candidate.j, c.candidate.mass_flow, c.candidate.take_up
+            ));
+            match &c.prediction {
+                Some(p) => {
+                    for v in &p.stderr {
+                        s.push_str(&format!("{v:e},"));
+                    }
+                    s.push_str(&format!(
+                        "{},{},{},{},{},{},\n",
+                        p.correlation_n_kappa,
+                        p.d_gain,
+                        p.a_ratio,
+                        p.e_ratio,
+                        c.gain,
+                        c.rank.map_or(String::new(), |r| r.to_string())
+                    ));
+                }
+                None => {
+                    s.push_str(&",".repeat(d.parameters.len() + 6));
+                    let why = c.infeasible.as_deref().unwrap_or("singular information");
+                    s.push_str(&format!("\"{}\"\n", why.replace('"', "'")));
+                }
+            }
+        }
+        s
     }
 }

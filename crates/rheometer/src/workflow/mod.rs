@@ -26,6 +26,7 @@
 mod compare;
 mod design;
 mod fit;
+pub mod request;
 mod simulate;
 
 pub use compare::{compare, CompareRequest};

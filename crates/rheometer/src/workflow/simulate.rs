@@ -33,6 +33,8 @@ pub struct SimulateRequest {
     pub effects: Vec<(Effect, f64)>,
     /// Output positions \[m\] used for every experiment instead of `points` uniform ones.
     pub positions: Option<Vec<f64>>,
+    /// The door the request came through (the words of its messages).
+    pub door: super::request::Door,
     /// Also compute the exact sensitivities of the profiles with respect to `n`, `κ` and the
     /// effects' strengths ([`SimulatedProfile::sensitivities`]).
     pub sensitivities: bool,
@@ -51,6 +53,7 @@ impl SimulateRequest {
             source,
             effects: Vec::new(),
             positions: None,
+            door: super::request::Door::Cli,
             sensitivities: false,
         }
     }
@@ -162,12 +165,15 @@ fn simulate_one(
                 e.name,
                 location(data, request, k)
             ),
-            TakeUpError::Missing => format!(
-                "experiment {} has no take-up condition: give take_up_diameter_m or \
-                 take_up_velocity_m_s in {}, or a take-up diameter (--take-up-diameter M) or \
-                 take it from the data (--take-up-from-data)",
-                e.name,
-                request.source.display()
+            TakeUpError::Missing => super::request::in_words_of(
+                &format!(
+                    "experiment {} has no take-up condition: give take_up_diameter_m or \
+                     take_up_velocity_m_s in {}, or a take-up diameter (@take_up_diameter@) \
+                     or take it from the data (@take_up_from_data@)",
+                    e.name,
+                    request.source.display()
+                ),
+                request.door,
             ),
         })
     })?;
@@ -183,9 +189,12 @@ fn simulate_one(
             Box::new(source),
         );
         if let Some(d) = from_data {
-            f.hints.push(format!(
-                "the take-up diameter {d:.4e} m is d_fit(L) of the smoothed measurements \
-                 (--take-up-from-data; in the library MissingTakeUp::FromData)"
+            f.hints.push(super::request::in_words_of(
+                &format!(
+                    "the take-up diameter {d:.4e} m is d_fit(L) of the smoothed measurements \
+                     (@take_up_from_data@; in the library MissingTakeUp::FromData)"
+                ),
+                request.door,
             ));
         }
         SimulateError::Experiment(Box::new(f))
