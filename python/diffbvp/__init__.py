@@ -29,7 +29,8 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from . import _native
-from .bvp import BvpFitResult, BvpResult, CubicInterpolant, fit_bvp, solve_bvp, to_expression
+from .bvp import (BvpFitResult, BvpResult, CubicInterpolant, continue_bvp, fit_bvp, solve_bvp,
+                  to_expression)
 from .errors import DiffbvpError, EvaluationError, FitError, InputError, SimulationError
 from .results import (Candidate, Comparison, Diagnosis, Estimate, FitResult, Landscape, Result,
                       SimulationResult)
@@ -59,6 +60,7 @@ __all__ = [
     "solve_bvp",
     "fit_bvp",
     "to_expression",
+    "continue_bvp",
     "BvpResult",
     "BvpFitResult",
     "CubicInterpolant",

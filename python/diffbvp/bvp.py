@@ -38,6 +38,7 @@ __all__ = [
     "CubicInterpolant",
     "BvpFitResult",
     "to_expression",
+    "continue_bvp",
 ]
 
 _STATUS_MESSAGES = {
@@ -756,3 +757,70 @@ def fit_bvp(
     res.nfev = int(out.nfev)
     res.solution = solve_at(out.x)
     return res
+
+
+# ---------------------------------------------------------------- continuation
+
+
+def continue_bvp(
+    fun: Any,
+    bc: Any,
+    x: Any,
+    y: Any,
+    param: str,
+    values: Sequence[float],
+    params: Mapping[str, float],
+    p: Any = None,
+    tol: float = 1e-3,
+    max_nodes: int = 1000,
+    constants: Optional[Mapping[str, float]] = None,
+    unknowns: Optional[Sequence[str]] = None,
+    min_step: float = 1e-8,
+) -> List[BvpResult]:
+    """Natural-parameter continuation of a problem given as expressions: solve at each of
+    ``values`` of the model parameter ``param`` in turn (``params`` holds the start values of
+    all model parameters), each solve starting from the previous solution moved along its exact
+    tangent ``y + (dy/dq) Δq`` (forward sensitivities). A step that fails is halved, down to
+    ``min_step``; then :class:`EvaluationError` names the value reached and the last failure
+    (past a turning point there is no solution nearby). Returns one result per value.
+
+    >>> import numpy as np
+    >>> rs = continue_bvp(["y[1]", "-k*exp(y[0])"], ["ya[0]", "yb[0]"], np.linspace(0, 1, 5),
+    ...                   np.zeros((2, 5)), "k", [1.0, 2.0, 3.0], {"k": 0.5}, tol=1e-6)
+    >>> [round(float(r.sol(0.5)[0]), 4) for r in rs]
+    [0.1405, 0.329, 0.6401]
+    """
+    params = dict(params)
+    if param not in params:
+        raise InputError(f"continue_bvp: {param!r} is not one of the model parameters {list(params)}")
+    names = list(params)
+    col = names.index(param)
+    kw = dict(tol=tol, max_nodes=max_nodes, constants=constants, unknowns=unknowns)
+    cur = solve_bvp(fun, bc, x, y, p=p, params=params, **kw)
+    if not cur.success:
+        raise EvaluationError(
+            f"continue_bvp: no solution at the start {param} = {params[param]}: {cur.message}"
+        )
+    q = float(params[param])
+    out = []
+    for target in [float(v) for v in values]:
+        step = target - q
+        while q != target:
+            trial = q + step if abs(step) < abs(target - q) else target
+            s = cur.sensitivities()
+            yg = cur.y + s["dy"][:, :, col] * (trial - q)
+            pg = None if cur.p is None else cur.p + s["dp"][:, col] * (trial - q)
+            nxt = solve_bvp(fun, bc, cur.x, yg, p=pg, params={**params, param: trial}, **kw)
+            if nxt.success:
+                cur, q = nxt, trial
+                params[param] = trial
+                continue
+            step /= 2
+            if abs(step) < min_step:
+                raise EvaluationError(
+                    f"continue_bvp: stopped at {param} = {q} (target {target}): the step fell "
+                    f"below min_step = {min_step:g}; last failure at {param} = {trial}: "
+                    f"{nxt.message}"
+                )
+        out.append(cur)
+    return out

@@ -739,3 +739,24 @@ def test_million_node_mesh_is_refused_fast_and_solved_when_allowed():
     assert r.success
     assert time.perf_counter() - t0 < 60
     assert_allclose(r.sol(0.5)[0], exp_sol(0.5), atol=1e-5)
+
+
+def test_continuation_follows_bratu_to_its_turning_point():
+    # Bratu y'' + k e^y = 0: lower branch y(0.5) = 2 ln cosh(t/4), t = sqrt(2k) cosh(t/4);
+    # the branch turns at k* = 3.5138...; beyond it there is no solution
+    from scipy.optimize import brentq
+
+    def exact(k):
+        t = brentq(lambda t: t - np.sqrt(2 * k) * np.cosh(t / 4), 0.1, 4.79)
+        return 2 * np.log(np.cosh(t / 4))
+
+    fun, bc = ["y[1]", "-k*exp(y[0])"], ["ya[0]", "yb[0]"]
+    x = np.linspace(0, 1, 5)
+    ks = [1.0, 2.0, 3.0, 3.5]
+    rs = diffbvp.continue_bvp(fun, bc, x, np.zeros((2, 5)), "k", ks, {"k": 0.5}, tol=1e-8)
+    for k, r in zip(ks, rs):
+        assert r.success and r.params["k"] == k
+        assert abs(r.sol(0.5)[0] - exact(k)) < 1e-6 * exact(k), (k, r.sol(0.5)[0], exact(k))
+    with pytest.raises(EvaluationError, match="stopped at k = 3.5"):
+        diffbvp.continue_bvp(fun, bc, x, np.zeros((2, 5)), "k", [3.5, 3.6], {"k": 0.5},
+                             tol=1e-6, min_step=1e-3)
