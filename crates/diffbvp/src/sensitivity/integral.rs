@@ -160,6 +160,10 @@ fn state_at(sol: &Solution, pt: &QuadPoint, y: &mut [f64]) {
     }
 }
 
+/// What a non-finite integrand reports (where: the point `x`; what to check: its domain).
+const INTEGRAND: &str =
+    "the integral functional's integrand g (value or derivative: is the state in its domain?)";
+
 fn non_finite(what: &'static str, x: f64) -> BvpError {
     BvpError::NonFinite {
         what,
@@ -185,13 +189,16 @@ pub fn integral_value<P: Bvp, G: IntegralFunction>(
         state_at(sol, &pt, &mut y);
         let v = g.integrand(pt.x, &y, &p);
         if !v.is_finite() {
-            return Err(non_finite("integrand", pt.x));
+            return Err(non_finite(INTEGRAND, pt.x));
         }
         value += pt.w * v;
     }
     let phi = g.endpoint(&sol.y[..n], &sol.y[(m - 1) * n..], &p);
     if !phi.is_finite() {
-        return Err(non_finite("endpoint term", sol.x[m - 1]));
+        return Err(non_finite(
+            "the integral functional's end-point term φ (value or derivative)",
+            sol.x[m - 1],
+        ));
     }
     Ok(value + phi)
 }
@@ -229,7 +236,7 @@ pub fn integral_adjoint<P: Bvp, G: IntegralFunction>(
         let f = IntegrandFn { g, x: pt.x, n };
         engine.jacobian(&f, &input[..n + np], n + np, &mut out, &mut grad[..n + np]);
         if !out[0].is_finite() || grad[..n + np].iter().any(|v| !v.is_finite()) {
-            return Err(non_finite("integrand", pt.x));
+            return Err(non_finite(INTEGRAND, pt.x));
         }
         let w = pt.w;
         value += w * out[0];
@@ -283,7 +290,10 @@ pub fn integral_adjoint<P: Bvp, G: IntegralFunction>(
         &mut grad,
     );
     if !out[0].is_finite() || grad.iter().any(|v| !v.is_finite()) {
-        return Err(non_finite("endpoint term", sol.x[m - 1]));
+        return Err(non_finite(
+            "the integral functional's end-point term φ (value or derivative)",
+            sol.x[m - 1],
+        ));
     }
     value += out[0];
     for l in 0..n {
@@ -358,7 +368,7 @@ pub fn integral_forward<P: Bvp, G: IntegralFunction>(
         let f = IntegrandFn { g, x: pt.x, n };
         engine.jacobian(&f, &input[..n + np], n + np, &mut out, &mut grad[..n + np]);
         if !out[0].is_finite() || grad[..n + np].iter().any(|v| !v.is_finite()) {
-            return Err(non_finite("integrand", pt.x));
+            return Err(non_finite(INTEGRAND, pt.x));
         }
         value += pt.w * out[0];
         for (j, &pj) in sens.columns.iter().enumerate() {
@@ -383,7 +393,10 @@ pub fn integral_forward<P: Bvp, G: IntegralFunction>(
         &mut grad,
     );
     if !out[0].is_finite() || grad.iter().any(|v| !v.is_finite()) {
-        return Err(non_finite("endpoint term", sol.x[m - 1]));
+        return Err(non_finite(
+            "the integral functional's end-point term φ (value or derivative)",
+            sol.x[m - 1],
+        ));
     }
     value += out[0];
     sens.at_into(sol.x[0], &mut dy, &mut dyp);
