@@ -105,12 +105,12 @@ impl ExprProblem {
         let mut out = vec![0.0; n * m];
         let (mut yi, mut fi) = (vec![0.0; n], vec![0.0; n]);
         for (j, &xj) in x.iter().enumerate() {
-            for c in 0..n {
-                yi[c] = ya[[c, j]];
+            for (c, v) in yi.iter_mut().enumerate() {
+                *v = ya[[c, j]];
             }
             self.bvp.eval_rhs(xj, &yi, &p, &mut fi);
-            for c in 0..n {
-                out[c * m + j] = fi[c];
+            for (c, v) in fi.iter().enumerate() {
+                out[c * m + j] = *v;
             }
         }
         crate::convert::array2(py, &out, n, m)
@@ -146,9 +146,9 @@ impl ExprProblem {
         }
         let ya = y.as_array();
         let mut g = vec![0.0; n * m];
-        for j in 0..m {
-            for c in 0..n {
-                g[j * n + c] = ya[[c, j]];
+        for (j, row) in g.chunks_exact_mut(n).enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                *v = ya[[c, j]];
             }
         }
         let guess = Guess { x, y: g, unknowns };
@@ -319,8 +319,8 @@ impl BvpSolution {
                 .try_eval_into(x, &mut y, &mut yp)
                 .map_err(|e| input_error(e.to_string()))?;
             let v = if nu == 0 { &y } else { &yp };
-            for c in 0..n {
-                out[c * xs.len() + j] = v[c];
+            for (c, vc) in v.iter().enumerate() {
+                out[c * xs.len() + j] = *vc;
             }
         }
         crate::convert::array2(py, &out, n, xs.len())
@@ -349,10 +349,9 @@ impl BvpSolution {
         let (mut dy, mut dyp) = (vec![0.0; n * q], vec![0.0; n * q]);
         for (j, &x) in pts.iter().enumerate() {
             sens.at_into(x, &mut dy, &mut dyp);
-            for c in 0..n {
-                for l in 0..q {
-                    out[(c * len + j) * q + l] = dy[c * q + l];
-                }
+            for (idx, d) in dy.iter().enumerate() {
+                let (c, l) = (idx / q, idx % q);
+                out[(c * len + j) * q + l] = *d;
             }
         }
         let a = PyArray1::from_slice(py, &out)
@@ -388,9 +387,9 @@ impl BvpSolution {
 /// `n × m` from `m × n` row-major.
 fn transposed<'py>(py: Python<'py>, v: &[f64], m: usize, n: usize) -> PyResult<Bound<'py, PyAny>> {
     let mut out = vec![0.0; v.len()];
-    for i in 0..m {
-        for c in 0..n {
-            out[c * m + i] = v[i * n + c];
+    for (i, row) in v.chunks_exact(n).enumerate() {
+        for (c, val) in row.iter().enumerate() {
+            out[c * m + i] = *val;
         }
     }
     crate::convert::array2(py, &out, n, m)
