@@ -522,3 +522,36 @@ fn errors_shrink_with_the_tolerance() {
         }
     }
 }
+
+/// r_j = T(x_j) − data_j.
+struct TemperatureMisfit {
+    data: Vec<f64>,
+}
+
+impl PointFunction for TemperatureMisfit {
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], _p: &[D]) -> D {
+        y[0] - self.data[j]
+    }
+}
+
+#[test]
+fn a_least_squares_fit_recovers_the_second_layer_and_the_contact_resistance() {
+    use diffbvp::least_squares::{fit, BvpResiduals, BvpRun, FitOptions, ParamMap};
+    use diffbvp::mesh::multipoint_linspace;
+    let truth = [1.0, 3.0, 0.5];
+    // data from the closed form, both sides of the interface
+    let xs: Vec<f64> = (1..20).map(|i| i as f64 / 20.0).collect();
+    let data = xs.iter().map(|&x| layers_exact(x, truth)[0]).collect();
+    let mut solver = Solver::new(&Layers, tight(1e-8));
+    let guess = Guess::constant(multipoint_linspace(&[0.0, XI, 1.0], 4), &[0.5, 0.0]);
+    let start = [2.0, 0.1];
+    let accepted = solver.solve(&[1.0, start[0], start[1]], &guess).unwrap();
+    let map = ParamMap::new(vec![1.0, 0.0, 0.0]).link(1, 0).link(2, 1);
+    let run = BvpRun::new(solver, accepted, xs, TemperatureMisfit { data }, map).unwrap();
+    let mut prob = BvpResiduals::new(2).with_run(run).unwrap();
+    let opts = FitOptions::with_bounds(vec![0.1, 0.0], vec![10.0, 2.0]);
+    let res = fit(&mut prob, &start, &opts).unwrap();
+    assert!((res.p[0] - truth[1]).abs() < 1e-8, "{:?}", res.p);
+    assert!((res.p[1] - truth[2]).abs() < 1e-8, "{:?}", res.p);
+    assert!(res.cost < 1e-20, "cost {}", res.cost);
+}
