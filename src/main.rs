@@ -411,7 +411,8 @@ fn bounded_environment() -> Result<(), String> {
 
 /// Below this address-space limit (`ulimit -v`) the program warns at start: a fit of the
 /// shipped data sets needs several hundred MB of address space (thread stacks included).
-const LOW_ADDRESS_SPACE_BYTES: u64 = 1 << 30;
+#[cfg(unix)]
+const LOW_ADDRESS_SPACE_BYTES: libc::rlim_t = 1 << 30;
 
 /// A warning when the address space is limited below [`LOW_ADDRESS_SPACE_BYTES`]: the program
 /// may then end with "memory allocation failed" (an abort the program cannot turn into a
@@ -425,8 +426,8 @@ fn memory_limit_note() -> Option<String> {
         };
         // SAFETY: getrlimit writes the struct it is given and nothing else
         let ok = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } == 0;
-        let cur = u64::try_from(lim.rlim_cur).unwrap_or(u64::MAX);
-        if ok && lim.rlim_cur != libc::RLIM_INFINITY && cur < LOW_ADDRESS_SPACE_BYTES {
+        let cur = lim.rlim_cur;
+        if ok && cur != libc::RLIM_INFINITY && cur < LOW_ADDRESS_SPACE_BYTES {
             return Some(format!(
                 "the address space of this process is limited to {} MB (ulimit -v); a fit may \
                  need more and would then end with \"memory allocation failed\"; raise the \

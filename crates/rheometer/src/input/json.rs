@@ -218,6 +218,8 @@ fn show_path(steps: &[Step]) -> String {
 struct Trail {
     steps: Vec<Step>,
     duplicate: Option<String>,
+    /// The path of the last value read whole (for an error between values).
+    last: Option<String>,
 }
 
 /// A [`Value`] read with its path tracked in `trail` (left at the failing value on error).
@@ -287,7 +289,10 @@ impl<'de> Visitor<'de> for Seed<'_> {
             }
             self.0.borrow_mut().steps.push(Step::Key(key.clone()));
             let v = map.next_value_seed(Seed(self.0))?;
-            self.0.borrow_mut().steps.pop();
+            let mut t = self.0.borrow_mut();
+            t.last = Some(show_path(&t.steps));
+            t.steps.pop();
+            drop(t);
             out.insert(key, v);
         }
         Ok(Value::Object(out))
@@ -390,7 +395,10 @@ pub fn parse_json(text: &str, path: &Path, remedy: &str) -> Result<Value, InputE
         let msg = msg
             .rsplit_once(" at line ")
             .map_or(msg.as_str(), |(head, _)| head);
-        format!("malformed JSON at `{field}`: {msg}")
+        match &trail.last {
+            Some(last) => format!("malformed JSON in `{field}` after `{last}`: {msg}"),
+            None => format!("malformed JSON in `{field}`: {msg}"),
+        }
     };
     Err(InputError::Json {
         at: at(Some(line)),
@@ -443,6 +451,8 @@ mod tests {
         assert!(e.contains("truncated") && e.contains("`n"), "{e}");
         let e = err("  \n");
         assert!(e.contains("empty (whitespace only)"), "{e}");
+        let e = err(r#"{"a": 1, "n": 1e300{"value": 1}}"#);
+        assert!(e.contains("in `the top level` after `n`"), "{e}");
         let e = err("this is the report text\n");
         assert!(
             e.contains("not valid JSON") && e.contains("`this is the report text`"),
