@@ -9,6 +9,7 @@ mod probe;
 mod cold_start;
 mod compare;
 mod design;
+mod design_noise;
 mod discrimination;
 mod effect_scale;
 mod effects_families;

@@ -103,18 +103,36 @@ pub struct Reference {
     n_kappa: Option<(usize, usize)>,
 }
 
+/// The covariance `A⁻¹ B A⁻¹` \[unit²\] of a fit whose information is `a` and whose score's
+/// covariance under the real noise is `b` (both `p × p` row-major; see
+/// [`information`](super::information)); `None` when `a` is not positive definite.
+pub fn sandwich(a: &[f64], b: &[f64], p: usize) -> Option<Vec<f64>> {
+    let (ai, _) = spd_inverse(&DMatrix::from_row_slice(p, p, a))?;
+    let c = &ai * DMatrix::from_row_slice(p, p, b) * &ai;
+    // symmetric by construction; rounding made exact so that Cholesky sees a symmetric matrix
+    let c = (&c + c.transpose()) * 0.5;
+    Some(c.transpose().as_slice().to_vec())
+}
+
 impl Reference {
     /// The reference for the current information `info` (`p × p` row-major) with the parameter
     /// `names`; `None` when the current data do not determine every parameter (singular).
     pub fn new(info: &[f64], names: &[String]) -> Option<Self> {
         let p = names.len();
-        let m = DMatrix::from_row_slice(p, p, info);
-        let (cov, logdet) = spd_inverse(&m)?;
-        let se = (0..p).map(|i| cov[(i, i)].sqrt()).collect();
+        let (cov, _) = spd_inverse(&DMatrix::from_row_slice(p, p, info))?;
+        Self::from_covariance(cov.transpose().as_slice(), names)
+    }
+
+    /// The reference for the current covariance `cov` \[unit²\] (`p × p` row-major) with the
+    /// parameter `names`; `None` when it is not positive definite.
+    pub fn from_covariance(cov: &[f64], names: &[String]) -> Option<Self> {
+        let p = names.len();
+        let (_, logdet_cov) = spd_inverse(&DMatrix::from_row_slice(p, p, cov))?;
+        let se = (0..p).map(|i| cov[i * p + i].sqrt()).collect();
         let n = names.iter().position(|s| s == "n");
         let k = names.iter().position(|s| s == "kappa");
         Some(Reference {
-            logdet,
+            logdet: -logdet_cov,
             se,
             n_kappa: n.zip(k),
         })
@@ -123,8 +141,18 @@ impl Reference {
     /// The prediction for information `info` (`p × p` row-major), `None` when singular.
     pub fn predict(&self, info: &[f64]) -> Option<Prediction> {
         let p = self.se.len();
-        let m = DMatrix::from_row_slice(p, p, info);
-        let (cov, logdet) = spd_inverse(&m)?;
+        let (cov, _) = spd_inverse(&DMatrix::from_row_slice(p, p, info))?;
+        self.predict_covariance(cov.transpose().as_slice())
+    }
+
+    /// The prediction for the covariance `cov` \[unit²\] (`p × p` row-major), `None` when it is
+    /// not positive definite. The D-criterion reads `ln det C⁻¹` as the information's
+    /// `ln det`.
+    pub fn predict_covariance(&self, cov: &[f64]) -> Option<Prediction> {
+        let p = self.se.len();
+        let cov = DMatrix::from_row_slice(p, p, cov);
+        let (_, logdet_cov) = spd_inverse(&cov)?;
+        let logdet = -logdet_cov;
         let stderr: Vec<f64> = (0..p).map(|i| cov[(i, i)].sqrt()).collect();
         let scaled = DMatrix::from_fn(p, p, |i, j| cov[(i, j)] / (self.se[i] * self.se[j]));
         let a_ratio = scaled.trace() / p as f64;
@@ -168,6 +196,15 @@ mod tests {
         assert!((p.a_ratio - 0.5).abs() < 1e-12);
         assert!((p.gain(Criterion::D, &now) - 0.5).abs() < 1e-12);
         assert!(Reference::new(&[1.0, 1.0, 1.0, 1.0], &names).is_none());
+        // the sandwich with B = A is A⁻¹, and a noise twice the fit's level quadruples it
+        let same = sandwich(&info, &info, 2).unwrap();
+        let q = r.predict_covariance(&same).unwrap();
+        assert!((q.stderr[0] - now.stderr[0]).abs() < 1e-12 * now.stderr[0]);
+        let four: Vec<f64> = info.iter().map(|v| 4.0 * v).collect();
+        let q = r
+            .predict_covariance(&sandwich(&info, &four, 2).unwrap())
+            .unwrap();
+        assert!((q.stderr[1] / now.stderr[1] - 2.0).abs() < 1e-12);
         assert_eq!(Criterion::parse(" E ").unwrap(), Criterion::E);
         assert!(Criterion::parse("x")
             .unwrap_err()
