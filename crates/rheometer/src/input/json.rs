@@ -311,11 +311,11 @@ fn token_at(text: &str, line: usize, column: usize) -> String {
     // serde_json's column may point at the token's last character: back up to its start
     let head = &l[..start];
     let begin = head
-        .rfind(|c: char| matches!(c, ',' | ':' | '[' | '{' | ' ' | '\t'))
+        .rfind([',', ':', '[', '{', ' ', '\t'])
         .map_or(0, |i| i + 1);
     let rest = &l[begin..];
     let end = rest
-        .find(|c: char| matches!(c, ',' | ']' | '}' | ' ' | '\t' | '\r'))
+        .find([',', ']', '}', ' ', '\t', '\r'])
         .unwrap_or(rest.len());
     short(&rest[..end], 40)
 }
