@@ -4,7 +4,7 @@
 
 use crate::convert::{array1, serde_to_py};
 use crate::dataset::Dataset;
-use crate::errors::{input_error, to_py_err};
+use crate::errors::to_py_err;
 use crate::options;
 use crate::run::interruptible;
 use pyo3::prelude::*;

@@ -4,7 +4,7 @@
 
 use crate::convert::{array1, array2};
 use crate::dataset::Dataset;
-use crate::errors::{input_error, to_py_err};
+use crate::errors::to_py_err;
 use crate::options;
 use crate::run::interruptible;
 use diffbvp::mesh::linspace;

@@ -82,7 +82,7 @@ def test_bad_arguments_name_the_argument(pmma):
         diffbvp.landscape(pmma, grid=(1, 5))
     with pytest.raises(InputError, match=r"tol: the tolerance must lie in"):
         diffbvp.fit(pmma, tol=0.5)
-    with pytest.raises(InputError, match="relative_uncertainty must lie in"):
+    with pytest.raises(InputError, match="relative_uncertainty: a relative uncertainty must lie in"):
         diffbvp.compare(pmma, n=0.8, kappa=11.7, relative_uncertainty=2.0)
     with pytest.raises(InputError, match="no \\(n, kappa\\) to start from"):
         diffbvp.fit(pmma, model="newtonian", start=(0.5, 11.0))

@@ -151,7 +151,7 @@ def test_a_robust_loss_weights_the_diagnosis_and_outliers_are_no_missing_physics
     fit["at_bound"] = [{"parameter": "kappa", "side": "lower", "bound": 7.0}]
     assert not diffbvp.Diagnosis(data).law_is_a_result
     for run in (diffbvp.diagnose, diffbvp.fit):
-        with pytest.raises(diffbvp.InputError, match="f_scale: a soft margin needs a robust loss"):
+        with pytest.raises(diffbvp.InputError, match="f_scale = 0.02: a soft margin needs a robust loss"):
             run(ds, f_scale=0.02)
 
 

@@ -547,7 +547,33 @@ impl Collocation {
         let bf = BcFn { problem, n };
         self.engine
             .jacobian_in(&bf, &self.input, bc_seeds, &mut fbuf[..nb], &mut self.jbc);
-        // the interface conditions, seeded as the boundary conditions ([left, right, p])
+        let interfaces = self.interface_jacobians(problem, y, p, bc_seeds, &mut fbuf);
+        self.fbuf = fbuf;
+        interfaces?;
+        for (c, v) in self.jbc.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(BvpError::NonFinite {
+                    what: "boundary-condition Jacobian",
+                    component: c / wb.max(1),
+                    x: self.x[0],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The interface conditions' Jacobians, seeded as the boundary conditions (`[left, right,
+    /// p]`), into `jif`; `fbuf` (at least `n` long) takes their values.
+    fn interface_jacobians<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        bc_seeds: Seeds<'_>,
+        fbuf: &mut [f64],
+    ) -> Result<(), BvpError> {
+        let (n, m) = (self.n, self.m());
+        let wb = bc_seeds.len();
         let interfaces = self.region.last().copied().unwrap_or(0);
         self.jif.resize(interfaces * n * wb, 0.0);
         for i in 0..m - 1 {
@@ -571,25 +597,14 @@ impl Collocation {
                 &mut self.jif[j * n * wb..(j + 1) * n * wb],
             );
         }
-        if let Some(c) = self.jif.iter().position(|v| !v.is_finite()) {
-            self.fbuf = fbuf;
-            return Err(BvpError::NonFinite {
+        match self.jif.iter().position(|v| !v.is_finite()) {
+            Some(c) => Err(BvpError::NonFinite {
                 what: "interface-condition Jacobian",
                 component: (c / wb.max(1)) % n,
                 x: self.x[0],
-            });
+            }),
+            None => Ok(()),
         }
-        self.fbuf = fbuf;
-        for (c, v) in self.jbc.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(BvpError::NonFinite {
-                    what: "boundary-condition Jacobian",
-                    component: c / wb.max(1),
-                    x: self.x[0],
-                });
-            }
-        }
-        Ok(())
     }
 
     /// The `n × n` blocks `A_i = ∂r_i/∂y_i` and `B_i = ∂r_i/∂y_{i+1}` side by side: row `r`

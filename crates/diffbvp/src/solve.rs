@@ -821,15 +821,9 @@ impl<'a, P: Bvp> Solver<'a, P> {
                     return Err(e);
                 }
             };
-            if report.converged {
-                if let Some(s) = &self.ws.col.singular {
-                    // the boundary conditions hold here: if they do not impose S y(0) = 0, no
-                    // refinement will (the solution is not smooth at 0)
-                    if let Err(e) = s.check_regular(&y, bc_tol) {
-                        self.keep_system(lin);
-                        return Err(e);
-                    }
-                }
+            if let Err(e) = self.check_regular(report.converged, &y, bc_tol) {
+                self.keep_system(lin);
+                return Err(e);
             }
             stats.newton_iterations += report.iterations;
             stats.jacobian_factorizations += lin.factorizations - factorizations_before;
@@ -872,23 +866,8 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 opts.verbose,
             );
             stats.mesh_rule_switched_at = control.switched_at;
-            let refined = if above > 0 {
-                let (rms, marks) = (&self.ws.rms, &self.ws.marks);
-                Some(per_region(&x, |xr, r| {
-                    let ints = r.start..r.end - 1;
-                    let marks = marks.get(ints.clone()).unwrap_or(&[]);
-                    mesh::apply(
-                        xr,
-                        &rms[ints],
-                        marks,
-                        opts.tol,
-                        &control.options,
-                        opts.max_nodes,
-                    )
-                }))
-            } else {
-                None
-            };
+            let refined = (above > 0)
+                .then(|| refine_regions(&x, &self.ws.rms, &self.ws.marks, opts, &control));
             if opts.verbose >= 1 {
                 let next = refined.as_ref().map_or(m, Vec::len);
                 report_mesh(iteration, m, &report, (max_res, max_bc_res), above, next);
@@ -904,10 +883,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 // coarsen only if the coarser mesh can still be solved and checked: the solution
                 // returned must belong to the mesh it was computed on
                 if coarsenings_left > 0 && m > 8 && iteration < opts.max_mesh_iterations {
-                    let rms = &self.ws.rms;
-                    let new_x = per_region(&x, |xr, r| {
-                        mesh::coarsen(xr, &rms[r.start..r.end - 1], opts.tol / 20.0)
-                    });
+                    let new_x = coarsen_regions(&x, &self.ws.rms, opts.tol);
                     if (m - new_x.len()) * 10 >= m {
                         self.keep_system(lin);
                         coarsenings_left -= 1;
@@ -927,6 +903,15 @@ impl<'a, P: Bvp> Solver<'a, P> {
             if iteration >= opts.max_mesh_iterations {
                 return Err(not_met(&control, opts, iteration, max_res, max_bc_res));
             }
+        }
+    }
+
+    /// After a converged Newton solve of a singular problem: the boundary conditions hold, so
+    /// if they do not impose `S y(0) = 0` no refinement will (the solution is not smooth at 0).
+    fn check_regular(&self, converged: bool, y: &[f64], bc_tol: f64) -> Result<(), BvpError> {
+        match &self.ws.col.singular {
+            Some(s) if converged => s.check_regular(y, bc_tol),
+            _ => Ok(()),
         }
     }
 
@@ -1103,6 +1088,37 @@ fn allowed_size(
         });
     }
     Ok(())
+}
+
+/// The refined mesh: each region of `x` refined where its intervals' `rms` residuals exceed the
+/// tolerance (`marks` from the mesh control's plan).
+fn refine_regions(
+    x: &[f64],
+    rms: &[f64],
+    marks: &[u8],
+    opts: &SolveOptions,
+    control: &MeshControl,
+) -> Vec<f64> {
+    per_region(x, |xr, r| {
+        let ints = r.start..r.end - 1;
+        let marks = marks.get(ints.clone()).unwrap_or(&[]);
+        mesh::apply(
+            xr,
+            &rms[ints],
+            marks,
+            opts.tol,
+            &control.options,
+            opts.max_nodes,
+        )
+    })
+}
+
+/// The coarsened mesh: each region of `x` without the nodes whose intervals' residuals lie far
+/// below the tolerance `tol` (a twentieth of it).
+fn coarsen_regions(x: &[f64], rms: &[f64], tol: f64) -> Vec<f64> {
+    per_region(x, |xr, r| {
+        mesh::coarsen(xr, &rms[r.start..r.end - 1], tol / 20.0)
+    })
 }
 
 #[cfg(test)]
