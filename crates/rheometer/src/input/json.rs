@@ -375,11 +375,12 @@ pub fn parse_json(text: &str, path: &Path, remedy: &str) -> Result<Value, InputE
             "`{field}` = {token}: the number is out of the range of a 64-bit float (about \
              ±1.8e308)"
         )
-    } else if trail.steps.is_empty()
-        && !text.trim_start().starts_with([
-            '{', '[', '"', '-', 't', 'f', 'n', '0', '1', '2', '3', '4', '5', '6', '7', '8', '9',
-        ])
-    {
+    } else if trail.steps.is_empty() && {
+        let t = text.trim_start();
+        !(t.starts_with(['{', '[', '"', '-'])
+            || t.starts_with(|c: char| c.is_ascii_digit())
+            || ["true", "false", "null"].iter().any(|w| t.starts_with(w)))
+    } {
         format!(
             "not valid JSON, so no report of this program (it starts `{}`); give the file \
              `{remedy}` wrote",
