@@ -769,6 +769,9 @@ mod tests {
             "{e}"
         );
         let e = FitSummary::from_fit_or_diagnosis_json("{", "d.json").unwrap_err();
-        assert!(e.contains("d.json") && e.contains("ends early (truncated?)"), "{e}");
+        assert!(
+            e.contains("d.json") && e.contains("ends early (truncated?)"),
+            "{e}"
+        );
     }
 }
