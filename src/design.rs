@@ -3,6 +3,7 @@
 use crate::*;
 use rheometer::design::{Criterion, DesignRequest, DiscriminationRequest};
 use rheometer::effects::Effect;
+use rheometer::report_json::{to_report_json, ReportKind};
 use rheometer::workflow::request::{self, DesignRanges, Door};
 
 /// Arguments of `rheometer design`.
@@ -132,7 +133,11 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             ));
             let run = workflow::discriminate(&loaded, &fit_request, effects, &request)?;
             let d = &run.design;
-            (d.to_text(), serde_json::to_string_pretty(d)?, d.to_csv())
+            (
+                d.to_text(),
+                to_report_json(ReportKind::Discrimination, d)?,
+                d.to_csv(),
+            )
         }
         None => {
             let mut request = DesignRequest::new(grid, args.criterion);
@@ -145,7 +150,11 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             ));
             let run = workflow::design(&loaded, &fit_request, &request)?;
             let d = &run.design;
-            (d.to_text(), serde_json::to_string_pretty(d)?, d.to_csv())
+            (
+                d.to_text(),
+                to_report_json(ReportKind::Design, d)?,
+                d.to_csv(),
+            )
         }
     };
     outln!("{text}");

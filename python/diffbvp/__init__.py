@@ -32,7 +32,7 @@ from . import _native
 from .bvp import (BvpFitResult, BvpResult, CubicInterpolant, continue_bvp, fit_bvp, solve_bvp,
                   to_expression)
 from .errors import DiffbvpError, EvaluationError, FitError, InputError, SimulationError
-from .results import (Candidate, Comparison, Diagnosis, Estimate, FitResult, Landscape, Result,
+from .results import (Candidate, Comparison, DesignResult, Diagnosis, Estimate, FitResult, Landscape, Result,
                       SimulationResult)
 
 __all__ = [
@@ -43,6 +43,7 @@ __all__ = [
     "compare",
     "diagnose",
     "landscape",
+    "design",
     "DiffbvpError",
     "InputError",
     "SimulationError",
@@ -56,6 +57,7 @@ __all__ = [
     "Comparison",
     "Diagnosis",
     "Landscape",
+    "DesignResult",
     "Result",
     "solve_bvp",
     "fit_bvp",
@@ -240,13 +242,14 @@ def _effects(effects: Union[None, str, Iterable[str]]) -> List[str]:
     return [str(e) for e in effects]
 
 
-def simulate(dataset: Union[Dataset, PathLike], n: float = 0.8, kappa: float = 11.71, *,
+def simulate(dataset: Union[Dataset, PathLike], n: float, kappa: float, *,
              effects: Union[None, str, Iterable[str]] = None,
              take_up_diameter: Optional[float] = None, take_up_from_data: bool = False,
              points: int = 101, positions: Optional[Sequence[float]] = None,
              sensitivities: bool = False, tol: Optional[float] = None,
              max_nodes: Optional[int] = None) -> SimulationResult:
-    """Simulates every experiment with the Carreau-type law (n [-], kappa = ln(K / 1 Pa)).
+    """Simulates every experiment with the Carreau-type law (n [-], kappa = ln(K / 1 Pa); both
+    required: there is no default law).
 
     ``effects``: fixed effects, ``"radiation=0.9"``; ``take_up_diameter`` [m] or
     ``take_up_from_data`` for experiments without a take-up condition; ``points`` uniform
@@ -258,8 +261,9 @@ def simulate(dataset: Union[Dataset, PathLike], n: float = 0.8, kappa: float = 1
     pos = None if positions is None else [float(x) for x in np.asarray(positions, dtype=float).ravel()]
     d = _native.simulate(_ds(dataset), float(n), float(kappa), effects=_effects(effects),
                          take_up_diameter=take_up_diameter, take_up_from_data=take_up_from_data,
-                         points=points, positions=pos, sensitivities=sensitivities, tol=tol,
-                         max_nodes=max_nodes)
+                         points=_int(points, "points"), positions=pos,
+                         sensitivities=sensitivities, tol=tol,
+                         max_nodes=_opt_int(max_nodes, "max_nodes"))
     return SimulationResult(d)
 
 
@@ -295,8 +299,9 @@ def fit(dataset: Union[Dataset, PathLike], *, start: Optional[Tuple[float, float
     d = _native.fit(_ds(dataset), start=None if start is None else (float(start[0]), float(start[1])),
                     estimator=estimator, model=model, effects=_effects(effects), loss=loss,
                     f_scale=f_scale, relative_uncertainty=relative_uncertainty,
-                    error_budget=error_budget, tol=tol, max_nodes=max_nodes,
-                    profile_points=profile_points, start_from=_previous(start_from))
+                    error_budget=error_budget, tol=tol, max_nodes=_opt_int(max_nodes, "max_nodes"),
+                    profile_points=_int(profile_points, "profile_points"),
+                    start_from=_previous(start_from))
     result = FitResult._from_native(d)
     for note in result.notes:
         _warnings.warn(note, RuntimeWarning, stacklevel=2)
@@ -323,7 +328,8 @@ def compare(dataset: Union[Dataset, PathLike], fit: Optional[FitResult] = None, 
             notes.append(f"the fit carries a warning: [{w.get('code')}] {w.get('message')}")
     d = _native.compare(_ds(dataset), summary, n=n, kappa=kappa, newtonian=newtonian,
                         take_up_from_data=take_up_from_data, effects=_effects(effects),
-                        relative_uncertainty=relative_uncertainty, tol=tol, max_nodes=max_nodes)
+                        relative_uncertainty=relative_uncertainty, tol=tol,
+                        max_nodes=_opt_int(max_nodes, "max_nodes"))
     for w in notes:
         _warnings.warn(w, RuntimeWarning, stacklevel=2)
     return Comparison(d["comparison"], d["text"], notes)
@@ -353,8 +359,9 @@ def diagnose(dataset: Union[Dataset, PathLike], *, model: Optional[str] = None,
     to half a minute where two effects are missing (2 cores)."""
     d = _native.diagnose(_ds(dataset), model=model, effects=_effects(effects),
                          candidates=None if candidates is None else [str(c) for c in candidates],
-                         refit_top=refit_top, start=start, loss=loss, f_scale=f_scale, tol=tol,
-                         max_nodes=max_nodes, start_from=_previous(start_from))
+                         refit_top=_opt_int(refit_top, "refit_top"), start=start, loss=loss,
+                         f_scale=f_scale, tol=tol, max_nodes=_opt_int(max_nodes, "max_nodes"),
+                         start_from=_previous(start_from))
     return Diagnosis._from_native(d)
 
 
@@ -391,9 +398,87 @@ def landscape(dataset: Union[Dataset, PathLike], *, grid: Tuple[int, int] = (41,
     lowest are solved at ten times ``tol`` (at most 1e-3; their costs to a few 1e-4 relative),
     unless ``uniform_tol``; the result's ``point_tol`` array says which. Ctrl-C stops it between grid
     points (``KeyboardInterrupt``)."""
-    d = _native.landscape(_ds(dataset), grid=(int(grid[0]), int(grid[1])),
+    d = _native.landscape(_ds(dataset), grid=_grid(grid),
                           n_range=(float(n_range[0]), float(n_range[1])),
                           kappa_range=(float(kappa_range[0]), float(kappa_range[1])),
-                          estimator=estimator, tol=tol, max_nodes=max_nodes,
+                          estimator=estimator, tol=tol, max_nodes=_opt_int(max_nodes, "max_nodes"),
                           uniform_tol=bool(uniform_tol))
     return Landscape(d)
+
+
+def design(dataset: Union[Dataset, PathLike], *, template: Optional[str] = None,
+           mass_flow: Optional[Tuple[float, float]] = None,
+           stencil_velocity: Optional[Tuple[float, float]] = None,
+           take_up_diameter: Optional[Tuple[float, float]] = None,
+           take_up_velocity: Optional[Tuple[float, float]] = None,
+           grid: Tuple[int, int] = (9, 9), criterion: str = "d",
+           discriminate: Optional[Sequence[str]] = None,
+           start: Optional[Tuple[float, float]] = None, noise: Optional[float] = None,
+           tol: float = 1e-6, max_nodes: Optional[int] = None) -> DesignResult:
+    """Which experiment next, as ``rheometer design``: candidates on a ``grid`` of mass flows
+    (``mass_flow`` in kg/s, or ``stencil_velocity`` in mm/s) x take-up values
+    (``take_up_diameter`` in m, or ``take_up_velocity`` in m/s), each a ``(min, max)`` range
+    within the plausible ranges of the experiments file (default: from the data set), copies of
+    the experiment ``template``; ranked by ``criterion`` ("d": volume of the confidence region,
+    "a": mean variance, "e": worst direction) of (n, κ) after adding the candidate, or, with
+    ``discriminate=["mass_flow_scale", "nusselt_scale"]``, by how well it tells those rival
+    explanations apart. ``noise``: the relative measurement noise (default: the data set's
+    relative_uncertainty, else the fit's residual level). The result's dict is what
+    ``rheometer design --json`` writes.
+
+    >>> import diffbvp
+    >>> d = diffbvp.design("data/pmma7n_synthetic/experiments.toml", grid=(3, 3))  # doctest: +SKIP
+    >>> d.ranked[0]["candidate"]["mass_flow"]  # doctest: +SKIP
+    """
+    r = _native.design(_ds(dataset), template=template,
+                       mass_flow=_pair(mass_flow, "mass_flow"), stencil_velocity=_pair(stencil_velocity, "stencil_velocity"),
+                       take_up_diameter=_pair(take_up_diameter, "take_up_diameter"),
+                       take_up_velocity=_pair(take_up_velocity, "take_up_velocity"),
+                       grid=_grid(grid),
+                       criterion=criterion,
+                       discriminate=None if discriminate is None else [str(e) for e in discriminate],
+                       start=_pair(start, "start"), noise=noise, tol=tol,
+                       max_nodes=None if max_nodes is None else _int(max_nodes, "max_nodes"))
+    return DesignResult(r["design"], r["text"], r["csv"])
+
+
+def _pair(v: Optional[Sequence[float]], name: str) -> Optional[Tuple[float, float]]:
+    """A pair of floats for the argument ``name`` (or None)."""
+    if v is None:
+        return None
+    try:
+        a, b = v
+        return (float(a), float(b))
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected a pair of numbers, got {v!r}") from None
+
+
+def _int(v: Any, name: str) -> int:
+    """A whole number for the argument ``name`` (an int, or a float without a fraction); its
+    range is the library's to check, up to a size no count reaches."""
+    if isinstance(v, bool):
+        raise InputError(f"{name}: expected a whole number, got {v!r}")
+    if isinstance(v, (int, np.integer)):
+        i = int(v)
+    elif isinstance(v, (float, np.floating)) and float(v).is_integer():
+        i = int(v)
+    else:
+        raise InputError(f"{name}: expected a whole number, got {v!r}")
+    if abs(i) > 2**100:
+        raise InputError(f"{name}: {i} is far outside any accepted range")
+    return i
+
+
+def _grid(v: Any) -> Tuple[int, int]:
+    """The argument ``grid``: a pair of whole numbers."""
+    try:
+        a, b = v
+    except (TypeError, ValueError):
+        raise InputError(f"grid: expected a pair of whole numbers (N, M), got {v!r}") from None
+    return (_int(a, "grid"), _int(b, "grid"))
+
+
+def _opt_int(v: Any, name: str) -> Optional[int]:
+    """``None``, or a whole number for the argument ``name`` (see :func:`_int`)."""
+    return None if v is None else _int(v, name)
+

@@ -33,7 +33,7 @@ def fit(dataset: Dataset, *, start: Optional[Tuple[float, float]] = None, estima
         profile_points: int = 101, start_from: Optional[str] = None) -> Dict[str, Any]:
     """{"summary": FitSummary dict, "text": str, "arrays": {"residual_profiles", "profiles"},
     "notes": [str]}"""
-def simulate(dataset: Dataset, n: float = 0.8, kappa: float = 11.71, *, effects: Sequence[str] = ...,
+def simulate(dataset: Dataset, n: float, kappa: float, *, effects: Sequence[str] = ...,
              take_up_diameter: Optional[float] = None, take_up_from_data: bool = False,
              points: int = 101, positions: Optional[Sequence[float]] = None,
              sensitivities: bool = False, tol: Optional[float] = None,
@@ -53,6 +53,15 @@ def landscape(dataset: Dataset, *, grid: Tuple[int, int] = (41, 41),
               n_range: Tuple[float, float] = (0.0, 1.0), kappa_range: Tuple[float, float] = (9.0, 16.0),
               estimator: str = "paper", tol: float = 1e-4,
               max_nodes: Optional[int] = None, uniform_tol: bool = False) -> Dict[str, Any]: ...
+def design(dataset: Dataset, *, template: Optional[str] = None,
+           mass_flow: Optional[Tuple[float, float]] = None,
+           stencil_velocity: Optional[Tuple[float, float]] = None,
+           take_up_diameter: Optional[Tuple[float, float]] = None,
+           take_up_velocity: Optional[Tuple[float, float]] = None,
+           grid: Tuple[int, int] = (9, 9), criterion: str = "d",
+           discriminate: Optional[Sequence[str]] = None,
+           start: Optional[Tuple[float, float]] = None, noise: Optional[float] = None,
+           tol: float = 1e-6, max_nodes: Optional[int] = None) -> Dict[str, Any]: ...
 def library_version() -> str: ...
 def set_threads(n: Optional[int] = None) -> None: ...
 def threads() -> int: ...

@@ -2,7 +2,7 @@
 //! [`FitSummary`], read back from the dict `fit` returned) or of given law parameters against
 //! the measurements; the `Comparison` goes to Python through its serde JSON form.
 
-use crate::convert::{from_py, serde_to_py};
+use crate::convert::{from_py, report_to_py};
 use crate::dataset::Dataset;
 use crate::errors::{input_error, to_py_err};
 use crate::options;
@@ -10,6 +10,7 @@ use crate::run::interruptible;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::diagnostics::compare::MissingTakeUp;
+use rheometer::report_json::ReportKind;
 use rheometer::rheometer::FitSummary;
 use rheometer::workflow::{self, CompareRequest};
 
@@ -88,7 +89,10 @@ pub fn compare<'py>(
     let cmp =
         out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), Some(request.law)))?;
     let d = PyDict::new(py);
-    d.set_item("comparison", serde_to_py(py, &cmp)?)?;
+    d.set_item(
+        "comparison",
+        report_to_py(py, ReportKind::Comparison, &cmp)?,
+    )?;
     d.set_item("text", cmp.to_text())?;
     Ok(d)
 }

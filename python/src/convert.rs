@@ -39,14 +39,19 @@ pub fn to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
     })
 }
 
-/// A serialisable value as a Python object through its JSON form.
-pub fn serde_to_py<'py, T: serde::Serialize>(
+/// A report as the dict the `rheometer` program writes with `--json`: the stamp of `kind`
+/// (schema version, report kind, program version) first, then the report's fields; so that a
+/// dict saved from Python is a file the program reads.
+pub fn report_to_py<'py, T: serde::Serialize>(
     py: Python<'py>,
+    kind: rheometer::report_json::ReportKind,
     v: &T,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let value = serde_json::to_value(v).map_err(|e| {
+    let fail = |e: serde_json::Error| {
         crate::errors::diffbvp_error(py, "DiffbvpError", format!("cannot convert a result: {e}"))
-    })?;
+    };
+    let text = rheometer::report_json::to_report_json(kind, v).map_err(fail)?;
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(fail)?;
     to_py(py, &value)
 }
 

@@ -2,7 +2,7 @@
 //! [`workflow::design`] and [`workflow::discriminate`]); the design goes to Python through
 //! the same serde JSON form `rheometer design --json` writes.
 
-use crate::convert::serde_to_py;
+use crate::convert::report_to_py;
 use crate::dataset::Dataset;
 use crate::errors::{input_error, to_py_err};
 use crate::options;
@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::design::{Criterion, DesignRequest, DiscriminationRequest};
 use rheometer::effects::Effect;
+use rheometer::report_json::ReportKind;
 use rheometer::rheometer::{Estimator, IdentifyOptions};
 use rheometer::workflow::request::{self, DesignRanges};
 use rheometer::workflow::{self, FitRequest};
@@ -95,7 +96,10 @@ pub fn design<'py>(
                 workflow::discriminate(loaded, &fit_request, &effects, &request)
             })?;
             let run = out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), None))?;
-            d.set_item("design", serde_to_py(py, &run.design)?)?;
+            d.set_item(
+                "design",
+                report_to_py(py, ReportKind::Discrimination, &run.design)?,
+            )?;
             d.set_item("text", run.design.to_text())?;
             d.set_item("csv", run.design.to_csv())?;
         }
@@ -108,7 +112,7 @@ pub fn design<'py>(
                 workflow::design(loaded, &fit_request, &request)
             })?;
             let run = out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), None))?;
-            d.set_item("design", serde_to_py(py, &run.design)?)?;
+            d.set_item("design", report_to_py(py, ReportKind::Design, &run.design)?)?;
             d.set_item("text", run.design.to_text())?;
             d.set_item("csv", run.design.to_csv())?;
         }

@@ -5,7 +5,7 @@
 //!
 //! [`Diagnosis`]: rheometer::diagnostics::diagnosis::Diagnosis
 
-use crate::convert::serde_to_py;
+use crate::convert::report_to_py;
 use crate::dataset::Dataset;
 use crate::errors::{input_error, to_py_err};
 use crate::fit::identification_arrays;
@@ -15,6 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::diagnostics::diagnose::DiagnoseOptions;
 use rheometer::effects::{Effect, ModelSpec};
+use rheometer::report_json::ReportKind;
 use rheometer::workflow::{
     self,
     request::{self, Arg},
@@ -95,7 +96,10 @@ pub fn diagnose<'py>(
     })?;
     let run = out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), None))?;
     let d = PyDict::new(py);
-    d.set_item("diagnosis", serde_to_py(py, &run.diagnosis.json())?)?;
+    d.set_item(
+        "diagnosis",
+        report_to_py(py, ReportKind::Diagnosis, &run.diagnosis.json())?,
+    )?;
     d.set_item("text", run.diagnosis.to_text())?;
     d.set_item("base_arrays", identification_arrays(py, &run.base, None)?)?;
     match &run.best {

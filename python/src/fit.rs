@@ -2,7 +2,7 @@
 //! (`FitRun::summary`), goes to Python through its serde JSON form, with the arrays a notebook
 //! plots besides (residuals at the measurement positions, fitted profiles).
 
-use crate::convert::{array1, serde_to_py};
+use crate::convert::{array1, report_to_py};
 use crate::dataset::Dataset;
 use crate::errors::to_py_err;
 use crate::options;
@@ -10,6 +10,7 @@ use crate::run::interruptible;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::effects::{LawChoice, ModelSpec};
+use rheometer::report_json::ReportKind;
 use rheometer::rheometer::{Identification, IdentifyOptions, Rheometer};
 use rheometer::workflow::request::{self, Arg};
 use rheometer::workflow::{self, FitRequest};
@@ -142,7 +143,7 @@ pub fn fit<'py>(
     })?;
     let run = out.map_err(|e| to_py_err(py, Box::new(e), Some((loaded, path)), None))?;
     let d = PyDict::new(py);
-    d.set_item("summary", serde_to_py(py, run.summary())?)?;
+    d.set_item("summary", report_to_py(py, ReportKind::Fit, run.summary())?)?;
     d.set_item("text", run.summary().to_text())?;
     d.set_item(
         "arrays",

@@ -3,7 +3,7 @@
 //! Each function checks its arguments as the `rheometer` program checks its flags, calls the
 //! library's workflow ([`rheometer::workflow`]: fit, simulate, compare, diagnose, design,
 //! landscape) and hands its result to Python through the result's serde JSON form (one path:
-//! [`convert::serde_to_py`]; dicts, lists, floats) plus numpy arrays for array-valued data;
+//! [`convert::report_to_py`]; dicts, lists, floats) plus numpy arrays for array-valued data;
 //! the Python result classes in `python/diffbvp/` wrap those dicts. Long calls run with the GIL released and stop
 //! on Ctrl-C ([`run`]). Errors become `diffbvp.errors` exceptions with the CLI's messages
 //! ([`errors`]).
