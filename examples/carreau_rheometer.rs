@@ -10,8 +10,8 @@
 use diffbvp::mesh::linspace;
 use indicatif::{ProgressBar, ProgressStyle};
 use rheometer::figures::{identification_figures, landscape_map};
+use rheometer::fit::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
 use std::path::{Path, PathBuf};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -77,7 +77,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sweep.inc(1);
         let a = rheometer.identify([n0, k0], &principled);
         let b = rheometer.identify([n0, k0], &paper);
-        let cell = |r: &Result<rheometer::rheometer::Identification, _>| match r {
+        let cell = |r: &Result<rheometer::fit::Identification, _>| match r {
             Ok(i) => format!(
                 "{:>8.4} {:>8.4} {:>5} {:>8.3}",
                 i.law()[0],

@@ -13,8 +13,8 @@
 //! from a SplitMix64 stream seeded with `seed` (default 1). Prints the planned cost, the
 //! progress on stderr, then the estimate with its standard errors and the time of each phase.
 
+use rheometer::fit::{FitProgress, IdentifyOptions, ProgressHook, Rheometer};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{FitProgress, IdentifyOptions, ProgressHook, Rheometer};
 use rheometer::setup::{ExperimentSet, Measurements};
 use rheometer::synthetic::{NoiseModel, SplitMix64};
 use std::error::Error;

@@ -14,8 +14,8 @@
 use rheometer::diagnostics::compare::FigureFormat;
 use rheometer::diagnostics::diagnose::DiagnoseOptions;
 use rheometer::effects::{EffectSetting, ModelSpec};
+use rheometer::fit::IdentifyOptions;
 use rheometer::input::load_experiments_with;
-use rheometer::rheometer::IdentifyOptions;
 use rheometer::workflow::{self, CompareRequest, FitRequest};
 use std::error::Error;
 use std::path::{Path, PathBuf};

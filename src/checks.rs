@@ -4,8 +4,8 @@
 
 use rheometer::effects::Effect;
 use rheometer::failure_hints::ExperimentFailure;
+use rheometer::fit::{IdentifyOptions, LandscapeSample};
 use rheometer::input::{parse_experiments, Location};
-use rheometer::rheometer::{IdentifyOptions, LandscapeSample};
 use std::error::Error;
 use std::path::Path;
 
@@ -235,7 +235,7 @@ pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, String> {
 }
 
 /// The estimate of a landscape's run time, from its sample rows (computed and timed exactly as
-/// the landscape computes its rows, [`Rheometer::landscape_sample`](rheometer::rheometer::Rheometer::landscape_sample); the run keeps them):
+/// the landscape computes its rows, [`Rheometer::landscape_sample`](rheometer::fit::Rheometer::landscape_sample); the run keeps them):
 /// "landscape: 441 points on 2 threads, about 16 s (measured on 3 of its 21 rows, 1.5 s in
 /// all: about 0.65 s per row of 21 points)". `grid` is (n values, κ values), `sample_s` the
 /// wall time the sample took.

@@ -9,6 +9,10 @@ use rheometer::diagnostics::report::save_residual_figure;
 use rheometer::effects::{EffectSetting, LawChoice, ModelSpec};
 use rheometer::failure_hints::ExperimentFailure;
 use rheometer::figures::{self, ExperimentView, ModelCurves, View};
+use rheometer::fit::{
+    DataCheck, Estimator, FarRule, FitSummary, IdentifyOptions, LandscapeRun, PointStatus,
+    Rheometer,
+};
 use rheometer::flow_curve_figure::save_flow_curve_figure;
 use rheometer::input::{
     load_experiments_with_options, InputError, LoadOptions, LoadedExperiments,
@@ -17,10 +21,6 @@ use rheometer::input::{
 use rheometer::output::write_profiles_csv;
 use rheometer::output_files::{CheckedOutputs, PARTIAL_NAME};
 use rheometer::report_json::{to_report_json, ReportKind};
-use rheometer::rheometer::{
-    DataCheck, Estimator, FarRule, FitSummary, IdentifyOptions, LandscapeRun, PointStatus,
-    Rheometer,
-};
 use rheometer::workflow::{self, CompareRequest, FitRequest, FitRun};
 use rheometer::{FiberSolution, SimulateOptions};
 use std::error::Error;

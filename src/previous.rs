@@ -2,7 +2,7 @@
 //! a fit continues from, its effects joined with the ones `--with` adds.
 
 use crate::*;
-use rheometer::rheometer::ContinuedEffects;
+use rheometer::fit::ContinuedEffects;
 
 /// A previous result `fit --from` or `diagnose --from` continues from.
 pub struct Previous {

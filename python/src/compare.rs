@@ -10,8 +10,8 @@ use crate::run::interruptible;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::diagnostics::compare::MissingTakeUp;
+use rheometer::fit::FitSummary;
 use rheometer::report_json::ReportKind;
-use rheometer::rheometer::FitSummary;
 use rheometer::workflow::{self, CompareRequest};
 
 /// How a fit given from Python is named in messages.

@@ -11,8 +11,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::design::{Criterion, DesignRequest, DiscriminationRequest};
 use rheometer::effects::Effect;
+use rheometer::fit::{Estimator, IdentifyOptions};
 use rheometer::report_json::ReportKind;
-use rheometer::rheometer::{Estimator, IdentifyOptions};
 use rheometer::workflow::request::{self, DesignRanges};
 use rheometer::workflow::{self, FitRequest};
 

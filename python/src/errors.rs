@@ -8,8 +8,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyType;
 use rheometer::diagnostics::compare::CompareError;
 use rheometer::failure_hints::{failed_experiment, name_experiment, ExperimentFailure};
+use rheometer::fit::RheometerError;
 use rheometer::input::{InputError, LoadedExperiments};
-use rheometer::rheometer::RheometerError;
 use std::error::Error;
 use std::path::Path;
 

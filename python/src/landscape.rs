@@ -10,7 +10,7 @@ use crate::run::interruptible;
 use diffbvp::mesh::linspace;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rheometer::rheometer::{FarRule, IdentifyOptions, PointStatus};
+use rheometer::fit::{FarRule, IdentifyOptions, PointStatus};
 use rheometer::workflow::request::{self, Arg};
 use rheometer::workflow::{self, LandscapeRequest};
 

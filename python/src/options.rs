@@ -5,7 +5,7 @@ use crate::errors::input_error;
 use diffbvp::least_squares::Loss;
 use pyo3::prelude::*;
 use rheometer::effects::{EffectSetting, LawChoice};
-use rheometer::rheometer::{Estimator, FitSummary, IdentifyOptions};
+use rheometer::fit::{Estimator, FitSummary, IdentifyOptions};
 
 pub use rheometer::workflow::request::MAX_POINTS;
 use rheometer::workflow::request::{self, Arg, Door, Refusal};

@@ -9,8 +9,8 @@
 
 use std::path::{Path, PathBuf};
 
+use rheometer::fit::{IdentifyOptions, Rheometer};
 use rheometer::input::{load_experiments, parse_experiments, parse_measurements};
-use rheometer::rheometer::{IdentifyOptions, Rheometer};
 use rheometer::setup::{ExperimentSet, Inlet};
 
 fn shipped() -> PathBuf {

@@ -23,7 +23,7 @@ use independent::dataset::{Expected, Faults, Scenario};
 use independent::scenarios;
 use rheometer::diagnostics::detection::DetectionLimit;
 use rheometer::diagnostics::diagnose::{earns_its_place, DiagnoseOptions, Diagnosis};
-use rheometer::rheometer::FitSummary;
+use rheometer::fit::FitSummary;
 use std::sync::OnceLock;
 
 /// Generates, loads and diagnoses `sc`.

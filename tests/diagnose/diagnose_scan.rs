@@ -7,8 +7,8 @@
 use diffbvp::DualNum;
 use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, StrengthStatus};
 use rheometer::effects::{LawChoice, ModelSpec};
+use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
 use rheometer::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
 use rheometer::simulate::simulate_params;
 use rheometer::synthetic::{NoiseModel, SplitMix64};

@@ -17,7 +17,7 @@ use rheometer::diagnostics::candidate::earns_its_place;
 use rheometer::diagnostics::diagnose::verdict::Verdict;
 use rheometer::diagnostics::diagnose::{DiagnoseOptions, DiagnosisRun};
 use rheometer::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
-use rheometer::rheometer::{FitStart, Rheometer};
+use rheometer::fit::{FitStart, Rheometer};
 use rheometer::setup::ExperimentSet;
 use std::time::Instant;
 
@@ -594,13 +594,13 @@ fn control_with_a_noisy_take_up_names_nothing() {
 fn law_outcome(r: &DiagnosisRun, sc: &Scenario) -> (&'static str, f64) {
     let d = &r.diagnosis;
     let fit = d.law_fit();
-    let z = |e: &rheometer::rheometer::Estimate, truth: f64| (e.value - truth).abs() / e.stderr;
+    let z = |e: &rheometer::fit::Estimate, truth: f64| (e.value - truth).abs() / e.stderr;
     let worst = z(&fit.n, sc.law.n).max(z(&fit.kappa, sc.law.kappa));
     let flagged = !d.law_is_a_result()
         || fit
             .warnings
             .iter()
-            .any(|w| w.code == rheometer::rheometer::WarningCode::Implausible);
+            .any(|w| w.code == rheometer::fit::WarningCode::Implausible);
     if let Verdict::Ambiguous {
         n_range,
         kappa_range,

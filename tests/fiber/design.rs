@@ -16,8 +16,8 @@ use rheometer::design::{
     design_for_estimation, CandidateGrid, CandidateOutcome, Criterion, Design, DesignRequest,
     TakeUpAxis,
 };
+use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments_with;
-use rheometer::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
 use rheometer::setup::{Experiment, ExperimentSet};
 use std::time::Instant;
 

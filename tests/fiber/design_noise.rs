@@ -24,8 +24,8 @@ use rheometer::design::{
     design_for_estimation, noise_level, CandidateGrid, CandidateOutcome, Criterion, Design,
     DesignRequest, TakeUpAxis,
 };
+use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments_with;
-use rheometer::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
 use rheometer::setup::{Experiment, ExperimentSet, Measurements};
 use std::time::Instant;
 

@@ -27,8 +27,8 @@ use rheometer::design::{
     TakeUpAxis,
 };
 use rheometer::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments_with;
-use rheometer::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer};
 use rheometer::setup::{Experiment, ExperimentSet};
 use rheometer::simulate::{simulate_params, SimulateOptions};
 use std::time::Instant;

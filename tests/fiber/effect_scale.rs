@@ -11,8 +11,8 @@ use crate::independent;
 use diffbvp::least_squares::Termination;
 use independent::scenarios;
 use rheometer::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::fit::{FitStart, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{FitStart, IdentifyOptions, Rheometer};
 
 #[test]
 fn a_far_co_flow_start_reaches_the_optimum_of_the_truth_start() {
@@ -36,7 +36,7 @@ fn a_far_co_flow_start_reaches_the_optimum_of_the_truth_start() {
     };
     let truth = rh.identify_from(&start(150.0, 0.08), &opts).unwrap();
     let far = rh.identify_from(&start(10.0, 0.05), &opts).unwrap();
-    let strength = |id: &rheometer::rheometer::Identification| {
+    let strength = |id: &rheometer::fit::Identification| {
         id.names
             .iter()
             .position(|n| n == "air_coflow")

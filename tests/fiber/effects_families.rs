@@ -10,8 +10,8 @@
 use diffbvp::sensitivity::{residual_jacobian, Sensitivities};
 use diffbvp::{Guess, SolveOptions, Solver};
 use rheometer::effects::{Category, Effect, EffectSetting, ModelSpec, ALL_NAMES, BUILTIN_NAMES};
-use rheometer::rheometer::estimator::RelativeResidual;
-use rheometer::rheometer::{FitStart, FitSummary, IdentifyOptions, Layout, Rheometer};
+use rheometer::fit::estimator::RelativeResidual;
+use rheometer::fit::{FitStart, FitSummary, IdentifyOptions, Layout, Rheometer};
 use rheometer::setup::{Air, Experiment, ExperimentSet, Inlet, Material, Measurements};
 use rheometer::simulate::simulate_params;
 use rheometer::synthetic::{NoiseModel, SplitMix64};

@@ -15,12 +15,12 @@
 use crate::probe;
 
 use rheometer::effects::{Effect, EffectSetting, ModelSpec};
-use rheometer::input::{load_experiments_with, parse_experiments, LoadedExperiments};
-use rheometer::rheometer::summary_checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
-use rheometer::rheometer::{
+use rheometer::fit::summary::checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
+use rheometer::fit::{
     error_budget, ErrorBudget, Identification, IdentifyOptions, Rheometer, SourceStatus,
     WarningCode,
 };
+use rheometer::input::{load_experiments_with, parse_experiments, LoadedExperiments};
 use rheometer::setup::{ExperimentSet, Inlet};
 use rheometer::uncertainty::{Origin, Scope, Uncertainties};
 use serde_json::Value;
@@ -41,7 +41,7 @@ fn fit(set: &ExperimentSet, start: [f64; 2]) -> (Rheometer, Identification) {
     (rh, id)
 }
 
-fn entry<'a>(b: &'a ErrorBudget, key: &str) -> &'a rheometer::rheometer::BudgetEntry {
+fn entry<'a>(b: &'a ErrorBudget, key: &str) -> &'a rheometer::fit::BudgetEntry {
     b.sources.iter().find(|e| e.key == key).unwrap()
 }
 
@@ -325,7 +325,7 @@ fn totals_are_root_sum_squares_and_warnings_follow_the_statistical_error() {
         }
     }
     // the systematic total is the root-sum-square of the shifts
-    let rss = |f: fn(&rheometer::rheometer::BudgetEntry) -> Option<f64>| {
+    let rss = |f: fn(&rheometer::fit::BudgetEntry) -> Option<f64>| {
         b.sources
             .iter()
             .filter_map(f)

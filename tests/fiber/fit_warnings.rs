@@ -10,10 +10,8 @@
 
 use crate::probe;
 
+use rheometer::fit::{BoundSide, Estimator, FitSummary, IdentifyOptions, Rheometer, WarningCode};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{
-    BoundSide, Estimator, FitSummary, IdentifyOptions, Rheometer, WarningCode,
-};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::time::Duration;

@@ -9,10 +9,10 @@
 use crate::independent::rng::Rng;
 use crate::independent::scenarios;
 use rheometer::effects::LawChoice;
+use rheometer::fit::{BandMethod, FitSummary, IdentifyOptions};
 use rheometer::flow_curve_figure::save_flow_curve_figure;
 use rheometer::format::{fmt_pm, LINE_WIDTH};
 use rheometer::input::{load_experiments_with, LoadedExperiments};
-use rheometer::rheometer::{BandMethod, FitSummary, IdentifyOptions};
 use rheometer::workflow::{fit, FitRequest, FitRun};
 use std::path::Path;
 use std::time::Duration;

@@ -7,8 +7,8 @@
 
 use diffbvp::GrowthLimit;
 use rheometer::diagnostics::scan::{ScanOptions, REFINE_GROWTH_LIMIT};
+use rheometer::fit::{Identification, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{Identification, IdentifyOptions, Rheometer};
 use std::path::Path;
 
 fn fit(rh: &Rheometer, limit: Option<GrowthLimit>) -> Identification {

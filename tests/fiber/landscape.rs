@@ -2,8 +2,8 @@
 //! warm starts change the path to a point, not the point's cost), its minimum lies next to the
 //! truth of the synthetic data, and the strongly strain-thinning corner is marked missing.
 
+use rheometer::fit::{Estimator, FarRule, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{Estimator, FarRule, IdentifyOptions, Rheometer};
 use std::path::Path;
 
 #[test]
@@ -60,7 +60,7 @@ fn strongly_strain_thinning_corner_is_missing() {
 /// included), and its progress starts at the sample's points.
 #[test]
 fn a_landscape_keeps_its_sample_rows_unchanged() {
-    use rheometer::rheometer::PointStatus;
+    use rheometer::fit::PointStatus;
     use std::sync::atomic::AtomicBool;
     let set = load_experiments(Path::new("data/pmma7n_synthetic/experiments.toml")).unwrap();
     let rh = Rheometer::new(&set).unwrap();
@@ -95,7 +95,7 @@ fn a_landscape_keeps_its_sample_rows_unchanged() {
 /// less than 1e-3 relative.
 #[test]
 fn far_points_are_solved_looser_and_the_rest_as_with_one_tolerance() {
-    use rheometer::rheometer::PointStatus;
+    use rheometer::fit::PointStatus;
     use std::sync::atomic::AtomicBool;
     assert_eq!(FarRule::for_tol(1e-4).tol, 1e-3);
     assert_eq!(FarRule::for_tol(1e-6).tol, 1e-5);

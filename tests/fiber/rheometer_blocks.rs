@@ -3,9 +3,9 @@
 //! dense driver lands, for the linear and a robust loss.
 
 use diffbvp::least_squares::{fit, Accuracy, FitOptions, FitResult, LeastSquaresProblem, Loss};
+use rheometer::fit::objective::Objective;
+use rheometer::fit::{Estimator, FitStart, IdentifyOptions, Rheometer, RheometerError};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::objective::Objective;
-use rheometer::rheometer::{Estimator, FitStart, IdentifyOptions, Rheometer, RheometerError};
 use std::path::Path;
 
 fn rheometer() -> Rheometer {
@@ -107,7 +107,7 @@ fn block_fit_of_the_shipped_experiments_is_the_dense_fit() {
 
 #[test]
 fn progress_is_reported_and_the_plan_is_the_fit_size() {
-    use rheometer::rheometer::{FitProgress, ProgressHook};
+    use rheometer::fit::{FitProgress, ProgressHook};
     use std::sync::{Arc, Mutex};
     let rh = rheometer();
     let start = [0.5, 11.51];

@@ -1,7 +1,7 @@
 //! Acceptance of the rheometer on the shipped synthetic data (truth (n, κ) = (0.8, 11.71)).
 
+use rheometer::fit::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
 use rheometer::synthetic::NoiseModel;
 use std::path::Path;
 

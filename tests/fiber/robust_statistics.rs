@@ -7,9 +7,9 @@
 
 use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem, Loss};
 use rheometer::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
+use rheometer::fit::{FitSummary, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments;
 use rheometer::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
-use rheometer::rheometer::{FitSummary, IdentifyOptions, Rheometer};
 use rheometer::setup::{ExperimentSet, TakeUp};
 use rheometer::synthetic::{NoiseModel as SyntheticNoise, SplitMix64};
 use rheometer::Physics;
@@ -406,7 +406,7 @@ fn a_robust_loss_with_the_paper_estimator_or_a_bad_margin_is_refused() {
     let rh = Rheometer::new(&shipped()).unwrap();
     let paper = IdentifyOptions {
         loss: Loss::Huber,
-        ..IdentifyOptions::with_estimator(rheometer::rheometer::Estimator::Paper)
+        ..IdentifyOptions::with_estimator(rheometer::fit::Estimator::Paper)
     };
     let e = rh.identify(TRUTH, &paper).unwrap_err().to_string();
     assert!(e.contains("principled"), "{e}");

@@ -4,8 +4,8 @@
 //! more than 1e-4 of the standard errors against a fit with every solve at the tight tolerance.
 
 use rheometer::effects::{Effect, EffectSetting, ModelSpec};
+use rheometer::fit::{Estimator, Identification, IdentifyOptions, Rheometer};
 use rheometer::input::load_experiments;
-use rheometer::rheometer::{Estimator, Identification, IdentifyOptions, Rheometer};
 use std::path::Path;
 
 fn fit(rh: &Rheometer, loose: Option<f64>) -> Identification {
@@ -119,7 +119,7 @@ fn accuracy_matched_to_the_noise_moves_no_estimate_by_a_hundredth_of_a_standard_
             "{label}: recorded shift {}",
             sv.discretisation_shift_se
         );
-        let nodes = |s: &rheometer::rheometer::SolverRecord| s.nodes.iter().sum::<usize>();
+        let nodes = |s: &rheometer::fit::SolverRecord| s.nodes.iter().sum::<usize>();
         assert!(
             nodes(sv) < nodes(&reference.summary.solver),
             "{label}: {} nodes at tol {:.0e} vs {} at 1e-8",

@@ -11,8 +11,8 @@
 
 use super::diagnostics::compare::CompareError;
 use super::error::FiberError;
+use super::fit::RheometerError;
 use super::input::{LoadedExperiments, Location};
-use super::rheometer::RheometerError;
 use super::setup::{Experiment, Inlet, Material, TakeUp};
 use diffbvp::error::BvpError;
 use std::error::Error;

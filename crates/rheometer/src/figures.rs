@@ -7,8 +7,8 @@
 //! [`ensure_not_input`]); the format follows the extension (`.png` or `.svg`), and a function
 //! given a format writes that format. Residual panels carry the noise band (shaded `±2σ`).
 
+use super::fit::{Identification, Landscape, Rheometer, RheometerError};
 use super::output::{ensure_not_input, OutputError};
-use super::rheometer::{Identification, Landscape, Rheometer, RheometerError};
 use super::simulate::FiberSolution;
 use super::simulate::Profiles;
 use super::smoothing::SmoothFit;

@@ -1,6 +1,6 @@
 //! The HTML report of a fit ([`fit_report_page`]): one self-contained page a rheologist can
 //! keep, print or mail, rendered from the values of a finished fit (its [`FitSummary`] with
-//! the [`FlowCurve`](crate::rheometer::FlowCurve), the experiments' names, data files
+//! the [`FlowCurve`](crate::fit::FlowCurve), the experiments' names, data files
 //! and point counts, and optionally the relative residuals); nothing is refitted.
 //!
 //! The page (built with the generic [`crate::html_page`], which escapes every text and forbids
@@ -18,12 +18,12 @@
 use std::path::{Path, PathBuf};
 
 use crate::figures::{residuals_svg, ResidualView};
+use crate::fit::summary::text::{fmt_interval, unit_suffix};
+use crate::fit::{BandMethod, Estimate, FitSummary};
 use crate::flow_curve_figure::flow_curve_figure_svg;
 use crate::format::{fmt_e, fmt_g, fmt_pm, fmt_sig};
 use crate::html_page::{HtmlPage, Table, Tone};
 use crate::input::LoadedExperiments;
-use crate::rheometer::summary_text::{fmt_interval, unit_suffix};
-use crate::rheometer::{BandMethod, Estimate, FitSummary};
 
 /// The name of the report in a `fit --out` directory.
 pub const FIT_REPORT_HTML: &str = "fit_report.html";
@@ -323,7 +323,7 @@ fn flow_curve_section(page: &mut HtmlPage, s: &FitSummary) {
         match c.band {
             BandMethod::Delta => "its statistical 95 % band (delta method)",
             BandMethod::Profile => "its statistical 95 % band (along the likelihood profile)",
-            BandMethod::None => crate::rheometer::summary_text::NO_BAND,
+            BandMethod::None => crate::fit::summary::text::NO_BAND,
         },
         if c.systematic {
             " and the band with the systematic uncertainty of the error budget"
@@ -402,7 +402,7 @@ fn fit_section(page: &mut HtmlPage, input: &FitReportInput<'_>) {
         s.solver.termination
     ));
     page.paragraph(lines.join("\n"));
-    let take_up = s.estimator == crate::rheometer::Estimator::Principled;
+    let take_up = s.estimator == crate::fit::Estimator::Principled;
     let mut header = vec!["experiment", "data file", "points", "RMS residual / %"];
     if take_up {
         header.push("take-up factor");
@@ -483,8 +483,8 @@ fn inputs_section(page: &mut HtmlPage, input: &FitReportInput<'_>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rheometer::summary::tests::example;
-    use crate::rheometer::{AtBound, BoundSide, FitWarning, FlowCurve, FlowPoint, WarningCode};
+    use crate::fit::summary::tests::example;
+    use crate::fit::{AtBound, BoundSide, FitWarning, FlowCurve, FlowPoint, WarningCode};
 
     /// A flow curve of five points, the middle three covered by the data.
     fn curve() -> FlowCurve {

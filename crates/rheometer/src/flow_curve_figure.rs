@@ -6,9 +6,9 @@
 //! value alone, as a file ([`save_flow_curve_figure`]) or as SVG text for an HTML report
 //! ([`flow_curve_figure_svg`]): the two are the same drawing.
 
+use crate::fit::{BandMethod, FlowCurve, FlowPoint};
 use crate::format::fmt_g;
 use crate::plot::{flow_curve_svg, save_flow_curve, FlowCurvePlot, PlotError, ReferencePoints};
-use crate::rheometer::{BandMethod, FlowCurve, FlowPoint};
 use std::path::Path;
 
 /// Size of the figure \[px\].

@@ -23,7 +23,7 @@
 //! * [`profile_sensitivities`]: exact derivatives of the SI profiles with respect to the law
 //!   parameters and the effects' strengths;
 //! * [`smoothing`]: the velocity-ansatz smoothing of measured diameters (paper eq. 5);
-//! * [`rheometer`]: identification of the elongational viscosity from diameter profiles;
+//! * [`fit`]: identification of the elongational viscosity from diameter profiles;
 //! * [`figures`]: profile, fit and landscape figures (PNG/SVG);
 //! * [`flow_curve_figure`]: the flow curve `η_E(ε̇)` with its bands (PNG/SVG);
 //! * [`fit_html`]: the HTML report of a fit (self-contained page, from the fit's values);
@@ -46,6 +46,8 @@
 //! 0. `plot`, `html_page`, `output_files` (the output layer: checks of every output before the
 //!    work, temporary-then-rename writing of regular files, special files written in place);
 //! 1. `setup`, `error`, `scaling`, `material_law`, `format` (numbers for people), `serde_nan`,
+//!    `report_json` (the stamp of every JSON report: schema version, kind, program),
+//!    `environment` (the `DIFFBVP_*` variables and the thread count, checked),
 //!    `in_order` (the first failure of a parallel loop in the experiments' order);
 //! 2. `catalog` (one descriptor per effect), `contributions` (force and heat terms) and
 //!    `effects` (the candidate effects vocabulary);
@@ -53,12 +55,12 @@
 //! 4. `cold_start`, `simulate`, `profile_sensitivities`;
 //! 5. `smoothing`, `synthetic`, `input`, `output`, `statistics`, `noise_model`,
 //!    `noise_summary` (the one noise level), `take_up`, `uncertainty`;
-//! 6. `rheometer` (inside, bottom to top: `estimator` → `options` → `data`, `layout`,
-//!    `parameter_shift` and the values `thresholds`, `budget`, `curve`, `likelihood` →
-//!    `coverage`, `objective`, `plan`, `landscape` → the value `summary` → what reads it
-//!    (`summary_checks`, `summary_text`, `summary_read`) → `summary_build`, `identification` →
-//!    `accuracy` → `identify` → `nested`, `profile`, `flow_curve`, `error_budget` →
-//!    `summary_finding`);
+//! 6. `fit` (the identification; inside, bottom to top: `estimator` → `options` → `data`,
+//!    `layout`, `parameter_shift` and the values `thresholds`, `budget`, `curve`,
+//!    `likelihood` → `coverage`, `objective`, `plan`, `landscape` → `summary` (the record of a
+//!    fit: the value, then what reads it, `checks`, `text`, `read`, then `build`),
+//!    `identification` → `accuracy` → `identify` → `nested`, `profile`, `flow_curve`,
+//!    `error_budget` → `summary::finding`);
 //! 7. `figures`, `flow_curve_figure`, `fit_html` (the HTML report of a fit);
 //! 8. `diagnostics` (`compare`, `candidate` → `ties`, `calibration`, `diagnose` (its stages),
 //!    `diagnosis`, `report`);
@@ -79,6 +81,7 @@ pub mod environment;
 pub mod error;
 pub mod failure_hints;
 pub mod figures;
+pub mod fit;
 pub mod fit_html;
 pub mod flow_curve_figure;
 pub mod format;
@@ -94,7 +97,6 @@ pub mod output_files;
 pub mod plot;
 pub mod profile_sensitivities;
 pub mod report_json;
-pub mod rheometer;
 pub mod scaling;
 pub(crate) mod serde_nan;
 pub mod setup;

@@ -238,7 +238,7 @@ fn merge_bins(counts: &[usize], min_count: usize) -> Vec<usize> {
 impl NoiseModel {
     /// The model of `(positions [m], residuals [-])` per experiment (names `#1`, `#2`, …; no
     /// diameters; `L` = last position). The call the diagnosis uses with
-    /// [`Identification::residual_profiles`](crate::rheometer::Identification::residual_profiles).
+    /// [`Identification::residual_profiles`](crate::fit::Identification::residual_profiles).
     pub fn from_profiles(
         profiles: &[(Vec<f64>, Vec<f64>)],
         options: &NoiseOptions,

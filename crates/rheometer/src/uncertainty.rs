@@ -4,7 +4,7 @@
 //! whose strength represents it, in that effect's descriptor.
 //!
 //! The data cannot identify these quantities; the
-//! [error budget](crate::rheometer::error_budget()) propagates their uncertainties through
+//! [error budget](crate::fit::error_budget()) propagates their uncertainties through
 //! the exact sensitivities into `(n, κ, K)` as a systematic uncertainty beside the statistical
 //! one.
 //!

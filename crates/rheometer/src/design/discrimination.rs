@@ -25,13 +25,13 @@
 //! The noise level is the one of the first rival's fit ([`FitSummary`]'s noise, declared or
 //! estimated by the noise model), unless given.
 //!
-//! [`FitSummary`]: crate::rheometer::FitSummary
+//! [`FitSummary`]: crate::fit::FitSummary
 
 use super::candidates::{Candidate, CandidateGrid};
 use super::estimation::{candidate_information, candidate_positions, shared_columns};
 use super::information::{experiment_information, Columns, ExperimentInformation};
+use crate::fit::{Identification, Rheometer, RheometerError};
 use crate::in_order::CollectInOrder;
-use crate::rheometer::{Identification, Rheometer, RheometerError};
 use crate::simulate::SimulateOptions;
 use diffbvp::solution::Solution;
 use nalgebra::{DMatrix, DVector};

@@ -11,11 +11,11 @@
 use super::candidates::{Candidate, CandidateGrid};
 use super::criteria::{sandwich, Criterion, Prediction, Reference};
 use super::information::{experiment_information_under, Columns, ExperimentInformation};
+use crate::fit::{CarreauFiber, Identification, Rheometer, RheometerError};
 use crate::in_order::CollectInOrder;
 use crate::material_law::CarreauLike;
 use crate::model::FiberModel;
 use crate::noise_model::NoiseModel;
-use crate::rheometer::{CarreauFiber, Identification, Rheometer, RheometerError};
 use crate::simulate::{simulate_params, SimulateOptions};
 use diffbvp::solution::Solution;
 use diffbvp::solve::{Guess, Solver};
@@ -505,7 +505,7 @@ pub fn design_for_estimation(
                     .map_or(f64::NAN, |m| m.noise_rms)
         ));
     }
-    if id.summary.estimator != crate::rheometer::Estimator::Principled {
+    if id.summary.estimator != crate::fit::Estimator::Principled {
         notes.push(
             "the fit used the paper's estimator; the predictions are for the principled one".into(),
         );

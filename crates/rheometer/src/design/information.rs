@@ -18,7 +18,7 @@
 //! Both sum over experiments; with `σ_j = τ_j`, `B = A` and the covariance is `A⁻¹`.
 
 use crate::error::FiberError;
-use crate::rheometer::CarreauFiber;
+use crate::fit::CarreauFiber;
 use diffbvp::sensitivity::{residual_jacobian, PointFunction, Sensitivities};
 use diffbvp::solution::Solution;
 use diffbvp::{Bvp, DualNum};

@@ -7,8 +7,8 @@
 
 use super::scan::{physical, search_range, Profile, ShapeParameter};
 use crate::effects::Effect;
-use crate::rheometer::summary_checks::bound_side;
-use crate::rheometer::{AtBound, Estimate, FitSummary};
+use crate::fit::summary::checks::bound_side;
+use crate::fit::{AtBound, Estimate, FitSummary};
 use serde::{Deserialize, Serialize};
 
 /// How many standard errors a strength may lie beyond its physical range and still count as
@@ -322,7 +322,7 @@ fn flat_beyond_physics(effect: &Effect, bound: f64, unbounded: f64, stderr: f64)
 /// value plus its component of the fit's Gauss–Newton step
 /// ([`FitResult::gauss_newton_step`](diffbvp::least_squares::FitResult::gauss_newton_step);
 /// `None` without that parameter or that step).
-pub fn unbounded_optimum(id: &crate::rheometer::Identification, name: &str) -> Option<f64> {
+pub fn unbounded_optimum(id: &crate::fit::Identification, name: &str) -> Option<f64> {
     let i = id.names.iter().position(|n| n == name)?;
     let step = id.fit.gauss_newton_step()?;
     Some(id.fit.p[i] + step[i])
@@ -396,7 +396,7 @@ pub struct Indistinguishable {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rheometer::BoundSide;
+    use crate::fit::BoundSide;
 
     fn result(
         effect: &str,
@@ -422,7 +422,7 @@ mod tests {
             status_note: None,
             physical_range: [0.0, 1.0],
             search_range: [0.0, 1.0],
-            refit: refitted.then(crate::rheometer::summary::tests::example),
+            refit: refitted.then(crate::fit::summary::tests::example),
             shape_alternative: None,
             profiles: Vec::new(),
             scan_errors: Vec::new(),

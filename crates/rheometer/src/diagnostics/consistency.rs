@@ -20,9 +20,9 @@
 //! noise level does not enter. An effect fails the test when `P(F > f)` is below
 //! [`CONSISTENCY_LEVEL`] divided by the number of effects tested.
 
+use crate::fit::summary::text::fmt_p;
+use crate::fit::{FitWarning, Identification, WarningCode};
 use crate::format::{fmt_at, unit_suffix};
-use crate::rheometer::summary_text::fmt_p;
-use crate::rheometer::{FitWarning, Identification, WarningCode};
 use crate::setup::ExperimentSet;
 use crate::statistics::distributions::f_survival;
 use diffbvp::least_squares::Loss;

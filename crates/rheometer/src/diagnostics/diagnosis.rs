@@ -7,7 +7,7 @@ use super::detection::DetectionLimits;
 use super::diagnose::verdict::Verdict;
 use super::ties::Alternative;
 use crate::effects::LawChoice;
-use crate::rheometer::{FitSummary, Identification, IdentifyOptions};
+use crate::fit::{FitSummary, Identification, IdentifyOptions};
 use diffbvp::least_squares::Loss;
 use serde::{Deserialize, Serialize};
 
@@ -208,7 +208,7 @@ impl Diagnosis {
     /// range, if any: such a law has no valid interval and is no material result, whatever
     /// the verdict (a 300 m/s aspirator's co-flow "explained" the data with `κ` at its lower
     /// bound 7, `K` a hundred times below the truth).
-    pub fn law_at_bound(&self) -> Option<&crate::rheometer::AtBound> {
+    pub fn law_at_bound(&self) -> Option<&crate::fit::AtBound> {
         self.law_fit().law_at_bound()
     }
 

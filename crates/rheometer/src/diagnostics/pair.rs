@@ -11,7 +11,7 @@
 //!   (either estimate of `n` or `κ` outside the other's 95 % interval), the data cannot tell
 //!   which law is right, and neither is a result.
 
-use crate::rheometer::FitSummary;
+use crate::fit::FitSummary;
 use serde::{Deserialize, Serialize};
 
 /// The best pair of candidates fitted jointly, judged against the forward search's result.
@@ -138,7 +138,7 @@ pub fn disagreement(result: &FitSummary, rivals: &[(String, &FitSummary)]) -> St
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rheometer::summary::tests::example;
+    use crate::fit::summary::tests::example;
 
     fn pair(dbic: f64) -> PairFound {
         PairFound {

@@ -5,9 +5,9 @@ use super::consistency::Consistency;
 use super::diagnose::verdict::Verdict;
 use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::scan::Profile;
+use crate::fit::summary::Z95;
 use crate::format::{fmt_at, fmt_g, fmt_pm, unit_suffix};
 use crate::plot::{save_panels, Panel, PlotError, Series};
-use crate::rheometer::summary::Z95;
 use std::path::Path;
 
 mod text;
@@ -348,7 +348,7 @@ fn estimate_with_ci(c: &Candidate, name: &str, value: f64, ci: [f64; 2]) -> Stri
 
 /// [`estimate_with_ci`] of a fit's estimate `name` (its bounds from `at_bound`).
 fn estimate_with_ci_bounds(
-    at_bound: &[crate::rheometer::AtBound],
+    at_bound: &[crate::fit::AtBound],
     name: &str,
     value: f64,
     ci: [f64; 2],
@@ -438,7 +438,7 @@ fn shape_alternative_line(c: &Candidate, a: &ShapeAlternative) -> String {
         .collect::<Vec<_>>()
         .join(", ");
     let shift = |x: f64, x0: f64, se: f64| (x - x0) / se;
-    let se_of = |ci: [f64; 2]| (ci[1] - ci[0]) / (2.0 * crate::rheometer::summary::Z95);
+    let se_of = |ci: [f64; 2]| (ci[1] - ci[0]) / (2.0 * crate::fit::summary::Z95);
     format!(
         "SHAPE: these data cannot choose the shape of {}: with {shape} (delta BIC {:+.1}) its \
          strength is {}, n = {} (95% CI [{}, {}]), kappa = {} (95% CI [{}, {}]): n {:+.1}, \

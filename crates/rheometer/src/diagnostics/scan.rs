@@ -25,9 +25,9 @@
 //!   [`physical_range`] and [`shape_variants`].
 
 use crate::effects::{Effect, EffectSetting, ModelSpec};
-use crate::rheometer::identification::WarmFit;
-use crate::rheometer::thresholds::PLAUSIBLE_N;
-use crate::rheometer::{FitStart, Identification, IdentifyOptions, Rheometer, RheometerError};
+use crate::fit::identification::WarmFit;
+use crate::fit::thresholds::PLAUSIBLE_N;
+use crate::fit::{FitStart, Identification, IdentifyOptions, Rheometer, RheometerError};
 use crate::simulate::SimulateOptions;
 use diffbvp::least_squares::Loss;
 use diffbvp::solution::Solution;

@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 /// `ΔBIC` gap below 6 is less than "strong" evidence (Kass–Raftery) for the named cause.
 pub const DEFAULT_TIE_MARGIN: f64 = 6.0;
 
-use crate::rheometer::summary::Z95;
+use crate::fit::summary::Z95;
 
 /// Shifts of `n` and `κ` (in the named refit's standard errors) below which the material
 /// result is robust to the choice between tied causes.
@@ -353,7 +353,7 @@ pub(super) fn ties_paragraph(
 pub(crate) mod tests {
     use super::*;
     use crate::diagnostics::candidate::StrengthStatus;
-    use crate::rheometer::summary::tests::refit_summary;
+    use crate::fit::summary::tests::refit_summary;
 
     /// A candidate with a refit (unless not refitted): `ΔBIC` `dbic`, law `(n, kappa)` with
     /// standard errors 0.01 and 0.1.

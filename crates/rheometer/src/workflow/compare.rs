@@ -6,8 +6,8 @@ use crate::diagnostics::compare::{
     MissingTakeUp, ModelSetup,
 };
 use crate::effects::{physics_with, Effect, EffectSetting};
+use crate::fit::FitSummary;
 use crate::input::LoadedExperiments;
-use crate::rheometer::FitSummary;
 use crate::simulate::SimulateOptions;
 use crate::Physics;
 

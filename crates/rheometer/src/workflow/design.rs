@@ -8,9 +8,9 @@ use crate::design::{
     DiscriminationRequest, Rival,
 };
 use crate::effects::{Effect, EffectSetting};
+use crate::fit::profile::ProfileMode;
+use crate::fit::RheometerError;
 use crate::input::LoadedExperiments;
-use crate::rheometer::profile::ProfileMode;
-use crate::rheometer::RheometerError;
 
 /// The outcome of the `design` workflow.
 #[derive(Debug)]

@@ -6,14 +6,14 @@
 use crate::diagnostics::consistency;
 use crate::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::figures::ResidualView;
-use crate::fit_html::{fit_report_page, FitReportInput, ReportExperiment};
-use crate::html_page::HtmlPage;
-use crate::input::LoadedExperiments;
-use crate::rheometer::profile::{intervals, ProfileMode};
-use crate::rheometer::{
+use crate::fit::profile::{intervals, ProfileMode};
+use crate::fit::{
     error_budget, FitSummary, FlowCurve, FlowCurveOptions, Identification, IdentifyOptions,
     Rheometer, RheometerError, StartPoint,
 };
+use crate::fit_html::{fit_report_page, FitReportInput, ReportExperiment};
+use crate::html_page::HtmlPage;
+use crate::input::LoadedExperiments;
 use diffbvp::solution::Solution;
 
 /// What to fit.

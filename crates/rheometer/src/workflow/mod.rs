@@ -5,7 +5,7 @@
 //! | subcommand | call | result |
 //! |---|---|---|
 //! | `simulate` | [`simulate_experiments`] | profiles per experiment |
-//! | `fit` | [`fit()`] | [`FitRun`] (its [`FitSummary`](crate::rheometer::FitSummary)) |
+//! | `fit` | [`fit()`] | [`FitRun`] (its [`FitSummary`](crate::fit::FitSummary)) |
 //! | `compare` | [`compare()`] | [`Comparison`](crate::diagnostics::compare::Comparison) |
 //! | `diagnose` | [`diagnose()`] | [`DiagnosisRun`] |
 //! | `landscape` | [`landscape()`] | [`LandscapeRun`] |
@@ -14,7 +14,7 @@
 //!
 //! ```no_run
 //! use rheometer::input::load_experiments_with;
-//! use rheometer::rheometer::IdentifyOptions;
+//! use rheometer::fit::IdentifyOptions;
 //! use rheometer::workflow::{fit, FitRequest};
 //! use std::path::Path;
 //! let data = load_experiments_with(Path::new("data/pmma7n_synthetic/experiments.toml"), 4)?;
@@ -37,8 +37,8 @@ pub use simulate::{simulate_experiments, SimulateError, SimulateRequest, Simulat
 use crate::diagnostics::diagnose::{diagnose as run_diagnosis, DiagnoseOptions};
 use crate::diagnostics::diagnosis::DiagnosisRun;
 use crate::effects::ModelSpec;
+use crate::fit::{FarRule, IdentifyOptions, LandscapeRun, Rheometer, RheometerError};
 use crate::input::LoadedExperiments;
-use crate::rheometer::{FarRule, IdentifyOptions, LandscapeRun, Rheometer, RheometerError};
 use std::sync::atomic::AtomicBool;
 
 /// Diagnoses which candidate effect is missing from `model` on `data` (see

@@ -7,9 +7,9 @@
 //! which is the same text for both.
 
 use crate::effects::Effect;
+use crate::fit::landscape::LANDSCAPE_MAX_NODES;
+use crate::fit::IdentifyOptions;
 use crate::input::{LoadedExperiments, MAX_PLAUSIBLE_DIAMETER_M};
-use crate::rheometer::landscape::LANDSCAPE_MAX_NODES;
-use crate::rheometer::IdentifyOptions;
 use diffbvp::least_squares::Loss;
 use std::fmt;
 

@@ -2,10 +2,10 @@
 //! conditions (from the data set, from the smoothed data, or as fitted) and the physics.
 
 use super::{compare, CompareError, CompareOptions, Comparison, SimulatedExperiment};
+use crate::fit::FitSummary;
 use crate::in_order::CollectInOrder;
 use crate::material_law::CarreauLike;
 use crate::model::FiberModel;
-use crate::rheometer::FitSummary;
 use crate::setup::ExperimentSet;
 use crate::simulate::{simulate_params, SimulateOptions};
 pub use crate::take_up::MissingTakeUp;

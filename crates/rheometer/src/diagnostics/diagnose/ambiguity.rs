@@ -29,7 +29,7 @@ use super::verdict::Verdict;
 use super::DiagnoseOptions;
 use crate::diagnostics::candidate::{Candidate, StrengthStatus};
 use crate::diagnostics::pair::{disagreement, law_envelope_of, laws_disagree, PairFound};
-use crate::rheometer::{FitSummary, FitWarning, WarningCode};
+use crate::fit::{FitSummary, FitWarning, WarningCode};
 
 /// A rival explanation: its effects, whether its strengths are credible, and its fit.
 pub(crate) struct Rival<'a> {

@@ -3,13 +3,13 @@
 use super::DiagnoseOptions;
 use crate::diagnostics::diagnosis::RobustWeights;
 use crate::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
-use crate::noise_summary::NoiseSummary;
-use crate::rheometer::identification::WarmFit;
-use crate::rheometer::summary_checks::check_misfit;
-use crate::rheometer::WarningCode;
-use crate::rheometer::{
+use crate::fit::identification::WarmFit;
+use crate::fit::summary::checks::check_misfit;
+use crate::fit::WarningCode;
+use crate::fit::{
     Estimator, FitStart, Identification, IdentifyOptions, Layout, Rheometer, RheometerError,
 };
+use crate::noise_summary::NoiseSummary;
 use crate::setup::ExperimentSet;
 use diffbvp::least_squares::Loss;
 use std::sync::Arc;

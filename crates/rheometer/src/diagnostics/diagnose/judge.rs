@@ -10,8 +10,8 @@ use crate::diagnostics::candidate::{
 };
 use crate::diagnostics::diagnosis::ResidualProfiles;
 use crate::effects::Effect;
-use crate::rheometer::summary_checks::law_jump;
-use crate::rheometer::{FitSummary, Identification, WarningCode};
+use crate::fit::summary::checks::law_jump;
+use crate::fit::{FitSummary, Identification, WarningCode};
 
 /// Fills `record` from its chosen refit (`variant` the shape variant it belongs to) and the
 /// other shape's refit; returns the refit's identification.

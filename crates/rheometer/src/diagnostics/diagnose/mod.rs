@@ -77,10 +77,10 @@ use super::scan::ScanOptions;
 use super::ties::DEFAULT_TIE_MARGIN;
 use crate::diagnostics::scan::refitted_effect;
 use crate::effects::{Effect, EffectSetting, ModelSpec};
-use crate::noise_summary::NoiseSummary;
-use crate::rheometer::{
+use crate::fit::{
     Estimator, FitWarning, Identification, IdentifyOptions, RheometerError, WarningCode,
 };
+use crate::noise_summary::NoiseSummary;
 use crate::setup::ExperimentSet;
 use std::time::Instant;
 use verdict::{Help, Verdict};
@@ -273,7 +273,7 @@ fn something_to_explain(steps: &[step::Step]) -> bool {
 
 /// `ΔBIC` against the user's model of the steps' final fit (all effects found), and that fit
 /// (`0` and `None` when nothing was found).
-fn steps_result(steps: &[step::Step]) -> (f64, Option<&crate::rheometer::FitSummary>) {
+fn steps_result(steps: &[step::Step]) -> (f64, Option<&crate::fit::FitSummary>) {
     let Some(first) = steps.first() else {
         return (0.0, None);
     };

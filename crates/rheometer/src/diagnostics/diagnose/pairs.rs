@@ -31,7 +31,7 @@ use crate::diagnostics::candidate::{strength_status, Candidate, StrengthStatus};
 use crate::diagnostics::pair::delta_bic;
 use crate::diagnostics::pair::PairFound;
 use crate::effects::{Effect, EffectSetting, ModelSpec};
-use crate::rheometer::{
+use crate::fit::{
     FitStart, FitSummary, Identification, IdentifyOptions, Rheometer, RheometerError,
 };
 use crate::setup::ExperimentSet;

@@ -9,7 +9,7 @@ use crate::diagnostics::scan::{
     refine, scan_profile, shape_variants, GridStart, ProfileScan, Refit, ShapeParameter,
 };
 use crate::effects::{Effect, LawChoice};
-use crate::rheometer::{Identification, RheometerError};
+use crate::fit::{Identification, RheometerError};
 use rayon::prelude::*;
 
 /// The scans that started, each with its candidate's index.

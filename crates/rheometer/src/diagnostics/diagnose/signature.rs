@@ -1,7 +1,7 @@
 //! Where along the spin line a change of the residuals lies, and residual profiles by name.
 
 use super::super::diagnosis::ResidualProfiles;
-use crate::rheometer::Identification;
+use crate::fit::Identification;
 
 /// Where along `s` a residual change lies: the position \[m\] of the largest pooled change and
 /// the 10%–90% range \[m\] of its cumulative weight.

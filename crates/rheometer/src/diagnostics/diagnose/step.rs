@@ -15,7 +15,7 @@ use crate::diagnostics::diagnosis::{RobustWeights, StageTimes};
 use crate::diagnostics::scores::cosine;
 use crate::diagnostics::ties::{alternatives_among, Alternative};
 use crate::effects::{Effect, ModelSpec};
-use crate::rheometer::{Estimate, Identification, IdentifyOptions, ParameterShift, RheometerError};
+use crate::fit::{Estimate, Identification, IdentifyOptions, ParameterShift, RheometerError};
 use crate::setup::ExperimentSet;
 use std::time::Instant;
 

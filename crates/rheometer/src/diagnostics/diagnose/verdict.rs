@@ -22,8 +22,8 @@
 //!   span is given; see the stage `ambiguity`).
 
 use crate::diagnostics::compare::segments::{find_segments, Segment, SegmentOptions};
+use crate::fit::FitSummary;
 use crate::noise_summary::NoiseSummary;
-use crate::rheometer::FitSummary;
 use serde::{Deserialize, Serialize};
 
 /// Share of the excess misfit an effect must remove to be named \[-\].

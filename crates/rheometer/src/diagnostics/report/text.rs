@@ -7,8 +7,8 @@ use super::{
     estimate_with_ci, estimate_with_ci_bounds, fmt_range, pm_unit, probability, profile_line,
     shape_alternative_line, unit_suffix, EXACT_TIE,
 };
+use crate::fit::FitSummary;
 use crate::format::{fmt_g, wrap_long_lines};
-use crate::rheometer::FitSummary;
 
 impl Diagnosis {
     /// The report in words.

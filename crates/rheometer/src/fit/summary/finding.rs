@@ -2,10 +2,10 @@
 //! thinning detected or not over the strain rates the data cover, the one-sided bound on `n`,
 //! the likelihood-ratio test) and a profile interval in words.
 
-use super::profile::ProfileInterval;
-use super::summary::{BoundSide, FitSummary};
-use super::summary_text::{fmt_interval, fmt_p};
 use crate::effects::LawChoice;
+use crate::fit::profile::ProfileInterval;
+use crate::fit::summary::text::{fmt_interval, fmt_p};
+use crate::fit::summary::{BoundSide, FitSummary};
 use crate::format::{fmt_at, fmt_e, fmt_g, fmt_pm, fmt_sig};
 
 impl ProfileInterval {

@@ -4,10 +4,10 @@
 //! bounded, strict reader [`read_json`], the report's stamp [`check_report`], the field types
 //! with their paths, the values' ranges); every error names the file and the field.
 
-use super::estimator::Estimator;
-use super::summary::{FitSummary, WarningCode};
 use crate::effects::{Effect, EffectSetting};
 use crate::error::Readable;
+use crate::fit::estimator::Estimator;
+use crate::fit::summary::{FitSummary, WarningCode};
 use crate::input::{parse_json, read_json, show_json_path, JsonSource};
 use crate::report_json::{check_report, ReportKind};
 use crate::setup::{Experiment, Measurements};
@@ -404,7 +404,7 @@ impl FitSummary {
 
     /// Reports written before the error budget became a table warned for every source that
     /// shifted an estimate by more than its statistical error; their budget's warnings are
-    /// recomputed by today's rule ([`ErrorBudget::warnings`](super::ErrorBudget::warnings)).
+    /// recomputed by today's rule ([`ErrorBudget::warnings`](crate::fit::ErrorBudget::warnings)).
     fn upgrade_systematic_warnings(&mut self) {
         let Some(b) = &self.error_budget else { return };
         let now = b.warnings();
@@ -477,7 +477,7 @@ impl FitSummary {
     /// start: each effect with the strength fitted where it was fitted (else fixed at its
     /// value), its fitted shapes free again and the others fixed at their values; the start
     /// values of the fitted strengths (by effect name) and shapes (by model-parameter name),
-    /// as [`FitStart::strengths`](super::FitStart::strengths) takes them.
+    /// as [`FitStart::strengths`](crate::fit::FitStart::strengths) takes them.
     pub fn continued_effects(&self) -> Result<ContinuedEffects, String> {
         let mut effects = Vec::new();
         let mut starts = Vec::new();
@@ -699,8 +699,8 @@ fn readable_type_error(msg: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rheometer::summary::tests::refit_summary;
-    use crate::rheometer::Estimate;
+    use crate::fit::summary::tests::refit_summary;
+    use crate::fit::Estimate;
 
     /// A fit with a co-flow: strength 27 ± 3 m/s, decay length fitted, tail fixed at 0.5.
     fn coflow_fit(n: f64) -> FitSummary {

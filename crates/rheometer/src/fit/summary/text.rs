@@ -6,9 +6,9 @@
 //! [`LINE_WIDTH`](crate::format::LINE_WIDTH) characters
 //! ([`wrap_long_lines`]).
 
-use super::estimator::Estimator;
-use super::summary::{Estimate, FitSummary};
 use crate::effects::LawChoice;
+use crate::fit::estimator::Estimator;
+use crate::fit::summary::{Estimate, FitSummary};
 use crate::format::{fmt_at, fmt_e, fmt_g, fmt_pm, fmt_sig, wrap_long_lines};
 
 /// `" unit"`, or nothing for a dimensionless quantity.
@@ -441,9 +441,9 @@ impl FitSummary {
                 fmt_sig(p.strain_rate_per_s, 2),
                 fmt_sig(p.eta_pa_s, 3),
                 match c.band {
-                    super::flow_curve::BandMethod::Delta => how("delta method"),
-                    super::flow_curve::BandMethod::Profile => how("along the profile"),
-                    super::flow_curve::BandMethod::None => format!(" ({NO_BAND})"),
+                    crate::fit::flow_curve::BandMethod::Delta => how("delta method"),
+                    crate::fit::flow_curve::BandMethod::Profile => how("along the profile"),
+                    crate::fit::flow_curve::BandMethod::None => format!(" ({NO_BAND})"),
                 },
                 if c.systematic {
                     format!(", with systematic {} Pa s", band(p.total95_pa_s))
@@ -456,7 +456,7 @@ impl FitSummary {
     }
 }
 
-/// Why a flow curve has no statistical band ([`BandMethod::None`](super::flow_curve::BandMethod::None)).
+/// Why a flow curve has no statistical band ([`BandMethod::None`](crate::fit::flow_curve::BandMethod::None)).
 pub(crate) const NO_BAND: &str =
     "no statistical band: no fitted law parameter, or no covariance of the fitted ones";
 

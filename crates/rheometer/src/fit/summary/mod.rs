@@ -1,6 +1,6 @@
 //! The outcome of a fit as one value: [`FitSummary`].
 //!
-//! An identification ([`Rheometer::identify`](super::Rheometer::identify)) produces it once;
+//! An identification ([`Rheometer::identify`](crate::fit::Rheometer::identify)) produces it once;
 //! the text report renders it ([`FitSummary::to_text`]), the JSON serialises it, and the next
 //! step reads it back (`compare --fit`, `fit --from`, `diagnose`, the Python package). Nothing
 //! copies its numbers into other structs: a diagnosis' refits hold their own summaries.
@@ -11,15 +11,21 @@
 //! approximation; `N` is in the hundreds). For `K = e^κ` the interval is the image of κ's. For
 //! the paper's estimator the residuals are weighted distances to smoothed data, not
 //! measurement errors: its standard errors are shown for comparison only. The checks that make
-//! a fit doubtful are in [`summary_checks`](super::summary_checks).
+//! a fit doubtful are in [`summary::checks`](crate::fit::summary::checks).
 
-use super::budget::ErrorBudget;
-use super::coverage::StrainRateCoverage;
-use super::curve::FlowCurve;
-use super::estimator::Estimator;
-use super::likelihood::{NewtonianTest, ProfileInterval};
-pub use super::options::{BoundSide, FitWarning, WarningCode};
+pub(crate) mod build;
+pub mod checks;
+pub(crate) mod finding;
+pub(crate) mod read;
+pub(crate) mod text;
+
 use crate::effects::{Category, LawChoice};
+use crate::fit::budget::ErrorBudget;
+use crate::fit::coverage::StrainRateCoverage;
+use crate::fit::curve::FlowCurve;
+use crate::fit::estimator::Estimator;
+use crate::fit::likelihood::{NewtonianTest, ProfileInterval};
+pub use crate::fit::options::{BoundSide, FitWarning, WarningCode};
 use crate::noise_summary::NoiseSummary;
 use crate::serde_nan;
 use diffbvp::least_squares::Loss;
@@ -270,7 +276,7 @@ pub struct FitSummary {
     /// Experiment names, in the order of `take_up_factors`.
     #[serde(default)]
     pub experiments: Vec<String>,
-    /// A digest of the data the fit was made on ([`data_digest`](super::data_digest): the
+    /// A digest of the data the fit was made on ([`data_digest`](crate::fit::data_digest): the
     /// experiments' names, conditions and measurements), so that a reader can tell this
     /// fit's data from other data with the same experiment names (empty: not recorded).
     #[serde(default, skip_serializing_if = "String::is_empty")]
@@ -342,7 +348,7 @@ pub struct FitSummary {
     pub strain_rates: Option<StrainRateCoverage>,
     /// Profile-likelihood intervals of the fitted law parameters and strengths, with the
     /// reasons the linearised interval is not trusted where it is not (see
-    /// [`profile`](super::profile)); empty where the model misses the data by several times
+    /// [`profile`](crate::fit::profile)); empty where the model misses the data by several times
     /// the noise ([`likelihood_skipped`](Self::likelihood_skipped)).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub intervals: Vec<ProfileInterval>,
@@ -484,7 +490,7 @@ impl FitSummary {
 
     /// Why the profile-likelihood intervals and the likelihood-ratio test against the
     /// Newtonian law are not computed for this fit: a `misfit` warning (the RMS relative
-    /// residual beyond [`MISFIT_RATIO`](super::thresholds::MISFIT_RATIO) times the noise).
+    /// residual beyond [`MISFIT_RATIO`](crate::fit::thresholds::MISFIT_RATIO) times the noise).
     /// Both read the deviance as a likelihood of a model that describes the data up to the
     /// noise; where it misses them by several times the noise they would be statements about
     /// a wrong model (the law is no result either, see [`law_not_a_result`](Self::law_not_a_result)),

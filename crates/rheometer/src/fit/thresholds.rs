@@ -1,4 +1,4 @@
-//! The thresholds of the checks of a fit (see [`summary_checks`](super::summary_checks)): when
+//! The thresholds of the checks of a fit (see [`summary::checks`](super::summary::checks)): when
 //! an estimate is at a bound, a misfit too large, a standard error huge, a covariance
 //! ill-conditioned, an `n` implausible for a melt, a refit's law a jump. Values only, shared by
 //! the checks and by the error budget's warnings.
@@ -31,7 +31,7 @@ pub const ILL_CONDITIONED_RCOND: f64 = 1e-10;
 pub const PLAUSIBLE_N: [f64; 2] = [0.2, 1.0];
 
 /// A law that moved by more than this many of the plain fit's standard errors is checked
-/// against the gain in fit it bought ([`law_jump`](super::summary_checks::law_jump)).
+/// against the gain in fit it bought ([`law_jump`](super::summary::checks::law_jump)).
 pub const JUMP_SE: f64 = 20.0;
 
 /// A fit that ended without a convergence test being met is reported as not converged when its

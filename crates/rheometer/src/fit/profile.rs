@@ -348,7 +348,7 @@ impl Profiler<'_> {
         let theta = fit.p[c];
         let (lo, hi) = (self.id.lower[c], self.id.upper[c]);
         let se = fit.standard_errors().map_or(f64::NAN, |s| s[c]).abs();
-        let side_at = super::summary_checks::bound_side(theta, lo, hi);
+        let side_at = super::summary::checks::bound_side(theta, lo, hi);
         let corr = fit.correlation().map_or(0.0, |m| {
             let np = fit.p.len();
             (0..np)

@@ -1,14 +1,14 @@
 //! Building a [`FitSummary`] from an identification: the named estimates with their
 //! uncertainties, the covariance in reported units, the estimates at a bound, and the checks.
 
-use super::estimator::Estimator;
-use super::layout::EffectSlot;
-use super::options::FitWarning;
-use super::summary::{
+use crate::effects::LawChoice;
+use crate::fit::estimator::Estimator;
+use crate::fit::layout::EffectSlot;
+use crate::fit::options::FitWarning;
+use crate::fit::summary::checks::{self, bound_side};
+use crate::fit::summary::{
     AtBound, BoundSide, Covariance, EffectEstimate, Estimate, FitSummary, SolverRecord,
 };
-use super::summary_checks::{self, bound_side};
-use crate::effects::LawChoice;
 use crate::noise_summary::NoiseSummary;
 use diffbvp::least_squares::{BlockCovariance, FitResult};
 use nalgebra::DMatrix;
@@ -149,7 +149,7 @@ impl Uncertainty {
 }
 
 impl FitSummary {
-    /// The summary of an identification, with its checks ([`summary_checks`]).
+    /// The summary of an identification, with its checks ([`summary::checks`]).
     pub(crate) fn new(input: SummaryInput<'_>) -> Self {
         let u = Uncertainty::of(&input);
         let col = |name: &str| input.names.iter().position(|n| n == name);
@@ -224,8 +224,8 @@ impl FitSummary {
             flow_curve: None,
         };
         let mut w = input.data_warnings;
-        summary_checks::check_bounds(&summary, &mut w);
-        summary_checks::check_uncertainty(
+        checks::check_bounds(&summary, &mut w);
+        checks::check_uncertainty(
             &summary,
             input.effects,
             u.have_se,
@@ -233,10 +233,10 @@ impl FitSummary {
             np,
             &mut w,
         );
-        summary_checks::check_misfit(&summary, &mut w);
-        summary_checks::check_convergence(fit, &mut w);
-        summary_checks::check_law(&summary, &mut w);
-        summary_checks::check_fixed_effects(&summary, &mut w);
+        checks::check_misfit(&summary, &mut w);
+        checks::check_convergence(fit, &mut w);
+        checks::check_law(&summary, &mut w);
+        checks::check_fixed_effects(&summary, &mut w);
         summary.warnings = w;
         summary
     }

@@ -18,16 +18,16 @@
 //!   budget, stall, collapsed trust region) and the Gauss–Newton step from its end would still
 //!   lower `χ²` by at least [`NOT_CONVERGED_CHI2`].
 //! * **Data the model cannot describe**: measured diameters that do not decrease along the spin
-//!   line ([`Rheometer::data_warnings`](super::Rheometer::data_warnings)).
+//!   line ([`Rheometer::data_warnings`](crate::fit::Rheometer::data_warnings)).
 //!
 //! Each finding is a [`FitWarning`] (a [`WarningCode`] and a message naming the parameter or
 //! experiment) in [`FitSummary::warnings`].
 
-use super::estimator::Estimator;
-use super::layout::EffectSlot;
-use super::options::{FitWarning, WarningCode};
-use super::summary::{BoundSide, FitSummary};
-pub use super::thresholds::{
+use crate::fit::estimator::Estimator;
+use crate::fit::layout::EffectSlot;
+use crate::fit::options::{FitWarning, WarningCode};
+use crate::fit::summary::{BoundSide, FitSummary};
+pub use crate::fit::thresholds::{
     AT_BOUND_TOLERANCE, ILL_CONDITIONED_RCOND, IMPLAUSIBLE_NOISE_RATIO, JUMP_SE,
     LARGE_STDERR_KAPPA, LARGE_STDERR_N, LARGE_STDERR_STRENGTH_FRACTION, MISFIT_RATIO,
     MISFIT_WITHOUT_NOISE, NOT_CONVERGED_CHI2, PLAUSIBLE_N,
@@ -302,7 +302,7 @@ pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarnin
     if base.n.value < PLAUSIBLE_N[0] && lowest >= PLAUSIBLE_N[0] {
         return None;
     }
-    let z = |a: &super::summary::Estimate, b: &super::summary::Estimate| {
+    let z = |a: &crate::fit::summary::Estimate, b: &crate::fit::summary::Estimate| {
         if a.fitted && b.fitted && a.stderr > 0.0 && a.stderr.is_finite() {
             ((b.value - a.value) / a.stderr).abs()
         } else {
@@ -451,8 +451,8 @@ pub(crate) fn check_misfit(s: &FitSummary, w: &mut Vec<FitWarning>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rheometer::summary::tests::refit_summary;
-    use crate::rheometer::summary::{AtBound, BoundSide};
+    use crate::fit::summary::tests::refit_summary;
+    use crate::fit::summary::{AtBound, BoundSide};
 
     /// A refit moved 30 standard errors of the plain fit's `n` with a gain of 100 in units
     /// of the noise variance (worth 900): a jump from a plausible law, none from an

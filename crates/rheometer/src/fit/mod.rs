@@ -29,7 +29,7 @@
 //! * [`profile`]: profile-likelihood intervals, one-sided bounds at a bound, and the
 //!   likelihood-ratio test against the nested Newtonian law; the values it yields
 //!   ([`ProfileInterval`], [`NewtonianTest`]) are in [`likelihood`];
-//! * [`summary_checks`]: the checks of a fit (estimates at bounds, misfit, huge errors, data
+//! * [`summary::checks`]: the checks of a fit (estimates at bounds, misfit, huge errors, data
 //!   the model cannot describe), their thresholds in [`thresholds`].
 //!
 //! The values a [`FitSummary`] holds (`budget`, `curve`, `coverage`, `likelihood`) sit below
@@ -56,11 +56,6 @@ pub mod parameter_shift;
 pub mod plan;
 pub mod profile;
 pub mod summary;
-mod summary_build;
-pub mod summary_checks;
-mod summary_finding;
-mod summary_read;
-pub(crate) mod summary_text;
 pub mod thresholds;
 
 pub use coverage::StrainRateCoverage;
@@ -81,11 +76,11 @@ pub use options::{
 pub use parameter_shift::ParameterShift;
 pub use plan::FitPlan;
 pub use profile::ProfileMode;
+pub use summary::read::{
+    data_digest, ContinuedEffects, DataCheck, FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE,
+    FIT_FILE_TAKE_UP_RANGE,
+};
 pub use summary::{
     AtBound, Covariance, EffectEstimate, Estimate, FitSummary, FitWarning, SolverRecord,
     WarningCode,
-};
-pub use summary_read::{
-    data_digest, ContinuedEffects, DataCheck, FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE,
-    FIT_FILE_TAKE_UP_RANGE,
 };
