@@ -2,7 +2,7 @@
 //! candidate experiment to the data of a fit, ranked by a design criterion.
 //!
 //! Every experiment of the fit contributes its information about the shared parameters
-//! ([`experiment_information`], take-up factor profiled out); a candidate is simulated at the
+//! ([`experiment_information`](super::information::experiment_information), take-up factor profiled out); a candidate is simulated at the
 //! fitted parameters and its information added. The candidates of one mass flow are solved in
 //! order of the take-up axis, each warm-started from its neighbour (cold start where that
 //! fails); the mass flows run in parallel (rayon). A candidate whose model cannot be built or
