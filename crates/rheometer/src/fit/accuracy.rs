@@ -205,7 +205,9 @@ mod tests {
                 ModelSpec::default().with(EffectSetting::fitted(Effect::Radiation)),
             ),
         ] {
-            let set = load_experiments(Path::new(file)).unwrap();
+            // the shipped data sets live at the workspace root, two folders above this crate
+            let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+            let set = load_experiments(&root.join(file)).unwrap();
             let rh = Rheometer::with_spec(&set, spec).unwrap();
             for est in [Estimator::Paper, Estimator::Principled] {
                 let mut o = IdentifyOptions::with_estimator(est);

@@ -5,6 +5,7 @@
 //! every error (`n.value`), refuses duplicate keys (the last value would silently win) and
 //! says what a `NaN`, an `Infinity`, an out-of-range number or a truncated file is.
 
+use super::source::special_kind;
 use std::cell::RefCell;
 use std::collections::HashSet;
 use std::fmt::Write as _;
@@ -41,34 +42,6 @@ fn is_stdin_path(path: &Path) -> bool {
         return false;
     };
     parent == "/dev/fd" || (parent.starts_with("/proc/") && parent.ends_with("/fd"))
-}
-
-/// What kind of file `meta` is, if it is not a regular file.
-fn special_kind(meta: &std::fs::Metadata) -> Option<&'static str> {
-    let t = meta.file_type();
-    if t.is_file() {
-        return None;
-    }
-    if t.is_dir() {
-        return Some("a directory");
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return Some("a FIFO (named pipe)");
-        }
-        if t.is_char_device() {
-            return Some("a character device");
-        }
-        if t.is_block_device() {
-            return Some("a block device");
-        }
-        if t.is_socket() {
-            return Some("a socket");
-        }
-    }
-    Some("a special file")
 }
 
 fn too_large(path: &Path, max: u64) -> InputError {

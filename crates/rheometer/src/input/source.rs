@@ -21,8 +21,9 @@ pub(super) fn is_stdin_like(path: &Path) -> bool {
         || (parent.starts_with("/proc/") && parent.ends_with("/fd"))
 }
 
-/// What kind of non-regular file `meta` describes, if it is not a regular file.
-fn special_kind(meta: &std::fs::Metadata) -> Option<&'static str> {
+/// What kind of non-regular file `meta` describes, if it is not a regular file (the words
+/// every file input's refusal uses).
+pub(super) fn special_kind(meta: &std::fs::Metadata) -> Option<&'static str> {
     let t = meta.file_type();
     if t.is_file() {
         return None;
