@@ -1249,7 +1249,7 @@ fn x03d_g50_g51_x08b_x02c_numbers_and_negative_values_in_messages() {
         &[&data],
         LIMIT,
     );
-    p.assert_clean_failure(&["--grid", "\"-3\" is not a count"]);
+    p.assert_clean_failure(&["--grid", "-3x3", "at least 2 points per direction"]);
     // G51: a range of 1e-300 width: no 300-digit numbers in messages or in the CSV
     let p = land(&["--n-range", "0,1e-300"]);
     assert!(!p.panicked(), "{}", p.stderr);

@@ -347,16 +347,16 @@ fn cli_writes_summary_json_and_figures() {
         .join(format!("diffbvp-compare-run-{}", std::process::id()));
     let fit = dir.join("fit.json");
     std::fs::create_dir_all(&dir).unwrap();
-    // a fit report with the fields `compare` reads, stamped as this version writes it (NaN
-    // standard errors become null)
-    std::fs::write(
-        &fit,
-        r#"{"schema_version": 1, "report": "fit", "written_by": "rheometer",
-            "estimator": "Paper", "start": [0.5, 12.0],
-            "n": 0.8, "kappa": 11.71, "experiments": [],
-            "take_up_factors": [1,1,1,1,1,1,1,1,1]}"#,
-    )
-    .unwrap();
+    // a fit report as this version writes it (the paper's estimator: n and kappa fitted)
+    let (ok, err) = rheometer(&[
+        "fit",
+        "data/hidden_radiation/experiments.toml",
+        "--estimator",
+        "paper",
+        "--json",
+        fit.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
     let out = dir.join("cmp");
     let (ok, err) = rheometer(&[
         "compare",

@@ -308,9 +308,17 @@ fn the_fit_report_on_the_shipped_data_reads_well_and_writes_the_flow_curve() {
     let csv = std::fs::read_to_string(out.join("flow_curve.csv")).unwrap();
     assert!(csv.starts_with("strain_rate_per_s,eta_E_Pa_s,stat95_low_Pa_s,stat95_high_Pa_s,"));
     assert!(csv.lines().count() > 30);
-    let fc: serde_json::Value =
+    let mut fc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("flow_curve.json")).unwrap())
             .unwrap();
+    // the file is the fit's flow curve behind the stamp every JSON report carries
+    let stamp = fc.as_object_mut().unwrap();
+    assert_eq!(stamp.remove("schema_version"), Some(serde_json::json!(1)));
+    assert_eq!(
+        stamp.remove("report"),
+        Some(serde_json::json!("flow_curve"))
+    );
+    assert!(stamp.remove("written_by").is_some());
     assert_eq!(fc, v["flow_curve"]);
     assert!(std::fs::metadata(out.join("flow_curve.png")).unwrap().len() > 10_000);
     let _ = std::fs::remove_dir_all(&dir);

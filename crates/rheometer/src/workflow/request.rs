@@ -533,8 +533,8 @@ pub fn newtonian_start(newtonian: bool, start: Option<(f64, f64)>) -> Result<(),
     match start {
         Some(_) if newtonian => Err(Refusal::new(
             Arg::Start,
-            "the Newtonian model (n = 1) has no (n, kappa) to start from; drop @start@ or fit \
-             the Carreau-type law (@model=carreau@)"
+            "the Newtonian model (@model=newtonian@, n = 1) has no (n, kappa) to start from; \
+             drop @start@ or fit the Carreau-type law (@model=carreau@)"
                 .into(),
         )),
         _ => Ok(()),
