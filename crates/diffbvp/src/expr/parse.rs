@@ -341,16 +341,19 @@ impl<'a> Parser<'a> {
                 _ => None,
             };
             if let Some(op) = bin {
-                let mut a = self.args(name, start, 2)?;
-                let b = a.pop().expect("two arguments");
-                let a = a.pop().expect("two arguments");
+                let a = self.args(name, start, 2)?;
+                let count = a.len();
+                let Ok([a, b]) = <[Node; 2]>::try_from(a) else {
+                    return Err(self.err(start, format!("{name} takes 2 arguments, got {count}")));
+                };
                 return Ok(Node::Bin(op, Box::new(a), Box::new(b)));
             }
             if name == "where" {
-                let mut a = self.args(name, start, 3)?;
-                let b = a.pop().expect("three arguments");
-                let t = a.pop().expect("three arguments");
-                let c = a.pop().expect("three arguments");
+                let a = self.args(name, start, 3)?;
+                let count = a.len();
+                let Ok([c, t, b]) = <[Node; 3]>::try_from(a) else {
+                    return Err(self.err(start, format!("where takes 3 arguments, got {count}")));
+                };
                 return Ok(Node::Where(Box::new(c), Box::new(t), Box::new(b)));
             }
             return Err(self.err(

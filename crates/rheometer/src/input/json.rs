@@ -328,7 +328,26 @@ pub fn parse_json(text: &str, path: &Path, remedy: &str) -> Result<Value, InputE
     let field = show_path(&trail.steps);
     let (line, column) = (e.line(), e.column());
     let token = token_at(text, line, column);
-    let message = if let Some(key) = &trail.duplicate {
+    let message = failure_message(text, &e, &trail, &field, &token, remedy);
+    Err(InputError::Json {
+        at: at(Some(line)),
+        column: Some(column),
+        message,
+    })
+}
+
+/// The words of a failed parse `e` of `text`: a duplicate key, a truncated file, NaN or
+/// Infinity, a number out of range, text that is no JSON, a second report, or malformed JSON
+/// in `field` (the path `trail` reached; `token` the text at the error).
+fn failure_message(
+    text: &str,
+    e: &serde_json::Error,
+    trail: &Trail,
+    field: &str,
+    token: &str,
+    remedy: &str,
+) -> String {
+    if let Some(key) = &trail.duplicate {
         format!(
             "`{field}`: the key \"{key}\" appears twice in its object; JSON readers differ on \
              which value counts, so neither is used: keep one"
@@ -373,12 +392,7 @@ pub fn parse_json(text: &str, path: &Path, remedy: &str) -> Result<Value, InputE
             Some(last) => format!("malformed JSON in `{field}` after `{last}`: {msg}"),
             None => format!("malformed JSON in `{field}`: {msg}"),
         }
-    };
-    Err(InputError::Json {
-        at: at(Some(line)),
-        column: Some(column),
-        message,
-    })
+    }
 }
 
 /// Whether `text` holds a complete JSON value followed by more text.
