@@ -63,15 +63,25 @@ class CubicInterpolant:
 
     def __init__(self, x: np.ndarray, y: np.ndarray, yp: np.ndarray):
         self.x = np.asarray(x, dtype=float)
-        y = np.asarray(y)
-        yp = np.asarray(yp)
-        h = np.diff(self.x)
-        slope = np.diff(y, axis=1) / h
-        f0, f1 = yp[:, :-1], yp[:, 1:]
-        # y(x_i + s) = c0 + c1 s + c2 s^2 + c3 s^3 on interval i
-        self.c = np.stack(
-            (y[:, :-1], f0, (3 * slope - 2 * f0 - f1) / h, (f0 + f1 - 2 * slope) / h**2)
-        )
+        self._y = np.asarray(y)
+        self._yp = np.asarray(yp)
+        # the coefficients are computed at the first call (a solve whose `sol` is never
+        # evaluated does not pay for them)
+        self._c: Optional[np.ndarray] = None
+
+    @property
+    def c(self) -> np.ndarray:
+        """The coefficients, shape ``(4, n, len(x) - 1)``: ``y(x_i + s) = c[0] + c[1] s +
+        c[2] s² + c[3] s³`` on interval ``i``."""
+        if self._c is None:
+            y, yp = self._y, self._yp
+            h = np.diff(self.x)
+            slope = np.diff(y, axis=1) / h
+            f0, f1 = yp[:, :-1], yp[:, 1:]
+            self._c = np.stack(
+                (y[:, :-1], f0, (3 * slope - 2 * f0 - f1) / h, (f0 + f1 - 2 * slope) / h**2)
+            )
+        return self._c
 
     def __call__(self, x: Any, nu: int = 0) -> np.ndarray:
         if nu not in (0, 1, 2, 3):
@@ -296,11 +306,11 @@ def _check_inputs(x, y, p, tol, max_nodes, bc_tol, complex_ok):
         raise InputError(f"x: expected a 1-D array, got shape {x.shape}")
     if x.size < 2:
         raise InputError(f"x: at least 2 nodes are needed, got {x.size}")
-    if not np.all(np.isfinite(x)):
+    if not np.isfinite(x).all():
         j = int(np.flatnonzero(~np.isfinite(x))[0])
         raise InputError(f"x[{j}] is not finite ({x[j]})")
-    if not np.all(np.diff(x) > 0):
-        j = int(np.flatnonzero(np.diff(x) <= 0)[0])
+    if not (x[1:] > x[:-1]).all():
+        j = int(np.flatnonzero(x[1:] <= x[:-1])[0])
         raise InputError(
             f"x must be strictly increasing: x[{j}] = {x[j]} and x[{j + 1}] = {x[j + 1]}"
         )
@@ -311,7 +321,7 @@ def _check_inputs(x, y, p, tol, max_nodes, bc_tol, complex_ok):
             "complex problems (solved by scipy)"
         )
     try:
-        ya = ya.astype(complex if ya.dtype.kind == "c" else float)
+        ya = np.asarray(ya, dtype=complex if ya.dtype.kind == "c" else float)
     except (TypeError, ValueError) as e:
         raise InputError(f"y: expected a 2-D array of numbers ({e})") from None
     if ya.ndim != 2:
@@ -320,7 +330,7 @@ def _check_inputs(x, y, p, tol, max_nodes, bc_tol, complex_ok):
         raise InputError(
             f"y: expected shape (n, {x.size}) (one column per node of x), got {ya.shape}"
         )
-    if not np.all(np.isfinite(ya)):
+    if not np.isfinite(ya).all():
         c, j = (int(v[0]) for v in np.nonzero(~np.isfinite(ya)))
         raise InputError(f"y[{c}, {j}] (state {c} at x = {x[j]}) is not finite ({ya[c, j]})")
     if p is None:
@@ -332,7 +342,7 @@ def _check_inputs(x, y, p, tol, max_nodes, bc_tol, complex_ok):
             raise InputError(f"p: expected a 1-D array of numbers ({e})") from None
         if pa.ndim != 1:
             raise InputError(f"p: expected a 1-D array, got shape {pa.shape}")
-        if not np.all(np.isfinite(pa)):
+        if not np.isfinite(pa).all():
             raise InputError(f"p is not finite: {pa}")
     if not (isinstance(tol, (int, float)) and 0 < tol < 1):
         raise InputError(f"tol must be in (0, 1), got {tol!r}")
@@ -511,7 +521,7 @@ def _solve_expressions(
     else:
         # scipy returns its last iterate; the toolkit returns none: the guess, with the message
         res.x = x
-        res.y = ya
+        res.y = ya.copy()
         res.yp = np.asarray(problem.rhs(x.tolist(), np.ascontiguousarray(ya), pa.tolist() + pvals))
         res.p = pa if k else None
         res.rms_residuals = np.full(x.size - 1, np.nan)

@@ -1,6 +1,7 @@
 //! The problem classes of issue 63 at tol 1e-6: singular problems (Emden's equation, the
 //! catalyst pellet; compare with benches/peers/scipy_singular.py) and a multipoint problem
-//! against the same equations on one interval with as many nodes.
+//! against the same equations on one interval with as many nodes; scipy's 60-state problem
+//! with and without its declared sparsity ([`Bvp::rhs_sparsity`]).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use diffbvp::mesh::{linspace, multipoint_linspace};
@@ -139,9 +140,85 @@ fn multipoint(c: &mut Criterion) {
     g.finish();
 }
 
+/// scipy's big problem: 60 states in pairs `y'' = -p_j² y` with two unknown eigenvalues; its
+/// sparsity declared (`sparse`) or not.
+struct BigPairs {
+    deps: Vec<Vec<usize>>,
+    sparse: bool,
+}
+
+impl BigPairs {
+    fn new(sparse: bool) -> Self {
+        let n = 60;
+        let deps = (0..n)
+            .map(|i| {
+                if i % 2 == 0 {
+                    vec![i + 1]
+                } else {
+                    vec![i - 1, n + (i / 2) % 2]
+                }
+            })
+            .collect();
+        BigPairs { deps, sparse }
+    }
+}
+
+impl Bvp for BigPairs {
+    fn dim(&self) -> usize {
+        60
+    }
+    fn num_unknowns(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        for i in (0..60).step_by(2) {
+            f[i] = y[i + 1];
+            f[i + 1] = -p[(i / 2) % 2].powi(2) * y[i];
+        }
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D], r: &mut [D]) {
+        for (j, i) in (0..60).step_by(2).enumerate() {
+            r[j] = ya[i];
+            r[30 + j] = yb[i];
+        }
+        r[60] = ya[1] - p[0];
+        r[61] = ya[3] - p[1];
+    }
+    fn rhs_sparsity(&self) -> Option<&[Vec<usize>]> {
+        self.sparse.then_some(self.deps.as_slice())
+    }
+}
+
+fn sparse_jacobian(c: &mut Criterion) {
+    // scipy's contract (tol 1e-3, its mesh rule): the same 17 nodes either way
+    let opts = SolveOptions {
+        tol: 1e-3,
+        coarsen: false,
+        mesh: diffbvp::mesh::MeshOptions::scipy(),
+        ..SolveOptions::default()
+    };
+    let mut guess = Guess::constant(linspace(0.0, std::f64::consts::PI, 5), &[1.0; 60]);
+    guess.unknowns = vec![0.5, 0.5];
+    let mut g = c.benchmark_group("big_60_states_2_unknowns");
+    for sparse in [true, false] {
+        let bvp = BigPairs::new(sparse);
+        let s = solve(&bvp, &[], &guess, &opts).unwrap();
+        println!(
+            "sparsity declared {sparse}: {} nodes, {} dual evaluations",
+            s.nodes(),
+            s.stats.rhs_dual_evaluations
+        );
+        let name = if sparse { "sparsity_declared" } else { "dense" };
+        g.bench_function(name, |b| {
+            b.iter(|| solve(&bvp, &[], black_box(&guess), &opts).unwrap())
+        });
+    }
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(30).measurement_time(std::time::Duration::from_secs(3));
-    targets = singular, multipoint
+    targets = singular, multipoint, sparse_jacobian
 }
 criterion_main!(benches);

@@ -12,7 +12,7 @@
 //! exact dual-number Jacobians of `f` at the nodes and midpoints and of `g`, combined by the chain
 //! rule (Ascher, Mattheij & Russell; Kierzenka & Shampine 2001).
 
-use crate::dual_jacobian::{BcFn, DualJacobian, InterfaceFn, RhsFn, Seeds};
+use crate::dual_jacobian::{BcFn, Coloring, DualJacobian, InterfaceFn, RhsFn, Seeds};
 use crate::error::BvpError;
 use crate::problem::Bvp;
 use crate::singular::Singular;
@@ -69,6 +69,9 @@ pub(crate) struct Collocation {
     seed_list: Vec<usize>,
     bc_seed_list: Vec<usize>,
     engine: DualJacobian,
+    /// The colouring of the node seeds by the problem's [`Bvp::rhs_sparsity`], when it saves
+    /// dual passes in the current pass.
+    coloring: Coloring,
 }
 
 impl Collocation {
@@ -98,6 +101,7 @@ impl Collocation {
             seed_list: Vec::new(),
             bc_seed_list: Vec::new(),
             engine: DualJacobian::default(),
+            coloring: Coloring::default(),
         }
     }
 
@@ -115,6 +119,42 @@ impl Collocation {
             }
         }
         Ok(())
+    }
+
+    /// Colours the node seeds by the problem's [`Bvp::rhs_sparsity`] (checked); whether the
+    /// node and midpoint Jacobians of this pass are compressed (not with a singular term, nor
+    /// when every seeded column needs a colour of its own).
+    fn refresh_coloring<P: Bvp>(
+        &mut self,
+        problem: &P,
+        seeds: Seeds<'_>,
+    ) -> Result<bool, BvpError> {
+        let Some(pattern) = problem.rhs_sparsity() else {
+            return Ok(false);
+        };
+        let inputs = self.n + self.k + self.q;
+        if pattern.len() != self.n {
+            return Err(BvpError::InvalidInput(format!(
+                "rhs_sparsity lists {} components for {} states",
+                pattern.len(),
+                self.n
+            )));
+        }
+        if let Some((i, &d)) = pattern
+            .iter()
+            .enumerate()
+            .find_map(|(i, deps)| deps.iter().find(|&&d| d >= inputs).map(|d| (i, d)))
+        {
+            return Err(BvpError::InvalidInput(format!(
+                "rhs_sparsity: component {i} lists input {d}, but [y, p] has {inputs} entries \
+                 ({} states, {} unknowns, {} model parameters)",
+                self.n, self.k, self.q
+            )));
+        }
+        if self.singular.is_some() {
+            return Ok(false);
+        }
+        Ok(self.coloring.build(pattern, seeds, inputs))
     }
 
     /// The region of every node from the zero-width intervals of the mesh (a multipoint mesh
@@ -444,6 +484,7 @@ impl Collocation {
         values: bool,
     ) -> Result<(), BvpError> {
         self.refresh_singular(problem)?;
+        let colored = self.refresh_coloring(problem, node_seeds)?;
         let (n, m) = (self.n, self.m());
         // the widths of the node and the boundary Jacobians' rows: `n + seeded` and
         // `2 n + seeded` but for `param_jacobians_only`
@@ -471,13 +512,20 @@ impl Collocation {
             } else {
                 &mut fbuf[..n]
             };
-            self.engine.jacobian_in(
-                &rf,
-                &self.input,
-                node_seeds,
-                out,
-                &mut self.jn[i * n * w..(i + 1) * n * w],
-            );
+            let jac = &mut self.jn[i * n * w..(i + 1) * n * w];
+            if colored {
+                self.engine.jacobian_colored(
+                    &rf,
+                    &self.input,
+                    node_seeds,
+                    &self.coloring,
+                    out,
+                    jac,
+                );
+            } else {
+                self.engine
+                    .jacobian_in(&rf, &self.input, node_seeds, out, jac);
+            }
         }
         if values {
             if let Err(e) = check_finite(&self.f, n, 1, |i| self.x[i], "right-hand side") {
@@ -511,15 +559,27 @@ impl Collocation {
             } else {
                 &mut fbuf[..n]
             };
-            self.engine.jacobian_in(
-                &rf,
-                &self.input,
-                node_seeds,
-                out,
-                &mut self.jm[i * n * w..(i + 1) * n * w],
-            );
+            let jac = &mut self.jm[i * n * w..(i + 1) * n * w];
+            if colored {
+                self.engine.jacobian_colored(
+                    &rf,
+                    &self.input,
+                    node_seeds,
+                    &self.coloring,
+                    out,
+                    jac,
+                );
+            } else {
+                self.engine
+                    .jacobian_in(&rf, &self.input, node_seeds, out, jac);
+            }
         }
-        self.jac_evals += (2 * m - 1) * w.div_ceil(8).max(1);
+        let passes = if colored {
+            self.coloring.passes()
+        } else {
+            w.div_ceil(8).max(1)
+        };
+        self.jac_evals += (2 * m - 1) * passes;
         if values {
             if let Err(e) = check_finite(
                 &self.f_mid,
@@ -674,13 +734,18 @@ impl Collocation {
         let jj = &self.jn[(i + 1) * n * w..(i + 2) * n * w];
         let jm = &self.jm[i * n * w..(i + 1) * n * w];
         // A = -I - h/6 (J_i + 4 Jm (I/2 + h/8 J_i)),  B = I - h/6 (J_j + 4 Jm (I/2 - h/8 J_j));
-        // the products Jm J_i and Jm J_j are accumulated row by row over contiguous rows of J
+        // the products Jm J_i and Jm J_j are accumulated row by row over contiguous rows of J;
+        // a zero of Jm adds nothing (exactly: the sums start at +0), so a sparse right-hand side
+        // costs O(n · nonzeros) instead of O(n³)
         for r in 0..n {
             let (sa, sb) = out[r * ld..r * ld + 2 * n].split_at_mut(n);
             sa.fill(0.0);
             sb.fill(0.0);
             let jmr = &jm[r * w..r * w + n];
             for (l, &jml) in jmr.iter().enumerate() {
+                if jml == 0.0 {
+                    continue;
+                }
                 let jil = &ji[l * w..l * w + n];
                 let jjl = &jj[l * w..l * w + n];
                 for (((a, b), &vi), &vj) in sa.iter_mut().zip(sb.iter_mut()).zip(jil).zip(jjl) {
@@ -767,12 +832,13 @@ impl Collocation {
             }
             let jm = &self.jm[i * n * w..(i + 1) * n * w];
             for r in 0..n {
-                // d y_mid / dp = -h/8 (fp_j - fp_i)
+                // d y_mid / dp = -h/8 (fp_j - fp_i); a zero of Jm adds nothing (the sum starts
+                // at +0), so a sparse right-hand side skips it
                 let mut s = 0.0;
-                for l in 0..n {
-                    s += jm[r * w + l]
-                        * (-0.125 * h)
-                        * (fp(parts.jn, i + 1, l) - fp(parts.jn, i, l));
+                for (l, &jml) in jm[r * w..r * w + n].iter().enumerate() {
+                    if jml != 0.0 {
+                        s += jml * (-0.125 * h) * (fp(parts.jn, i + 1, l) - fp(parts.jn, i, l));
+                    }
                 }
                 out[i * n + r] = -h / 6.0
                     * (fp(parts.jn, i, r)

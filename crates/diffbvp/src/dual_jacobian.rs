@@ -199,6 +199,179 @@ impl<const W: usize> Buffers<W> {
     }
 }
 
+impl<const W: usize> Buffers<W> {
+    /// The Jacobian in the seeded inputs by column compression: the columns of one colour of
+    /// `coloring` share a dual direction, and each row reads back only the columns its pattern
+    /// lists (the others are zero).
+    fn jacobian_colored<F: DualFn>(
+        &mut self,
+        f: &F,
+        input: &[f64],
+        seeds: Seeds<'_>,
+        coloring: &Coloring,
+        out: &mut [f64],
+        jac: &mut [f64],
+    ) {
+        let n_seeds = seeds.len();
+        let n_out = out.len();
+        self.seeded_for = None;
+        self.input.clear();
+        self.input
+            .extend(input.iter().map(|&v| DenseDual64::<W>::from_re(v)));
+        self.out.clear();
+        self.out.resize(n_out, DenseDual64::<W>::from_re(0.0));
+        jac[..n_out * n_seeds].fill(0.0);
+        let mut start = 0;
+        while start < coloring.colors.max(1) {
+            let end = (start + W).min(coloring.colors);
+            for v in self.input.iter_mut() {
+                *v = DenseDual64::<W>::from_re(v.re);
+            }
+            for (j, &c) in coloring.color.iter().enumerate() {
+                if (start..end).contains(&c) {
+                    let v = &mut self.input[seeds.input(j)];
+                    v.eps.0[c - start] = 1.0;
+                }
+            }
+            for o in self.out.iter_mut() {
+                *o = DenseDual64::<W>::from_re(0.0);
+            }
+            f.eval(&self.input, &mut self.out);
+            for (i, o) in self.out.iter().enumerate() {
+                if start == 0 {
+                    out[i] = o.re;
+                }
+                let row = &mut jac[i * n_seeds..(i + 1) * n_seeds];
+                for &j in coloring.row(i) {
+                    let c = coloring.color[j];
+                    if (start..end).contains(&c) {
+                        row[j] = o.eps.0[c - start];
+                    }
+                }
+            }
+            if coloring.colors == 0 {
+                break;
+            }
+            start = end;
+        }
+    }
+}
+
+/// A colouring of the seeded columns of a sparse Jacobian ([`Bvp::rhs_sparsity`]): columns
+/// that share no row get the same colour, so one dual direction carries them all (Curtis,
+/// Powell and Reid's compression, greedy in column order). Its buffers are kept between builds.
+#[derive(Default, Debug)]
+pub(crate) struct Coloring {
+    /// Colour of each seeded column.
+    color: Vec<usize>,
+    /// Number of colours.
+    colors: usize,
+    /// The seeded columns of row `i` (ascending): `cols[row_start[i]..row_start[i + 1]]`.
+    row_start: Vec<usize>,
+    cols: Vec<usize>,
+    /// Seeded column of each input (`usize::MAX` where not seeded).
+    column_of: Vec<usize>,
+    /// The rows of each column (`col_rows[col_start[j]..col_start[j + 1]]`).
+    col_start: Vec<usize>,
+    col_rows: Vec<usize>,
+    /// Per colour, the last column that found it taken.
+    taken: Vec<usize>,
+    /// Scratch: the next free slot of every column in `col_rows`.
+    fill: Vec<usize>,
+}
+
+impl Coloring {
+    /// Colours the columns `seeds` of a Jacobian whose row `i` depends on the inputs
+    /// `pattern[i]` (indices below `n_inputs`). Returns whether compression saves dual passes
+    /// (fewer colours than seeded columns).
+    pub(crate) fn build(
+        &mut self,
+        pattern: &[Vec<usize>],
+        seeds: Seeds<'_>,
+        n_inputs: usize,
+    ) -> bool {
+        let s = seeds.len();
+        self.column_of.clear();
+        self.column_of.resize(n_inputs, usize::MAX);
+        for j in 0..s {
+            self.column_of[seeds.input(j)] = j;
+        }
+        self.row_start.clear();
+        self.cols.clear();
+        self.row_start.push(0);
+        for deps in pattern {
+            let first = self.cols.len();
+            self.cols.extend(
+                deps.iter()
+                    .filter_map(|&d| self.column_of.get(d).copied())
+                    .filter(|&j| j != usize::MAX),
+            );
+            self.cols[first..].sort_unstable();
+            let mut w = first;
+            for r in first..self.cols.len() {
+                if r == first || self.cols[r] != self.cols[w - 1] {
+                    self.cols[w] = self.cols[r];
+                    w += 1;
+                }
+            }
+            self.cols.truncate(w);
+            self.row_start.push(self.cols.len());
+        }
+        // the rows of every column (counting sort of the row lists)
+        self.col_start.clear();
+        self.col_start.resize(s + 1, 0);
+        for &j in &self.cols {
+            self.col_start[j + 1] += 1;
+        }
+        for j in 0..s {
+            self.col_start[j + 1] += self.col_start[j];
+        }
+        self.col_rows.clear();
+        self.col_rows.resize(self.cols.len(), 0);
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.col_start[..s]);
+        for i in 0..pattern.len() {
+            for &j in &self.cols[self.row_start[i]..self.row_start[i + 1]] {
+                self.col_rows[self.fill[j]] = i;
+                self.fill[j] += 1;
+            }
+        }
+        self.color.clear();
+        self.color.resize(s, usize::MAX);
+        self.taken.clear();
+        self.colors = 0;
+        for j in 0..s {
+            for &i in &self.col_rows[self.col_start[j]..self.col_start[j + 1]] {
+                for &other in &self.cols[self.row_start[i]..self.row_start[i + 1]] {
+                    let c = self.color[other];
+                    if c != usize::MAX {
+                        self.taken[c] = j;
+                    }
+                }
+            }
+            let c = (0..self.colors)
+                .find(|&c| self.taken[c] != j)
+                .unwrap_or(self.colors);
+            if c == self.colors {
+                self.colors += 1;
+                self.taken.push(usize::MAX);
+            }
+            self.color[j] = c;
+        }
+        self.colors < s
+    }
+
+    /// The seeded columns row `i` depends on.
+    fn row(&self, i: usize) -> &[usize] {
+        &self.cols[self.row_start[i]..self.row_start[i + 1]]
+    }
+
+    /// Dual passes of a compressed Jacobian (at most 8 directions each).
+    pub(crate) fn passes(&self) -> usize {
+        self.colors.div_ceil(8).max(1)
+    }
+}
+
 /// Reusable workspace for dual-number Jacobians.
 #[derive(Default)]
 pub(crate) struct DualJacobian {
@@ -240,6 +413,37 @@ impl DualJacobian {
             2 => self.w2.jacobian(f, input, seeds, out, jac),
             3 | 4 => self.w4.jacobian(f, input, seeds, out, jac),
             _ => self.w8.jacobian(f, input, seeds, out, jac),
+        }
+    }
+}
+
+impl DualJacobian {
+    /// [`jacobian_in`](Self::jacobian_in) by column compression with `coloring` (built for
+    /// `seeds` by [`Coloring::build`]): the same derivatives in `ceil(colours / W)` passes.
+    pub(crate) fn jacobian_colored<F: DualFn>(
+        &mut self,
+        f: &F,
+        input: &[f64],
+        seeds: Seeds<'_>,
+        coloring: &Coloring,
+        out: &mut [f64],
+        jac: &mut [f64],
+    ) {
+        debug_assert_eq!(coloring.color.len(), seeds.len());
+        debug_assert_eq!(coloring.row_start.len(), out.len() + 1);
+        match coloring.colors {
+            0 | 1 => self
+                .w1
+                .jacobian_colored(f, input, seeds, coloring, out, jac),
+            2 => self
+                .w2
+                .jacobian_colored(f, input, seeds, coloring, out, jac),
+            3 | 4 => self
+                .w4
+                .jacobian_colored(f, input, seeds, coloring, out, jac),
+            _ => self
+                .w8
+                .jacobian_colored(f, input, seeds, coloring, out, jac),
         }
     }
 }
@@ -326,6 +530,58 @@ mod tests {
                     full[i * 13 + c],
                     "prefix row {i}, input {c}"
                 );
+            }
+        }
+    }
+
+    /// `out_i = x_i x_{(i+3) mod n} + sin(x_n)` for `n` outputs of `n + 1` inputs: a banded
+    /// part and one input every row reads.
+    struct Banded(usize);
+    impl DualFn for Banded {
+        fn eval<D: DualNum<Primitive = f64> + Copy>(&self, x: &[D], out: &mut [D]) {
+            let n = self.0;
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = x[i] * x[(i + 3) % n] + x[n].sin();
+            }
+        }
+    }
+
+    #[test]
+    fn colored_jacobian_equals_the_dense_one() {
+        for n in [3usize, 5, 8, 13, 40] {
+            let x: Vec<f64> = (0..=n).map(|i| 0.2 + 0.05 * i as f64).collect();
+            let pattern: Vec<Vec<usize>> = (0..n).map(|i| vec![i, (i + 3) % n, n]).collect();
+            let f = Banded(n);
+            let mut engine = DualJacobian::default();
+            let mut out = vec![0.0; n];
+            let mut full = vec![0.0; n * (n + 1)];
+            engine.jacobian(&f, &x, n + 1, &mut out, &mut full);
+            // all columns, the states only, and a list that skips some
+            let lists: [Vec<usize>; 3] = [
+                (0..=n).collect(),
+                (0..n).collect(),
+                (0..=n).filter(|j| j % 3 != 1).collect(),
+            ];
+            for list in &lists {
+                let s = list.len();
+                let mut coloring = Coloring::default();
+                let saves = coloring.build(&pattern, Seeds::These(list), n + 1);
+                // a band of width 2 and one dense column: at most 4 colours
+                assert!(coloring.colors <= 4, "n = {n}: {} colours", coloring.colors);
+                assert_eq!(saves, coloring.colors < s);
+                let mut jac = vec![f64::NAN; n * s];
+                let mut o = vec![0.0; n];
+                engine.jacobian_colored(&f, &x, Seeds::These(list), &coloring, &mut o, &mut jac);
+                assert_eq!(o, out);
+                for i in 0..n {
+                    for (j, &c) in list.iter().enumerate() {
+                        assert_eq!(
+                            jac[i * s + j],
+                            full[i * (n + 1) + c],
+                            "n {n} row {i} in {c}"
+                        );
+                    }
+                }
             }
         }
     }

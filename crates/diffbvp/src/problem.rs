@@ -107,6 +107,22 @@ pub trait Bvp {
         None
     }
 
+    /// The structural sparsity of the right-hand side (default `None`: every component may read
+    /// every input): entry `i` lists the inputs `f_i` may depend on, as indices into `[y, p]`
+    /// (the states `0..n`, then the `k` unknowns and the `q` model parameters at `n..n + k + q`),
+    /// in every region of a multipoint problem. With it the solver seeds inputs that no
+    /// component reads together in one dual direction (a greedy column colouring, computed once
+    /// per Jacobian evaluation), so a large sparse system needs a few dual passes instead of
+    /// `(n + k) / 8`; the derivatives are the same numbers. A listed input that `f_i` does not
+    /// read costs only speed; an input `f_i` reads but that is not listed makes the Jacobian
+    /// wrong, so list every one. An index out of range is an
+    /// [`BvpError::InvalidInput`](crate::BvpError::InvalidInput). Ignored for a problem with a
+    /// [`singular_term`](Bvp::singular_term) (whose value at the singular point mixes the
+    /// components). `expr::ExprBvp` (feature `expr`) derives it from its expressions.
+    fn rhs_sparsity(&self) -> Option<&[Vec<usize>]> {
+        None
+    }
+
     /// Interior interface points `x_1 < … < x_{R-1}` of a multipoint problem (default none):
     /// the interval `[a, b]` is split into `R` regions, the states may jump at every interface,
     /// and the mesh holds each interface twice (its left and its right limit, as bvp4c's

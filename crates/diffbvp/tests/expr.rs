@@ -5,6 +5,7 @@
 
 use diffbvp::expr::{ExprBvp, ExprError};
 use diffbvp::mesh::linspace;
+use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{solve, Bvp, BvpError, Guess, SolveOptions};
 use num_dual::Dual64;
 
@@ -213,5 +214,151 @@ fn division_by_zero_is_a_non_finite_error() {
     match solve(&bad, &[], &g, &SolveOptions::default()) {
         Err(BvpError::NonFinite { component, .. }) => assert_eq!(component, 1),
         other => panic!("expected NonFinite, got {other:?}"),
+    }
+}
+
+/// The same problem without its declared sparsity: every Jacobian dense.
+struct Dense<'a>(&'a ExprBvp);
+
+impl Bvp for Dense<'_> {
+    fn dim(&self) -> usize {
+        self.0.dim()
+    }
+    fn num_unknowns(&self) -> usize {
+        self.0.num_unknowns()
+    }
+    fn num_params(&self) -> usize {
+        self.0.num_params()
+    }
+    fn rhs<D: diffbvp::DualNum<Primitive = f64> + Copy>(
+        &self,
+        x: f64,
+        y: &[D],
+        p: &[D],
+        f: &mut [D],
+    ) {
+        self.0.rhs(x, y, p, f)
+    }
+    fn bc<D: diffbvp::DualNum<Primitive = f64> + Copy>(
+        &self,
+        ya: &[D],
+        yb: &[D],
+        p: &[D],
+        r: &mut [D],
+    ) {
+        self.0.bc(ya, yb, p, r)
+    }
+}
+
+/// scipy's big problem: `n` states in pairs `y'' = -p_j² y` with two unknown eigenvalues, plus
+/// a model parameter `c` in a weak coupling of the last pair (so the sparsity has a parameter
+/// column shared by rows that also read states).
+fn big(n: usize) -> ExprBvp {
+    let fun: Vec<String> = (0..n)
+        .map(|i| match i % 4 {
+            0 | 2 => format!("y[{}]", i + 1),
+            1 => format!("-p[0]**2*y[{}]", i - 1),
+            _ if i == n - 1 => format!("-p[1]**2*y[{}] + c*sin(y[0])*0", i - 1),
+            _ => format!("-p[1]**2*y[{}]", i - 1),
+        })
+        .collect();
+    let mut bc: Vec<String> = (0..n).step_by(2).map(|i| format!("ya[{i}]")).collect();
+    bc.extend((0..n).step_by(2).map(|i| format!("yb[{i}]")));
+    bc.push("ya[1] - p[0]".into());
+    bc.push("ya[3] - p[1]".into());
+    let f: Vec<&str> = fun.iter().map(String::as_str).collect();
+    let b: Vec<&str> = bc.iter().map(String::as_str).collect();
+    ExprBvp::builder()
+        .unknowns(&["", ""])
+        .params(&["c"])
+        .build(&f, &b)
+        .unwrap()
+}
+
+#[test]
+fn declared_sparsity_gives_the_same_solution_in_fewer_dual_passes() {
+    let bvp = big(60);
+    let deps = bvp.rhs_sparsity().unwrap();
+    assert_eq!(deps[0], vec![1]);
+    assert_eq!(deps[1], vec![0, 60]);
+    assert_eq!(deps[59], vec![0, 58, 61, 62]);
+    let mut guess = Guess::constant(linspace(0.0, std::f64::consts::PI, 5), &[1.0; 60]);
+    guess.unknowns = vec![0.5, 0.5];
+    let opts = SolveOptions::with_tol(1e-3);
+    let sparse = solve(&bvp, &[0.3], &guess, &opts).unwrap();
+    let dense = solve(&Dense(&bvp), &[0.3], &guess, &opts).unwrap();
+    // the derivatives are the same numbers, so is every iterate
+    assert_eq!(sparse.x, dense.x);
+    assert_eq!(sparse.y, dense.y);
+    assert_eq!(sparse.unknowns, dense.unknowns);
+    assert_eq!(
+        sparse.stats.newton_iterations,
+        dense.stats.newton_iterations
+    );
+    // y'' = -p² y, y(0) = y(π) = 0, y'(0) = p: the eigenvalue p = 1 (y = sin x) for both
+    assert!(
+        sparse.unknowns.iter().all(|p| (p - 1.0).abs() < 1e-3),
+        "{:?}",
+        sparse.unknowns
+    );
+    // 60 state columns and 2 unknowns in 2 colours: one pass per point instead of 8
+    assert!(
+        sparse.stats.rhs_dual_evaluations * 4 <= dense.stats.rhs_dual_evaluations,
+        "{} dual evaluations with the sparsity, {} without",
+        sparse.stats.rhs_dual_evaluations,
+        dense.stats.rhs_dual_evaluations
+    );
+    // sensitivities in the model parameter through the compressed Jacobians: as dense
+    let a = Sensitivities::compute(&bvp, &sparse).unwrap();
+    let b = Sensitivities::compute(&Dense(&bvp), &dense).unwrap();
+    for x in [0.5, 1.5, 2.5] {
+        assert_eq!(a.at(x), b.at(x), "x = {x}");
+    }
+}
+
+/// A problem whose declared sparsity is out of range.
+struct BadSparsity(Vec<Vec<usize>>);
+
+impl Bvp for BadSparsity {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs<D: diffbvp::DualNum<Primitive = f64> + Copy>(
+        &self,
+        _x: f64,
+        y: &[D],
+        _p: &[D],
+        f: &mut [D],
+    ) {
+        f[0] = y[1];
+        f[1] = -y[0];
+    }
+    fn bc<D: diffbvp::DualNum<Primitive = f64> + Copy>(
+        &self,
+        ya: &[D],
+        yb: &[D],
+        _p: &[D],
+        r: &mut [D],
+    ) {
+        r[0] = ya[0];
+        r[1] = yb[0] - 1.0;
+    }
+    fn rhs_sparsity(&self) -> Option<&[Vec<usize>]> {
+        Some(&self.0)
+    }
+}
+
+#[test]
+fn a_sparsity_out_of_range_is_refused_with_its_component() {
+    let guess = Guess::constant(linspace(0.0, 1.0, 5), &[0.0, 0.0]);
+    let opts = SolveOptions::with_tol(1e-6);
+    for (deps, want) in [
+        (vec![vec![1], vec![2]], "component 1 lists input 2"),
+        (vec![vec![1]], "lists 1 components for 2 states"),
+    ] {
+        match solve(&BadSparsity(deps), &[], &guess, &opts) {
+            Err(BvpError::InvalidInput(m)) => assert!(m.contains(want), "{m}"),
+            other => panic!("expected InvalidInput, got {other:?}"),
+        }
     }
 }

@@ -256,7 +256,18 @@ impl ExprBuilder {
         }
         let rhs = self.parse_all(rhs, "fun", Place::Rhs, n)?;
         let bc = self.parse_all(bc, "bc", Place::Bc, n)?;
+        let sparsity = rhs
+            .iter()
+            .map(|e| {
+                let mut deps = Vec::new();
+                e.node.inputs(n, &mut deps);
+                deps.sort_unstable();
+                deps.dedup();
+                deps
+            })
+            .collect();
         Ok(ExprBvp {
+            sparsity,
             n,
             k,
             q: self.params.len(),
@@ -287,6 +298,8 @@ pub struct ExprBvp {
     bc: Vec<Expr>,
     names: Vec<String>,
     singular: Option<Vec<f64>>,
+    /// The inputs (`[y, p]`) each right-hand-side expression reads ([`Bvp::rhs_sparsity`]).
+    sparsity: Vec<Vec<usize>>,
 }
 
 impl ExprBvp {
@@ -353,6 +366,10 @@ impl Bvp for ExprBvp {
 
     fn singular_term(&self) -> Option<Vec<f64>> {
         self.singular.clone()
+    }
+
+    fn rhs_sparsity(&self) -> Option<&[Vec<usize>]> {
+        Some(&self.sparsity)
     }
 }
 

@@ -193,6 +193,28 @@ impl Node {
         }
     }
 
+    /// Adds the inputs this tree reads, as indices into `[y, p]` for `n` states, to `deps`
+    /// (unsorted, possibly repeated).
+    pub(crate) fn inputs(&self, n: usize, deps: &mut Vec<usize>) {
+        match self {
+            Node::Y(i) => deps.push(*i),
+            Node::P(i) => deps.push(n + i),
+            Node::Const(_) | Node::X | Node::Ya(_) | Node::Yb(_) => {}
+            Node::Neg(a) | Node::PowI(a, _) | Node::PowF(a, _) | Node::Call(_, a) => {
+                a.inputs(n, deps)
+            }
+            Node::Bin(_, a, b) | Node::Cmp(_, a, b) => {
+                a.inputs(n, deps);
+                b.inputs(n, deps);
+            }
+            Node::Where(c, a, b) => {
+                c.inputs(n, deps);
+                a.inputs(n, deps);
+                b.inputs(n, deps);
+            }
+        }
+    }
+
     /// The node with constant subtrees folded into constants.
     pub(crate) fn fold(self) -> Node {
         let c = |n: &Node| match n {
