@@ -10,6 +10,8 @@ Contenders per problem:
   scipy+jac   the same with the analytic fun_jac/bc_jac (where scipy's tests give them)
   expr        diffbvp.solve_bvp with expressions (Rust, exact Jacobians, GIL released)
   callable    diffbvp.solve_bvp with the same callables (scipy's collocation, wrapped)
+  pounce      pounce.solve_bvp (pounce-solver on PyPI, the other Rust/PyO3 drop-in), the same
+              callables; pounce+jac with the analytic Jacobians (only where it is installed)
 """
 
 from __future__ import annotations
@@ -22,6 +24,11 @@ import numpy as np
 from scipy.integrate import solve_bvp as scipy_solve_bvp
 
 import diffbvp
+
+try:  # the other Rust/PyO3 drop-in, where it installs (pip install pounce-solver)
+    import pounce
+except ImportError:  # pragma: no cover - optional peer
+    pounce = None
 
 sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/tests")
 import test_solve_bvp as T  # noqa: E402  (scipy's problems, written once)
@@ -76,6 +83,8 @@ def main(n: int) -> None:
     head = f"{'problem':<24}{'contender':<11}{'time':>11}{'ratio':>9}{'nodes':>7}  status"
     print(head)
     print("-" * len(head))
+    if pounce is None:
+        print("(pounce-solver not installed: its rows are left out)")
     for name, (f, g, fj, gj), (ef, eb, kw), x, y, p, tol in PROBLEMS:
         S = kw.get("S")
         kw_cb = {"S": S} if S is not None else {}
@@ -87,7 +96,18 @@ def main(n: int) -> None:
         if fj is not None:
             runs["scipy+jac"] = lambda: scipy_solve_bvp(f, g, x, y, p=p, tol=tol, fun_jac=fj,
                                                         bc_jac=gj, **kw_cb)
-        results = {k: r() for k, r in runs.items()}
+        if pounce is not None:
+            runs["pounce"] = lambda: pounce.solve_bvp(f, g, x, y, p=p, tol=tol, **kw_cb)
+            if fj is not None:
+                runs["pounce+jac"] = lambda: pounce.solve_bvp(f, g, x, y, p=p, tol=tol,
+                                                              fun_jac=fj, bc_jac=gj, **kw_cb)
+        results, refused = {}, {}
+        for k, r in list(runs.items()):
+            try:
+                results[k] = r()
+            except Exception as e:  # a peer that does not support the problem (pounce and S)
+                refused[k] = f"{type(e).__name__}: {e}"
+                del runs[k]
         times = {k: [] for k in runs}
         for _ in range(n):  # alternate the contenders
             for k, r in runs.items():
@@ -95,7 +115,9 @@ def main(n: int) -> None:
                 r()
                 times[k].append(time.perf_counter() - t0)
         base = statistics.median(times["scipy"])
-        for k in ["scipy", "scipy+jac", "expr", "callable"]:
+        for k in ["scipy", "scipy+jac", "expr", "callable", "pounce", "pounce+jac"]:
+            if k in refused:
+                print(f"{name:<24}{k:<11}  refused: {refused[k][:70]}")
             if k not in runs:
                 continue
             t = statistics.median(times[k])

@@ -87,6 +87,12 @@ class ExprProblem:
     def solve(self, x: List[float], y: np.ndarray, unknowns: List[float], params: List[float],
               tol: float, bc_tol: Optional[float], max_nodes: int, verbose: int,
               scipy_mesh: bool) -> Tuple[int, str, Optional["BvpSolution"]]: ...
+    def fit(self, x: List[float], y: np.ndarray, unknowns: List[float], params: List[float],
+            fit: List[int], lower: List[float], upper: List[float], data_x: List[float],
+            data_y: List[float], sigma: List[float], component: int, tol: float,
+            max_nodes: int, xtol: float, ftol: float, max_iterations: int
+            ) -> Tuple[List[float], float, List[float], List[float], str, bool, int, int,
+                       "BvpSolution"]: ...
 
 class BvpSolution:
     """A converged solution of an ``ExprProblem`` with its derivatives."""
@@ -107,3 +113,5 @@ class BvpSolution:
     def sensitivities(self, xs: Optional[List[float]] = None) -> Tuple[np.ndarray, np.ndarray]: ...
     def adjoint_gradient(self, functional: str, xs: List[float],
                          weights: List[float]) -> Tuple[float, np.ndarray]: ...
+    def integral(self, integrand: str,
+                 endpoint: Optional[str] = None) -> Tuple[float, np.ndarray]: ...

@@ -41,6 +41,9 @@ __all__ = [
     "continue_bvp",
 ]
 
+# the most observations fit_bvp takes (the data set loader's row limit)
+_MAX_FIT_POINTS = 1_000_000
+
 _STATUS_MESSAGES = {
     0: "The algorithm converged to the desired accuracy.",
     1: "The maximum number of mesh nodes is exceeded.",
@@ -177,6 +180,28 @@ class BvpResult(dict):
         if w.shape != xs.shape:
             raise InputError(f"gradient: {xs.size} points but {w.size} weights")
         value, grad = native.adjoint_gradient(to_expression(functional), xs.tolist(), w.tolist())
+        return value, np.asarray(grad)
+
+    def integral(self, integrand: Any, endpoint: Any = None) -> Tuple[float, np.ndarray]:
+        """Value and gradient with respect to the model parameters of the integral functional
+        ``G = ∫ g(x, y, p) dx + φ(y(a), y(b), p)`` by the adjoint method (one transposed solve).
+        ``integrand`` is an expression (string or SymPy) in ``x``, ``y[i]`` and the parameters;
+        ``endpoint`` (optional) one in ``ya[i]``, ``yb[i]`` and the parameters. The quadrature
+        is Simpson's rule on the solution's cubic interpolant (exact for ``g`` linear in
+        ``y``), and the gradient is that of the same quadrature.
+
+        >>> import numpy as np
+        >>> from diffbvp import solve_bvp
+        >>> r = solve_bvp(["y[1]", "k**2*y[0]"], ["ya[0] - 1", "yb[0]"], np.linspace(0, 1, 11),
+        ...               np.zeros((2, 11)), tol=1e-8, params={"k": 2.0})
+        >>> G, dG = r.integral("y[0]")      # (cosh k - 1) / (k sinh k) and its d/dk
+        >>> round(G, 6), round(float(dG[0]), 6)
+        (0.380797, -0.085405)
+        """
+        native = self._native_solution()
+        value, grad = native.integral(
+            to_expression(integrand), None if endpoint is None else to_expression(endpoint)
+        )
         return value, np.asarray(grad)
 
 
@@ -502,24 +527,11 @@ def _solve_expressions(
         x.tolist(), np.ascontiguousarray(ya), pa.tolist(), pvals, float(tol),
         None if bc_tol is None else float(bc_tol), int(max_nodes), 0, True,
     )
-    res = BvpResult()
-    res.jacobian = "exact (expressions)"
-    res.backend = "diffbvp"
-    res.params = dict(zip(pnames, pvals))
-    res.status = status
-    res.success = status == 0
     if native is not None:
-        res.x = np.asarray(native.x)
-        res.y = np.asarray(native.y)
-        res.yp = np.asarray(native.yp)
-        res.p = np.asarray(native.unknowns) if k else None
-        res.rms_residuals = np.asarray(native.rms_residuals)
-        newton, refinements, coarsenings, max_res, max_bc = native.stats
-        res.niter = 1 + refinements + coarsenings
-        res.message = _STATUS_MESSAGES[0]
-        object.__setattr__(res, "_native", native)
+        res, max_res, max_bc = _result_of(native, k, dict(zip(pnames, pvals)))
     else:
         # scipy returns its last iterate; the toolkit returns none: the guess, with the message
+        res = _expr_result(dict(zip(pnames, pvals)), status)
         res.x = x
         res.y = ya.copy()
         res.yp = np.asarray(problem.rhs(x.tolist(), np.ascontiguousarray(ya), pa.tolist() + pvals))
@@ -527,10 +539,36 @@ def _solve_expressions(
         res.rms_residuals = np.full(x.size - 1, np.nan)
         res.niter = 0
         res.message = f"{_STATUS_MESSAGES.get(status, 'Failed.')} {message}"
+        res.sol = CubicInterpolant(res.x, res.y, res.yp)
         max_res = max_bc = float("nan")
-    res.sol = CubicInterpolant(res.x, res.y, res.yp)
     _report(verbose, res, max_res, max_bc)
     return res
+
+
+def _expr_result(params: Dict[str, float], status: int) -> BvpResult:
+    res = BvpResult()
+    res.jacobian = "exact (expressions)"
+    res.backend = "diffbvp"
+    res.params = params
+    res.status = status
+    res.success = status == 0
+    return res
+
+
+def _result_of(native: Any, k: int, params: Dict[str, float]) -> Tuple[BvpResult, float, float]:
+    """The result of a converged native solution, with its largest residuals."""
+    res = _expr_result(params, 0)
+    res.x = np.asarray(native.x)
+    res.y = np.asarray(native.y)
+    res.yp = np.asarray(native.yp)
+    res.p = np.asarray(native.unknowns) if k else None
+    res.rms_residuals = np.asarray(native.rms_residuals)
+    newton, refinements, coarsenings, max_res, max_bc = native.stats
+    res.niter = 1 + refinements + coarsenings
+    res.message = _STATUS_MESSAGES[0]
+    res.sol = CubicInterpolant(res.x, res.y, res.yp)
+    object.__setattr__(res, "_native", native)
+    return res, max_res, max_bc
 
 
 def _report(verbose, res, max_res, max_bc):
@@ -679,12 +717,16 @@ def fit_bvp(
     unknowns: Optional[Sequence[str]] = None,
     xtol: float = 1e-10,
     ftol: float = 1e-12,
+    max_iterations: int = 100,
 ) -> BvpFitResult:
     """Fit the model parameters ``params`` (name → start value) of a problem given as
-    expressions to observations ``data_y ≈ y_component(data_x)`` by bounded least squares
-    (scipy's trust-region reflective method, the Jacobian exact from the toolkit's forward
-    sensitivities; each evaluation warm-starts from the previous solution). ``bounds`` maps
-    names to ``(low, high)``; ``sigma`` weights the residuals ``(y - data)/sigma``.
+    expressions to observations ``data_y ≈ y_component(data_x)`` by the toolkit's bounded
+    trust-region least squares, in Rust with the GIL released: the Jacobian exact from forward
+    sensitivities, each solve warm-started from the last accepted one, Ctrl-C honoured.
+    ``bounds`` maps names to ``(low, high)``; ``sigma`` weights the residuals
+    ``(y - data)/sigma``; ``xtol``, ``ftol`` and ``max_iterations`` (trial steps) end the fit,
+    and ``message`` says which did. ``data_x`` must lie within ``[x[0], x[-1]]`` and holds at
+    most 1,000,000 observations.
 
     >>> import numpy as np
     >>> from diffbvp import fit_bvp
@@ -694,78 +736,99 @@ def fit_bvp(
     >>> round(f.params["k"], 5)
     0.7
     """
-    try:
-        from scipy.optimize import least_squares
-    except ImportError:
-        raise InputError("fit_bvp needs scipy (scipy.optimize.least_squares)") from None
+    from . import _native
+
     names = list(params)
     if not names:
         raise InputError("fit_bvp: params must name at least one model parameter")
-    p0 = np.array([float(params[k]) for k in names])
+    p0 = []
+    for name in names:
+        try:
+            v = float(params[name])
+        except (TypeError, ValueError):
+            raise InputError(f"params[{name!r}]: expected a number, got {params[name]!r}") from None
+        if not np.isfinite(v):
+            raise InputError(f"params[{name!r}] is not finite ({v})")
+        p0.append(v)
+    x, ya, pa = _check_inputs(x, y, p, tol, max_nodes, None, complex_ok=False)
     xd = np.asarray(data_x, dtype=float).ravel()
     yd = np.asarray(data_y, dtype=float).ravel()
     if xd.shape != yd.shape or xd.size == 0:
         raise InputError(f"data_x and data_y: {xd.size} and {yd.size} values; they must match")
-    if not (np.all(np.isfinite(xd)) and np.all(np.isfinite(yd))):
+    if not (np.isfinite(xd).all() and np.isfinite(yd).all()):
         raise InputError("data_x and data_y must be finite")
-    sig = np.ones_like(yd) if sigma is None else np.broadcast_to(np.asarray(sigma, float), yd.shape)
-    if np.any(~(sig > 0)):
-        raise InputError("sigma must be positive")
-    lo = np.full(p0.size, -np.inf)
-    hi = np.full(p0.size, np.inf)
+    outside = (xd < x[0]) | (xd > x[-1])
+    if outside.any():
+        j = int(np.flatnonzero(outside)[0])
+        raise InputError(
+            f"data_x[{j}] = {xd[j]} is outside the interval [{x[0]}, {x[-1]}] of x"
+        )
+    if xd.size > _MAX_FIT_POINTS:
+        raise InputError(
+            f"data_x: {xd.size} observations, more than {_MAX_FIT_POINTS}; thin the data"
+        )
+    try:
+        sig = np.broadcast_to(np.asarray(1.0 if sigma is None else sigma, float), yd.shape)
+    except ValueError:
+        raise InputError(f"sigma: a number or {yd.size} values, got shape "
+                         f"{np.shape(sigma)}") from None
+    if not (sig > 0).all() or not np.isfinite(sig).all():
+        raise InputError("sigma must be positive and finite")
+    lo = np.full(len(p0), -np.inf)
+    hi = np.full(len(p0), np.inf)
     for name, (a, b) in dict(bounds or {}).items():
         if name not in names:
             raise InputError(f"bounds: {name!r} is not one of the fitted params {names}")
         i = names.index(name)
         lo[i], hi[i] = float(a), float(b)
-    state = {"x": np.asarray(x, dtype=float), "y": np.asarray(y, dtype=float), "p": p,
-             "last": None, "key": None}
-
-    def solve_at(q):
-        key = tuple(q)
-        if state["key"] == key:
-            return state["last"]
-        r = solve_bvp(fun, bc, state["x"], state["y"], p=state["p"], tol=tol,
-                      max_nodes=max_nodes, params=dict(zip(names, q)), constants=constants,
-                      unknowns=unknowns)
-        if not r.success:
-            raise EvaluationError(
-                f"fit_bvp: the solve failed at params {dict(zip(names, q))}: {r.message}"
-            )
-        state.update(x=r.x, y=r.y, p=r.p, last=r, key=key)
-        return r
-
-    def residuals(q):
-        r = solve_at(q)
-        return (r.sol(xd)[component] - yd) / sig
-
-    def jac(q):
-        r = solve_at(q)
-        return r.sensitivities(xd)["dy"][component] / sig[:, None]
-
-    out = least_squares(residuals, p0, jac=jac, bounds=(lo, hi), method="trf",
-                        xtol=xtol, ftol=ftol, gtol=1e-12)
-    J = out.jac
-    dof = max(yd.size - p0.size, 1)
-    s2 = 2 * out.cost / dof if sigma is None else 1.0
+        if not lo[i] < hi[i]:
+            raise InputError(f"bounds[{name!r}] = ({a}, {b}): the lower bound must be below "
+                             "the upper one")
+        if not lo[i] <= p0[i] <= hi[i]:
+            raise InputError(f"params[{name!r}] = {p0[i]} is outside its bounds ({a}, {b})")
+    fun_s = _expressions(fun, "fun")
+    bc_s = _expressions(bc, "bc")
+    n, k = len(fun_s), pa.size
+    if ya.shape[0] != n:
+        raise InputError(f"y: {ya.shape[0]} rows for {n} states; expected shape ({n}, {x.size})")
+    if not (isinstance(component, (int, np.integer)) and 0 <= component < n):
+        raise InputError(f"component must be a state index in 0..{n - 1}, got {component!r}")
+    unknowns = [""] * k if unknowns is None else [str(u) for u in unknowns]
+    if len(unknowns) != k:
+        raise InputError(f"unknowns: {len(unknowns)} names for {k} values of p")
+    consts = [(str(a), float(b)) for a, b in dict(constants or {}).items()]
+    problem = _native.ExprProblem(fun_s, bc_s, unknowns, names, consts, None)
+    if len(bc_s) != n + k:
+        raise InputError(f"bc: {len(bc_s)} boundary conditions for {n} states and {k} unknown "
+                         f"parameters; n + k = {n + k} are needed")
+    (pf, cost, resid, jac, termination, success, iterations, accepted,
+     native) = problem.fit(
+        x.tolist(), np.ascontiguousarray(ya), pa.tolist(), p0, list(range(len(p0))),
+        lo.tolist(), hi.tolist(), xd.tolist(), yd.tolist(), sig.tolist(), int(component),
+        float(tol), int(max_nodes), float(xtol), float(ftol), int(max_iterations),
+    )
+    pf = np.asarray(pf)
+    J = np.asarray(jac).reshape(xd.size, len(p0))
+    dof = max(yd.size - pf.size, 1)
+    s2 = 2 * cost / dof if sigma is None else 1.0
     try:
         cov = np.linalg.inv(J.T @ J) * s2
     except np.linalg.LinAlgError:
-        cov = np.full((p0.size, p0.size), np.nan)
+        cov = np.full((pf.size, pf.size), np.nan)
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
     res = BvpFitResult()
-    res.params = dict(zip(names, out.x.tolist()))
-    res.x = out.x
-    res.cost = float(out.cost)
-    res.residuals = out.fun
+    res.params = dict(zip(names, pf.tolist()))
+    res.x = pf
+    res.cost = float(cost)
+    res.residuals = np.asarray(resid)
     res.jac = J
     res.covariance = cov
     res.stderr = se
-    res.ci95 = np.stack((out.x - 1.959963984540054 * se, out.x + 1.959963984540054 * se), axis=1)
-    res.success = bool(out.success)
-    res.message = out.message
-    res.nfev = int(out.nfev)
-    res.solution = solve_at(out.x)
+    res.ci95 = np.stack((pf - 1.959963984540054 * se, pf + 1.959963984540054 * se), axis=1)
+    res.success = bool(success)
+    res.message = f"{termination} ({iterations} trial steps, {accepted} accepted)"
+    res.nfev = int(iterations) + 1
+    res.solution = _result_of(native, k, dict(zip(names, pf.tolist())))[0]
     return res
 
 

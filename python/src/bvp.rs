@@ -6,8 +6,10 @@
 
 use crate::errors::{diffbvp_error, input_error};
 use diffbvp::expr::{ExprBuilder, ExprBvp, ExprError};
+use diffbvp::least_squares::{self, BvpResiduals, BvpRun, FitOptions, ParamMap, Termination};
 use diffbvp::mesh::MeshOptions;
-use diffbvp::sensitivity::{adjoint_gradient, Sensitivities};
+use diffbvp::sensitivity::{adjoint_gradient, integral_adjoint, PointFunction, Sensitivities};
+use diffbvp::DualNum;
 use diffbvp::{Bvp, BvpError, Guess, Solution, SolveOptions, Solver};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -135,8 +137,7 @@ impl ExprProblem {
         verbose: u8,
         scipy_mesh: bool,
     ) -> PyResult<(i32, String, Option<BvpSolution>)> {
-        let (n, m) = shape(&y, self.bvp.dim(), x.len(), "y")?;
-        check_p(&unknowns, self.bvp.num_unknowns())?;
+        let guess = self.guess(x, &y, unknowns)?;
         if params.len() != self.bvp.num_params() {
             return Err(input_error(format!(
                 "params: the problem has {} model parameters, got {} values",
@@ -144,14 +145,6 @@ impl ExprProblem {
                 params.len()
             )));
         }
-        let ya = y.as_array();
-        let mut g = vec![0.0; n * m];
-        for (j, row) in g.chunks_exact_mut(n).enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v = ya[[c, j]];
-            }
-        }
-        let guess = Guess { x, y: g, unknowns };
         let options = SolveOptions {
             tol,
             bc_tol,
@@ -219,6 +212,144 @@ impl ExprProblem {
                 Ok((status, e.to_string(), None))
             }
         }
+    }
+
+    /// Fits the model parameters `fit` (indices into `params`, start values there) to the
+    /// observations `data_y ≈ y_component(data_x)`, residuals `(y − data) / sigma`, within
+    /// `[lower, upper]`, by the toolkit's bounded trust-region least squares with the Jacobian
+    /// exact from forward sensitivities, each solve warm-started from the last accepted one,
+    /// with the GIL released. Returns `(p, cost, residuals, jacobian (N × P row-major),
+    /// termination, success, iterations, accepted steps, solution at p)`.
+    #[pyo3(signature = (x, y, unknowns, params, fit, lower, upper, data_x, data_y, sigma,
+                        component, tol, max_nodes, xtol, ftol, max_iterations))]
+    #[allow(clippy::too_many_arguments)]
+    fn fit(
+        &self,
+        py: Python<'_>,
+        x: Vec<f64>,
+        y: PyReadonlyArray2<'_, f64>,
+        unknowns: Vec<f64>,
+        params: Vec<f64>,
+        fit: Vec<usize>,
+        lower: Vec<f64>,
+        upper: Vec<f64>,
+        data_x: Vec<f64>,
+        data_y: Vec<f64>,
+        sigma: Vec<f64>,
+        component: usize,
+        tol: f64,
+        max_nodes: usize,
+        xtol: f64,
+        ftol: f64,
+        max_iterations: usize,
+    ) -> PyResult<FitOutput> {
+        let guess = self.guess(x, &y, unknowns)?;
+        let (n, q) = (self.bvp.dim(), self.bvp.num_params());
+        if params.len() != q || component >= n {
+            return Err(input_error(format!(
+                "fit: {} model parameter values for {q}, component {component} of {n} states",
+                params.len()
+            )));
+        }
+        if fit.is_empty()
+            || fit.iter().any(|&j| j >= q)
+            || lower.len() != fit.len()
+            || upper.len() != fit.len()
+        {
+            return Err(input_error(format!(
+                "fit: the fitted parameters {fit:?} must be indices below {q}, with one lower \
+                 and one upper bound each"
+            )));
+        }
+        if data_y.len() != data_x.len() || sigma.len() != data_x.len() {
+            return Err(input_error(format!(
+                "fit: {} points, {} values and {} sigmas; they must match",
+                data_x.len(),
+                data_y.len(),
+                sigma.len()
+            )));
+        }
+        let bvp = self.bvp.clone();
+        let options = SolveOptions {
+            tol,
+            max_nodes,
+            ..SolveOptions::default()
+        };
+        // Ctrl-C sets the fit's cancellation flag (checked before every model evaluation)
+        let out = crate::run::interruptible(py, move |cancel| -> Result<_, String> {
+            let mut solver = Solver::new(bvp.as_ref(), options);
+            let start = solver
+                .solve(&params, &guess)
+                .map_err(|e| format!("the solve at the start values failed: {e}"))?;
+            let p0: Vec<f64> = fit.iter().map(|&j| params[j]).collect();
+            let map = fit
+                .iter()
+                .enumerate()
+                .fold(ParamMap::new(params), |m, (i, &j)| m.link(j, i));
+            let misfit = Misfit {
+                component,
+                data: data_y,
+                sigma,
+            };
+            let run = BvpRun::new(solver, start, data_x, misfit, map).map_err(|e| e.to_string())?;
+            let mut problem = BvpResiduals::new(fit.len())
+                .with_run(run)
+                .map_err(|e| e.to_string())?;
+            let mut opts = FitOptions::with_bounds(lower, upper);
+            opts.xtol = xtol;
+            opts.ftol = ftol;
+            opts.max_iterations = max_iterations;
+            opts.cancel = Some(cancel);
+            let result = least_squares::fit(&mut problem, &p0, &opts).map_err(|e| e.to_string())?;
+            let sol = problem.runs()[0].accepted().clone();
+            Ok((result, sol))
+        });
+        let (result, sol) =
+            out?.map_err(|m| diffbvp_error(py, "EvaluationError", format!("fit_bvp: {m}")))?;
+        let success = matches!(
+            result.termination,
+            Termination::Gradient
+                | Termination::Step
+                | Termination::CostChange
+                | Termination::RelativeOffset
+                | Termination::NoiseFloor
+        );
+        Ok((
+            result.p.clone(),
+            result.cost,
+            result.residuals.clone(),
+            result.dense_jacobian(),
+            result.termination.to_string(),
+            success,
+            result.iterations,
+            result.accepted_steps,
+            BvpSolution {
+                bvp: self.bvp.clone(),
+                builder: self.builder.clone(),
+                sol: Arc::new(sol),
+            },
+        ))
+    }
+}
+
+impl ExprProblem {
+    /// The guess of `x`, `y` (`n × m`, checked) and the unknowns (checked), node-major.
+    fn guess(
+        &self,
+        x: Vec<f64>,
+        y: &PyReadonlyArray2<'_, f64>,
+        unknowns: Vec<f64>,
+    ) -> PyResult<Guess> {
+        let (n, m) = shape(y, self.bvp.dim(), x.len(), "y")?;
+        check_p(&unknowns, self.bvp.num_unknowns())?;
+        let ya = y.as_array();
+        let mut g = vec![0.0; n * m];
+        for (j, row) in g.chunks_exact_mut(n).enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                *v = ya[[c, j]];
+            }
+        }
+        Ok(Guess { x, y: g, unknowns })
     }
 }
 
@@ -381,6 +512,53 @@ impl BvpSolution {
             .detach(move || adjoint_gradient(bvp.as_ref(), &sol, &xs, &weights, &g))
             .map_err(to_py_bvp_error)?;
         Ok((v, PyArray1::from_slice(py, &grad).into_any()))
+    }
+
+    /// Value and gradient (model parameters) of the integral functional
+    /// `G = ∫ g(x, y, p) dx + φ(ya, yb, p)` by the adjoint method: `integrand` in `x`, `y[i]`
+    /// and the parameters, `endpoint` (optional) in `ya[i]`, `yb[i]` and the parameters.
+    #[pyo3(signature = (integrand, endpoint=None))]
+    fn integral<'py>(
+        &self,
+        py: Python<'py>,
+        integrand: String,
+        endpoint: Option<String>,
+    ) -> PyResult<(f64, Bound<'py, PyAny>)> {
+        let g = self
+            .builder
+            .integral(self.sol.n, &integrand, endpoint.as_deref())
+            .map_err(expr_error)?;
+        let (bvp, sol) = (self.bvp.clone(), self.sol.clone());
+        let (v, grad) = py
+            .detach(move || integral_adjoint(bvp.as_ref(), &sol, &g))
+            .map_err(to_py_bvp_error)?;
+        Ok((v, PyArray1::from_slice(py, &grad).into_any()))
+    }
+}
+
+/// What [`ExprProblem::fit`] returns to Python.
+type FitOutput = (
+    Vec<f64>,
+    f64,
+    Vec<f64>,
+    Vec<f64>,
+    String,
+    bool,
+    usize,
+    usize,
+    BvpSolution,
+);
+
+/// The weighted misfit `(y_c(x_j) − d_j) / σ_j` of one state component at the observations.
+struct Misfit {
+    component: usize,
+    data: Vec<f64>,
+    sigma: Vec<f64>,
+}
+
+impl PointFunction for Misfit {
+    fn eval<D: DualNum<Primitive = f64> + Copy>(&self, j: usize, _x: f64, y: &[D], _p: &[D]) -> D {
+        (y[self.component] - self.data[j]) / self.sigma[j]
     }
 }
 

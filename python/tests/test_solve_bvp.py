@@ -587,6 +587,32 @@ def test_sensitivities_linear_two_parameters_closed_form():
     assert_allclose(g, [np.sum(w * xs * (xs - 1) / 2), np.sum(w * xs)], rtol=1e-6)
 
 
+def test_integral_functional_gradient_closed_form():
+    # y'' = k^2 y, y(0) = 1, y(1) = 0: y = sinh(k(1-x))/sinh(k);
+    # G = ∫ y dx + y'(0)^2/2 = (cosh k - 1)/(k sinh k) + (k coth k)^2/2
+    k = 2.0
+    x = np.linspace(0, 1, 11)
+    r = solve_bvp(["y[1]", "k**2*y[0]"], ["ya[0] - 1", "yb[0]"], x, np.zeros((2, 11)),
+                  params={"k": k}, tol=1e-8)
+    assert r.success
+    v, g = r.integral("y[0]", endpoint="ya[1]**2/2")
+    coth = 1 / np.tanh(k)
+    mean = (np.cosh(k) - 1) / (k * np.sinh(k))
+    d_mean = (k * np.sinh(k) ** 2 - (np.cosh(k) - 1) * (np.sinh(k) + k * np.cosh(k))) / (
+        k * np.sinh(k)
+    ) ** 2
+    d_end = k * coth * (coth - k / np.sinh(k) ** 2)
+    assert_allclose(v, mean + (k * coth) ** 2 / 2, rtol=1e-6)
+    assert_allclose(g, [d_mean + d_end], rtol=1e-6)
+    # the integrand alone, from SymPy
+    sympy = pytest.importorskip("sympy")
+    v2, g2 = r.integral(sympy.Symbol("y0"))
+    assert_allclose([v2, g2[0]], [mean, d_mean], rtol=1e-6)
+    # a state symbol in the end-point term is refused, naming the term
+    with pytest.raises(InputError, match="endpoint"):
+        r.integral("y[0]", endpoint="y[0]")
+
+
 def test_sensitivities_sturm_liouville_unknown_closed_form():
     # y'' = -lam^2 y, y(0) = 0, y(pi/c) = 0, y'(0) = lam * A: lam = c; d lam/d c = 1
     c = 1.3
@@ -624,6 +650,70 @@ def test_fit_recovers_parameter_with_confidence_interval():
     f2 = fit_bvp(["-k*y[0]"], ["ya[0] - 1"], np.linspace(0, 2, 5), np.ones((1, 5)),
                  {"k": 2.0}, xd, yd, bounds={"k": (1.0, 5.0)})
     assert abs(f2.params["k"] - 1.0) < 1e-8
+
+
+def test_fit_matches_scipy_least_squares_on_the_same_solves():
+    # Bratu with two model parameters y'' = -a exp(y) + b, y(0) = y(1) = 0, fitted to y and
+    # compared with scipy's trust-region reflective method run on diffbvp's own solves
+    least_squares = pytest.importorskip("scipy.optimize").least_squares
+    fun, bc = ["y[1]", "-a*exp(y[0]) + b"], ["ya[0]", "yb[0]"]
+    x0, y0 = np.linspace(0, 1, 5), np.zeros((2, 5))
+    xd = np.linspace(0.05, 0.95, 19)
+    truth = solve_bvp(fun, bc, x0, y0, params={"a": 1.7, "b": 0.4}, tol=1e-9)
+    yd = truth.sol(xd)[0] + 2e-4 * np.random.default_rng(3).standard_normal(xd.size)
+    f = fit_bvp(fun, bc, x0, y0, {"a": 0.5, "b": 0.0}, xd, yd, tol=1e-9,
+                bounds={"a": (0.0, 3.0), "b": (-1.0, 1.0)})
+    assert f.success, f.message
+
+    def resid(q):
+        r = solve_bvp(fun, bc, x0, y0, params={"a": q[0], "b": q[1]}, tol=1e-9)
+        return r.sol(xd)[0] - yd
+
+    ref = least_squares(resid, [0.5, 0.0], bounds=([0.0, -1.0], [3.0, 1.0]), xtol=1e-12,
+                        ftol=1e-12, gtol=1e-12)
+    assert_allclose(f.x, ref.x, rtol=1e-5)
+    assert_allclose(f.cost, ref.cost, rtol=1e-6)
+    # the Jacobian is the exact one of the residuals at the optimum (central differences)
+    h = 1e-6
+    fd = np.stack([(resid(f.x + h * e) - resid(f.x - h * e)) / (2 * h) for e in np.eye(2)], 1)
+    assert_allclose(f.jac, fd, rtol=1e-5, atol=1e-7)
+    assert f.solution.success and f.solution.params == f.params
+
+
+def test_fit_intervals_cover_the_truth_over_replicates():
+    # y' = -k y, 15 points with 1 % noise: over 40 fresh-noise replicates the 95 % interval
+    # holds k in at least 34 (a binomial(40, 0.95) gives fewer than 34 with probability 0.3 %)
+    rng = np.random.default_rng(11)
+    k_true, xd = 0.7, np.linspace(0, 2, 15)
+    covered = 0
+    for _ in range(40):
+        yd = np.exp(-k_true * xd) * (1 + 0.01 * rng.standard_normal(xd.size))
+        f = fit_bvp(["-k*y[0]"], ["ya[0] - 1"], np.linspace(0, 2, 5), np.ones((1, 5)),
+                    {"k": 2.0}, xd, yd, bounds={"k": (0.1, 5.0)}, tol=1e-8)
+        assert f.success, f.message
+        covered += f.ci95[0, 0] <= k_true <= f.ci95[0, 1]
+    assert covered >= 34, covered
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"data_x": [0.5, 3.0], "data_y": [1.0, 1.0]}, r"data_x\[1\] = 3.0 is outside"),
+        ({"bounds": {"k": (3.0, 5.0)}}, r"params\['k'\] = 2.0 is outside its bounds"),
+        ({"bounds": {"k": (5.0, 3.0)}}, "lower bound must be below"),
+        ({"sigma": [1.0, 2.0]}, "sigma: a number or 3 values"),
+        ({"sigma": -1.0}, "sigma must be positive"),
+        ({"component": 1}, "component must be a state index"),
+        ({"params": {"k": "fast"}}, r"params\['k'\]: expected a number"),
+    ],
+)
+def test_fit_refuses_bad_arguments_naming_them(kwargs, match):
+    args = {"fun": ["-k*y[0]"], "bc": ["ya[0] - 1"], "x": np.linspace(0, 2, 5),
+            "y": np.ones((1, 5)), "params": {"k": 2.0}, "data_x": [0.0, 1.0, 2.0],
+            "data_y": [1.0, 0.5, 0.25]}
+    args.update(kwargs)
+    with pytest.raises(InputError, match=match):
+        fit_bvp(**args)
 
 
 def test_results_pickle_and_sol_matches_native_interpolant():
@@ -760,3 +850,14 @@ def test_continuation_follows_bratu_to_its_turning_point():
     with pytest.raises(EvaluationError, match="stopped at k = 3.5"):
         diffbvp.continue_bvp(fun, bc, x, np.zeros((2, 5)), "k", [3.5, 3.6], {"k": 0.5},
                              tol=1e-6, min_step=1e-3)
+
+
+def test_docstring_examples_run_and_print_what_they_show():
+    # the examples in the docstrings of diffbvp.bvp (solve_bvp, integral, fit_bvp, ...)
+    import doctest
+
+    import diffbvp.bvp
+
+    result = doctest.testmod(diffbvp.bvp, optionflags=doctest.ELLIPSIS)
+    assert result.attempted >= 6
+    assert result.failed == 0, result

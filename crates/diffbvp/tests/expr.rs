@@ -362,3 +362,38 @@ fn a_sparsity_out_of_range_is_refused_with_its_component() {
         }
     }
 }
+
+#[test]
+fn integral_functional_through_expressions_matches_closed_form() {
+    // y'' = k² y, y(0) = 1, y(1) = 0: y = sinh(k(1−x))/sinh(k); G = ∫ y dx + y'(0)² / 2
+    let b = ExprBvp::builder().params(&["k"]);
+    let bvp = b
+        .clone()
+        .build(&["y[1]", "k**2*y[0]"], &["ya[0] - 1", "yb[0]"])
+        .unwrap();
+    let k = 2.0f64;
+    let guess = Guess::constant(linspace(0.0, 1.0, 11), &[0.5, -1.0]);
+    let sol = solve(&bvp, &[k], &guess, &SolveOptions::with_tol(1e-9)).unwrap();
+    let g = b.integral(2, "y[0]", Some("ya[1]**2/2")).unwrap();
+    let (value, grad) = diffbvp::sensitivity::integral_adjoint(&bvp, &sol, &g).unwrap();
+    // ∫ y = (cosh k − 1)/(k sinh k); y'(0) = −k coth k
+    let mean = (k.cosh() - 1.0) / (k * k.sinh());
+    let slope = -k / k.tanh();
+    assert!(
+        (value - (mean + slope * slope / 2.0)).abs() < 1e-7,
+        "{value}"
+    );
+    let d_mean = (k * k.sinh() * k.sinh() - (k.cosh() - 1.0) * (k.sinh() + k * k.cosh()))
+        / (k * k.sinh()).powi(2);
+    // d/dk (k coth k)² / 2 = k coth k (coth k − k / sinh² k)
+    let d_end = k / k.tanh() * (1.0 / k.tanh() - k / k.sinh().powi(2));
+    let exact = d_mean + d_end;
+    assert!(
+        (grad[0] - exact).abs() < 1e-6 * exact.abs(),
+        "{} vs {exact}",
+        grad[0]
+    );
+    // an unknown symbol in the end-point term names its expression
+    let e = b.integral(2, "y[0]", Some("y[0]")).unwrap_err();
+    assert_eq!(e.what, "endpoint[0]");
+}

@@ -47,7 +47,7 @@ mod parse;
 mod tree;
 
 use crate::problem::Bvp;
-use crate::sensitivity::PointFunction;
+use crate::sensitivity::{IntegralFunction, PointFunction};
 use num_dual::DualNum;
 use parse::{Parser, Place, Symbols};
 use std::fmt;
@@ -56,7 +56,8 @@ use tree::{Node, Vars};
 /// An expression that did not parse, or a problem whose expressions do not fit together.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExprError {
-    /// Which expression: `fun[1]`, `bc[0]`, `functional`, or `problem` for a whole-problem
+    /// Which expression: `fun[1]`, `bc[0]`, `functional`, `integrand`, `endpoint`, or
+    /// `problem` for a whole-problem
     /// mismatch (counts, names).
     pub what: String,
     /// The expression's text (empty for a whole-problem mismatch).
@@ -285,6 +286,67 @@ impl ExprBuilder {
         self.check_names()?;
         let mut e = self.parse_all(&[expr], "functional", Place::Rhs, n)?;
         Ok(ExprFunction { expr: e.remove(0) })
+    }
+}
+
+impl ExprBuilder {
+    /// Parses an integral functional `G = ∫ g(x, y, p) dx + φ(ya, yb, p)` for `n` states:
+    /// `integrand` in the right-hand side's symbols (`x`, `y[i]`, parameters), `endpoint`
+    /// (optional) in the boundary conditions' (`ya[i]`, `yb[i]`, parameters); for
+    /// [`integral_adjoint`](crate::sensitivity::integral_adjoint) and
+    /// [`integral_value`](crate::sensitivity::integral_value).
+    pub fn integral(
+        &self,
+        n: usize,
+        integrand: &str,
+        endpoint: Option<&str>,
+    ) -> Result<ExprIntegral, ExprError> {
+        self.check_names()?;
+        let mut g = self.parse_all(&[integrand], "integrand", Place::Rhs, n)?;
+        let endpoint = match endpoint {
+            Some(src) => Some(self.parse_all(&[src], "endpoint", Place::Bc, n)?.remove(0)),
+            None => None,
+        };
+        Ok(ExprIntegral {
+            integrand: g.remove(0),
+            endpoint,
+        })
+    }
+}
+
+/// An integral functional given by expressions ([`ExprBuilder::integral`]).
+#[derive(Debug, Clone)]
+pub struct ExprIntegral {
+    integrand: Expr,
+    endpoint: Option<Expr>,
+}
+
+impl IntegralFunction for ExprIntegral {
+    fn integrand<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D]) -> D {
+        let v = Vars {
+            x,
+            y,
+            ya: &[],
+            yb: &[],
+            p,
+        };
+        self.integrand.node.eval(&v)
+    }
+
+    fn endpoint<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], p: &[D]) -> D {
+        match &self.endpoint {
+            Some(e) => {
+                let v = Vars {
+                    x: 0.0,
+                    y: &[],
+                    ya,
+                    yb,
+                    p,
+                };
+                e.node.eval(&v)
+            }
+            None => D::zero(),
+        }
     }
 }
 
