@@ -26,6 +26,10 @@ pub fn profiles_dict<'py>(py: Python<'py>, p: &Profiles) -> PyResult<Bound<'py, 
     d.set_item("temperature_K", array1(py, &p.temperature))?;
     d.set_item("strain_rate_1_s", array1(py, &p.strain_rate))?;
     d.set_item("diameter_m", array1(py, &p.diameter))?;
+    if let Some(g) = &p.gauge_reading {
+        // what the gauge reads, with the model's gauge effects
+        d.set_item("gauge_reading_m", array1(py, g))?;
+    }
     d.set_item("viscosity_Pa_s", array1(py, &p.viscosity))?;
     let terms = PyDict::new(py);
     for (name, balance, v) in &p.terms {

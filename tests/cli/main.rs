@@ -9,6 +9,7 @@ mod cli_argument_probes;
 mod cli_output_layer;
 mod cli_output_safety;
 mod design_cli;
+mod diameter_level;
 mod fit_from;
 mod fit_html;
 mod fit_report_findings;

@@ -138,10 +138,12 @@ pub fn experiment_panels(
         }
         for (c, curve) in curves.iter().enumerate() {
             if let Some(p) = curve.profiles.get(k) {
+                // beside the measurements: what the gauge reads (the diameter without gauge
+                // effects)
                 let pts: Vec<(f64, f64)> = p
                     .position
                     .iter()
-                    .zip(&p.diameter)
+                    .zip(p.gauge_reading.as_ref().unwrap_or(&p.diameter))
                     .map(|(&s, &d)| (s, view.value(d)))
                     .collect();
                 let series = if curve.dashed {

@@ -97,12 +97,19 @@ pub fn write_text(path: &Path, text: &str, inputs: &[PathBuf]) -> Result<(), Out
 pub const PROFILE_HEADER: &str =
     "position_m,velocity_m_s,force_N,temperature_K,strain_rate_1_s,diameter_m";
 
+/// The column [`write_profiles_csv`] adds after [`PROFILE_HEADER`]'s for a model with gauge
+/// effects: what the gauge reads ([`Profiles::gauge_reading`]).
+pub const GAUGE_READING_COLUMN: &str = "gauge_reading_m";
+
 /// Writes profiles as CSV with [`PROFILE_HEADER`] to `w`, row by row (no string of the whole
-/// table is built).
+/// table is built); with gauge effects a last column [`GAUGE_READING_COLUMN`].
 pub fn write_profiles_csv(w: &mut dyn Write, p: &Profiles) -> std::io::Result<()> {
-    writeln!(w, "{PROFILE_HEADER}")?;
+    match &p.gauge_reading {
+        Some(_) => writeln!(w, "{PROFILE_HEADER},{GAUGE_READING_COLUMN}")?,
+        None => writeln!(w, "{PROFILE_HEADER}")?,
+    }
     for i in 0..p.position.len() {
-        writeln!(
+        write!(
             w,
             "{:.6e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e}",
             p.position[i],
@@ -112,6 +119,10 @@ pub fn write_profiles_csv(w: &mut dyn Write, p: &Profiles) -> std::io::Result<()
             p.strain_rate[i],
             p.diameter[i]
         )?;
+        match &p.gauge_reading {
+            Some(g) => writeln!(w, ",{:.10e}", g[i])?,
+            None => writeln!(w)?,
+        }
     }
     Ok(())
 }

@@ -191,8 +191,13 @@ pub struct Profiles {
     pub temperature: Vec<f64>,
     /// Strain rate `ε̇ = u'` \[1/s\].
     pub strain_rate: Vec<f64>,
-    /// Diameter `d` \[m\].
+    /// Diameter `d` \[m\] the model predicts: with the mass flow its `mass_flow_scale` sets,
+    /// where it has one.
     pub diameter: Vec<f64>,
+    /// What the diameter gauge reads \[m\]: the diameter through the model's gauge effects
+    /// (`gauge_scale`, `gauge_offset`), the quantity the fit's residuals and `compare` set
+    /// against the measurements; `None` where the gauge reads the diameter itself.
+    pub gauge_reading: Option<Vec<f64>>,
     /// Elongational viscosity `μ_e(T, ε̇)` \[Pa s\].
     pub viscosity: Vec<f64>,
     /// Every named term: name, balance, values in N/m (momentum) or W/m (energy).
@@ -226,16 +231,18 @@ impl FiberSolution {
         let mut out = Profiles::default();
         let mut y = [0.0; 4];
         let mut yp = [0.0; 4];
+        let mut reading = Vec::with_capacity(positions.len());
         for &s in positions {
             let x = s / l_o;
             self.solution.eval_into(x, &mut y, &mut yp);
-            let rho = model.density(y[2]);
             out.position.push(s);
             out.velocity.push(y[0] * u_o);
             out.force.push(y[1] * n_o);
             out.temperature.push(y[2] * t_o);
             out.strain_rate.push(y[3] * rate_o);
-            out.diameter.push(model.diameter(y[0], rho) * d_o);
+            let d = model.fiber_diameter(&y, p);
+            out.diameter.push(d * d_o);
+            reading.push(model.observed_diameter(&y, p) * d_o);
             out.viscosity.push(model.viscosity_at(y[2], y[3], p) * mu_o);
             for (k, (name, balance, v)) in model.terms_at(x, &y, p).into_iter().enumerate() {
                 let scale = match balance {
@@ -248,6 +255,9 @@ impl FiberSolution {
                 }
                 out.terms[k].2.push(v * scale);
             }
+        }
+        if reading != out.diameter {
+            out.gauge_reading = Some(reading);
         }
         out
     }

@@ -366,7 +366,9 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
     }
     let mut points = Vec::with_capacity(n);
     for i in 0..n {
-        let (dm, dd) = (run.measured[i], p.diameter[i]);
+        // the model's value is what the gauge reads (as in the fit's residuals)
+        let model_d = p.gauge_reading.as_ref().unwrap_or(&p.diameter);
+        let (dm, dd) = (run.measured[i], model_d[i]);
         if !(dm > 0.0 && dd > 0.0 && dm.is_finite() && dd.is_finite()) {
             return Err(CompareError::Data(format!(
                 "experiment {} at s = {} m: diameters must be positive (measured {dm} m, model {dd} m)",
@@ -391,7 +393,11 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
     Ok(ComparedExperiment {
         name: run.name.clone(),
         curve_position_m: run.curve.position.clone(),
-        curve_diameter_m: run.curve.diameter.clone(),
+        curve_diameter_m: run
+            .curve
+            .gauge_reading
+            .clone()
+            .unwrap_or_else(|| run.curve.diameter.clone()),
         rms: (r.iter().map(|v| v * v).sum::<f64>() / m).sqrt(),
         mean: r.iter().sum::<f64>() / m,
         chi2: f64::NAN,
