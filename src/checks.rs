@@ -17,11 +17,6 @@ fn reason(r: Refusal) -> String {
     r.reason(Door::Cli)
 }
 
-/// A refusal with the flag and value named, for a check after parsing.
-fn message(r: Refusal) -> String {
-    r.message(Door::Cli)
-}
-
 /// A value as given, for a message: trimmed and, if very long, cut to its first 40
 /// characters.
 fn given(s: &str) -> String {
@@ -111,9 +106,11 @@ pub struct LossArgs {
 }
 
 impl LossArgs {
-    /// Sets the loss and its soft margin of `opts`. Error: a soft margin without a robust loss.
-    pub fn apply(&self, opts: &mut IdentifyOptions) -> Result<(), String> {
-        let (loss, margin) = request::robust_loss(self.loss, self.f_scale).map_err(message)?;
+    /// Sets the loss and its soft margin of `opts`. Errors: a soft margin without a robust
+    /// loss, a robust loss with the paper's estimator (of `opts`).
+    pub fn apply(&self, opts: &mut IdentifyOptions) -> Result<(), Refusal> {
+        let (loss, margin) = request::robust_loss(self.loss, self.f_scale)?;
+        request::loss_for(loss, opts.estimator)?;
         opts.loss = loss;
         opts.f_scale = margin;
         Ok(())
@@ -155,15 +152,13 @@ pub fn check_range(
     name: &str,
     range: (f64, f64),
     bounds: [f64; 2],
-) -> Result<(), String> {
-    request::range(arg, name, range, bounds)
-        .map(|_| ())
-        .map_err(message)
+) -> Result<(), Refusal> {
+    request::range(arg, name, range, bounds).map(|_| ())
 }
 
 /// Checks `--start N,KAPPA` against the fit's bounds.
-pub fn check_start(start: (f64, f64), opts: &IdentifyOptions) -> Result<(), String> {
-    request::start(start, opts).map(|_| ()).map_err(message)
+pub fn check_start(start: (f64, f64), opts: &IdentifyOptions) -> Result<(), Refusal> {
+    request::start(start, opts).map(|_| ())
 }
 
 /// Two values separated by one of `separators` ("0.5,11" or "41x41"); `form` and `what` name
@@ -230,8 +225,8 @@ pub fn name_experiment(e: Box<dyn Error>, toml: &Path, law: Option<[f64; 2]>) ->
 
 /// The mesh limit of a landscape: `--max-nodes` (at most the cap of the landscape's solves)
 /// or that cap.
-pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, String> {
-    request::landscape_max_nodes(max_nodes.map(|m| m as i128)).map_err(message)
+pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, Refusal> {
+    request::landscape_max_nodes(max_nodes.map(|m| m as i128))
 }
 
 /// The estimate of a landscape's run time, from its sample rows (computed and timed exactly as

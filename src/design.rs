@@ -101,7 +101,7 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         take_up_velocity: args.take_up_velocity,
         grid: args.grid,
     };
-    let grid = request::design_grid(&ranges, &loaded).map_err(|r| r.message(Door::Cli))?;
+    let grid = request::design_grid(&ranges, &loaded)?;
     // every output is checked before the work starts, against the inputs and each other
     let names = vec![
         ("report".to_string(), "design.txt".to_string()),

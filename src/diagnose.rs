@@ -1,7 +1,7 @@
 //! `rheometer diagnose`.
 
 use crate::*;
-use rheometer::workflow::request::{self, Door};
+use rheometer::workflow::request;
 
 /// Arguments of `rheometer diagnose`.
 #[derive(clap::Args)]
@@ -81,7 +81,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         effects,
         candidates: Vec::new(),
     };
-    spec.validate()?;
+    spec.validate().map_err(FlagError)?;
     // every output is checked before the work starts, against the inputs and each other
     let ext = g.format.ext();
     let names = vec![
@@ -110,7 +110,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     }
     robust.apply(&mut opts.identify)?;
     opts.identify.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
-    request::given_tol(&mut opts.identify, tol).map_err(|r| r.message(Door::Cli))?;
+    request::given_tol(&mut opts.identify, tol)?;
     // a spinner on a terminal (indicatif draws nothing when stderr is not a terminal)
     let spinner = if g.quiet {
         ProgressBar::hidden()

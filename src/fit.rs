@@ -2,7 +2,7 @@
 
 use crate::*;
 use rheometer::fit_html::FIT_REPORT_HTML;
-use rheometer::workflow::request::{self, Door};
+use rheometer::workflow::request;
 
 /// Arguments of `rheometer fit`.
 #[derive(clap::Args)]
@@ -78,7 +78,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         .map(|p| previous::read_previous(p, g))
         .transpose()?;
     let mut opts = IdentifyOptions::with_estimator(estimator(est));
-    request::given_tol(&mut opts, tol).map_err(|r| r.message(Door::Cli))?;
+    request::given_tol(&mut opts, tol)?;
     robust.apply(&mut opts)?;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     let model = if newtonian {
@@ -95,8 +95,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         }
         None => (with, start, Vec::new()),
     };
-    request::newtonian_start(law == LawChoice::Newtonian, start)
-        .map_err(|r| r.message(Door::Cli))?;
+    request::newtonian_start(law == LawChoice::Newtonian, start)?;
     if let Some(s) = start {
         checks::check_start(s, &opts)?;
     }
@@ -105,7 +104,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         effects: with.clone(),
         candidates: Vec::new(),
     };
-    spec.validate()?;
+    spec.validate().map_err(FlagError)?;
     let loaded = load_input(g, &experiments, true, true)?;
     if let Some(p) = &previous {
         p.check_experiments(&loaded, g)?;

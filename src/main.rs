@@ -15,12 +15,12 @@ use rheometer::fit::{
 };
 use rheometer::flow_curve_figure::save_flow_curve_figure;
 use rheometer::input::{
-    load_experiments_with_options, InputError, LoadOptions, LoadedExperiments,
-    DEFAULT_MAX_JSON_BYTES,
+    load_experiments_with_options, LoadOptions, LoadedExperiments, DEFAULT_MAX_JSON_BYTES,
 };
 use rheometer::output::write_profiles_csv;
 use rheometer::output_files::{CheckedOutputs, PARTIAL_NAME};
 use rheometer::report_json::{to_report_json, ReportKind};
+use rheometer::workflow::request::{self, Door, Refusal};
 use rheometer::workflow::{self, CompareRequest, FitRequest, FitRun};
 use rheometer::{FiberSolution, SimulateOptions};
 use std::error::Error;
@@ -52,6 +52,25 @@ impl std::fmt::Display for Interrupted {
 
 impl Error for Interrupted {}
 
+/// A malformed or out-of-range flag found after parsing, where the parser cannot judge a
+/// value alone (a start outside the fit's bounds, an effect given twice): reported as
+/// `error: ...` with exit code 2, like the parser's own usage errors (the rule of the CLI
+/// reference). A [`Refusal`] of the library's request rules is one too.
+#[derive(Debug)]
+pub struct FlagError(pub String);
+
+impl std::fmt::Display for FlagError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl Error for FlagError {}
+
+/// Exit code of a malformed or out-of-range flag (clap's usage errors, [`FlagError`],
+/// [`Refusal`]).
+const EXIT_USAGE: u8 = 2;
+
 // after the macro, which they use
 mod checks;
 mod compare;
@@ -80,7 +99,7 @@ Input format, outputs and error messages: see the book (mdbook build book)."
 )]
 struct Cli {
     /// Print nothing but results and errors.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, conflicts_with = "verbose")]
     quiet: bool,
     /// Print more detail (solver statistics, iterations).
     #[arg(long, short, global = true)]
@@ -222,24 +241,18 @@ pub fn load_input(
     take_up_from_data: bool,
     require_data: bool,
 ) -> Result<LoadedExperiments, Box<dyn Error>> {
-    let mut options = LoadOptions {
+    let base = LoadOptions {
         take_up_from_data,
         require_data,
         ..LoadOptions::with_min_points(4)
     };
-    if g.allow_large_inputs {
-        options.max_toml_bytes = u64::MAX;
-        options.max_csv_bytes = u64::MAX;
-        options.max_line_bytes = usize::MAX;
-        options.max_rows_per_file = usize::MAX;
-        options.max_experiments = usize::MAX;
-        options.max_fit_memory_bytes = u64::MAX;
-    }
-    let loaded = load_experiments_with_options(path, &options).map_err(|e| match e {
-        InputError::Limit { .. } => {
-            format!("{e} (on the command line: --allow-large-inputs)").into()
+    let options = request::load_options(base, g.allow_large_inputs);
+    let loaded = load_experiments_with_options(path, &options).map_err(|e| {
+        if e.exceeded_limit().is_some() {
+            request::input_message(&e, Door::Cli).into()
+        } else {
+            Box::<dyn Error>::from(e)
         }
-        e => Box::<dyn Error>::from(e),
     })?;
     for w in &loaded.warnings {
         g.warn(w.to_string());
@@ -308,6 +321,12 @@ pub fn warn_other_data(g: &Global, fit: &FitSummary, loaded: &LoadedExperiments,
 }
 
 fn run(cli: Cli) -> Result<(), Box<dyn Error>> {
+    // the parser's conflict misses the two on different levels (`--verbose fit ... --quiet`)
+    if cli.quiet && cli.verbose {
+        return Err(Box::new(FlagError(
+            "the argument '--quiet' cannot be used with '--verbose': give one of them".into(),
+        )));
+    }
     let g = Global {
         quiet: cli.quiet,
         verbose: cli.verbose,
@@ -377,6 +396,9 @@ fn main() -> ExitCode {
                 return ExitCode::from(signals::exit_code());
             }
             report_error(e.as_ref());
+            if e.downcast_ref::<FlagError>().is_some() || e.downcast_ref::<Refusal>().is_some() {
+                return ExitCode::from(EXIT_USAGE);
+            }
             ExitCode::FAILURE
         }
     }

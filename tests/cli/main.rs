@@ -13,6 +13,7 @@ mod diameter_level;
 mod fit_from;
 mod fit_html;
 mod fit_report_findings;
+mod flags_t4;
 mod input_bounds;
 mod input_loading;
 mod input_messages;

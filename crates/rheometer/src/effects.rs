@@ -438,8 +438,9 @@ impl Effect {
                 u => format!(" {u}"),
             };
             return Err(format!(
-                "{}:{name} = {value} is outside its admissible range [{lo}, {hi}]{unit}",
-                self.name()
+                "{}:{name} = {} is outside its admissible range [{lo}, {hi}]{unit}",
+                self.name(),
+                crate::workflow::request::show(value)
             ));
         }
         let name_of = self.name();
@@ -525,8 +526,9 @@ impl Effect {
         let (lo, hi) = self.bounds();
         if !(strength.is_finite() && strength >= lo && strength <= hi) {
             return Err(format!(
-                "{} = {strength} is outside its admissible range [{lo}, {hi}] {}",
+                "{} = {} is outside its admissible range [{lo}, {hi}] {}",
                 self.name(),
+                crate::workflow::request::show(strength),
                 self.unit()
             ));
         }
@@ -617,8 +619,9 @@ impl FromStr for EffectSetting {
             let (lo, hi) = effect.bounds();
             if x < lo || x > hi {
                 return Err(format!(
-                    "{} = {x} is outside its admissible range [{lo}, {hi}] {}",
+                    "{} = {} is outside its admissible range [{lo}, {hi}] {}",
                     effect.name(),
+                    crate::workflow::request::show(x),
                     effect.unit()
                 ));
             }

@@ -14,6 +14,7 @@ use super::error::FiberError;
 use super::fit::RheometerError;
 use super::input::{LoadedExperiments, Location};
 use super::setup::{Experiment, Inlet, Material, TakeUp};
+use crate::workflow::request::show;
 use diffbvp::error::BvpError;
 use std::error::Error;
 use std::f64::consts::PI;
@@ -162,8 +163,9 @@ pub fn hints(
     if let Some([n, _]) = law {
         if n < STRONG_THINNING_N && (stalled_at.is_some() || non_finite || max_nodes.is_some()) {
             out.push(format!(
-                "n = {n} is strong strain thinning: for this take-up the model may have no \
-                 solution (the strain rate explodes towards the take-up); try a larger n"
+                "n = {} is strong strain thinning: for this take-up the model may have no \
+                 solution (the strain rate explodes towards the take-up); try a larger n",
+                show(n)
             ));
         }
     }
@@ -293,7 +295,7 @@ impl fmt::Display for ExperimentFailure {
             self.experiment, self.at
         )?;
         if let Some([n, kappa]) = self.law_params {
-            write!(f, " at (n, kappa) = ({n}, {kappa})")?;
+            write!(f, " at (n, kappa) = ({}, {})", show(n), show(kappa))?;
         }
         write!(f, " failed")
     }

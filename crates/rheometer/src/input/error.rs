@@ -209,6 +209,19 @@ pub struct InputWarning {
     pub message: String,
 }
 
+impl InputError {
+    /// The cap of [`LoadOptions`](super::LoadOptions) this error says was exceeded, also
+    /// where it is the cause of an experiment's data file ([`InputError::Data`]); `None` for
+    /// any other error.
+    pub fn exceeded_limit(&self) -> Option<Limit> {
+        match self {
+            InputError::Limit { limit, .. } => Some(*limit),
+            InputError::Data { cause, .. } => cause.exceeded_limit(),
+            _ => None,
+        }
+    }
+}
+
 impl fmt::Display for InputWarning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}: {}", self.at, self.message)

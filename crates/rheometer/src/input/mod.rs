@@ -171,6 +171,7 @@ pub use loaded::{ExperimentDetails, LoadedExperiments};
 pub use measurements::{
     load_measurements, load_measurements_with, parse_measurements, CSV_HEADER, DEFAULT_MIN_POINTS,
 };
+pub(crate) use options::show_count;
 pub use options::{
     estimated_fit_memory_bytes, max_fit_rows, Limit, LoadOptions, DEFAULT_MAX_CSV_BYTES,
     DEFAULT_MAX_EXPERIMENTS, DEFAULT_MAX_FIT_MEMORY_BYTES, DEFAULT_MAX_LINE_BYTES,

@@ -185,7 +185,7 @@ pub(super) fn show_bytes(bytes: u64) -> String {
 }
 
 /// `n` with thousands separators: `1,000,000`.
-pub(super) fn show_count(n: u64) -> String {
+pub(crate) fn show_count(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::with_capacity(digits.len() + digits.len() / 3);
     for (i, c) in digits.chars().enumerate() {

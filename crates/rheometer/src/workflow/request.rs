@@ -9,7 +9,9 @@
 use crate::effects::Effect;
 use crate::fit::landscape::LANDSCAPE_MAX_NODES;
 use crate::fit::IdentifyOptions;
-use crate::input::{LoadedExperiments, MAX_PLAUSIBLE_DIAMETER_M};
+use crate::input::{
+    max_fit_rows, show_count, LoadOptions, LoadedExperiments, MAX_PLAUSIBLE_DIAMETER_M,
+};
 use diffbvp::least_squares::Loss;
 use std::fmt;
 
@@ -72,6 +74,8 @@ pub enum Arg {
     Model,
     ProfilePoints,
     Positions,
+    Measurements,
+    AllowLargeInputs,
 }
 
 impl Arg {
@@ -102,6 +106,8 @@ impl Arg {
             Arg::Model => ("--model", "model"),
             Arg::ProfilePoints => ("--points", "profile_points"),
             Arg::Positions => ("--positions", "positions"),
+            Arg::Measurements => ("measurements", "measurements"),
+            Arg::AllowLargeInputs => ("--allow-large-inputs", "allow_large_inputs"),
         };
         match door {
             Door::Cli => cli,
@@ -174,7 +180,8 @@ impl Refusal {
     /// The reason alone in `door`'s words (for a door that names the input itself, as clap
     /// does for a flag): another input the reason names is written `@name@` or
     /// `@name=value@` (Python's name) in [`Refusal::reason`] and rendered here as
-    /// `--name value` or `name="value"`.
+    /// `--name value` or `name="value"`; a switch, `@name=True@`, as `--name` or
+    /// `name=True`.
     pub fn reason(&self, door: Door) -> String {
         let mut out = String::with_capacity(self.reason.len());
         let mut parts = self.reason.split('@');
@@ -189,6 +196,9 @@ impl Refusal {
                     None => (part, None),
                 };
                 let shown = match (door, value) {
+                    // a switch: `--allow-large-inputs` on the command line
+                    (Door::Cli, Some("True")) => format!("--{}", name.replace('_', "-")),
+                    (Door::Python, Some(v @ ("True" | "False"))) => format!("{name}={v}"),
                     (Door::Cli, None) => format!("--{}", name.replace('_', "-")),
                     (Door::Cli, Some(v)) => format!("--{} {v}", name.replace('_', "-")),
                     (Door::Python, None) => name.to_string(),
@@ -220,6 +230,84 @@ pub fn show(v: f64) -> String {
     } else {
         format!("{v:e}")
     }
+}
+
+/// The caps of the loader as a request sets them: `base`, or none at all with the override
+/// every door offers (`--allow-large-inputs` on the command line, `allow_large_inputs=True`
+/// in Python); inputs must still be regular files.
+pub fn load_options(base: LoadOptions, allow_large_inputs: bool) -> LoadOptions {
+    if !allow_large_inputs {
+        return base;
+    }
+    LoadOptions {
+        max_toml_bytes: u64::MAX,
+        max_csv_bytes: u64::MAX,
+        max_line_bytes: usize::MAX,
+        max_rows_per_file: usize::MAX,
+        max_experiments: usize::MAX,
+        max_fit_memory_bytes: u64::MAX,
+        ..base
+    }
+}
+
+/// How `door` lifts the input caps, for the message of an exceeded one: `on the command line:
+/// --allow-large-inputs`, `in Python: allow_large_inputs=True`.
+pub fn lift_caps(door: Door) -> &'static str {
+    match door {
+        Door::Cli => "on the command line: --allow-large-inputs",
+        Door::Python => "in Python: allow_large_inputs=True",
+    }
+}
+
+/// The message of a loader's error in `door`'s words: an exceeded cap (also of a data
+/// file) says how that door lifts the caps (`... (on the command line:
+/// --allow-large-inputs)`); any other error as it is.
+pub fn input_message(e: &crate::input::InputError, door: Door) -> String {
+    match e.exceeded_limit() {
+        Some(_) => format!("{e} ({})", lift_caps(door)),
+        None => e.to_string(),
+    }
+}
+
+/// Measurement arrays given directly rather than as files (Python's `Dataset.from_arrays`,
+/// `Dataset.from_toml(measurements=...)`), checked on their lengths before any row is
+/// converted: the caps of a measurement file in `options` apply to them alike, at most
+/// [`LoadOptions::max_rows_per_file`] rows per experiment and, in all `experiments`, the rows
+/// a fit can hold within [`LoadOptions::max_fit_memory_bytes`] ([`max_fit_rows`]). `rows`:
+/// each experiment's name and number of rows.
+pub fn measurement_rows(
+    rows: &[(&str, usize)],
+    experiments: usize,
+    options: &LoadOptions,
+) -> Result<(), Refusal> {
+    let thin = "thin the data (every 10th row carries the same information for the smoothing \
+                and the fit, at a tenth of the cost), or lift the caps with \
+                @allow_large_inputs=True@";
+    if let Some((name, n)) = rows.iter().find(|(_, n)| *n > options.max_rows_per_file) {
+        return Err(Refusal::new(
+            Arg::Measurements,
+            format!(
+                "experiment \"{name}\" has {} rows, more than the {} a measurement file may \
+                 hold (the cap `max_rows_per_file` of the loader); {thin}",
+                show_count(*n as u64),
+                show_count(options.max_rows_per_file as u64)
+            ),
+        ));
+    }
+    let total = rows.iter().map(|(_, n)| *n as u64).sum::<u64>();
+    let most = max_fit_rows(experiments as u64, options.max_fit_memory_bytes);
+    if total > most {
+        return Err(Refusal::new(
+            Arg::Measurements,
+            format!(
+                "{} rows in all, more than a fit of {experiments} experiments can hold within \
+                 the estimated memory cap `max_fit_memory_bytes` ({} rows); {thin}",
+                show_count(total),
+                show_count(most)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A whole number `v` of `arg` within `lo..=hi`; `what` says what is counted ("give 2 to
@@ -379,6 +467,22 @@ pub fn robust_loss(loss: Loss, margin: Option<f64>) -> Result<(Loss, Option<f64>
         }
     }
     Ok((loss, margin))
+}
+
+/// A robust loss needs the principled estimator (relative residuals): the paper's estimator
+/// fits with the linear loss only.
+pub fn loss_for(loss: Loss, estimator: crate::fit::Estimator) -> Result<(), Refusal> {
+    if loss.is_linear() || estimator == crate::fit::Estimator::Principled {
+        return Ok(());
+    }
+    Err(Refusal::with(
+        Arg::Loss,
+        Given::Text(loss.to_string()),
+        "a robust loss needs the principled estimator (relative residuals); the paper's \
+         estimator fits with the linear loss only: drop @loss@ or use \
+         @estimator=principled@"
+            .into(),
+    ))
 }
 
 /// `n`: the Carreau-type law's domain, a finite n >= 0.
@@ -805,5 +909,24 @@ mod tests {
         assert!(grid(1, 5, MAX_GRID_POINTS).is_err() && grid(1001, 2, usize::MAX).is_err());
         assert!(newtonian_start(true, Some((0.8, 11.0))).is_err());
         assert!(newtonian_start(false, Some((0.8, 11.0))).is_ok());
+    }
+
+    #[test]
+    fn arrays_meet_the_caps_of_files_with_one_override() {
+        let caps = LoadOptions::default();
+        let r = measurement_rows(&[("a", 10), ("b", 10_000_000)], 2, &caps).unwrap_err();
+        let py = r.message(Door::Python);
+        assert!(
+            py.starts_with("measurements: experiment \"b\" has 10,000,000 rows"),
+            "{py}"
+        );
+        assert!(py.ends_with("allow_large_inputs=True"), "{py}");
+        assert!(r.message(Door::Cli).ends_with("--allow-large-inputs"));
+        assert!(measurement_rows(&[("a", 1_000_000)], 1, &caps).is_ok());
+        let lifted = load_options(caps, true);
+        assert!(measurement_rows(&[("b", 10_000_000)], 1, &lifted).is_ok());
+        // nine files of a million rows exceed the fit-memory cap
+        let nine: Vec<(&str, usize)> = (0..9).map(|_| ("x", 1_000_000)).collect();
+        assert!(measurement_rows(&nine, 9, &LoadOptions::default()).is_err());
     }
 }
