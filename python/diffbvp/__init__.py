@@ -85,26 +85,35 @@ class Dataset:
         self._native = native
 
     @classmethod
-    def load(cls, path: PathLike) -> "Dataset":
+    def load(cls, path: PathLike, *, allow_large_inputs: bool = False) -> "Dataset":
         """Reads a TOML experiments file and the CSV files (``position_m,diameter_m``) it
-        names. Raises :class:`InputError` naming file, line, table and key."""
-        return cls(_native.Dataset.load(os.fspath(path)))
+        names. Raises :class:`InputError` naming file, line, table and key.
+
+        The input caps are the command line's (the book's input reference, *Limits*: 16 MiB
+        experiments file, 1,000,000 rows and 128 MiB per measurement file, 1000 experiments,
+        4 GiB estimated fit memory); ``allow_large_inputs=True`` lifts them all, as
+        ``--allow-large-inputs`` does."""
+        return cls(_native.Dataset.load(os.fspath(path), _flag(allow_large_inputs, "allow_large_inputs")))
 
     @classmethod
     def from_toml(cls, text: str, path: PathLike = "<text>",
-                  measurements: Optional[Mapping[str, Tuple[Sequence[float], Sequence[float]]]] = None) -> "Dataset":
+                  measurements: Optional[Mapping[str, Tuple[Sequence[float], Sequence[float]]]] = None,
+                  *, allow_large_inputs: bool = False) -> "Dataset":
         """A data set from TOML text. ``path`` labels it in messages and resolves relative
         ``data`` files; ``measurements`` (name → (positions [m], diameters [m])) replaces
-        them."""
+        them. The caps of :meth:`load` apply to the arrays as to files (lifted by
+        ``allow_large_inputs=True``)."""
         m = {k: (np.asarray(p, dtype=float), np.asarray(d, dtype=float))
              for k, (p, d) in (measurements or {}).items()}
-        return cls(_native.Dataset.from_toml(text, os.fspath(path), m))
+        return cls(_native.Dataset.from_toml(text, os.fspath(path), m,
+                                             _flag(allow_large_inputs, "allow_large_inputs")))
 
     @classmethod
     def from_arrays(cls, material: Mapping[str, float], experiments: Sequence[Mapping[str, Any]], *,
                     defaults: Optional[Mapping[str, float]] = None,
                     relative_uncertainty: Optional[float] = None,
-                    uncertainty: Optional[Mapping[str, float]] = None) -> "Dataset":
+                    uncertainty: Optional[Mapping[str, float]] = None,
+                    allow_large_inputs: bool = False) -> "Dataset":
         """A data set from dicts in the TOML file's layout and numpy arrays.
 
         ``material``: the ``[material]`` keys (``density_slope_kg_m3_K``, ...,
@@ -115,6 +124,12 @@ class Dataset:
         ``diameters_m`` (1-D arrays, metres); ``defaults``: keys shared by all experiments;
         ``relative_uncertainty``: the diameters' relative measurement uncertainty [-];
         ``uncertainty``: the ``[uncertainty]`` table of the error budget.
+
+        The arrays meet the caps of a measurement file read by :meth:`load` (at most
+        1,000,000 rows per experiment, and the rows a fit can hold within the estimated
+        memory cap in all), checked on their lengths before any row is converted;
+        ``allow_large_inputs=True`` lifts the caps, as for :meth:`load`. Ctrl-C stops the
+        conversion (``KeyboardInterrupt``).
 
         Every value is checked as in a TOML file; messages name ``<conditions>`` with the
         line of the generated TOML (:attr:`toml`), or ``<arrays of experiment "NAME">`` with
@@ -141,14 +156,16 @@ class Dataset:
         if defaults is not None:
             cond["defaults"] = dict(defaults)
         cond["experiment"] = exps
-        return cls(_native.Dataset.from_conditions(cond, meas))
+        return cls(_native.Dataset.from_conditions(cond, meas,
+                                                   _flag(allow_large_inputs, "allow_large_inputs")))
 
     @classmethod
-    def _from_state(cls, toml: str, path: str, measurements: Dict[str, Tuple[np.ndarray, np.ndarray]]) -> "Dataset":
-        return cls(_native.Dataset.from_toml(toml, path, measurements))
+    def _from_state(cls, toml: str, path: str, measurements: Dict[str, Tuple[np.ndarray, np.ndarray]],
+                    allow_large_inputs: bool = False) -> "Dataset":
+        return cls(_native.Dataset.from_toml(toml, path, measurements, bool(allow_large_inputs)))
 
     def __reduce__(self):
-        return (Dataset._from_state, (self.toml, self.path, self.measurements()))
+        return (Dataset._from_state, (self.toml, self.path, self.measurements(), self.allow_large_inputs))
 
     def with_measurements(self, measurements: Mapping[str, Tuple[Sequence[float], Sequence[float]]]) -> "Dataset":
         """The same experiments with other measured diameters (name → (positions [m],
@@ -156,7 +173,7 @@ class Dataset:
         m = self.measurements()
         for k, (p, d) in measurements.items():
             m[k] = (np.asarray(p, dtype=float), np.asarray(d, dtype=float))
-        return Dataset._from_state(self.toml, self.path, m)
+        return Dataset._from_state(self.toml, self.path, m, self.allow_large_inputs)
 
     @property
     def path(self) -> str:
@@ -167,6 +184,20 @@ class Dataset:
     def toml(self) -> str:
         """The TOML text of the data set."""
         return self._native.toml
+
+    @property
+    def allow_large_inputs(self) -> bool:
+        """Whether the input caps were lifted when it was made (``allow_large_inputs=True``);
+        a pickled copy and :meth:`with_measurements` keep it."""
+        return self._native.allow_large_inputs
+
+    @property
+    def data_digest(self) -> str:
+        """The digest of the data (experiment names, conditions and measurements) that a fit
+        made on them records in its summary (``FitResult.summary["data_digest"]``), as the
+        ``rheometer`` program does: it tells this data set from other data with the same
+        experiment names."""
+        return self._native.data_digest
 
     @property
     def names(self) -> List[str]:
@@ -221,9 +252,10 @@ def threads() -> int:
     return _native.threads()
 
 
-def load(path: PathLike) -> Dataset:
-    """Reads a TOML experiments file and its CSV files (see :meth:`Dataset.load`)."""
-    return Dataset.load(path)
+def load(path: PathLike, *, allow_large_inputs: bool = False) -> Dataset:
+    """Reads a TOML experiments file and its CSV files (see :meth:`Dataset.load`; the input
+    caps are the command line's, lifted by ``allow_large_inputs=True``)."""
+    return Dataset.load(path, allow_large_inputs=allow_large_inputs)
 
 
 def _ds(dataset: Union[Dataset, PathLike]) -> "_native.Dataset":
@@ -467,6 +499,13 @@ def _int(v: Any, name: str) -> int:
     if abs(i) > 2**100:
         raise InputError(f"{name}: {i} is far outside any accepted range")
     return i
+
+
+def _flag(v: Any, name: str) -> bool:
+    """A switch for the argument ``name``: ``True`` or ``False`` (numpy's bools too)."""
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    raise InputError(f"{name}: expected True or False, got {v!r}")
 
 
 def _grid(v: Any) -> Tuple[int, int]:

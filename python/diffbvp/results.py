@@ -1,6 +1,15 @@
 """Result objects of :mod:`diffbvp`: plain data (a dict from the library's JSON form plus numpy
 arrays), attribute access, ``to_dict()``, tables for pandas, picklable, with a short ``repr``.
 
+``to_dict()`` is strict JSON (``json.dumps(r.to_dict(), allow_nan=False)`` holds): a number
+that does not exist (a NaN: a missing standard error, a landscape point without a solution; or
+an infinity) is ``None``, as the ``rheometer`` program writes ``null``. It is the format to
+exchange results in (a file, another program, another version); a pickle is for the same
+package version on a trusted machine (Dask workers): unpickling checks a fit's and a
+diagnosis' fields with the library's reader of fit reports and refuses a tampered one with
+an :class:`~diffbvp.errors.InputError` naming the field. ``==`` compares results, not timing
+(``wall_time_s``, ``stage_times`` are left out).
+
 Units are SI and part of every array key (``position_m``, ``diameter_m``, ``temperature_K``,
 ``strain_rate_1_s``, ``viscosity_Pa_s``, ``force_N``, ``velocity_m_s``); relative residuals are
 fractions (0.01 = 1 %).
@@ -33,16 +42,52 @@ def _num(x: Any) -> float:
 
 
 def _plain(x: Any) -> Any:
-    """Numpy arrays (recursively) as lists, for ``to_dict()``."""
+    """Numpy arrays (recursively) as lists and non-finite floats as ``None``, for
+    ``to_dict()``: strict JSON."""
     if isinstance(x, np.ndarray):
-        return x.tolist()
+        return _plain(x.tolist())
     if isinstance(x, Mapping):
         return {k: _plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [_plain(v) for v in x]
     if isinstance(x, np.generic):
-        return x.item()
+        return _plain(x.item())
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
     return x
+
+
+# keys of a result that time the computation rather than describe its outcome: two runs of
+# the same computation differ in them, so equality leaves them out
+_TIMING_KEYS = frozenset({"wall_time_s", "stage_times"})
+
+
+def _check_state(state: Any, kind: str, sizes: Tuple[int, ...]) -> None:
+    """A pickled state of ``kind`` is a tuple of one of ``sizes`` parts whose first is a dict
+    (else an :class:`~diffbvp.errors.InputError` naming what is wrong)."""
+    from .errors import InputError
+    if not isinstance(state, tuple) or len(state) not in sizes:
+        raise InputError(f"the pickled {kind} is not a {kind}'s state (a tuple of "
+                         f"{' or '.join(map(str, sizes))} parts): re-create it, or exchange "
+                         "results as to_dict() / JSON")
+    if not isinstance(state[0], dict):
+        raise InputError(f"the pickled {kind}: its data is {type(state[0]).__name__}, not a dict")
+    if len(state) > 1 and not isinstance(state[1], dict):
+        raise InputError(f"the pickled {kind}: its arrays are {type(state[1]).__name__}, not a dict")
+
+
+def _check_report(data: Dict[str, Any], kind: str) -> None:
+    """The dict of a fit or a diagnosis checked by the library's reader of fit reports (the one
+    ``rheometer fit --from`` uses): an :class:`~diffbvp.errors.InputError` naming the field
+    (``n.value``)."""
+    import json
+    from . import _native
+    from .errors import InputError
+    try:
+        text = json.dumps(data, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"the pickled {kind}: its data is not JSON data ({e})") from None
+    _native.check_fit_summary(text, f"the pickled {kind}")
 
 
 def _pm(value: float, se: float, digits: int = 1) -> str:
@@ -99,6 +144,8 @@ class Result:
         object.__setattr__(self, "_arrays", state[1])
 
     def __eq__(self, other: object) -> bool:
+        """Equal results: the same data and arrays, the timing (``wall_time_s``,
+        ``stage_times``) left out, so that ``fit(ds) == fit(ds)``."""
         if type(other) is not type(self):
             return NotImplemented
         return _same(self.to_dict(), other.to_dict())  # type: ignore[attr-defined]
@@ -107,11 +154,13 @@ class Result:
 
 
 def _same(a: Any, b: Any) -> bool:
-    """Structural equality that treats nan == nan (a missing standard error on both sides)."""
+    """Structural equality that treats nan == nan (a missing standard error on both sides) and
+    leaves the timing keys out (:data:`_TIMING_KEYS`)."""
     if isinstance(a, float) and isinstance(b, float):
         return a == b or (math.isnan(a) and math.isnan(b))
     if isinstance(a, dict) and isinstance(b, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+        ka = a.keys() - _TIMING_KEYS
+        return ka == b.keys() - _TIMING_KEYS and all(_same(a[k], b[k]) for k in ka)
     if isinstance(a, list) and isinstance(b, list):
         return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
     return a == b
@@ -285,10 +334,14 @@ class FitResult(Result):
         return (self._data, self._arrays, self.text, self.notes, self.context)
 
     def __setstate__(self, state):  # type: ignore[override]
+        # checked before it is taken: a tampered pickle is refused here, naming the field,
+        # not later with a bare KeyError
+        _check_state(state, "FitResult", (4, 5))
+        _check_report(state[0], "FitResult")
         object.__setattr__(self, "_data", state[0])
         object.__setattr__(self, "_arrays", state[1])
-        object.__setattr__(self, "text", state[2])
-        object.__setattr__(self, "notes", state[3])
+        object.__setattr__(self, "text", str(state[2]))
+        object.__setattr__(self, "notes", [str(x) for x in state[3]])
         # a state pickled before the context was kept has four parts
         object.__setattr__(self, "context", state[4] if len(state) > 4 else None)
 
@@ -645,6 +698,8 @@ class Diagnosis(Result):
         return (self._data, self._arrays, self.text)
 
     def __setstate__(self, state):  # type: ignore[override]
+        _check_state(state, "Diagnosis", (3,))
+        _check_report(state[0], "Diagnosis")
         for k, v in zip(("_data", "_arrays", "text"), state):
             object.__setattr__(self, k, v)
 

@@ -7,9 +7,11 @@ use crate::errors::{input_error, to_py_err};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use rheometer::input::{
-    load_experiments_with, parse_experiments, parse_measurements, InputError, LoadedExperiments,
+    load_experiments_with_options, parse_experiments_with, parse_measurements, InputError,
+    LoadOptions, LoadedExperiments,
 };
 use rheometer::setup::{Inlet, TakeUp};
+use rheometer::workflow::request::{self, Door};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -26,6 +28,15 @@ pub struct DatasetInner {
     pub path: PathBuf,
     /// The TOML text (kept for pickling and `Dataset.toml`).
     pub toml: String,
+    /// Whether it was made with `allow_large_inputs=True` (the input caps lifted); kept so
+    /// that a pickled or re-measured copy is read under the same caps.
+    pub allow_large_inputs: bool,
+}
+
+/// The loader's caps of a data set made from Python: the defaults (as `load()` and the
+/// command line apply them), or none with `allow_large_inputs`.
+fn caps(allow_large_inputs: bool) -> LoadOptions {
+    request::load_options(LoadOptions::with_min_points(MIN_POINTS), allow_large_inputs)
 }
 
 /// A data set of spinning experiments (immutable; cheap to share between calls and threads).
@@ -52,18 +63,52 @@ fn csv_text(positions: &[f64], diameters: &[f64]) -> String {
     s
 }
 
+/// The number of rows of a measurement array as Python sees it (`len()`), before it is
+/// converted; `None` when it has no length (the conversion then names the argument).
+fn rows_of(obj: &Bound<'_, PyAny>) -> Option<usize> {
+    obj.len().ok()
+}
+
 /// Parses `text` (labelled `path`) and fills the measurements: the arrays given in
 /// `measurements` (name → (positions \[m\], diameters \[m\])), else the experiment's `data`
-/// file.
+/// file. The caps of [`caps`] apply to both: the arrays' lengths are checked by the library's
+/// request rule before any row is converted, the files while they are read. Ctrl-C is
+/// honoured between experiments (`KeyboardInterrupt`).
 fn build(
+    py: Python<'_>,
     text: &str,
     path: &Path,
     measurements: Option<&Bound<'_, PyDict>>,
+    allow_large_inputs: bool,
 ) -> PyResult<DatasetInner> {
-    let mut loaded = parse_experiments(text, path)
-        .map_err(|e| Python::attach(|py| to_py_err(py, Box::new(e), None, None)))?;
+    let options = caps(allow_large_inputs);
+    if !allow_large_inputs && text.len() as u64 > options.max_toml_bytes {
+        return Err(input_error(format!(
+            "{}: the experiments text has {} bytes, more than the cap `max_toml_bytes` ({} \
+             bytes); {}",
+            path.display(),
+            text.len(),
+            options.max_toml_bytes,
+            request::lift_caps(Door::Python)
+        )));
+    }
+    let mut loaded = parse_experiments_with(text, path, &options).map_err(|e| {
+        let lifted = matches!(e, InputError::Limit { .. });
+        let err = to_py_err(py, Box::new(e), None, None);
+        if lifted {
+            input_error(format!(
+                "{} ({})",
+                err.value(py),
+                request::lift_caps(Door::Python)
+            ))
+        } else {
+            err
+        }
+    })?;
+    let n_experiments = loaded.set.experiments.len();
     if let Some(m) = measurements {
-        for key in m.keys() {
+        let mut rows: Vec<(String, usize)> = Vec::new();
+        for (key, pair) in m.iter() {
             let name: String = key.extract()?;
             if !loaded.set.experiments.iter().any(|e| e.name == name) {
                 let names: Vec<&str> = loaded
@@ -78,9 +123,22 @@ fn build(
                     names.join(", ")
                 )));
             }
+            let longest = match pair.cast::<PyTuple>() {
+                Ok(t) if t.len() == 2 => {
+                    let a = rows_of(&t.get_item(0)?).unwrap_or(0);
+                    let b = rows_of(&t.get_item(1)?).unwrap_or(0);
+                    a.max(b)
+                }
+                _ => 0,
+            };
+            rows.push((name, longest));
         }
+        let named: Vec<(&str, usize)> = rows.iter().map(|(n, r)| (n.as_str(), *r)).collect();
+        request::measurement_rows(&named, n_experiments, &options)
+            .map_err(|r| input_error(r.message(Door::Python)))?;
     }
-    for k in 0..loaded.set.experiments.len() {
+    for k in 0..n_experiments {
+        py.check_signals()?;
         let e = &loaded.set.experiments[k];
         let given = match measurements {
             Some(m) => m.get_item(&e.name)?,
@@ -106,21 +164,26 @@ fn build(
                         dia.len()
                     )));
                 }
+                py.check_signals()?;
                 // rows are lines 2, 3, ... of this virtual CSV file (line 1 is its header)
                 let label = PathBuf::from(format!("<arrays of experiment \"{}\">", e.name));
                 let text = csv_text(&pos, &dia);
                 Some(
-                    parse_measurements(&text, &label, e.spinline_length, MIN_POINTS).map_err(
-                        |err| Python::attach(|py| to_py_err(py, Box::new(err), None, None)),
-                    )?,
+                    parse_measurements(&text, &label, e.spinline_length, MIN_POINTS)
+                        .map_err(|err| to_py_err(py, Box::new(err), None, None))?,
                 )
             }
             None => match &loaded.details[k].data {
                 Some(file) => Some(
-                    rheometer::input::load_measurements(file, e.spinline_length, MIN_POINTS)
+                    rheometer::input::load_measurements_with(file, e.spinline_length, &options)
                         .map_err(|err| {
+                            let lift = if matches!(err, InputError::Limit { .. }) {
+                                format!(" ({})", request::lift_caps(Door::Python))
+                            } else {
+                                String::new()
+                            };
                             input_error(format!(
-                                "{}: experiment \"{}\": {err}",
+                                "{}: experiment \"{}\": {err}{lift}",
                                 path.display(),
                                 e.name
                             ))
@@ -135,6 +198,7 @@ fn build(
         loaded,
         path: path.to_path_buf(),
         toml: text.to_string(),
+        allow_large_inputs,
     })
 }
 
@@ -155,11 +219,14 @@ fn strip_nulls(v: Value) -> Value {
 #[pymethods]
 impl Dataset {
     /// Loads a TOML experiments file and the CSV files it names (the CLI's reader: every
-    /// value checked, errors name file, line, table and key).
+    /// value checked, errors name file, line, table and key), under the input caps unless
+    /// `allow_large_inputs` (the CLI's `--allow-large-inputs`).
     #[staticmethod]
-    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+    #[pyo3(signature = (path, allow_large_inputs=false))]
+    fn load(py: Python<'_>, path: PathBuf, allow_large_inputs: bool) -> PyResult<Self> {
+        let options = caps(allow_large_inputs);
         let result = py.detach(|| -> Result<DatasetInner, Box<InputError>> {
-            let loaded = load_experiments_with(&path, MIN_POINTS).map_err(Box::new)?;
+            let loaded = load_experiments_with_options(&path, &options).map_err(Box::new)?;
             let toml = std::fs::read_to_string(&path).map_err(|e| {
                 Box::new(InputError::Io {
                     path: path.clone(),
@@ -171,39 +238,48 @@ impl Dataset {
                 loaded,
                 path: path.clone(),
                 toml,
+                allow_large_inputs,
             })
         });
         match result {
             Ok(inner) => Ok(Dataset {
                 inner: Arc::new(inner),
             }),
+            Err(e) if e.exceeded_limit().is_some() => {
+                Err(input_error(request::input_message(&e, Door::Python)))
+            }
             Err(e) => Err(to_py_err(py, e, None, None)),
         }
     }
 
     /// A data set from TOML text; `path` labels it in messages and resolves relative `data`
-    /// files; `measurements` (name → (positions_m, diameters_m)) replaces data files.
+    /// files; `measurements` (name → (positions_m, diameters_m)) replaces data files; the
+    /// input caps apply unless `allow_large_inputs`.
     #[staticmethod]
-    #[pyo3(signature = (text, path, measurements=None))]
+    #[pyo3(signature = (text, path, measurements=None, allow_large_inputs=false))]
     fn from_toml(
+        py: Python<'_>,
         text: &str,
         path: PathBuf,
         measurements: Option<&Bound<'_, PyDict>>,
+        allow_large_inputs: bool,
     ) -> PyResult<Self> {
         Ok(Dataset {
-            inner: Arc::new(build(text, &path, measurements)?),
+            inner: Arc::new(build(py, text, &path, measurements, allow_large_inputs)?),
         })
     }
 
     /// A data set from a dict in the TOML file's layout (`material`, optional `defaults`,
     /// `experiment` = a list of dicts, optional `relative_uncertainty`, `uncertainty`) and
     /// measurement arrays. Messages name `<conditions>` and the line of the generated TOML
-    /// text (`Dataset.toml`).
+    /// text (`Dataset.toml`). The input caps apply unless `allow_large_inputs`.
     #[staticmethod]
-    #[pyo3(signature = (conditions, measurements=None))]
+    #[pyo3(signature = (conditions, measurements=None, allow_large_inputs=false))]
     fn from_conditions(
+        py: Python<'_>,
         conditions: &Bound<'_, PyAny>,
         measurements: Option<&Bound<'_, PyDict>>,
+        allow_large_inputs: bool,
     ) -> PyResult<Self> {
         let value = strip_nulls(from_py(conditions, "conditions")?);
         if !value.is_object() {
@@ -216,7 +292,13 @@ impl Dataset {
         let text = toml::to_string(&value)
             .map_err(|e| input_error(format!("conditions: cannot be written as TOML: {e}")))?;
         Ok(Dataset {
-            inner: Arc::new(build(&text, Path::new("<conditions>"), measurements)?),
+            inner: Arc::new(build(
+                py,
+                &text,
+                Path::new("<conditions>"),
+                measurements,
+                allow_large_inputs,
+            )?),
         })
     }
 
@@ -230,6 +312,25 @@ impl Dataset {
     #[getter]
     fn toml(&self) -> &str {
         &self.inner.toml
+    }
+
+    /// Whether the input caps were lifted (`allow_large_inputs=True`).
+    #[getter]
+    fn allow_large_inputs(&self) -> bool {
+        self.inner.allow_large_inputs
+    }
+
+    /// The digest of the data (the library's `data_digest`: experiment names, conditions and
+    /// measurements), as a fit made on them records it in its summary (`data_digest`).
+    #[getter]
+    fn data_digest(&self) -> String {
+        let set = &self.inner.loaded.set;
+        rheometer::fit::data_digest(
+            set.experiments
+                .iter()
+                .zip(&set.measurements)
+                .filter_map(|(e, m)| m.as_ref().map(|m| (e, m))),
+        )
     }
 
     /// Experiment names, in file order.

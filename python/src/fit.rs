@@ -165,3 +165,14 @@ pub fn fit<'py>(
     d.set_item("notes", notes)?;
     Ok(d)
 }
+
+/// Checks a fit summary or a diagnosis given as JSON text (the dict of a `FitResult` or a
+/// `Diagnosis`, e.g. from a pickle) with the library's reader of fit reports, the one
+/// `rheometer fit --from` uses: every field's type and range, an error naming the field's
+/// path (`n.value`) and `what` (the object it came from).
+#[pyfunction]
+pub fn check_fit_summary(text: &str, what: &str) -> PyResult<()> {
+    rheometer::fit::FitSummary::from_fit_or_diagnosis_json(text, what)
+        .map(|_| ())
+        .map_err(crate::errors::input_error)
+}

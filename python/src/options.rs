@@ -78,9 +78,10 @@ fn loss(name: &str) -> PyResult<Loss> {
 
 /// Sets the loss (by name) and its soft margin `f_scale` of `opts`, as `fit` and `diagnose`
 /// take them. Errors: an unknown loss, a margin outside (0, 1), a margin without a robust
-/// loss.
+/// loss, a robust loss with the paper's estimator (of `opts`).
 pub fn robust_loss(opts: &mut IdentifyOptions, name: &str, margin: Option<f64>) -> PyResult<()> {
     let (l, c) = request::robust_loss(loss(name)?, margin).map_err(refused)?;
+    request::loss_for(l, opts.estimator).map_err(refused)?;
     opts.loss = l;
     opts.f_scale = c;
     Ok(())
