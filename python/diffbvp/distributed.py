@@ -26,8 +26,9 @@ variable ``RAYON_NUM_THREADS`` (:func:`worker_env`) does the same for every call
 process, if set before its first call.
 
 **What travels.** The data set (its TOML text and the measurement arrays, about 15 kB for the
-shipped 9 experiments) and the base fit go to every worker once
-(``client.scatter(..., broadcast=True)``); a task is then only (replicate indices, seed, fit
+shipped 9 experiments) and the base fit go to every worker once per call
+(``client.scatter(..., broadcast=True)``: keys of their own, so that calls on one
+client, the same data or not, never share or release each other's data); a task is then only (replicate indices, seed, fit
 options), and its result the pickled :class:`~diffbvp.results.FitResult` of each replicate
 (the ``FitSummary`` dict and the residual arrays, about 40 kB with ``profile_points=2``, plus
 about 50 kB per 100 profile points).
@@ -38,6 +39,14 @@ replicates per worker), so that the scheduler's cost per task (about 1 ms) stays
 work and the last tasks still balance. A worker holds one data set and one fit at a time (a
 few MB).
 
+**Checked before anything travels.** ``replicates``, ``seed``, ``noise``, ``batch_size`` and
+``threads_per_fit`` are checked, every key of ``fit_options`` must be an argument of
+:func:`diffbvp.fit` (a typo is an :class:`~diffbvp.errors.InputError` naming the key at once,
+not a failed replicate), and the base fit must have been made on the data set (the data digest
+its summary records, else its experiment names). A replicate that fails on a worker keeps its
+exception: :attr:`BootstrapResult.errors` (and :func:`map_fits`' list) hold the exception
+object with its class and attributes (``experiment``, ``hints``, ...).
+
 Results are deterministic: the same replicate index and seed give the same synthetic data and
 so the same fit on any worker, in any order, with any thread count
 (``tests/test_distributed.py`` checks the ``LocalCluster`` results equal the serial ones
@@ -46,12 +55,16 @@ bitwise).
 
 from __future__ import annotations
 
+import difflib
+import inspect
 import math
+import pickle
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence
 
 import numpy as np
 
-from . import Dataset, FitResult, fit as _fit, set_threads
+from . import Dataset, FitResult, _int, fit as _fit, set_threads
+from .errors import DiffbvpError, InputError
 
 __all__ = ["worker_env", "replicate_dataset", "bootstrap_fit", "bootstrap", "map_fits", "BootstrapResult"]
 
@@ -97,11 +110,15 @@ def bootstrap_fit(dataset: Dataset, base: FitResult, index: int, seed: int = 0,
 
 class BootstrapResult:
     """The fits of a parametric bootstrap: ``fits`` (list of :class:`FitResult` in replicate
-    order), ``failed`` (index → error message)."""
+    order, ``None`` where a fit failed), ``failed`` (index → error message, ``"Class:
+    message"``) and ``errors`` (index → the exception the worker raised, with its class and
+    attributes)."""
 
-    def __init__(self, fits: List[Optional[FitResult]], failed: Dict[int, str]):
+    def __init__(self, fits: List[Optional[FitResult]], failed: Dict[int, str],
+                 errors: Optional[Dict[int, BaseException]] = None):
         self.fits = fits
         self.failed = failed
+        self.errors = dict(errors or {})
 
     def estimates(self) -> Dict[str, np.ndarray]:
         """name → estimates of every replicate (nan where a fit failed)."""
@@ -117,10 +134,11 @@ class BootstrapResult:
         return {k: float(np.nanstd(v, ddof=1)) for k, v in self.estimates().items()}
 
     def __getstate__(self):
-        return (self.fits, self.failed)
+        return (self.fits, self.failed, self.errors)
 
     def __setstate__(self, s):
-        self.fits, self.failed = s
+        self.fits, self.failed = s[0], s[1]
+        self.errors = s[2] if len(s) > 2 else {}
 
     def __repr__(self) -> str:
         s = self.std()
@@ -128,11 +146,82 @@ class BootstrapResult:
         return f"BootstrapResult({len(self.fits)} replicates, {len(self.failed)} failed, {parts})"
 
 
+# the keyword arguments of diffbvp.fit that a fit_options dict may set
+_FIT_ARGS = tuple(p for p in inspect.signature(_fit).parameters if p != "dataset")
+
+
+def _check_fit_options(options: Any, name: str = "fit_options") -> Dict[str, Any]:
+    """``options`` as a dict whose every key is a keyword argument of :func:`diffbvp.fit`;
+    else an :class:`InputError` naming the key (and the closest argument)."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise InputError(f"{name}: expected a dict of diffbvp.fit keyword arguments, "
+                         f"got {type(options).__name__}")
+    for key in options:
+        if key not in _FIT_ARGS:
+            close = difflib.get_close_matches(str(key), _FIT_ARGS, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise InputError(f"{name}: {key!r} is not an argument of diffbvp.fit{hint} "
+                             f"(the arguments are {', '.join(_FIT_ARGS)})")
+    return dict(options)
+
+
+def _check_base(dataset: Any, base: Any) -> None:
+    """``base`` is a fit of ``dataset``: the data digest its summary records (or, for a
+    summary without one, its experiment names) matches the data set's."""
+    if not isinstance(dataset, Dataset):
+        raise InputError(f"dataset: expected a diffbvp.Dataset, got {type(dataset).__name__}")
+    if not isinstance(base, FitResult):
+        raise InputError(f"base: expected the diffbvp.FitResult of a fit of the data set, "
+                         f"got {type(base).__name__}")
+    recorded = base.summary.get("data_digest")
+    if recorded:
+        if recorded != dataset.data_digest:
+            raise InputError(
+                f"base: a fit of other data (its data digest {recorded} differs from the data "
+                f"set's {dataset.data_digest}): the replicates would be simulated from another "
+                "data set's fit; fit this data set first (diffbvp.fit(dataset))")
+        return
+    names = base.summary.get("experiments") or list(base.residual_profiles)
+    if list(names) != list(dataset.names):
+        raise InputError(f"base: a fit of the experiments {list(names)}, the data set has "
+                         f"{list(dataset.names)}; fit this data set first")
+
+
+def _check_threads(v: Optional[int]) -> Optional[int]:
+    if v is None:
+        return None
+    t = _int(v, "threads_per_fit")
+    if t < 1:
+        raise InputError(f"threads_per_fit: give at least 1 thread, or None (got {t})")
+    return t
+
+
+def _check_batch(v: Optional[int]) -> Optional[int]:
+    if v is None:
+        return None
+    b = _int(v, "batch_size")
+    if b < 1:
+        raise InputError(f"batch_size: give at least 1 replicate per task, or None (got {b})")
+    return b
+
+
+def _portable(e: BaseException) -> BaseException:
+    """``e`` itself if it pickles (to travel back from a worker with its class and
+    attributes), else a :class:`DiffbvpError` with its class name and message."""
+    try:
+        pickle.loads(pickle.dumps(e))
+        return e
+    except Exception:
+        return DiffbvpError(f"{type(e).__name__}: {e}")
+
+
 def _safe(fn, *args, **kwargs):
     try:
         return ("ok", fn(*args, **kwargs))
     except Exception as e:  # a failed replicate is reported, not fatal to the others
-        return ("error", f"{type(e).__name__}: {e}")
+        return ("error", _portable(e))
 
 
 def _use_threads(threads: Optional[int]) -> None:
@@ -158,9 +247,7 @@ def _batches(count: int, client: Any, batch_size: Optional[int]) -> List[List[in
     if batch_size is None:
         workers = max(1, len(client.scheduler_info().get("workers", {}))) if client is not None else 1
         batch_size = max(1, count // (_TASKS_PER_WORKER * workers))
-    if int(batch_size) < 1:
-        raise ValueError(f"batch_size must be at least 1 (got {batch_size})")
-    b = int(batch_size)
+    b = _check_batch(batch_size) or 1
     return [list(range(i, min(i + b, count))) for i in range(0, count, b)]
 
 
@@ -174,26 +261,52 @@ def bootstrap(client: Any, dataset: Dataset, base: FitResult, replicates: int = 
 
     ``threads_per_fit``: Rust threads of each worker process (default 1: one worker process
     per core; None leaves the workers' setting); ``batch_size``: replicates per task (see
-    the module's notes on granularity)."""
-    opts = {"start": (base.n.value, base.kappa.value)}
-    opts.update(fit_options or {})
+    the module's notes on granularity).
+
+    Everything is checked before anything is sent (see the module's notes): a typo in
+    ``fit_options``, ``replicates < 1`` or a base fit of other data raise
+    :class:`~diffbvp.errors.InputError` naming the argument. Repeated calls on one client
+    work (each call scatters its data under keys of its own)."""
+    _check_base(dataset, base)
+    replicates = _int(replicates, "replicates")
+    if replicates < 1:
+        raise InputError(f"replicates: give at least 1 replicate (got {replicates})")
+    seed = _int(seed, "seed")
+    if seed < 0:
+        raise InputError(f"seed: give a whole number >= 0 (got {seed})")
+    if noise is not None:
+        if isinstance(noise, bool) or not isinstance(noise, (int, float, np.floating, np.integer)) \
+                or not (0.0 < float(noise) < 1.0):
+            raise InputError(f"noise: a relative noise level in (0, 1) (got {noise!r}; 0.015 is 1.5 %)")
+        noise = float(noise)
+    threads_per_fit = _check_threads(threads_per_fit)
+    batch_size = _check_batch(batch_size)
+    opts: Dict[str, Any] = {"start": (base.n.value, base.kappa.value)}
+    opts.update(_check_fit_options(fit_options))
     if client is None:
         outs = [_safe(bootstrap_fit, dataset, base, i, seed, noise, opts) for i in range(replicates)]
     else:
-        ds_f, base_f = client.scatter([dataset, base], broadcast=True)
+        batches = _batches(replicates, client, batch_size)
+        # hash=False: keys of this call's own; with content-derived keys a second call on the
+        # same data shares the first call's keys, whose release by the first call loses the
+        # second call's dependencies (FutureCancelledError) or leaves it waiting
+        ds_f, base_f = client.scatter([dataset, base], broadcast=True, hash=False)
         futures = [client.submit(_bootstrap_batch, ds_f, base_f, b, seed, noise, opts, threads_per_fit,
                                  pure=False)
-                   for b in _batches(replicates, client, batch_size)]
+                   for b in batches]
         outs = [o for batch in client.gather(futures) for o in batch]
+        del futures, ds_f, base_f
     fits: List[Optional[FitResult]] = []
     failed: Dict[int, str] = {}
+    errors: Dict[int, BaseException] = {}
     for i, (status, value) in enumerate(outs):
         if status == "ok":
             fits.append(value)
         else:
             fits.append(None)
-            failed[i] = value
-    return BootstrapResult(fits, failed)
+            failed[i] = f"{type(value).__name__}: {value}"
+            errors[i] = value
+    return BootstrapResult(fits, failed, errors)
 
 
 def map_fits(client: Any, datasets: Sequence[Dataset],
@@ -202,10 +315,18 @@ def map_fits(client: Any, datasets: Sequence[Dataset],
     """Fits many data sets (e.g. a screening of materials) over ``client`` (None: serially).
     ``fit_options``: one dict of :func:`diffbvp.fit` keyword arguments per data set (default:
     none); ``threads_per_fit``, ``batch_size`` as for :func:`bootstrap`. Returns one
-    :class:`FitResult` per data set, or the exception of a failed fit."""
+    :class:`FitResult` per data set, or the exception a failed fit raised (its class and
+    attributes kept). Every data set and option dict is checked before anything is sent."""
+    datasets = list(datasets)
+    for i, d in enumerate(datasets):
+        if not isinstance(d, Dataset):
+            raise InputError(f"datasets[{i}]: expected a diffbvp.Dataset, got {type(d).__name__}")
     opts = list(fit_options) if fit_options is not None else [{}] * len(datasets)
     if len(opts) != len(datasets):
-        raise ValueError(f"{len(datasets)} data sets but {len(opts)} option dicts")
+        raise InputError(f"fit_options: {len(datasets)} data sets but {len(opts)} option dicts")
+    opts = [_check_fit_options(o, f"fit_options[{i}]") for i, o in enumerate(opts)]
+    threads_per_fit = _check_threads(threads_per_fit)
+    batch_size = _check_batch(batch_size)
     if client is None:
         outs = [_safe(_fit, d, **o) for d, o in zip(datasets, opts)]
     else:
@@ -213,5 +334,4 @@ def map_fits(client: Any, datasets: Sequence[Dataset],
                                  threads_per_fit, pure=False)
                    for b in _batches(len(datasets), client, batch_size)]
         outs = [o for batch in client.gather(futures) for o in batch]
-    from .errors import DiffbvpError
-    return [v if s == "ok" else DiffbvpError(v) for s, v in outs]
+    return [v for _, v in outs]
