@@ -496,37 +496,7 @@ impl Collocation {
         self.jbc.resize(nb * wb, 0.0);
         let mut fbuf = std::mem::take(&mut self.fbuf);
         fbuf.resize(n.max(nb), 0.0);
-        for i in 0..m {
-            self.input.clear();
-            self.input.extend_from_slice(&y[i * n..(i + 1) * n]);
-            self.input.extend_from_slice(p);
-            let rf = RhsFn {
-                problem,
-                x: self.x[i],
-                n,
-                singular: self.singular.as_ref(),
-                region: self.region[i],
-            };
-            let out = if values {
-                &mut self.f[i * n..(i + 1) * n]
-            } else {
-                &mut fbuf[..n]
-            };
-            let jac = &mut self.jn[i * n * w..(i + 1) * n * w];
-            if colored {
-                self.engine.jacobian_colored(
-                    &rf,
-                    &self.input,
-                    node_seeds,
-                    &self.coloring,
-                    out,
-                    jac,
-                );
-            } else {
-                self.engine
-                    .jacobian_in(&rf, &self.input, node_seeds, out, jac);
-            }
-        }
+        self.node_jacobians(problem, y, p, node_seeds, colored, values, &mut fbuf);
         if values {
             if let Err(e) = check_finite(&self.f, n, 1, |i| self.x[i], "right-hand side") {
                 self.fbuf = fbuf;
@@ -534,46 +504,7 @@ impl Collocation {
             }
             self.midpoint_states(y);
         }
-        for i in 0..m - 1 {
-            if self.h[i] == 0.0 {
-                // an interface: its rows come from `jif`
-                self.jm[i * n * w..(i + 1) * n * w].fill(0.0);
-                if values {
-                    self.f_mid[i * n..(i + 1) * n].fill(0.0);
-                }
-                continue;
-            }
-            self.input.clear();
-            self.input
-                .extend_from_slice(&self.y_mid[i * n..(i + 1) * n]);
-            self.input.extend_from_slice(p);
-            let rf = RhsFn {
-                problem,
-                x: self.x[i] + 0.5 * self.h[i],
-                n,
-                singular: self.singular.as_ref(),
-                region: self.region[i],
-            };
-            let out = if values {
-                &mut self.f_mid[i * n..(i + 1) * n]
-            } else {
-                &mut fbuf[..n]
-            };
-            let jac = &mut self.jm[i * n * w..(i + 1) * n * w];
-            if colored {
-                self.engine.jacobian_colored(
-                    &rf,
-                    &self.input,
-                    node_seeds,
-                    &self.coloring,
-                    out,
-                    jac,
-                );
-            } else {
-                self.engine
-                    .jacobian_in(&rf, &self.input, node_seeds, out, jac);
-            }
-        }
+        self.midpoint_jacobians(problem, p, node_seeds, colored, values, &mut fbuf);
         let passes = if colored {
             self.coloring.passes()
         } else {
@@ -600,6 +531,118 @@ impl Collocation {
             |i| self.x[i] + 0.5 * self.h[i],
             "Jacobian",
         )?;
+        let boundary = self.boundary_jacobians(problem, y, p, bc_seeds, &mut fbuf);
+        self.fbuf = fbuf;
+        boundary
+    }
+
+    /// The right-hand side's values (into `f` if `values`, else scratch `fbuf`) and Jacobians
+    /// (`jn`) at the nodes.
+    #[allow(clippy::too_many_arguments)]
+    fn node_jacobians<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        node_seeds: Seeds<'_>,
+        colored: bool,
+        values: bool,
+        fbuf: &mut [f64],
+    ) {
+        let (n, m, w) = (self.n, self.m(), node_seeds.len());
+        for i in 0..m {
+            self.input.clear();
+            self.input.extend_from_slice(&y[i * n..(i + 1) * n]);
+            self.input.extend_from_slice(p);
+            let rf = RhsFn {
+                problem,
+                x: self.x[i],
+                n,
+                singular: self.singular.as_ref(),
+                region: self.region[i],
+            };
+            let out = if values {
+                &mut self.f[i * n..(i + 1) * n]
+            } else {
+                &mut fbuf[..n]
+            };
+            let jac = &mut self.jn[i * n * w..(i + 1) * n * w];
+            let coloring = colored.then_some(&self.coloring);
+            rhs_jacobian(
+                &mut self.engine,
+                coloring,
+                &rf,
+                &self.input,
+                node_seeds,
+                out,
+                jac,
+            );
+        }
+    }
+
+    /// The right-hand side's values (into `f_mid` if `values`) and Jacobians (`jm`) at the
+    /// midpoints (zero rows at an interface, whose rows come from `jif`).
+    fn midpoint_jacobians<P: Bvp>(
+        &mut self,
+        problem: &P,
+        p: &[f64],
+        node_seeds: Seeds<'_>,
+        colored: bool,
+        values: bool,
+        fbuf: &mut [f64],
+    ) {
+        let (n, m, w) = (self.n, self.m(), node_seeds.len());
+        for i in 0..m - 1 {
+            if self.h[i] == 0.0 {
+                // an interface: its rows come from `jif`
+                self.jm[i * n * w..(i + 1) * n * w].fill(0.0);
+                if values {
+                    self.f_mid[i * n..(i + 1) * n].fill(0.0);
+                }
+                continue;
+            }
+            self.input.clear();
+            self.input
+                .extend_from_slice(&self.y_mid[i * n..(i + 1) * n]);
+            self.input.extend_from_slice(p);
+            let rf = RhsFn {
+                problem,
+                x: self.x[i] + 0.5 * self.h[i],
+                n,
+                singular: self.singular.as_ref(),
+                region: self.region[i],
+            };
+            let out = if values {
+                &mut self.f_mid[i * n..(i + 1) * n]
+            } else {
+                &mut fbuf[..n]
+            };
+            let jac = &mut self.jm[i * n * w..(i + 1) * n * w];
+            let coloring = colored.then_some(&self.coloring);
+            rhs_jacobian(
+                &mut self.engine,
+                coloring,
+                &rf,
+                &self.input,
+                node_seeds,
+                out,
+                jac,
+            );
+        }
+    }
+
+    /// The boundary conditions' Jacobian (`jbc`) and the interface conditions' (`jif`), seeded
+    /// with `bc_seeds`; `fbuf` (at least `n + k` long) takes their values.
+    fn boundary_jacobians<P: Bvp>(
+        &mut self,
+        problem: &P,
+        y: &[f64],
+        p: &[f64],
+        bc_seeds: Seeds<'_>,
+        fbuf: &mut [f64],
+    ) -> Result<(), BvpError> {
+        let (n, m) = (self.n, self.m());
+        let nb = n + self.k;
         self.input.clear();
         self.input.extend_from_slice(&y[..n]);
         self.input.extend_from_slice(&y[(m - 1) * n..]);
@@ -607,19 +650,16 @@ impl Collocation {
         let bf = BcFn { problem, n };
         self.engine
             .jacobian_in(&bf, &self.input, bc_seeds, &mut fbuf[..nb], &mut self.jbc);
-        let interfaces = self.interface_jacobians(problem, y, p, bc_seeds, &mut fbuf);
-        self.fbuf = fbuf;
-        interfaces?;
-        for (c, v) in self.jbc.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(BvpError::NonFinite {
-                    what: "boundary-condition Jacobian",
-                    component: c / wb.max(1),
-                    x: self.x[0],
-                });
-            }
+        self.interface_jacobians(problem, y, p, bc_seeds, fbuf)?;
+        let wb = bc_seeds.len();
+        match self.jbc.iter().position(|v| !v.is_finite()) {
+            Some(c) => Err(BvpError::NonFinite {
+                what: "boundary-condition Jacobian",
+                component: c / wb.max(1),
+                x: self.x[0],
+            }),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// The interface conditions' Jacobians, seeded as the boundary conditions (`[left, right,
@@ -872,6 +912,23 @@ struct ParamParts<'a> {
     bc_column: usize,
     /// The interface conditions' derivatives (rows of `bc_width`, at `bc_column`).
     jif: &'a [f64],
+}
+
+/// The Jacobian of the right-hand side `rf` at `input` in the seeds `seeds`, compressed by
+/// `coloring` where given ([`Coloring`]), else one direction per seed.
+fn rhs_jacobian<P: Bvp>(
+    engine: &mut DualJacobian,
+    coloring: Option<&Coloring>,
+    rf: &RhsFn<'_, P>,
+    input: &[f64],
+    seeds: Seeds<'_>,
+    out: &mut [f64],
+    jac: &mut [f64],
+) {
+    match coloring {
+        Some(c) => engine.jacobian_colored(rf, input, seeds, c, out, jac),
+        None => engine.jacobian_in(rf, input, seeds, out, jac),
+    }
 }
 
 fn check_finite(
