@@ -77,7 +77,7 @@ pub struct SimulateOptions {
     pub keep_newton_matrix: bool,
     /// Solve a warm start on the start's mesh with every interval halved, on that fixed mesh
     /// (no adaptation; Newton to `tol`) (default `false`):
-    /// the discretisation check of a fit ([`accuracy`](crate::fit::accuracy)),
+    /// the discretisation check of a fit (`accuracy`),
     /// whose difference from the start is the start's discretisation error to first order
     /// ([`Guess::on_halved_mesh`]). Every solve of these options is then on a fixed mesh:
     /// without a start solution (a cold start) it is an error.

@@ -2,7 +2,7 @@
 //! autocorrelation and Spearman rank correlation. One home for the statistics the rheometer
 //! (its fit report and data checks), the comparison (`diagnostics::compare`) and the diagnosis
 //! (`diagnostics::diagnose`) compute; tail probabilities of the F distribution in
-//! [`distributions`].
+//! `distributions`.
 //!
 //! **The noise model of record is [`NoiseModel`](crate::noise_model::NoiseModel)** (robust scale, scale along the line,
 //! outliers, one lag-1 autocorrelation, the judgement numbers); the comparison uses it. The
@@ -19,7 +19,7 @@
 //! robust estimate is smaller where the residual has kinks, so that it would call the noise of
 //! a correct model systematic.
 
-pub mod distributions;
+pub(crate) mod distributions;
 
 use serde::{Deserialize, Serialize};
 

@@ -9,7 +9,7 @@
 //!
 //! Data only: this module imports nothing of the model, so that the physics below and the
 //! effects above both read it. The built-in effects live in one file per family
-//! ([`physics`], [`process`], [`instrument`], [`material`]) and in one table, [`BUILTIN`]; a
+//! (`physics`, `process`, `instrument`, `material`) and in one table, [`BUILTIN`]; a
 //! user-written candidate is a descriptor ([`EffectDescriptor::user`]) and a
 //! [`FiberTerm`](crate::FiberTerm), joined by
 //! [`Effect::user`](crate::effects::Effect::user).
@@ -45,10 +45,10 @@
 //! [`EffectDescriptor::user`].
 
 mod descriptor;
-pub mod instrument;
-pub mod material;
-pub mod physics;
-pub mod process;
+pub(crate) mod instrument;
+pub(crate) mod material;
+pub(crate) mod physics;
+pub(crate) mod process;
 
 pub use descriptor::{
     one_per_unit, BudgetSource, Category, EffectDescriptor, GaugeColumn, Install, Scope,

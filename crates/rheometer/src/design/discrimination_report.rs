@@ -6,7 +6,7 @@ use super::report::{infeasible_paragraph, TEXT_TOP};
 use std::fmt::Write as _;
 
 impl Discrimination {
-    /// The design as a text report (top [`TEXT_TOP`] candidates, the worst feasible one, and
+    /// The design as a text report (top `TEXT_TOP` candidates, the worst feasible one, and
     /// the number of infeasible ones with the first reason).
     pub fn to_text(&self) -> String {
         let mut t = String::new();

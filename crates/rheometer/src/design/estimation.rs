@@ -2,7 +2,7 @@
 //! candidate experiment to the data of a fit, ranked by a design criterion.
 //!
 //! Every experiment of the fit contributes its information about the shared parameters
-//! ([`experiment_information`](super::information::experiment_information), take-up factor profiled out); a candidate is simulated at the
+//! (`experiment_information`, take-up factor profiled out); a candidate is simulated at the
 //! fitted parameters and its information added. The candidates of one mass flow are solved in
 //! order of the take-up axis, each warm-started from its neighbour (cold start where that
 //! fails); the mass flows run in parallel (rayon). A candidate whose model cannot be built or
@@ -380,7 +380,7 @@ fn add(total: &mut [f64], part: &[f64]) {
 /// The prediction is for the principled estimator weighting every point alike (as the fit
 /// does), each experiment's take-up factor fitted, under relative Gaussian noise as
 /// [`NoisePlan`] says (the fitted noise model along the line unless a level is declared or
-/// given): the covariance `A⁻¹ B A⁻¹` (see [`information`](super::information)). Errors: a fit
+/// given): the covariance `A⁻¹ B A⁻¹` (see `information`). Errors: a fit
 /// without noise level or standard errors (the current data must determine every fitted
 /// parameter), a bad grid.
 pub fn design_for_estimation(

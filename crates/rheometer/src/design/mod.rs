@@ -1,25 +1,25 @@
 //! Which experiment next: optimal experimental design for the spinning line from the exact
 //! sensitivities of the BVP.
 //!
-//! * [`information`]: the Fisher information one experiment carries about the fitted
+//! * `information`: the Fisher information one experiment carries about the fitted
 //!   parameters (exact forward sensitivities of the predicted gauge readings, take-up factor
 //!   profiled out);
 //! * [`criteria`]: predicted covariance, standard errors, correlation of `(n, κ)`, and the D-,
 //!   A- and E-criteria;
-//! * [`candidates`]: the grid of candidate experiments (mass flow × take-up condition) made
+//! * `candidates`: the grid of candidate experiments (mass flow × take-up condition) made
 //!   from a template experiment;
 //! * [`estimation`]: the design for estimation, ranking the candidates in parallel;
-//! * [`discrimination`]: the design for discrimination, ranking the candidates by how well
+//! * `discrimination`: the design for discrimination, ranking the candidates by how well
 //!   they tell rival explanations (the base model plus one effect or another) apart;
-//! * [`report`], [`discrimination_report`]: the designs as text.
+//! * `report`, [`discrimination_report`]: the designs as text.
 
-pub mod candidates;
+pub(crate) mod candidates;
 pub mod criteria;
-pub mod discrimination;
+pub(crate) mod discrimination;
 pub mod discrimination_report;
 pub mod estimation;
-pub mod information;
-pub mod report;
+pub(crate) mod information;
+pub(crate) mod report;
 
 pub use candidates::{Candidate, CandidateGrid, TakeUpAxis};
 pub use criteria::{Criterion, Prediction};

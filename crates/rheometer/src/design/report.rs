@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 pub const TEXT_TOP: usize = 10;
 
 impl Design {
-    /// The design as a text report (top [`TEXT_TOP`] candidates, the worst feasible one, and
+    /// The design as a text report (top `TEXT_TOP` candidates, the worst feasible one, and
     /// the number of infeasible ones with the first reason).
     pub fn to_text(&self) -> String {
         let mut t = String::new();

@@ -133,7 +133,7 @@ pub struct Candidate {
     pub refit_starts: [usize; 2],
     /// The probability that the search over all candidates and shapes finds an effect at
     /// least this convincing (`ΔBIC` at or below this one's) on effect-free data like these
-    /// (see [`calibrate`](super::diagnose::calibrate); `NaN` where not computed).
+    /// (see `calibrate`; `NaN` where not computed).
     #[serde(
         default = "crate::serde_nan::nan",
         deserialize_with = "crate::serde_nan::f64"

@@ -29,13 +29,13 @@
 //!   `dof = N − outliers − p` (`p` fitted parameters);
 //! * whiteness: the Wald–Wolfowitz runs test on the residual signs ([`RunsTest`]) and the noise
 //!   model's lag-1 autocorrelation, per experiment and pooled;
-//! * where: systematic segments of the pooled residual profile ([`segments`]), pooled over all
+//! * where: systematic segments of the pooled residual profile (`segments`), pooled over all
 //!   experiments and per experiment;
 //! * trends: Spearman rank correlations of the residual with strain rate, temperature, speed.
 
-pub mod compare_figures;
-pub mod model_runs;
-pub mod segments;
+pub(crate) mod compare_figures;
+pub(crate) mod model_runs;
+pub(crate) mod segments;
 pub mod summary_text;
 
 pub use crate::statistics::RunsTest;
@@ -460,7 +460,7 @@ impl Comparison {
         ["compare_summary.txt", "compare.json", "compare_points.csv"];
 
     /// Writes `compare_summary.txt`, `compare.json`, `compare_points.csv` and the figures
-    /// (see [`compare_figures::write_figures`]) into `dir` (created; refused if it is an input
+    /// (see `compare_figures::write_figures`) into `dir` (created; refused if it is an input
     /// or a file), never over a file in `inputs`, each file atomically (see
     /// [`write_atomically`](crate::output::write_atomically)). Returns the written paths.
     pub fn write(

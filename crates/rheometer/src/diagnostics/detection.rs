@@ -6,7 +6,7 @@
 //! **Linearised at strength 0.** A candidate present with strength `s` adds `s c` to the
 //! residuals (`c = ∂r/∂s`, its exact sensitivity column, weighted as the residuals are). The
 //! refit of the fitted parameters absorbs the part of `c` they can mimic; what is left is the
-//! orthogonalised signature `c⊥` ([`scores`](super::scores)). With white noise of standard
+//! orthogonalised signature `c⊥` (`scores`). With white noise of standard
 //! deviation `σ` (in the residuals' units), the cost the candidate removes is
 //! `σ² χ²₁(λ)`, a non-central χ² with one degree of freedom and non-centrality
 //!

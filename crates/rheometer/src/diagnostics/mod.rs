@@ -12,7 +12,7 @@
 //!   they explain;
 //! * [`candidate`]: the record of one candidate and how candidates are judged and ranked;
 //! * [`diagnosis`]: the result of a diagnosis (JSON) and what figures need besides;
-//! * [`calibration`]: the look-elsewhere calibration of a diagnosis as a value (the null
+//! * `calibration`: the look-elsewhere calibration of a diagnosis as a value (the null
 //!   distribution of the best `ΔBIC`), computed by the stage `diagnose::calibrate`;
 //! * [`report`]: the diagnosis in words and its figures;
 //! * [`detection`]: the detection limit of each candidate (the strength the data would reveal)
@@ -20,18 +20,18 @@
 //! * [`scan`]: the global search of one candidate's strength (and shape): the profile of `J`
 //!   and the refits of its best points;
 //! * [`ties`]: candidates about as consistent with the data as the named one (alternatives);
-//! * [`consistency`]: whether a fitted effect has one strength in every experiment (a score
+//! * `consistency`: whether a fitted effect has one strength in every experiment (a score
 //!   test of the fit; the diagnosis' stage 10 and `fit --with` both use it).
 
-pub mod calibration;
+pub(crate) mod calibration;
 pub mod candidate;
 pub mod compare;
-pub mod consistency;
+pub(crate) mod consistency;
 pub mod detection;
 pub mod diagnose;
 pub mod diagnosis;
 pub mod pair;
 pub mod report;
 pub mod scan;
-pub mod scores;
+pub(crate) mod scores;
 pub mod ties;

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 pub const DRAWING_FRACTION: f64 = 0.01;
 
 /// The strain rates \[1/s\] of a fit's model at the measurement positions where the fiber
-/// draws ([`DRAWING_FRACTION`]) (JSON: `strain_rates` of a fit).
+/// draws (`DRAWING_FRACTION`) (JSON: `strain_rates` of a fit).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StrainRateCoverage {
     /// Temperature the reduced rates refer to \[K\]: the median die (inlet) temperature.

@@ -239,7 +239,7 @@ impl Rheometer {
     }
 
     /// The one noise summary of a fit's residual profiles (see
-    /// [`noise_summary`](crate::noise_summary)): the declared relative uncertainty
+    /// `noise_summary`): the declared relative uncertainty
     /// (`declared`, else the data set's), else the noise model's estimate.
     pub fn noise_summary(
         &self,

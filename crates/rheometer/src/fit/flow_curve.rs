@@ -8,7 +8,7 @@
 //!   offsets), generic over the [`ViscosityLaw`]; derivatives with respect to the law's
 //!   parameters are exact (dual numbers through the same evaluation).
 //! * **Strain rates the data cover.** The model's strain rates at the measurement positions of
-//!   the fitted solutions ([`StrainRateCoverage`]), shifted to the curve's temperature by the
+//!   the fitted solutions ([`StrainRateCoverage`](super::StrainRateCoverage)), shifted to the curve's temperature by the
 //!   VFT factor `a_T = η₀(T)/η₀(T_ref)` (time–temperature superposition: the Carreau-type laws
 //!   depend on `η₀(T)·ε̇` only, so a point of the spin line at temperature `T` and rate `ε̇`
 //!   probes the curve at `T_ref` at the rate `a_T ε̇`). Outside that range, extended by a decade
@@ -23,7 +23,6 @@
 //!   added in quadrature. The total band combines both in quadrature.
 
 use super::budget::ErrorBudget;
-pub use super::coverage::{StrainRateCoverage, DRAWING_FRACTION};
 pub use super::curve::{BandMethod, FlowCurve, FlowPoint, Isotherm};
 use super::summary::{FitSummary, Z95};
 use crate::contributions::NusseltLaw;

@@ -117,8 +117,8 @@ pub struct FarRule {
 
 impl FarRule {
     /// The landscape's default for the tolerance `tol`: far beyond
-    /// [`LANDSCAPE_FAR_COST`] times the row's minimum, solved at
-    /// [`LANDSCAPE_FAR_TOL_FACTOR`]` · tol`, at most [`LANDSCAPE_FAR_TOL_MAX`] (and never
+    /// `LANDSCAPE_FAR_COST` times the row's minimum, solved at
+    /// `LANDSCAPE_FAR_TOL_FACTOR`` · tol`, at most `LANDSCAPE_FAR_TOL_MAX` (and never
     /// tighter than `tol`: at `tol >= 1e-3` every point is solved at `tol`).
     pub fn for_tol(tol: f64) -> Self {
         let far = (LANDSCAPE_FAR_TOL_FACTOR * tol).min(LANDSCAPE_FAR_TOL_MAX);

@@ -170,7 +170,7 @@ impl Layout {
 
     /// The trust region's scale of each shared free parameter
     /// ([`FitOptions::x_scale`](diffbvp::least_squares::FitOptions::x_scale)): 1 for `n` and
-    /// `κ`; for an effect's strength or shape, [`EFFECT_SCALE_FRACTION`] of its search range
+    /// `κ`; for an effect's strength or shape, `EFFECT_SCALE_FRACTION` of its search range
     /// where that exceeds 1 in the parameter's unit (an air speed in m/s, a temperature in
     /// K), else 1 (radii of O(1) parameters stay as they were).
     pub fn x_scale(&self) -> Vec<f64> {

@@ -105,7 +105,7 @@ impl ProfileInterval {
 pub struct NewtonianTest {
     /// `LR = (J_N − J)/σ̂²` \[-\].
     pub statistic: f64,
-    /// `½ P(χ²₁ > LR)` (boundary mixture; approximate, see [`profile`](super::profile)).
+    /// `½ P(χ²₁ > LR)` (boundary mixture; approximate, see `profile`).
     pub p_value: f64,
     /// RMS relative residual of the Newtonian refit \[-\].
     pub rms_newtonian: f64,

@@ -55,7 +55,7 @@ impl NestedFit {
 
 impl Rheometer {
     /// Identification of this model from `start = (n, κ)` that never ends worse than the plain
-    /// model (see the [module](self)). Without fitted effects it is
+    /// model (see the module). Without fitted effects it is
     /// [`identify`](Self::identify). Costs two more fits with them. An error of the fit from
     /// the given start is kept only when the fit from the plain optimum fails too.
     pub fn identify_nested(

@@ -87,7 +87,7 @@ pub struct IdentifyOptions {
     /// (default `Some(0.01)`): the fit is checked at the optimum with every BVP re-solved on its
     /// mesh with every interval halved (Richardson) and refined at tighter tolerances until it
     /// holds (see
-    /// [`accuracy`](super::accuracy)). `None`: no check, `simulate.tol` as given.
+    /// `accuracy`). `None`: no check, `simulate.tol` as given.
     pub max_discretisation_shift: Option<f64>,
     /// How close \[standard errors\] to the optimum of the discretised model the fit must
     /// come (default `Some(0.01)`, the same budget as the discretisation's shift): it stops

@@ -42,7 +42,7 @@ pub struct FitPlan {
     /// fastest of three) \[s\].
     pub evaluation_s: f64,
     /// Expected wall time of the fit \[s\]: every experiment's cold start and
-    /// [`PLANNED_EVALUATIONS`] evaluations, divided over [`threads`](Self::threads). The fit's
+    /// `PLANNED_EVALUATIONS` evaluations, divided over [`threads`](Self::threads). The fit's
     /// loose early iterations make it an upper estimate on an otherwise idle machine.
     pub seconds: f64,
     /// Expected peak memory of the fit's state \[bytes\]: per experiment the accepted and the

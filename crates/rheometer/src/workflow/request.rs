@@ -386,7 +386,7 @@ pub fn max_nodes(v: i128) -> Result<usize, Refusal> {
 }
 
 /// The mesh limit of a landscape: in the range of [`max_nodes`] and at most
-/// [`LANDSCAPE_MAX_NODES`] (its solves' cap), which is also the default.
+/// `LANDSCAPE_MAX_NODES` (its solves' cap), which is also the default.
 pub fn landscape_max_nodes(v: Option<i128>) -> Result<usize, Refusal> {
     match v {
         None => Ok(LANDSCAPE_MAX_NODES),

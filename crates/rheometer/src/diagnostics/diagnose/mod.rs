@@ -9,7 +9,7 @@
 //!    (one sensitivity solve per experiment, reusing the factorisation of the last Newton step,
 //!    gives all of them), orthogonalised against the fitted parameters' directions; its
 //!    projection of the residual is the cost it would remove to first order
-//!    ([`scores`](super::scores)).
+//!    (`scores`).
 //! 3. **Test the noise**: are the residuals systematic? The RMS relative residual against the
 //!    fit's one noise level (declared, else the noise model's estimate, outliers excluded) and
 //!    the lag-1 autocorrelation of the residuals along each spin line (white noise:
@@ -31,7 +31,7 @@
 //! 7. **Rank** ([`rank_order`]): credible refits by `ΔBIC`, then the others. A candidate earns
 //!    its place when `ΔBIC` is below [`DiagnoseOptions::earn_threshold`] (−10: "very strong"
 //!    evidence on the Kass–Raftery scale) and its strength is credible.
-//!    The false-alarm probability of each refit ([`calibrate`]: how often the search over all
+//!    The false-alarm probability of each refit (`calibrate`: how often the search over all
 //!    candidates and shapes finds an effect at least that convincing on effect-free data like
 //!    the user's) must be at most [`DiagnoseOptions::max_false_alarm`] (5 %), and the effect
 //!    must remove at least half the excess misfit ([`verdict`]).
@@ -49,7 +49,7 @@
 //!    by `ΔBIC` (beyond a margin corrected for the pairs tried) replaces the forward search's
 //!    result; one within it is reported beside it, and where the two laws disagree neither is
 //!    a result.
-//! 10. **One strength in every experiment** ([`consistency`]): a score test of the final fit
+//! 10. **One strength in every experiment** (`consistency`): a score test of the final fit
 //!     against each found effect's strength varying with the conditions that differ between
 //!     the experiments (no new fit); an effect that fails is a stand-in for something else.
 //!     Where the residuals would otherwise be explained, the verdict is then "none of the
@@ -62,7 +62,7 @@
 
 mod ambiguity;
 mod base;
-pub mod calibrate;
+pub(crate) mod calibrate;
 mod judge;
 mod linearise;
 mod pairs;
@@ -124,7 +124,7 @@ pub struct DiagnoseOptions {
     /// strength (default: none).
     pub start_strengths: Vec<(String, f64)>,
     /// Largest false-alarm probability of the search at which an effect is named (default
-    /// 0.05; see [`calibrate`]).
+    /// 0.05; see `calibrate`).
     pub max_false_alarm: f64,
     /// Replicates of the look-elsewhere calibration (default 2000).
     pub calibration_replicates: usize,

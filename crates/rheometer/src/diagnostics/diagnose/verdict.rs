@@ -2,7 +2,7 @@
 //!
 //! * An effect is named as missing only when it earns its place (credible strength and law,
 //!   `ΔBIC` below the threshold), is unlikely to be a false alarm of the search over all
-//!   candidates ([`calibrate`](super::calibrate)), and removes at least
+//!   candidates (`calibrate`), and removes at least
 //!   [`MIN_SHARE_OF_EXCESS`] of the excess misfit (the cost above what the noise alone
 //!   leaves).
 //! * It is *the* explanation only when, with the named effects, the residuals are at the noise:
@@ -12,7 +12,7 @@
 //!   experiments) the unexplained residual lies — a user-written effect is the next step.
 //!   It is "none of the candidates" too where the named effects bring the residuals to the
 //!   noise only with a strength that differs between the experiments (the stage
-//!   [`consistency`](crate::diagnostics::consistency)): they stand in for something else.
+//!   `consistency`): they stand in for something else.
 //! * Where a candidate within the tie margin of the result (credible, or refused only for a
 //!   strength outside its physical range or at a search bound), or a pair of candidates fitted
 //!   jointly within the look-elsewhere margin (see [`pair`](crate::diagnostics::pair)),

@@ -348,7 +348,7 @@ pub struct FitSummary {
     pub strain_rates: Option<StrainRateCoverage>,
     /// Profile-likelihood intervals of the fitted law parameters and strengths, with the
     /// reasons the linearised interval is not trusted where it is not (see
-    /// [`profile`](crate::fit::profile)); empty where the model misses the data by several times
+    /// `profile`); empty where the model misses the data by several times
     /// the noise ([`likelihood_skipped`](Self::likelihood_skipped)).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub intervals: Vec<ProfileInterval>,
