@@ -27,7 +27,7 @@ use diffbvp::solve::{Guess, SolveOptions, Solver};
 /// overwritten). Returns the solution at `p[index] = 1`, solved with `options` (intermediate
 /// steps at the looser `path.intermediate_tol`). The solver's workspace (and its cached
 /// symbolic factorisations) is reused for every step; its own options are not used.
-pub fn continuation_in_c<P: Bvp>(
+pub(crate) fn continuation_in_c<P: Bvp>(
     solver: &mut Solver<'_, P>,
     params: &[f64],
     index: usize,
@@ -55,7 +55,7 @@ fn with_value(params: &[f64], index: usize, value: f64) -> Vec<f64> {
 /// started (e.g. `options` with another mesh rule). Returns `(loose, final)`. A fit with loose
 /// inner iterations uses the loose end point as its loose solve at the start parameters
 /// instead of re-solving the final solution loosely.
-pub fn continuation_in_c_with_loose<P: Bvp>(
+pub(crate) fn continuation_in_c_with_loose<P: Bvp>(
     solver: &mut Solver<'_, P>,
     params: &[f64],
     index: usize,

@@ -8,7 +8,7 @@ use crate::output_files::FIFO_WAIT_VARIABLE;
 
 /// A numeric `DIFFBVP_*` variable: its name, range and meaning.
 #[derive(Debug, Clone, Copy)]
-pub struct NumericVariable {
+pub(crate) struct NumericVariable {
     /// The name (`DIFFBVP_FIFO_WAIT_S`).
     pub name: &'static str,
     /// The accepted values, inclusive.
@@ -18,7 +18,7 @@ pub struct NumericVariable {
 }
 
 /// Every `DIFFBVP_*` variable the program reads.
-pub const DIFFBVP_VARIABLES: [NumericVariable; 1] = [NumericVariable {
+pub(crate) const DIFFBVP_VARIABLES: [NumericVariable; 1] = [NumericVariable {
     name: FIFO_WAIT_VARIABLE,
     range: [0.1, 3600.0],
     meaning: "seconds a write into a FIFO waits for a reader (default 10)",
@@ -26,7 +26,7 @@ pub const DIFFBVP_VARIABLES: [NumericVariable; 1] = [NumericVariable {
 
 /// The value of `var` from the text `value`: a finite number within its range, else an error
 /// naming the variable, the value and the range.
-pub fn parse_numeric(var: &NumericVariable, value: &str) -> Result<f64, String> {
+pub(crate) fn parse_numeric(var: &NumericVariable, value: &str) -> Result<f64, String> {
     let [lo, hi] = var.range;
     match value.trim().parse::<f64>() {
         Ok(x) if x.is_finite() && (lo..=hi).contains(&x) => Ok(x),
@@ -40,7 +40,7 @@ pub fn parse_numeric(var: &NumericVariable, value: &str) -> Result<f64, String> 
 
 /// Checks every `DIFFBVP_*` variable of `vars` (name, value pairs, as
 /// [`std::env::vars_os`] gives them): each must be one the program reads
-/// ([`DIFFBVP_VARIABLES`]) with a value in its range.
+/// (`DIFFBVP_VARIABLES`) with a value in its range.
 pub fn check_diffbvp_variables<I>(vars: I) -> Result<(), String>
 where
     I: IntoIterator<Item = (std::ffi::OsString, std::ffi::OsString)>,

@@ -23,15 +23,15 @@ use std::path::Path;
 
 /// Below this distance \[K\] between the coldest prescribed temperature (inlet or air) and the
 /// VFT temperature `T_VF`, a non-finite solve is blamed on the VFT law.
-pub const VFT_MARGIN_K: f64 = 20.0;
+pub(crate) const VFT_MARGIN_K: f64 = 20.0;
 
 /// Power index `n` \[-\] below which a stalled solve is blamed (also) on strong strain
 /// thinning.
-pub const STRONG_THINNING_N: f64 = 0.3;
+pub(crate) const STRONG_THINNING_N: f64 = 0.3;
 
 /// Ratio of inlet to take-up diameter \[-\] above which a stalled solve is blamed (also) on a
 /// very thin take-up.
-pub const THIN_TAKE_UP_RATIO: f64 = 50.0;
+pub(crate) const THIN_TAKE_UP_RATIO: f64 = 50.0;
 
 /// The experiment an error in a chain belongs to: the first [`RheometerError::Simulation`] or
 /// [`CompareError::Simulation`] in the chain of `error`, with the law parameters `(n, κ)` where
@@ -62,7 +62,7 @@ pub fn failed_experiment(error: &(dyn Error + 'static)) -> Option<(String, Optio
 }
 
 /// The first [`BvpError`] in the chain of `error` (also behind a [`FiberError::Solver`]).
-pub fn solver_error<'a>(error: &'a (dyn Error + 'static)) -> Option<&'a BvpError> {
+pub(crate) fn solver_error<'a>(error: &'a (dyn Error + 'static)) -> Option<&'a BvpError> {
     let mut cur: Option<&'a (dyn Error + 'static)> = Some(error);
     while let Some(e) = cur {
         if let Some(b) = e.downcast_ref::<BvpError>() {

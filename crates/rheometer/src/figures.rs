@@ -4,7 +4,7 @@
 //! A thin fiber-specific layer over the model-agnostic [`crate::plot`]: it converts units for
 //! display (positions in m, diameters in µm, `1/d²` in 1/mm², temperatures in °C) and lays out
 //! one panel per experiment. Every function refuses to write over one of the `inputs` (see
-//! [`ensure_not_input`]); the format follows the extension (`.png` or `.svg`), and a function
+//! `ensure_not_input`); the format follows the extension (`.png` or `.svg`), and a function
 //! given a format writes that format. Residual panels carry the noise band (shaded `±2σ`).
 
 use super::fit::{Identification, Landscape, Rheometer, RheometerError};
@@ -110,7 +110,7 @@ fn grid_size(k: usize) -> (u32, u32) {
 
 /// One panel per experiment: measured points, the smooth fit (if given) and `curves`, in the
 /// chosen `view`. Writes `path`.
-pub fn experiment_panels(
+pub(crate) fn experiment_panels(
     path: &Path,
     experiments: &[ExperimentView<'_>],
     curves: &[ModelCurves<'_>],
@@ -181,7 +181,7 @@ pub fn panel_page_names(stem: &str, ext: &str, experiments: usize) -> Vec<String
         .collect()
 }
 
-/// Like [`experiment_panels`], split into figures of at most [`MAX_PANELS_PER_FIGURE`] panels
+/// Like `experiment_panels`, split into figures of at most [`MAX_PANELS_PER_FIGURE`] panels
 /// so that any number of experiments can be drawn: up to that many, `path` itself; beyond,
 /// `STEM_1.EXT`, `STEM_2.EXT`, … next to it (see [`panel_page_names`]). Returns the paths
 /// written.
@@ -438,7 +438,7 @@ pub fn residual_panels(
 
 /// The figure of [`residual_panels`] (without `after`) as an SVG document in memory, for an
 /// HTML report; an error without experiments.
-pub fn residuals_svg(
+pub(crate) fn residuals_svg(
     views: &[ResidualView<'_>],
     noise_sigma: Option<f64>,
 ) -> Result<String, PlotError> {

@@ -75,7 +75,7 @@ pub struct FitReportInput<'a> {
 }
 
 /// The version line of the page: `diffbvp 0.1.0`.
-pub fn program_version() -> String {
+pub(crate) fn program_version() -> String {
     format!("diffbvp {}", env!("CARGO_PKG_VERSION"))
 }
 

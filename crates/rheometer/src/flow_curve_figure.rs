@@ -4,7 +4,7 @@
 //!
 //! Drawn by [`crate::plot`]'s flow-curve figure ([`FlowCurvePlot`]) from the [`FlowCurve`]
 //! value alone, as a file ([`save_flow_curve_figure`]) or as SVG text for an HTML report
-//! ([`flow_curve_figure_svg`]): the two are the same drawing.
+//! (`flow_curve_figure_svg`): the two are the same drawing.
 
 use crate::fit::{BandMethod, FlowCurve, FlowPoint};
 use crate::format::fmt_g;
@@ -106,6 +106,6 @@ pub fn save_flow_curve_figure(path: &Path, curve: &FlowCurve) -> Result<(), Plot
 
 /// The flow-curve figure of `curve` as an SVG document (the drawing of
 /// [`save_flow_curve_figure`]), e.g. for an HTML report.
-pub fn flow_curve_figure_svg(curve: &FlowCurve) -> Result<String, PlotError> {
+pub(crate) fn flow_curve_figure_svg(curve: &FlowCurve) -> Result<String, PlotError> {
     Drawn::of(curve).with_plot(curve, flow_curve_svg)
 }

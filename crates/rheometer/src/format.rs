@@ -1,7 +1,7 @@
 //! Numbers for people: short forms for messages and reports.
 //!
-//! * [`fmt_g`]: a number alone, 6 significant digits, trailing zeros trimmed;
-//! * [`fmt_sig`]: a number alone with a given number of significant digits;
+//! * `fmt_g`: a number alone, 6 significant digits, trailing zeros trimmed;
+//! * `fmt_sig`: a number alone with a given number of significant digits;
 //! * [`fmt_pm`]: a value with its uncertainty, both rounded to the digits the uncertainty
 //!   supports (`0.804 ± 0.007`, `(4.9 ± 4.4)e2`);
 //! * [`fmt_at`]: a value at the precision of an uncertainty (interval ends: `[0.790, 0.818]`);
@@ -13,7 +13,7 @@
 
 /// `v` with 6 significant digits, trailing zeros trimmed (`1e5` and above or below `1e-3` in
 /// exponent notation).
-pub fn fmt_g(v: f64) -> String {
+pub(crate) fn fmt_g(v: f64) -> String {
     if !v.is_finite() {
         return format!("{v}");
     }
@@ -35,7 +35,7 @@ pub fn fmt_g(v: f64) -> String {
 
 /// `v` with `digits` significant digits (at least 1), in exponent notation from `1e5` and
 /// below `1e-3` (`fmt_sig(0.016234, 2) = "0.016"`, `fmt_sig(123456.0, 3) = "1.23e5"`).
-pub fn fmt_sig(v: f64, digits: usize) -> String {
+pub(crate) fn fmt_sig(v: f64, digits: usize) -> String {
     let digits = digits.max(1);
     if !v.is_finite() {
         return format!("{v}");
@@ -64,7 +64,7 @@ pub fn fmt_sig(v: f64, digits: usize) -> String {
 
 /// `v` in exponent notation with `digits` significant digits (`fmt_e(112345.0, 3) = "1.12e5"`):
 /// for quantities spanning decades (`K`, viscosities) so that neighbours look alike.
-pub fn fmt_e(v: f64, digits: usize) -> String {
+pub(crate) fn fmt_e(v: f64, digits: usize) -> String {
     if !v.is_finite() {
         return format!("{v}");
     }
@@ -118,7 +118,7 @@ fn at_place(v: f64, place: i32) -> String {
 /// doc): `fmt_pm(0.80412, 0.00713) = "0.804 ± 0.007"`, `fmt_pm(11.634, 0.0312) = "11.634 ±
 /// 0.031"`, `fmt_pm(489.1999, 440.1617) = "500 ± 400"`; a common power of ten outside
 /// `1e-3..1e5`: `fmt_pm(1.2345e6, 2.1e4) = "(1.234 ± 0.021)e6"`. An uncertainty that is not
-/// positive and finite gives the value alone ([`fmt_g`]).
+/// positive and finite gives the value alone (`fmt_g`).
 pub fn fmt_pm(value: f64, uncertainty: f64) -> String {
     if !(uncertainty.is_finite() && uncertainty > 0.0 && value.is_finite()) {
         return fmt_g(value);
@@ -138,7 +138,7 @@ pub fn fmt_pm(value: f64, uncertainty: f64) -> String {
 }
 
 /// `" unit"`, or nothing for a dimensionless quantity (unit `""` or `"-"`).
-pub fn unit_suffix(unit: &str) -> String {
+pub(crate) fn unit_suffix(unit: &str) -> String {
     match unit.trim() {
         "" | "-" => String::new(),
         u => format!(" {u}"),
@@ -146,7 +146,7 @@ pub fn unit_suffix(unit: &str) -> String {
 }
 
 /// `v` at the precision an uncertainty `u` supports (the same decimal place as in
-/// [`fmt_pm`]): interval ends and values beside a `±`. `u` not positive and finite: [`fmt_g`].
+/// [`fmt_pm`]): interval ends and values beside a `±`. `u` not positive and finite: `fmt_g`.
 pub fn fmt_at(v: f64, u: f64) -> String {
     if !(u.is_finite() && u > 0.0 && v.is_finite()) {
         return fmt_g(v);
@@ -199,7 +199,7 @@ pub fn wrap(text: &str, width: usize, first: &str, rest: &str) -> String {
 /// Every line of `text` longer than [`LINE_WIDTH`] wrapped at word boundaries, continuation
 /// lines indented 4 more than the line's own indentation. Lines that fit are kept as they are
 /// (tables stay aligned).
-pub fn wrap_long_lines(text: &str) -> String {
+pub(crate) fn wrap_long_lines(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for line in text.split_inclusive('\n') {
         let (body, nl) = match line.strip_suffix('\n') {

@@ -406,7 +406,7 @@ fn render_table(h: &mut String, t: &Table) {
 
 /// `text` with `&`, `<`, `>`, `"` and `'` replaced by character references, and control
 /// characters other than tab and line breaks dropped (they are not allowed in HTML).
-pub fn escape(text: &str) -> String {
+pub(crate) fn escape(text: &str) -> String {
     let mut s = String::with_capacity(text.len() + 16);
     for c in text.chars() {
         match c {

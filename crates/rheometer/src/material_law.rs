@@ -24,7 +24,7 @@ use nalgebra::Const;
 use num_dual::DualNum;
 
 /// Largest number of law parameters supported by [`viscosity_with_partials`].
-pub const MAX_LAW_PARAMS: usize = 8;
+pub(crate) const MAX_LAW_PARAMS: usize = 8;
 
 /// Inputs of a viscosity law at one point, dimensionless.
 #[derive(Debug, Clone, Copy)]
@@ -316,7 +316,10 @@ pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Co
 
 /// [`viscosity_with_partials`] with the VFT parameters shifted by `shift`.
 #[inline(always)]
-pub fn viscosity_with_partials_shifted<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
+pub(crate) fn viscosity_with_partials_shifted<
+    L: ViscosityLaw,
+    D: DualNum<Primitive = f64> + Copy,
+>(
     law: &L,
     zero: &ZeroRateViscosity,
     shift: VftShift<D>,
@@ -353,7 +356,7 @@ pub fn viscosity<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
 
 /// [`viscosity`] with the VFT parameters shifted by `shift`.
 #[inline(always)]
-pub fn viscosity_shifted<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
+pub(crate) fn viscosity_shifted<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
     law: &L,
     zero: &ZeroRateViscosity,
     shift: VftShift<D>,

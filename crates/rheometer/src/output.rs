@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 
 /// Fails if `path` exists and is one of `inputs` (the same file, see [`same_file`]), or if it
 /// is an existing directory.
-pub fn ensure_not_input(path: &Path, inputs: &[PathBuf]) -> Result<(), OutputError> {
+pub(crate) fn ensure_not_input(path: &Path, inputs: &[PathBuf]) -> Result<(), OutputError> {
     crate::output_files::ensure_not_input(path, inputs)?;
     if path.is_dir() {
         return Err(OutputError::IsADirectory {
@@ -35,7 +35,7 @@ pub fn ensure_not_input(path: &Path, inputs: &[PathBuf]) -> Result<(), OutputErr
 
 /// Creates `dir` (and parents). A `dir` that is, or lies below, an existing file gives
 /// [`OutputError::NotADirectory`] naming that file.
-pub fn create_dir(dir: &Path) -> Result<(), OutputError> {
+pub(crate) fn create_dir(dir: &Path) -> Result<(), OutputError> {
     if let Some(file) = blocking_file(dir) {
         return Err(OutputError::NotADirectory {
             path: dir.to_path_buf(),
@@ -49,7 +49,7 @@ pub fn create_dir(dir: &Path) -> Result<(), OutputError> {
 /// ([`OutputError::DirectoryIsInput`]) or an existing file, and refuses every file of `names`
 /// (written into `dir`) that is an input. Creates nothing. (A command checks all its outputs
 /// at once with an [`OutputPlan`].)
-pub fn check_output_dir(
+pub(crate) fn check_output_dir(
     dir: &Path,
     names: &[String],
     inputs: &[PathBuf],
@@ -72,7 +72,7 @@ pub fn check_output_dir(
 }
 
 /// Creates the output directory `dir` after [`check_output_dir`]`(dir, &[], inputs)`.
-pub fn create_output_dir(dir: &Path, inputs: &[PathBuf]) -> Result<(), OutputError> {
+pub(crate) fn create_output_dir(dir: &Path, inputs: &[PathBuf]) -> Result<(), OutputError> {
     check_output_dir(dir, &[], inputs)?;
     create_dir(dir)
 }
@@ -80,7 +80,7 @@ pub fn create_output_dir(dir: &Path, inputs: &[PathBuf]) -> Result<(), OutputErr
 /// Writes the output `path` with `write`, never over one of `inputs` (see
 /// [`output_files::write_file`](crate::output_files::write_file): regular files atomically,
 /// special files in place).
-pub fn write_atomically(
+pub(crate) fn write_atomically(
     path: &Path,
     inputs: &[PathBuf],
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
@@ -88,21 +88,21 @@ pub fn write_atomically(
     crate::output_files::write_file(path, inputs, write)
 }
 
-/// Writes text to `path` unless it is an input (see [`write_atomically`]).
+/// Writes text to `path` unless it is an input (see `write_atomically`).
 pub fn write_text(path: &Path, text: &str, inputs: &[PathBuf]) -> Result<(), OutputError> {
     write_atomically(path, inputs, |w| w.write_all(text.as_bytes()))
 }
 
 /// CSV header of simulated profiles.
-pub const PROFILE_HEADER: &str =
+pub(crate) const PROFILE_HEADER: &str =
     "position_m,velocity_m_s,force_N,temperature_K,strain_rate_1_s,diameter_m";
 
 /// The column [`write_profiles_csv`] adds after [`PROFILE_HEADER`]'s for a model with gauge
 /// effects: what the gauge reads ([`Profiles::gauge_reading`]).
-pub const GAUGE_READING_COLUMN: &str = "gauge_reading_m";
+pub(crate) const GAUGE_READING_COLUMN: &str = "gauge_reading_m";
 
-/// Writes profiles as CSV with [`PROFILE_HEADER`] to `w`, row by row (no string of the whole
-/// table is built); with gauge effects a last column [`GAUGE_READING_COLUMN`].
+/// Writes profiles as CSV with `PROFILE_HEADER` to `w`, row by row (no string of the whole
+/// table is built); with gauge effects a last column `GAUGE_READING_COLUMN`.
 pub fn write_profiles_csv(w: &mut dyn Write, p: &Profiles) -> std::io::Result<()> {
     match &p.gauge_reading {
         Some(_) => writeln!(w, "{PROFILE_HEADER},{GAUGE_READING_COLUMN}")?,
@@ -127,13 +127,13 @@ pub fn write_profiles_csv(w: &mut dyn Write, p: &Profiles) -> std::io::Result<()
     Ok(())
 }
 
-/// Writes profiles as CSV ([`PROFILE_HEADER`]) to `path`, streamed and atomically, unless
+/// Writes profiles as CSV (`PROFILE_HEADER`) to `path`, streamed and atomically, unless
 /// `path` is an input.
 pub fn write_profiles(path: &Path, p: &Profiles, inputs: &[PathBuf]) -> Result<(), OutputError> {
     write_atomically(path, inputs, |w| write_profiles_csv(w, p))
 }
 
-/// Profiles as CSV text with [`PROFILE_HEADER`] (for large tables prefer [`write_profiles`],
+/// Profiles as CSV text with `PROFILE_HEADER` (for large tables prefer [`write_profiles`],
 /// which streams).
 pub fn profiles_csv(p: &Profiles) -> String {
     let mut v = Vec::with_capacity(80 * (p.position.len() + 1));

@@ -1,7 +1,7 @@
 //! The stamp of every JSON report the program writes: `"schema_version"` (the layout of the
-//! report, [`SCHEMA_VERSION`]), `"report"` (which report it is: [`ReportKind`]) and
+//! report, `SCHEMA_VERSION`), `"report"` (which report it is: [`ReportKind`]) and
 //! `"written_by"` (the program and version that wrote it), first in the file. A reader
-//! ([`check_report`]) accepts the current schema version only, so that a report of another
+//! (`check_report`) accepts the current schema version only, so that a report of another
 //! layout is never half-read; it names the program version that wrote the file and what to
 //! do, and says which report a file of the wrong kind is.
 
@@ -10,7 +10,7 @@ use serde_json::Value;
 
 /// The layout version of the JSON reports this program writes and reads. It changes whenever
 /// a field a reader needs changes meaning, type or name.
-pub const SCHEMA_VERSION: u64 = 1;
+pub(crate) const SCHEMA_VERSION: u64 = 1;
 
 /// The program and version recorded as `"written_by"`.
 pub fn written_by() -> String {
@@ -124,7 +124,7 @@ fn wanted_list(wanted: &[ReportKind]) -> String {
 /// Checks the stamp of the report `value` read from `source` (a file name, for messages):
 /// an object of the current [`SCHEMA_VERSION`] whose `"report"` is one of `wanted`; `flag`
 /// names the option that gave the file (`--from`). Returns the kind.
-pub fn check_report(
+pub(crate) fn check_report(
     value: &Value,
     wanted: &[ReportKind],
     source: &str,

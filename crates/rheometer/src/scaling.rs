@@ -75,7 +75,7 @@ pub fn stokes_tangential_resistance(delta: f64) -> f64 {
 }
 
 /// Slenderness `δ = 1e-3` used by the paper for the drag coefficient \[-\].
-pub const PAPER_SLENDERNESS: f64 = 1e-3;
+pub(crate) const PAPER_SLENDERNESS: f64 = 1e-3;
 
 /// Reference values and the derived dimensionless numbers.
 #[derive(Debug, Clone, PartialEq)]

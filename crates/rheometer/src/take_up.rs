@@ -21,7 +21,7 @@ pub enum MissingTakeUp {
 /// Why no take-up condition could be found (callers say it in their own words: a TOML key, a
 /// command-line flag).
 #[derive(Debug, Clone)]
-pub enum TakeUpError {
+pub(crate) enum TakeUpError {
     /// The experiment has none and the rule is [`MissingTakeUp::Error`].
     Missing,
     /// [`MissingTakeUp::FromData`] for an experiment without measurements.
@@ -44,7 +44,7 @@ impl std::error::Error for TakeUpError {}
 
 /// The resolved take-up condition of one experiment.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ResolvedTakeUp {
+pub(crate) struct ResolvedTakeUp {
     /// The condition the model uses.
     pub take_up: TakeUp,
     /// `d_fit(L)` \[m\] if it was taken from the smoothed measurements.
@@ -55,7 +55,7 @@ pub struct ResolvedTakeUp {
 /// `missing`. For [`MissingTakeUp::FromData`] the measurements are smoothed, unless `fit`
 /// (their smoothing, already computed) is given. `d_fit(L)` is not checked for sign: callers
 /// that need a positive diameter check [`ResolvedTakeUp::from_data`].
-pub fn resolve_take_up(
+pub(crate) fn resolve_take_up(
     experiment: &Experiment,
     measurements: Option<&Measurements>,
     missing: MissingTakeUp,

@@ -1,5 +1,5 @@
 //! Declared standard uncertainties of process conditions, instrument and material data (the
-//! `[uncertainty]` table of the experiment file), and the table of the sources ([`SOURCES`]):
+//! `[uncertainty]` table of the experiment file), and the table of the sources (`SOURCES`):
 //! each source is the [`budget`](crate::catalog::EffectDescriptor::budget) of the effect
 //! whose strength represents it, in that effect's descriptor.
 //!
@@ -124,7 +124,7 @@ impl Source {
 /// rows: the budget sources of their descriptors (see the module documentation). A new source
 /// is a [`budget`](EffectDescriptor::budget) in its effect's descriptor and its row here (a
 /// unit test checks that every built-in budget source has exactly one row).
-pub const SOURCES: &[Source] = &[
+pub(crate) const SOURCES: &[Source] = &[
     Source::builtin(&DIE_TEMPERATURE_OFFSET),
     Source::builtin(&MASS_FLOW_SCALE),
     Source::builtin(&INLET_DIAMETER),
@@ -136,7 +136,7 @@ pub const SOURCES: &[Source] = &[
 ];
 
 /// The keys of [`SOURCES`] (the allowed keys of an `[uncertainty]` table).
-pub fn source_keys() -> Vec<&'static str> {
+pub(crate) fn source_keys() -> Vec<&'static str> {
     SOURCES.iter().map(|s| s.key).collect()
 }
 

@@ -35,7 +35,7 @@ pub struct DesignRequest {
     /// Relative noise level \[-\] of the measurements, current and new, the same on every point
     /// (an assumption, labelled so in the report); `None` (default): the data set's declared
     /// level (uniform, also an assumption), else the noise the fit estimates along the line
-    /// (see [`NoisePlan`]).
+    /// (see `NoisePlan`).
     pub noise: Option<f64>,
 }
 
@@ -87,7 +87,7 @@ pub struct Design {
     /// Relative noise level \[-\] of the prediction ([`noise_level`]): the uniform level, or
     /// for the fitted noise model the RMS of its `σ_j` over the current points.
     pub noise_level: f64,
-    /// Which noise the prediction uses, in words ([`NoisePlan::words`]): `"fitted along the
+    /// Which noise the prediction uses, in words (`NoisePlan::words`): `"fitted along the
     /// line (…)"`, `"assumed: declared uniform …"` or `"assumed: given uniform … (--noise)"`.
     pub noise_model: String,
     /// Where that noise comes from: `"fitted"`, `"declared"` or `"given"`.
@@ -131,7 +131,10 @@ impl Design {
 }
 
 /// The local model-parameter index of each shared fitted parameter of `id` (in fit order).
-pub fn shared_columns(model: &CarreauFiber, id: &Identification) -> Result<Vec<usize>, String> {
+pub(crate) fn shared_columns(
+    model: &CarreauFiber,
+    id: &Identification,
+) -> Result<Vec<usize>, String> {
     let layout = model.param_layout();
     (0..id.names.len())
         .map(|c| {
@@ -155,7 +158,7 @@ pub fn shared_columns(model: &CarreauFiber, id: &Identification) -> Result<Vec<u
 
 /// The relative noise level \[-\] of a design: `given`, else the data set's declared level
 /// (both uniform), else the fit's residual level (the RMS scale of the fitted noise along the
-/// line, see [`NoisePlan`]) `σ̂ = √(Σ r²/(N − P))` over the relative residuals
+/// line, see `NoisePlan`) `σ̂ = √(Σ r²/(N − P))` over the relative residuals
 /// (`P` fitted parameters, take-up factors included) — the level the fit's own standard errors
 /// use, so that the design's prediction for the current data is the fit's. The noise model's
 /// level (second differences, robust to a smooth misfit) is what a misfit is judged against,
@@ -205,7 +208,7 @@ pub enum NoiseSource {
 ///   correlation (its lag-1 autocorrelation of the residuals is a test for a misfit, which
 ///   raises it as much as a correlated noise does).
 #[derive(Debug, Clone)]
-pub struct NoisePlan {
+pub(crate) struct NoisePlan {
     /// Where the noise comes from.
     pub source: NoiseSource,
     /// The uniform level, or the RMS of `σ_j` over the current points \[-\].
@@ -379,7 +382,7 @@ fn add(total: &mut [f64], part: &[f64]) {
 ///
 /// The prediction is for the principled estimator weighting every point alike (as the fit
 /// does), each experiment's take-up factor fitted, under relative Gaussian noise as
-/// [`NoisePlan`] says (the fitted noise model along the line unless a level is declared or
+/// `NoisePlan` says (the fitted noise model along the line unless a level is declared or
 /// given): the covariance `A⁻¹ B A⁻¹` (see `information`). Errors: a fit
 /// without noise level or standard errors (the current data must determine every fitted
 /// parameter), a bad grid.

@@ -462,7 +462,7 @@ impl Comparison {
     /// Writes `compare_summary.txt`, `compare.json`, `compare_points.csv` and the figures
     /// (see `compare_figures::write_figures`) into `dir` (created; refused if it is an input
     /// or a file), never over a file in `inputs`, each file atomically (see
-    /// [`write_atomically`](crate::output::write_atomically)). Returns the written paths.
+    /// `write_atomically`). Returns the written paths.
     pub fn write(
         &self,
         dir: &Path,

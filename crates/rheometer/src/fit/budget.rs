@@ -96,7 +96,7 @@ impl BudgetEntry {
 pub struct ErrorBudget {
     /// Whether any uncertainty was declared in the data set (else all are defaults).
     pub declared: bool,
-    /// The sources, in the order of [`SOURCES`], then user-written effects'
+    /// The sources, in the order of `SOURCES`, then user-written effects'
     /// (`budget_sources`).
     pub sources: Vec<BudgetEntry>,
     /// Systematic standard uncertainty of `n`: root-sum-square of the sources' shifts.

@@ -35,7 +35,7 @@ pub const MAX_ABS_KAPPA: f64 = 700.0;
 /// Range of a BVP tolerance \[-\].
 pub const TOL_RANGE: (f64, f64) = (1e-12, 0.1);
 /// Range (exclusive) of a relative noise level given to the design \[-\].
-pub const NOISE_RANGE: (f64, f64) = (0.0, 0.5);
+pub(crate) const NOISE_RANGE: (f64, f64) = (0.0, 0.5);
 
 /// The door a request came through: it decides how an input is named in a refusal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -541,7 +541,7 @@ pub fn refit_top(v: i128) -> Result<usize, Refusal> {
     )
 }
 
-/// A relative noise level for the design, in [`NOISE_RANGE`] (exclusive).
+/// A relative noise level for the design, in `NOISE_RANGE` (exclusive).
 pub fn noise(v: f64) -> Result<f64, Refusal> {
     if !(v > NOISE_RANGE.0 && v < NOISE_RANGE.1) {
         return Err(Refusal::new(

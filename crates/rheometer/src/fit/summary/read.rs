@@ -309,7 +309,7 @@ impl FitSummary {
     /// Reads the fit of a report file `path` (`-`: standard input): a fit report or, where
     /// `wanted` has [`ReportKind::Diagnosis`], a diagnosis' final fit (its base fit if it has
     /// none). The file is read bounded (at most `max_bytes`) and strictly ([`read_json`]),
-    /// its stamp checked ([`check_report`]: the current schema version, a wanted kind), then
+    /// its stamp checked (`check_report`: the current schema version, a wanted kind), then
     /// its fields' types (errors name the path, `n.value`) and values
     /// ([`validate`](Self::validate)); `flag` names the option that gave the file.
     pub fn read_file(
