@@ -64,8 +64,8 @@ use std::str::FromStr;
 use std::sync::Arc;
 
 pub use crate::catalog::{
-    BudgetSource, Category, EffectDescriptor, ShapeParameter, ShapeScan, StrengthMap, ALL_NAMES,
-    BUILTIN_NAMES, DEFAULT_COFLOW_DECAY_LENGTH, DEFAULT_COFLOW_LINE_ONSET,
+    BudgetSource, Category, EffectDescriptor, EffectId, ShapeParameter, ShapeScan, StrengthMap,
+    ALL_NAMES, BUILTIN_NAMES, DEFAULT_COFLOW_DECAY_LENGTH, DEFAULT_COFLOW_LINE_ONSET,
     DEFAULT_COFLOW_LINE_RAMP_WIDTH, DEFAULT_WARM_AIR_DECAY_LENGTH, STRAIN_THINNING_REFERENCE_KAPPA,
 };
 #[cfg(test)]
@@ -272,6 +272,22 @@ impl Effect {
             Effect::VftTvfOffset => &catalog::VFT_T_VF_OFFSET,
             Effect::Custom(u) => &u.descriptor,
         }
+    }
+
+    /// Its identity (compare effects by it, not by name).
+    pub fn id(&self) -> EffectId {
+        self.descriptor().id()
+    }
+
+    /// The effect among `effects` whose name is `name` (a name read from a record or the
+    /// command line, parsed into the effect it names).
+    pub fn find<'a>(effects: &'a [Effect], name: &str) -> Option<&'a Effect> {
+        Self::position(effects, name).map(|i| &effects[i])
+    }
+
+    /// The index of the effect among `effects` whose name is `name` (see [`find`](Self::find)).
+    pub fn position(effects: &[Effect], name: &str) -> Option<usize> {
+        effects.iter().position(|e| e.id().name() == name)
     }
 
     /// Canonical name (CLI, JSON, docs).
@@ -552,15 +568,13 @@ impl FromStr for Effect {
     /// A built-in effect by name ([`ALL_NAMES`]), shapes not fixed.
     fn from_str(s: &str) -> Result<Self, String> {
         let s = s.trim();
-        Effect::all()
-            .into_iter()
-            .find(|e| e.name() == s)
-            .ok_or_else(|| {
-                format!(
-                    "unknown effect \"{s}\"; the candidates are {}",
-                    ALL_NAMES.join(", ")
-                )
-            })
+        let all = Effect::all();
+        Effect::find(&all, s).cloned().ok_or_else(|| {
+            format!(
+                "unknown effect \"{s}\"; the candidates are {}",
+                ALL_NAMES.join(", ")
+            )
+        })
     }
 }
 
@@ -714,17 +728,17 @@ impl ModelSpec {
         self
     }
 
-    /// Whether an effect named `name` is in the model or a candidate.
-    pub fn contains(&self, name: &str) -> bool {
-        self.effects.iter().any(|e| e.effect.name() == name)
-            || self.candidates.iter().any(|e| e.name() == name)
+    /// Whether the effect `id` is in the model or a candidate.
+    pub fn contains(&self, id: EffectId) -> bool {
+        self.effects.iter().any(|e| e.effect.id() == id)
+            || self.candidates.iter().any(|e| e.id() == id)
     }
 
     /// Adds `effects` as neutral candidates, skipping those already present (and those that
     /// live in the law, `strain_thinning`, for a Carreau law, which has it).
     pub fn with_candidates(mut self, effects: &[Effect]) -> Self {
         for e in effects {
-            if self.contains(e.name()) || (self.law == LawChoice::Carreau && e.installs_in_law()) {
+            if self.contains(e.id()) || (self.law == LawChoice::Carreau && e.installs_in_law()) {
                 continue;
             }
             self.candidates.push(e.clone());
@@ -736,14 +750,14 @@ impl ModelSpec {
     /// model, and user effects: a name not taken by a built-in term, strength or effect, and a
     /// consistent descriptor ([`EffectDescriptor::validate`]).
     pub fn validate(&self) -> Result<(), String> {
-        let mut names: Vec<&str> = Vec::new();
+        let mut ids: Vec<EffectId> = Vec::new();
         for e in self
             .effects
             .iter()
             .map(|s| &s.effect)
             .chain(self.candidates.iter())
         {
-            if names.contains(&e.name()) {
+            if ids.contains(&e.id()) {
                 return Err(format!("effect {} given twice", e.name()));
             }
             if let Effect::Custom(u) = e {
@@ -768,7 +782,7 @@ impl ModelSpec {
                     e.name()
                 ));
             }
-            names.push(e.name());
+            ids.push(e.id());
         }
         Ok(())
     }

@@ -305,8 +305,10 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         };
         let params = ParamLayout::new(law.num_params(), physics.num_strength_params());
         let plan = physics.plan();
-        let mass_flow_scaled =
-            !matches!(physics.mass_flow_scale, super::contributions::Strength::Off);
+        let mass_flow_scaled = !matches!(
+            physics.strength_of(super::catalog::MASS_FLOW_SCALE.id()),
+            super::contributions::Strength::Off
+        );
         Ok(FiberModel {
             law,
             rho_a: material.density_slope * r.temperature / r.density,

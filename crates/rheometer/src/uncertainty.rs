@@ -45,7 +45,7 @@
 //! reading `(1 + a) d + b` (exact, from the residual's definition).
 
 use crate::catalog::{
-    BudgetSource, EffectDescriptor, DIE_TEMPERATURE_OFFSET, GAUGE_OFFSET, GAUGE_SCALE,
+    BudgetSource, EffectDescriptor, EffectId, DIE_TEMPERATURE_OFFSET, GAUGE_OFFSET, GAUGE_SCALE,
     INLET_DIAMETER, INLET_VELOCITY, MASS_FLOW_SCALE, VFT_B_OFFSET, VFT_T_VF_OFFSET,
 };
 use crate::setup::Experiment;
@@ -72,9 +72,9 @@ pub struct Source {
     pub max: f64,
     /// Common to all experiments or independent per experiment.
     pub scope: Scope,
-    /// Name of the effect (in [`Effect`](crate::effects::Effect)) whose strength
-    /// represents the source.
-    pub effect: &'static str,
+    /// The effect (an [`Effect`](crate::effects::Effect)) whose strength represents the
+    /// source.
+    pub effect: EffectId,
     /// Strength of the effect per unit of the source, for experiment `e` (`None`: the source
     /// does not apply to `e`).
     pub per_unit: fn(&Experiment) -> Option<f64>,
@@ -85,8 +85,8 @@ pub struct Source {
 }
 
 impl Source {
-    /// The source `budget` represented by the effect named `effect`.
-    pub const fn new(effect: &'static str, budget: &BudgetSource) -> Self {
+    /// The source `budget` represented by the effect `effect`.
+    pub const fn new(effect: EffectId, budget: &BudgetSource) -> Self {
         Source {
             key: budget.key,
             unit: budget.unit,
@@ -105,7 +105,7 @@ impl Source {
     /// The source the effect described by `d` represents (`None` if it is not a budget source).
     pub const fn of(d: &EffectDescriptor) -> Option<Self> {
         match &d.budget {
-            Some(b) => Some(Source::new(d.name, b)),
+            Some(b) => Some(Source::new(d.id(), b)),
             None => None,
         }
     }
@@ -280,9 +280,9 @@ mod tests {
     fn sources_are_the_descriptors_budgets() {
         let mut from_descriptors: Vec<&str> = crate::catalog::BUILTIN
             .iter()
-            .filter_map(|d| Source::of(d).map(|s| s.effect))
+            .filter_map(|d| Source::of(d).map(|s| s.effect.name()))
             .collect();
-        let mut rows: Vec<&str> = SOURCES.iter().map(|s| s.effect).collect();
+        let mut rows: Vec<&str> = SOURCES.iter().map(|s| s.effect.name()).collect();
         from_descriptors.sort_unstable();
         rows.sort_unstable();
         assert_eq!(rows, from_descriptors);

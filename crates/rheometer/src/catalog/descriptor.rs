@@ -280,6 +280,26 @@ pub struct EffectDescriptor {
     pub default_candidate: bool,
 }
 
+/// The identity of an effect, handed out by its descriptor ([`EffectDescriptor::id`]): two
+/// effects are the same effect exactly when their ids are equal (the catalog and
+/// [`ModelSpec::validate`](crate::effects::ModelSpec::validate) keep names unique). Compare ids,
+/// not names; a name from input becomes an id where it is parsed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct EffectId(&'static str);
+
+impl EffectId {
+    /// The effect's canonical name (CLI, JSON, reports).
+    pub const fn name(self) -> &'static str {
+        self.0
+    }
+}
+
+impl fmt::Display for EffectId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
 impl EffectDescriptor {
     /// A user-written effect named `name`: the strength (neutral 0, dimensionless, search and
     /// physical range `(−10, 10)`) multiplies the user's term; missing physics; no shapes,
@@ -320,7 +340,7 @@ impl EffectDescriptor {
     /// The fields the built-in effects share (a default candidate, a part of
     /// [`Physics`](crate::Physics), strength = parameter, neutral 0, no shapes, no
     /// independent check or budget source); each built-in constant overrides the rest.
-    pub(super) const fn builtin(name: &'static str, category: Category) -> Self {
+    pub(crate) const fn builtin(name: &'static str, category: Category) -> Self {
         EffectDescriptor {
             name,
             model_param: name,
@@ -339,6 +359,11 @@ impl EffectDescriptor {
             install: Install::Physics,
             default_candidate: true,
         }
+    }
+
+    /// Its identity.
+    pub const fn id(&self) -> EffectId {
+        EffectId(self.name)
     }
 
     /// With the strength's unit and its symbol in messages.

@@ -51,7 +51,7 @@ pub(crate) mod physics;
 pub(crate) mod process;
 
 pub use descriptor::{
-    one_per_unit, BudgetSource, Category, EffectDescriptor, GaugeColumn, Install, Scope,
+    one_per_unit, BudgetSource, Category, EffectDescriptor, EffectId, GaugeColumn, Install, Scope,
     ShapeParameter, ShapeScan, StrengthMap,
 };
 pub use instrument::{GAUGE_OFFSET, GAUGE_SCALE};
@@ -112,6 +112,11 @@ pub const BUILTIN_NAMES: [&str; 11] = names(&BUILTIN, true);
 /// The built-in descriptor named `name`.
 pub fn builtin(name: &str) -> Option<&'static EffectDescriptor> {
     BUILTIN.iter().copied().find(|d| d.name == name)
+}
+
+/// The id of the built-in effect named `name` (a name from input parsed once).
+pub fn builtin_id(name: &str) -> Option<EffectId> {
+    builtin(name).map(EffectDescriptor::id)
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@
 
 use super::scan::{physical, search_range, Profile, ShapeParameter};
 use crate::effects::Effect;
+use crate::fit::options::BoundSide;
 use crate::fit::summary::checks::bound_side;
 use crate::fit::{AtBound, Estimate, FitSummary};
 use serde::{Deserialize, Serialize};
@@ -260,7 +261,7 @@ pub fn strength_status(
         .map(|b| (b.side, b.bound))
         .or_else(|| {
             bound_side(strength, lo, hi).map(|s| {
-                let b = if s.name() == "lower" { lo } else { hi };
+                let b = if s == BoundSide::Lower { lo } else { hi };
                 (s, b)
             })
         });

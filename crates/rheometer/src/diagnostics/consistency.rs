@@ -332,7 +332,7 @@ pub fn check(id: &Identification, effects: &[String], set: &ExperimentSet) -> Ve
     let tested: Vec<(&String, usize, f64, &str)> = effects
         .iter()
         .filter_map(|e| {
-            let slot = id.effects.iter().find(|s| s.effect.name() == e)?;
+            let slot = id.effects.iter().find(|s| s.effect.id().name() == e)?;
             let col = slot.column?;
             Some((e, col, slot.effect.param_per_strength(), slot.effect.unit()))
         })

@@ -168,12 +168,7 @@ pub fn alternatives_among(
     effects: &[Effect],
     cosine: impl Fn(&str) -> f64,
 ) -> Vec<Alternative> {
-    let of = |name: &str| {
-        effects
-            .iter()
-            .find(|e| e.name() == name)
-            .map(Effect::descriptor)
-    };
+    let of = |name: &str| Effect::find(effects, name).map(Effect::descriptor);
     let category = |d: Option<&EffectDescriptor>| d.map_or(Category::Physics, |d| d.category);
     let check = |d: Option<&EffectDescriptor>| d.and_then(|d| d.independent_check);
     let named_d = of(&named.effect);

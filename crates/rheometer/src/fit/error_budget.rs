@@ -213,7 +213,7 @@ impl Propagation<'_> {
             unit: s.unit.into(),
             what: s.what.into(),
             scope: s.scope,
-            effect: s.effect.into(),
+            effect: s.effect.name().into(),
             status: SourceStatus::NotAvailable,
             sigma,
             origin,

@@ -60,7 +60,7 @@ impl CompareRequest {
         };
         for w in &self.with {
             let name = w.effect.name();
-            let value = match (w.value, out.iter().find(|(e, _)| e.name() == name)) {
+            let value = match (w.value, out.iter().find(|(e, _)| e.id() == w.effect.id())) {
                 (Some(v), _) => v,
                 (None, Some((_, v))) => *v,
                 (None, None) => {

@@ -69,7 +69,7 @@ pub fn discriminate(
     // every rival is checked before the first fit
     let mut requests = Vec::with_capacity(effects.len());
     for e in effects {
-        if fit_request.model.contains(e.name()) {
+        if fit_request.model.contains(e.id()) {
             return Err(RheometerError::Data(format!(
                 "{} is already in the model: a rival adds an effect the model lacks",
                 e.name()

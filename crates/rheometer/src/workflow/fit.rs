@@ -3,6 +3,7 @@
 //! the figures need (the Newtonian reference and, for a model with added effects, the same fit
 //! without them).
 
+use crate::catalog::STRAIN_THINNING;
 use crate::diagnostics::consistency;
 use crate::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
 use crate::figures::ResidualView;
@@ -69,7 +70,7 @@ impl FitRequest {
                 .model
                 .effects
                 .iter()
-                .any(|w| w.effect.name() == "strain_thinning" && w.value.is_none())
+                .any(|w| w.effect.id() == STRAIN_THINNING.id() && w.value.is_none())
     }
 }
 

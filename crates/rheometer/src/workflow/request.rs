@@ -848,7 +848,7 @@ pub fn rivals(effects: Vec<Effect>) -> Result<Vec<Effect>, Refusal> {
         ));
     }
     for (i, e) in effects.iter().enumerate() {
-        if effects[..i].iter().any(|o| o.name() == e.name()) {
+        if effects[..i].iter().any(|o| o.id() == e.id()) {
             return Err(Refusal::new(
                 Arg::Discriminate,
                 format!("effect {} given twice", e.name()),

@@ -177,11 +177,7 @@ pub fn diagnose(
         spec.candidates.clear();
         // the effect its refit fitted: the fitted shapes free again (the variant fixes them at
         // the grid's values), the discrete ones at the variant's
-        let effect = match options
-            .candidates
-            .iter()
-            .find(|c| c.name() == variant.name())
-        {
+        let effect = match options.candidates.iter().find(|c| c.id() == variant.id()) {
             Some(c) => refitted_effect(c, variant).map_err(RheometerError::Data)?,
             None => variant.clone(),
         };

@@ -270,11 +270,7 @@ fn judge(
 /// The member of candidate `c`: its variant (discrete shapes of its refit fixed) and its start
 /// (the refit's strength and fitted shapes).
 fn member<'a>(c: &'a Candidate, options: &DiagnoseOptions) -> Option<Member<'a>> {
-    let mut effect = options
-        .candidates
-        .iter()
-        .find(|e| e.name() == c.effect)?
-        .clone();
+    let mut effect = Effect::find(&options.candidates, &c.effect)?.clone();
     let fitted: Vec<&'static str> = effect
         .descriptor()
         .shapes

@@ -281,7 +281,7 @@ fn ties(
         ctx.options.earn_threshold,
         ctx.options.tie_margin,
         &ctx.cands,
-        |name| match ctx.cands.iter().position(|e| e.name() == name) {
+        |name| match Effect::position(&ctx.cands, name) {
             Some(i) => cosine(&lin.scores[b].signature, &lin.scores[i].signature),
             None => f64::NAN,
         },

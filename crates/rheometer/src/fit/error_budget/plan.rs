@@ -4,7 +4,7 @@
 use super::super::data::Rheometer;
 use super::super::identify::Identification;
 use super::SourceStatus;
-use crate::effects::{Effect, EffectSetting, ModelSpec};
+use crate::effects::{Effect, EffectId, EffectSetting, ModelSpec};
 use crate::uncertainty::{GaugeColumn, Source};
 
 /// How a source's column is obtained.
@@ -62,14 +62,10 @@ impl SourcePlan {
 
     /// The effect `effect` whose column a source takes: fitted already (no column needed),
     /// fixed (freed at its strength), a candidate (freed), or added to the model.
-    fn column_of(&mut self, effect: &str) -> Result<String, SourceStatus> {
+    fn column_of(&mut self, id: EffectId) -> Result<String, SourceStatus> {
         let free = &mut self.free;
-        if let Some(set) = self
-            .spec
-            .effects
-            .iter_mut()
-            .find(|x| x.effect.name() == effect)
-        {
+        let effect = id.name();
+        if let Some(set) = self.spec.effects.iter_mut().find(|x| x.effect.id() == id) {
             match set.value {
                 None if !free.iter().any(|f| f == effect) => Err(SourceStatus::Fitted),
                 None => Ok(effect.to_string()),
@@ -81,7 +77,7 @@ impl SourcePlan {
                     Ok(effect.to_string())
                 }
             }
-        } else if self.spec.candidates.iter().any(|c| c.name() == effect) {
+        } else if self.spec.candidates.iter().any(|c| c.id() == id) {
             if !free.iter().any(|f| f == effect) {
                 free.push(effect.to_string());
             }

@@ -523,7 +523,7 @@ impl FitSummary {
         let mut effects = c.effects;
         for w in with {
             let name = w.effect.name();
-            if effects.iter().any(|e| e.effect.name() == name) {
+            if effects.iter().any(|e| e.effect.id() == w.effect.id()) {
                 return Err(format!(
                     "{with_label} {name}: {name} is in the model of {source} already (its \
                      strength is fitted from that fit's value); give it once: drop it from \

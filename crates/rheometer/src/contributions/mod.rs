@@ -16,32 +16,33 @@
 //!
 //! Built in ([`Physics::paper`] switches on the first four, as the paper's model):
 //! gravity, Stokes air drag, convective cooling (pluggable [`NusseltLaw`]), viscous heating;
-//! off by default: grey-body radiation ([`Physics::with_radiation`]), a warm-air profile
-//! ([`Physics::with_warm_air`]), an aspirator co-flow ([`Physics::with_coflow`]) and a co-flow
-//! along the line ([`Physics::with_line_coflow`]), whose decay lengths and onset may be model
-//! parameters too ([`Physics::set_strength`] with `"air_coflow.decay_length"` etc.).
-//! Process parameters (inlet velocity and diameter, die temperature offset, mass-flow scale,
-//! [`Physics::process`]) change the boundary conditions and the mass flow; instrument
-//! parameters (gauge scale and offset, [`Physics::gauge_reading`]) only the predicted
-//! measurement.
+//! off by default: grey-body radiation ([`Physics::with_radiation`]).
 //! Users add their own SI terms with [`Physics::with_custom`] (a [`FiberTerm`]).
 //!
-//! The strengths that are candidate effects are named by the effects' descriptors
-//! ([`catalog`](super::catalog)): the radiation term, the convection term's factor
-//! `nusselt_scale`, and the parameter slots of the air profiles, process, instrument and
-//! material parameters; [`Physics::enable`] switches on the part that carries an effect.
+//! The other built-in effects change the model without a term of their own: a warm-air
+//! profile ([`Physics::with_warm_air`]), an aspirator co-flow ([`Physics::with_coflow`]) and a
+//! co-flow along the line ([`Physics::with_line_coflow`]), whose decay lengths and onset may be
+//! model parameters too ([`Physics::set_strength`] with `"air_coflow.decay_length"` etc.);
+//! process parameters (inlet velocity and diameter, die temperature offset, mass-flow scale,
+//! [`Physics::process_planned`]) change the boundary conditions and the mass flow; instrument
+//! parameters (gauge scale and offset, [`Physics::gauge_reading_planned`]) only the predicted
+//! measurement; material parameters the VFT law. Each is a small type in its own file of
+//! [`modifiers`], registered there by one line, its strength and shapes named by its descriptor
+//! ([`catalog`](super::catalog)); [`Physics`] holds the ones it has, in registry order.
+//!
+//! The strengths that are candidate effects are named by the effects' descriptors: the
+//! radiation term, the convection term's factor `nusselt_scale`, and the modifiers' strengths
+//! and shapes; [`Physics::enable`] switches on the part that carries an effect.
 
-use super::catalog::{
-    AIR_COFLOW, AIR_COFLOW_LINE, AIR_TEMPERATURE_PROFILE, COFLOW_DECAY, COFLOW_LINE_ONSET,
-    COFLOW_LINE_RAMP, COFLOW_TAIL, DIE_TEMPERATURE_OFFSET, GAUGE_OFFSET, GAUGE_SCALE,
-    INLET_DIAMETER, INLET_VELOCITY, MASS_FLOW_SCALE, NUSSELT_SCALE, RADIATION, VFT_B_OFFSET,
-    VFT_T_VF_OFFSET, WARM_AIR_DECAY,
-};
+use super::catalog::{EffectId, NUSSELT_SCALE, RADIATION};
 use super::error::FiberError;
 use super::setup::Air;
 use diffbvp::dyn_dual::{eval_dyn, DualScalarFn, DynDualScalarFn};
+use modifiers::{AirProfile, InletFactors, Part};
 use num_dual::DualNum;
 use std::f64::consts::PI;
+
+pub mod modifiers;
 
 /// Stefan–Boltzmann constant σ [W/(m² K⁴)].
 pub const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
@@ -64,12 +65,6 @@ pub enum Strength {
     Fixed(f64),
     /// A model parameter in `p` (its default value given here): differentiable and continuable.
     Parameter(f64),
-}
-
-impl Strength {
-    fn is_parameter(&self) -> bool {
-        matches!(self, Strength::Parameter(_))
-    }
 }
 
 /// Nusselt function `𝒩(Re_τ, Re², Pr)` of the heat-transfer coefficient `α = λ_*/d 𝒩`
@@ -330,106 +325,6 @@ impl Term {
     }
 }
 
-/// Air speed along the fiber `v_air(s)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum AirSpeed {
-    /// Still air, `v_air = 0`.
-    Still,
-    /// Aspirator co-flow `v_air(s) = strength · V φ_r((L − s)/ℓ)` with the decay
-    /// `φ_r(u) = (1 + r u)^(−1/r)`: `φ_0(u) = exp(−u)`, an algebraic tail `u^(−1/r)` for
-    /// `r > 0` (`r = 1/2`: inverse square, as the entrainment towards a sink; `r = 1`: inverse,
-    /// as a jet).
-    CoFlow {
-        /// `V` \[m/s\].
-        speed: f64,
-        /// Decay length `ℓ` \[m\] (`Parameter` makes it a model parameter named
-        /// `"air_coflow.decay_length"`).
-        length: Strength,
-        /// Factor on `V` (`Parameter` makes it a model parameter named `"air_coflow"`).
-        strength: Strength,
-        /// Tail `r` \[-\], `0 <= r <= 1` (`Parameter` makes it a model parameter named
-        /// `"air_coflow.tail"`).
-        tail: Strength,
-    },
-}
-
-/// Air temperature along the fiber `T_air(s)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum AirTemperature {
-    /// The experiment's uniform air temperature.
-    Uniform,
-    /// Warm air near the nozzle: `T_air(s) = T_air + strength · ΔT exp(−s/ℓ)`.
-    WarmNozzle {
-        /// `ΔT` \[K\].
-        excess: f64,
-        /// Decay length `ℓ` \[m\] (`Parameter` makes it a model parameter named
-        /// `"air_temperature_profile.decay_length"`).
-        length: Strength,
-        /// Factor on `ΔT` (`Parameter` makes it a model parameter named
-        /// `"air_temperature_profile"`).
-        strength: Strength,
-    },
-}
-
-/// Air co-flow along the spin line, added to [`AirSpeed`]: switched on smoothly after an
-/// onset position, `v_air(s) = strength · V / (1 + exp(−(s − s₀)/w))`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum LineCoflow {
-    /// No co-flow along the line.
-    Off,
-    /// The logistic ramp.
-    On {
-        /// `V` \[m/s\].
-        speed: f64,
-        /// Onset `s₀` \[m\] (`Parameter`: model parameter `"air_coflow_line.onset"`).
-        onset: Strength,
-        /// Ramp width `w` \[m\] (`Parameter`: model parameter `"air_coflow_line.ramp_width"`).
-        ramp_width: Strength,
-        /// Factor on `V` (`Parameter`: model parameter `"air_coflow_line"`).
-        strength: Strength,
-    },
-}
-
-/// Number of parameter slots after the terms' strengths ([`Physics::strength_parameters`]).
-const SLOTS: usize = 16;
-const S_COFLOW: usize = 0;
-const S_COFLOW_LEN: usize = 1;
-const S_LINE: usize = 2;
-const S_LINE_ONSET: usize = 3;
-const S_LINE_RAMP: usize = 4;
-const S_WARM: usize = 5;
-const S_WARM_LEN: usize = 6;
-const S_INLET_VELOCITY: usize = 7;
-const S_INLET_DIAMETER: usize = 8;
-const S_DIE_TEMPERATURE: usize = 9;
-const S_MASS_FLOW: usize = 10;
-const S_GAUGE_SCALE: usize = 11;
-const S_GAUGE_OFFSET: usize = 12;
-const S_VFT_B: usize = 13;
-const S_VFT_T_VF: usize = 14;
-const S_COFLOW_TAIL: usize = 15;
-
-/// Names of the parameter slots after the terms, in `p` order: each slot carries an effect's
-/// strength or one of its shape parameters, named by the effect's descriptor.
-const SLOT_NAMES: [&str; SLOTS] = [
-    AIR_COFLOW.model_param,
-    COFLOW_DECAY.model_param,
-    AIR_COFLOW_LINE.model_param,
-    COFLOW_LINE_ONSET.model_param,
-    COFLOW_LINE_RAMP.model_param,
-    AIR_TEMPERATURE_PROFILE.model_param,
-    WARM_AIR_DECAY.model_param,
-    INLET_VELOCITY.model_param,
-    INLET_DIAMETER.model_param,
-    DIE_TEMPERATURE_OFFSET.model_param,
-    MASS_FLOW_SCALE.model_param,
-    GAUGE_SCALE.model_param,
-    GAUGE_OFFSET.model_param,
-    VFT_B_OFFSET.model_param,
-    VFT_T_VF_OFFSET.model_param,
-    COFLOW_TAIL.model_param,
-];
-
 /// Process and instrument factors of a model evaluation (dual numbers, so that derivatives with
 /// respect to the process parameters are exact).
 #[derive(Debug, Clone, Copy)]
@@ -447,46 +342,22 @@ pub struct ProcessFactors<D> {
     pub has_mass_flow: bool,
 }
 
-/// The set of contributions and the air environment.
+/// The set of contributions: the force and heat terms, the Nusselt law, and the built-in
+/// effects that change the air, the inlet, the gauge or the material data (each a modifier
+/// registered in [`modifiers`], held in registry order, added by its `with_*` builder,
+/// [`enable`](Self::enable) or [`set_strength`](Self::set_strength)).
 #[derive(Debug)]
 pub struct Physics<H: NusseltLaw = InclinedChurchillBernstein> {
     /// Named terms, in evaluation and report order.
     pub terms: Vec<Term>,
     /// The Nusselt law of the convection term.
     pub nusselt: H,
-    /// Air speed profile.
-    pub air_speed: AirSpeed,
-    /// Air temperature profile.
-    pub air_temperature: AirTemperature,
     /// Slenderness `δ` of the drag coefficient \[-\] (paper: 1e-3).
     pub slenderness: f64,
-    /// Relative error `δ` \[-\] of the inlet velocity (die swell): the inlet condition becomes
-    /// `u(0) = (1 + δ) u_in` (`Off` by default; `Parameter` makes `δ` a model parameter named
-    /// `"inlet_velocity"`, neutral value 0).
-    pub inlet_velocity: Strength,
-    /// Air co-flow along the line (in addition to [`air_speed`](Self::air_speed)).
-    pub line_coflow: LineCoflow,
-    /// Die swell `δ` \[-\]: inlet diameter `(1 + δ) d_in` at the same mass flow, `u(0) =
-    /// u_in/(1 + δ)²` (model parameter `"inlet_diameter"`).
-    pub inlet_diameter: Strength,
-    /// Die temperature offset `ΔT` \[K\]: `T(0) = T_in + ΔT` (model parameter
-    /// `"die_temperature_offset"`).
-    pub die_temperature_offset: Strength,
-    /// Mass-flow error `δ` \[-\]: true mass flow `(1 + δ) Q` (model parameter
-    /// `"mass_flow_scale"`).
-    pub mass_flow_scale: Strength,
-    /// Gauge scale error `g` \[-\]: the gauge reads `(1 + g) d + o` (model parameter
-    /// `"gauge_scale"`; not in the balances, only in the predicted measurement).
-    pub gauge_scale: Strength,
-    /// Gauge offset `o` \[µm\] (model parameter `"gauge_offset"`).
-    pub gauge_offset: Strength,
-    /// Offset `ΔB` \[K\] of the VFT parameter `B`, the zero-rate viscosity at the reference
-    /// temperature `T_o` held (model parameter `"vft_b_offset"`; see
-    /// [`ZeroRateViscosity::eval_shifted`](super::material_law::ZeroRateViscosity::eval_shifted)).
-    pub vft_b_offset: Strength,
-    /// Offset `ΔT_VF` \[K\] of the VFT temperature `T_VF`, the level at `T_o` held (model
-    /// parameter `"vft_t_vf_offset"`).
-    pub vft_t_vf_offset: Strength,
+    /// The modifiers, in registry order.
+    modifiers: Vec<Part>,
+    /// Whether a modifier moves the air.
+    air_flow: bool,
 }
 
 impl Default for Physics {
@@ -520,26 +391,10 @@ impl<H: NusseltLaw> Physics<H> {
                 t("viscous_heating", Balance::Energy, TermKind::ViscousHeating),
             ],
             nusselt,
-            air_speed: AirSpeed::Still,
-            air_temperature: AirTemperature::Uniform,
             slenderness: super::scaling::PAPER_SLENDERNESS,
-            inlet_velocity: Strength::Off,
-            line_coflow: LineCoflow::Off,
-            inlet_diameter: Strength::Off,
-            die_temperature_offset: Strength::Off,
-            mass_flow_scale: Strength::Off,
-            gauge_scale: Strength::Off,
-            gauge_offset: Strength::Off,
-            vft_b_offset: Strength::Off,
-            vft_t_vf_offset: Strength::Off,
+            modifiers: Vec::new(),
+            air_flow: false,
         }
-    }
-
-    /// Makes the relative inlet-velocity error `δ` (`u(0) = (1 + δ) u_in`) a model parameter
-    /// named `"inlet_velocity"` with default value `error` \[-\].
-    pub fn with_inlet_velocity_error(mut self, error: f64) -> Self {
-        self.inlet_velocity = Strength::Parameter(error);
-        self
     }
 
     /// Adds grey-body radiation with emissivity `emissivity` \[-\] (term `"radiation"`).
@@ -553,86 +408,36 @@ impl<H: NusseltLaw> Physics<H> {
         self
     }
 
-    /// Warm air near the nozzle: `T_air(s) = T_air + ΔT exp(−s/ℓ)`, `excess` = ΔT \[K\],
-    /// `length` = ℓ \[m\].
-    pub fn with_warm_air(mut self, excess: f64, length: f64) -> Self {
-        self.air_temperature = AirTemperature::WarmNozzle {
-            excess,
-            length: Strength::Fixed(length),
-            strength: Strength::Fixed(1.0),
-        };
-        self
-    }
-
-    /// Aspirator co-flow `v_air(s) = V exp(−(L − s)/ℓ)`, `speed` = V \[m/s\], `length` = ℓ \[m\].
-    pub fn with_coflow(mut self, speed: f64, length: f64) -> Self {
-        self.air_speed = AirSpeed::CoFlow {
-            speed,
-            length: Strength::Fixed(length),
-            strength: Strength::Fixed(1.0),
-            tail: Strength::Fixed(0.0),
-        };
-        self
-    }
-
-    /// Air co-flow along the line `v_air(s) = V / (1 + exp(−(s − s₀)/w))`, `speed` = V \[m/s\],
-    /// `onset` = s₀ \[m\], `ramp_width` = w \[m\] (added to an aspirator co-flow).
-    pub fn with_line_coflow(mut self, speed: f64, onset: f64, ramp_width: f64) -> Self {
-        self.line_coflow = LineCoflow::On {
-            speed,
-            onset: Strength::Fixed(onset),
-            ramp_width: Strength::Fixed(ramp_width),
-            strength: Strength::Fixed(1.0),
-        };
-        self
-    }
-
     /// Whether the air moves (an aspirator co-flow or a co-flow along the line).
     pub fn has_air_flow(&self) -> bool {
-        !matches!(self.air_speed, AirSpeed::Still) || !matches!(self.line_coflow, LineCoflow::Off)
+        self.air_flow
     }
 
-    /// The parameter slots after the terms' strengths, in `p` order (`Off` where absent).
-    fn slots(&self) -> [Strength; SLOTS] {
-        let mut v = [Strength::Off; SLOTS];
-        if let AirSpeed::CoFlow {
-            length,
-            strength,
-            tail,
-            ..
-        } = self.air_speed
+    /// Puts `part` in registry order, replacing a part of the same kind.
+    pub(crate) fn put(&mut self, part: Part) {
+        let rank = part.kind.rank();
+        match self
+            .modifiers
+            .binary_search_by_key(&rank, |p| p.kind.rank())
         {
-            v[S_COFLOW] = strength;
-            v[S_COFLOW_LEN] = length;
-            v[S_COFLOW_TAIL] = tail;
+            Ok(i) => self.modifiers[i] = part,
+            Err(i) => self.modifiers.insert(i, part),
         }
-        if let LineCoflow::On {
-            onset,
-            ramp_width,
-            strength,
-            ..
-        } = self.line_coflow
-        {
-            v[S_LINE] = strength;
-            v[S_LINE_ONSET] = onset;
-            v[S_LINE_RAMP] = ramp_width;
+        self.air_flow = self.modifiers.iter().any(|p| p.kind.moves_air());
+    }
+
+    /// The strength of effect `effect`'s strength (its descriptor's
+    /// [`model_param`](super::catalog::EffectDescriptor::model_param)): a term's or a
+    /// modifier's, `Off` where the physics does not have it.
+    pub fn strength_of(&self, effect: EffectId) -> Strength {
+        let name = effect.name();
+        if let Some(t) = self.terms.iter().find(|t| t.parameter_name() == name) {
+            return t.strength;
         }
-        if let AirTemperature::WarmNozzle {
-            length, strength, ..
-        } = self.air_temperature
-        {
-            v[S_WARM] = strength;
-            v[S_WARM_LEN] = length;
-        }
-        v[S_INLET_VELOCITY] = self.inlet_velocity;
-        v[S_INLET_DIAMETER] = self.inlet_diameter;
-        v[S_DIE_TEMPERATURE] = self.die_temperature_offset;
-        v[S_MASS_FLOW] = self.mass_flow_scale;
-        v[S_GAUGE_SCALE] = self.gauge_scale;
-        v[S_GAUGE_OFFSET] = self.gauge_offset;
-        v[S_VFT_B] = self.vft_b_offset;
-        v[S_VFT_T_VF] = self.vft_t_vf_offset;
-        v
+        self.modifiers
+            .iter()
+            .find(|p| p.kind.effect().id() == effect)
+            .map_or(Strength::Off, |p| p.strengths[0])
     }
 
     /// Adds a user term (SI) named `name` to `balance`.
@@ -652,15 +457,16 @@ impl<H: NusseltLaw> Physics<H> {
     }
 
     /// Sets the strength named `name`: a term's (by its name or [`Term::parameter_name`], e.g.
-    /// `"convection"` or `"nusselt_scale"`), `"air_coflow"`, `"air_coflow.decay_length"` and
-    /// `"air_coflow.tail"` (need [`with_coflow`](Self::with_coflow)), `"air_coflow_line"`,
+    /// `"convection"` or `"nusselt_scale"`) or a modifier's strength or shape, named by its
+    /// effect's descriptor: `"air_coflow"`, `"air_coflow.decay_length"` and `"air_coflow.tail"`
+    /// (need [`with_coflow`](Self::with_coflow)), `"air_coflow_line"`,
     /// `"air_coflow_line.onset"`, `"air_coflow_line.ramp_width"` (need
     /// [`with_line_coflow`](Self::with_line_coflow)), `"air_temperature_profile"` and
     /// `"air_temperature_profile.decay_length"` (need [`with_warm_air`](Self::with_warm_air)),
     /// a process or instrument parameter (`"inlet_velocity"`, `"inlet_diameter"`,
     /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"`) or a
-    /// material-data offset (`"vft_b_offset"`, `"vft_t_vf_offset"`): the slots are named by the
-    /// effects' descriptors. An unknown name, or an air profile that is not there, is an error.
+    /// material-data offset (`"vft_b_offset"`, `"vft_t_vf_offset"`), which setting adds. An
+    /// unknown name, or an air profile that is not there, is an error.
     pub fn set_strength(&mut self, name: &str, strength: Strength) -> Result<(), FiberError> {
         if let Some(t) = self
             .terms
@@ -670,109 +476,76 @@ impl<H: NusseltLaw> Physics<H> {
             t.strength = strength;
             return Ok(());
         }
-        let Some(slot) = SLOT_NAMES.iter().position(|n| *n == name) else {
+        for p in &mut self.modifiers {
+            if let Some((slot, _, _)) = p.slots().find(|s| s.1 == name) {
+                p.strengths[slot] = strength;
+                return Ok(());
+            }
+        }
+        let registered = modifiers::registered();
+        let Some((kind, strengths, added_by)) = registered.iter().find(|(k, s, _)| {
+            Part {
+                kind: *k,
+                strengths: *s,
+            }
+            .slots()
+            .any(|s| s.1 == name)
+        }) else {
             let mut known: Vec<&str> = self.terms.iter().map(|t| t.parameter_name()).collect();
-            known.extend(SLOT_NAMES);
+            let parts: Vec<Part> = registered
+                .iter()
+                .map(|(kind, strengths, _)| Part {
+                    kind: *kind,
+                    strengths: *strengths,
+                })
+                .collect();
+            known.extend(modifiers::slot_order(&parts).iter().map(|s| s.2));
             return Err(FiberError::InvalidInput(format!(
                 "unknown strength \"{name}\"; the strengths are {}",
                 known.join(", ")
             )));
         };
-        *self.slot_mut(slot)? = strength;
-        Ok(())
-    }
-
-    /// The strength in parameter slot `slot` (an `S_*` index), or an error naming the air
-    /// profile it needs when that is switched off.
-    fn slot_mut(&mut self, slot: usize) -> Result<&mut Strength, FiberError> {
-        let name = SLOT_NAMES[slot];
-        let missing = |what: &str, how: &str| {
-            FiberError::InvalidInput(format!(
+        if let Some((how, what)) = added_by {
+            return Err(FiberError::InvalidInput(format!(
                 "strength {name}: the physics has no {what} (add it with {how})"
-            ))
-        };
-        Ok(match slot {
-            S_COFLOW | S_COFLOW_LEN | S_COFLOW_TAIL => match &mut self.air_speed {
-                AirSpeed::CoFlow {
-                    length,
-                    strength,
-                    tail,
-                    ..
-                } => match slot {
-                    S_COFLOW => strength,
-                    S_COFLOW_LEN => length,
-                    _ => tail,
-                },
-                AirSpeed::Still => return Err(missing("air co-flow", "with_coflow")),
-            },
-            S_LINE | S_LINE_ONSET | S_LINE_RAMP => match &mut self.line_coflow {
-                LineCoflow::On {
-                    onset,
-                    ramp_width,
-                    strength,
-                    ..
-                } => match slot {
-                    S_LINE => strength,
-                    S_LINE_ONSET => onset,
-                    _ => ramp_width,
-                },
-                LineCoflow::Off => {
-                    return Err(missing("air co-flow along the line", "with_line_coflow"))
-                }
-            },
-            S_WARM | S_WARM_LEN => match &mut self.air_temperature {
-                AirTemperature::WarmNozzle {
-                    length, strength, ..
-                } => match slot {
-                    S_WARM => strength,
-                    _ => length,
-                },
-                AirTemperature::Uniform => {
-                    return Err(missing("warm-air profile", "with_warm_air"))
-                }
-            },
-            S_INLET_VELOCITY => &mut self.inlet_velocity,
-            S_INLET_DIAMETER => &mut self.inlet_diameter,
-            S_DIE_TEMPERATURE => &mut self.die_temperature_offset,
-            S_MASS_FLOW => &mut self.mass_flow_scale,
-            S_GAUGE_SCALE => &mut self.gauge_scale,
-            S_GAUGE_OFFSET => &mut self.gauge_offset,
-            S_VFT_B => &mut self.vft_b_offset,
-            _ => &mut self.vft_t_vf_offset,
-        })
+            )));
+        }
+        self.put(Part {
+            kind: *kind,
+            strengths: *strengths,
+        });
+        self.set_strength(name, strength)
     }
 
     /// Switches on the built-in part that carries the strength named `name` (an effect's
     /// [`model_param`](super::catalog::EffectDescriptor::model_param)), at unit amplitude with
-    /// its shapes at their defaults: the radiation term (emissivity 1), the aspirator co-flow,
-    /// the co-flow along the line or the warm-air profile (speed or excess 1). Nothing changes
-    /// where the part is there already or always is (a term's factor such as `nusselt_scale`,
-    /// a process, instrument or material parameter). Set the strength afterwards with
-    /// [`set_strength`](Self::set_strength); an unknown name is an error.
-    pub fn enable(self, name: &str) -> Result<Self, FiberError> {
+    /// its shapes at their defaults: the radiation term (emissivity 1) or a modifier that needs
+    /// its builder (the aspirator co-flow, the co-flow along the line or the warm-air profile,
+    /// speed or excess 1). Nothing changes where the part is there already or always is (a
+    /// term's factor such as `nusselt_scale`, a process, instrument or material parameter). Set
+    /// the strength afterwards with [`set_strength`](Self::set_strength); an unknown name is an
+    /// error.
+    pub fn enable(mut self, name: &str) -> Result<Self, FiberError> {
         if self.terms.iter().any(|t| t.parameter_name() == name) {
             return Ok(self);
         }
         if name == RADIATION.model_param {
             return Ok(self.with_radiation(1.0));
         }
-        Ok(match SLOT_NAMES.iter().position(|n| *n == name) {
-            Some(S_COFLOW) if matches!(self.air_speed, AirSpeed::Still) => {
-                self.with_coflow(1.0, COFLOW_DECAY.default)
+        for (kind, strengths, added_by) in modifiers::registered() {
+            let part = Part { kind, strengths };
+            if !part.slots().any(|s| s.1 == name) {
+                continue;
             }
-            Some(S_LINE) if matches!(self.line_coflow, LineCoflow::Off) => {
-                self.with_line_coflow(1.0, COFLOW_LINE_ONSET.default, COFLOW_LINE_RAMP.default)
+            let present = self.modifiers.iter().any(|p| p.kind.rank() == kind.rank());
+            if added_by.is_some() && !present && kind.effect().model_param == name {
+                self.put(part);
             }
-            Some(S_WARM) if matches!(self.air_temperature, AirTemperature::Uniform) => {
-                self.with_warm_air(1.0, WARM_AIR_DECAY.default)
-            }
-            Some(_) => self,
-            None => {
-                return Err(FiberError::InvalidInput(format!(
-                    "no built-in part of the physics carries the strength \"{name}\""
-                )))
-            }
-        })
+            return Ok(self);
+        }
+        Err(FiberError::InvalidInput(format!(
+            "no built-in part of the physics carries the strength \"{name}\""
+        )))
     }
 
     /// Builder form of [`set_strength`](Self::set_strength).
@@ -782,14 +555,9 @@ impl<H: NusseltLaw> Physics<H> {
     }
 
     /// Names and default values of the strengths that are model parameters, in `p` order:
-    /// terms first (in term order, by [`Term::parameter_name`]), then the slots (named by the
-    /// effects' descriptors): `"air_coflow"`,
-    /// `"air_coflow.decay_length"`, `"air_coflow_line"`, `"air_coflow_line.onset"`,
-    /// `"air_coflow_line.ramp_width"`, `"air_temperature_profile"`,
-    /// `"air_temperature_profile.decay_length"`, `"inlet_velocity"`, `"inlet_diameter"`,
-    /// `"die_temperature_offset"`, `"mass_flow_scale"`, `"gauge_scale"`, `"gauge_offset"`,
-    /// `"vft_b_offset"`, `"vft_t_vf_offset"`, `"air_coflow.tail"` (each where it is a
-    /// parameter).
+    /// terms first (in term order, by [`Term::parameter_name`]), then the modifiers' (named by
+    /// the effects' descriptors) in registry order, each modifier's strength and the shapes
+    /// fitted with it, then the shapes that are not (`"air_coflow.tail"`).
     pub fn strength_parameters(&self) -> Vec<(&'static str, f64)> {
         let mut v: Vec<(&'static str, f64)> = self
             .terms
@@ -799,8 +567,8 @@ impl<H: NusseltLaw> Physics<H> {
                 _ => None,
             })
             .collect();
-        for (name, s) in SLOT_NAMES.iter().zip(self.slots()) {
-            if let Strength::Parameter(d) = s {
+        for (i, slot, name) in modifiers::slot_order(&self.modifiers) {
+            if let Strength::Parameter(d) = self.modifiers[i].strengths[slot] {
                 v.push((name, d));
             }
         }
@@ -957,7 +725,7 @@ fn strength_value<D: DualNum<Primitive = f64> + Copy>(
 
 /// Where one strength comes from, resolved once ([`StrengthPlan`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Source {
+pub(crate) enum Source {
     /// Switched off.
     Off,
     /// A fixed factor.
@@ -970,7 +738,7 @@ impl Source {
     /// The value with strength parameters `sp` (`NaN` where `sp` is too short), as
     /// [`strength_value`] gives it.
     #[inline]
-    fn value<D: DualNum<Primitive = f64> + Copy>(self, sp: &[D]) -> Option<D> {
+    pub(crate) fn value<D: DualNum<Primitive = f64> + Copy>(self, sp: &[D]) -> Option<D> {
         match self {
             Source::Off => None,
             Source::Fixed(v) => Some(D::from(v)),
@@ -979,25 +747,16 @@ impl Source {
     }
 }
 
-/// The strengths of a [`Physics`] resolved once: for every term and every parameter slot
-/// (co-flow, warm air, process and instrument parameters) whether it is off, a fixed factor or
-/// which entry of the strength parameters `sp` it reads. [`FiberModel`](super::FiberModel)
-/// builds it at construction so that its right-hand side neither counts the parameterised terms
-/// nor rebuilds the slots on every call; the `*_planned` methods of [`Physics`] take it (the
-/// plain methods build it on the fly and give bit-identical results). A plan belongs to the
-/// physics it was made from: rebuild it ([`Physics::plan`]) after changing a strength.
+/// The strengths of a [`Physics`] resolved once: for every term and every slot of every
+/// modifier whether it is off, a fixed factor or which entry of the strength parameters `sp` it
+/// reads. [`FiberModel`](super::FiberModel) builds it at construction so that its right-hand
+/// side neither counts the parameterised terms nor looks up the modifiers' slots on every call;
+/// the `*_planned` methods of [`Physics`] take it. A plan belongs to the physics it was made
+/// from: rebuild it ([`Physics::plan`]) after changing a strength.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StrengthPlan {
-    slots: [Source; SLOTS],
     terms: Vec<Source>,
-}
-
-impl StrengthPlan {
-    /// The value of slot `i` with strength parameters `sp`.
-    #[inline]
-    fn slot<D: DualNum<Primitive = f64> + Copy>(&self, i: usize, sp: &[D]) -> Option<D> {
-        self.slots[i].value(sp)
-    }
+    modifiers: Vec<[Source; modifiers::SLOTS]>,
 }
 
 fn source(s: &Strength, k: &mut usize) -> Source {
@@ -1020,65 +779,25 @@ impl<H: NusseltLaw> Physics<H> {
             .iter()
             .map(|t| source(&t.strength, &mut k))
             .collect();
+        let mut parts = vec![[Source::Off; modifiers::SLOTS]; self.modifiers.len()];
+        for (i, slot, _) in modifiers::slot_order(&self.modifiers) {
+            parts[i][slot] = source(&self.modifiers[i].strengths[slot], &mut k);
+        }
         StrengthPlan {
-            slots: self.slot_plan(),
             terms,
+            modifiers: parts,
         }
     }
 
-    /// The slots' sources (after the terms' parameters).
-    fn slot_plan(&self) -> [Source; SLOTS] {
-        let mut k = self
-            .terms
-            .iter()
-            .filter(|t| t.strength.is_parameter())
-            .count();
-        let mut out = [Source::Off; SLOTS];
-        for (o, s) in out.iter_mut().zip(&self.slots()) {
-            *o = source(s, &mut k);
-        }
-        out
-    }
-
-    /// A plan with the slots only (no allocation), for the plain methods.
-    fn slots_only(&self) -> StrengthPlan {
-        StrengthPlan {
-            slots: self.slot_plan(),
-            terms: Vec::new(),
-        }
-    }
-}
-
-impl<H: NusseltLaw> Physics<H> {
     /// Number of strength parameters in `p`.
     pub fn num_strength_params(&self) -> usize {
         self.strength_parameters().len()
     }
 
-    /// The inlet-velocity factor `1 + δ` of `inlet_velocity` with strength parameters `sp` (1
-    /// when the error is off); see [`process`](Self::process) for all process factors.
-    #[inline]
-    pub fn inlet_velocity_factor<D: DualNum<Primitive = f64> + Copy>(&self, sp: &[D]) -> D {
-        match self.slot_plan()[S_INLET_VELOCITY].value(sp) {
-            Some(d) => d + 1.0,
-            None => D::one(),
-        }
-    }
-
-    /// The process factors with strength parameters `sp` (`temperature_scale` = `T_o` \[K\]):
-    /// inlet-velocity factor `(1 + δ_u)/(1 + δ_d)²`, die temperature offset `ΔT/T_o`, mass-flow
-    /// factor `1 + δ`. Exactly 1, 0, 1 where the parameters are off or neutral.
-    #[inline]
-    pub fn process<D: DualNum<Primitive = f64> + Copy>(
-        &self,
-        sp: &[D],
-        temperature_scale: f64,
-    ) -> ProcessFactors<D> {
-        self.process_planned(&self.slots_only(), sp, temperature_scale)
-    }
-
-    /// [`process`](Self::process) with the strengths resolved by `plan` (made by
-    /// [`plan`](Self::plan) from this physics).
+    /// The process factors with the strengths resolved by `plan` (made by [`plan`](Self::plan)
+    /// from this physics; `temperature_scale` = `T_o` \[K\]): inlet-velocity factor
+    /// `(1 + δ_u)/(1 + δ_d)²`, die temperature offset `ΔT/T_o`, mass-flow factor `1 + δ`.
+    /// Exactly 1, 0, 1 where the parameters are off.
     #[inline]
     pub fn process_planned<D: DualNum<Primitive = f64> + Copy>(
         &self,
@@ -1086,24 +805,21 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         temperature_scale: f64,
     ) -> ProcessFactors<D> {
-        let velocity = plan.slot(S_INLET_VELOCITY, sp);
-        let diameter = plan.slot(S_INLET_DIAMETER, sp);
-        let die = plan.slot(S_DIE_TEMPERATURE, sp);
-        let mass = plan.slot(S_MASS_FLOW, sp);
-        let mut inlet = match velocity {
-            Some(d) => d + 1.0,
-            None => D::one(),
+        let mut f = InletFactors {
+            velocity: None,
+            die_temperature: None,
+            mass_flow: None,
         };
-        if let Some(d) = diameter {
-            let f = d + 1.0;
-            inlet /= f * f;
+        for (p, src) in self.modifiers.iter().zip(&plan.modifiers) {
+            p.kind
+                .inlet(Part::values(src, sp), temperature_scale, &mut f);
         }
         ProcessFactors {
-            inlet_velocity: inlet,
-            die_temperature: die.map_or(D::zero(), |d| d * temperature_scale.recip()),
-            mass_flow: mass.map_or(D::one(), |d| d + 1.0),
-            has_die_temperature: die.is_some(),
-            has_mass_flow: mass.is_some(),
+            inlet_velocity: f.velocity.unwrap_or(D::one()),
+            die_temperature: f.die_temperature.unwrap_or(D::zero()),
+            mass_flow: f.mass_flow.unwrap_or(D::one()),
+            has_die_temperature: f.die_temperature.is_some(),
+            has_mass_flow: f.mass_flow.is_some(),
         }
     }
 
@@ -1116,32 +832,20 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         temperature_scale: f64,
     ) -> Option<[D; 2]> {
-        let b = plan.slot(S_VFT_B, sp);
-        let t_vf = plan.slot(S_VFT_T_VF, sp);
-        if b.is_none() && t_vf.is_none() {
-            return None;
+        let mut shift = [None, None];
+        for (p, src) in self.modifiers.iter().zip(&plan.modifiers) {
+            p.kind
+                .material(Part::values(src, sp), temperature_scale, &mut shift);
         }
-        let per = temperature_scale.recip();
-        Some([
-            b.map_or(D::zero(), |v| v * per),
-            t_vf.map_or(D::zero(), |v| v * per),
-        ])
+        match shift {
+            [None, None] => None,
+            [b, t] => Some([b.unwrap_or(D::zero()), t.unwrap_or(D::zero())]),
+        }
     }
 
-    /// The gauge's reading of a true diameter: `(1 + g) d + o` with `d`, the result and
-    /// `diameter_scale` = `d_o` \[m\] (the offset `o` is in µm); `d` itself where the gauge
-    /// parameters are off.
-    #[inline]
-    pub fn gauge_reading<D: DualNum<Primitive = f64> + Copy>(
-        &self,
-        d: D,
-        sp: &[D],
-        diameter_scale: f64,
-    ) -> D {
-        self.gauge_reading_planned(&self.slots_only(), d, sp, diameter_scale)
-    }
-
-    /// [`gauge_reading`](Self::gauge_reading) with the strengths resolved by `plan`.
+    /// The gauge's reading of a true diameter with the strengths resolved by `plan`:
+    /// `(1 + g) d + o` with `d`, the result and `diameter_scale` = `d_o` \[m\] (the offset `o` is
+    /// in µm); `d` itself where the gauge parameters are off.
     #[inline]
     pub fn gauge_reading_planned<D: DualNum<Primitive = f64> + Copy>(
         &self,
@@ -1151,27 +855,14 @@ impl<H: NusseltLaw> Physics<H> {
         diameter_scale: f64,
     ) -> D {
         let mut out = d;
-        if let Some(g) = plan.slot(S_GAUGE_SCALE, sp) {
-            out = d * (g + 1.0);
-        }
-        if let Some(o) = plan.slot(S_GAUGE_OFFSET, sp) {
-            out += o * (1e-6 / diameter_scale);
+        for (p, src) in self.modifiers.iter().zip(&plan.modifiers) {
+            p.kind
+                .gauge(Part::values(src, sp), diameter_scale, &mut out);
         }
         out
     }
 
-    /// `(T̃_air(s̃), ṽ_air(s̃))` with strength parameters `sp`.
-    #[inline]
-    pub fn environment<D: DualNum<Primitive = f64> + Copy>(
-        &self,
-        s: f64,
-        sp: &[D],
-        co: &Coefficients,
-    ) -> (D, D) {
-        self.environment_planned(&self.slots_only(), s, sp, co)
-    }
-
-    /// [`environment`](Self::environment) with the strengths resolved by `plan`.
+    /// `(T̃_air(s̃), ṽ_air(s̃))` with the strengths resolved by `plan`.
     #[inline]
     pub fn environment_planned<D: DualNum<Primitive = f64> + Copy>(
         &self,
@@ -1180,44 +871,19 @@ impl<H: NusseltLaw> Physics<H> {
         sp: &[D],
         co: &Coefficients,
     ) -> (D, D) {
-        let val = |i| plan.slot(i, sp);
-        let l_o = co.si.length;
-        let mut v = match (&self.air_speed, val(S_COFLOW), val(S_COFLOW_LEN)) {
-            (AirSpeed::CoFlow { speed, .. }, Some(f), Some(ell)) => {
-                let u = D::from((co.length - s) * l_o) / ell;
-                let decay = match val(S_COFLOW_TAIL) {
-                    Some(r) => coflow_decay(u, r),
-                    None => (-u).exp(),
-                };
-                f * decay * (speed / co.si.velocity)
-            }
-            _ => D::zero(),
+        let mut air = AirProfile {
+            excess: None,
+            speed: None,
         };
-        if let (LineCoflow::On { speed, .. }, Some(f), Some(s0), Some(w)) = (
-            &self.line_coflow,
-            val(S_LINE),
-            val(S_LINE_ONSET),
-            val(S_LINE_RAMP),
-        ) {
-            // logistic 1/(1 + e^(−z)) written without overflow for either sign of z
-            let z = (-s0 + s * l_o) / w;
-            let ramp = if z.re() >= 0.0 {
-                ((-z).exp() + 1.0).recip()
-            } else {
-                let e = z.exp();
-                e / (e + 1.0)
-            };
-            v += f * ramp * (speed / co.si.velocity);
+        for (p, src) in self.modifiers.iter().zip(&plan.modifiers) {
+            p.kind.air(Part::values(src, sp), s, co, &mut air);
         }
-        let t = match (&self.air_temperature, val(S_WARM), val(S_WARM_LEN)) {
-            (AirTemperature::WarmNozzle { excess, .. }, Some(f), Some(ell)) => {
-                f * (D::from(-s * l_o) / ell).exp() * (excess / co.si.temperature) + co.t_air
-            }
-            _ => D::from(co.t_air),
+        let t = match air.excess {
+            Some(e) => e + co.t_air,
+            None => D::from(co.t_air),
         };
-        (t, v)
+        (t, air.speed.unwrap_or(D::zero()))
     }
-
     /// Unscaled dimensionless value of one term (force per length in units of `f_o` or heat
     /// per length in units of `h_o`).
     ///
@@ -1360,29 +1026,10 @@ impl<H: NusseltLaw> Physics<H> {
     }
 }
 
-/// The co-flow's decay `φ_r(u) = (1 + r u)^(−1/r)` at `u = (L − s)/ℓ >= 0`, tail `r >= 0`:
-/// `exp(−ln(1 + r u)/r)`, with `ln(1 + x)/r = u (1 − x/2 + x²/3 − …)` for `|x| = |r u| < 10⁻²`
-/// (relative error below 10⁻¹⁵), so that `r = 0` gives `exp(−u)` with the right derivative
-/// `∂φ/∂r = u² e^(−u)/2` as well.
-fn coflow_decay<D: DualNum<Primitive = f64> + Copy>(u: D, r: D) -> D {
-    let x = r * u;
-    let log = if x.re().abs() < 1e-2 {
-        let mut q = x * (1.0 / 7.0) - 1.0 / 6.0;
-        q = q * x + 0.2;
-        q = q * x - 0.25;
-        q = q * x + 1.0 / 3.0;
-        q = q * x - 0.5;
-        q = q * x + 1.0;
-        u * q
-    } else {
-        x.ln_1p() / r
-    };
-    (-log).exp()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use modifiers::coflow_decay;
 
     /// The Churchill–Bernstein factor `(1 + x)^(4/5)` by its series: value and slope equal to
     /// the closed form (`exp(⅘ log1p x)`, slope `⅘ (1 + x)^(−1/5)`) over the series' range and
@@ -1519,7 +1166,15 @@ mod tests {
             assert_eq!(p.enable(d.model_param).unwrap().num_strength_params(), n);
         }
         named.sort_unstable();
-        let mut slots = SLOT_NAMES.to_vec();
+        let registered: Vec<Part> = modifiers::registered()
+            .into_iter()
+            .map(|(kind, strengths, _)| Part { kind, strengths })
+            .filter(|p| p.kind.effect().id() != modifiers::test_effect::UNIFORM_AIR.id())
+            .collect();
+        let mut slots: Vec<&str> = modifiers::slot_order(&registered)
+            .iter()
+            .map(|s| s.2)
+            .collect();
         slots.sort_unstable();
         assert_eq!(named, slots);
         assert!(Physics::paper().enable("nonsense").is_err());
@@ -1546,24 +1201,41 @@ mod tests {
         assert!((cross - cb).abs() < 1e-6 * cb);
     }
 
-    /// The planned evaluations (strengths resolved once) give bit-identical results to the
-    /// plain ones, with terms, air profiles, process and instrument parameters mixed.
+    /// The planned evaluation of the modifiers gives the closed forms of the model's equations,
+    /// bit for bit, with air profiles, process and instrument parameters mixed and set in any
+    /// order; the parameters come in registry order (each strength with its fitted shapes,
+    /// then the others); a too short `sp` gives NaN strengths. Terms: planned and plain sums
+    /// agree bit for bit.
     #[test]
-    fn planned_evaluation_is_bit_identical() {
+    fn planned_evaluation_is_the_closed_form() {
         let physics = Physics::paper()
             .with_radiation(0.9)
-            .with_coflow(2.0, 0.1)
-            .with_warm_air(30.0, 0.05)
-            .strength("radiation", Strength::Parameter(0.8))
+            .strength("gauge_offset", Strength::Parameter(1.5))
+            .and_then(|p| p.strength("mass_flow_scale", Strength::Parameter(-0.02)))
+            .map(|p| p.with_warm_air(30.0, 0.05).with_coflow(2.0, 0.1))
+            .and_then(|p| p.strength("radiation", Strength::Parameter(0.8)))
             .and_then(|p| p.strength("air_coflow", Strength::Parameter(1.1)))
+            .and_then(|p| p.strength("air_coflow.tail", Strength::Parameter(0.2)))
             .and_then(|p| p.strength("air_coflow.decay_length", Strength::Parameter(0.12)))
             .and_then(|p| p.strength("air_temperature_profile", Strength::Fixed(0.7)))
             .and_then(|p| p.strength("inlet_diameter", Strength::Parameter(0.05)))
-            .and_then(|p| p.strength("mass_flow_scale", Strength::Parameter(-0.02)))
             .and_then(|p| p.strength("die_temperature_offset", Strength::Parameter(3.0)))
-            .and_then(|p| p.strength("gauge_offset", Strength::Parameter(1.5)))
             .and_then(|p| p.strength("gauge_scale", Strength::Fixed(0.01)))
             .unwrap();
+        let names: Vec<&str> = physics.strength_parameters().iter().map(|p| p.0).collect();
+        assert_eq!(
+            names,
+            [
+                "radiation",
+                "air_coflow",
+                "air_coflow.decay_length",
+                "inlet_diameter",
+                "die_temperature_offset",
+                "mass_flow_scale",
+                "gauge_offset",
+                "air_coflow.tail"
+            ]
+        );
         let plan = physics.plan();
         let n = physics.num_strength_params();
         let sp: Vec<f64> = (0..n).map(|i| 0.3 + 0.1 * i as f64).collect();
@@ -1575,42 +1247,52 @@ mod tests {
             300.0,
             1.0,
         );
-        for short in [false, true] {
-            // a too short `sp` gives NaN strengths, the same way in both
-            let sp = if short { &sp[..n - 2] } else { &sp[..] };
-            let (a, b) = (
-                physics.process(sp, 500.0),
-                physics.process_planned(&plan, sp, 500.0),
-            );
-            let bits = |v: f64| v.to_bits();
-            assert_eq!(bits(a.inlet_velocity), bits(b.inlet_velocity));
-            assert_eq!(bits(a.die_temperature), bits(b.die_temperature));
-            assert_eq!(bits(a.mass_flow), bits(b.mass_flow));
-            assert_eq!(
-                bits(physics.gauge_reading(0.7, sp, 1e-4)),
-                bits(physics.gauge_reading_planned(&plan, 0.7, sp, 1e-4))
-            );
-            for s in [0.0, 0.4, 0.9] {
-                let (t, v) = physics.environment(s, sp, &co);
-                let (tp, vp) = physics.environment_planned(&plan, s, sp, &co);
-                assert_eq!((bits(t), bits(v)), (bits(tp), bits(vp)));
-                let st = LocalState {
-                    s,
-                    u: 2.0,
-                    n: 5000.0,
-                    t: 0.9,
-                    rate: 3.0,
-                    rho: 1.1,
-                    cp: 1.2,
-                    d: 0.4,
-                    q: 1.0,
-                    t_air: t,
-                    v_air: v,
-                };
-                let (f, h) = physics.sums(&st, sp, &co);
-                let (fp, hp) = physics.sums_planned(&plan, &st, sp, &co);
-                assert_eq!((bits(f), bits(h)), (bits(fp), bits(hp)));
-            }
+        let bits = |v: f64| v.to_bits();
+        let pf = physics.process_planned(&plan, &sp, 500.0);
+        let swell = sp[3] + 1.0;
+        assert_eq!(bits(pf.inlet_velocity), bits(1.0 / (swell * swell)));
+        assert_eq!(bits(pf.die_temperature), bits(sp[4] * 500f64.recip()));
+        assert_eq!(bits(pf.mass_flow), bits(sp[5] + 1.0));
+        assert!(pf.has_die_temperature && pf.has_mass_flow);
+        assert_eq!(
+            bits(physics.gauge_reading_planned(&plan, 0.7, &sp, 1e-4)),
+            bits(0.7 * (0.01 + 1.0) + sp[6] * (1e-6 / 1e-4))
+        );
+        assert_eq!(physics.vft_shift_planned(&plan, &sp, 500.0), None);
+        let short = &sp[..n - 2];
+        assert!(physics
+            .gauge_reading_planned(&plan, 0.7, short, 1e-4)
+            .is_nan());
+        assert!(physics
+            .process_planned(&plan, short, 500.0)
+            .mass_flow
+            .is_finite());
+        assert!(physics
+            .process_planned(&plan, &sp[..5], 500.0)
+            .mass_flow
+            .is_nan());
+        for s in [0.0, 0.4, 0.9] {
+            let (t, v) = physics.environment_planned(&plan, s, &sp, &co);
+            let u = ((co.length - s) * co.si.length) / sp[2];
+            let v_closed = sp[1] * coflow_decay(u, sp[7]) * (2.0 / co.si.velocity);
+            let warm = 0.7 * ((-s * co.si.length) / 0.05).exp() * (30.0 / co.si.temperature);
+            assert_eq!((bits(t), bits(v)), (bits(warm + co.t_air), bits(v_closed)));
+            let st = LocalState {
+                s,
+                u: 2.0,
+                n: 5000.0,
+                t: 0.9,
+                rate: 3.0,
+                rho: 1.1,
+                cp: 1.2,
+                d: 0.4,
+                q: 1.0,
+                t_air: t,
+                v_air: v,
+            };
+            let (f, h) = physics.sums(&st, &sp, &co);
+            let (fp, hp) = physics.sums_planned(&plan, &st, &sp, &co);
+            assert_eq!((bits(f), bits(h)), (bits(fp), bits(hp)));
         }
     }
 }
