@@ -56,7 +56,7 @@
 //! gives it a name, unit, ranges, category and remedy; `diagnose` then scans, refits, ranks and
 //! reports it like a built-in one.
 
-use crate::catalog::{self, Install};
+use crate::catalog::{self, EffectId, Install};
 use crate::contributions::{Balance, FiberTerm, Physics, Strength};
 use crate::error::FiberError;
 use std::fmt;
@@ -64,8 +64,8 @@ use std::str::FromStr;
 use std::sync::Arc;
 
 pub use crate::catalog::{
-    BudgetSource, Category, EffectDescriptor, EffectId, ShapeParameter, ShapeScan, StrengthMap,
-    ALL_NAMES, BUILTIN_NAMES, DEFAULT_COFLOW_DECAY_LENGTH, DEFAULT_COFLOW_LINE_ONSET,
+    BudgetSource, Category, EffectDescriptor, ShapeParameter, ShapeScan, StrengthMap, ALL_NAMES,
+    BUILTIN_NAMES, DEFAULT_COFLOW_DECAY_LENGTH, DEFAULT_COFLOW_LINE_ONSET,
     DEFAULT_COFLOW_LINE_RAMP_WIDTH, DEFAULT_WARM_AIR_DECAY_LENGTH, STRAIN_THINNING_REFERENCE_KAPPA,
 };
 #[cfg(test)]

@@ -3,8 +3,8 @@
 //! search and physical ranges, shapes, how its strength maps to the model parameter, how many
 //! parameters a refit adds, the independent check that tells it apart from a cause with the same
 //! signature, the error-budget source it represents, and how it enters the model. Every consumer
-//! reads the descriptor: the model ([`Physics`](crate::Physics) names its parameter slots
-//! after the descriptors), the fit's parameter layout, `diagnose` (scan, judge, rank, ties,
+//! reads the descriptor: the model ([`Physics`](crate::Physics) names its modifiers' strengths
+//! and shapes after the descriptors), the fit's parameter layout, `diagnose` (scan, judge, rank, ties,
 //! detection limits), the error budget and the reports.
 //!
 //! Data only: this module imports nothing of the model, so that the physics below and the
@@ -38,10 +38,10 @@
 //! error budget's sources are the descriptors' [`budget`](EffectDescriptor::budget) fields.
 //!
 //! **Adding a built-in effect**: its descriptor in its family's file and in [`BUILTIN`], its
-//! physics in [`Physics`](crate::Physics) (a term or a parameter slot named after the
-//! descriptor, switched on by [`Physics::enable`](crate::Physics::enable)), a variant of
-//! [`Effect`](crate::effects::Effect) returning the descriptor, and a row above (a unit
-//! test checks the table against the descriptors). **Adding your own**: see
+//! physics in one file of [`modifiers`](crate::contributions::modifiers) with its registry line
+//! (the descriptor names its strength and shapes; a term instead for a force or heat flux), a
+//! variant of [`Effect`](crate::effects::Effect) returning the descriptor, and a row above (a
+//! unit test checks the table against the descriptors). **Adding your own**: see
 //! [`EffectDescriptor::user`].
 
 mod descriptor;
@@ -112,11 +112,6 @@ pub const BUILTIN_NAMES: [&str; 11] = names(&BUILTIN, true);
 /// The built-in descriptor named `name`.
 pub fn builtin(name: &str) -> Option<&'static EffectDescriptor> {
     BUILTIN.iter().copied().find(|d| d.name == name)
-}
-
-/// The id of the built-in effect named `name` (a name from input parsed once).
-pub fn builtin_id(name: &str) -> Option<EffectId> {
-    builtin(name).map(EffectDescriptor::id)
 }
 
 #[cfg(test)]

@@ -24,7 +24,7 @@ impl Modifier for GaugeScale {
         reading: &mut D,
     ) {
         if let Some(g) = v.get(0) {
-            *reading = *reading * (g + 1.0);
+            *reading *= g + 1.0;
         }
     }
 }

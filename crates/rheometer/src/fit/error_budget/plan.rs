@@ -4,7 +4,8 @@
 use super::super::data::Rheometer;
 use super::super::identify::Identification;
 use super::SourceStatus;
-use crate::effects::{Effect, EffectId, EffectSetting, ModelSpec};
+use crate::catalog::EffectId;
+use crate::effects::{Effect, EffectSetting, ModelSpec};
 use crate::uncertainty::{GaugeColumn, Source};
 
 /// How a source's column is obtained.
