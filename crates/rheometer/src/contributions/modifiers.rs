@@ -1,11 +1,11 @@
 //! The built-in effects that change the model without adding a force or heat term: the air's
 //! speed and temperature along the line, the inlet conditions and the mass flow, the gauge's
 //! reading and the material data. Each is a small type in its own file implementing
-//! [`Modifier`] and registered by one line of the registry below; its descriptor in
+//! `Modifier` and registered by one line of the registry below; its descriptor in
 //! [`catalog`](crate::catalog) names its strength (slot 0) and its shape parameters (slots 1..,
 //! in the descriptor's order), so nothing else names them.
 //!
-//! **Adding a built-in effect**: a file here with its type, its [`Modifier`] impl (the
+//! **Adding a built-in effect**: a file here with its type, its `Modifier` impl (the
 //! descriptor, how it is switched on, the hook it fills) and, if it has settings of its own, its
 //! `Physics::with_*` builder; its line in the registry; its descriptor in the catalog (and its
 //! row in the catalog's table). The unit test `a_modifier_added_in_one_file_is_fitted` adds one
@@ -13,8 +13,9 @@
 //!
 //! The registry's order is the order of evaluation and of the parameters in `p`: each
 //! modifier's strength and the shapes fitted with it, modifier by modifier, then the shapes that
-//! are not (the co-flow's tail). Evaluation is resolved once ([`StrengthPlan`](super::StrengthPlan))
-//! and dispatched by a `match` on [`Kind`]: no trait objects and no allocation per point.
+//! are not (the co-flow's tail). Evaluation is resolved once
+//! ([`StrengthPlan`](super::StrengthPlan)) and dispatched by a `match` on `Kind`: no trait
+//! objects and no allocation per point.
 
 use super::{Coefficients, Source, Strength};
 use crate::catalog::EffectDescriptor;
@@ -141,6 +142,14 @@ pub(crate) trait Modifier: Copy + fmt::Debug + PartialEq + Send + Sync {
     }
 }
 
+/// A registered modifier switched on: its kind, its slots' strengths and its builder (see
+/// [`Modifier::ADDED_BY`]).
+pub(crate) type Registered = (
+    Kind,
+    [Strength; SLOTS],
+    Option<(&'static str, &'static str)>,
+);
+
 /// The registry: one line per built-in modifier, in evaluation and parameter order. Makes
 /// [`Kind`] (one variant per modifier) and its dispatch.
 macro_rules! registry {
@@ -234,7 +243,7 @@ macro_rules! registry {
 
         /// Every registered modifier switched on ([`Modifier::switched_on`]) with the builder
         /// that adds it ([`Modifier::ADDED_BY`]), in registry order.
-        pub(crate) fn registered() -> Vec<(Kind, [Strength; SLOTS], Option<(&'static str, &'static str)>)> {
+        pub(crate) fn registered() -> Vec<Registered> {
             let mut v = Vec::new();
             $($(#[$meta])* {
                 let (k, s) = <$ty as Modifier>::switched_on();

@@ -1,4 +1,5 @@
-//! `die_temperature_offset`: the melt leaves the die `ΔT` \[K\] off the nominal inlet temperature, `T(0) = T_in + ΔT`. Slot: `ΔT` \[K\].
+//! `die_temperature_offset`: the melt leaves the die `ΔT` \[K\] off the nominal inlet temperature,
+//! `T(0) = T_in + ΔT`. Slot: `ΔT` \[K\].
 
 use super::{add, InletFactors, Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, DIE_TEMPERATURE_OFFSET};

@@ -1,4 +1,5 @@
-//! `gauge_offset`: the gauge reads `d + o`, `o` in µm (after its scale); not in the balances, only in the predicted measurement. Slot: `o` \[µm\].
+//! `gauge_offset`: the gauge reads `d + o`, `o` in µm (after its scale); not in the balances, only
+//! in the predicted measurement. Slot: `o` \[µm\].
 
 use super::{Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, GAUGE_OFFSET};

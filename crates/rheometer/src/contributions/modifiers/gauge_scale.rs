@@ -1,4 +1,5 @@
-//! `gauge_scale`: the gauge reads `(1 + g) d` (before its offset); not in the balances, only in the predicted measurement. Slot: `g` \[-\].
+//! `gauge_scale`: the gauge reads `(1 + g) d` (before its offset); not in the balances, only in the
+//! predicted measurement. Slot: `g` \[-\].
 
 use super::{Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, GAUGE_SCALE};

@@ -1,4 +1,5 @@
-//! `inlet_diameter`: die swell `δ` \[-\], the inlet diameter `(1 + δ) d_in` at the same mass flow, so `u(0) = u_in/(1 + δ)²`. Slot: `δ`.
+//! `inlet_diameter`: die swell `δ` \[-\], the inlet diameter `(1 + δ) d_in` at the same mass flow,
+//! so `u(0) = u_in/(1 + δ)²`. Slot: `δ`.
 
 use super::{InletFactors, Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, INLET_DIAMETER};

@@ -1,4 +1,5 @@
-//! `inlet_velocity`: the relative error `δ` \[-\] of the inlet velocity (die swell), `u(0) = (1 + δ) u_in`. Slot: `δ`.
+//! `inlet_velocity`: the relative error `δ` \[-\] of the inlet velocity (die swell), `u(0) = (1 +
+//! δ) u_in`. Slot: `δ`.
 
 use super::{InletFactors, Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, INLET_VELOCITY};

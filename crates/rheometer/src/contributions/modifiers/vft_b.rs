@@ -1,4 +1,7 @@
-//! `vft_b_offset`: the VFT parameter `B + ΔB`, the zero-rate viscosity at the reference temperature `T_o` held (see [`ZeroRateViscosity::eval_shifted`](crate::material_law::ZeroRateViscosity::eval_shifted)). Slot: `ΔB` \[K\].
+//! `vft_b_offset`: the VFT parameter `B + ΔB`, the zero-rate viscosity at the reference temperature
+//! `T_o` held (see
+//! [`ZeroRateViscosity::eval_shifted`](crate::material_law::ZeroRateViscosity::eval_shifted)).
+//! Slot: `ΔB` \[K\].
 
 use super::{add, Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, VFT_B_OFFSET};

@@ -1,4 +1,5 @@
-//! `vft_t_vf_offset`: the VFT temperature `T_VF + ΔT_VF`, the level at `T_o` held. Slot: `ΔT_VF` \[K\].
+//! `vft_t_vf_offset`: the VFT temperature `T_VF + ΔT_VF`, the level at `T_o` held. Slot: `ΔT_VF`
+//! \[K\].
 
 use super::{add, Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, VFT_T_VF_OFFSET};
