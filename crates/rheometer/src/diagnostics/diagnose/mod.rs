@@ -184,7 +184,7 @@ pub fn diagnose(
         let spec = spec.with(EffectSetting::fitted(effect));
         let mut opts = options.clone();
         opts.candidates
-            .retain(|c| !spec.effects.iter().any(|e| e.effect.name() == c.name()));
+            .retain(|c| !spec.effects.iter().any(|e| e.effect.id() == c.id()));
         if opts.candidates.is_empty() {
             break;
         }
