@@ -456,7 +456,7 @@ impl Effect {
             return Err(format!(
                 "{}:{name} = {} is outside its admissible range [{lo}, {hi}]{unit}",
                 self.name(),
-                crate::workflow::request::show(value)
+                crate::format::show(value)
             ));
         }
         let name_of = self.name();
@@ -544,7 +544,7 @@ impl Effect {
             return Err(format!(
                 "{} = {} is outside its admissible range [{lo}, {hi}] {}",
                 self.name(),
-                crate::workflow::request::show(strength),
+                crate::format::show(strength),
                 self.unit()
             ));
         }
@@ -635,7 +635,7 @@ impl FromStr for EffectSetting {
                 return Err(format!(
                     "{} = {} is outside its admissible range [{lo}, {hi}] {}",
                     effect.name(),
-                    crate::workflow::request::show(x),
+                    crate::format::show(x),
                     effect.unit()
                 ));
             }

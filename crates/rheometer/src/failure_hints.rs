@@ -14,7 +14,7 @@ use super::error::FiberError;
 use super::fit::RheometerError;
 use super::input::{LoadedExperiments, Location};
 use super::setup::{Experiment, Inlet, Material, TakeUp};
-use crate::workflow::request::show;
+use crate::format::show;
 use diffbvp::error::BvpError;
 use std::error::Error;
 use std::f64::consts::PI;

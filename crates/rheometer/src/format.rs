@@ -218,6 +218,16 @@ pub(crate) fn wrap_long_lines(text: &str) -> String {
     out
 }
 
+/// A number as people read it: the shortest form that reads back exactly, in exponent
+/// notation below 1e-4 and from 1e6 on (`1e308`, not 309 digits).
+pub fn show(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -222,15 +222,7 @@ impl fmt::Display for Refusal {
 
 impl std::error::Error for Refusal {}
 
-/// A number as people read it: the shortest form that reads back exactly, in exponent
-/// notation below 1e-4 and from 1e6 on (`1e308`, not 309 digits).
-pub fn show(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&v.abs()) {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
-    }
-}
+pub use crate::format::show;
 
 /// The caps of the loader as a request sets them: `base`, or none at all with the override
 /// every door offers (`--allow-large-inputs` on the command line, `allow_large_inputs=True`
