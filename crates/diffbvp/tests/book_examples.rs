@@ -10,6 +10,18 @@ mod tutorial_continuation;
 #[path = "../examples/tutorial_fit.rs"]
 mod tutorial_fit;
 
+#[path = "../examples/two_layers.rs"]
+mod two_layers;
+
+#[test]
+fn two_layer_wall_matches_its_closed_forms() {
+    // the multipoint example: the flux of two resistances in series, the interface
+    // temperature, and its exact sensitivity to a source in the second layer
+    if let Err(e) = two_layers::run() {
+        panic!("{e}");
+    }
+}
+
 fn rel(a: f64, b: f64) -> f64 {
     ((a - b) / b).abs()
 }
