@@ -125,6 +125,18 @@ class Result:
     def __dir__(self) -> List[str]:
         return sorted(set(super().__dir__()) | set(self._data) | set(self._arrays))
 
+    @property
+    def report(self) -> str:
+        """The text report, as the command line prints it (``str(result)``) — for a fit, a
+        comparison, a diagnosis and a design. The JSON's own ``report`` field (which kind of
+        report it is: ``"fit"``, ``"diagnosis"``, ...) stays a key of ``to_dict()``."""
+        text = getattr(self, "text", None)
+        if not isinstance(text, str):
+            raise AttributeError(
+                f"{type(self).__name__} has no text report; its values are in to_dict()"
+            )
+        return text
+
     def keys(self) -> List[str]:
         """The keys of the data and the arrays."""
         return list(self._data) + [k for k in self._arrays if k not in self._data]

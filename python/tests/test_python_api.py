@@ -72,6 +72,20 @@ def test_repr_and_to_dict(pmma_fit, radiation_diagnosis):
     assert cands.effect[0] == radiation_diagnosis.candidates[0].effect
 
 
+def test_report_is_the_text_report(pmma_fit, radiation_diagnosis):
+    # `.report` is what the command line prints, not the JSON's kind stamp
+    assert pmma_fit.report == pmma_fit.text == str(pmma_fit)
+    assert "n" in pmma_fit.report and len(pmma_fit.report.splitlines()) > 5
+    assert radiation_diagnosis.report == str(radiation_diagnosis)
+    assert "radiation" in radiation_diagnosis.report
+    # the kind stays in the JSON form
+    assert pmma_fit.to_dict()["report"] == "fit"
+    # a result without a text report says so
+    cand = radiation_diagnosis.candidate("radiation")
+    with pytest.raises(AttributeError, match="report"):
+        cand.report
+
+
 def test_set_threads(pmma):
     default = diffbvp.threads()
     try:
