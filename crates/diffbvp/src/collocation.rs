@@ -549,34 +549,9 @@ impl Collocation {
         values: bool,
         fbuf: &mut [f64],
     ) {
-        let (n, m, w) = (self.n, self.m(), node_seeds.len());
-        for i in 0..m {
-            self.input.clear();
-            self.input.extend_from_slice(&y[i * n..(i + 1) * n]);
-            self.input.extend_from_slice(p);
-            let rf = RhsFn {
-                problem,
-                x: self.x[i],
-                n,
-                singular: self.singular.as_ref(),
-                region: self.region[i],
-            };
-            let out = if values {
-                &mut self.f[i * n..(i + 1) * n]
-            } else {
-                &mut fbuf[..n]
-            };
-            let jac = &mut self.jn[i * n * w..(i + 1) * n * w];
-            let coloring = colored.then_some(&self.coloring);
-            rhs_jacobian(
-                &mut self.engine,
-                coloring,
-                &rf,
-                &self.input,
-                node_seeds,
-                out,
-                jac,
-            );
+        for i in 0..self.m() {
+            let at = Point::Node(i);
+            self.point_jacobian(problem, at, y, p, node_seeds, colored, values, fbuf);
         }
     }
 
@@ -591,8 +566,8 @@ impl Collocation {
         values: bool,
         fbuf: &mut [f64],
     ) {
-        let (n, m, w) = (self.n, self.m(), node_seeds.len());
-        for i in 0..m - 1 {
+        let (n, w) = (self.n, node_seeds.len());
+        for i in 0..self.m() - 1 {
             if self.h[i] == 0.0 {
                 // an interface: its rows come from `jif`
                 self.jm[i * n * w..(i + 1) * n * w].fill(0.0);
@@ -601,34 +576,69 @@ impl Collocation {
                 }
                 continue;
             }
-            self.input.clear();
-            self.input
-                .extend_from_slice(&self.y_mid[i * n..(i + 1) * n]);
-            self.input.extend_from_slice(p);
-            let rf = RhsFn {
-                problem,
-                x: self.x[i] + 0.5 * self.h[i],
-                n,
-                singular: self.singular.as_ref(),
-                region: self.region[i],
-            };
-            let out = if values {
-                &mut self.f_mid[i * n..(i + 1) * n]
-            } else {
-                &mut fbuf[..n]
-            };
-            let jac = &mut self.jm[i * n * w..(i + 1) * n * w];
-            let coloring = colored.then_some(&self.coloring);
-            rhs_jacobian(
-                &mut self.engine,
-                coloring,
-                &rf,
-                &self.input,
-                node_seeds,
-                out,
-                jac,
-            );
+            let at = Point::Midpoint(i);
+            self.point_jacobian(problem, at, &[], p, node_seeds, colored, values, fbuf);
         }
+    }
+
+    /// The right-hand side's value and Jacobian at one point: node `i` (state from `y`, into
+    /// `f` and `jn`) or the midpoint of interval `i` (state from `y_mid`, into `f_mid` and
+    /// `jm`); the value into scratch `fbuf` unless `values`.
+    #[allow(clippy::too_many_arguments)]
+    fn point_jacobian<P: Bvp>(
+        &mut self,
+        problem: &P,
+        at: Point,
+        y: &[f64],
+        p: &[f64],
+        seeds: Seeds<'_>,
+        colored: bool,
+        values: bool,
+        fbuf: &mut [f64],
+    ) {
+        let (n, w) = (self.n, seeds.len());
+        let (i, x, state, f, jac) = match at {
+            Point::Node(i) => (
+                i,
+                self.x[i],
+                &y[i * n..(i + 1) * n],
+                &mut self.f,
+                &mut self.jn,
+            ),
+            Point::Midpoint(i) => (
+                i,
+                self.x[i] + 0.5 * self.h[i],
+                &self.y_mid[i * n..(i + 1) * n],
+                &mut self.f_mid,
+                &mut self.jm,
+            ),
+        };
+        self.input.clear();
+        self.input.extend_from_slice(state);
+        self.input.extend_from_slice(p);
+        let rf = RhsFn {
+            problem,
+            x,
+            n,
+            singular: self.singular.as_ref(),
+            region: self.region[i],
+        };
+        let out = if values {
+            &mut f[i * n..(i + 1) * n]
+        } else {
+            &mut fbuf[..n]
+        };
+        let jac = &mut jac[i * n * w..(i + 1) * n * w];
+        let coloring = colored.then_some(&self.coloring);
+        rhs_jacobian(
+            &mut self.engine,
+            coloring,
+            &rf,
+            &self.input,
+            seeds,
+            out,
+            jac,
+        );
     }
 
     /// The boundary conditions' Jacobian (`jbc`) and the interface conditions' (`jif`), seeded
@@ -912,6 +922,13 @@ struct ParamParts<'a> {
     bc_column: usize,
     /// The interface conditions' derivatives (rows of `bc_width`, at `bc_column`).
     jif: &'a [f64],
+}
+
+/// A collocation point of a dual pass: a node or the midpoint of an interval.
+#[derive(Clone, Copy)]
+enum Point {
+    Node(usize),
+    Midpoint(usize),
 }
 
 /// The Jacobian of the right-hand side `rf` at `input` in the seeds `seeds`, compressed by
