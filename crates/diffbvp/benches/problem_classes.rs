@@ -8,101 +8,18 @@ use diffbvp::mesh::{linspace, multipoint_linspace};
 use diffbvp::{solve, Bvp, DualNum, Guess, SolveOptions};
 use std::hint::black_box;
 
-/// Emden's equation y'' + (2/x) y' + y^5 = 0, y'(0) = 0, y(1) = sqrt(3/4).
-struct Emden;
-impl Bvp for Emden {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -y[0].powi(5);
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[1];
-        r[1] = yb[0] - 0.75f64.sqrt();
-    }
-    fn singular_term(&self) -> Option<Vec<f64>> {
-        Some(vec![0.0, 0.0, 0.0, -2.0])
-    }
-}
-
-/// The first-order catalyst pellet y'' + (2/x) y' = φ² y, y'(0) = 0, y(1) = 1.
-struct Pellet;
-impl Bvp for Pellet {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_params(&self) -> usize {
-        1
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = p[0] * p[0] * y[0];
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[1];
-        r[1] = yb[0] - 1.0;
-    }
-    fn singular_term(&self) -> Option<Vec<f64>> {
-        Some(vec![0.0, 0.0, 0.0, -2.0])
-    }
-}
-
-const XI: f64 = 0.4;
-
-/// A reacting layer [0, ξ] (u'' = φ² u) behind an inert layer (u'' = 0), u'(0) = 0, u(1) = 1:
-/// with `multipoint`, two regions joined by continuity at ξ; without, the same equations on
-/// one interval (the region from x).
-struct Layer {
-    multipoint: bool,
-}
-impl Bvp for Layer {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_params(&self) -> usize {
-        1
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        self.rhs_in_region(usize::from(x > XI), x, y, p, f);
-    }
-    fn rhs_in_region<D: DualNum<Primitive = f64> + Copy>(
-        &self,
-        region: usize,
-        _x: f64,
-        y: &[D],
-        p: &[D],
-        f: &mut [D],
-    ) {
-        f[0] = y[1];
-        f[1] = if region == 0 {
-            p[0] * p[0] * y[0]
-        } else {
-            D::zero()
-        };
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[1];
-        r[1] = yb[0] - 1.0;
-    }
-    fn interfaces(&self) -> &[f64] {
-        if self.multipoint {
-            &[XI]
-        } else {
-            &[]
-        }
-    }
-}
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::{Emden, Pellet, ReactingLayer, LAYER_XI};
 
 fn singular(c: &mut Criterion) {
     let opts = SolveOptions::with_tol(1e-6);
     let mut g = c.benchmark_group("singular_tol_1e-6");
     let guess = Guess::constant(linspace(0.0, 1.0, 5), &[1.0, 0.0]);
-    let s = solve(&Emden, &[], &guess, &opts).unwrap();
+    let s = solve(&Emden { regular_bc: true }, &[], &guess, &opts).unwrap();
     println!("emden: {} nodes", s.nodes());
     g.bench_function("emden", |b| {
-        b.iter(|| solve(&Emden, &[], black_box(&guess), &opts).unwrap())
+        b.iter(|| solve(&Emden { regular_bc: true }, &[], black_box(&guess), &opts).unwrap())
     });
     let guess = Guess::constant(linspace(0.0, 1.0, 5), &[0.5, 0.0]);
     let s = solve(&Pellet, &[3.0], &guess, &opts).unwrap();
@@ -118,10 +35,10 @@ fn multipoint(c: &mut Criterion) {
     // the cost of the Newton solve itself
     let opts = SolveOptions::fixed_mesh();
     let mut g = c.benchmark_group("multipoint_202_nodes_fixed_mesh");
-    let two = Guess::constant(multipoint_linspace(&[0.0, XI, 1.0], 101), &[0.5, 0.0]);
+    let two = Guess::constant(multipoint_linspace(&[0.0, LAYER_XI, 1.0], 101), &[0.5, 0.0]);
     let one = Guess::constant(linspace(0.0, 1.0, 202), &[0.5, 0.0]);
-    let mp = Layer { multipoint: true };
-    let sp = Layer { multipoint: false };
+    let mp = ReactingLayer { multipoint: true };
+    let sp = ReactingLayer { multipoint: false };
     let a = solve(&mp, &[5.0], &two, &opts).unwrap();
     let b = solve(&sp, &[5.0], &one, &opts).unwrap();
     println!(

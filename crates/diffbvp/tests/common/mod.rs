@@ -237,3 +237,101 @@ pub fn oscillatory_linear_exact(eps: f64, x: f64) -> f64 {
     let w = 1.0 / eps;
     (w * x).cos() - (w * x).sin() / w.tan()
 }
+
+/// Emden's equation y'' + (2/x) y' + y^5 = 0, y'(0) = 0, y(1) = sqrt(3/4) (scipy's test
+/// problem); `regular_bc: false` replaces y'(0) = 0 by y(0) = 1.1, which the regularity
+/// condition contradicts.
+pub struct Emden {
+    /// y'(0) = 0 (else y(0) = 1.1).
+    pub regular_bc: bool,
+}
+
+impl Bvp for Emden {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = -y[0].powi(5);
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = if self.regular_bc { ya[1] } else { ya[0] - 1.1 };
+        r[1] = yb[0] - 0.75f64.sqrt();
+    }
+    fn singular_term(&self) -> Option<Vec<f64>> {
+        Some(vec![0.0, 0.0, 0.0, -2.0])
+    }
+}
+
+/// The first-order reaction in a spherical catalyst pellet y'' + (2/x) y' = φ² y, y'(0) = 0,
+/// y(1) = 1, with the Thiele modulus φ the model parameter.
+pub struct Pellet;
+
+impl Bvp for Pellet {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        1
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        f[0] = y[1];
+        f[1] = p[0] * p[0] * y[0];
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[1];
+        r[1] = yb[0] - 1.0;
+    }
+    fn singular_term(&self) -> Option<Vec<f64>> {
+        Some(vec![0.0, 0.0, 0.0, -2.0])
+    }
+}
+
+/// The interface of [`ReactingLayer`].
+pub const LAYER_XI: f64 = 0.4;
+
+/// A reacting layer [0, ξ] (u'' = φ² u) behind an inert diffusion layer [ξ, 1] (u'' = 0),
+/// u'(0) = 0, u(1) = 1, u and u' continuous at ξ = [`LAYER_XI`]; φ is the model parameter.
+/// Without `multipoint` the same equations on one interval (the region from x).
+pub struct ReactingLayer {
+    /// Two regions joined at ξ (else one interval).
+    pub multipoint: bool,
+}
+
+impl Bvp for ReactingLayer {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_params(&self) -> usize {
+        1
+    }
+    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
+        self.rhs_in_region(usize::from(x > LAYER_XI), x, y, p, f);
+    }
+    fn rhs_in_region<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        region: usize,
+        _x: f64,
+        y: &[D],
+        p: &[D],
+        f: &mut [D],
+    ) {
+        f[0] = y[1];
+        f[1] = if region == 0 {
+            p[0] * p[0] * y[0]
+        } else {
+            D::zero()
+        };
+    }
+    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
+        r[0] = ya[1];
+        r[1] = yb[0] - 1.0;
+    }
+    fn interfaces(&self) -> &[f64] {
+        if self.multipoint {
+            &[LAYER_XI]
+        } else {
+            &[]
+        }
+    }
+}

@@ -2,61 +2,14 @@
 //! problems `y' = S y / x + f` (Emden's equation, the first-order catalyst pellet) and
 //! multipoint problems (two-layer diffusion with continuity and with a jump).
 
+use crate::common::{Emden, Pellet, ReactingLayer, LAYER_XI};
 use diffbvp::continuation::{continuation, ContinuationOptions};
 use diffbvp::mesh::linspace;
 use diffbvp::sensitivity::{adjoint_gradient, PointFunction, Sensitivities};
 use diffbvp::{solve, Bvp, BvpError, DualNum, Guess, SolveOptions, Solver};
 
-/// Emden's equation y'' + (2/x) y' + y^5 = 0, y'(0) = 0, y(1) = sqrt(3/4) (scipy's test
-/// problem); `regular_bc: false` replaces y'(0) = 0 by y(0) = 1.1, which the regularity
-/// condition contradicts.
-struct Emden {
-    regular_bc: bool,
-}
-
-impl Bvp for Emden {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], _p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = -y[0].powi(5);
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = if self.regular_bc { ya[1] } else { ya[0] - 1.1 };
-        r[1] = yb[0] - 0.75f64.sqrt();
-    }
-    fn singular_term(&self) -> Option<Vec<f64>> {
-        Some(vec![0.0, 0.0, 0.0, -2.0])
-    }
-}
-
 fn emden_exact(x: f64) -> f64 {
     (1.0 + x * x / 3.0).powf(-0.5)
-}
-
-/// The first-order reaction in a spherical catalyst pellet y'' + (2/x) y' = φ² y, y'(0) = 0,
-/// y(1) = 1, with the Thiele modulus φ the model parameter.
-struct Pellet;
-
-impl Bvp for Pellet {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_params(&self) -> usize {
-        1
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, _x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        f[0] = y[1];
-        f[1] = p[0] * p[0] * y[0];
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[1];
-        r[1] = yb[0] - 1.0;
-    }
-    fn singular_term(&self) -> Option<Vec<f64>> {
-        Some(vec![0.0, 0.0, 0.0, -2.0])
-    }
 }
 
 /// y = sinh(φx) / (x sinh φ) and dy/dφ (x > 0).
@@ -398,52 +351,14 @@ fn two_layers_with_a_contact_jump_match_the_closed_form_and_its_derivatives() {
     }
 }
 
-/// A reacting layer [0, ξ] (u'' = φ² u) behind an inert diffusion layer [ξ, 1] (u'' = 0),
-/// u'(0) = 0, u(1) = 1, u and u' continuous at ξ; φ is the model parameter.
-struct ReactingLayer;
-
-impl Bvp for ReactingLayer {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_params(&self) -> usize {
-        1
-    }
-    fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, x: f64, y: &[D], p: &[D], f: &mut [D]) {
-        self.rhs_in_region(usize::from(x > XI), x, y, p, f);
-    }
-    fn rhs_in_region<D: DualNum<Primitive = f64> + Copy>(
-        &self,
-        region: usize,
-        _x: f64,
-        y: &[D],
-        p: &[D],
-        f: &mut [D],
-    ) {
-        f[0] = y[1];
-        f[1] = if region == 0 {
-            p[0] * p[0] * y[0]
-        } else {
-            D::zero()
-        };
-    }
-    fn bc<D: DualNum<Primitive = f64> + Copy>(&self, ya: &[D], yb: &[D], _p: &[D], r: &mut [D]) {
-        r[0] = ya[1];
-        r[1] = yb[0] - 1.0;
-    }
-    fn interfaces(&self) -> &[f64] {
-        &[XI]
-    }
-}
-
 /// u(x) of [`ReactingLayer`]: A cosh(φx) in the reacting layer, linear beyond it.
 fn reacting_exact<D: DualNum<Primitive = f64> + Copy>(x: f64, phi: D) -> D {
-    let (c, s) = ((phi * XI).cosh(), (phi * XI).sinh());
-    let a = (c + phi * s * (1.0 - XI)).recip();
-    if x <= XI {
+    let (c, s) = ((phi * LAYER_XI).cosh(), (phi * LAYER_XI).sinh());
+    let a = (c + phi * s * (1.0 - LAYER_XI)).recip();
+    if x <= LAYER_XI {
         a * (phi * x).cosh()
     } else {
-        a * (c + phi * s * (x - XI))
+        a * (c + phi * s * (x - LAYER_XI))
     }
 }
 
@@ -452,14 +367,20 @@ fn a_reacting_layer_refines_its_own_region_and_matches_the_closed_form() {
     use diffbvp::mesh::{multipoint_linspace, regions};
     use num_dual::Dual64;
     let phi = 30.0;
-    let guess = Guess::constant(multipoint_linspace(&[0.0, XI, 1.0], 5), &[0.5, 0.0]);
-    let s = solve(&ReactingLayer, &[phi], &guess, &tight(1e-8)).unwrap();
+    let guess = Guess::constant(multipoint_linspace(&[0.0, LAYER_XI, 1.0], 5), &[0.5, 0.0]);
+    let s = solve(
+        &ReactingLayer { multipoint: true },
+        &[phi],
+        &guess,
+        &tight(1e-8),
+    )
+    .unwrap();
     let r = regions(&s.x);
     // the steep layer is refined, the linear region keeps its few nodes
     assert!(r[0].len() > 4 * r[1].len(), "{:?}", r);
     assert!(r[1].len() <= 5, "{:?}", r);
-    let sens = Sensitivities::compute(&ReactingLayer, &s).unwrap();
-    for x in [0.0, 0.2, 0.38, XI, 0.6, 1.0] {
+    let sens = Sensitivities::compute(&ReactingLayer { multipoint: true }, &s).unwrap();
+    for x in [0.0, 0.2, 0.38, LAYER_XI, 0.6, 1.0] {
         let want = reacting_exact(x, phi);
         assert!((s.eval(x)[0] - want).abs() < 1e-7, "u({x})");
         let dwant = reacting_exact(x, Dual64::new(phi, 1.0)).eps;
@@ -474,7 +395,7 @@ fn a_reacting_layer_refines_its_own_region_and_matches_the_closed_form() {
 #[test]
 fn multipoint_meshes_must_hold_the_interfaces_twice() {
     let msg = solve(
-        &ReactingLayer,
+        &ReactingLayer { multipoint: true },
         &[2.0],
         &Guess::constant(linspace(0.0, 1.0, 5), &[0.5, 0.0]),
         &tight(1e-4),
@@ -509,7 +430,13 @@ fn errors_shrink_with_the_tolerance() {
             (pl.eval(x)[0] - y).abs()
         });
         let g = Guess::constant(multipoint_linspace(&[0.0, XI, 1.0], 5), &[0.5, 0.0]);
-        let rl = solve(&ReactingLayer, &[30.0], &g, &tight(tol)).unwrap();
+        let rl = solve(
+            &ReactingLayer { multipoint: true },
+            &[30.0],
+            &g,
+            &tight(tol),
+        )
+        .unwrap();
         let err_r = grid(&|x| (rl.eval(x)[0] - reacting_exact(x, 30.0)).abs());
         eprintln!(
             "| {tol:.0e} | {err_e:.1e} | {} | {err_p:.1e} | {} | {err_r:.1e} | {} |",
