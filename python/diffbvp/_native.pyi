@@ -95,8 +95,8 @@ class ExprProblem:
               tol: float, bc_tol: Optional[float], max_nodes: int, verbose: int,
               scipy_mesh: bool) -> Tuple[int, str, Optional["BvpSolution"]]: ...
     def fit(self, x: List[float], y: np.ndarray, unknowns: List[float], params: List[float],
-            fit: List[int], lower: List[float], upper: List[float], data_x: List[float],
-            data_y: List[float], sigma: List[float], component: int, tol: float,
+            fit: List[int], lower: List[float], upper: List[float], data_x: np.ndarray,
+            data_y: np.ndarray, sigma: np.ndarray, component: int, tol: float,
             max_nodes: int, xtol: float, ftol: float, max_iterations: int
             ) -> Tuple[List[float], float, List[float], List[float], str, bool, int, int,
                        "BvpSolution"]: ...

@@ -41,9 +41,6 @@ __all__ = [
     "continue_bvp",
 ]
 
-# the most observations fit_bvp takes (the data set loader's row limit)
-_MAX_FIT_POINTS = 1_000_000
-
 _STATUS_MESSAGES = {
     0: "The algorithm converged to the desired accuracy.",
     1: "The maximum number of mesh nodes is exceeded.",
@@ -763,10 +760,6 @@ def fit_bvp(
         raise InputError(
             f"data_x[{j}] = {xd[j]} is outside the interval [{x[0]}, {x[-1]}] of x"
         )
-    if xd.size > _MAX_FIT_POINTS:
-        raise InputError(
-            f"data_x: {xd.size} observations, more than {_MAX_FIT_POINTS}; thin the data"
-        )
     try:
         sig = np.broadcast_to(np.asarray(1.0 if sigma is None else sigma, float), yd.shape)
     except ValueError:
@@ -804,7 +797,7 @@ def fit_bvp(
     (pf, cost, resid, jac, termination, success, iterations, accepted,
      native) = problem.fit(
         x.tolist(), np.ascontiguousarray(ya), pa.tolist(), p0, list(range(len(p0))),
-        lo.tolist(), hi.tolist(), xd.tolist(), yd.tolist(), sig.tolist(), int(component),
+        lo.tolist(), hi.tolist(), xd, yd, np.ascontiguousarray(sig), int(component),
         float(tol), int(max_nodes), float(xtol), float(ftol), int(max_iterations),
     )
     pf = np.asarray(pf)

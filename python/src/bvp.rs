@@ -11,7 +11,7 @@ use diffbvp::mesh::MeshOptions;
 use diffbvp::sensitivity::{adjoint_gradient, integral_adjoint, PointFunction, Sensitivities};
 use diffbvp::DualNum;
 use diffbvp::{Bvp, BvpError, Guess, Solution, SolveOptions, Solver};
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::sync::Arc;
 
@@ -233,9 +233,9 @@ impl ExprProblem {
         fit: Vec<usize>,
         lower: Vec<f64>,
         upper: Vec<f64>,
-        data_x: Vec<f64>,
-        data_y: Vec<f64>,
-        sigma: Vec<f64>,
+        data_x: PyReadonlyArray1<'_, f64>,
+        data_y: PyReadonlyArray1<'_, f64>,
+        sigma: PyReadonlyArray1<'_, f64>,
         component: usize,
         tol: f64,
         max_nodes: usize,
@@ -261,6 +261,15 @@ impl ExprProblem {
                  and one upper bound each"
             )));
         }
+        // the same cap as a data set's measurement rows (the loader's, one limit for both),
+        // checked on the arrays' lengths before anything is copied
+        let cap = rheometer::input::DEFAULT_MAX_ROWS_PER_FILE;
+        if data_x.len() > cap {
+            return Err(input_error(format!(
+                "data_x: {} observations, more than {cap}; thin the data",
+                data_x.len()
+            )));
+        }
         if data_y.len() != data_x.len() || sigma.len() != data_x.len() {
             return Err(input_error(format!(
                 "fit: {} points, {} values and {} sigmas; they must match",
@@ -269,6 +278,8 @@ impl ExprProblem {
                 sigma.len()
             )));
         }
+        let copy = |a: &PyReadonlyArray1<'_, f64>| a.as_array().to_vec();
+        let (data_x, data_y, sigma) = (copy(&data_x), copy(&data_y), copy(&sigma));
         let bvp = self.bvp.clone();
         let options = SolveOptions {
             tol,

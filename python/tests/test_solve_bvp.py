@@ -695,6 +695,15 @@ def test_fit_intervals_cover_the_truth_over_replicates():
     assert covered >= 34, covered
 
 
+def test_fit_refuses_more_observations_than_a_data_file_may_hold():
+    # the loader's row cap, owned by the library, before any solve
+    n = 1_000_001
+    xd = np.linspace(0, 2, n)
+    with pytest.raises(InputError, match="1000001 observations, more than 1000000"):
+        fit_bvp(["-k*y[0]"], ["ya[0] - 1"], np.linspace(0, 2, 5), np.ones((1, 5)), {"k": 2.0},
+                xd, np.exp(-0.7 * xd))
+
+
 @pytest.mark.parametrize(
     "kwargs, match",
     [
