@@ -86,6 +86,15 @@ pub(crate) fn add<D: DualNum<Primitive = f64> + Copy>(acc: &mut Option<D>, x: D)
     });
 }
 
+/// `acc · x` (`x` where nothing was multiplied yet).
+#[inline]
+pub(crate) fn scale<D: DualNum<Primitive = f64> + Copy>(acc: &mut Option<D>, x: D) {
+    *acc = Some(match *acc {
+        Some(a) => a * x,
+        None => x,
+    });
+}
+
 /// A built-in effect that changes the model without a term of its own. Every hook is a no-op
 /// unless the modifier fills it; `v` holds its strength and shapes.
 pub(crate) trait Modifier: Copy + fmt::Debug + PartialEq + Send + Sync {

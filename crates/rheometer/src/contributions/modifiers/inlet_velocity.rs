@@ -1,7 +1,7 @@
 //! `inlet_velocity`: the relative error `δ` \[-\] of the inlet velocity (die swell), `u(0) = (1 +
 //! δ) u_in`. Slot: `δ`.
 
-use super::{InletFactors, Modifier, Values, SLOTS};
+use super::{scale, InletFactors, Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, INLET_VELOCITY};
 use crate::contributions::Strength;
 use num_dual::DualNum;
@@ -25,10 +25,7 @@ impl Modifier for InletVelocity {
         f: &mut InletFactors<D>,
     ) {
         if let Some(d) = v.get(0) {
-            f.velocity = Some(match f.velocity {
-                Some(u) => u * (d + 1.0),
-                None => d + 1.0,
-            });
+            scale(&mut f.velocity, d + 1.0);
         }
     }
 }

@@ -1,6 +1,6 @@
 //! `mass_flow_scale`: the true mass flow is `(1 + δ) Q`. Slot: `δ` \[-\].
 
-use super::{InletFactors, Modifier, Values, SLOTS};
+use super::{scale, InletFactors, Modifier, Values, SLOTS};
 use crate::catalog::{EffectDescriptor, MASS_FLOW_SCALE};
 use crate::contributions::Strength;
 use num_dual::DualNum;
@@ -24,10 +24,7 @@ impl Modifier for MassFlow {
         f: &mut InletFactors<D>,
     ) {
         if let Some(d) = v.get(0) {
-            f.mass_flow = Some(match f.mass_flow {
-                Some(m) => m * (d + 1.0),
-                None => d + 1.0,
-            });
+            scale(&mut f.mass_flow, d + 1.0);
         }
     }
 }
