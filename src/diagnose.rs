@@ -111,15 +111,7 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     robust.apply(&mut opts.identify)?;
     opts.identify.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
     request::given_tol(&mut opts.identify, tol)?;
-    // a spinner on a terminal (indicatif draws nothing when stderr is not a terminal)
-    let spinner = if g.quiet {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::new_spinner();
-        b.set_message("fitting your model and scoring the candidate effects");
-        b.enable_steady_tick(std::time::Duration::from_millis(120));
-        b
-    };
+    let spinner = spinner(g, "fitting your model and scoring the candidate effects");
     let run = workflow::diagnose(&loaded, &spec, &opts);
     spinner.finish_and_clear();
     let run = run?;
@@ -149,4 +141,16 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         out.display()
     ));
     Ok(())
+}
+
+/// A spinner saying `message` on a terminal (hidden under `--quiet`; indicatif draws nothing
+/// when stderr is not a terminal).
+fn spinner(g: &Global, message: &'static str) -> ProgressBar {
+    if g.quiet {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new_spinner();
+    b.set_message(message);
+    b.enable_steady_tick(std::time::Duration::from_millis(120));
+    b
 }

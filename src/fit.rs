@@ -81,11 +81,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     request::given_tol(&mut opts, tol)?;
     robust.apply(&mut opts)?;
     opts.simulate.max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
-    let model = if newtonian {
-        Some(LawChoice::Newtonian)
-    } else {
-        model
-    };
+    let model = newtonian.then_some(LawChoice::Newtonian).or(model);
     let law = previous::law(model, previous.as_ref());
     let (with, start, start_strengths) = match &previous {
         Some(p) => {
@@ -136,24 +132,7 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         ..FitRequest::new(IdentifyOptions::default())
     };
     let run = workflow::fit(&loaded, &request)?;
-    if let Some(sp) = &run.start_heuristic {
-        g.say(format!(
-            "start heuristic: (n, kappa) = ({}, {})",
-            sp.start[0], sp.start[1]
-        ));
-    }
-    for (what, e) in [
-        ("error budget", &run.budget_error),
-        (
-            "profile intervals and likelihood-ratio test",
-            &run.profile_error,
-        ),
-        ("flow curve", &run.flow_curve_error),
-    ] {
-        if let Some(e) = e {
-            g.say(format!("note: {what} not computed: {e}"));
-        }
-    }
+    say_notes(&run, g);
     // the report is the one place of the warnings (stdout); stderr only says where they are
     let rep = run.summary();
     outln!("{}", rep.to_text());
@@ -178,6 +157,29 @@ pub fn run(args: FitArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         write_fit_outputs(&run, &outputs, &dir, names, (&text, &page), &with, g)?;
     }
     Ok(())
+}
+
+/// What the fit says on stderr beside its report: the start heuristic's start and the parts
+/// that were not computed.
+fn say_notes(run: &FitRun, g: &Global) {
+    if let Some(sp) = &run.start_heuristic {
+        g.say(format!(
+            "start heuristic: (n, kappa) = ({}, {})",
+            sp.start[0], sp.start[1]
+        ));
+    }
+    for (what, e) in [
+        ("error budget", &run.budget_error),
+        (
+            "profile intervals and likelihood-ratio test",
+            &run.profile_error,
+        ),
+        ("flow curve", &run.flow_curve_error),
+    ] {
+        if let Some(e) = e {
+            g.say(format!("note: {what} not computed: {e}"));
+        }
+    }
 }
 
 /// The files `fit --out` writes, as `(label, name)`: the report, the JSON, the fitted

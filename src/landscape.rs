@@ -88,17 +88,7 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
             t0.elapsed().as_secs_f64(),
         ));
     }
-    let bar = if g.quiet {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::new((grid.0 * grid.1) as u64);
-        b.set_style(
-            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta} left)")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b.set_message("landscape");
-        b
-    };
+    let bar = progress_bar(g, grid.0 * grid.1);
     let run = rh.landscape_from(sample, |d| bar.set_position(d as u64), &INTERRUPTED)?;
     bar.finish_and_clear();
     let mut dir = outputs::DirWriter::begin(&outputs, &out, "rheometer landscape", "files", names)?;
@@ -118,23 +108,7 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         .into());
     }
     let l = run.landscape;
-    if failed > 0 {
-        outln!(
-            "{failed} of {total} grid points failed (no solution there; cost NaN, grey in the \
-             figure, status failed in the CSV)"
-        );
-    }
-    if 2 * failed > total {
-        g.warn(format!(
-            "most grid points failed ({failed} of {total}): the ranges --n-range {},{} \
-             --kappa-range {},{} reach far beyond where the model has a solution for these \
-             experiments; narrow them",
-            checks::show(n_range.0),
-            checks::show(n_range.1),
-            checks::show(kappa_range.0),
-            checks::show(kappa_range.1)
-        ));
-    }
+    say_failures(g, failed, total, n_range, kappa_range);
     let mut markers = Vec::new();
     if let Some((n, k, c)) = l.minimum() {
         outln!("grid minimum: n = {n:.4}, kappa = {k:.4}, J = {c:.6e}");
@@ -154,6 +128,49 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
         path.display()
     ));
     Ok(())
+}
+
+/// The progress bar of `points` grid points (hidden under `--quiet`).
+fn progress_bar(g: &Global, points: usize) -> ProgressBar {
+    if g.quiet {
+        ProgressBar::hidden()
+    } else {
+        let b = ProgressBar::new(points as u64);
+        b.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta} left)")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b.set_message("landscape");
+        b
+    }
+}
+
+/// What the failed grid points mean: their count, and a warning when most failed (the ranges
+/// reach beyond where the model has a solution).
+fn say_failures(
+    g: &Global,
+    failed: usize,
+    total: usize,
+    n_range: (f64, f64),
+    kappa_range: (f64, f64),
+) {
+    if failed > 0 {
+        outln!(
+            "{failed} of {total} grid points failed (no solution there; cost NaN, grey in the \
+             figure, status failed in the CSV)"
+        );
+    }
+    if 2 * failed > total {
+        g.warn(format!(
+            "most grid points failed ({failed} of {total}): the ranges --n-range {},{} \
+             --kappa-range {},{} reach far beyond where the model has a solution for these \
+             experiments; narrow them",
+            checks::show(n_range.0),
+            checks::show(n_range.1),
+            checks::show(kappa_range.0),
+            checks::show(kappa_range.1)
+        ));
+    }
 }
 
 /// Writes the landscape as CSV `n,kappa,cost,status,tol`, one row per grid point (`n` varying

@@ -775,8 +775,7 @@ impl<'a, P: Bvp> Solver<'a, P> {
         let mut x = guess.x.clone();
         let mut y = guess.y.clone();
         if let Some(s) = problem.singular_term() {
-            // the guess's y(0) onto the null space of S (scipy's projection): the start then
-            // satisfies the regularity condition S y(0) = 0
+            // y(0) onto the null space of S (scipy's projection): S y(0) = 0 from the start
             Singular::new(s, n, x[0])?.project(&mut y[..n]);
         }
         let mut p: Vec<f64> = guess.unknowns.iter().chain(params).copied().collect();
@@ -786,11 +785,6 @@ impl<'a, P: Bvp> Solver<'a, P> {
         // the mesh options of this solve: the rule switches to scipy's when the mesh cycles
         let mut control = MeshControl::new(&opts.mesh);
         let mut coarsenings_left = if opts.coarsen && opts.adapt { 3 } else { 0 };
-        // the largest mesh this solve may reach from its guess (below `max_nodes`)
-        let growth_limit = opts
-            .growth_limit
-            .map(|g| g.nodes(guess.x.len()))
-            .filter(|&l| l < opts.max_nodes);
         let mut iteration = 0;
         // values interpolated onto a refined mesh rarely pass the termination test as they
         // are: their Jacobian is evaluated with their residual (one pass instead of two)
@@ -798,102 +792,59 @@ impl<'a, P: Bvp> Solver<'a, P> {
         loop {
             iteration += 1;
             let m = x.len();
-            self.ws.col.set_mesh(&x);
-            let mut lin = self.take_system(m, opts)?;
-            let factorizations_before = lin.factorizations;
-            let scale = self.scale_for(&y, &opts.scale);
-            let report = newton(
-                problem,
-                &mut self.ws.col,
-                &mut lin,
+            let settled = self.newton_on_mesh(
+                &x,
                 &mut y,
                 &mut p,
-                &scale,
+                opts,
                 &settings,
-                &mut self.ws.newton_work,
                 initial.take(),
                 start,
-            );
-            let report = match report {
-                Ok(r) => r,
-                Err(e) => {
-                    self.keep_system(lin);
-                    return Err(e);
-                }
-            };
-            if let Err(e) = self.check_regular(report.converged, &y, bc_tol) {
-                self.keep_system(lin);
-                return Err(e);
-            }
-            stats.newton_iterations += report.iterations;
-            stats.jacobian_factorizations += lin.factorizations - factorizations_before;
-            let factored = lin.factorizations > factorizations_before;
-            let max_bc_res = max_bc(&self.ws.col);
-            rms_residuals(
-                problem,
-                &mut self.ws.col,
-                &y,
-                &p,
-                &scale,
-                &mut self.ws.rms,
-                &mut self.ws.buf,
-            );
-            let max_res = self.ws.rms.iter().fold(0.0f64, |a, &v| a.max(v));
-            stats.max_residual = max_res;
-            stats.max_bc_residual = max_bc_res;
+                &mut stats,
+            )?;
+            let MeshPass {
+                lin,
+                report,
+                factored,
+                scale,
+                max_res,
+                max_bc_res,
+            } = settled;
 
-            if !opts.adapt {
-                if report.converged {
-                    let kept = kept_matrix(opts, &lin, factored, x == guess.x, &carried);
-                    return self.finish(problem, lin, x, y, p, scale, stats, opts, kept);
-                }
+            if !opts.adapt && !report.converged {
                 self.keep_system(lin);
-                return Err(BvpError::NewtonFailed {
-                    iterations: report.iterations,
-                    nodes: m,
-                    reason: "no convergence on the fixed mesh".into(),
-                    max_residual: max_res,
-                    max_bc_residual: max_bc_res,
-                });
+                return Err(fixed_mesh_failure(&report, m, (max_res, max_bc_res)));
             }
 
-            let pass = (m, max_res, iteration);
-            let above = control.plan(
-                &self.ws.rms,
-                opts.tol,
-                &mut self.ws.marks,
-                pass,
-                opts.verbose,
-            );
+            let residuals = (max_res, max_bc_res);
+            let refined = opts
+                .adapt
+                .then(|| self.refinement(&x, &mut control, opts, iteration, &report, residuals))
+                .flatten();
             stats.mesh_rule_switched_at = control.switched_at;
-            let refined = (above > 0)
-                .then(|| refine_regions(&x, &self.ws.rms, &self.ws.marks, opts, &control));
-            if opts.verbose >= 1 {
-                let next = refined.as_ref().map_or(m, Vec::len);
-                report_mesh(iteration, m, &report, (max_res, max_bc_res), above, next);
-            }
             if let Some(new_x) = refined {
                 self.keep_system(lin);
-                allowed_size(new_x.len(), guess.x.len(), growth_limit, max_res, opts)?;
+                allowed_size(new_x.len(), guess.x.len(), max_res, opts)?;
                 y = resample_regions(&x, &y, &self.ws.col.f, n, &new_x);
                 x = new_x;
                 stats.mesh_refinements += 1;
                 start = Start::WithJacobian;
-            } else if max_bc_res <= bc_tol {
+            } else if max_bc_res <= bc_tol || !opts.adapt {
                 // coarsen only if the coarser mesh can still be solved and checked: the solution
-                // returned must belong to the mesh it was computed on
-                if coarsenings_left > 0 && m > 8 && iteration < opts.max_mesh_iterations {
-                    let new_x = coarsen_regions(&x, &self.ws.rms, opts.tol);
-                    if (m - new_x.len()) * 10 >= m {
-                        self.keep_system(lin);
-                        coarsenings_left -= 1;
-                        y = resample_regions(&x, &y, &self.ws.col.f, n, &new_x);
-                        x = new_x;
-                        stats.mesh_refinements += 1;
-                        stats.mesh_coarsenings += 1;
-                        start = Start::Lazy;
-                        continue;
-                    }
+                // returned must belong to the mesh it was computed on (10 % fewer nodes at least)
+                let coarser =
+                    (coarsenings_left > 0 && m > 8 && iteration < opts.max_mesh_iterations)
+                        .then(|| coarsen_regions(&x, &self.ws.rms, opts.tol))
+                        .filter(|c| (m - c.len()) * 10 >= m);
+                if let Some(new_x) = coarser {
+                    self.keep_system(lin);
+                    coarsenings_left -= 1;
+                    y = resample_regions(&x, &y, &self.ws.col.f, n, &new_x);
+                    x = new_x;
+                    stats.mesh_refinements += 1;
+                    stats.mesh_coarsenings += 1;
+                    start = Start::Lazy;
+                    continue;
                 }
                 let kept = kept_matrix(opts, &lin, factored, x == guess.x, &carried);
                 return self.finish(problem, lin, x, y, p, scale, stats, opts, kept);
@@ -904,6 +855,106 @@ impl<'a, P: Bvp> Solver<'a, P> {
                 return Err(not_met(&control, opts, iteration, max_res, max_bc_res));
             }
         }
+    }
+
+    /// The refined mesh the residuals of the pass on `x` ask for (`None`: every interval meets
+    /// the tolerance), reported at `verbose >= 1`; `residuals` are the pass's largest
+    /// collocation and boundary residuals.
+    fn refinement(
+        &mut self,
+        x: &[f64],
+        control: &mut MeshControl,
+        opts: &SolveOptions,
+        iteration: usize,
+        report: &NewtonReport,
+        residuals: (f64, f64),
+    ) -> Option<Vec<f64>> {
+        let m = x.len();
+        let pass = (m, residuals.0, iteration);
+        let above = control.plan(
+            &self.ws.rms,
+            opts.tol,
+            &mut self.ws.marks,
+            pass,
+            opts.verbose,
+        );
+        let refined =
+            (above > 0).then(|| refine_regions(x, &self.ws.rms, &self.ws.marks, opts, control));
+        if opts.verbose >= 1 {
+            let next = refined.as_ref().map_or(m, Vec::len);
+            report_mesh(iteration, m, report, residuals, above, next);
+        }
+        refined
+    }
+
+    /// One Newton solve on the mesh `x` from `y`, `p` (both updated in place), then the scaled
+    /// RMS residuals of its intervals (left in the workspace's `rms`), counted in `stats`.
+    /// Errors: a Newton failure, an irregular singular solution (the system is kept).
+    #[allow(clippy::too_many_arguments)]
+    fn newton_on_mesh(
+        &mut self,
+        x: &[f64],
+        y: &mut [f64],
+        p: &mut [f64],
+        opts: &SolveOptions,
+        settings: &NewtonSettings,
+        initial: Option<&Factorization>,
+        start: Start,
+        stats: &mut SolveStats,
+    ) -> Result<MeshPass, BvpError> {
+        let problem = self.problem;
+        let m = x.len();
+        self.ws.col.set_mesh(x);
+        let mut lin = self.take_system(m, opts)?;
+        let factorizations_before = lin.factorizations;
+        let scale = self.scale_for(y, &opts.scale);
+        let report = newton(
+            problem,
+            &mut self.ws.col,
+            &mut lin,
+            y,
+            p,
+            &scale,
+            settings,
+            &mut self.ws.newton_work,
+            initial,
+            start,
+        );
+        let report = match report {
+            Ok(r) => r,
+            Err(e) => {
+                self.keep_system(lin);
+                return Err(e);
+            }
+        };
+        if let Err(e) = self.check_regular(report.converged, y, settings.bc_tol) {
+            self.keep_system(lin);
+            return Err(e);
+        }
+        stats.newton_iterations += report.iterations;
+        stats.jacobian_factorizations += lin.factorizations - factorizations_before;
+        let factored = lin.factorizations > factorizations_before;
+        let max_bc_res = max_bc(&self.ws.col);
+        rms_residuals(
+            problem,
+            &mut self.ws.col,
+            y,
+            p,
+            &scale,
+            &mut self.ws.rms,
+            &mut self.ws.buf,
+        );
+        let max_res = self.ws.rms.iter().fold(0.0f64, |a, &v| a.max(v));
+        stats.max_residual = max_res;
+        stats.max_bc_residual = max_bc_res;
+        Ok(MeshPass {
+            lin,
+            report,
+            factored,
+            scale,
+            max_res,
+            max_bc_res,
+        })
     }
 
     /// After a converged Newton solve of a singular problem: the boundary conditions hold, so
@@ -1013,6 +1064,33 @@ pub(crate) fn resample_regions(
     out
 }
 
+/// The error of a Newton solve that did not converge on a fixed mesh of `m` nodes;
+/// `residuals` are its largest collocation and boundary residuals.
+fn fixed_mesh_failure(report: &NewtonReport, m: usize, residuals: (f64, f64)) -> BvpError {
+    BvpError::NewtonFailed {
+        iterations: report.iterations,
+        nodes: m,
+        reason: "no convergence on the fixed mesh".into(),
+        max_residual: residuals.0,
+        max_bc_residual: residuals.1,
+    }
+}
+
+/// A Newton solve on one mesh, with its residuals (see `Solver::newton_on_mesh`).
+struct MeshPass {
+    /// The linear system (kept for the next solve, or finished with).
+    lin: LinearSystem,
+    report: NewtonReport,
+    /// Whether a new matrix was factored on this mesh.
+    factored: bool,
+    /// The residual scale of this pass.
+    scale: Vec<f64>,
+    /// The largest scaled RMS residual of the intervals.
+    max_res: f64,
+    /// The largest boundary-condition residual.
+    max_bc_res: f64,
+}
+
 /// The factorisation a solve nearby may start from ([`Solver::solve_near`]).
 #[derive(Clone, Copy)]
 pub(crate) enum Initial<'f> {
@@ -1060,16 +1138,19 @@ fn kept_matrix(
     }
 }
 
-/// Whether a refined mesh of `nodes` nodes may be solved: within the growth limit `limit`
-/// (already resolved for a guess of `start_nodes` nodes) and within `opts.max_nodes`; the error
+/// Whether a refined mesh of `nodes` nodes may be solved: within the growth limit of a guess
+/// of `start_nodes` nodes (when it is below `max_nodes`) and within `opts.max_nodes`; the error
 /// says which bound it exceeds, with the largest scaled residual `max_res` reached.
 fn allowed_size(
     nodes: usize,
     start_nodes: usize,
-    limit: Option<usize>,
     max_res: f64,
     opts: &SolveOptions,
 ) -> Result<(), BvpError> {
+    let limit = opts
+        .growth_limit
+        .map(|g| g.nodes(start_nodes))
+        .filter(|&l| l < opts.max_nodes);
     if let Some(limit) = limit.filter(|&l| nodes > l) {
         return Err(BvpError::MeshGrowthLimit {
             start_nodes,
