@@ -12,6 +12,7 @@ use pyo3::types::PyDict;
 use rheometer::diagnostics::compare::MissingTakeUp;
 use rheometer::fit::FitSummary;
 use rheometer::report_json::ReportKind;
+use rheometer::workflow::request::Door;
 use rheometer::workflow::{self, CompareRequest};
 
 /// How a fit given from Python is named in messages.
@@ -75,6 +76,7 @@ pub fn compare<'py>(
             r
         }
     };
+    request.door = Door::Python;
     request.with = options::effects(&effects)?;
     request.relative_uncertainty = options::fraction(relative_uncertainty)?;
     request.simulate.max_nodes = options::max_nodes(max_nodes)?;

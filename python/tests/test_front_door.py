@@ -97,3 +97,16 @@ def test_python_design_returns_what_the_cli_writes(rheometer, scratch, pmma):
     assert "Which experiment next" in got.text
     assert got.csv.splitlines()[0].startswith("i,j,mass_flow_kg_s,take_up,")
     assert len(got.csv.splitlines()) == 1 + 9
+
+
+def test_a_missing_take_up_names_the_input_at_each_door(rheometer, pmma):
+    # bad-input finding D51: the model with an effect and no take-up condition in the TOML
+    p = run_cli(rheometer, "compare", str(PMMA), "--with", "radiation=0.9", "--n", "0.8",
+                "--kappa", "11.7", "--out", "target/pytest-scratch/never")
+    assert p.returncode != 0, p.stdout
+    assert "has no take-up condition" in p.stderr and "--take-up-from-data" in p.stderr, p.stderr
+    with pytest.raises(diffbvp.DiffbvpError) as e:
+        diffbvp.compare(pmma, n=0.8, kappa=11.7, effects="radiation=0.9")
+    py = str(e.value)
+    assert "has no take-up condition" in py and "take_up_from_data=True" in py, py
+    assert "--" not in py, py

@@ -158,3 +158,27 @@ fn d_numbers_are_printed_as_written_or_in_g() {
     p.assert_clean_failure(&["(n, kappa) = (1e-300, 11)", "n = 1e-300 is strong"]);
     assert!(!long_zeros(&p.stderr, 20), "{}", p.stderr);
 }
+
+/// Finding D50: a landscape at a tolerance its mesh limit cannot reach fails at its first point;
+/// the hint offers the tolerance as well as the node limit, which landscape caps.
+#[test]
+fn d_a_mesh_limit_failure_offers_a_looser_tolerance() {
+    let (dir, toml, data) = probe::shipped_copy("flags_mesh_limit");
+    let out = dir.join("l");
+    let p = probe::rheometer(
+        &[
+            "landscape",
+            s(&toml),
+            "--grid",
+            "3x3",
+            "--tol",
+            "1e-12",
+            "--uniform-tol",
+            "--out",
+            s(&out),
+        ],
+        &[&data],
+        LIMIT,
+    );
+    p.assert_clean_failure(&["--max-nodes", "loosen the tolerance (--tol", "1e-12"]);
+}

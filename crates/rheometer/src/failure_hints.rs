@@ -117,8 +117,8 @@ pub fn hints(
     };
     let non_finite = matches!(root, Some(BvpError::NonFinite { .. }));
     let max_nodes = match (solver, root) {
-        (Some(BvpError::MaxNodesExceeded { max_nodes, .. }), _)
-        | (_, Some(BvpError::MaxNodesExceeded { max_nodes, .. })) => Some(*max_nodes),
+        (Some(BvpError::MaxNodesExceeded { max_nodes, tol, .. }), _)
+        | (_, Some(BvpError::MaxNodesExceeded { max_nodes, tol, .. })) => Some((*max_nodes, *tol)),
         _ => None,
     };
     let (t_in, t_air, t_vf) = (
@@ -137,12 +137,13 @@ pub fn hints(
              shorter one); in the library, SimulateOptions::growth_limit = None lifts the limit"
         ));
     }
-    if let Some(m) = max_nodes {
+    if let Some((m, tol)) = max_nodes {
         out.push(format!(
             "the mesh needed more than {m} nodes: raise the limit with --max-nodes (in the \
-             library the option max_nodes; default 20000, the landscape uses at most 1000), or \
-             check this experiment's inputs (a very thin take-up or strong strain thinning makes \
-             the profiles steep)"
+             library the option max_nodes; default 20000, the landscape uses at most 1000), \
+             loosen the tolerance (--tol; this solve asked for {}), or check this experiment's \
+             inputs (a very thin take-up or strong strain thinning makes the profiles steep)",
+            show(tol)
         ));
     }
     if solver.is_some() && t_in.min(t_air) - t_vf < VFT_MARGIN_K {

@@ -60,6 +60,16 @@ pub enum CompareError {
     /// Unusable input (named).
     #[error("{0}")]
     Data(String),
+    /// An experiment has no take-up condition and none is taken from the data (a workflow
+    /// says which input gives one in its door's words).
+    #[error(
+        "experiment {experiment} has no take-up condition: give take_up_diameter_m or \
+         take_up_velocity_m_s in the TOML, or take it from the data"
+    )]
+    NoTakeUp {
+        /// Experiment name.
+        experiment: String,
+    },
     /// Smoothing an experiment's data (for its take-up diameter) failed.
     #[error("experiment {experiment}: smoothing the measurements failed: {source}")]
     Smoothing {

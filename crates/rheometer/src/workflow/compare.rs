@@ -9,6 +9,7 @@ use crate::effects::{physics_with, Effect, EffectSetting};
 use crate::fit::FitSummary;
 use crate::input::LoadedExperiments;
 use crate::simulate::SimulateOptions;
+use crate::workflow::request::{in_words_of, Door};
 use crate::Physics;
 
 /// What to compare.
@@ -28,6 +29,8 @@ pub struct CompareRequest {
     pub relative_uncertainty: Option<f64>,
     /// BVP settings.
     pub simulate: SimulateOptions,
+    /// The door the request came through: its messages name the inputs in its words.
+    pub door: Door,
 }
 
 impl CompareRequest {
@@ -40,6 +43,7 @@ impl CompareRequest {
             missing_take_up: MissingTakeUp::Error,
             relative_uncertainty: None,
             simulate: SimulateOptions::default(),
+            door: Door::Cli,
         }
     }
 
@@ -105,6 +109,17 @@ pub fn compare(
             options.fit_noise = Some(fit.noise.clone());
         }
     }
-    let runs = simulate_experiments(set, &setup)?;
+    let runs = simulate_experiments(set, &setup).map_err(|e| match e {
+        CompareError::NoTakeUp { experiment } => CompareError::Data(in_words_of(
+            &format!(
+                "experiment {experiment} has no take-up condition: give take_up_diameter_m or \
+                 take_up_velocity_m_s in {}, or take it from the data \
+                 (@take_up_from_data=True@)",
+                data.path.display()
+            ),
+            request.door,
+        )),
+        e => e,
+    })?;
     compare_runs(&runs, set.relative_uncertainty, &options)
 }

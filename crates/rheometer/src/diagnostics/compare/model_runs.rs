@@ -95,13 +95,9 @@ pub fn simulate_experiments(
                         experiment: e.name.clone(),
                         source,
                     },
-                    TakeUpError::Missing | TakeUpError::NoMeasurements => {
-                        CompareError::Data(format!(
-                            "experiment {} has no take-up condition: give take_up_diameter_m \
-                             or take_up_velocity_m_s in the TOML, or take it from the data",
-                            e.name
-                        ))
-                    }
+                    TakeUpError::Missing | TakeUpError::NoMeasurements => CompareError::NoTakeUp {
+                        experiment: e.name.clone(),
+                    },
                 },
             )?;
             if let Some(d) = resolved.from_data {
