@@ -5,9 +5,15 @@ expressions, comments and strings left out), resolved to the file it names, chec
 the Layers section of that crate's src/lib.rs. (That the toolkit never imports the rheometer
 the compiler keeps: `diffbvp` does not depend on `rheometer`.)
 
+The units of the check are the modules the Layers section names: a top-level module
+(`fit`), or a module inside one (`report::format`) when the modules of a folder sit on
+different layers; every module belongs to the longest of them that is a prefix of its path.
+A folder whose modules are listed one by one (`report`) is a unit of none: it only declares
+them and may import nothing.
+
 Checks:
-  1. the Layers section lists every top-level module of the crate (no module missing, none
-     listed that does not exist);
+  1. the Layers section covers every module of the crate (each belongs to a listed unit or is
+     a folder of listed units that imports nothing; none listed that does not exist);
   2. no upward arrow: a module imports only from its own layer or the layers below it;
   3. no circle: no two files import each other, directly or through others;
   4. (report) the import circles between modules of the same layer.
@@ -119,8 +125,8 @@ def resolve(path, here, mods):
 
 
 def layers(src):
-    """{unit: layer} from the Layers section of the crate's src/lib.rs (units are top-level
-    module names)."""
+    """{unit: layer} from the Layers section of the crate's src/lib.rs (units are module paths:
+    `fit`, `report::format`)."""
     text = open(os.path.join(src, "lib.rs"), encoding="utf-8").read()
     doc = "\n".join(l[4:] if l.startswith("//! ") else l[3:] for l in text.splitlines() if l.startswith("//!"))
     sec = doc.split("## Layers", 1)[1].split("\n## ", 1)[0]
@@ -140,8 +146,17 @@ def layers(src):
     return out
 
 
-def unit_of(mod):
-    return mod[:1] if mod else None
+def unit_of(mod, lay):
+    """The longest module path listed in the Layers section that is a prefix of `mod`."""
+    for k in range(len(mod), 0, -1):
+        if mod[:k] in lay:
+            return mod[:k]
+    return None
+
+
+def is_folder(mod, lay):
+    """A module that only holds listed units (`report` when `report::format` is listed)."""
+    return bool(mod) and any(len(u) > len(mod) and u[: len(mod)] == mod for u in lay)
 
 
 def check(crate):
@@ -150,28 +165,44 @@ def check(crate):
     mods = module_files(src)
     lay = layers(src)
     problems = []
-    units = {unit_of(m) for m in mods if unit_of(m)}
-    for u in sorted(units):
-        if u not in lay:
-            problems.append(f"module {'::'.join(u)} is not in the Layers section of {crate}/src/lib.rs")
+    units = {unit_of(m, lay) for m in mods if unit_of(m, lay)}
+    for m in sorted(mods):
+        if m and unit_of(m, lay) is None and not is_folder(m, lay):
+            problems.append(f"module {'::'.join(m)} is not in the Layers section of {crate}/src/lib.rs")
     for u in sorted(lay):
-        if u not in units:
+        if u not in mods:
             problems.append(f"the Layers section lists {'::'.join(u)}, which does not exist")
-    edges = {}
+    edges, to_parent = {}, {}
     for mod, f in mods.items():
         code = strip(open(f, encoding="utf-8").read())
         # test modules may reach anywhere
         code = code.split("#[cfg(test)]", 1)[0]
         for p in paths_of(code):
             t = resolve(p, mod, mods)
-            if t is None or t == mod or (t and mod[: len(t)] == t):
+            if t is None or t == mod:
+                continue
+            if t and mod[: len(t)] == t:
+                # the module's own folder: not a circle, but an upward arrow if the folder is a
+                # unit of a higher layer (`workflow` from `workflow::failure_hints`)
+                if unit_of(t, lay) not in (None, unit_of(mod, lay)):
+                    to_parent.setdefault(mod, set()).add(t)
                 continue
             edges.setdefault(mod, set()).add(t)
-    # upward arrows between units
+    # a folder of units only declares them
     for a, ts in sorted(edges.items()):
-        ua = unit_of(a)
+        if a and unit_of(a, lay) is None and is_folder(a, lay):
+            for b in sorted(ts):
+                problems.append(
+                    f"{'::'.join(a)} is a folder of units in the Layers section but imports {'::'.join(b) or 'crate'}"
+                )
+    # upward arrows between units
+    arrows = {a: set(ts) for a, ts in edges.items()}
+    for a, ts in to_parent.items():
+        arrows.setdefault(a, set()).update(ts)
+    for a, ts in sorted(arrows.items()):
+        ua = unit_of(a, lay)
         for b in sorted(ts):
-            ub = unit_of(b)
+            ub = unit_of(b, lay)
             if ua is None or ub is None or ua == ub:
                 continue
             la, lb = lay.get(ua), lay.get(ub)
