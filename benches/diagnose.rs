@@ -3,9 +3,9 @@
 //! the best grid points)) on the 9 shipped experiments. Target: < 10 s median on 2 cores.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use rheometer::data::input::load_experiments;
 use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions};
-use rheometer::effects::ModelSpec;
-use rheometer::input::load_experiments;
+use rheometer::model::effects::ModelSpec;
 use std::hint::black_box;
 use std::path::Path;
 

@@ -4,9 +4,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use diffbvp::continuation::ContinuationOptions as AdapterOptions;
-use rheometer::cold_start::StepControl;
-use rheometer::setup::{Air, Experiment, Material};
-use rheometer::simulate::simulate_from;
+use rheometer::model::cold_start::StepControl;
+use rheometer::model::setup::{Air, Experiment, Material};
+use rheometer::model::simulate::simulate_from;
 use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions, Simulator};
 use std::hint::black_box;
 

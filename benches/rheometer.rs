@@ -4,8 +4,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use diffbvp::mesh::linspace;
+use rheometer::data::input::load_experiments;
 use rheometer::fit::{Estimator, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments;
 use std::hint::black_box;
 use std::path::Path;
 

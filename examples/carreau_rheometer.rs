@@ -9,9 +9,9 @@
 
 use diffbvp::mesh::linspace;
 use indicatif::{ProgressBar, ProgressStyle};
-use rheometer::figures::{identification_figures, landscape_map};
+use rheometer::data::input::load_experiments;
 use rheometer::fit::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
-use rheometer::input::load_experiments;
+use rheometer::report::figures::{identification_figures, landscape_map};
 use std::path::{Path, PathBuf};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -11,8 +11,8 @@
 
 use std::path::PathBuf;
 
-use rheometer::html_page::{HtmlPage, Table, Tone};
-use rheometer::plot::{
+use rheometer::report::html_page::{HtmlPage, Table, Tone};
+use rheometer::report::plot::{
     flow_curve_svg, panels_svg, save_flow_curve, save_panels, FlowCurvePlot, Panel,
     ReferencePoints, Series,
 };

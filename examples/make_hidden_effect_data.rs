@@ -12,11 +12,11 @@
 //! (`Physics::paper().with_radiation(0.9)`), the true take-up diameters of
 //! `data/pmma7n_synthetic/TRUTH.md`, the same positions. Noise as in that data set:
 //! `d_meas = d_true (1 + 0.015 ξ₁ + sd_extra(s) ξ₂)`, `sd_extra(s) = 0.04 ((s − 0.35)/0.16)²`
-//! for `s > 0.35 m`, with the seeded generator of `rheometer::synthetic`.
+//! for `s > 0.35 m`, with the seeded generator of `rheometer::data::synthetic`.
 
-use rheometer::input::load_experiments;
-use rheometer::setup::Experiment;
-use rheometer::synthetic::{NoiseModel, SplitMix64};
+use rheometer::data::input::load_experiments;
+use rheometer::data::synthetic::{NoiseModel, SplitMix64};
+use rheometer::model::setup::Experiment;
 use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use std::error::Error;
 use std::fmt::Write as _;

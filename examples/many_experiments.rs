@@ -13,10 +13,10 @@
 //! from a SplitMix64 stream seeded with `seed` (default 1). Prints the planned cost, the
 //! progress on stderr, then the estimate with its standard errors and the time of each phase.
 
+use rheometer::data::input::load_experiments;
+use rheometer::data::synthetic::{NoiseModel, SplitMix64};
 use rheometer::fit::{FitProgress, IdentifyOptions, ProgressHook, Rheometer};
-use rheometer::input::load_experiments;
-use rheometer::setup::{ExperimentSet, Measurements};
-use rheometer::synthetic::{NoiseModel, SplitMix64};
+use rheometer::model::setup::{ExperimentSet, Measurements};
 use std::error::Error;
 use std::path::Path;
 use std::time::Instant;

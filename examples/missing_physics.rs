@@ -11,11 +11,11 @@
 //!
 //! `cargo run --release --example missing_physics [-- OUT_DIR]`
 
+use rheometer::data::input::load_experiments_with;
 use rheometer::diagnostics::compare::FigureFormat;
 use rheometer::diagnostics::diagnose::DiagnoseOptions;
-use rheometer::effects::{EffectSetting, ModelSpec};
 use rheometer::fit::IdentifyOptions;
-use rheometer::input::load_experiments_with;
+use rheometer::model::effects::{EffectSetting, ModelSpec};
 use rheometer::workflow::{self, CompareRequest, FitRequest};
 use std::error::Error;
 use std::path::{Path, PathBuf};

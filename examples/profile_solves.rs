@@ -10,9 +10,9 @@
 use diffbvp::mesh::linspace;
 use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{solve, Guess, Solution, SolveOptions};
-use rheometer::effects::{Effect, ModelSpec};
-use rheometer::setup::{Air, Experiment, Material};
-use rheometer::simulate::simulate_from;
+use rheometer::model::effects::{Effect, ModelSpec};
+use rheometer::model::setup::{Air, Experiment, Material};
+use rheometer::model::simulate::simulate_from;
 use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 use std::hint::black_box;
 

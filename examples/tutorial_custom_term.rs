@@ -11,8 +11,8 @@
 #![allow(dead_code)]
 
 use diffbvp::DualNum;
-use rheometer::contributions::STEFAN_BOLTZMANN;
-use rheometer::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use rheometer::model::contributions::STEFAN_BOLTZMANN;
+use rheometer::model::setup::{Air, Experiment, Inlet, Material, TakeUp};
 use rheometer::{
     simulate, Balance, CarreauLike, FiberError, FiberModel, FiberTerm, Physics, Profiles, SiState,
     SimulateOptions,

@@ -2,11 +2,10 @@
 //! refused with the flag and value named before any work starts, and failures of one
 //! experiment's simulation named with the experiment and its TOML line.
 
-use rheometer::design::DesignEstimate;
-use rheometer::effects::Effect;
-use rheometer::failure_hints::ExperimentFailure;
+use rheometer::data::input::{parse_experiments, Location};
 use rheometer::fit::{IdentifyOptions, LandscapeSample};
-use rheometer::input::{parse_experiments, Location};
+use rheometer::model::effects::Effect;
+use rheometer::workflow::failure_hints::ExperimentFailure;
 use std::error::Error;
 use std::path::Path;
 
@@ -206,14 +205,14 @@ pub fn name_experiment(e: Box<dyn Error>, toml: &Path, law: Option<[f64; 2]>) ->
     if e.downcast_ref::<ExperimentFailure>().is_some() {
         return e;
     }
-    let Some((name, _)) = rheometer::failure_hints::failed_experiment(e.as_ref()) else {
+    let Some((name, _)) = rheometer::workflow::failure_hints::failed_experiment(e.as_ref()) else {
         return e;
     };
     let loaded = std::fs::read_to_string(toml)
         .ok()
         .and_then(|text| parse_experiments(&text, toml).ok());
     match loaded {
-        Some(loaded) => rheometer::failure_hints::name_experiment(e, &loaded, toml, law),
+        Some(loaded) => rheometer::workflow::failure_hints::name_experiment(e, &loaded, toml, law),
         None => {
             let unlocated = Location {
                 path: toml.to_path_buf(),
@@ -237,7 +236,14 @@ pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, Refusal> {
 /// wall time the sample took.
 pub fn landscape_estimate(sample: &LandscapeSample, grid: (usize, usize), sample_s: f64) -> String {
     let threads = rayon::current_num_threads().clamp(1, grid.1.max(1));
-    let about = about(sample_s + sample.remaining_s(threads));
+    let t = sample_s + sample.remaining_s(threads);
+    let about = if t < 90.0 {
+        format!("{t:.0} s")
+    } else if t < 5400.0 {
+        format!("{:.0} min", t / 60.0)
+    } else {
+        format!("{:.1} h", t / 3600.0)
+    };
     format!(
         "landscape: {} points on {threads} threads, about {about} (measured on {} of its {} \
          rows, {sample_s:.1} s in all: about {:.2} s per row of {} points)",
@@ -247,34 +253,4 @@ pub fn landscape_estimate(sample: &LandscapeSample, grid: (usize, usize), sample
         sample.row_s(),
         grid.0
     )
-}
-
-/// A duration for people: "16 s", "12 min", "1.5 h".
-fn about(t: f64) -> String {
-    if t < 90.0 {
-        format!("{t:.0} s")
-    } else if t < 5400.0 {
-        format!("{:.0} min", t / 60.0)
-    } else {
-        format!("{:.1} h", t / 3600.0)
-    }
-}
-
-/// What a long design says once its first rows are done (`None` under 10 s left: a short
-/// design says nothing), e.g. "design: 100000 candidates on 2 threads, about 55 s more
-/// (measured on 2 of its 1000 rows: 0.11 s per row of 100 candidates)".
-pub fn design_estimate(e: &DesignEstimate) -> Option<String> {
-    (e.remaining_s >= 10.0).then(|| {
-        format!(
-            "design: {} candidates on {} threads, about {} more (measured on {} of its {} \
-             rows: {:.2} s per row of {} candidates)",
-            e.candidates,
-            e.threads,
-            about(e.remaining_s),
-            e.rows_measured,
-            e.rows,
-            e.measured_s * e.threads as f64 / e.rows_measured.max(1) as f64,
-            e.candidates / e.rows.max(1)
-        )
-    })
 }

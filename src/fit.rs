@@ -1,7 +1,7 @@
 //! `rheometer fit`.
 
 use crate::*;
-use rheometer::fit_html::FIT_REPORT_HTML;
+use rheometer::report::fit_html::FIT_REPORT_HTML;
 use rheometer::workflow::request;
 
 /// Arguments of `rheometer fit`.

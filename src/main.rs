@@ -3,23 +3,23 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
+use rheometer::data::input::{
+    load_experiments_with_options, LoadOptions, LoadedExperiments, DEFAULT_MAX_JSON_BYTES,
+};
 use rheometer::diagnostics::compare::{Comparison, FigureFormat, MissingTakeUp};
 use rheometer::diagnostics::diagnose::{DiagnoseOptions, ResidualProfiles};
 use rheometer::diagnostics::report::save_residual_figure;
-use rheometer::effects::{EffectSetting, LawChoice, ModelSpec};
-use rheometer::failure_hints::ExperimentFailure;
-use rheometer::figures::{self, ExperimentView, ModelCurves, View};
 use rheometer::fit::{
     DataCheck, Estimator, FarRule, FitSummary, IdentifyOptions, LandscapeRun, PointStatus,
     Rheometer,
 };
-use rheometer::flow_curve_figure::save_flow_curve_figure;
-use rheometer::input::{
-    load_experiments_with_options, LoadOptions, LoadedExperiments, DEFAULT_MAX_JSON_BYTES,
-};
-use rheometer::output::write_profiles_csv;
-use rheometer::output_files::{CheckedOutputs, PARTIAL_NAME};
-use rheometer::report_json::{to_report_json, ReportKind};
+use rheometer::model::effects::{EffectSetting, LawChoice, ModelSpec};
+use rheometer::report::figures::{self, ExperimentView, ModelCurves, View};
+use rheometer::report::flow_curve_figure::save_flow_curve_figure;
+use rheometer::report::output::write_profiles_csv;
+use rheometer::report::output_files::{CheckedOutputs, PARTIAL_NAME};
+use rheometer::report::report_json::{to_report_json, ReportKind};
+use rheometer::workflow::failure_hints::ExperimentFailure;
 use rheometer::workflow::request::{self, Door, Refusal};
 use rheometer::workflow::{self, CompareRequest, FitRequest, FitRun};
 use rheometer::{FiberSolution, SimulateOptions};

@@ -3,7 +3,7 @@
 //! marked incomplete (`DIR/PARTIAL.txt`) from its first file to its last.
 
 use crate::*;
-use rheometer::output_files::{CheckedOutputs, OutputPlan, PartialMarker, PARTIAL_NAME};
+use rheometer::report::output_files::{CheckedOutputs, OutputPlan, PartialMarker, PARTIAL_NAME};
 use std::time::SystemTime;
 
 /// A plan whose inputs are the experiments file `toml` and its data files.

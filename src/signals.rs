@@ -115,7 +115,7 @@ fn watchdog(grace: Duration) {
 }
 
 fn end(code: i32, message: &str) -> ! {
-    rheometer::output_files::remove_pending_temporaries();
+    rheometer::report::output_files::remove_pending_temporaries();
     crate::err_line(message);
     std::process::exit(code);
 }

@@ -1,8 +1,8 @@
 //! `rheometer simulate`.
 
 use crate::*;
-use rheometer::setup::ExperimentSet;
-use rheometer::simulate::Profiles;
+use rheometer::model::setup::ExperimentSet;
+use rheometer::model::simulate::Profiles;
 use rheometer::workflow::{SimulateError, SimulateRequest};
 use std::ops::ControlFlow;
 

@@ -14,7 +14,7 @@ the raw relative residuals of the diameters (sigma = 1, so J is the plain sum of
 the `cost` of our JSON), with one take-up diameter per experiment fitted as a nuisance parameter.
 
 The model is the paper's strain-rate formulation at continuation parameter c = 1, written out
-here independently of the Rust code from `crates/rheometer/src/model.rs`, `material_law.rs`,
+here independently of the Rust code from `crates/rheometer/src/model/bvp.rs`, `material_law.rs`,
 `contributions.rs`, `scaling.rs` and `../shared/docs/model-closure.md`: dimensionless states
 (u, N, T, epsdot) on s in [0, L/L_o], gravity, Stokes air drag (delta = 1e-3), convective cooling
 with the regularised inclined Churchill-Bernstein law, viscous heating, still air at 293.15 K,

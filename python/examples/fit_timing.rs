@@ -4,8 +4,8 @@
 //! `cargo run --release -p diffbvp-python --example fit_timing -- [RUNS] [EXPERIMENTS.toml]`
 //! prints one wall time per run (s) and the median, then `n kappa` of the last fit.
 
+use rheometer::data::input::load_experiments_with;
 use rheometer::fit::IdentifyOptions;
-use rheometer::input::load_experiments_with;
 use rheometer::workflow::{fit, FitRequest};
 use rheometer::FiberSolution;
 use std::time::Instant;

@@ -263,7 +263,7 @@ impl ExprProblem {
         }
         // the same cap as a data set's measurement rows (the loader's, one limit for both),
         // checked on the arrays' lengths before anything is copied
-        let cap = rheometer::input::DEFAULT_MAX_ROWS_PER_FILE;
+        let cap = rheometer::data::input::DEFAULT_MAX_ROWS_PER_FILE;
         if data_x.len() > cap {
             return Err(input_error(format!(
                 "data_x: {} observations, more than {cap}; thin the data",

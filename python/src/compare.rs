@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::diagnostics::compare::MissingTakeUp;
 use rheometer::fit::FitSummary;
-use rheometer::report_json::ReportKind;
+use rheometer::report::report_json::ReportKind;
 use rheometer::workflow::request::Door;
 use rheometer::workflow::{self, CompareRequest};
 

@@ -44,13 +44,13 @@ pub fn to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
 /// dict saved from Python is a file the program reads.
 pub fn report_to_py<'py, T: serde::Serialize>(
     py: Python<'py>,
-    kind: rheometer::report_json::ReportKind,
+    kind: rheometer::report::report_json::ReportKind,
     v: &T,
 ) -> PyResult<Bound<'py, PyAny>> {
     let fail = |e: serde_json::Error| {
         crate::errors::diffbvp_error(py, "DiffbvpError", format!("cannot convert a result: {e}"))
     };
-    let text = rheometer::report_json::to_report_json(kind, v).map_err(fail)?;
+    let text = rheometer::report::report_json::to_report_json(kind, v).map_err(fail)?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(fail)?;
     to_py(py, &value)
 }

@@ -6,11 +6,11 @@ use crate::convert::{array1, from_py, vec_f64};
 use crate::errors::{input_error, to_py_err};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use rheometer::input::{
+use rheometer::data::input::{
     load_experiments_with_options, parse_experiments_with, parse_measurements, InputError,
     LoadOptions, LoadedExperiments,
 };
-use rheometer::setup::{Inlet, TakeUp};
+use rheometer::model::setup::{Inlet, TakeUp};
 use rheometer::workflow::request::{self, Door};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -175,19 +175,23 @@ fn build(
             }
             None => match &loaded.details[k].data {
                 Some(file) => Some(
-                    rheometer::input::load_measurements_with(file, e.spinline_length, &options)
-                        .map_err(|err| {
-                            let lift = if matches!(err, InputError::Limit { .. }) {
-                                format!(" ({})", request::lift_caps(Door::Python))
-                            } else {
-                                String::new()
-                            };
-                            input_error(format!(
-                                "{}: experiment \"{}\": {err}{lift}",
-                                path.display(),
-                                e.name
-                            ))
-                        })?,
+                    rheometer::data::input::load_measurements_with(
+                        file,
+                        e.spinline_length,
+                        &options,
+                    )
+                    .map_err(|err| {
+                        let lift = if matches!(err, InputError::Limit { .. }) {
+                            format!(" ({})", request::lift_caps(Door::Python))
+                        } else {
+                            String::new()
+                        };
+                        input_error(format!(
+                            "{}: experiment \"{}\": {err}{lift}",
+                            path.display(),
+                            e.name
+                        ))
+                    })?,
                 ),
                 None => None,
             },

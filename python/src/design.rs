@@ -10,9 +10,9 @@ use crate::run::interruptible;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::design::{Criterion, DesignRequest, DiscriminationRequest};
-use rheometer::effects::Effect;
 use rheometer::fit::{Estimator, IdentifyOptions};
-use rheometer::report_json::ReportKind;
+use rheometer::model::effects::Effect;
+use rheometer::report::report_json::ReportKind;
 use rheometer::workflow::request::{self, DesignRanges};
 use rheometer::workflow::{self, FitRequest};
 

@@ -14,8 +14,8 @@ use crate::run::interruptible;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::diagnostics::diagnose::DiagnoseOptions;
-use rheometer::effects::{Effect, ModelSpec};
-use rheometer::report_json::ReportKind;
+use rheometer::model::effects::{Effect, ModelSpec};
+use rheometer::report::report_json::ReportKind;
 use rheometer::workflow::{
     self,
     request::{self, Arg},

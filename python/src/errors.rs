@@ -6,10 +6,10 @@ use diffbvp::least_squares::FitError;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::types::PyType;
+use rheometer::data::input::{InputError, LoadedExperiments};
 use rheometer::diagnostics::compare::CompareError;
-use rheometer::failure_hints::{failed_experiment, name_experiment, ExperimentFailure};
 use rheometer::fit::RheometerError;
-use rheometer::input::{InputError, LoadedExperiments};
+use rheometer::workflow::failure_hints::{failed_experiment, name_experiment, ExperimentFailure};
 use std::error::Error;
 use std::path::Path;
 

@@ -581,7 +581,7 @@ fn diagnose_refit_top_zero_or_huge_is_refused() {
 #[test]
 fn loaded_experiments_know_their_toml_line() {
     let (_dir, toml, _dd) = probe::shipped_copy("args_lines");
-    let loaded = rheometer::input::load_experiments_with(&toml, 4).unwrap();
+    let loaded = rheometer::data::input::load_experiments_with(&toml, 4).unwrap();
     assert_eq!(loaded.details.len(), loaded.set.experiments.len());
     for (e, d) in loaded.set.experiments.iter().zip(&loaded.details) {
         let want = place(&toml, &e.name);

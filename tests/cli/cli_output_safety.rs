@@ -815,8 +815,8 @@ fn landscape_counts_failed_points_and_warns_when_most_fail() {
 
 #[test]
 fn library_landscape_cancelled_up_front_reaches_no_point() {
+    use rheometer::data::input::load_experiments_with;
     use rheometer::fit::{Estimator, IdentifyOptions, PointStatus, Rheometer};
-    use rheometer::input::load_experiments_with;
     use std::sync::atomic::AtomicBool;
     let (_dir, toml, _data) = shipped_copy("library_cancel");
     let loaded = load_experiments_with(&toml, 4).unwrap();

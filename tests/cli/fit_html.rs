@@ -5,7 +5,7 @@
 #![cfg(unix)]
 
 use crate::probe::{copy_data_set, rheometer, s, scratch, shipped_copy};
-use rheometer::format::{fmt_at, fmt_pm};
+use rheometer::report::format::{fmt_at, fmt_pm};
 use std::fs;
 use std::path::Path;
 use std::time::Duration;

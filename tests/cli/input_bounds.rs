@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use rheometer::input::{
+use rheometer::data::input::{
     estimated_fit_memory_bytes, load_experiments, load_experiments_with_options, InputError, Limit,
     LoadOptions, DEFAULT_MAX_EXPERIMENTS,
 };

@@ -3,10 +3,10 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use rheometer::input::{
+use rheometer::data::input::{
     load_experiments, load_experiments_with, load_measurements, parse_experiments, InputError,
 };
-use rheometer::setup::{Air, ExperimentSet, Inlet, Material, TakeUp};
+use rheometer::model::setup::{Air, ExperimentSet, Inlet, Material, TakeUp};
 
 const SHIPPED: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use rheometer::input::{
+use rheometer::data::input::{
     load_experiments, load_experiments_with, load_experiments_with_options, InputError,
     LoadOptions, MAX_NAME_BYTES,
 };

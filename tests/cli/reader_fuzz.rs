@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
-use rheometer::input::{load_experiments_with, parse_experiments, parse_measurements};
+use rheometer::data::input::{load_experiments_with, parse_experiments, parse_measurements};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/pmma7n_synthetic");
 
@@ -407,7 +407,7 @@ fn loader_survives_mutated_toml_and_csv_files() {
                 Ok(Err(e)) => {
                     let msg = e.to_string();
                     prop_assert!(msg.starts_with(&toml_path.display().to_string()), "{msg:?}");
-                    if let rheometer::input::InputError::Data { cause, .. } = &*e {
+                    if let rheometer::data::input::InputError::Data { cause, .. } = &*e {
                         let cause = cause.to_string();
                         prop_assert!(cause.contains(".csv"), "{cause:?}");
                     }

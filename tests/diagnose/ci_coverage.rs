@@ -19,7 +19,7 @@ use independent::dataset::Scenario;
 use independent::model::AirFlow;
 use independent::scenarios;
 use rheometer::diagnostics::diagnose::DiagnoseOptions;
-use rheometer::effects::Effect;
+use rheometer::model::effects::Effect;
 use std::time::Instant;
 
 /// Seeds per scenario (the scenario's own seed first): 16, or `COVERAGE_SEEDS` from the

@@ -3,11 +3,11 @@
 
 use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{DualNum, Guess, SolveOptions, Solver};
-use rheometer::effects::{
+use rheometer::model::effects::{
     Category, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
 };
-use rheometer::setup::{Air, Experiment, Material};
-use rheometer::simulate::simulate_params;
+use rheometer::model::setup::{Air, Experiment, Material};
+use rheometer::model::simulate::simulate_params;
 use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
 
 fn experiment() -> Experiment {
@@ -163,7 +163,7 @@ fn strength_derivatives_match_finite_differences() {
 
 #[test]
 fn settings_parse_names_and_values() {
-    for name in rheometer::effects::BUILTIN_NAMES {
+    for name in rheometer::model::effects::BUILTIN_NAMES {
         let s: EffectSetting = name.parse().unwrap();
         assert_eq!(s.effect.name(), name);
         assert!(s.value.is_none());

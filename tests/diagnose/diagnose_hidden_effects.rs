@@ -6,11 +6,11 @@
 //! reported 95% CIs. On data without a hidden effect no candidate may earn its place.
 
 use diffbvp::DualNum;
+use rheometer::data::synthetic::{NoiseModel, SplitMix64};
 use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
-use rheometer::effects::{Effect, LawChoice, ModelSpec};
-use rheometer::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
-use rheometer::simulate::simulate_params;
-use rheometer::synthetic::{NoiseModel, SplitMix64};
+use rheometer::model::effects::{Effect, LawChoice, ModelSpec};
+use rheometer::model::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
+use rheometer::model::simulate::simulate_params;
 use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
 
 /// 1.5% white noise plus up to 3% extra near the take-up (aspirator disturbance): 3% at

@@ -105,7 +105,7 @@ fn assert_named_is_credible(r: &DiagnosisRun) {
         .iter()
         .find(|c| &c.effect == named)
         .expect("the named candidate is listed");
-    let effect: rheometer::effects::Effect = named.parse().unwrap();
+    let effect: rheometer::model::effects::Effect = named.parse().unwrap();
     let (plo, phi) = effect.physical_range();
     for a in c.at_bound().iter().filter(|a| &a.parameter == named) {
         let beyond = (a.bound - phi).max(plo - a.bound);
@@ -296,7 +296,7 @@ fn strong_aspirator_coflow_is_found() {
     let r = run(&sc);
     assert_found(&sc, &r);
     let c = &r.diagnosis.candidates[0];
-    let tail = |shape: &[rheometer::diagnostics::scan::ShapeParameter]| {
+    let tail = |shape: &[rheometer::diagnostics::refits::scan::ShapeParameter]| {
         shape.iter().find(|p| p.name == "tail").map(|p| p.value)
     };
     let a = c
@@ -310,7 +310,7 @@ fn strong_aspirator_coflow_is_found() {
     let other_shape: Vec<_> = other
         .shapes
         .iter()
-        .map(|sh| rheometer::diagnostics::scan::ShapeParameter {
+        .map(|sh| rheometer::diagnostics::refits::scan::ShapeParameter {
             name: sh.name.clone(),
             value: sh.value,
             unit: sh.unit.clone(),

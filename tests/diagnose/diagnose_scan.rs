@@ -5,13 +5,13 @@
 //! must be in the diagnosis.
 
 use diffbvp::DualNum;
+use rheometer::data::input::load_experiments;
+use rheometer::data::synthetic::{NoiseModel, SplitMix64};
 use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, StrengthStatus};
-use rheometer::effects::{LawChoice, ModelSpec};
 use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments;
-use rheometer::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
-use rheometer::simulate::simulate_params;
-use rheometer::synthetic::{NoiseModel, SplitMix64};
+use rheometer::model::effects::{LawChoice, ModelSpec};
+use rheometer::model::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
+use rheometer::model::simulate::simulate_params;
 use rheometer::SimulateOptions;
 use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, Physics, SiState};
 
@@ -146,8 +146,8 @@ fn hidden_radiation_fit() -> (ExperimentSet, Rheometer, Identification) {
 /// distance, the bound of their noise floor) and its ΔBIC within 0.1.
 #[test]
 fn the_grid_tolerance_moves_no_refit() {
-    use rheometer::diagnostics::scan::{scan_candidate, CandidateScan, ScanOptions};
-    use rheometer::effects::Effect;
+    use rheometer::diagnostics::refits::scan::{scan_candidate, CandidateScan, ScanOptions};
+    use rheometer::model::effects::Effect;
 
     let (set, rh, base) = hidden_radiation_fit();
     let opts = IdentifyOptions::default();
@@ -185,7 +185,7 @@ fn the_grid_tolerance_moves_no_refit() {
     }
     assert!(compared >= 3, "{compared} grid points near the user's J");
     let (a, b) = (&loose.refits[0], &tight.refits[0]);
-    let strength = |r: &rheometer::diagnostics::scan::Refit| {
+    let strength = |r: &rheometer::diagnostics::refits::scan::Refit| {
         r.identification
             .summary
             .effect("radiation")
@@ -212,10 +212,10 @@ fn the_grid_tolerance_moves_no_refit() {
 #[test]
 fn the_grid_growth_limit_moves_no_refit() {
     use diffbvp::GrowthLimit;
-    use rheometer::diagnostics::scan::{
+    use rheometer::diagnostics::refits::scan::{
         scan_candidate, CandidateScan, ScanOptions, GRID_GROWTH_LIMIT,
     };
-    use rheometer::effects::Effect;
+    use rheometer::model::effects::Effect;
 
     let (_, rh, base) = hidden_radiation_fit();
     let opts = IdentifyOptions::default();

@@ -24,7 +24,7 @@ use crate::shared;
 use independent::dataset::Scenario;
 use independent::scenarios::{self, NOISE_SD};
 use rheometer::diagnostics::diagnose::{DiagnoseOptions, Diagnosis};
-use rheometer::effects::Effect;
+use rheometer::model::effects::Effect;
 
 /// Diagnoses `sc` with the two rival candidates only.
 fn rivals(sc: &Scenario) -> Diagnosis {

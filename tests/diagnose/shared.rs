@@ -7,10 +7,10 @@
 use crate::independent;
 
 use independent::dataset::Scenario;
+use rheometer::data::input::load_experiments;
 use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
-use rheometer::effects::{LawChoice, ModelSpec};
-use rheometer::input::load_experiments;
-use rheometer::setup::ExperimentSet;
+use rheometer::model::effects::{LawChoice, ModelSpec};
+use rheometer::model::setup::ExperimentSet;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;

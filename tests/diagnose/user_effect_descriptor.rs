@@ -13,9 +13,9 @@
 use crate::independent::line_force::LineForce;
 use crate::independent::scenarios::{self, NOISE_SD};
 use diffbvp::DualNum;
+use rheometer::data::input::load_experiments;
 use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions};
-use rheometer::effects::{Category, Effect, EffectDescriptor, LawChoice, ModelSpec};
-use rheometer::input::load_experiments;
+use rheometer::model::effects::{Category, Effect, EffectDescriptor, LawChoice, ModelSpec};
 use rheometer::{Balance, FiberTerm, SiState};
 use std::f64::consts::PI;
 

@@ -3,8 +3,8 @@
 
 use diffbvp::continuation::ContinuationOptions as AdapterOptions;
 use diffbvp::BvpError;
-use rheometer::cold_start::StepControl;
-use rheometer::setup::{Air, Experiment, Material};
+use rheometer::model::cold_start::StepControl;
+use rheometer::model::setup::{Air, Experiment, Material};
 use rheometer::{
     simulate, CarreauLike, FiberError, FiberModel, Physics, SimulateOptions, Simulator,
 };

@@ -1,12 +1,12 @@
 //! Model vs measurement comparison: residual statistics, systematic segments, the CLI's error
 //! paths and the shipped hidden-effect data set.
 
+use rheometer::data::input::load_experiments;
 use rheometer::diagnostics::compare::{
     compare, compare_set, simulate_experiments, CompareOptions, Comparison, ModelSetup,
     NoiseSource, RunsTest, SimulatedExperiment,
 };
-use rheometer::input::load_experiments;
-use rheometer::setup::{ExperimentSet, TakeUp};
+use rheometer::model::setup::{ExperimentSet, TakeUp};
 use rheometer::{Physics, SimulateOptions};
 use std::path::Path;
 use std::process::Command;

@@ -12,13 +12,13 @@ use crate::independent::scenarios::control;
 use crate::independent::solve::diameters;
 use crate::noisy_data::noisy_set;
 use rayon::prelude::*;
+use rheometer::data::input::load_experiments_with;
 use rheometer::design::{
     design_for_estimation, CandidateGrid, CandidateOutcome, Criterion, Design, DesignRequest,
     TakeUpAxis,
 };
 use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments_with;
-use rheometer::setup::{Experiment, ExperimentSet};
+use rheometer::model::setup::{Experiment, ExperimentSet};
 use std::time::Instant;
 
 /// Replicates of each simulated design (≥ 200 for the criterion; `DESIGN_REPLICATES`

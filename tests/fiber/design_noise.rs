@@ -19,14 +19,14 @@ use crate::independent::rng::Rng;
 use crate::independent::scenarios::control;
 use crate::independent::solve::diameters;
 use rayon::prelude::*;
+use rheometer::data::input::load_experiments_with;
 use rheometer::design::estimation::NoiseSource;
 use rheometer::design::{
     design_for_estimation, noise_level, CandidateGrid, CandidateOutcome, Criterion, Design,
     DesignRequest, TakeUpAxis,
 };
 use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments_with;
-use rheometer::setup::{Experiment, ExperimentSet, Measurements};
+use rheometer::model::setup::{Experiment, ExperimentSet, Measurements};
 use std::time::Instant;
 
 const TRUTH: Law = Law {

@@ -22,15 +22,15 @@ use crate::independent::scenarios::with_faults;
 use crate::independent::solve::diameters;
 use crate::noisy_data::noisy_set;
 use rayon::prelude::*;
+use rheometer::data::input::load_experiments_with;
 use rheometer::design::{
     design_for_discrimination, CandidateGrid, Discrimination, DiscriminationRequest, Rival,
     TakeUpAxis,
 };
-use rheometer::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
 use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments_with;
-use rheometer::setup::{Experiment, ExperimentSet};
-use rheometer::simulate::{simulate_params, SimulateOptions};
+use rheometer::model::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::model::setup::{Experiment, ExperimentSet};
+use rheometer::model::simulate::{simulate_params, SimulateOptions};
 use std::time::Instant;
 
 /// True mass flow over the nominal one.

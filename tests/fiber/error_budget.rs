@@ -14,15 +14,15 @@
 
 use crate::probe;
 
-use rheometer::effects::{Effect, EffectSetting, ModelSpec};
+use rheometer::data::input::{load_experiments_with, parse_experiments, LoadedExperiments};
+use rheometer::data::uncertainty::{Origin, Scope, Uncertainties};
 use rheometer::fit::summary::checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 use rheometer::fit::{
     error_budget, ErrorBudget, Identification, IdentifyOptions, Rheometer, SourceStatus,
     WarningCode,
 };
-use rheometer::input::{load_experiments_with, parse_experiments, LoadedExperiments};
-use rheometer::setup::{ExperimentSet, Inlet};
-use rheometer::uncertainty::{Origin, Scope, Uncertainties};
+use rheometer::model::effects::{Effect, EffectSetting, ModelSpec};
+use rheometer::model::setup::{ExperimentSet, Inlet};
 use serde_json::Value;
 use std::path::Path;
 use std::time::Duration;

@@ -1,7 +1,7 @@
 //! Physics checks of the fiber model: alternative formulations, closed forms, balances, limits.
 
 use diffbvp::{Bvp, DualNum, Guess, ResidualScale, SolveOptions};
-use rheometer::setup::{Air, Experiment, Material, TakeUp};
+use rheometer::model::setup::{Air, Experiment, Material, TakeUp};
 use rheometer::{
     simulate, CarreauLike, FiberModel, FiberSolution, Newtonian, Physics, SimulateOptions,
     Strength, ViscosityLaw,
@@ -48,7 +48,7 @@ impl Bvp for ThreeState<'_> {
         r[0] = ya[0] - m.inlet_velocity();
         r[1] = ya[2] - m.inlet_temperature();
         let d_out = match m.take_up() {
-            rheometer::model::DimensionlessTakeUp::Diameter { d_out, .. } => d_out,
+            rheometer::model::bvp::DimensionlessTakeUp::Diameter { d_out, .. } => d_out,
             _ => unreachable!(),
         };
         r[2] = m.diameter(yb[0], m.density(yb[2])) / d_out - 1.0;
@@ -249,7 +249,7 @@ fn profiles_do_not_depend_on_reference_values() {
 
 #[test]
 fn fiber_model_refuses_an_overflowing_inlet_velocity() {
-    use rheometer::setup::{Air, Experiment, Material};
+    use rheometer::model::setup::{Air, Experiment, Material};
     use rheometer::{CarreauLike, FiberModel, Physics};
     let mut e = Experiment::pmma7n_v0p53_p2();
     e.mass_flow = 1e308;

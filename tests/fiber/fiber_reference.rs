@@ -1,8 +1,8 @@
 //! Agreement with the noise-free reference profiles of an independent scipy implementation
 //! (`tests/data/reference_profiles/`, solve_bvp tol 1e-8 with every output point a node).
 
-use rheometer::setup::{Air, Experiment, Material};
-use rheometer::simulate::simulate_from;
+use rheometer::model::setup::{Air, Experiment, Material};
+use rheometer::model::simulate::simulate_from;
 use rheometer::{
     simulate, CarreauLike, FiberModel, Newtonian, Physics, SimulateOptions, ViscosityLaw,
 };

@@ -10,8 +10,8 @@
 
 use crate::probe;
 
+use rheometer::data::input::load_experiments;
 use rheometer::fit::{BoundSide, Estimator, FitSummary, IdentifyOptions, Rheometer, WarningCode};
-use rheometer::input::load_experiments;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -685,7 +685,7 @@ fn diagnose_marks_a_candidate_refit_at_its_bound() {
     }
     let coflow = cands.iter().find(|c| c["effect"] == "air_coflow").unwrap();
     let (lo, hi) = "air_coflow"
-        .parse::<rheometer::effects::Effect>()
+        .parse::<rheometer::model::effects::Effect>()
         .unwrap()
         .bounds();
     let s = coflow["refit"]["effects"]

@@ -8,11 +8,11 @@
 
 use crate::independent::rng::Rng;
 use crate::independent::scenarios;
-use rheometer::effects::LawChoice;
+use rheometer::data::input::{load_experiments_with, LoadedExperiments};
 use rheometer::fit::{BandMethod, FitSummary, IdentifyOptions};
-use rheometer::flow_curve_figure::save_flow_curve_figure;
-use rheometer::format::{fmt_pm, LINE_WIDTH};
-use rheometer::input::{load_experiments_with, LoadedExperiments};
+use rheometer::model::effects::LawChoice;
+use rheometer::report::flow_curve_figure::save_flow_curve_figure;
+use rheometer::report::format::{fmt_pm, LINE_WIDTH};
 use rheometer::workflow::{fit, FitRequest, FitRun};
 use std::path::Path;
 use std::time::Duration;

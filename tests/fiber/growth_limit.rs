@@ -6,9 +6,9 @@
 //! optimum.
 
 use diffbvp::GrowthLimit;
-use rheometer::diagnostics::scan::{ScanOptions, REFINE_GROWTH_LIMIT};
+use rheometer::data::input::load_experiments;
+use rheometer::diagnostics::refits::scan::{ScanOptions, REFINE_GROWTH_LIMIT};
 use rheometer::fit::{Identification, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments;
 use std::path::Path;
 
 fn fit(rh: &Rheometer, limit: Option<GrowthLimit>) -> Identification {

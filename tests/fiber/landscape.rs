@@ -2,8 +2,8 @@
 //! warm starts change the path to a point, not the point's cost), its minimum lies next to the
 //! truth of the synthetic data, and the strongly strain-thinning corner is marked missing.
 
+use rheometer::data::input::load_experiments;
 use rheometer::fit::{Estimator, FarRule, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments;
 use std::path::Path;
 
 #[test]

@@ -3,7 +3,7 @@
 
 use diffbvp::sensitivity::{adjoint_gradient, PointFunction, Sensitivities};
 use diffbvp::{Bvp, DualNum, Guess, LinearSolverKind, Solution, SolveOptions, Solver};
-use rheometer::setup::{Air, Experiment, Material};
+use rheometer::model::setup::{Air, Experiment, Material};
 use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 
 const AGREE: f64 = 1e-12;

@@ -8,9 +8,9 @@
 use crate::independent;
 
 use independent::scenarios;
-use rheometer::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::data::input::load_experiments;
 use rheometer::fit::{Estimator, IdentifyOptions, NestedStart, Rheometer};
-use rheometer::input::load_experiments;
+use rheometer::model::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
 
 #[test]
 fn a_fitted_effect_never_leaves_the_fit_worse_than_without_it() {

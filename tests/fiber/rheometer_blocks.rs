@@ -3,9 +3,9 @@
 //! dense driver lands, for the linear and a robust loss.
 
 use diffbvp::least_squares::{fit, Accuracy, FitOptions, FitResult, LeastSquaresProblem, Loss};
+use rheometer::data::input::load_experiments;
 use rheometer::fit::objective::Objective;
 use rheometer::fit::{Estimator, FitStart, IdentifyOptions, Rheometer, RheometerError};
-use rheometer::input::load_experiments;
 use std::path::Path;
 
 fn rheometer() -> Rheometer {

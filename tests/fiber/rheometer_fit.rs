@@ -1,8 +1,8 @@
 //! Acceptance of the rheometer on the shipped synthetic data (truth (n, κ) = (0.8, 11.71)).
 
+use rheometer::data::input::load_experiments;
+use rheometer::data::synthetic::NoiseModel;
 use rheometer::fit::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
-use rheometer::input::load_experiments;
-use rheometer::synthetic::NoiseModel;
 use std::path::Path;
 
 fn rheometer() -> Rheometer {

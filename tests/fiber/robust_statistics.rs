@@ -6,12 +6,12 @@
 //! the take-up.
 
 use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem, Loss};
+use rheometer::data::input::load_experiments;
+use rheometer::data::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
+use rheometer::data::synthetic::{NoiseModel as SyntheticNoise, SplitMix64};
 use rheometer::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
 use rheometer::fit::{FitSummary, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments;
-use rheometer::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
-use rheometer::setup::{ExperimentSet, TakeUp};
-use rheometer::synthetic::{NoiseModel as SyntheticNoise, SplitMix64};
+use rheometer::model::setup::{ExperimentSet, TakeUp};
 use rheometer::Physics;
 use std::path::Path;
 
@@ -474,7 +474,7 @@ fn the_correct_model_stays_consistent_with_noise_and_outliers_are_reported() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("diffbvp-robust-{}", std::process::id()));
     let written = cmp
-        .write(&dir, rheometer::plot::FigureFormat::Svg, &[])
+        .write(&dir, rheometer::report::plot::FigureFormat::Svg, &[])
         .unwrap();
     let svg = std::fs::read_to_string(dir.join("compare_residuals.svg")).unwrap();
     assert!(svg.contains("outliers (") && svg.contains("pooled trend"));

@@ -1,7 +1,7 @@
 //! Ansatz smoothing (paper eq. 5) on the shipped synthetic data set.
 
-use rheometer::input::load_experiments;
-use rheometer::smoothing::smooth;
+use rheometer::data::input::load_experiments;
+use rheometer::data::smoothing::smooth;
 use std::path::Path;
 
 #[test]

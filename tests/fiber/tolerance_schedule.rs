@@ -3,9 +3,9 @@
 //! accuracy for the final ones. The estimates and their standard errors must not change by
 //! more than 1e-4 of the standard errors against a fit with every solve at the tight tolerance.
 
-use rheometer::effects::{Effect, EffectSetting, ModelSpec};
+use rheometer::data::input::load_experiments;
 use rheometer::fit::{Estimator, Identification, IdentifyOptions, Rheometer};
-use rheometer::input::load_experiments;
+use rheometer::model::effects::{Effect, EffectSetting, ModelSpec};
 use std::path::Path;
 
 fn fit(rh: &Rheometer, loose: Option<f64>) -> Identification {

@@ -4,11 +4,11 @@
 
 use crate::probe;
 
+use rheometer::data::input::{load_experiments_with, LoadedExperiments};
 use rheometer::diagnostics::compare::MissingTakeUp;
 use rheometer::diagnostics::diagnose::DiagnoseOptions;
-use rheometer::effects::ModelSpec;
 use rheometer::fit::{Estimator, FitSummary, IdentifyOptions};
-use rheometer::input::{load_experiments_with, LoadedExperiments};
+use rheometer::model::effects::ModelSpec;
 use rheometer::workflow::{self, CompareRequest, FitRequest, LandscapeRequest, SimulateRequest};
 use rheometer::SimulateOptions;
 use serde_json::Value;

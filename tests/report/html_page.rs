@@ -4,8 +4,8 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use rheometer::html_page::{HtmlError, HtmlPage, Table, Tone};
-use rheometer::plot::{panels_svg, Panel, Series};
+use rheometer::report::html_page::{HtmlError, HtmlPage, Table, Tone};
+use rheometer::report::plot::{panels_svg, Panel, Series};
 
 fn out_dir() -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join("test-html")

@@ -3,7 +3,9 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use rheometer::plot::{save_heatmap, save_panels, Heatmap, Panel, PlotError, Series, Style};
+use rheometer::report::plot::{
+    save_heatmap, save_panels, Heatmap, Panel, PlotError, Series, Style,
+};
 
 fn out_dir() -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join("test-plots")
@@ -500,7 +502,9 @@ fn noise_band_is_shaded_behind_residuals() {
 
 #[test]
 fn flow_curve_figure() {
-    use rheometer::plot::{flow_curve_svg, save_flow_curve, FlowCurvePlot, ReferencePoints};
+    use rheometer::report::plot::{
+        flow_curve_svg, save_flow_curve, FlowCurvePlot, ReferencePoints,
+    };
     let dir = out_dir();
     // a Carreau-type law η = 3η₀ (1 + (λ ε̇)²)^((n−1)/2) sampled over 6 decades
     let (eta0, lambda, n) = (2.0e3, 0.4, 0.55);

@@ -4,7 +4,7 @@
 //! by a default), and `RAYON_NUM_THREADS`, the size of the thread pool, clamped to a number a
 //! machine can run ([`thread_count`]).
 
-use crate::output_files::FIFO_WAIT_VARIABLE;
+use crate::report::output_files::FIFO_WAIT_VARIABLE;
 
 /// A numeric `DIFFBVP_*` variable: its name, range and meaning.
 #[derive(Debug, Clone, Copy)]

@@ -8,15 +8,15 @@
 //! fails); the mass flows run in parallel (rayon). A candidate whose model cannot be built or
 //! solved is reported as infeasible, with the reason.
 
-use super::candidates::{rows_in_order, Candidate, CandidateGrid, DesignEstimate};
+use super::candidates::{Candidate, CandidateGrid};
 use super::criteria::{sandwich, Criterion, Prediction, Reference};
 use super::information::{experiment_information_under, Columns, ExperimentInformation};
+use crate::data::noise_model::NoiseModel;
 use crate::fit::{CarreauFiber, Identification, Rheometer, RheometerError};
 use crate::in_order::CollectInOrder;
-use crate::material_law::CarreauLike;
-use crate::model::FiberModel;
-use crate::noise_model::NoiseModel;
-use crate::simulate::{simulate_params, SimulateOptions};
+use crate::model::bvp::FiberModel;
+use crate::model::material_law::CarreauLike;
+use crate::model::simulate::{simulate_params, SimulateOptions};
 use diffbvp::solution::Solution;
 use diffbvp::solve::{Guess, Solver};
 use rayon::prelude::*;
@@ -391,17 +391,6 @@ pub fn design_for_estimation(
     id: &Identification,
     request: &DesignRequest,
 ) -> Result<Design, RheometerError> {
-    design_for_estimation_with(rh, id, request, &|_| {})
-}
-
-/// [`design_for_estimation`], telling `report` how long the candidates will take once the
-/// first rows are done (see `rows_in_order`).
-pub(crate) fn design_for_estimation_with(
-    rh: &Rheometer,
-    id: &Identification,
-    request: &DesignRequest,
-    report: &(dyn Fn(&DesignEstimate) + Sync),
-) -> Result<Design, RheometerError> {
     let t0 = Instant::now();
     let grid = &request.grid;
     grid.validate().map_err(RheometerError::Data)?;
@@ -464,8 +453,10 @@ pub(crate) fn design_for_estimation_with(
     };
     let all = grid.candidates();
     let nt = grid.take_up.values().len();
-    let mut candidates: Vec<CandidateOutcome> =
-        rows_in_order(&all, nt, |row| ctx.row(row, template), report);
+    let mut candidates: Vec<CandidateOutcome> = all
+        .par_chunks(nt)
+        .flat_map_iter(|row| ctx.row(row, template))
+        .collect();
     let crit = request.criterion;
     for c in &mut candidates {
         c.gain = c
@@ -562,7 +553,11 @@ struct Context<'a> {
 
 impl Context<'_> {
     /// The candidates of one mass flow, in order, each warm-started from the last solved one.
-    fn row(&self, row: &[Candidate], template: &crate::setup::Experiment) -> Vec<CandidateOutcome> {
+    fn row(
+        &self,
+        row: &[Candidate],
+        template: &crate::model::setup::Experiment,
+    ) -> Vec<CandidateOutcome> {
         let mut last: Option<Solution> = None;
         row.iter()
             .map(|c| {
@@ -610,7 +605,7 @@ impl Context<'_> {
 /// start where that fails).
 pub(super) fn candidate_information(
     rh: &Rheometer,
-    exp: &crate::setup::Experiment,
+    exp: &crate::model::setup::Experiment,
     params: &[f64],
     (positions, sigmas): (&[f64], &[f64]),
     columns: &Columns,
@@ -632,7 +627,7 @@ pub(super) fn candidate_information(
 /// `σ_j` (`(τ, σ)` \[-\], see [`experiment_information_under`]).
 fn candidate_information_under(
     rh: &Rheometer,
-    exp: &crate::setup::Experiment,
+    exp: &crate::model::setup::Experiment,
     params: &[f64],
     (positions, sigmas): (&[f64], (&[f64], &[f64])),
     columns: &Columns,

@@ -5,11 +5,11 @@
 //! its global search, and — when refitted — the refit's own [`FitSummary`] (its strength, shapes,
 //! `(n, κ)` with intervals, RMS, at-bound flags): nothing of the refit is copied into the record.
 
-use super::scan::{physical, search_range, Profile, ShapeParameter};
-use crate::effects::Effect;
+use super::refits::scan::{physical, search_range, Profile, ShapeParameter};
 use crate::fit::options::BoundSide;
 use crate::fit::summary::checks::bound_side;
 use crate::fit::{AtBound, Estimate, FitSummary};
+use crate::model::effects::Effect;
 use serde::{Deserialize, Serialize};
 
 /// How many standard errors a strength may lie beyond its physical range and still count as
@@ -136,15 +136,15 @@ pub struct Candidate {
     /// least this convincing (`ΔBIC` at or below this one's) on effect-free data like these
     /// (see `calibrate`; `NaN` where not computed).
     #[serde(
-        default = "crate::serde_nan::nan",
-        deserialize_with = "crate::serde_nan::f64"
+        default = "crate::report::serde_nan::nan",
+        deserialize_with = "crate::report::serde_nan::f64"
     )]
     pub false_alarm: f64,
     /// Share of the excess misfit (the cost above what the noise alone leaves) the effect
     /// removes \[-\] (`NaN` where not computed).
     #[serde(
-        default = "crate::serde_nan::nan",
-        deserialize_with = "crate::serde_nan::f64"
+        default = "crate::report::serde_nan::nan",
+        deserialize_with = "crate::report::serde_nan::f64"
     )]
     pub share_of_excess: f64,
 }

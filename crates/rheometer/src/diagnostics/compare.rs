@@ -5,7 +5,7 @@
 //!
 //! ```no_run
 //! use rheometer::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
-//! use rheometer::input::load_experiments;
+//! use rheometer::data::input::load_experiments;
 //! use rheometer::Physics;
 //! use std::path::Path;
 //! let set = load_experiments(Path::new("data/hidden_radiation/experiments.toml"))?;
@@ -38,18 +38,18 @@ pub(crate) mod model_runs;
 pub(crate) mod segments;
 pub mod summary_text;
 
-pub use crate::statistics::RunsTest;
+pub use crate::data::statistics::RunsTest;
 pub use model_runs::{compare_set, simulate_experiments, MissingTakeUp, ModelSetup};
 pub use segments::{Segment, SegmentOptions, Station};
 
+pub use crate::data::noise_model::{NoiseModel, NoiseOptions, Outlier, ResidualSeries};
+pub use crate::data::noise_summary::{NoiseSource, NoiseSummary};
+use crate::data::smoothing::SmoothingError;
+use crate::data::statistics;
 use crate::error::FiberError;
-pub use crate::noise_model::{NoiseModel, NoiseOptions, Outlier, ResidualSeries};
-pub use crate::noise_summary::{NoiseSource, NoiseSummary};
-use crate::output::{create_output_dir, write_text, OutputError};
-use crate::plot::PlotError;
-use crate::simulate::Profiles;
-use crate::smoothing::SmoothingError;
-use crate::statistics;
+use crate::model::simulate::Profiles;
+use crate::report::output::{create_output_dir, write_text, OutputError};
+use crate::report::plot::PlotError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -94,7 +94,7 @@ pub enum CompareError {
     Plot(#[from] PlotError),
     /// Writing a figure failed.
     #[error(transparent)]
-    Figure(#[from] crate::figures::FigureError),
+    Figure(#[from] crate::report::figures::FigureError),
     /// Serialising the JSON summary failed.
     #[error("cannot serialise the comparison: {0}")]
     Json(#[from] serde_json::Error),
@@ -419,14 +419,14 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
 }
 
 /// Output image format of the figures (the plotting module's).
-pub use crate::plot::FigureFormat;
+pub use crate::report::plot::FigureFormat;
 
 impl Comparison {
     /// The JSON summary (all numbers, per point), stamped as a
-    /// [`ReportKind::Comparison`](crate::report_json::ReportKind::Comparison) report.
+    /// [`ReportKind::Comparison`](crate::report::report_json::ReportKind::Comparison) report.
     pub fn to_json(&self) -> Result<String, CompareError> {
-        Ok(crate::report_json::to_report_json(
-            crate::report_json::ReportKind::Comparison,
+        Ok(crate::report::report_json::to_report_json(
+            crate::report::report_json::ReportKind::Comparison,
             self,
         )?)
     }

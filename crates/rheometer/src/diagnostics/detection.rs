@@ -47,7 +47,7 @@
 //! absolute units and in units of the fit's statistical standard error.
 
 use super::scores::LinearScore;
-use crate::effects::Effect;
+use crate::model::effects::Effect;
 use serde::{Deserialize, Serialize};
 
 /// The one-sided 95 % quantile of the standard normal distribution.

@@ -6,8 +6,8 @@ use super::candidate::{Candidate, Indistinguishable};
 use super::detection::DetectionLimits;
 use super::diagnose::verdict::Verdict;
 use super::ties::Alternative;
-use crate::effects::LawChoice;
 use crate::fit::{FitSummary, Identification, IdentifyOptions};
+use crate::model::effects::LawChoice;
 use diffbvp::least_squares::Loss;
 use serde::{Deserialize, Serialize};
 
@@ -110,18 +110,18 @@ pub struct Diagnosis {
     pub found: Vec<String>,
     /// The best pair of candidates fitted jointly (stage 9b), where one qualifies: it replaces
     /// the forward search's result when better by more than its
-    /// [`replace_margin`](super::pair::PairFound::replace_margin) in `ΔBIC` (`found` then lists
+    /// [`replace_margin`](super::refits::pair::PairFound::replace_margin) in `ΔBIC` (`found` then lists
     /// it), else it is reported beside it (with its fit), and where the two laws disagree the
     /// law is no result.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pair: Option<super::pair::PairFound>,
+    pub pair: Option<super::refits::pair::PairFound>,
     /// The fit with all found effects (fitted jointly), if any was found.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub final_fit: Option<FitSummary>,
     /// For each found effect, whether its strength in the final fit is the same in every
     /// experiment (stage `consistency`; empty where the test cannot be done).
     #[serde(default)]
-    pub consistency: Vec<super::consistency::Consistency>,
+    pub consistency: Vec<super::refits::consistency::Consistency>,
     /// Why the forward search stopped before its last step, where a step failed (the effects
     /// found before it stand; `None` where every step ran).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -298,7 +298,7 @@ impl Diagnosis {
     /// Gross outliers by experiment and position, of the final fit (with the found effects)
     /// where there is one, else of the user's fit: a point that only looks wrong to a model
     /// missing an effect is no outlier.
-    pub fn outliers(&self) -> &[crate::noise_model::Outlier] {
+    pub fn outliers(&self) -> &[crate::data::noise_model::Outlier] {
         self.law_fit()
             .noise
             .model

@@ -6,32 +6,31 @@
 //!   spin line, text/JSON summaries and figures;
 //! * the candidate effects themselves (canonical names, strength parameters, neutral values,
 //!   the model specification a rheometer fit uses) live below the model, in
-//!   [`effects`](crate::effects);
+//!   [`effects`](crate::model::effects);
 //! * [`diagnose`]: the stages of a diagnosis (fit the base, linearise, test the noise,
 //!   search, choose shapes, judge, rank, ties), ranking the candidates by the excess misfit
 //!   they explain;
 //! * [`candidate`]: the record of one candidate and how candidates are judged and ranked;
 //! * [`diagnosis`]: the result of a diagnosis (JSON) and what figures need besides;
 //! * `calibration`: the look-elsewhere calibration of a diagnosis as a value (the null
-//!   distribution of the best `ΔBIC`), computed by the stage `diagnose::calibrate`;
+//!   distribution of the best `ΔBIC`), computed by the stage `diagnose::linear::calibrate`;
 //! * [`report`]: the diagnosis in words and its figures;
 //! * [`detection`]: the detection limit of each candidate (the strength the data would reveal)
 //!   and the shift of `(n, κ)` an effect just below it would cause;
-//! * [`scan`]: the global search of one candidate's strength (and shape): the profile of `J`
-//!   and the refits of its best points;
-//! * [`ties`]: candidates about as consistent with the data as the named one (alternatives);
-//! * `consistency`: whether a fitted effect has one strength in every experiment (a score
-//!   test of the fit; the diagnosis' stage 10 and `fit --with` both use it).
+//! * [`refits`]: the refits behind a diagnosis — [`refits::scan`], the global search of one
+//!   candidate's strength (and shape): the profile of `J` and the refits of its best points;
+//!   [`refits::pair`], two candidates fitted jointly; and `refits::consistency`, whether a
+//!   fitted effect has one strength in every experiment (a score test of the fit; the
+//!   diagnosis' stage 10 and `fit --with` both use it);
+//! * [`ties`]: candidates about as consistent with the data as the named one (alternatives).
 
 pub(crate) mod calibration;
 pub mod candidate;
 pub mod compare;
-pub(crate) mod consistency;
 pub mod detection;
 pub mod diagnose;
 pub mod diagnosis;
-pub mod pair;
+pub mod refits;
 pub mod report;
-pub mod scan;
 pub(crate) mod scores;
 pub mod ties;

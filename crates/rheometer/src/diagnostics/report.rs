@@ -1,13 +1,13 @@
 //! The diagnosis in words, and the before/after residual figure.
 
 use super::candidate::{Candidate, ShapeAlternative};
-use super::consistency::Consistency;
 use super::diagnose::verdict::Verdict;
 use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
-use super::scan::Profile;
+use super::refits::consistency::Consistency;
+use super::refits::scan::Profile;
 use crate::fit::summary::Z95;
-use crate::format::{fmt_at, fmt_g, fmt_pm, unit_suffix};
-use crate::plot::{save_panels, Panel, PlotError, Series};
+use crate::report::format::{fmt_at, fmt_g, fmt_pm, unit_suffix};
+use crate::report::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
 
 mod text;

@@ -14,11 +14,11 @@
 //! material result is robust to the choice. Every effect in a tie but strain thinning can be
 //! checked independently of these data (a process condition, the instrument, the air's speed
 //! or temperature, the fiber's temperature): the check is its descriptor's
-//! [`independent_check`](crate::effects::EffectDescriptor::independent_check), a
+//! [`independent_check`](crate::model::effects::EffectDescriptor::independent_check), a
 //! user-written candidate's included.
 
 use super::candidate::{earns_its_place, Candidate};
-use crate::effects::{Category, Effect, EffectDescriptor};
+use crate::model::effects::{Category, Effect, EffectDescriptor};
 use serde::{Deserialize, Serialize};
 
 /// Default [`DiagnoseOptions::tie_margin`](super::diagnose::DiagnoseOptions::tie_margin): a
@@ -189,7 +189,7 @@ pub fn alternatives_among(
 /// [`independent_check`](EffectDescriptor::independent_check); `None` for strain thinning and
 /// unknown names).
 pub fn independent_check(effect: &str) -> Option<&'static str> {
-    crate::catalog::builtin(effect).and_then(|d| d.independent_check)
+    crate::model::catalog::builtin(effect).and_then(|d| d.independent_check)
 }
 
 /// What else tells explanations apart that no measurement along the line decides: data at
@@ -547,7 +547,7 @@ pub(crate) mod tests {
 
     #[test]
     fn every_effect_but_the_law_has_an_independent_check() {
-        for e in crate::effects::Effect::all() {
+        for e in crate::model::effects::Effect::all() {
             assert_eq!(
                 independent_check(e.name()).is_some(),
                 e.name() != "strain_thinning",

@@ -2,15 +2,15 @@
 //! one fiber model per experiment, and the residuals of a set of solutions against the data.
 
 use super::options::{CarreauFiber, FitWarning, RheometerError, WarningCode};
-use crate::effects::ModelSpec;
-use crate::material_law::CarreauLike;
-use crate::model::FiberModel;
-use crate::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
-use crate::noise_summary::NoiseSummary;
-use crate::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
-use crate::smoothing::{smooth, SmoothFit};
-use crate::statistics::median;
-use crate::take_up::{resolve_take_up, MissingTakeUp};
+use crate::data::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
+use crate::data::noise_summary::NoiseSummary;
+use crate::data::smoothing::{smooth, SmoothFit};
+use crate::data::statistics::median;
+use crate::data::take_up::{resolve_take_up, MissingTakeUp};
+use crate::model::bvp::FiberModel;
+use crate::model::effects::ModelSpec;
+use crate::model::material_law::CarreauLike;
+use crate::model::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
 use diffbvp::solution::Solution;
 
 /// Prepared data: smoothed measurements and one fiber model per experiment.

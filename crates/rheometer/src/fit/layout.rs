@@ -1,5 +1,5 @@
 //! Which model parameters a fit frees: the law's `(n, κ)`, effect strengths (see
-//! [`effects`](crate::effects)) and, for the principled estimator,
+//! [`effects`](crate::model::effects)) and, for the principled estimator,
 //! one take-up factor per experiment.
 //!
 //! Every experiment's model has the same parameter layout
@@ -9,9 +9,9 @@
 //! `nusselt_scale`).
 
 use super::options::{CarreauFiber, IdentifyOptions, RheometerError};
-use crate::effects::{Effect, LawChoice, ModelSpec, ShapeParameter, NEWTONIAN_LAW};
-use crate::material_law::CarreauLike;
-use crate::model::ParamLayout;
+use crate::model::bvp::ParamLayout;
+use crate::model::effects::{Effect, LawChoice, ModelSpec, ShapeParameter, NEWTONIAN_LAW};
+use crate::model::material_law::CarreauLike;
 use diffbvp::solution::Solution;
 
 /// Start of a fit.

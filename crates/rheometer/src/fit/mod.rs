@@ -36,46 +36,29 @@
 //! it and the steps that compute them above it, so that no two files import each other (the
 //! order is in the Layers section of the crate's documentation).
 
-pub(crate) mod accuracy;
-pub(crate) mod budget;
-pub(crate) mod coverage;
-pub(crate) mod curve;
 pub mod data;
-pub(crate) mod error_budget;
 pub mod estimator;
-pub(crate) mod flow_curve;
-pub(crate) mod identification;
 pub(crate) mod identify;
 pub(crate) mod landscape;
 pub(crate) mod layout;
-pub(crate) mod likelihood;
-pub(crate) mod nested;
 pub mod objective;
 pub(crate) mod options;
-pub(crate) mod parameter_shift;
 pub(crate) mod plan;
-pub(crate) mod profile;
 pub mod summary;
-pub(crate) mod thresholds;
+pub(crate) mod uncertainty;
+pub(crate) mod values;
 
-pub use coverage::StrainRateCoverage;
-pub use curve::{BandMethod, FlowCurve, FlowPoint};
 pub use data::Rheometer;
-pub use error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
 pub use estimator::Estimator;
-pub use flow_curve::FlowCurveOptions;
-pub use identification::Identification;
-pub use identify::{StartPoint, PAPER_TABLE3_STARTS};
+pub use identify::gauss_newton::{StartPoint, PAPER_TABLE3_STARTS};
+pub use identify::identification::Identification;
+pub use identify::nested::{NestedFit, NestedStart};
 pub use landscape::{FarRule, Landscape, LandscapeRun, LandscapeSample, PointStatus};
 pub use layout::{EffectSlot, FitStart, Layout, ShapeSlot};
-pub use likelihood::{NewtonianTest, OneSidedBound, ProfileInterval, ProfilePoint, ThinningBound};
-pub use nested::{NestedFit, NestedStart};
 pub use options::{
     BoundSide, CarreauFiber, FitProgress, IdentifyOptions, ProgressHook, RheometerError,
 };
-pub use parameter_shift::ParameterShift;
 pub use plan::FitPlan;
-pub use profile::ProfileMode;
 pub use summary::read::{
     data_digest, ContinuedEffects, DataCheck, FIT_FILE_KAPPA_RANGE, FIT_FILE_N_RANGE,
     FIT_FILE_TAKE_UP_RANGE,
@@ -84,3 +67,12 @@ pub use summary::{
     AtBound, Covariance, EffectEstimate, Estimate, FitSummary, FitWarning, SolverRecord,
     WarningCode,
 };
+pub use uncertainty::error_budget::{error_budget, BudgetEntry, ErrorBudget, SourceStatus};
+pub use uncertainty::flow_curve::FlowCurveOptions;
+pub use uncertainty::profile::ProfileMode;
+pub use values::coverage::StrainRateCoverage;
+pub use values::curve::{BandMethod, FlowCurve, FlowPoint};
+pub use values::likelihood::{
+    NewtonianTest, OneSidedBound, ProfileInterval, ProfilePoint, ThinningBound,
+};
+pub use values::parameter_shift::ParameterShift;

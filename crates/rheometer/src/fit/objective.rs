@@ -10,7 +10,7 @@ use super::layout::{FitStart, Layout};
 use super::options::{CarreauFiber, FitProgress, IdentifyOptions, RheometerError};
 use crate::error::FiberError;
 use crate::in_order::CollectInOrder;
-use crate::simulate::{simulate_params, SimulateOptions, Simulator};
+use crate::model::simulate::{simulate_params, SimulateOptions, Simulator};
 use diffbvp::least_squares::{
     BvpResiduals, BvpRun, Jacobian, LeastSquaresProblem, ParamMap, RunError,
 };

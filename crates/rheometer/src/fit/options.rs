@@ -4,11 +4,11 @@
 //! the Layers section of the crate's documentation.
 
 use super::estimator::Estimator;
+use crate::data::smoothing::SmoothingError;
 use crate::error::FiberError;
-use crate::material_law::CarreauLike;
-use crate::model::FiberModel;
-use crate::simulate::SimulateOptions;
-use crate::smoothing::SmoothingError;
+use crate::model::bvp::FiberModel;
+use crate::model::material_law::CarreauLike;
+use crate::model::simulate::SimulateOptions;
 use diffbvp::least_squares::{FitError, FitIteration, Loss};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -16,7 +16,7 @@ use std::sync::Arc;
 use thiserror::Error;
 
 /// The fiber model the rheometer identifies: Carreau-type law (a Newtonian model is `n = 1`),
-/// the paper's physics plus the effects of its [`ModelSpec`](crate::effects::ModelSpec).
+/// the paper's physics plus the effects of its [`ModelSpec`](crate::model::effects::ModelSpec).
 pub type CarreauFiber = FiberModel<CarreauLike>;
 
 /// What can go wrong in the rheometer.

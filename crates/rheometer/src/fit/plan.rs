@@ -11,7 +11,7 @@ use super::data::Rheometer;
 use super::estimator::Estimator;
 use super::layout::{FitStart, Layout};
 use super::options::{IdentifyOptions, RheometerError};
-use crate::simulate::simulate_params;
+use crate::model::simulate::simulate_params;
 use diffbvp::least_squares::BlockStructure;
 use diffbvp::sensitivity::Sensitivities;
 use std::time::Instant;

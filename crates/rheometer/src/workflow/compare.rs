@@ -1,14 +1,14 @@
 //! The `compare` workflow: the model of a fit (or given law parameters), with effects added or
 //! overridden, simulated for every experiment and compared with the measurements.
 
+use crate::data::input::LoadedExperiments;
 use crate::diagnostics::compare::{
     compare as compare_runs, simulate_experiments, CompareError, CompareOptions, Comparison,
     MissingTakeUp, ModelSetup,
 };
-use crate::effects::{physics_with, Effect, EffectSetting};
 use crate::fit::FitSummary;
-use crate::input::LoadedExperiments;
-use crate::simulate::SimulateOptions;
+use crate::model::effects::{physics_with, Effect, EffectSetting};
+use crate::model::simulate::SimulateOptions;
 use crate::workflow::request::{in_words_of, Door};
 use crate::Physics;
 

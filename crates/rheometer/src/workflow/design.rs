@@ -3,15 +3,14 @@
 //! candidate experiment, the uncertainty after adding it ([`design_for_estimation`]).
 
 use super::fit::{fit, FitRequest, FitRun};
-use crate::design::discrimination::design_for_discrimination_with;
-use crate::design::estimation::design_for_estimation_with;
+use crate::data::input::LoadedExperiments;
 use crate::design::{
-    Design, DesignEstimate, DesignRequest, Discrimination, DiscriminationRequest, Rival,
+    design_for_discrimination, design_for_estimation, Design, DesignRequest, Discrimination,
+    DiscriminationRequest, Rival,
 };
-use crate::effects::{Effect, EffectSetting};
-use crate::fit::profile::ProfileMode;
+use crate::fit::uncertainty::profile::ProfileMode;
 use crate::fit::RheometerError;
-use crate::input::LoadedExperiments;
+use crate::model::effects::{Effect, EffectSetting};
 
 /// The outcome of the `design` workflow.
 #[derive(Debug)]
@@ -29,17 +28,6 @@ pub fn design(
     fit_request: &FitRequest,
     request: &DesignRequest,
 ) -> Result<DesignRun, RheometerError> {
-    design_with_estimate(data, fit_request, request, &|_| {})
-}
-
-/// [`design`], telling `estimate` how long the candidates will take once their first rows
-/// are done (a grid of more than two rows per thread; see [`DesignEstimate`]).
-pub fn design_with_estimate(
-    data: &LoadedExperiments,
-    fit_request: &FitRequest,
-    request: &DesignRequest,
-    estimate: &(dyn Fn(&DesignEstimate) + Sync),
-) -> Result<DesignRun, RheometerError> {
     request.grid.validate().map_err(RheometerError::Data)?;
     let mut fr = fit_request.clone();
     fr.error_budget = false;
@@ -47,8 +35,7 @@ pub fn design_with_estimate(
     fr.baseline = false;
     fr.newtonian_reference = false;
     let run = fit(data, &fr)?;
-    let design =
-        design_for_estimation_with(&run.rheometer, &run.identification, request, estimate)?;
+    let design = design_for_estimation(&run.rheometer, &run.identification, request)?;
     Ok(DesignRun { fit: run, design })
 }
 
@@ -72,18 +59,6 @@ pub fn discriminate(
     fit_request: &FitRequest,
     effects: &[Effect],
     request: &DiscriminationRequest,
-) -> Result<DiscriminationRun, RheometerError> {
-    discriminate_with_estimate(data, fit_request, effects, request, &|_| {})
-}
-
-/// [`discriminate`], telling `estimate` how long the candidates will take once their first
-/// rows are done (see [`DesignEstimate`]).
-pub fn discriminate_with_estimate(
-    data: &LoadedExperiments,
-    fit_request: &FitRequest,
-    effects: &[Effect],
-    request: &DiscriminationRequest,
-    estimate: &(dyn Fn(&DesignEstimate) + Sync),
 ) -> Result<DiscriminationRun, RheometerError> {
     request.grid.validate().map_err(RheometerError::Data)?;
     if effects.len() < 2 {
@@ -122,6 +97,6 @@ pub fn discriminate_with_estimate(
             fit: &f.identification,
         })
         .collect();
-    let design = design_for_discrimination_with(&rivals, request, estimate)?;
+    let design = design_for_discrimination(&rivals, request)?;
     Ok(DiscriminationRun { fits, design })
 }

@@ -3,18 +3,18 @@
 //! the figures need (the Newtonian reference and, for a model with added effects, the same fit
 //! without them).
 
-use crate::catalog::STRAIN_THINNING;
-use crate::diagnostics::consistency;
-use crate::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
-use crate::figures::ResidualView;
-use crate::fit::profile::{intervals, ProfileMode};
+use crate::data::input::LoadedExperiments;
+use crate::diagnostics::refits::consistency;
+use crate::fit::uncertainty::profile::{intervals, ProfileMode};
 use crate::fit::{
     error_budget, FitSummary, FlowCurve, FlowCurveOptions, Identification, IdentifyOptions,
     Rheometer, RheometerError, StartPoint,
 };
-use crate::fit_html::{fit_report_page, FitReportInput, ReportExperiment};
-use crate::html_page::HtmlPage;
-use crate::input::LoadedExperiments;
+use crate::model::catalog::STRAIN_THINNING;
+use crate::model::effects::{LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::report::figures::ResidualView;
+use crate::report::fit_html::{fit_report_page, FitReportInput, ReportExperiment};
+use crate::report::html_page::HtmlPage;
 use diffbvp::solution::Solution;
 
 /// What to fit.

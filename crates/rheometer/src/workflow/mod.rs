@@ -13,7 +13,7 @@
 //! | `design --discriminate` | [`discriminate()`] | [`DiscriminationRun`] (its [`Discrimination`](crate::design::Discrimination)) |
 //!
 //! ```no_run
-//! use rheometer::input::load_experiments_with;
+//! use rheometer::data::input::load_experiments_with;
 //! use rheometer::fit::IdentifyOptions;
 //! use rheometer::workflow::{fit, FitRequest};
 //! use std::path::Path;
@@ -25,23 +25,21 @@
 
 mod compare;
 mod design;
+pub mod failure_hints;
 mod fit;
 pub mod request;
 mod simulate;
 
 pub use compare::{compare, CompareRequest};
-pub use design::{
-    design, design_with_estimate, discriminate, discriminate_with_estimate, DesignRun,
-    DiscriminationRun,
-};
+pub use design::{design, discriminate, DesignRun, DiscriminationRun};
 pub use fit::{fit, FitRequest, FitRun};
 pub use simulate::{simulate_experiments, SimulateError, SimulateRequest, SimulatedProfile};
 
+use crate::data::input::LoadedExperiments;
 use crate::diagnostics::diagnose::{diagnose as run_diagnosis, DiagnoseOptions};
 use crate::diagnostics::diagnosis::DiagnosisRun;
-use crate::effects::ModelSpec;
 use crate::fit::{FarRule, IdentifyOptions, LandscapeRun, Rheometer, RheometerError};
-use crate::input::LoadedExperiments;
+use crate::model::effects::ModelSpec;
 use std::sync::atomic::AtomicBool;
 
 /// Diagnoses which candidate effect is missing from `model` on `data` (see

@@ -6,12 +6,12 @@
 //! ([`Arg::name`]: `--max-nodes` on the command line, `max_nodes` in Python), then the reason,
 //! which is the same text for both.
 
-use crate::effects::Effect;
-use crate::fit::landscape::LANDSCAPE_MAX_NODES;
-use crate::fit::IdentifyOptions;
-use crate::input::{
+use crate::data::input::{
     max_fit_rows, show_count, LoadOptions, LoadedExperiments, MAX_PLAUSIBLE_DIAMETER_M,
 };
+use crate::fit::landscape::LANDSCAPE_MAX_NODES;
+use crate::fit::IdentifyOptions;
+use crate::model::effects::Effect;
 use diffbvp::least_squares::Loss;
 use std::fmt;
 
@@ -222,7 +222,7 @@ impl fmt::Display for Refusal {
 
 impl std::error::Error for Refusal {}
 
-pub use crate::format::show;
+pub use crate::report::format::show;
 
 /// The caps of the loader as a request sets them: `base`, or none at all with the override
 /// every door offers (`--allow-large-inputs` on the command line, `allow_large_inputs=True`
@@ -254,7 +254,7 @@ pub fn lift_caps(door: Door) -> &'static str {
 /// The message of a loader's error in `door`'s words: an exceeded cap (also of a data
 /// file) says how that door lifts the caps (`... (on the command line:
 /// --allow-large-inputs)`); any other error as it is.
-pub fn input_message(e: &crate::input::InputError, door: Door) -> String {
+pub fn input_message(e: &crate::data::input::InputError, door: Door) -> String {
     match e.exceeded_limit() {
         Some(_) => format!("{e} ({})", lift_caps(door)),
         None => e.to_string(),
@@ -694,10 +694,10 @@ pub fn design_grid(
     ranges: &DesignRanges,
     loaded: &LoadedExperiments,
 ) -> Result<crate::design::CandidateGrid, Refusal> {
+    use crate::data::input::PLAUSIBLE_RANGES;
+    use crate::data::take_up::{resolve_take_up, MissingTakeUp};
     use crate::design::{CandidateGrid, TakeUpAxis};
-    use crate::input::PLAUSIBLE_RANGES;
-    use crate::setup::TakeUp;
-    use crate::take_up::{resolve_take_up, MissingTakeUp};
+    use crate::model::setup::TakeUp;
     let set = &loaded.set;
     let names = || {
         set.experiments
@@ -835,7 +835,7 @@ pub fn rivals(effects: Vec<Effect>) -> Result<Vec<Effect>, Refusal> {
             format!(
                 "give at least two rival effects (e.g. mass_flow_scale,nusselt_scale); the \
                  effects are {}",
-                crate::effects::ALL_NAMES.join(", ")
+                crate::model::effects::ALL_NAMES.join(", ")
             ),
         ));
     }

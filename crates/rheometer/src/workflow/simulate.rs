@@ -4,12 +4,12 @@
 //! and stopped experiment by experiment), optionally with the exact sensitivities of the
 //! profiles ([`profile_sensitivities`]).
 
-use crate::effects::{physics_with, Effect};
-use crate::failure_hints::ExperimentFailure;
-use crate::input::{LoadedExperiments, Location};
-use crate::profile_sensitivities::{profile_sensitivities, ProfileSensitivities};
-use crate::simulate::{simulate, Profiles, SimulateOptions};
-use crate::take_up::{resolve_take_up, MissingTakeUp, TakeUpError};
+use crate::data::input::{LoadedExperiments, Location};
+use crate::data::take_up::{resolve_take_up, MissingTakeUp, TakeUpError};
+use crate::model::effects::{physics_with, Effect};
+use crate::model::profile_sensitivities::{profile_sensitivities, ProfileSensitivities};
+use crate::model::simulate::{simulate, Profiles, SimulateOptions};
+use crate::workflow::failure_hints::ExperimentFailure;
 use crate::{CarreauLike, FiberModel};
 use std::fmt;
 use std::ops::ControlFlow;

@@ -2,11 +2,13 @@
 //! residuals against the local strain rate, temperature and speed.
 
 use super::{CompareError, Comparison, FigureFormat};
-use crate::figures::{experiment_panel_pages, panel_page_names, ExperimentView, ModelCurves, View};
-use crate::output::ensure_not_input;
-use crate::plot::{save_panels, Panel, Series};
-use crate::simulate::Profiles;
-use crate::statistics::median;
+use crate::data::statistics::median;
+use crate::model::simulate::Profiles;
+use crate::report::figures::{
+    experiment_panel_pages, panel_page_names, ExperimentView, ModelCurves, View,
+};
+use crate::report::output::ensure_not_input;
+use crate::report::plot::{save_panels, Panel, Series};
 use std::path::{Path, PathBuf};
 
 fn grid_size(panels: usize, columns: usize) -> (u32, u32) {
@@ -60,7 +62,7 @@ pub fn figure_names(experiments: usize, format: FigureFormat) -> Vec<String> {
 /// * `compare_diameters.EXT`: measured and simulated diameters per experiment (µm);
 /// * `compare_inverse_d2.EXT`: `1/d²` measured and simulated per experiment (1/mm²);
 ///   (both split into `NAME_1.EXT`, `NAME_2.EXT`, … beyond
-///   [`MAX_PANELS_PER_FIGURE`](crate::figures::MAX_PANELS_PER_FIGURE) experiments);
+///   [`MAX_PANELS_PER_FIGURE`](crate::report::figures::MAX_PANELS_PER_FIGURE) experiments);
 /// * `compare_residuals.EXT`: relative residual vs `s`, per experiment, with the noise model's
 ///   `±2σ(s/L)` band (varying along the line; plus the given `±2σ` if one was given), the
 ///   pooled trend across experiments (median of the residuals in bins of `s/L`, outliers left

@@ -2,14 +2,14 @@
 //! conditions (from the data set, from the smoothed data, or as fitted) and the physics.
 
 use super::{compare, CompareError, CompareOptions, Comparison, SimulatedExperiment};
+pub use crate::data::take_up::MissingTakeUp;
+use crate::data::take_up::{resolve_take_up, TakeUpError};
 use crate::fit::FitSummary;
 use crate::in_order::CollectInOrder;
-use crate::material_law::CarreauLike;
-use crate::model::FiberModel;
-use crate::setup::ExperimentSet;
-use crate::simulate::{simulate_params, SimulateOptions};
-pub use crate::take_up::MissingTakeUp;
-use crate::take_up::{resolve_take_up, TakeUpError};
+use crate::model::bvp::FiberModel;
+use crate::model::material_law::CarreauLike;
+use crate::model::setup::ExperimentSet;
+use crate::model::simulate::{simulate_params, SimulateOptions};
 use crate::Physics;
 use diffbvp::mesh::linspace;
 use rayon::prelude::*;

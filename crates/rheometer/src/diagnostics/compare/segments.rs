@@ -112,7 +112,7 @@ fn stations_of(experiments: &[(Vec<f64>, Vec<f64>)], sigma: f64) -> Vec<(Station
         .flat_map(|(s, _)| s.windows(2).map(|w| w[1] - w[0]))
         .filter(|h| *h > 0.0)
         .collect();
-    let tol = 0.5 * crate::statistics::median(&mut spacings);
+    let tol = 0.5 * crate::data::statistics::median(&mut spacings);
     let tol = if tol.is_finite() { tol } else { 0.0 };
     let mut pts: Vec<Point> = experiments
         .iter()

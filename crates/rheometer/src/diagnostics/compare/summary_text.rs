@@ -213,6 +213,6 @@ impl Comparison {
                 let _ = writeln!(s, "      {}", segment_line(seg, 1, &names, false));
             }
         }
-        crate::format::wrap_long_lines(&s)
+        crate::report::format::wrap_long_lines(&s)
     }
 }

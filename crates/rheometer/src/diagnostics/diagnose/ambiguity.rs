@@ -9,7 +9,7 @@
 //!   strength lies outside its physical range or at a search bound — a fit as good, which only
 //!   the range's prior excludes;
 //! * a pair of candidates fitted jointly within the look-elsewhere margin (see
-//!   [`pair`](crate::diagnostics::pair)).
+//!   [`pair`](crate::diagnostics::refits::pair)).
 //!
 //! Where every rival's law agrees with the result's (each estimate inside the other's 95 %
 //! interval, [`laws_disagree`]), the choice does not matter for the law. Where one disagrees,
@@ -28,7 +28,7 @@
 use super::verdict::Verdict;
 use super::DiagnoseOptions;
 use crate::diagnostics::candidate::{Candidate, StrengthStatus};
-use crate::diagnostics::pair::{disagreement, law_envelope_of, laws_disagree, PairFound};
+use crate::diagnostics::refits::pair::{disagreement, law_envelope_of, laws_disagree, PairFound};
 use crate::fit::{FitSummary, FitWarning, WarningCode};
 
 /// A rival explanation: its effects, whether its strengths are credible, and its fit.

@@ -1,16 +1,16 @@
 //! Stage 1: the setting of a diagnosis and the user's fit.
 
 use super::DiagnoseOptions;
+use crate::data::noise_summary::NoiseSummary;
 use crate::diagnostics::diagnosis::RobustWeights;
-use crate::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
-use crate::fit::identification::WarmFit;
+use crate::fit::identify::identification::WarmFit;
 use crate::fit::summary::checks::check_misfit;
 use crate::fit::WarningCode;
 use crate::fit::{
     Estimator, FitStart, Identification, IdentifyOptions, Layout, Rheometer, RheometerError,
 };
-use crate::noise_summary::NoiseSummary;
-use crate::setup::ExperimentSet;
+use crate::model::effects::{Effect, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA};
+use crate::model::setup::ExperimentSet;
 use diffbvp::least_squares::Loss;
 use std::sync::Arc;
 

@@ -2,16 +2,16 @@
 //! strength (and shape) is credible, where along the line it changes the residuals, and the
 //! other shape the data cannot rule out.
 
-use super::linearise::Linearisation;
+use super::linear::linearise::Linearisation;
+use super::linear::signature::{named_residuals, signature_location};
 use super::shapes::Choice;
-use super::signature::{named_residuals, signature_location};
 use crate::diagnostics::candidate::{
     strength_status, unbounded_optimum, Candidate, ShapeAlternative, StrengthStatus,
 };
 use crate::diagnostics::diagnosis::ResidualProfiles;
-use crate::effects::Effect;
 use crate::fit::summary::checks::law_jump;
 use crate::fit::{FitSummary, Identification, WarningCode};
+use crate::model::effects::Effect;
 
 /// Fills `record` from its chosen refit (`variant` the shape variant it belongs to) and the
 /// other shape's refit; returns the refit's identification.

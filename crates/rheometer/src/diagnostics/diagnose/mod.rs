@@ -5,8 +5,8 @@
 //!    take-up diameters fitted): the paper's smoothed-data estimator leaves residuals ~1.4× the
 //!    noise even for a correct model, which would mask missing physics. The candidates are
 //!    carried in the model at neutral strength (which reproduces the user's model exactly).
-//! 2. **Linearise** (`linearise`): each candidate's exact sensitivity direction at the fit
-//!    (one sensitivity solve per experiment, reusing the factorisation of the last Newton step,
+//! 2. **Linearise** (`linear::linearise`): each candidate's exact sensitivity direction at the
+//!    fit (one sensitivity solve per experiment, reusing the factorisation of the last Newton step,
 //!    gives all of them), orthogonalised against the fitted parameters' directions; its
 //!    projection of the residual is the cost it would remove to first order
 //!    (`scores`).
@@ -31,7 +31,7 @@
 //! 7. **Rank** ([`rank_order`]): credible refits by `ΔBIC`, then the others. A candidate earns
 //!    its place when `ΔBIC` is below [`DiagnoseOptions::earn_threshold`] (−10: "very strong"
 //!    evidence on the Kass–Raftery scale) and its strength is credible.
-//!    The false-alarm probability of each refit (`calibrate`: how often the search over all
+//!    The false-alarm probability of each refit (`linear::calibrate`: how often the search over all
 //!    candidates and shapes finds an effect at least that convincing on effect-free data like
 //!    the user's) must be at most [`DiagnoseOptions::max_false_alarm`] (5 %), and the effect
 //!    must remove at least half the excess misfit ([`verdict`]).
@@ -43,7 +43,7 @@
 //!    noise, it is added to the model (strength and shapes fitted jointly with the law) and the
 //!    search runs again over the remaining candidates, at most
 //!    [`DiagnoseOptions::max_effects`] effects in all. Then, wherever there is something to
-//!    explain, every pair of refitted candidates is fitted jointly (`pairs`, [`PairFound`](super::pair::PairFound)): two effects
+//!    explain, every pair of refitted candidates is fitted jointly (`pairs`, [`PairFound`](super::refits::pair::PairFound)): two effects
 //!    that hide each other (warm air heating where radiation cools) each explain little
 //!    alone, and a third effect can mimic their sum with a biased law. A pair clearly better
 //!    by `ΔBIC` (beyond a margin corrected for the pairs tried) replaces the forward search's
@@ -62,26 +62,24 @@
 
 mod ambiguity;
 mod base;
-pub(crate) mod calibrate;
 mod judge;
-mod linearise;
+mod linear;
 mod pairs;
 mod search;
 mod shapes;
-mod signature;
 mod step;
 pub mod verdict;
 
-use super::consistency;
-use super::scan::ScanOptions;
+use super::refits::consistency;
+use super::refits::scan::ScanOptions;
 use super::ties::DEFAULT_TIE_MARGIN;
-use crate::diagnostics::scan::refitted_effect;
-use crate::effects::{Effect, EffectSetting, ModelSpec};
+use crate::data::noise_summary::NoiseSummary;
+use crate::diagnostics::refits::scan::refitted_effect;
 use crate::fit::{
     Estimator, FitWarning, Identification, IdentifyOptions, RheometerError, WarningCode,
 };
-use crate::noise_summary::NoiseSummary;
-use crate::setup::ExperimentSet;
+use crate::model::effects::{Effect, EffectSetting, ModelSpec};
+use crate::model::setup::ExperimentSet;
 use std::time::Instant;
 use verdict::{Help, Verdict};
 
@@ -145,7 +143,7 @@ impl Default for DiagnoseOptions {
             start: None,
             start_strengths: Vec::new(),
             max_false_alarm: MAX_FALSE_ALARM,
-            calibration_replicates: calibrate::DEFAULT_REPLICATES,
+            calibration_replicates: linear::calibrate::DEFAULT_REPLICATES,
             max_effects: 2,
         }
     }
@@ -226,8 +224,14 @@ pub fn diagnose(
             _ => Vec::new(),
         };
         pairs::search(set, base_spec, options, &steps[0], &settled).and_then(|(p, id)| {
-            crate::diagnostics::pair::against_steps(p, dbic, fit, options.tie_margin, &id.summary)
-                .map(|p| (p, id))
+            crate::diagnostics::refits::pair::against_steps(
+                p,
+                dbic,
+                fit,
+                options.tie_margin,
+                &id.summary,
+            )
+            .map(|p| (p, id))
         })
     } else {
         None
@@ -244,7 +248,7 @@ pub fn diagnose(
 /// their fit flags as gross outliers (the report lists those on their own).
 fn without_outliers(
     profiles: &[(Vec<f64>, Vec<f64>)],
-    noise: &crate::noise_summary::NoiseSummary,
+    noise: &crate::data::noise_summary::NoiseSummary,
 ) -> Vec<(Vec<f64>, Vec<f64>)> {
     profiles
         .iter()
@@ -285,7 +289,12 @@ fn steps_result(steps: &[step::Step]) -> (f64, Option<&crate::fit::FitSummary>) 
         .filter_map(|s| s.named_candidate().map(|c| c.extra_parameters))
         .sum();
     let n = first.base.fit.num_residuals() as f64;
-    let dbic = crate::diagnostics::pair::delta_bic(n, first.base.summary.cost, fit.summary.cost, k);
+    let dbic = crate::diagnostics::refits::pair::delta_bic(
+        n,
+        first.base.summary.cost,
+        fit.summary.cost,
+        k,
+    );
     (dbic, Some(&fit.summary))
 }
 
@@ -294,7 +303,7 @@ fn steps_result(steps: &[step::Step]) -> (f64, Option<&crate::fit::FitSummary>) 
 fn assemble(
     set: &ExperimentSet,
     mut steps: Vec<step::Step>,
-    pair: Option<(crate::diagnostics::pair::PairFound, Identification)>,
+    pair: Option<(crate::diagnostics::refits::pair::PairFound, Identification)>,
     options: &DiagnoseOptions,
     t0: Instant,
 ) -> DiagnosisRun {
@@ -386,8 +395,8 @@ fn assemble(
             named: s.named_candidate().map(|c| c.effect.clone()),
         })
         .collect();
-    let residuals_before = signature::named_residuals(&first.base);
-    let residuals_after = final_id.as_ref().map(signature::named_residuals);
+    let residuals_before = linear::signature::named_residuals(&first.base);
+    let residuals_after = final_id.as_ref().map(linear::signature::named_residuals);
     DiagnosisRun {
         diagnosis: Diagnosis {
             model: first.spec.law,

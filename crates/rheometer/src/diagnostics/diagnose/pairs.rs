@@ -21,20 +21,20 @@
 //! that optimum and judged as above (most pairs fail the screen, so few pay for full accuracy).
 //!
 //! The kept pair with the lowest `ΔBIC` (against the user's model) is judged against the
-//! forward search's result by [`against_steps`](crate::diagnostics::pair): it replaces
+//! forward search's result by [`against_steps`](crate::diagnostics::refits::pair): it replaces
 //! it only beyond a margin corrected for the pairs tried, and within it a disagreeing law is
 //! no result.
 
 use super::step::Step;
 use super::DiagnoseOptions;
 use crate::diagnostics::candidate::{strength_status, Candidate, StrengthStatus};
-use crate::diagnostics::pair::delta_bic;
-use crate::diagnostics::pair::PairFound;
-use crate::effects::{Effect, EffectSetting, ModelSpec};
+use crate::diagnostics::refits::pair::delta_bic;
+use crate::diagnostics::refits::pair::PairFound;
 use crate::fit::{
     FitStart, FitSummary, Identification, IdentifyOptions, Rheometer, RheometerError,
 };
-use crate::setup::ExperimentSet;
+use crate::model::effects::{Effect, EffectSetting, ModelSpec};
+use crate::model::setup::ExperimentSet;
 use diffbvp::least_squares::Loss;
 use diffbvp::solve::GrowthLimit;
 use rayon::prelude::*;

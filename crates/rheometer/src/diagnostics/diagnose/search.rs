@@ -3,13 +3,13 @@
 //! strength (and fitted shapes) freed ([`refine`]) — all jobs in parallel.
 
 use super::base::Context;
-use super::linearise::Linearisation;
+use super::linear::linearise::Linearisation;
 use crate::diagnostics::candidate::Candidate;
-use crate::diagnostics::scan::{
+use crate::diagnostics::refits::scan::{
     refine, scan_profile, shape_variants, GridStart, ProfileScan, Refit, ShapeParameter,
 };
-use crate::effects::{Effect, LawChoice};
 use crate::fit::{Identification, RheometerError};
+use crate::model::effects::{Effect, LawChoice};
 use rayon::prelude::*;
 
 /// The scans that started, each with its candidate's index.

@@ -3,10 +3,10 @@
 //! better by more than the tie margin — and the other one where the data cannot choose.
 
 use super::base::Context;
-use super::linearise::Linearisation;
+use super::linear::linearise::Linearisation;
 use super::search::{discrete_shapes_at_defaults, Refined, Scans};
-use crate::diagnostics::scan::Refit;
-use crate::effects::Effect;
+use crate::diagnostics::refits::scan::Refit;
+use crate::model::effects::Effect;
 
 /// A candidate's chosen refit with the variant it belongs to.
 pub(crate) type Choice = (Effect, Refit);

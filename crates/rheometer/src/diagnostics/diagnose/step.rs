@@ -2,11 +2,11 @@
 //! the effects found so far), ending in the ranked candidates and the one it names.
 
 use super::base::Context;
-use super::calibrate::{calibrate, Calibration};
-use super::linearise::{self, Linearisation};
+use super::linear::calibrate::{calibrate, Calibration};
+use super::linear::linearise::{self, Linearisation};
+use super::linear::signature;
 use super::search;
 use super::shapes;
-use super::signature;
 use super::verdict::{noise_cost, share_of_excess, MIN_SHARE_OF_EXCESS};
 use super::{judge, DiagnoseOptions};
 use crate::diagnostics::candidate::{earns_its_place, rank_order, Candidate, Indistinguishable};
@@ -14,9 +14,9 @@ use crate::diagnostics::detection::{detection_limits, DetectionContext, Detectio
 use crate::diagnostics::diagnosis::{RobustWeights, StageTimes};
 use crate::diagnostics::scores::cosine;
 use crate::diagnostics::ties::{alternatives_among, Alternative};
-use crate::effects::{Effect, ModelSpec};
 use crate::fit::{Estimate, Identification, IdentifyOptions, ParameterShift, RheometerError};
-use crate::setup::ExperimentSet;
+use crate::model::effects::{Effect, ModelSpec};
+use crate::model::setup::ExperimentSet;
 use std::time::Instant;
 
 /// Largest false-alarm probability of the search at which an effect may be named.

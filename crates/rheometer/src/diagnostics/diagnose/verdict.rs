@@ -15,15 +15,15 @@
 //!   `consistency`): they stand in for something else.
 //! * Where a candidate within the tie margin of the result (credible, or refused only for a
 //!   strength outside its physical range or at a search bound), or a pair of candidates fitted
-//!   jointly within the look-elsewhere margin (see [`pair`](crate::diagnostics::pair)),
+//!   jointly within the look-elsewhere margin (see [`pair`](crate::diagnostics::refits::pair)),
 //!   explains the data about as well with a law outside the result's intervals, the verdict
 //!   is "ambiguous":
 //!   the data cannot tell the explanations apart, and the law is not a result (the range all
 //!   span is given; see the stage `ambiguity`).
 
+use crate::data::noise_summary::NoiseSummary;
 use crate::diagnostics::compare::segments::{find_segments, Segment, SegmentOptions};
 use crate::fit::FitSummary;
-use crate::noise_summary::NoiseSummary;
 use serde::{Deserialize, Serialize};
 
 /// Share of the excess misfit an effect must remove to be named \[-\].
@@ -112,7 +112,7 @@ pub enum Verdict {
         /// differs between the experiments (stage `consistency`): stand-ins for an effect none
         /// of the candidates describes (empty where the residuals are not at the noise).
         #[serde(default)]
-        stand_ins: Vec<crate::diagnostics::consistency::Consistency>,
+        stand_ins: Vec<crate::diagnostics::refits::consistency::Consistency>,
     },
 }
 

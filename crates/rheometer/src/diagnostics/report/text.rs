@@ -8,7 +8,7 @@ use super::{
     shape_alternative_line, unit_suffix, EXACT_TIE,
 };
 use crate::fit::FitSummary;
-use crate::format::{fmt_g, wrap_long_lines};
+use crate::report::format::{fmt_g, wrap_long_lines};
 
 impl Diagnosis {
     /// The report in words.
@@ -58,8 +58,8 @@ impl Diagnosis {
         s.push_str(&format!(
             "[[Diagnosis: which effect is missing from the {} model?]]\n",
             match self.model {
-                crate::effects::LawChoice::Newtonian => "Newtonian",
-                crate::effects::LawChoice::Carreau => "Carreau-type",
+                crate::model::effects::LawChoice::Newtonian => "Newtonian",
+                crate::model::effects::LawChoice::Carreau => "Carreau-type",
             }
         ));
         s.push_str(&format!(
@@ -284,7 +284,10 @@ impl Diagnosis {
                 s.push_str(&format!(
                     "WARNING: {}. A measurement that separates the effects (the air temperature \
                      along the line, the fiber temperature, the throughput) decides.\n",
-                    crate::diagnostics::pair::disagreement(f, &[(p.effects.join(" + "), pf)])
+                    crate::diagnostics::refits::pair::disagreement(
+                        f,
+                        &[(p.effects.join(" + "), pf)]
+                    )
                 ));
             }
         }

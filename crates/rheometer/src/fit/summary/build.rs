@@ -1,7 +1,7 @@
 //! Building a [`FitSummary`] from an identification: the named estimates with their
 //! uncertainties, the covariance in reported units, the estimates at a bound, and the checks.
 
-use crate::effects::LawChoice;
+use crate::data::noise_summary::NoiseSummary;
 use crate::fit::estimator::Estimator;
 use crate::fit::layout::EffectSlot;
 use crate::fit::options::FitWarning;
@@ -9,7 +9,7 @@ use crate::fit::summary::checks::{self, bound_side};
 use crate::fit::summary::{
     AtBound, BoundSide, Covariance, EffectEstimate, Estimate, FitSummary, SolverRecord,
 };
-use crate::noise_summary::NoiseSummary;
+use crate::model::effects::LawChoice;
 use diffbvp::least_squares::{BlockCovariance, FitResult};
 use nalgebra::DMatrix;
 

@@ -6,7 +6,7 @@
 //!   range, and the normal-approximation interval is not valid: its `ci95` is `NaN` (`null` in
 //!   JSON) and the text prints no interval for it.
 //! * **Misfit far above the noise.** The RMS relative residual is compared with the fit's one
-//!   noise level ([`NoiseSummary`](crate::noise_summary::NoiseSummary): declared, else
+//!   noise level ([`NoiseSummary`](crate::data::noise_summary::NoiseSummary): declared, else
 //!   estimated by the noise model). Above [`MISFIT_RATIO`] times the noise the report warns and
 //!   names the worst experiments.
 //! * **Huge standard errors**: `SE(n) >` [`LARGE_STDERR_N`], `SE(κ) >` [`LARGE_STDERR_KAPPA`],
@@ -27,12 +27,12 @@ use crate::fit::estimator::Estimator;
 use crate::fit::layout::EffectSlot;
 use crate::fit::options::{FitWarning, WarningCode};
 use crate::fit::summary::{BoundSide, FitSummary};
-pub use crate::fit::thresholds::{
+pub use crate::fit::values::thresholds::{
     AT_BOUND_TOLERANCE, ILL_CONDITIONED_RCOND, IMPLAUSIBLE_NOISE_RATIO, JUMP_SE,
     LARGE_STDERR_KAPPA, LARGE_STDERR_N, LARGE_STDERR_STRENGTH_FRACTION, MISFIT_RATIO,
     MISFIT_WITHOUT_NOISE, NOT_CONVERGED_CHI2, PLAUSIBLE_N,
 };
-use crate::format::fmt_g;
+use crate::report::format::fmt_g;
 use diffbvp::least_squares::{FitResult, Termination};
 use nalgebra::{DMatrix, SymmetricEigen};
 
@@ -217,13 +217,13 @@ fn check_covariance(
 }
 
 /// An effect fixed (`--with radiation=2`) at a strength outside its physical range (G02):
-/// the fit then rests on a model no spinning line can have; an `unphysical` warning naming the effect, its value and its range ([`Effect::judge`](crate::effects::Effect::judge)).
+/// the fit then rests on a model no spinning line can have; an `unphysical` warning naming the effect, its value and its range ([`Effect::judge`](crate::model::effects::Effect::judge)).
 pub(crate) fn check_fixed_effects(s: &FitSummary, w: &mut Vec<FitWarning>) {
     for e in &s.effects {
         if e.strength.fitted {
             continue;
         }
-        let Ok(effect) = e.effect.parse::<crate::effects::Effect>() else {
+        let Ok(effect) = e.effect.parse::<crate::model::effects::Effect>() else {
             continue;
         };
         if let Some(words) = effect.judge(e.strength.value) {

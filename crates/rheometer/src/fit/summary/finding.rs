@@ -2,11 +2,11 @@
 //! thinning detected or not over the strain rates the data cover, the one-sided bound on `n`,
 //! the likelihood-ratio test) and a profile interval in words.
 
-use crate::effects::LawChoice;
-use crate::fit::profile::ProfileInterval;
 use crate::fit::summary::text::{fmt_interval, fmt_p};
 use crate::fit::summary::{BoundSide, FitSummary};
-use crate::format::{fmt_at, fmt_e, fmt_g, fmt_pm, fmt_sig};
+use crate::fit::uncertainty::profile::ProfileInterval;
+use crate::model::effects::LawChoice;
+use crate::report::format::{fmt_at, fmt_e, fmt_g, fmt_pm, fmt_sig};
 
 impl ProfileInterval {
     /// The interval in words: `[0.79, 0.82] (95 %)`, an end left open by the search range,

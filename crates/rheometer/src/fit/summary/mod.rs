@@ -19,15 +19,15 @@ pub(crate) mod finding;
 pub(crate) mod read;
 pub(crate) mod text;
 
-use crate::effects::{Category, LawChoice};
-use crate::fit::budget::ErrorBudget;
-use crate::fit::coverage::StrainRateCoverage;
-use crate::fit::curve::FlowCurve;
+use crate::data::noise_summary::NoiseSummary;
 use crate::fit::estimator::Estimator;
-use crate::fit::likelihood::{NewtonianTest, ProfileInterval};
 pub use crate::fit::options::{BoundSide, FitWarning, WarningCode};
-use crate::noise_summary::NoiseSummary;
-use crate::serde_nan;
+use crate::fit::values::budget::ErrorBudget;
+use crate::fit::values::coverage::StrainRateCoverage;
+use crate::fit::values::curve::FlowCurve;
+use crate::fit::values::likelihood::{NewtonianTest, ProfileInterval};
+use crate::model::effects::{Category, LawChoice};
+use crate::report::serde_nan;
 use diffbvp::least_squares::Loss;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -466,7 +466,7 @@ impl FitSummary {
                 "{} is at its {} bound {}, where the fit has no valid interval{}",
                 b.parameter,
                 b.side.name(),
-                crate::format::fmt_g(b.bound),
+                crate::report::format::fmt_g(b.bound),
                 if !newtonian {
                     ""
                 } else if self.misfit_warned() {
@@ -490,7 +490,7 @@ impl FitSummary {
 
     /// Why the profile-likelihood intervals and the likelihood-ratio test against the
     /// Newtonian law are not computed for this fit: a `misfit` warning (the RMS relative
-    /// residual beyond [`MISFIT_RATIO`](crate::fit::thresholds::MISFIT_RATIO) times the noise).
+    /// residual beyond [`MISFIT_RATIO`](crate::fit::values::thresholds::MISFIT_RATIO) times the noise).
     /// Both read the deviance as a likelihood of a model that describes the data up to the
     /// noise; where it misses them by several times the noise they would be statements about
     /// a wrong model (the law is no result either, see [`law_not_a_result`](Self::law_not_a_result)),
@@ -522,7 +522,7 @@ impl FitSummary {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::noise_summary::{NoiseSource, ESTIMATED_NOISE_WORDS};
+    use crate::data::noise_summary::{NoiseSource, ESTIMATED_NOISE_WORDS};
 
     /// A summary of a refit with `effect` at `(strength, se)`, `n` and `κ` at `(value, se)`.
     pub(crate) fn refit_summary(

@@ -4,13 +4,13 @@
 //! bounded, strict reader [`read_json`], the report's stamp [`check_report`], the field types
 //! with their paths, the values' ranges); every error names the file and the field.
 
-use crate::effects::{Effect, EffectSetting};
+use crate::data::input::{parse_json, read_json, show_json_path, JsonSource};
 use crate::error::Readable;
 use crate::fit::estimator::Estimator;
 use crate::fit::summary::{FitSummary, WarningCode};
-use crate::input::{parse_json, read_json, show_json_path, JsonSource};
-use crate::report_json::{check_report, ReportKind};
-use crate::setup::{Experiment, Measurements};
+use crate::model::effects::{Effect, EffectSetting};
+use crate::model::setup::{Experiment, Measurements};
+use crate::report::report_json::{check_report, ReportKind};
 use serde_json::Value;
 use std::path::Path;
 
@@ -333,7 +333,7 @@ impl FitSummary {
             },
         )
         .map_err(|e| {
-            let limit = matches!(e, crate::input::InputError::Limit { .. });
+            let limit = matches!(e, crate::data::input::InputError::Limit { .. });
             format!(
                 "{flag}: {e}{}",
                 if limit {

@@ -3,13 +3,13 @@
 //! warnings), the details below (how the fit ran, the other fitted parameters, the profile
 //! intervals, the flow curve, correlations, the error budget). Numbers carry the digits their
 //! uncertainty supports ([`fmt_pm`]); lines are at most
-//! [`LINE_WIDTH`](crate::format::LINE_WIDTH) characters
+//! [`LINE_WIDTH`](crate::report::format::LINE_WIDTH) characters
 //! ([`wrap_long_lines`]).
 
-use crate::effects::LawChoice;
 use crate::fit::estimator::Estimator;
 use crate::fit::summary::{Estimate, FitSummary};
-use crate::format::{fmt_at, fmt_e, fmt_g, fmt_pm, fmt_sig, wrap_long_lines};
+use crate::model::effects::LawChoice;
+use crate::report::format::{fmt_at, fmt_e, fmt_g, fmt_pm, fmt_sig, wrap_long_lines};
 
 /// `" unit"`, or nothing for a dimensionless quantity.
 pub(crate) fn unit_suffix(unit: &str) -> String {
@@ -144,7 +144,7 @@ impl FitSummary {
             s.push_str(&format!(
                 "    fit: RMS relative residual {rms:.3} %, {:.2} times the noise level {} %\n",
                 self.rms_relative_residual / self.noise.level,
-                crate::noise_summary::percent(self.noise.level)
+                crate::data::noise_summary::percent(self.noise.level)
             ));
         } else {
             s.push_str(&format!(
@@ -441,9 +441,11 @@ impl FitSummary {
                 fmt_sig(p.strain_rate_per_s, 2),
                 fmt_sig(p.eta_pa_s, 3),
                 match c.band {
-                    crate::fit::flow_curve::BandMethod::Delta => how("delta method"),
-                    crate::fit::flow_curve::BandMethod::Profile => how("along the profile"),
-                    crate::fit::flow_curve::BandMethod::None => format!(" ({NO_BAND})"),
+                    crate::fit::uncertainty::flow_curve::BandMethod::Delta => how("delta method"),
+                    crate::fit::uncertainty::flow_curve::BandMethod::Profile =>
+                        how("along the profile"),
+                    crate::fit::uncertainty::flow_curve::BandMethod::None =>
+                        format!(" ({NO_BAND})"),
                 },
                 if c.systematic {
                     format!(", with systematic {} Pa s", band(p.total95_pa_s))
@@ -456,7 +458,7 @@ impl FitSummary {
     }
 }
 
-/// Why a flow curve has no statistical band ([`BandMethod::None`](crate::fit::flow_curve::BandMethod::None)).
+/// Why a flow curve has no statistical band ([`BandMethod::None`](crate::fit::uncertainty::flow_curve::BandMethod::None)).
 pub(crate) const NO_BAND: &str =
     "no statistical band: no fitted law parameter, or no covariance of the fitted ones";
 

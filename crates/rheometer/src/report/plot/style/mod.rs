@@ -1,0 +1,5 @@
+//! The look of a figure: the colours (`colors`) and the embedded fonts and text widths
+//! (`fonts`).
+
+pub(super) mod colors;
+pub(super) mod fonts;
