@@ -33,8 +33,9 @@
 //! * [`report`]: what the program writes — [`report::plot`] and the figures
 //!   ([`report::figures`], [`report::flow_curve_figure`]), the HTML page
 //!   ([`report::html_page`]) and the report of a fit ([`report::fit_html`]), numbers for
-//!   people ([`report::format`](mod@report::format)), the stamp of JSON reports ([`report::report_json`]), and the
-//!   output layer every file goes through ([`report::output_files`], [`report::output`]);
+//!   people ([`report::format`](mod@report::format)), the stamp of JSON reports
+//!   ([`report::report_json`]), and the output layer every file goes through
+//!   ([`report::output_files`], [`report::output`]);
 //! * [`workflow`]: what each `rheometer` subcommand does, as library calls returning values,
 //!   and [`workflow::failure_hints`] (simulation failures naming their experiment, with likely
 //!   causes);

@@ -4,9 +4,9 @@
 //! (`diagnostics::diagnose`) compute; tail probabilities of the F distribution in
 //! `distributions`.
 //!
-//! **The noise model of record is [`NoiseModel`](crate::data::noise_model::NoiseModel)** (robust scale, scale along the line,
-//! outliers, one lag-1 autocorrelation, the judgement numbers); the comparison uses it. The
-//! older estimators below remain until the diagnosis is switched over:
+//! **The noise model of record is [`NoiseModel`](crate::data::noise_model::NoiseModel)** (robust
+//! scale, scale along the line, outliers, one lag-1 autocorrelation, the judgement numbers); the
+//! comparison uses it. The older estimators below remain until the diagnosis is switched over:
 //!
 //! | function | used by | what |
 //! |---|---|---|

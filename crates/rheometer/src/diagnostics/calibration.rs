@@ -1,8 +1,8 @@
 //! The look-elsewhere calibration of a diagnosis as a value ([`Calibration`]): the null
 //! distribution of the best `ΔBIC` over all candidates and shapes on effect-free data like the
 //! user's, and the false-alarm probability it gives a `ΔBIC`. Computed by the bootstrap of
-//! [`calibrate`](super::diagnose::linear::calibrate); the [`Diagnosis`](super::diagnosis::Diagnosis)
-//! holds it.
+//! [`calibrate`](super::diagnose::linear::calibrate); the
+//! [`Diagnosis`](super::diagnosis::Diagnosis) holds it.
 
 use serde::{Deserialize, Serialize};
 

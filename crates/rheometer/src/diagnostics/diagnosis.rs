@@ -110,8 +110,8 @@ pub struct Diagnosis {
     pub found: Vec<String>,
     /// The best pair of candidates fitted jointly (stage 9b), where one qualifies: it replaces
     /// the forward search's result when better by more than its
-    /// [`replace_margin`](super::refits::pair::PairFound::replace_margin) in `ΔBIC` (`found` then lists
-    /// it), else it is reported beside it (with its fit), and where the two laws disagree the
+    /// [`replace_margin`](super::refits::pair::PairFound::replace_margin) in `ΔBIC` (`found` then
+    /// lists it), else it is reported beside it (with its fit), and where the two laws disagree the
     /// law is no result.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pair: Option<super::refits::pair::PairFound>,

@@ -8,33 +8,36 @@
 //!   identification, the warnings of a fit, the side of a bound);
 //! * [`data`]: the prepared data ([`Rheometer`]: smoothed measurements, one model per
 //!   experiment);
-//! * `identify`: the start-point heuristic (paper Algorithm 2) and the bounded trust-region
-//!   Gauss–Newton fit, its result a value of its own, `identification` ([`Identification`]);
-//! * `accuracy`: the fit's BVPs solved only as accurately as the noise needs, and the proof;
-//! * `nested`: a fit with effects that never ends worse than the model without them
-//!   (also started from the plain model's optimum);
+//! * `identify`: the identification itself — `identify::gauss_newton`, the start-point
+//!   heuristic (paper Algorithm 2) and the bounded trust-region Gauss–Newton fit, its result a
+//!   value of its own, `identify::identification` ([`Identification`]);
+//!   `identify::accuracy`, the fit's BVPs solved only as accurately as the noise needs, and the
+//!   proof; `identify::nested`, a fit with effects that never ends worse than the model
+//!   without them (also started from the plain model's optimum);
 //! * [`objective`]: the least-squares objective over all experiments (solved in parallel,
 //!   warm-started, exact Jacobians from forward sensitivities);
 //! * `layout`: which parameters are fitted (law, effect strengths, take-up factors);
 //! * `plan`: the time and memory a fit will take, measured on one experiment before it starts;
 //! * `landscape`: the cost on a grid (paper Fig. 4);
-//! * [`error_budget()`]: what the data cannot identify (process conditions, instrument,
+//! * `uncertainty`: what the estimates are worth — [`error_budget()`] (in
+//!   `uncertainty::error_budget`): what the data cannot identify (process conditions, instrument,
 //!   material data) propagated through exact sensitivities into a systematic uncertainty;
 //! * [`summary`]: the outcome of a fit as one value, [`FitSummary`] (named estimates with
 //!   standard errors and 95% confidence intervals, covariance, the one noise level, warnings),
 //!   rendered as text and JSON and read back by the next step;
-//! * `flow_curve`: the identified law as `η_E(ε̇)` at a temperature, with its statistical
-//!   and systematic bands and the strain rates the data cover; the values it yields,
-//!   [`FlowCurve`] and [`StrainRateCoverage`], are in `curve` and `coverage`;
-//! * `profile`: profile-likelihood intervals, one-sided bounds at a bound, and the
+//! * `uncertainty::flow_curve`: the identified law as `η_E(ε̇)` at a temperature, with its
+//!   statistical and systematic bands and the strain rates the data cover; the values it
+//!   yields, [`FlowCurve`] and [`StrainRateCoverage`], are in `values::curve` and
+//!   `values::coverage`;
+//! * `uncertainty::profile`: profile-likelihood intervals, one-sided bounds at a bound, and the
 //!   likelihood-ratio test against the nested Newtonian law; the values it yields
-//!   ([`ProfileInterval`], [`NewtonianTest`]) are in `likelihood`;
+//!   ([`ProfileInterval`], [`NewtonianTest`]) are in `values::likelihood`;
 //! * [`summary::checks`]: the checks of a fit (estimates at bounds, misfit, huge errors, data
-//!   the model cannot describe), their thresholds in `thresholds`.
+//!   the model cannot describe), their thresholds in `values::thresholds`.
 //!
-//! The values a [`FitSummary`] holds (`budget`, `curve`, `coverage`, `likelihood`) sit below
-//! it and the steps that compute them above it, so that no two files import each other (the
-//! order is in the Layers section of the crate's documentation).
+//! The values a [`FitSummary`] holds (in `values`: `budget`, `curve`, `coverage`,
+//! `likelihood`) sit below it and the steps that compute them above it, so that no two files
+//! import each other (the order is in the Layers section of the crate's documentation).
 
 pub mod data;
 pub mod estimator;

@@ -1,8 +1,8 @@
 //! Figures of spinning experiments: simulated profiles, measured diameters with the smooth fit
 //! and model curves (paper Fig. 2, 3, 5), and the cost landscape (paper Fig. 4).
 //!
-//! A thin fiber-specific layer over the model-agnostic [`crate::report::plot`]: it converts units for
-//! display (positions in m, diameters in µm, `1/d²` in 1/mm², temperatures in °C) and lays out
+//! A thin fiber-specific layer over the model-agnostic [`crate::report::plot`]: it converts units
+//! for display (positions in m, diameters in µm, `1/d²` in 1/mm², temperatures in °C) and lays out
 //! one panel per experiment. Every function refuses to write over one of the `inputs` (see
 //! `ensure_not_input`); the format follows the extension (`.png` or `.svg`), and a function
 //! given a format writes that format. Residual panels carry the noise band (shaded `±2σ`).

@@ -3,8 +3,8 @@
 //! the [`FlowCurve`](crate::fit::FlowCurve), the experiments' names, data files
 //! and point counts, and optionally the relative residuals); nothing is refitted.
 //!
-//! The page (built with the generic [`crate::report::html_page`], which escapes every text and forbids
-//! loading anything from the network) shows, top to bottom:
+//! The page (built with the generic [`crate::report::html_page`], which escapes every text and
+//! forbids loading anything from the network) shows, top to bottom:
 //!
 //! * the verdict: whether the fit has warnings, the law `n`, `κ` with their 95 % intervals,
 //!   the fit against the one noise level of the summary;

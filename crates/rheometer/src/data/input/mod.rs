@@ -6,8 +6,8 @@
 //! of measured diameters per experiment. **The unit is part of every key name** (`_m`, `_kg_s`,
 //! `_K`, …) and of every CSV column name. The process conditions may be given in the units of a
 //! lab sheet, converted once at load to SI (the
-//! [`ExperimentSet`](crate::model::setup::ExperimentSet) is SI whatever the file used); a quantity given twice in different units is an error naming
-//! both keys:
+//! [`ExperimentSet`](crate::model::setup::ExperimentSet) is SI whatever the file used); a quantity
+//! given twice in different units is an error naming both keys:
 //!
 //! | quantity | units (key suffix) |
 //! |---|---|

@@ -43,12 +43,12 @@
 //!    noise, it is added to the model (strength and shapes fitted jointly with the law) and the
 //!    search runs again over the remaining candidates, at most
 //!    [`DiagnoseOptions::max_effects`] effects in all. Then, wherever there is something to
-//!    explain, every pair of refitted candidates is fitted jointly (`pairs`, [`PairFound`](super::refits::pair::PairFound)): two effects
-//!    that hide each other (warm air heating where radiation cools) each explain little
-//!    alone, and a third effect can mimic their sum with a biased law. A pair clearly better
-//!    by `ΔBIC` (beyond a margin corrected for the pairs tried) replaces the forward search's
-//!    result; one within it is reported beside it, and where the two laws disagree neither is
-//!    a result.
+//!    explain, every pair of refitted candidates is fitted jointly (`pairs`,
+//!    [`PairFound`](super::refits::pair::PairFound)): two effects that hide each other (warm air
+//!    heating where radiation cools) each explain little alone, and a third effect can mimic their
+//!    sum with a biased law. A pair clearly better by `ΔBIC` (beyond a margin corrected for the
+//!    pairs tried) replaces the forward search's result; one within it is reported beside it, and
+//!    where the two laws disagree neither is a result.
 //! 10. **One strength in every experiment** (`consistency`): a score test of the final fit
 //!     against each found effect's strength varying with the conditions that differ between
 //!     the experiments (no new fit); an effect that fails is a stand-in for something else.

@@ -9,9 +9,10 @@
 //! a fixed mesh, warm from the fit's solution), and the discretisation error of the fit's
 //! residuals is `e ≈ (r_half − r) · 16/15` (the collocation is of order 4: halving divides
 //! the error by 16). The optimum's first-order move `Δθ = −(JᵀJ)⁻¹ Jᵀ e` is compared with the
-//! standard errors. Above [`IdentifyOptions::max_discretisation_shift`](crate::fit::IdentifyOptions::max_discretisation_shift)
-//! (default 0.01 standard errors) the fit is refined at a tolerance ten times tighter and
-//! checked again. The measured shift and the check's node counts are in the fit's
+//! standard errors. Above
+//! [`IdentifyOptions::max_discretisation_shift`](crate::fit::IdentifyOptions::max_discretisation_shift)
+//! (default 0.01 standard errors) the fit is refined at a tolerance ten times tighter and checked
+//! again. The measured shift and the check's node counts are in the fit's
 //! [`SolverRecord`](crate::fit::SolverRecord).
 //!
 //! The check re-solves on the halved fixed mesh rather than 100 times more accurately on an

@@ -51,7 +51,8 @@ impl Identification {
     }
 
     /// The fitted strengths (the effects' units) and shapes by model-parameter name: the start
-    /// of a fit that continues from this one ([`FitStart::strengths`](crate::fit::FitStart::strengths)).
+    /// of a fit that continues from this one
+    /// ([`FitStart::strengths`](crate::fit::FitStart::strengths)).
     pub fn fitted_strengths(&self) -> Vec<(String, f64)> {
         let mut out = Vec::new();
         for slot in &self.effects {
@@ -79,7 +80,8 @@ impl Identification {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct WarmFit {
     /// Take-up factors to start from (principled estimator; one per experiment, clamped into
-    /// [`IdentifyOptions::take_up_bounds`](crate::fit::IdentifyOptions::take_up_bounds)); any other length: 1.
+    /// [`IdentifyOptions::take_up_bounds`](crate::fit::IdentifyOptions::take_up_bounds)); any other
+    /// length: 1.
     pub take_up: Vec<f64>,
     /// Stopping tolerance \[-\] of the gradient, step and cost-change tests (all three);
     /// `None`: the driver's defaults.

@@ -217,7 +217,8 @@ fn check_covariance(
 }
 
 /// An effect fixed (`--with radiation=2`) at a strength outside its physical range (G02):
-/// the fit then rests on a model no spinning line can have; an `unphysical` warning naming the effect, its value and its range ([`Effect::judge`](crate::model::effects::Effect::judge)).
+/// the fit then rests on a model no spinning line can have; an `unphysical` warning naming the
+/// effect, its value and its range ([`Effect::judge`](crate::model::effects::Effect::judge)).
 pub(crate) fn check_fixed_effects(s: &FitSummary, w: &mut Vec<FitWarning>) {
     for e in &s.effects {
         if e.strength.fitted {

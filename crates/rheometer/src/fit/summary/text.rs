@@ -458,7 +458,8 @@ impl FitSummary {
     }
 }
 
-/// Why a flow curve has no statistical band ([`BandMethod::None`](crate::fit::uncertainty::flow_curve::BandMethod::None)).
+/// Why a flow curve has no statistical band
+/// ([`BandMethod::None`](crate::fit::uncertainty::flow_curve::BandMethod::None)).
 pub(crate) const NO_BAND: &str =
     "no statistical band: no fitted law parameter, or no covariance of the fitted ones";
 

@@ -22,7 +22,8 @@
 //! *per-experiment* one by `√(Σ_k (s_k σ_k)²)`. Sources are independent: the systematic standard
 //! uncertainty is the root-sum-square of the sources' shifts. For `K = e^κ` the relative
 //! uncertainty is that of `κ` (first order). A source whose shift of `κ` or `n` exceeds the
-//! statistical standard error is a [`WarningCode::Systematic`](crate::fit::WarningCode::Systematic) warning: the data cannot tell.
+//! statistical standard error is a [`WarningCode::Systematic`](crate::fit::WarningCode::Systematic)
+//! warning: the data cannot tell.
 
 use crate::data::uncertainty::{GaugeColumn, Origin, Scope, Source, Uncertainties, SOURCES};
 use crate::fit::data::Rheometer;

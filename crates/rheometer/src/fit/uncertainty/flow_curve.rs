@@ -8,11 +8,11 @@
 //!   offsets), generic over the [`ViscosityLaw`]; derivatives with respect to the law's
 //!   parameters are exact (dual numbers through the same evaluation).
 //! * **Strain rates the data cover.** The model's strain rates at the measurement positions of
-//!   the fitted solutions ([`StrainRateCoverage`](crate::fit::StrainRateCoverage)), shifted to the curve's temperature by the
-//!   VFT factor `a_T = η₀(T)/η₀(T_ref)` (time–temperature superposition: the Carreau-type laws
-//!   depend on `η₀(T)·ε̇` only, so a point of the spin line at temperature `T` and rate `ε̇`
-//!   probes the curve at `T_ref` at the rate `a_T ε̇`). Outside that range, extended by a decade
-//!   on each side, the curve is extrapolated and marked so.
+//!   the fitted solutions ([`StrainRateCoverage`](crate::fit::StrainRateCoverage)), shifted to the
+//!   curve's temperature by the VFT factor `a_T = η₀(T)/η₀(T_ref)` (time–temperature superposition:
+//!   the Carreau-type laws depend on `η₀(T)·ε̇` only, so a point of the spin line at temperature
+//!   `T` and rate `ε̇` probes the curve at `T_ref` at the rate `a_T ε̇`). Outside that range,
+//!   extended by a decade on each side, the curve is extrapolated and marked so.
 //! * **Statistical band (95 %).** By the delta method on `ln η_E` from the covariance of the
 //!   law's fitted parameters (`(n, κ)`), `η_E exp(±1.96 σ_ln)`; where the linearised interval
 //!   of a law parameter is not trustworthy (see [`profile`](super::profile)), the envelope of

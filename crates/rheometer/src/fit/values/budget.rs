@@ -1,5 +1,6 @@
 //! The error budget of a fit as a value: its sources with their shifts of `(n, κ, K)`, as a
-//! table, in words, and as a warning where the systematic uncertainty dominates. Computed by [`error_budget`](crate::fit::error_budget()).
+//! table, in words, and as a warning where the systematic uncertainty dominates. Computed by
+//! [`error_budget`](crate::fit::error_budget()).
 
 use super::thresholds::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 use crate::data::uncertainty::{Origin, Scope, Source, SOURCES};

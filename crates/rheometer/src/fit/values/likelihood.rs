@@ -2,8 +2,8 @@
 //! profile-likelihood interval of a fitted parameter ([`ProfileInterval`], its refits
 //! [`ProfilePoint`] and a one-sided bound [`OneSidedBound`]), and the likelihood-ratio test
 //! against the nested Newtonian law ([`NewtonianTest`], with the strain thinning the data still
-//! allow, [`ThinningBound`]). A fit's summary holds them; [`profile`](crate::fit::uncertainty::profile) computes
-//! them.
+//! allow, [`ThinningBound`]). A fit's summary holds them;
+//! [`profile`](crate::fit::uncertainty::profile) computes them.
 
 use crate::fit::options::BoundSide;
 use crate::model::effects::LawChoice;

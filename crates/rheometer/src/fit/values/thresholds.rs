@@ -1,5 +1,5 @@
-//! The thresholds of the checks of a fit (see [`summary::checks`](crate::fit::summary::checks)): when
-//! an estimate is at a bound, a misfit too large, a standard error huge, a covariance
+//! The thresholds of the checks of a fit (see [`summary::checks`](crate::fit::summary::checks)):
+//! when an estimate is at a bound, a misfit too large, a standard error huge, a covariance
 //! ill-conditioned, an `n` implausible for a melt, a refit's law a jump. Values only, shared by
 //! the checks and by the error budget's warnings.
 

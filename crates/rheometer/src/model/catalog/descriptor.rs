@@ -282,8 +282,8 @@ pub struct EffectDescriptor {
 
 /// The identity of an effect, handed out by its descriptor ([`EffectDescriptor::id`]): two
 /// effects are the same effect exactly when their ids are equal (the catalog and
-/// [`ModelSpec::validate`](crate::model::effects::ModelSpec::validate) keep names unique). Compare ids,
-/// not names; a name from input becomes an id where it is parsed.
+/// [`ModelSpec::validate`](crate::model::effects::ModelSpec::validate) keep names unique). Compare
+/// ids, not names; a name from input becomes an id where it is parsed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct EffectId(&'static str);
 

@@ -38,10 +38,10 @@
 //! error budget's sources are the descriptors' [`budget`](EffectDescriptor::budget) fields.
 //!
 //! **Adding a built-in effect**: its descriptor in its family's file and in [`BUILTIN`], its
-//! physics in one file of [`modifiers`](crate::model::contributions::modifiers) with its registry line
-//! (the descriptor names its strength and shapes; a term instead for a force or heat flux), a
-//! variant of [`Effect`](crate::model::effects::Effect) returning the descriptor, and a row above (a
-//! unit test checks the table against the descriptors). **Adding your own**: see
+//! physics in one file of [`modifiers`](crate::model::contributions::modifiers) with its registry
+//! line (the descriptor names its strength and shapes; a term instead for a force or heat flux), a
+//! variant of [`Effect`](crate::model::effects::Effect) returning the descriptor, and a row above
+//! (a unit test checks the table against the descriptors). **Adding your own**: see
 //! [`EffectDescriptor::user`].
 
 mod descriptor;

@@ -2,8 +2,8 @@
 //! speed and temperature along the line, the inlet conditions and the mass flow, the gauge's
 //! reading and the material data. Each is a small type in its own file implementing
 //! `Modifier` and registered by one line of the registry below; its descriptor in
-//! [`catalog`](crate::model::catalog) names its strength (slot 0) and its shape parameters (slots 1..,
-//! in the descriptor's order), so nothing else names them.
+//! [`catalog`](crate::model::catalog) names its strength (slot 0) and its shape parameters (slots
+//! 1.., in the descriptor's order), so nothing else names them.
 //!
 //! **Adding a built-in effect**: a file here with its type, its `Modifier` impl (the
 //! descriptor, how it is switched on, the hook it fills) and, if it has settings of its own, its

@@ -25,7 +25,8 @@ pub use crate::diagnostics::calibration::Calibration;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
-/// Replicates of the bootstrap (default of [`DiagnoseOptions`](crate::diagnostics::diagnose::DiagnoseOptions)).
+/// Replicates of the bootstrap (default of
+/// [`DiagnoseOptions`](crate::diagnostics::diagnose::DiagnoseOptions)).
 pub const DEFAULT_REPLICATES: usize = 2000;
 
 /// The orthonormal basis of the columns of the `n × q` row-major `x` (singular values above

@@ -6,8 +6,8 @@ use plotters::style::RGBColor;
 /// Colour of missing heat-map cells.
 pub(in crate::report::plot) const MISSING: RGBColor = RGBColor(190, 190, 190);
 
-/// Series colours (matplotlib's "tab10"); [`Series::color`](crate::report::plot::Series::color) indexes this
-/// list cyclically.
+/// Series colours (matplotlib's "tab10"); [`Series::color`](crate::report::plot::Series::color)
+/// indexes this list cyclically.
 pub const PALETTE: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
