@@ -3,6 +3,7 @@
 //! experiment's simulation named with the experiment and its TOML line.
 
 use rheometer::data::input::{parse_experiments, Location};
+use rheometer::design::DesignEstimate;
 use rheometer::fit::{IdentifyOptions, LandscapeSample};
 use rheometer::model::effects::Effect;
 use rheometer::workflow::failure_hints::ExperimentFailure;
@@ -236,14 +237,7 @@ pub fn landscape_max_nodes(max_nodes: Option<usize>) -> Result<usize, Refusal> {
 /// wall time the sample took.
 pub fn landscape_estimate(sample: &LandscapeSample, grid: (usize, usize), sample_s: f64) -> String {
     let threads = rayon::current_num_threads().clamp(1, grid.1.max(1));
-    let t = sample_s + sample.remaining_s(threads);
-    let about = if t < 90.0 {
-        format!("{t:.0} s")
-    } else if t < 5400.0 {
-        format!("{:.0} min", t / 60.0)
-    } else {
-        format!("{:.1} h", t / 3600.0)
-    };
+    let about = about(sample_s + sample.remaining_s(threads));
     format!(
         "landscape: {} points on {threads} threads, about {about} (measured on {} of its {} \
          rows, {sample_s:.1} s in all: about {:.2} s per row of {} points)",
@@ -253,4 +247,34 @@ pub fn landscape_estimate(sample: &LandscapeSample, grid: (usize, usize), sample
         sample.row_s(),
         grid.0
     )
+}
+
+/// A duration for people: "16 s", "12 min", "1.5 h".
+fn about(t: f64) -> String {
+    if t < 90.0 {
+        format!("{t:.0} s")
+    } else if t < 5400.0 {
+        format!("{:.0} min", t / 60.0)
+    } else {
+        format!("{:.1} h", t / 3600.0)
+    }
+}
+
+/// What a long design says once its first rows are done (`None` under 10 s left: a short
+/// design says nothing), e.g. "design: 100000 candidates on 2 threads, about 55 s more
+/// (measured on 2 of its 1000 rows: 0.11 s per row of 100 candidates)".
+pub fn design_estimate(e: &DesignEstimate) -> Option<String> {
+    (e.remaining_s >= 10.0).then(|| {
+        format!(
+            "design: {} candidates on {} threads, about {} more (measured on {} of its {} \
+             rows: {:.2} s per row of {} candidates)",
+            e.candidates,
+            e.threads,
+            about(e.remaining_s),
+            e.rows_measured,
+            e.rows,
+            e.measured_s * e.threads as f64 / e.rows_measured.max(1) as f64,
+            e.candidates / e.rows.max(1)
+        )
+    })
 }

@@ -1,7 +1,7 @@
 //! `rheometer design`.
 
 use crate::*;
-use rheometer::design::{Criterion, DesignRequest, DiscriminationRequest};
+use rheometer::design::{Criterion, DesignEstimate, DesignRequest, DiscriminationRequest};
 use rheometer::model::effects::Effect;
 use rheometer::report::report_json::{to_report_json, ReportKind};
 use rheometer::workflow::request::{self, DesignRanges, Door};
@@ -120,6 +120,11 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let mut fit_request = FitRequest::new(opts);
     fit_request.start = args.start.map(|(n, k)| [n, k]);
     let max_nodes = g.max_nodes.unwrap_or(checks::DEFAULT_MAX_NODES);
+    let say_estimate = |e: &DesignEstimate| {
+        if let Some(line) = checks::design_estimate(e) {
+            g.say(line);
+        }
+    };
     let (text, json, csv) = match &args.discriminate {
         Some(Rivals(effects)) => {
             let mut request = DiscriminationRequest::new(grid);
@@ -131,7 +136,13 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
                 effects.len(),
                 request.grid.candidates().len()
             ));
-            let run = workflow::discriminate(&loaded, &fit_request, effects, &request)?;
+            let run = workflow::discriminate_with_estimate(
+                &loaded,
+                &fit_request,
+                effects,
+                &request,
+                &say_estimate,
+            )?;
             let d = &run.design;
             (
                 d.to_text(),
@@ -148,7 +159,8 @@ pub fn run(args: DesignArgs, g: &Global) -> Result<(), Box<dyn Error>> {
                 "fitting, then {} candidate experiments ...",
                 request.grid.candidates().len()
             ));
-            let run = workflow::design(&loaded, &fit_request, &request)?;
+            let run =
+                workflow::design_with_estimate(&loaded, &fit_request, &request, &say_estimate)?;
             let d = &run.design;
             (
                 d.to_text(),

@@ -224,6 +224,9 @@ def test_equal_fits_are_equal_whatever_their_timing(pmma):
     assert c == a
     other = diffbvp.fit(pmma, error_budget=False, estimator="paper")
     assert a != other
+    # one spelling (finding 14): the result says the estimator as the argument names it
+    assert a.summary["estimator"] == "principled"
+    assert other.summary["estimator"] == "paper"
 
 
 def test_landscape_to_dict_is_strict_json(pmma):

@@ -4,6 +4,7 @@
 
 use crate::model::setup::{Experiment, TakeUp};
 use serde::Serialize;
+use std::time::Instant;
 
 /// The take-up axis of the grid.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -138,6 +139,57 @@ impl CandidateGrid {
     }
 }
 
+/// How long the candidates of a design will take, measured on its first rows (one per thread,
+/// run before the others): what a long design says before it runs on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DesignEstimate {
+    /// Candidates in the grid.
+    pub candidates: usize,
+    /// Rows of the grid (one per mass flow; a row sweeps the take-up axis).
+    pub rows: usize,
+    /// Rows measured.
+    pub rows_measured: usize,
+    /// Wall time of the measured rows \[s\].
+    pub measured_s: f64,
+    /// Threads the rows run on.
+    pub threads: usize,
+    /// Predicted wall time of the rows not yet run \[s\].
+    pub remaining_s: f64,
+}
+
+/// `row` applied to every row of `all` (rows of `nt` candidates, each a warm-started sweep) in
+/// parallel, the outcomes in the grid's order. When the grid has more than two rows per
+/// thread, the first row of each thread runs first, timed, and `report` gets the estimate
+/// before the rest runs; the outcomes do not depend on it.
+pub(crate) fn rows_in_order<T: Send>(
+    all: &[Candidate],
+    nt: usize,
+    row: impl Fn(&[Candidate]) -> Vec<T> + Sync,
+    report: &(dyn Fn(&DesignEstimate) + Sync),
+) -> Vec<T> {
+    use rayon::prelude::*;
+    let nt = nt.max(1);
+    let rows = all.len().div_ceil(nt);
+    let threads = rayon::current_num_threads().max(1);
+    if rows <= 2 * threads {
+        return all.par_chunks(nt).flat_map_iter(&row).collect();
+    }
+    let (first, rest) = all.split_at(threads * nt);
+    let t0 = Instant::now();
+    let mut out: Vec<T> = first.par_chunks(nt).flat_map_iter(&row).collect();
+    let measured_s = t0.elapsed().as_secs_f64();
+    report(&DesignEstimate {
+        candidates: all.len(),
+        rows,
+        rows_measured: threads,
+        measured_s,
+        threads,
+        remaining_s: measured_s * (rows - threads).div_ceil(threads) as f64,
+    });
+    out.extend(rest.par_chunks(nt).flat_map_iter(&row).collect::<Vec<T>>());
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -162,5 +214,62 @@ mod tests {
             ..g
         };
         assert!(bad.validate().unwrap_err().contains("take-up speed -2"));
+    }
+}
+#[cfg(test)]
+mod rows_tests {
+    use super::*;
+    use std::sync::Mutex;
+
+    fn grid(rows: usize, nt: usize) -> Vec<Candidate> {
+        (0..rows * nt)
+            .map(|k| Candidate {
+                i: k / nt,
+                j: k % nt,
+                mass_flow: 1.0 + (k / nt) as f64,
+                take_up: 1.0 + (k % nt) as f64,
+            })
+            .collect()
+    }
+
+    fn run(rows: usize, threads: usize) -> (Vec<(usize, usize)>, Vec<DesignEstimate>) {
+        let all = grid(rows, 3);
+        let seen = Mutex::new(Vec::new());
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool of 2 or 3 threads");
+        let out = pool.install(|| {
+            rows_in_order(
+                &all,
+                3,
+                |row| row.iter().map(|c| (c.i, c.j)).collect(),
+                &|e| seen.lock().expect("not poisoned").push(*e),
+            )
+        });
+        (out, seen.into_inner().expect("not poisoned"))
+    }
+
+    #[test]
+    fn a_long_grid_is_estimated_once_from_its_first_rows_and_keeps_its_order() {
+        let (out, estimates) = run(11, 2);
+        let expected: Vec<(usize, usize)> = (0..33).map(|k| (k / 3, k % 3)).collect();
+        assert_eq!(out, expected);
+        assert_eq!(estimates.len(), 1);
+        let e = estimates[0];
+        assert_eq!(
+            (e.candidates, e.rows, e.rows_measured, e.threads),
+            (33, 11, 2, 2)
+        );
+        // 9 rows left on 2 threads: 5 rounds of the measured one
+        assert!((e.remaining_s - 5.0 * e.measured_s).abs() <= 1e-12 * e.measured_s.max(1.0));
+    }
+
+    #[test]
+    fn a_short_grid_runs_at_once_without_an_estimate() {
+        let (out, estimates) = run(6, 3);
+        assert_eq!(out.len(), 18);
+        assert_eq!(out[17], (5, 2));
+        assert!(estimates.is_empty());
     }
 }

@@ -27,7 +27,7 @@
 //!
 //! [`FitSummary`]: crate::fit::FitSummary
 
-use super::candidates::{Candidate, CandidateGrid};
+use super::candidates::{rows_in_order, Candidate, CandidateGrid, DesignEstimate};
 use super::estimation::{candidate_information, candidate_positions, shared_columns};
 use super::information::{experiment_information, Columns, ExperimentInformation};
 use crate::fit::{Identification, Rheometer, RheometerError};
@@ -308,6 +308,16 @@ pub fn design_for_discrimination(
     rivals: &[Rival<'_>],
     request: &DiscriminationRequest,
 ) -> Result<Discrimination, RheometerError> {
+    design_for_discrimination_with(rivals, request, &|_| {})
+}
+
+/// [`design_for_discrimination`], telling `report` how long the candidates will take once
+/// the first rows are done (see `rows_in_order`).
+pub(crate) fn design_for_discrimination_with(
+    rivals: &[Rival<'_>],
+    request: &DiscriminationRequest,
+    report: &(dyn Fn(&DesignEstimate) + Sync),
+) -> Result<Discrimination, RheometerError> {
     let t0 = Instant::now();
     if rivals.len() < 2 {
         return Err(RheometerError::Data(
@@ -366,9 +376,10 @@ pub fn design_for_discrimination(
     let n_new = n_now + positions.len();
     let nt = grid.take_up.values().len();
     let all = grid.candidates();
-    let mut candidates: Vec<DiscriminationOutcome> = all
-        .par_chunks(nt)
-        .flat_map_iter(|row| {
+    let mut candidates: Vec<DiscriminationOutcome> = rows_in_order(
+        &all,
+        nt,
+        |row| {
             // each rival's solutions warm-start its next candidate along the take-up axis
             let mut last: Vec<Option<Solution>> = vec![None; data.len()];
             row.iter()
@@ -420,8 +431,9 @@ pub fn design_for_discrimination(
                     out
                 })
                 .collect::<Vec<_>>()
-        })
-        .collect();
+        },
+        report,
+    );
     let ranking = rank_by_separation(&mut candidates);
     let rival_fits = rival_fits(rivals, n_now);
     let notes = design_notes(sigma, &noise_source);

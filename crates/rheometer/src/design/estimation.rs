@@ -8,7 +8,7 @@
 //! fails); the mass flows run in parallel (rayon). A candidate whose model cannot be built or
 //! solved is reported as infeasible, with the reason.
 
-use super::candidates::{Candidate, CandidateGrid};
+use super::candidates::{rows_in_order, Candidate, CandidateGrid, DesignEstimate};
 use super::criteria::{sandwich, Criterion, Prediction, Reference};
 use super::information::{experiment_information_under, Columns, ExperimentInformation};
 use crate::data::noise_model::NoiseModel;
@@ -391,6 +391,17 @@ pub fn design_for_estimation(
     id: &Identification,
     request: &DesignRequest,
 ) -> Result<Design, RheometerError> {
+    design_for_estimation_with(rh, id, request, &|_| {})
+}
+
+/// [`design_for_estimation`], telling `report` how long the candidates will take once the
+/// first rows are done (see `rows_in_order`).
+pub(crate) fn design_for_estimation_with(
+    rh: &Rheometer,
+    id: &Identification,
+    request: &DesignRequest,
+    report: &(dyn Fn(&DesignEstimate) + Sync),
+) -> Result<Design, RheometerError> {
     let t0 = Instant::now();
     let grid = &request.grid;
     grid.validate().map_err(RheometerError::Data)?;
@@ -453,10 +464,8 @@ pub fn design_for_estimation(
     };
     let all = grid.candidates();
     let nt = grid.take_up.values().len();
-    let mut candidates: Vec<CandidateOutcome> = all
-        .par_chunks(nt)
-        .flat_map_iter(|row| ctx.row(row, template))
-        .collect();
+    let mut candidates: Vec<CandidateOutcome> =
+        rows_in_order(&all, nt, |row| ctx.row(row, template), report);
     let crit = request.criterion;
     for c in &mut candidates {
         c.gain = c

@@ -21,7 +21,7 @@ pub mod estimation;
 pub(crate) mod information;
 pub(crate) mod report;
 
-pub use candidates::{Candidate, CandidateGrid, TakeUpAxis};
+pub use candidates::{Candidate, CandidateGrid, DesignEstimate, TakeUpAxis};
 pub use criteria::{Criterion, Prediction};
 pub use discrimination::{
     design_for_discrimination, Discrimination, DiscriminationOutcome, DiscriminationRequest, Rival,

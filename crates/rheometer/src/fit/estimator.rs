@@ -6,16 +6,20 @@ use crate::NusseltLaw;
 use diffbvp::sensitivity::PointFunction;
 use num_dual::DualNum;
 
-/// Which cost the identification minimises.
+/// Which cost the identification minimises. In JSON it is spelt as on the command line and in
+/// Python (`"principled"`, `"paper"`); reports that spelt it capitalised still read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Estimator {
     /// The paper's cost (eq. opt:disc): `J = Σ_k ‖diag(√Δ) diag(√ε̇) (d(p) − d_fit)‖²` on `n_o`
     /// regular points per experiment, against the smoothed data, with the take-up diameter fixed
     /// at `d_fit(L)`. Biased by the smoothing step (see the book).
+    #[serde(alias = "Paper")]
     Paper,
     /// Least squares of the relative residuals `(d_model − d_meas)/(σ d_meas)` against the raw
     /// measurements, with each experiment's take-up diameter fitted as a nuisance parameter
     /// (started from `d_fit(L)`); `σ` is the relative measurement uncertainty.
+    #[serde(alias = "Principled")]
     Principled,
 }
 

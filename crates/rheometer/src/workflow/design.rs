@@ -4,9 +4,10 @@
 
 use super::fit::{fit, FitRequest, FitRun};
 use crate::data::input::LoadedExperiments;
+use crate::design::discrimination::design_for_discrimination_with;
+use crate::design::estimation::design_for_estimation_with;
 use crate::design::{
-    design_for_discrimination, design_for_estimation, Design, DesignRequest, Discrimination,
-    DiscriminationRequest, Rival,
+    Design, DesignEstimate, DesignRequest, Discrimination, DiscriminationRequest, Rival,
 };
 use crate::fit::uncertainty::profile::ProfileMode;
 use crate::fit::RheometerError;
@@ -28,6 +29,17 @@ pub fn design(
     fit_request: &FitRequest,
     request: &DesignRequest,
 ) -> Result<DesignRun, RheometerError> {
+    design_with_estimate(data, fit_request, request, &|_| {})
+}
+
+/// [`design`], telling `estimate` how long the candidates will take once their first rows
+/// are done (a grid of more than two rows per thread; see [`DesignEstimate`]).
+pub fn design_with_estimate(
+    data: &LoadedExperiments,
+    fit_request: &FitRequest,
+    request: &DesignRequest,
+    estimate: &(dyn Fn(&DesignEstimate) + Sync),
+) -> Result<DesignRun, RheometerError> {
     request.grid.validate().map_err(RheometerError::Data)?;
     let mut fr = fit_request.clone();
     fr.error_budget = false;
@@ -35,7 +47,8 @@ pub fn design(
     fr.baseline = false;
     fr.newtonian_reference = false;
     let run = fit(data, &fr)?;
-    let design = design_for_estimation(&run.rheometer, &run.identification, request)?;
+    let design =
+        design_for_estimation_with(&run.rheometer, &run.identification, request, estimate)?;
     Ok(DesignRun { fit: run, design })
 }
 
@@ -59,6 +72,18 @@ pub fn discriminate(
     fit_request: &FitRequest,
     effects: &[Effect],
     request: &DiscriminationRequest,
+) -> Result<DiscriminationRun, RheometerError> {
+    discriminate_with_estimate(data, fit_request, effects, request, &|_| {})
+}
+
+/// [`discriminate`], telling `estimate` how long the candidates will take once their first
+/// rows are done (see [`DesignEstimate`]).
+pub fn discriminate_with_estimate(
+    data: &LoadedExperiments,
+    fit_request: &FitRequest,
+    effects: &[Effect],
+    request: &DiscriminationRequest,
+    estimate: &(dyn Fn(&DesignEstimate) + Sync),
 ) -> Result<DiscriminationRun, RheometerError> {
     request.grid.validate().map_err(RheometerError::Data)?;
     if effects.len() < 2 {
@@ -97,6 +122,6 @@ pub fn discriminate(
             fit: &f.identification,
         })
         .collect();
-    let design = design_for_discrimination(&rivals, request)?;
+    let design = design_for_discrimination_with(&rivals, request, estimate)?;
     Ok(DiscriminationRun { fits, design })
 }

@@ -31,7 +31,10 @@ pub mod request;
 mod simulate;
 
 pub use compare::{compare, CompareRequest};
-pub use design::{design, discriminate, DesignRun, DiscriminationRun};
+pub use design::{
+    design, design_with_estimate, discriminate, discriminate_with_estimate, DesignRun,
+    DiscriminationRun,
+};
 pub use fit::{fit, FitRequest, FitRun};
 pub use simulate::{simulate_experiments, SimulateError, SimulateRequest, SimulatedProfile};
 
