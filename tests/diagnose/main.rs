@@ -12,5 +12,6 @@ mod diagnose_realistic;
 mod diagnose_scan;
 mod diagnose_separability;
 mod global;
+mod newtonian_effects;
 mod shared;
 mod user_effect_descriptor;

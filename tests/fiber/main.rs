@@ -24,6 +24,7 @@ mod independent_model;
 mod landscape;
 mod linear_solvers;
 mod nested_fit;
+mod newtonian_corner;
 mod noisy_data;
 mod rheometer_blocks;
 mod rheometer_fit;

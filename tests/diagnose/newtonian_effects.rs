@@ -1,0 +1,97 @@
+//! Issue 65 item 2: a real effect on a Newtonian melt. The refit with the right effect may end
+//! at the Carreau-type law's other Newtonian corner (`n → 0` with `K` beyond the data's
+//! stresses): that is a Newtonian melt with that effect, not an implausible law, and the
+//! diagnosis must name the effect. Data by the independent simulator of `tests/independent/`
+//! (truth `n = 1`), radiation at twice its 95 % detection limit on a Newtonian melt (the
+//! limit read from the diagnosis of a Newtonian control), fresh noise per replicate.
+//!
+//! Slow and ignored (one diagnosis per replicate); run with
+//! `cargo test --release --test diagnose newtonian_effects -- --ignored --nocapture`.
+//! `NEWTONIAN_EFFECT_SEEDS` replicates (default 20). Each prints one `NEWTONIAN EFFECT` row and
+//! a summary; the target is the effect named in at least 80 %.
+
+use crate::independent;
+use crate::shared;
+
+use independent::dataset::Scenario;
+use independent::model::Law;
+use independent::scenarios;
+use rheometer::diagnostics::diagnose::DiagnoseOptions;
+
+/// Radiation of emissivity `emissivity` on a Newtonian melt with the noise of `seed`.
+fn newtonian_radiating(emissivity: f64, seed: u64) -> Scenario {
+    Scenario {
+        name: "newtonian_radiating",
+        law: Law {
+            n: 1.0,
+            kappa: 11.71,
+        },
+        ..scenarios::radiating(emissivity, seed)
+    }
+}
+
+#[test]
+#[ignore = "slow: one diagnosis per replicate (minutes on 2 cores)"]
+fn radiation_on_a_newtonian_melt_is_named() {
+    let seeds: u64 = std::env::var("NEWTONIAN_EFFECT_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20);
+    let control = Scenario {
+        seed: 6700,
+        ..scenarios::newtonian()
+    };
+    let c = shared::diagnose_with(&control, &DiagnoseOptions::default());
+    let limit = c
+        .run
+        .diagnosis
+        .detection
+        .limits
+        .iter()
+        .find(|l| l.effect == "radiation")
+        .map(|l| l.s95)
+        .expect("a detection limit for radiation");
+    let emissivity = (2.0 * limit).min(1.0);
+    println!(
+        "NEWTONIAN EFFECT | control seed {} named {:?}; radiation s95 {limit:.3}: emissivity \
+         {emissivity:.3}",
+        control.seed, c.run.diagnosis.most_likely_missing
+    );
+    let mut named = 0;
+    let mut seconds = Vec::new();
+    for k in 0..seeds {
+        let sc = newtonian_radiating(emissivity, 6800 + k);
+        let d = shared::diagnose_with(&sc, &DiagnoseOptions::default());
+        let r = &d.run.diagnosis;
+        let rad = r.candidate("radiation");
+        if r.most_likely_missing.as_deref() == Some("radiation") {
+            named += 1;
+        }
+        seconds.push(d.seconds);
+        println!(
+            "NEWTONIAN EFFECT | seed {} | named {:?} | radiation {:.3} ± {:.3} status {} ΔBIC \
+             {:.1} n {:.4} κ {:.3} | base n {:.4} κ {:.3} | {:.1} s",
+            sc.seed,
+            r.most_likely_missing,
+            rad.map_or(f64::NAN, |c| c.strength()),
+            rad.map_or(f64::NAN, |c| c.stderr_strength()),
+            rad.map_or("-", |c| c.status.name()),
+            rad.map_or(f64::NAN, |c| c.delta_bic),
+            rad.map_or(f64::NAN, |c| c.n()),
+            rad.map_or(f64::NAN, |c| c.kappa()),
+            r.base_fit.n.value,
+            r.base_fit.kappa.value,
+            d.seconds
+        );
+    }
+    seconds.sort_by(f64::total_cmp);
+    let m = seeds.max(1) as f64;
+    println!(
+        "NEWTONIAN EFFECT SUMMARY | {seeds} replicates, emissivity {emissivity:.3} | radiation \
+         named {named} ({:.0} %) | diagnosis median {:.1} s max {:.1} s",
+        100.0 * named as f64 / m,
+        seconds.get(seconds.len() / 2).copied().unwrap_or(f64::NAN),
+        seconds.last().copied().unwrap_or(f64::NAN)
+    );
+    assert!(named as f64 >= 0.8 * m, "radiation named in {named} of {seeds}");
+}
