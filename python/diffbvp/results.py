@@ -282,11 +282,17 @@ def law_not_a_result(fit: Mapping[str, Any]) -> Optional[str]:
     result, or None: n or kappa at a bound of its range (no valid interval there), an
     ``implausible`` warning, or a ``misfit`` warning (the model misses the data by several
     times the noise) (the warning's finding up to the first colon). None where the law was not
-    fitted. The library's ``FitSummary::law_not_a_result`` rule and words (the text report's
-    ``NOT A RESULT:`` line, ``flow_curve.not_a_result``)."""
+    fitted; a bound is no reason where the Newtonian law is preferred
+    (``newtonian_test.law_not_estimated``: n and kappa are not estimates there). The library's
+    ``FitSummary::law_not_a_result`` rule and words (the text report's ``NOT A RESULT:`` line,
+    ``flow_curve.not_a_result``)."""
     if not any(p in ("n", "kappa") for p in fit.get("fitted", [])):
         return None
-    bounds = fit.get("at_bound", []) or []
+    # where the likelihood-ratio test prefers the Newtonian law, the result is that law and a
+    # bound of n or kappa is one of its corners (newtonian_test.law_not_estimated)
+    test = fit.get("newtonian_test") or {}
+    newtonian_law = bool(test.get("law_not_estimated"))
+    bounds = [] if newtonian_law else (fit.get("at_bound", []) or [])
     for name in ("n", "kappa"):
         for b in bounds:
             if b.get("parameter") != name:

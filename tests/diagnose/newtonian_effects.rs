@@ -93,5 +93,8 @@ fn radiation_on_a_newtonian_melt_is_named() {
         seconds.get(seconds.len() / 2).copied().unwrap_or(f64::NAN),
         seconds.last().copied().unwrap_or(f64::NAN)
     );
-    assert!(named as f64 >= 0.8 * m, "radiation named in {named} of {seeds}");
+    assert!(
+        named as f64 >= 0.8 * m,
+        "radiation named in {named} of {seeds}"
+    );
 }

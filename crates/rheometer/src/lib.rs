@@ -67,8 +67,9 @@
 //!    `layout` and `values` (`parameter_shift`, `thresholds`, `budget`, `curve`, `likelihood`
 //!    → `coverage`) → `objective`, `plan`, `landscape` → `summary` (the record of a fit: the
 //!    value, then what reads it, `checks`, `text`, `read`, then `build`) → `identify`
-//!    (`identification` → `accuracy` → `gauss_newton` → `nested`) → `uncertainty` (`profile`,
-//!    `flow_curve`, `error_budget`) → `summary::finding`);
+//!    (`identification` → `accuracy` → `gauss_newton` → `nested`) → `lr_calibration` (the
+//!    Newtonian test's calibrated p) → `uncertainty` (`profile`, `flow_curve`, `error_budget`)
+//!    → `summary::finding`);
 //! 7. `report::figures`, `report::flow_curve_figure`, `report::fit_html` (the HTML report of
 //!    a fit);
 //! 8. `diagnostics` (`compare`, `refits` (`scan`, `pair`, `consistency`), `candidate` →

@@ -44,6 +44,7 @@ pub mod estimator;
 pub(crate) mod identify;
 pub(crate) mod landscape;
 pub(crate) mod layout;
+mod lr_calibration;
 pub mod objective;
 pub(crate) mod options;
 pub(crate) mod plan;

@@ -177,6 +177,7 @@ pub fn fit(data: &LoadedExperiments, request: &FitRequest) -> Result<FitRun, Rhe
         Ok((found, test)) => {
             id.summary.intervals = found;
             id.summary.newtonian_test = test;
+            id.summary.drop_law_estimate_warnings();
             None
         }
         Err(e) => Some(e.to_string()),

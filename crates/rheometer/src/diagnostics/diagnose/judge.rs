@@ -9,7 +9,7 @@ use crate::diagnostics::candidate::{
     strength_status, unbounded_optimum, Candidate, ShapeAlternative, StrengthStatus,
 };
 use crate::diagnostics::diagnosis::ResidualProfiles;
-use crate::fit::summary::checks::law_jump;
+use crate::fit::summary::checks::{about_the_law_estimate, law_jump, PLAUSIBLE_N};
 use crate::fit::{FitSummary, Identification, WarningCode};
 use crate::model::effects::Effect;
 
@@ -101,14 +101,22 @@ fn credibility(
 }
 
 /// A refit whose material law is implausible (its own checks, or a jump from the plain fit
-/// `base` that the gain in fit does not pay for) is not credible, whatever its strength.
+/// `base` that the gain in fit does not pay for) is not credible, whatever its strength. A
+/// refit that ends in the law's other Newtonian corner (`n` below the plausible range with
+/// `K` beyond the data's stresses: the law Newtonian over the data's strain rates,
+/// [`FitSummary::law_newtonian_over_data`]) is a Newtonian melt with the effect: its `n` is no
+/// reason, nor its move from a plain fit that is Newtonian over the data too.
 fn plausibility(base: &FitSummary, refit: &FitSummary) -> Option<(StrengthStatus, Option<String>)> {
+    let corner = refit.n.value < PLAUSIBLE_N[0] && refit.law_newtonian_over_data();
     let own = refit
         .warnings
         .iter()
+        .filter(|w| !(corner && about_the_law_estimate(w)))
         .find(|w| w.code == WarningCode::Implausible)
         .map(|w| w.message.clone());
-    let jump = law_jump(base, refit).map(|(_, w)| w.message);
+    let jump = law_jump(base, refit)
+        .filter(|_| !(corner && base.law_newtonian_over_data()))
+        .map(|(_, w)| w.message);
     own.or(jump).map(|m| {
         (
             StrengthStatus::ImplausibleLaw,

@@ -245,6 +245,28 @@ pub(crate) fn check_fixed_effects(s: &FitSummary, w: &mut Vec<FitWarning>) {
     }
 }
 
+/// Whether `w` is one of this module's warnings about `n` or `κ` as an estimate: at a bound of
+/// its range, its standard error or interval too large, an implausible `n` (by the words the
+/// checks above and below write). Where the Newtonian law is preferred they are not estimates
+/// and these warnings do not apply ([`FitSummary::newtonian_on_data`]).
+pub(crate) fn about_the_law_estimate(w: &FitWarning) -> bool {
+    let m = w.message.as_str();
+    match w.code {
+        WarningCode::AtBound | WarningCode::Implausible => {
+            m.starts_with("n = ") || m.starts_with("kappa = ")
+        }
+        WarningCode::LargeUncertainty => [
+            "the standard error of n ",
+            "the standard error of kappa ",
+            "the 95% interval of K ",
+            "the 95% interval of n,",
+        ]
+        .iter()
+        .any(|p| m.starts_with(p)),
+        _ => false,
+    }
+}
+
 /// An implausible material law (`n` below [`PLAUSIBLE_N`], at a bound of its range or not:
 /// not a result), or a 95 % interval of `n` reaching beyond `[0, 1]` (the law's own range: the
 /// linearised interval is not reliable there; a large-uncertainty warning). An `n` at its

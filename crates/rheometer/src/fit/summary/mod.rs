@@ -454,13 +454,17 @@ impl FitSummary {
     /// explanations that disagree on the law), or a `misfit` warning (the model misses the
     /// data by several times the noise: the law compensates what the model lacks): the
     /// warning's finding up to its first colon.
-    /// `None` where the law was not fitted or is a result. The one rule for the fit's text,
+    /// `None` where the law was not fitted or is a result; where the likelihood-ratio test
+    /// prefers the Newtonian law ([`newtonian_on_data`](Self::newtonian_on_data)) a bound of
+    /// `n` or `κ` is no reason (the result is the Newtonian law within the data's strain rates). The one rule for the fit's text,
     /// figures, flow curve and HTML page.
     pub fn law_not_a_result(&self) -> Option<String> {
         if !self.law_fitted() {
             return None;
         }
-        if let Some(b) = self.law_at_bound() {
+        // where the Newtonian law is preferred the result is that law, not (n, κ): a bound
+        // of theirs is one of its corners
+        if let Some(b) = self.law_at_bound().filter(|_| !self.newtonian_on_data()) {
             let newtonian = b.parameter == "n" && b.side == BoundSide::Upper && b.bound == 1.0;
             return Some(format!(
                 "{} is at its {} bound {}, where the fit has no valid interval{}",

@@ -105,7 +105,7 @@ impl FitSummary {
         }
         s.push_str(&self.intervals_text());
         s.push_str(&self.flow_curve_text());
-        if self.correlation_n_kappa.is_finite() {
+        if self.correlation_n_kappa.is_finite() && !self.newtonian_on_data() {
             s.push_str("[[Correlations]]\n");
             s.push_str(&format!(
                 "    C(n, kappa) = {:+.4}\n",
@@ -262,6 +262,16 @@ impl FitSummary {
             s.push_str("    law:   Newtonian (n = 1 fixed; kappa and K do not enter)\n");
             return s;
         }
+        if self.newtonian_on_data() {
+            s.push_str(&format!(
+                "    law:   Newtonian within the data's strain rates; n and kappa are not \
+                 estimated (the fit's n = {}, kappa = {} is one of many laws Newtonian over \
+                 them)\n",
+                fmt_sig(self.n.value, 2),
+                fmt_sig(self.kappa.value, 3)
+            ));
+            return s;
+        }
         s.push_str(&self.estimate_line("n:    ", &self.n));
         s.push_str(&self.estimate_line("kappa:", &self.kappa));
         let k = &self.k_pa;
@@ -391,12 +401,23 @@ impl FitSummary {
         }
         if let Some(t) = &self.newtonian_test {
             s.push_str("[[Newtonian law (n = 1) against this fit: likelihood-ratio test]]\n");
-            s.push_str(&format!(
-                "    LR = {}, {} (null distribution ½χ²₀ + ½χ²₁; kappa is not identified \
-                 under n = 1, so p is approximate)\n",
-                fmt_sig(t.statistic, 3),
-                fmt_p(t.p_value)
-            ));
+            match t.p_mixture {
+                Some(pm) => s.push_str(&format!(
+                    "    LR = {}, {} calibrated ({} draws of the largest one-sided score over \
+                     kappa under the Newtonian fit; ½χ²₀ + ½χ²₁ would give {}, too small as \
+                     kappa is not identified under n = 1)\n",
+                    fmt_sig(t.statistic, 3),
+                    fmt_p(t.p_value),
+                    t.calibration_replicates,
+                    fmt_p(pm)
+                )),
+                None => s.push_str(&format!(
+                    "    LR = {}, {} (null distribution ½χ²₀ + ½χ²₁; kappa is not identified \
+                     under n = 1, so p is approximate)\n",
+                    fmt_sig(t.statistic, 3),
+                    fmt_p(t.p_value)
+                )),
+            }
             s.push_str(&format!(
                 "    RMS relative residual {:.3} % with the Newtonian law, {:.3} % with this fit: \
                  {}\n",

@@ -182,6 +182,25 @@ impl FlowCurve {
                 model.material.vft_t_vf
             ));
         }
+        // where the Newtonian law is preferred the curve is that law's (flat), its band the
+        // thinning the data still allow (FitSummary::profile_trace)
+        let newtonian: Vec<f64>;
+        let params = if summary.newtonian_on_data() {
+            newtonian = params
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| {
+                    if i == model.param_layout().law().start {
+                        1.0
+                    } else {
+                        v
+                    }
+                })
+                .collect();
+            &newtonian[..]
+        } else {
+            params
+        };
         // the coverage shifted from its reference temperature to t_c
         let eta0 = |t: f64| eta_with_law(model, params, &law_values(model, params), t, 0.0);
         let shift = eta0(cov_range.reference_temperature_k) / eta0(t_c);

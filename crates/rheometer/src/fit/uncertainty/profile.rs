@@ -24,19 +24,27 @@
 //!
 //! **Nested Newtonian law.** The Newtonian law is the Carreau-type law at `n = 1` (where `κ`
 //! no longer enters). The statistic `LR = (J_N − J)/σ̂²` of the Newtonian refit against the
-//! fit has, under the Newtonian law, the same boundary mixture as its null distribution:
-//! `p = ½ P(χ²₁ > LR)`. `κ` is not identified under the null, so this `p` is approximate
-//! (Davies 1987); the test prefers the Newtonian law when `p ≥ 0.05`.
+//! fit is compared with the boundary mixture, `p = ½ P(χ²₁ > LR)`. `κ` is not identified
+//! under the null, so this `p` is too small (Davies 1987): where it is below the level but not
+//! far below it (`CALIBRATION_FLOOR`) it is calibrated by a simulated reference distribution
+//! ([`lr_calibration`](super::lr_calibration)); the test prefers the Newtonian law when
+//! `p ≥ 0.05`. It runs before the profiles: where it prefers the Newtonian law, `n` and `κ` are
+//! not estimates (the law is Newtonian over the data at `n = 1` and at `n → 0` with `K` beyond
+//! the data's stresses alike) and are not profiled; the [`ThinningBound`] says how much
+//! thinning the data still allow instead.
 
 use crate::data::statistics::chi2_1_survival;
 use crate::fit::data::Rheometer;
 use crate::fit::identify::identification::{Identification, WarmFit};
 use crate::fit::layout::FitStart;
+use crate::fit::lr_calibration::{calibrated_p, REPLICATES};
 use crate::fit::options::{IdentifyOptions, RheometerError};
 use crate::fit::summary::{BoundSide, FitSummary, Z95};
+use crate::fit::values::likelihood::trace_of;
 pub use crate::fit::values::likelihood::{
     NewtonianTest, OneSidedBound, ProfileInterval, ProfilePoint, ThinningBound,
 };
+use crate::fit::values::thresholds::PLAUSIBLE_N;
 use crate::model::effects::{LawChoice, STRAIN_THINNING_REFERENCE_KAPPA};
 use diffbvp::solution::Solution;
 
@@ -56,6 +64,15 @@ const MAX_REFITS_PER_SIDE: usize = 8;
 const ROOT_TOLERANCE: f64 = 0.1;
 /// Significance level of the likelihood-ratio test.
 pub const LR_LEVEL: f64 = 0.05;
+/// Below this boundary-mixture p-value the test is not calibrated: the calibrated p of a
+/// statistic that large stays far below [`LR_LEVEL`] (Davies' bound `½P(χ²₁ > LR) +
+/// V e^{−LR/2}/(2π)` would need a total variation `V` of the thinning direction over `κ` of
+/// about 37 radians to reach the level from 1e-3, where a few radians are what the law has).
+const CALIBRATION_FLOOR: f64 = 1e-3;
+/// How far beyond `ln(η_E0 ε̇_max)` \[-\] the calibration's grid of `κ` and the onset's walk
+/// start: at `K` e³ = 20 times the data's largest stress the law changes the viscosity there by
+/// at most 0.12 % (`n = 0`), and its shape no longer changes with `κ`.
+const CALIBRATION_BEYOND: f64 = 3.0;
 
 /// Whether to compute profile intervals.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -190,7 +207,9 @@ impl Profiler<'_> {
         self.rh.identify_unchecked(&start, &opts, &wf)
     }
 
-    /// The likelihood-ratio test against the Newtonian law (`n = 1`, `κ` then irrelevant).
+    /// The likelihood-ratio test against the Newtonian law (`n = 1`, `κ` then irrelevant),
+    /// its p-value calibrated ([`lr_calibration`](super::lr_calibration)) where the boundary
+    /// mixture's is below [`LR_LEVEL`] but above [`CALIBRATION_FLOOR`].
     fn newtonian_test(&self) -> Result<NewtonianTest, RheometerError> {
         let hold: Vec<(String, f64)> = [("n", 1.0), ("kappa", STRAIN_THINNING_REFERENCE_KAPPA)]
             .into_iter()
@@ -201,24 +220,63 @@ impl Profiler<'_> {
         warm.law = [1.0, STRAIN_THINNING_REFERENCE_KAPPA];
         let n_id = self.refit_id(self.options, hold, &warm)?;
         let lr = ((2.0 * n_id.fit.cost - self.cost) / self.s2).max(0.0);
-        let p_value = 0.5 * chi2_1_survival(lr);
+        let mixture = 0.5 * chi2_1_survival(lr);
+        let (mut p_value, mut p_mixture, mut replicates) = (mixture, None, 0);
+        if (CALIBRATION_FLOOR..LR_LEVEL).contains(&mixture) {
+            let top = self.kappa_on().map_or(self.options.upper[1], |k| {
+                (k + CALIBRATION_BEYOND).min(self.options.upper[1])
+            });
+            let range = [self.options.lower[1], top];
+            let strengths = Warm::of(&n_id).strengths;
+            if let Some(p) = calibrated_p(self.rh, &n_id, &strengths, self.options, range, lr)? {
+                (p_value, p_mixture, replicates) = (p.max(mixture), Some(mixture), REPLICATES);
+            }
+        }
         let preferred = if p_value >= LR_LEVEL {
             LawChoice::Newtonian
         } else {
             LawChoice::Carreau
         };
-        let thinning_bound = if preferred == LawChoice::Newtonian {
-            self.thinning_bound(&n_id, lr)?
+        let (thinning_bound, law_not_estimated) = if preferred == LawChoice::Newtonian {
+            (
+                self.thinning_bound(&n_id, lr)?,
+                Some(
+                    "no strain thinning detected: the law is Newtonian within the data's strain \
+                     rates, at n = 1 and at n -> 0 with K beyond the data's stresses alike; the \
+                     fit's (n, kappa) is one of many such laws"
+                        .to_string(),
+                ),
+            )
         } else {
-            None
+            (None, None)
         };
         Ok(NewtonianTest {
             statistic: lr,
             p_value,
+            p_mixture,
+            calibration_replicates: replicates,
             rms_newtonian: n_id.rms(),
             preferred,
+            law_not_estimated,
             thinning_bound,
         })
+    }
+
+    /// `ln(η_E0(T_ref)·ε̇_max)`: the `κ` at which the law's thinning sets in at the largest
+    /// reduced strain rate the data cover (`None` without a coverage).
+    fn kappa_on(&self) -> Option<f64> {
+        let (cov, model) = (
+            self.id.summary.strain_rates.as_ref()?,
+            self.rh.models.first()?,
+        );
+        let sc = &model.scaling;
+        let eta0 = model.viscosity_at(
+            cov.reference_temperature_k / sc.reference.temperature,
+            0.0,
+            &self.id.local_params,
+        ) * sc.reference.viscosity;
+        let k = (eta0 * cov.reduced_per_s[2]).ln();
+        k.is_finite().then_some(k)
     }
 
     /// The [`ThinningBound`], from the Newtonian refit `newtonian` (deviance `lr`); `None`
@@ -228,22 +286,14 @@ impl Profiler<'_> {
         newtonian: &Identification,
         lr: f64,
     ) -> Result<Option<ThinningBound>, RheometerError> {
-        let (Some(cov), Some(model)) = (&self.id.summary.strain_rates, self.rh.models.first())
-        else {
+        let Some(kappa_on) = self.kappa_on() else {
             return Ok(None);
         };
         if !self.id.names.iter().any(|n| n == "n") {
             return Ok(None);
         }
-        let sc = &model.scaling;
-        let eta0 = model.viscosity_at(
-            cov.reference_temperature_k / sc.reference.temperature,
-            0.0,
-            &self.id.local_params,
-        ) * sc.reference.viscosity;
-        let kappa_on = (eta0 * cov.reduced_per_s[2]).ln();
         let mut options = self.options.clone();
-        if !(kappa_on.is_finite() && kappa_on > options.lower[1] + 0.1) {
+        if !(kappa_on > options.lower[1] + 0.1) {
             return Ok(None);
         }
         options.upper[1] = options.upper[1].min(kappa_on);
@@ -258,22 +308,102 @@ impl Profiler<'_> {
             step: 0.05,
             hold: &|t| vec![("n".to_string(), t)],
             options: &options,
-            warm,
+            warm: warm.clone(),
         };
         self.walk(walk, &mut points)?;
         let bound = crossing(&points, 1.0, -1.0, CHI2_90).unwrap_or(f64::NAN);
-        Ok(Some(ThinningBound {
-            n_lower95: bound,
-            k_max_pa: options.upper[1].exp(),
-            points: points
-                .into_iter()
+        let (onset, onset_points) = self.onset(newtonian, lr, kappa_on)?;
+        let to_points = |v: Vec<Sample>| {
+            v.into_iter()
                 .map(|(value, deviance, law)| ProfilePoint {
                     value,
                     deviance,
                     law,
                 })
-                .collect(),
+                .collect()
+        };
+        Ok(Some(ThinningBound {
+            n_lower95: bound,
+            k_max_pa: options.upper[1].exp(),
+            points: to_points(points),
+            onset_lower95_per_s: onset,
+            onset_points: to_points(onset_points),
         }))
+    }
+
+    /// The one-sided 95 % lower bound \[1/s\] on where the strongest thinning a melt shows
+    /// (`n` at [`PLAUSIBLE_N`]'s lower end, 0.2) sets in, `K_min/η_E0(T_ref)`, and its
+    /// refits: `κ` walked down in steps of 1 from [`CALIBRATION_BEYOND`] above `kappa_on`
+    /// (where that law is Newtonian on the data; deviance taken as the Newtonian refit's
+    /// `lr`), warm from the Newtonian refit `newtonian` and then from the last refit below
+    /// 2.71, until the deviance passes 2.71 (or a refit does not solve), then refined where
+    /// it crosses 2.71. Beyond the data's stresses the law's thinning there is
+    /// `∝ (η_E0 ε̇/K)² = e^{−2κ}·…`, so `√D` is about linear in `u = e^{−2κ}`: the secant
+    /// steps and the crossing are taken in `u`.
+    fn onset(
+        &self,
+        newtonian: &Identification,
+        lr: f64,
+        kappa_on: f64,
+    ) -> Result<(Option<f64>, Vec<Sample>), RheometerError> {
+        // n = 0 bounds the stress by K: no fiber solves where the draw needs more
+        let n_lo = PLAUSIBLE_N[0].max(self.options.lower[0]);
+        let (bottom, top) = (
+            self.options.lower[1],
+            (kappa_on + CALIBRATION_BEYOND).min(self.options.upper[1]),
+        );
+        let mut points = vec![(top, lr, vec![n_lo, top])];
+        let mut warm = Warm::of(newtonian);
+        warm.law = [n_lo, top];
+        let u = |k: f64| (-2.0 * (k - top)).exp();
+        // the crossing of D = 2.71 between an inside and an outside refit, linear in (u, √D)
+        let cross = |(ki, di): (f64, f64), (ko, dout): (f64, f64)| {
+            let (zi, zo, zc) = (di.max(0.0).sqrt(), dout.sqrt(), CHI2_90.sqrt());
+            let f = ((zc - zi) / (zo - zi)).clamp(0.0, 1.0);
+            -0.5 * (u(ki) + f * (u(ko) - u(ki))).ln() + top
+        };
+        let mut inside = (top, lr);
+        let mut outside: Option<(f64, f64)> = None;
+        let mut kappa = top - 1.0;
+        for _ in 0..2 * MAX_REFITS_PER_SIDE {
+            let hold = vec![("n".to_string(), n_lo), ("kappa".to_string(), kappa)];
+            match self.refit(self.options, hold, &warm) {
+                Ok(r) => {
+                    points.push((kappa, r.deviance, r.law.clone()));
+                    if (r.deviance / CHI2_90 - 1.0).abs() <= ROOT_TOLERANCE {
+                        return Ok((Some(self.onset_rate(kappa, kappa_on)), points));
+                    }
+                    if r.deviance < CHI2_90 {
+                        (inside, warm) = ((kappa, r.deviance), r.warm);
+                    } else {
+                        outside = Some((kappa, r.deviance));
+                    }
+                }
+                // no fiber solves with that law: beyond the data's reach
+                Err(_) => outside = Some((kappa, f64::INFINITY)),
+            }
+            kappa = match outside {
+                None if inside.0 <= bottom => return Ok((None, points)),
+                None => (inside.0 - 1.0).max(bottom),
+                Some(o) if o.1.is_finite() => cross(inside, o),
+                Some(o) => 0.5 * (inside.0 + o.0),
+            };
+        }
+        let k_min = outside
+            .filter(|o| o.1.is_finite())
+            .map(|o| cross(inside, o));
+        Ok((k_min.map(|k| self.onset_rate(k, kappa_on)), points))
+    }
+
+    /// The onset rate \[1/s\] `K/η_E0(T_ref)` of `K = e^kappa`, with `kappa_on` that of the
+    /// largest reduced rate.
+    fn onset_rate(&self, kappa: f64, kappa_on: f64) -> f64 {
+        (kappa - kappa_on).exp() * self.max_rate()
+    }
+
+    /// The largest reduced strain rate the data cover \[1/s\] (`NaN` without a coverage).
+    fn max_rate(&self) -> f64 {
+        (self.id.summary.strain_rates.as_ref()).map_or(f64::NAN, |c| c.reduced_per_s[2])
     }
 
     /// Walks from `w.theta` in direction `w.dir` until the deviance reaches [`CHI2_95`]
@@ -531,15 +661,20 @@ pub fn intervals(
             });
         }
     }
-    let mut out = Vec::new();
-    for t in &targets {
-        out.push(p.profile(t)?);
-    }
     let test = if id.names.iter().any(|n| n == "n") {
         Some(p.newtonian_test()?)
     } else {
         None
     };
+    // where the Newtonian law is preferred, n and κ are not estimates: no profiles of them
+    // (in the corner n → 0, K beyond the data, each of their refits is slow, too)
+    let newtonian = test.as_ref().is_some_and(|t| t.law_not_estimated.is_some());
+    let mut out = Vec::new();
+    for t in &targets {
+        if !(newtonian && (t.name == "n" || t.name == "kappa")) {
+            out.push(p.profile(t)?);
+        }
+    }
     Ok((out, test))
 }
 
@@ -547,14 +682,31 @@ impl FitSummary {
     /// Whether the flow curve's band follows the profile: a law parameter whose linearised
     /// interval is not trusted.
     pub fn profile_band_needed(&self) -> bool {
-        self.intervals
-            .iter()
-            .any(|i| (i.parameter == "n" || i.parameter == "kappa") && !i.linearised_trusted())
+        self.newtonian_on_data()
+            || self
+                .intervals
+                .iter()
+                .any(|i| (i.parameter == "n" || i.parameter == "kappa") && !i.linearised_trusted())
     }
 
     /// The laws `(n, κ)` along the law parameters' profiles within deviance `level` (the
-    /// optimum included).
+    /// optimum included); where the Newtonian law is preferred
+    /// ([`newtonian_on_data`](Self::newtonian_on_data)), the Newtonian law and the thinning
+    /// laws within `level` that the [`ThinningBound`] refitted (onset within the data, and
+    /// the strongest thinning's onset beyond them).
     pub fn profile_trace(&self, level: f64) -> Vec<Vec<f64>> {
+        if let Some(t) = self
+            .newtonian_test
+            .as_ref()
+            .filter(|_| self.newtonian_on_data())
+        {
+            let mut out = vec![vec![1.0, self.kappa.value]];
+            if let Some(b) = &t.thinning_bound {
+                out.extend(trace_of(&b.points, level));
+                out.extend(trace_of(&b.onset_points, level));
+            }
+            return out;
+        }
         let mut out = vec![self.law_params().to_vec()];
         for i in &self.intervals {
             if i.parameter == "n" || i.parameter == "kappa" {

@@ -17,7 +17,7 @@ pub const DRAWING_FRACTION: f64 = 0.01;
 
 /// The strain rates \[1/s\] of a fit's model at the measurement positions where the fiber
 /// draws (`DRAWING_FRACTION`) (JSON: `strain_rates` of a fit).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct StrainRateCoverage {
     /// Temperature the reduced rates refer to \[K\]: the median die (inlet) temperature.
     pub reference_temperature_k: f64,
@@ -29,6 +29,21 @@ pub struct StrainRateCoverage {
     pub reduced_per_s: [f64; 3],
     /// Coldest and hottest melt temperature at those positions \[K\].
     pub temperature_k: [f64; 2],
+    /// How much the fitted law thins at the largest reduced rate and `reference_temperature_k`,
+    /// `1 − η_E(ε̇_max)/η_E0` \[-\] (in memory only, for judging a law in the diagnosis;
+    /// `NaN` when read from JSON).
+    #[serde(skip, default = "crate::report::serde_nan::nan")]
+    pub thinning_at_max: f64,
+}
+
+/// Equal as written to JSON (`thinning_at_max`, in memory only, left out).
+impl PartialEq for StrainRateCoverage {
+    fn eq(&self, other: &Self) -> bool {
+        self.reference_temperature_k == other.reference_temperature_k
+            && self.measured_per_s == other.measured_per_s
+            && self.reduced_per_s == other.reduced_per_s
+            && self.temperature_k == other.temperature_k
+    }
 }
 
 impl Rheometer {
@@ -43,6 +58,15 @@ impl Rheometer {
         let t_ref = median(&mut inlet);
         let (mut raw, mut reduced) = (Vec::new(), Vec::new());
         let (mut t_lo, mut t_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let thinning = |rate: f64| -> f64 {
+            let (Some(model), Some(sol)) = (self.models.first(), solutions.first()) else {
+                return f64::NAN;
+            };
+            let sc = &model.scaling;
+            let t = t_ref / sc.reference.temperature;
+            let eta = |r: f64| model.viscosity_at(t, r / sc.strain_rate(), &sol.params);
+            1.0 - eta(rate) / eta(0.0)
+        };
         let mut y = [0.0; 4];
         let mut yp = [0.0; 4];
         for (k, sol) in solutions.iter().enumerate() {
@@ -77,11 +101,13 @@ impl Rheometer {
             let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             (lo.is_finite() && hi.is_finite()).then(|| [lo, median(v), hi])
         };
+        let reduced_per_s = three(&mut reduced)?;
         Some(StrainRateCoverage {
             reference_temperature_k: t_ref,
             measured_per_s: three(&mut raw)?,
-            reduced_per_s: three(&mut reduced)?,
+            reduced_per_s,
             temperature_k: [t_lo, t_hi],
+            thinning_at_max: thinning(reduced_per_s[2]),
         })
     }
 }

@@ -68,35 +68,41 @@ impl ProfileInterval {
     /// The points within the two-sided 95 % deviance plus the interpolated ends: the law along
     /// the profile that the data support.
     pub fn trace(&self, level: f64) -> Vec<Vec<f64>> {
-        let mut out: Vec<Vec<f64>> = Vec::new();
-        let mut pts: Vec<&ProfilePoint> = self.points.iter().collect();
-        pts.sort_by(|a, b| a.value.total_cmp(&b.value));
-        for w in pts.windows(2) {
-            let (a, b) = (w[0], w[1]);
-            if a.deviance <= level {
-                out.push(a.law.clone());
-            }
-            // the crossing of the level between a and b (linear in √D)
-            let (za, zb) = (a.deviance.max(0.0).sqrt(), b.deviance.max(0.0).sqrt());
-            let zc = level.sqrt();
-            if (za - zc) * (zb - zc) < 0.0 && a.law.len() == b.law.len() {
-                let f = (zc - za) / (zb - za);
-                out.push(
-                    a.law
-                        .iter()
-                        .zip(&b.law)
-                        .map(|(x, y)| x + f * (y - x))
-                        .collect(),
-                );
-            }
-        }
-        if let Some(last) = pts.last() {
-            if last.deviance <= level {
-                out.push(last.law.clone());
-            }
-        }
-        out
+        trace_of(&self.points, level)
     }
+}
+
+/// The laws of the refits `points` within deviance `level` plus the interpolated crossings of
+/// it (ordered by the held value).
+pub(crate) fn trace_of(points: &[ProfilePoint], level: f64) -> Vec<Vec<f64>> {
+    let mut out: Vec<Vec<f64>> = Vec::new();
+    let mut pts: Vec<&ProfilePoint> = points.iter().collect();
+    pts.sort_by(|a, b| a.value.total_cmp(&b.value));
+    for w in pts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if a.deviance <= level {
+            out.push(a.law.clone());
+        }
+        // the crossing of the level between a and b (linear in √D)
+        let (za, zb) = (a.deviance.max(0.0).sqrt(), b.deviance.max(0.0).sqrt());
+        let zc = level.sqrt();
+        if (za - zc) * (zb - zc) < 0.0 && a.law.len() == b.law.len() {
+            let f = (zc - za) / (zb - za);
+            out.push(
+                a.law
+                    .iter()
+                    .zip(&b.law)
+                    .map(|(x, y)| x + f * (y - x))
+                    .collect(),
+            );
+        }
+    }
+    if let Some(last) = pts.last() {
+        if last.deviance <= level {
+            out.push(last.law.clone());
+        }
+    }
+    out
 }
 
 /// The likelihood-ratio test of the fit against the nested Newtonian law (JSON:
@@ -105,15 +111,36 @@ impl ProfileInterval {
 pub struct NewtonianTest {
     /// `LR = (J_N − J)/σ̂²` \[-\].
     pub statistic: f64,
-    /// `½ P(χ²₁ > LR)` (boundary mixture; approximate, see `profile`).
+    /// The p-value the decision uses \[-\]: `½ P(χ²₁ > LR)` (boundary mixture), or where
+    /// that is below the level but not far below it, the calibrated one (see
+    /// `p_mixture`; `profile` explains both).
     pub p_value: f64,
+    /// Where `p_value` is calibrated: the boundary mixture's `½ P(χ²₁ > LR)` \[-\], which
+    /// `κ`, not identified under the Newtonian law, makes too small.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub p_mixture: Option<f64>,
+    /// Where `p_value` is calibrated: the simulated replicates of its reference distribution
+    /// (the largest one-sided score for strain thinning over a grid of `κ`, under the
+    /// Newtonian fit) \[-\]; 0: not calibrated.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub calibration_replicates: usize,
     /// RMS relative residual of the Newtonian refit \[-\].
     pub rms_newtonian: f64,
     /// The law the test prefers: Newtonian when `p ≥ 0.05`.
     pub preferred: LawChoice,
+    /// Where the Newtonian law is preferred: why `n` and `κ` are not estimates (the law is
+    /// Newtonian within the data's strain rates, at `n = 1` and at `n → 0` with `K` beyond
+    /// the data's stresses alike: the fit's point is one of many such laws). Absent: they
+    /// are estimates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub law_not_estimated: Option<String>,
     /// Where the Newtonian law is preferred: how much strain thinning the data still allow.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thinning_bound: Option<ThinningBound>,
+}
+
+fn is_zero(v: &usize) -> bool {
+    *v == 0
 }
 
 /// The one-sided 95 % lower bound on `n` for strain thinning that sets in within the strain
@@ -131,4 +158,14 @@ pub struct ThinningBound {
     pub k_max_pa: f64,
     /// The refits, `n = 1` first.
     pub points: Vec<ProfilePoint>,
+    /// The one-sided 95 % lower bound on where the strongest thinning a polymer melt shows
+    /// (`n = 0.2`; at `n → 0` the law bounds the stress by `K` and the fiber does not solve)
+    /// sets in: `K_min/η_E0(T_ref)` \[1/s\] at the coverage's temperature, `K_min` where the
+    /// deviance of the refits with `n` held there, `κ` walked down from beyond the data's
+    /// stresses, reaches 2.71 (`None`: not reached, or not computed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub onset_lower95_per_s: Option<f64>,
+    /// The refits of the onset's walk (`n` held at 0.2; value: `κ`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub onset_points: Vec<ProfilePoint>,
 }

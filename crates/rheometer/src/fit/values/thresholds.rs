@@ -30,6 +30,12 @@ pub const ILL_CONDITIONED_RCOND: f64 = 1e-10;
 /// compensating a model error, not describing a melt.
 pub const PLAUSIBLE_N: [f64; 2] = [0.2, 1.0];
 
+/// A fitted law that thins by less than this fraction \[-\] at the largest strain rate the
+/// data cover is Newtonian over them, whatever its `n`: about the thinning there of the laws
+/// the data cannot tell from the Newtonian one (the one-sided bound `n > 0.85` for `K` at the
+/// data's largest stress thins by 5 % there; `n → 0` with `K` e times beyond it by 6 %).
+pub(crate) const NEWTONIAN_THINNING: f64 = 0.05;
+
 /// A law that moved by more than this many of the plain fit's standard errors is checked
 /// against the gain in fit it bought ([`law_jump`](crate::fit::summary::checks::law_jump)).
 pub const JUMP_SE: f64 = 20.0;
