@@ -152,7 +152,7 @@ mod tests {
     fn one_direction_gives_the_boundary_mixture() {
         let u = DVector::from_fn(5, |i, _| if i == 0 { 1.0 } else { 0.0 });
         for lr in [0.5, 2.71, 3.84] {
-            let p = p_of(&[u.clone()], lr);
+            let p = p_of(std::slice::from_ref(&u), lr);
             let exact = 0.5 * crate::data::statistics::chi2_1_survival(lr);
             assert!((p - exact).abs() < 0.015, "{lr}: {p} vs {exact}");
         }

@@ -293,7 +293,7 @@ impl Profiler<'_> {
             return Ok(None);
         }
         let mut options = self.options.clone();
-        if !(kappa_on > options.lower[1] + 0.1) {
+        if kappa_on <= options.lower[1] + 0.1 {
             return Ok(None);
         }
         options.upper[1] = options.upper[1].min(kappa_on);
