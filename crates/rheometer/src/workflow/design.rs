@@ -1,6 +1,6 @@
 //! The `design` workflow: fit the model to the data (no error budget, no profile intervals:
 //! the design needs the estimate, its solutions and its noise level), then predict, for every
-//! candidate experiment, the uncertainty after adding it ([`design_for_estimation`]).
+//! candidate experiment, the uncertainty after adding it ([`design_for_estimation`](crate::design::design_for_estimation)).
 
 use super::fit::{fit, FitRequest, FitRun};
 use crate::data::input::LoadedExperiments;
@@ -63,7 +63,7 @@ pub struct DiscriminationRun {
 
 /// Fits the rivals — `fit_request`'s model plus each of `effects` (strength fitted) — to
 /// `data` (error budget and profile intervals off) and ranks the candidates of `request` by
-/// how well they tell them apart ([`design_for_discrimination`]).
+/// how well they tell them apart ([`design_for_discrimination`](crate::design::design_for_discrimination)).
 ///
 /// Errors: fewer than two effects, an effect given twice or already in the model, a fit that
 /// fails, and the design's errors.

@@ -65,7 +65,7 @@ impl FitSummary {
             && (self.newtonian_test.as_ref()).is_some_and(|t| t.law_not_estimated.is_some())
     }
 
-    /// Whether the fitted law thins by less than [`NEWTONIAN_THINNING`] at the largest strain
+    /// Whether the fitted law thins by less than 5 % (`NEWTONIAN_THINNING`) at the largest strain
     /// rate the data cover (at the coverage's temperature): Newtonian over the data's strain
     /// rates whatever its `n` (at `n → 0`, `K` beyond the data's stresses). In memory only
     /// (false for a fit read from JSON).
