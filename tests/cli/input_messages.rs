@@ -668,3 +668,63 @@ fn metres_in_a_micrometre_uncertainty_key_are_refused() {
         ],
     );
 }
+
+/// Finding D36: two experiments reading one data file (a copied table whose `data` was not
+/// changed) are warned about at the second's `data` key, whatever the path's spelling.
+#[test]
+fn two_experiments_reading_one_data_file_are_warned_about() {
+    let (dir, toml, data) = crate::probe::shipped_copy("shared_data_file");
+    let (out, out2) = (dir.join("out"), dir.join("out2"));
+    let v = crate::probe::variant(
+        &toml,
+        "shared.toml",
+        "data = \"v0p27_p2.csv\"",
+        "data = \"./v0p27_p1.csv\"",
+    );
+    let line = crate::probe::line_where(&v, |l| l.contains("./v0p27_p1.csv"));
+    let p = crate::probe::rheometer(
+        &[
+            "simulate",
+            crate::probe::s(&v),
+            "--n",
+            "0.8",
+            "--kappa",
+            "11.71",
+            "--take-up-from-data",
+            "--out",
+            crate::probe::s(&out),
+        ],
+        &[&data],
+        std::time::Duration::from_secs(60),
+    );
+    p.assert_success();
+    assert!(
+        p.stderr.contains(&format!(
+            "shared.toml:{line}: experiments v0p27_p1 and v0p27_p2 read the same data file"
+        )),
+        "{}",
+        p.stderr
+    );
+    // the shipped data set, every experiment with its own file: no such warning
+    let p = crate::probe::rheometer(
+        &[
+            "simulate",
+            crate::probe::s(&toml),
+            "--n",
+            "0.8",
+            "--kappa",
+            "11.71",
+            "--take-up-from-data",
+            "--out",
+            crate::probe::s(&out2),
+        ],
+        &[&data],
+        std::time::Duration::from_secs(60),
+    );
+    p.assert_success();
+    assert!(
+        !p.stderr.contains("read the same data file"),
+        "{}",
+        p.stderr
+    );
+}

@@ -164,3 +164,46 @@ pub(super) fn cross_check(
         ),
     }))
 }
+
+/// A warning at the `data` key of each experiment whose data file an earlier experiment reads
+/// too (the same file after resolving links and `.`/`..`): two experiments with one set of
+/// measurements is most likely a copied table whose `data` was not changed.
+pub(super) fn shared_data_files(
+    loaded: &LoadedExperiments,
+    located: &[Located],
+) -> Vec<InputWarning> {
+    let files: Vec<Option<std::path::PathBuf>> = loaded
+        .details
+        .iter()
+        .map(|d| {
+            d.data
+                .as_ref()
+                .map(|p| std::fs::canonicalize(p).unwrap_or_else(|_| p.clone()))
+        })
+        .collect();
+    let mut out = Vec::new();
+    for (i, file) in files.iter().enumerate() {
+        let Some(file) = file else { continue };
+        let Some(j) = files[..i].iter().position(|f| f.as_ref() == Some(file)) else {
+            continue;
+        };
+        let (first, second) = (
+            &loaded.set.experiments[j].name,
+            &loaded.set.experiments[i].name,
+        );
+        out.push(InputWarning {
+            at: located[i]
+                .data
+                .clone()
+                .unwrap_or_else(|| located[i].name.clone()),
+            message: format!(
+                "experiments {} and {} read the same data file {}: each experiment needs its own \
+                 measurements (a copied table whose `data` was not changed?)",
+                short(first, 60),
+                short(second, 60),
+                file.display()
+            ),
+        });
+    }
+    out
+}

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use toml::de::DeTable;
 
-use super::cross_checks::{check_experiment_memory, cross_check, data_error};
+use super::cross_checks::{check_experiment_memory, cross_check, data_error, shared_data_files};
 use super::csv_file::measurements::{read_measurements, DEFAULT_MIN_POINTS};
 use super::csv_file::row_budget::FitBudget;
 use super::error::{short, InputError};
@@ -60,6 +60,8 @@ pub fn load_experiments_with_options(
         let warning = cross_check(&loaded, i, located, options)?;
         loaded.warnings.extend(warning);
     }
+    let shared = shared_data_files(&loaded, &located);
+    loaded.warnings.extend(shared);
     Ok(loaded)
 }
 
