@@ -728,3 +728,27 @@ fn two_experiments_reading_one_data_file_are_warned_about() {
         p.stderr
     );
 }
+
+/// Finding D37: an experiments file reached through a symbolic link in another folder resolves
+/// its relative `data` paths from the link's folder; the missing CSV's error says so and names
+/// the file beside the link's target.
+#[cfg(unix)]
+#[test]
+fn a_linked_experiments_file_explains_where_data_paths_are_resolved() {
+    let (dir, toml, data) = crate::probe::shipped_copy("linked_experiments_file");
+    let other = dir.join("elsewhere");
+    std::fs::create_dir_all(&other).expect("scratch folder");
+    let link = other.join("experiments.toml");
+    std::os::unix::fs::symlink(&toml, &link).expect("symlink");
+    let p = crate::probe::rheometer(
+        &["fit", crate::probe::s(&link)],
+        &[&data],
+        std::time::Duration::from_secs(60),
+    );
+    p.assert_clean_failure(&[
+        "v0p27_p1.csv: cannot read file",
+        "is a symbolic link",
+        "resolved from the folder it was given in",
+        &format!("{} exists", data.join("v0p27_p1.csv").display()),
+    ]);
+}

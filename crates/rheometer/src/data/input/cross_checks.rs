@@ -4,6 +4,8 @@
 //! spin-line length against the measured range when the take-up diameter is to be extrapolated
 //! from the data.
 
+use std::path::Path;
+
 use super::error::{readable, short, sig, InputError, InputWarning, Location};
 use super::loaded::LoadedExperiments;
 use super::options::{estimated_fit_memory_bytes, show_bytes, show_count, Limit, LoadOptions};
@@ -18,6 +20,60 @@ pub(super) fn data_error(at: &Located, experiment: &str, cause: InputError) -> I
         experiment: short(experiment, 60),
         cause: Box::new(cause),
     }
+}
+
+/// A missing data file of an experiments file reached through a symbolic link (the file itself
+/// or a folder on its path) gets a hint: relative `data` paths are resolved from the folder the
+/// experiments file was given in, not from the link's target, and whether the file exists
+/// beside the target.
+pub(super) fn with_link_hint(experiments: &Path, data: &Path, cause: InputError) -> InputError {
+    let InputError::Io { path, source, hint } = cause else {
+        return cause;
+    };
+    if source.kind() != std::io::ErrorKind::NotFound || !hint.is_empty() {
+        return InputError::Io { path, source, hint };
+    }
+    let given = experiments.parent().unwrap_or(Path::new(""));
+    let given = if given.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        given
+    };
+    let (Ok(target), Ok(given_real)) = (
+        std::fs::canonicalize(experiments),
+        std::fs::canonicalize(given),
+    ) else {
+        return InputError::Io { path, source, hint };
+    };
+    let Some(target_dir) = target.parent() else {
+        return InputError::Io { path, source, hint };
+    };
+    if target_dir == given_real {
+        return InputError::Io { path, source, hint };
+    }
+    let beside_target = data
+        .strip_prefix(experiments.parent().unwrap_or(Path::new("")))
+        .ok()
+        .filter(|rel| rel.is_relative())
+        .map(|rel| target_dir.join(rel))
+        .filter(|p| p.is_file());
+    let hint = format!(
+        "; the experiments file {} is a symbolic link (or lies in a linked folder) to {}, and \
+         relative `data` paths are resolved from the folder it was given in ({}), not from the \
+         link's target{}",
+        experiments.display(),
+        target.display(),
+        given.display(),
+        match beside_target {
+            Some(found) => format!(
+                "; {} exists: give the experiments file by its own path, or `data` as an \
+                 absolute path",
+                found.display()
+            ),
+            None => String::new(),
+        }
+    );
+    InputError::Io { path, source, hint }
 }
 
 /// Refuses a data set whose experiments alone exceed the fit's memory cap (before any CSV is

@@ -6,7 +6,9 @@ use std::path::Path;
 
 use toml::de::DeTable;
 
-use super::cross_checks::{check_experiment_memory, cross_check, data_error, shared_data_files};
+use super::cross_checks::{
+    check_experiment_memory, cross_check, data_error, shared_data_files, with_link_hint,
+};
 use super::csv_file::measurements::{read_measurements, DEFAULT_MIN_POINTS};
 use super::csv_file::row_budget::FitBudget;
 use super::error::{short, InputError};
@@ -53,7 +55,13 @@ pub fn load_experiments_with_options(
         let Some(data) = &details.data else { continue };
         let experiment = &loaded.set.experiments[i];
         let measured = read_measurements(data, experiment.spinline_length, options, &mut budget)
-            .map_err(|cause| data_error(&located[i], &experiment.name, cause))?;
+            .map_err(|cause| {
+                data_error(
+                    &located[i],
+                    &experiment.name,
+                    with_link_hint(path, data, cause),
+                )
+            })?;
         loaded.set.measurements[i] = Some(measured);
     }
     for (i, located) in located.iter().enumerate() {
