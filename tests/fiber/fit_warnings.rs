@@ -802,3 +802,49 @@ fn a_fit_stopped_short_of_its_optimum_says_so_and_a_converged_one_does_not() {
         "predicted {predicted}, reached {chi2}"
     );
 }
+
+/// Finding D58: noise-free diameters (the simulator's own profiles at the measured positions'
+/// kind of sampling) get a `noise_free` warning naming the level, in the text and the JSON; the
+/// shipped, noisy data do not (see `shipped_data_fit_has_no_warning`).
+#[test]
+fn noise_free_data_are_warned_about() {
+    let (dir, toml, data) = probe::shipped_copy("fw_noise_free");
+    let sim = dir.join("simulated");
+    let p = probe::rheometer(
+        &[
+            "simulate",
+            toml.to_str().unwrap(),
+            "--n",
+            "0.8",
+            "--kappa",
+            "11.71",
+            "--take-up-from-data",
+            "--out",
+            sim.to_str().unwrap(),
+        ],
+        &[&data],
+        LIMIT,
+    );
+    p.assert_success();
+    // each experiment's data replaced by its simulated profile (position and diameter only)
+    for entry in std::fs::read_dir(&data).unwrap() {
+        let csv = entry.unwrap().path();
+        if csv.extension().and_then(|e| e.to_str()) != Some("csv") {
+            continue;
+        }
+        let stem = csv.file_stem().unwrap().to_str().unwrap();
+        let profile = std::fs::read_to_string(sim.join(format!("{stem}_profile.csv"))).unwrap();
+        let mut out = String::from("position_m,diameter_m\n");
+        for row in profile.lines().skip(1) {
+            let cols: Vec<&str> = row.split(',').collect();
+            out.push_str(&format!("{},{}\n", cols[0], cols[cols.len() - 1]));
+        }
+        std::fs::write(&csv, out).unwrap();
+    }
+    let (p, v) = fit_cli(&toml, &data, &dir);
+    assert!(codes(&v).contains(&"noise_free".to_string()), "{v}");
+    assert!(warning_with(&v, "noise_free", "the data look noise-free"));
+    let level = 100.0 * v["noise"]["level"].as_f64().unwrap();
+    assert!(level < 1e-3, "noise level {level} %");
+    assert!(p.stdout.contains("WARNING [noise_free]"), "{}", p.stdout);
+}

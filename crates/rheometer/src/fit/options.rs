@@ -250,6 +250,9 @@ pub enum WarningCode {
     /// or a collapsed trust region) where its linearisation still places the optimum at least
     /// one unit of `χ²` lower: the estimates and intervals may belong to a point short of it.
     NotConverged,
+    /// The estimated noise level is far below any diameter gauge's resolution: the data look
+    /// noise-free (synthetic or smoothed), and intervals from them are not meaningful.
+    NoiseFree,
 }
 
 impl WarningCode {
@@ -266,6 +269,7 @@ impl WarningCode {
             WarningCode::Implausible => "implausible",
             WarningCode::Unphysical => "unphysical",
             WarningCode::NotConverged => "not_converged",
+            WarningCode::NoiseFree => "noise_free",
         }
     }
 }

@@ -234,6 +234,7 @@ impl FitSummary {
             &mut w,
         );
         checks::check_misfit(&summary, &mut w);
+        checks::check_noise_free(&summary, &mut w);
         checks::check_convergence(fit, &mut w);
         checks::check_law(&summary, &mut w);
         checks::check_fixed_effects(&summary, &mut w);

@@ -27,6 +27,7 @@ use crate::fit::estimator::Estimator;
 use crate::fit::layout::EffectSlot;
 use crate::fit::options::{FitWarning, WarningCode};
 use crate::fit::summary::{BoundSide, FitSummary};
+use crate::fit::values::thresholds::NOISE_FREE_LEVEL;
 pub use crate::fit::values::thresholds::{
     AT_BOUND_TOLERANCE, ILL_CONDITIONED_RCOND, IMPLAUSIBLE_NOISE_RATIO, JUMP_SE,
     LARGE_STDERR_KAPPA, LARGE_STDERR_N, LARGE_STDERR_STRENGTH_FRACTION, MISFIT_RATIO,
@@ -471,11 +472,64 @@ pub(crate) fn check_misfit(s: &FitSummary, w: &mut Vec<FitWarning>) {
     w.push(FitWarning::new(WarningCode::Misfit, m));
 }
 
+/// A noise level estimated from the residuals below [`NOISE_FREE_LEVEL`]: the data look
+/// noise-free, and the intervals, which scale with the noise, are not meaningful (a declared
+/// level is the user's statement and is not second-guessed).
+pub(crate) fn check_noise_free(s: &FitSummary, w: &mut Vec<FitWarning>) {
+    let level = s.noise.level;
+    if s.noise.declared() || !(0.0..NOISE_FREE_LEVEL).contains(&level) {
+        return;
+    }
+    w.push(FitWarning::new(
+        WarningCode::NoiseFree,
+        format!(
+            "the data look noise-free: the noise level estimated from the residuals, {} %, is \
+             far below any diameter gauge's resolution (synthetic or smoothed data?); standard \
+             errors and intervals scale with the noise and are not meaningful here: fit the \
+             measured diameters, add realistic noise to synthetic data, or declare the gauge's \
+             relative_uncertainty at the top of the TOML",
+            fmt_g(100.0 * level)
+        ),
+    ));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::fit::summary::tests::refit_summary;
     use crate::fit::summary::{AtBound, BoundSide};
+
+    /// Finding D58: a noise level estimated far below a gauge's resolution is warned about
+    /// (the level printed), a realistic one is not, and a declared one is the user's word.
+    #[test]
+    fn noise_free_data_are_said_to_be_noise_free() {
+        let mut s = refit_summary("radiation", (0.5, 0.1), (0.8, 0.01), (11.7, 0.05));
+        let warned = |s: &FitSummary| {
+            let mut w = Vec::new();
+            check_noise_free(s, &mut w);
+            w
+        };
+        s.noise.source = crate::data::noise_summary::NoiseSource::Estimated;
+        s.noise.level = 2.4e-8;
+        let w = warned(&s);
+        assert_eq!(w.len(), 1);
+        assert_eq!(w[0].code, WarningCode::NoiseFree);
+        assert!(w[0].message.contains("2.4000e-6 %"), "{}", w[0].message);
+        s.noise.level = 0.0;
+        assert_eq!(warned(&s).len(), 1, "an exact fit is noise-free too");
+        s.noise.level = 1.2e-5;
+        assert!(warned(&s).is_empty(), "1.2e-5 is above the line");
+        s.noise.level = 0.015;
+        assert!(warned(&s).is_empty());
+        s.noise.level = f64::NAN;
+        assert!(warned(&s).is_empty(), "no level, no claim");
+        s.noise.source = crate::data::noise_summary::NoiseSource::Declared;
+        s.noise.level = 1e-8;
+        assert!(
+            warned(&s).is_empty(),
+            "a declared level is not second-guessed"
+        );
+    }
 
     /// A refit moved 30 standard errors of the plain fit's `n` with a gain of 100 in units
     /// of the noise variance (worth 900): a jump from a plausible law, none from an
