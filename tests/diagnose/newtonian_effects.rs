@@ -30,6 +30,56 @@ fn newtonian_radiating(emissivity: f64, seed: u64) -> Scenario {
     }
 }
 
+/// The diagnosis of a Newtonian melt (independent model, no effect) reports its law as the fit
+/// does: Newtonian within the data's strain rates, `n` and `κ` not estimates (the fit's test
+/// attached to the base fit, no warnings about them as estimates), in the text and the JSON;
+/// nothing named. A melt that thins (the independent model's default `n = 0.8`) keeps its law
+/// as an estimate.
+#[test]
+fn a_newtonian_melt_is_reported_newtonian_by_the_diagnosis() {
+    for seed in [115, 6701] {
+        let sc = Scenario {
+            seed,
+            ..scenarios::newtonian()
+        };
+        let d = shared::diagnosed(&sc);
+        let g = &d.run.diagnosis;
+        assert!(g.found.is_empty(), "seed {seed}: named {:?}", g.found);
+        let b = &g.base_fit;
+        assert!(b.newtonian_on_data(), "seed {seed}: {:?}", b.newtonian_test);
+        let about_the_law = |m: &str| {
+            [
+                "the standard error of n",
+                "the standard error of kappa",
+                "the 95% interval of n",
+            ]
+            .iter()
+            .any(|p| m.starts_with(p))
+                || m.contains("leaves the law undetermined")
+        };
+        assert!(
+            !b.warnings.iter().any(|w| about_the_law(&w.message)),
+            "seed {seed}: {:?}",
+            b.warnings
+        );
+        let text = g.to_text();
+        assert!(
+            text.contains("Its law is Newtonian within the data's strain rates"),
+            "seed {seed}:\n{text}"
+        );
+        let json = serde_json::to_string(&g.json()).unwrap();
+        assert!(json.contains("\"law_not_estimated\""), "seed {seed}");
+    }
+    let thinning = shared::diagnosed(&scenarios::control());
+    let b = &thinning.run.diagnosis.base_fit;
+    assert!(!b.newtonian_on_data() && b.newtonian_test.is_none());
+    assert!(!thinning
+        .run
+        .diagnosis
+        .to_text()
+        .contains("Its law is Newtonian"));
+}
+
 #[test]
 #[ignore = "slow: one diagnosis per replicate (minutes on 2 cores)"]
 fn radiation_on_a_newtonian_melt_is_named() {

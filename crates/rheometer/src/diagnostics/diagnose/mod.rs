@@ -64,6 +64,7 @@ mod ambiguity;
 mod base;
 mod judge;
 mod linear;
+mod newtonian;
 mod pairs;
 mod search;
 mod shapes;
@@ -237,7 +238,9 @@ pub fn diagnose(
         None
     };
     times.pairs_s = t_pairs.elapsed().as_secs_f64();
+    let (spec0, opts0) = (steps[0].spec.clone(), steps[0].opts.clone());
     let mut run = assemble(set, steps, pair, options, t0);
+    newtonian::newtonian_law(set, &spec0, &opts0, &mut run);
     run.diagnosis.stopped = stopped;
     times.rest_s = (run.diagnosis.wall_time_s - times.steps_s() - times.pairs_s).max(0.0);
     run.diagnosis.stage_times = times;

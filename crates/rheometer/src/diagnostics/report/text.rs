@@ -93,6 +93,13 @@ impl Diagnosis {
         if let Some(r) = &self.robust {
             s.push_str(&format!("{}\n", r.words()));
         }
+        if b.newtonian_on_data() {
+            s.push_str(&format!(
+                "Its law is Newtonian within the data's strain rates; n and kappa are not \
+                 estimated: {}.\n",
+                b.law_finding()
+            ));
+        }
         for w in &b.warnings {
             s.push_str(&format!("WARNING about your model's fit: {w}\n"));
         }

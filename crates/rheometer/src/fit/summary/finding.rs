@@ -76,8 +76,8 @@ impl FitSummary {
 
     /// Where the Newtonian law is preferred ([`newtonian_on_data`](Self::newtonian_on_data)):
     /// the warnings about `n` and `κ` as estimates (at a bound, their uncertainty, an
-    /// implausible `n`, a covariance ill-conditioned by `κ` not entering) dropped, they are
-    /// not estimates.
+    /// implausible `n`, a covariance ill-conditioned by `κ` not entering, a systematic
+    /// uncertainty of `κ` "leaving the law undetermined") dropped, they are not estimates.
     pub(crate) fn drop_law_estimate_warnings(&mut self) {
         if !self.newtonian_on_data() {
             return;
@@ -85,6 +85,7 @@ impl FitSummary {
         let no_effects = self.effects.iter().all(|e| !e.strength.fitted);
         self.warnings.retain(|w| {
             !(super::checks::about_the_law_estimate(w)
+                || w.code == WarningCode::Systematic
                 || (no_effects && w.code == WarningCode::IllConditioned))
         });
     }

@@ -616,6 +616,30 @@ fn crossing(points: &[Sample], theta: f64, dir: f64, level: f64) -> Option<f64> 
     None
 }
 
+/// The likelihood-ratio test of `id` against the Newtonian law alone (no profile intervals),
+/// under the same conditions as [`intervals`]: `None` where `n` is not fitted, for the paper's
+/// estimator, or where the model misses the data.
+pub(crate) fn newtonian_test_of(
+    rh: &Rheometer,
+    id: &Identification,
+    options: &IdentifyOptions,
+) -> Result<Option<NewtonianTest>, RheometerError> {
+    if !id.names.iter().any(|n| n == "n")
+        || options.estimator != crate::fit::estimator::Estimator::Principled
+        || id.summary.likelihood_skipped().is_some()
+    {
+        return Ok(None);
+    }
+    let p = Profiler {
+        rh,
+        id,
+        options,
+        cost: 2.0 * id.fit.cost,
+        s2: id.fit.residual_variance(),
+    };
+    p.newtonian_test().map(Some)
+}
+
 /// The profile intervals of `id`'s fitted law parameters and strengths (not shapes) and the
 /// likelihood-ratio test against the Newtonian law (where `n` is fitted); none for the paper's
 /// estimator (its cost is not a likelihood). Under a robust loss the deviance is that of the
