@@ -49,6 +49,40 @@ fn design_runs_on_the_shipped_data_and_names_the_top_experiment() {
     assert!(stdout.contains("ranked by the D-criterion"), "{stdout}");
     let csv = std::fs::read_to_string(dir.join("design.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 9, "{csv}");
+    // a melt that thins: its (n, kappa) are estimates, no Newtonian note
+    assert!(
+        !stdout.contains("the data show no strain thinning"),
+        "{stdout}"
+    );
+}
+
+/// On a Newtonian melt (`data/newtonian_melt`, by the independent test model) the design says
+/// that the `(n, kappa)` it ranks by are the fit's point in the Newtonian corner, not
+/// estimates, in the text and the JSON's notes.
+#[test]
+fn design_on_a_newtonian_melt_says_n_and_kappa_are_not_estimates() {
+    let dir = out_dir("design_cli_newtonian");
+    let out = Command::new(env!("CARGO_BIN_EXE_rheometer"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args([
+            "design",
+            "data/newtonian_melt/experiments.toml",
+            "--grid",
+            "3x3",
+        ])
+        .args(["--out", dir.to_str().unwrap()])
+        .output()
+        .expect("the rheometer binary runs");
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("the data show no strain thinning") && stdout.contains("not estimates"),
+        "{stdout}"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("design.json")).unwrap()).unwrap();
+    let first = v["notes"][0].as_str().unwrap_or_default();
+    assert!(first.starts_with("the data show no strain thinning"), "{v}");
 }
 
 #[test]

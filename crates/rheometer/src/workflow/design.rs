@@ -9,7 +9,7 @@ use crate::design::estimation::design_for_estimation_with;
 use crate::design::{
     Design, DesignEstimate, DesignRequest, Discrimination, DiscriminationRequest, Rival,
 };
-use crate::fit::uncertainty::profile::ProfileMode;
+use crate::fit::uncertainty::profile::{newtonian_test_of, ProfileMode};
 use crate::fit::RheometerError;
 use crate::model::effects::{Effect, EffectSetting};
 
@@ -47,9 +47,29 @@ pub fn design_with_estimate(
     fr.baseline = false;
     fr.newtonian_reference = false;
     let run = fit(data, &fr)?;
-    let design =
+    let mut design =
         design_for_estimation_with(&run.rheometer, &run.identification, request, estimate)?;
+    if newtonian_on_data(&run, &fr) {
+        design.notes.insert(
+            0,
+            "the data show no strain thinning (the Newtonian law fits as well: likelihood-ratio \
+             test as in `fit`): n and kappa below are the fit's point in the Newtonian corner, \
+             not estimates, and the predicted uncertainties are linearised there; read the \
+             ranking as the direction that stretches the melt faster (where thinning would \
+             show), not as a predicted precision"
+                .into(),
+        );
+    }
     Ok(DesignRun { fit: run, design })
+}
+
+/// Whether the fit's law is Newtonian within the data's strain rates (the fit's
+/// likelihood-ratio test, which the design's fit skips with the profile intervals).
+fn newtonian_on_data(run: &FitRun, request: &FitRequest) -> bool {
+    matches!(
+        newtonian_test_of(&run.rheometer, &run.identification, &request.identify),
+        Ok(Some(t)) if t.law_not_estimated.is_some()
+    )
 }
 
 /// The outcome of the discrimination workflow.
