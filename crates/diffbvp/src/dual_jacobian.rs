@@ -2,8 +2,8 @@
 //!
 //! A function `out = F(input)` written generically over [`DualNum`] is evaluated with static
 //! vector duals ([`DenseDual64<W>`]) that carry `W` directional derivatives at once, always
-//! stored (num-dual's `DualSVec64<W>`, whose slopes are optional, made the fiber model's 4-wide
-//! pass 2.0× and its 8-wide pass 1.8× slower). Derivatives with respect to the seeded inputs
+//! stored (num-dual's `DualSVec64<W>`, whose slopes are optional, branches on every operation;
+//! the measured cost is in `benches/README.md`). Derivatives with respect to the seeded inputs
 //! ([`Seeds`]: the first `n_seeds`, or a list) are computed in `ceil(n_seeds / W)` passes; the
 //! remaining inputs are constants. The width `W ∈ {1, 2, 4, 8}` is chosen from `n_seeds`, so a
 //! 4-state right-hand side needs one pass. Buffers are kept between calls: no allocation once

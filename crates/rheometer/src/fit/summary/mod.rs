@@ -498,8 +498,8 @@ impl FitSummary {
     /// noise). Both read the deviance as a likelihood of a model that describes the data up to the
     /// noise; where it misses them by several times the noise they would be statements about
     /// a wrong model (the law is no result either, see [`law_not_a_result`](Self::law_not_a_result)),
-    /// and their refits of such a model are slow (the shipped data with the air at 600 K:
-    /// 3.7 s of profiles and test after a fit of 0.02 s). `None`: they are computed.
+    /// and their refits of such a model are slow (each walks far from the optimum of a model
+    /// that does not fit). `None`: they are computed.
     pub fn likelihood_skipped(&self) -> Option<String> {
         self.misfit_warned().then(|| {
             let noise = self.noise.level;
