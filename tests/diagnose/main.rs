@@ -5,6 +5,7 @@
 mod independent;
 
 mod ci_coverage;
+mod clean_white_noise;
 mod detection_limits;
 mod diagnose_candidates;
 mod diagnose_hidden_effects;
