@@ -5,7 +5,6 @@
 mod independent;
 
 mod ci_coverage;
-mod clean_white_noise;
 mod detection_limits;
 mod diagnose_candidates;
 mod diagnose_hidden_effects;
@@ -14,5 +13,6 @@ mod diagnose_scan;
 mod diagnose_separability;
 mod global;
 mod newtonian_effects;
+mod noise_rates;
 mod shared;
 mod user_effect_descriptor;

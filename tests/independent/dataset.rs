@@ -129,6 +129,9 @@ pub struct Scenario {
     pub noise_sd: f64,
     /// Noise near the take-up: σ times this factor for `s > 0.8 L` (1: uniform noise).
     pub take_up_noise: f64,
+    /// Lag-1 autocorrelation of the noise along each line, an AR(1) process in the points'
+    /// order (0: white noise; 0.5: as from a vibrating fiber or a slow gauge) [-].
+    pub noise_lag1: f64,
     /// Strain hardening β of the melt [-] (see [`Line::hardening`]; 0: none).
     pub hardening: f64,
     /// Seed of the noise.
@@ -207,6 +210,11 @@ impl Scenario {
             .iter()
             .enumerate()
             .map(|(k, d)| {
+                // AR(1) along the line, unit variance: e_i = ρ e_(i-1) + √(1 - ρ²) z_i,
+                // started from its stationary distribution (white noise at ρ = 0, the same
+                // draws as without correlation)
+                let rho = self.noise_lag1;
+                let mut e: Option<f64> = None;
                 d.iter()
                     .zip(&self.experiments[k].positions)
                     .map(|(&di, &s)| {
@@ -215,7 +223,13 @@ impl Scenario {
                         } else {
                             self.noise_sd
                         };
-                        (di * f.gauge_factor + f.gauge_offset_m) * (1.0 + sd * rng.normal())
+                        let z = rng.normal();
+                        let now = match e {
+                            Some(prev) => rho * prev + (1.0 - rho * rho).sqrt() * z,
+                            None => z,
+                        };
+                        e = Some(now);
+                        (di * f.gauge_factor + f.gauge_offset_m) * (1.0 + sd * now)
                     })
                     .collect()
             })

@@ -58,6 +58,7 @@ fn base(name: &'static str, seed: u64) -> Scenario {
         faults: Faults::none(),
         noise_sd: NOISE_SD,
         take_up_noise: 1.0,
+        noise_lag1: 0.0,
         hardening: 0.0,
         seed,
         acceptable: vec![],
