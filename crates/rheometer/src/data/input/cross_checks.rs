@@ -221,9 +221,10 @@ pub(super) fn cross_check(
     }))
 }
 
-/// A warning at the `data` key of each experiment whose data file an earlier experiment reads
-/// too (the same file after resolving links and `.`/`..`): two experiments with one set of
-/// measurements is most likely a copied table whose `data` was not changed.
+/// One warning per data file that several experiments read (the same file after resolving
+/// links and `.`/`..`), at the `data` key of the second of them, naming the first two and how
+/// many more: two experiments with one set of measurements is most likely a copied table whose
+/// `data` was not changed.
 pub(super) fn shared_data_files(
     loaded: &LoadedExperiments,
     located: &[Located],
@@ -237,29 +238,35 @@ pub(super) fn shared_data_files(
                 .map(|p| std::fs::canonicalize(p).unwrap_or_else(|_| p.clone()))
         })
         .collect();
-    let mut out = Vec::new();
+    // the experiments of each file, in the order of the experiments file
+    let mut readers: Vec<(&std::path::PathBuf, Vec<usize>)> = Vec::new();
     for (i, file) in files.iter().enumerate() {
         let Some(file) = file else { continue };
-        let Some(j) = files[..i].iter().position(|f| f.as_ref() == Some(file)) else {
-            continue;
-        };
-        let (first, second) = (
-            &loaded.set.experiments[j].name,
-            &loaded.set.experiments[i].name,
-        );
-        out.push(InputWarning {
-            at: located[i]
+        match readers.iter_mut().find(|(f, _)| *f == file) {
+            Some((_, r)) => r.push(i),
+            None => readers.push((file, vec![i])),
+        }
+    }
+    let name = |i: usize| short(&loaded.set.experiments[i].name, 60);
+    readers
+        .into_iter()
+        .filter(|(_, r)| r.len() > 1)
+        .map(|(file, r)| InputWarning {
+            at: located[r[1]]
                 .data
                 .clone()
-                .unwrap_or_else(|| located[i].name.clone()),
+                .unwrap_or_else(|| located[r[1]].name.clone()),
             message: format!(
-                "experiments {} and {} read the same data file {}: each experiment needs its own \
-                 measurements (a copied table whose `data` was not changed?)",
-                short(first, 60),
-                short(second, 60),
+                "experiments {} and {}{} read the same data file {}: each experiment needs its \
+                 own measurements (a copied table whose `data` was not changed?)",
+                name(r[0]),
+                name(r[1]),
+                match r.len() - 2 {
+                    0 => String::new(),
+                    more => format!(" (and {more} more)"),
+                },
                 file.display()
             ),
-        });
-    }
-    out
+        })
+        .collect()
 }
