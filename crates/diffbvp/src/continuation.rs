@@ -225,6 +225,42 @@ fn count_solve(path: &mut ContinuationPath, s: &Solution) {
     path.total_rhs_evaluations += s.stats.total_rhs_evaluations();
 }
 
+/// The stall check before a step of [`adapter`]: an error once the `attempts` exceed
+/// `max_steps` or the step falls below the minimum (`at = [c, target, step, min_step]`), with
+/// the last failed solve (taken from `last_error`) as its cause.
+fn check_stall(
+    attempts: usize,
+    max_steps: usize,
+    [c, target, step, min_step]: [f64; 4],
+    last_error: &mut Option<BvpError>,
+) -> Result<(), BvpError> {
+    if attempts > max_steps {
+        return Err(BvpError::ContinuationStalled {
+            reached: c,
+            target,
+            step,
+            min_step,
+            last_error: Box::new(last_error.take().unwrap_or_else(|| {
+                BvpError::InvalidInput(format!("more than {max_steps} continuation steps"))
+            })),
+        });
+    }
+    if step < min_step {
+        return Err(BvpError::ContinuationStalled {
+            reached: c,
+            target,
+            step,
+            min_step,
+            last_error: Box::new(
+                last_error
+                    .take()
+                    .unwrap_or_else(|| BvpError::InvalidInput("step below minimum".into())),
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The paper's Algorithm 1 (Adapter), options already checked.
 fn adapter<P: Bvp>(
     solver: &mut Solver<'_, P>,
@@ -247,32 +283,12 @@ fn adapter<P: Bvp>(
     let mut attempts = 0;
     while (target - c) * dir > 0.0 {
         attempts += 1;
-        if attempts > options.max_steps {
-            return Err(BvpError::ContinuationStalled {
-                reached: c,
-                target,
-                step,
-                min_step,
-                last_error: Box::new(last_error.unwrap_or_else(|| {
-                    BvpError::InvalidInput(format!(
-                        "more than {} continuation steps",
-                        options.max_steps
-                    ))
-                })),
-            });
-        }
-        if step < min_step {
-            return Err(BvpError::ContinuationStalled {
-                reached: c,
-                target,
-                step,
-                min_step,
-                last_error: Box::new(
-                    last_error
-                        .unwrap_or_else(|| BvpError::InvalidInput("step below minimum".into())),
-                ),
-            });
-        }
+        check_stall(
+            attempts,
+            options.max_steps,
+            [c, target, step, min_step],
+            &mut last_error,
+        )?;
         let h = step.min((target - c).abs());
         let c_full = if h == (target - c).abs() {
             target

@@ -329,38 +329,49 @@ impl<'a> Parser<'a> {
         let name = self.ident();
         let is_call = self.peek() == Some(b'(');
         if is_call {
-            if let Some(f) = Func::from_name(name) {
-                let mut a = self.args(name, start, 1)?;
-                return Ok(Node::Call(f, Box::new(a.remove(0))));
-            }
-            let bin = match name {
-                "atan2" => Some(BinOp::Atan2),
-                "min" | "Min" => Some(BinOp::Min),
-                "max" | "Max" => Some(BinOp::Max),
-                "pow" | "Pow" => Some(BinOp::Pow),
-                _ => None,
-            };
-            if let Some(op) = bin {
-                let a = self.args(name, start, 2)?;
-                let count = a.len();
-                let Ok([a, b]) = <[Node; 2]>::try_from(a) else {
-                    return Err(self.err(start, format!("{name} takes 2 arguments, got {count}")));
-                };
-                return Ok(Node::Bin(op, Box::new(a), Box::new(b)));
-            }
-            if name == "where" {
-                let a = self.args(name, start, 3)?;
-                let count = a.len();
-                let Ok([c, t, b]) = <[Node; 3]>::try_from(a) else {
-                    return Err(self.err(start, format!("where takes 3 arguments, got {count}")));
-                };
-                return Ok(Node::Where(Box::new(c), Box::new(t), Box::new(b)));
-            }
-            return Err(self.err(
-                start,
-                format!("unknown function '{name}' (known: {FUNCTIONS})"),
-            ));
+            return self.call(name, start);
         }
+        self.symbol(name, start)
+    }
+
+    /// A call of the function `name` (at `start`): its arguments, checked against its arity.
+    fn call(&mut self, name: &'a str, start: usize) -> Result<Node, ExprError> {
+        if let Some(f) = Func::from_name(name) {
+            let mut a = self.args(name, start, 1)?;
+            return Ok(Node::Call(f, Box::new(a.remove(0))));
+        }
+        let bin = match name {
+            "atan2" => Some(BinOp::Atan2),
+            "min" | "Min" => Some(BinOp::Min),
+            "max" | "Max" => Some(BinOp::Max),
+            "pow" | "Pow" => Some(BinOp::Pow),
+            _ => None,
+        };
+        if let Some(op) = bin {
+            let a = self.args(name, start, 2)?;
+            let count = a.len();
+            let Ok([a, b]) = <[Node; 2]>::try_from(a) else {
+                return Err(self.err(start, format!("{name} takes 2 arguments, got {count}")));
+            };
+            return Ok(Node::Bin(op, Box::new(a), Box::new(b)));
+        }
+        if name == "where" {
+            let a = self.args(name, start, 3)?;
+            let count = a.len();
+            let Ok([c, t, b]) = <[Node; 3]>::try_from(a) else {
+                return Err(self.err(start, format!("where takes 3 arguments, got {count}")));
+            };
+            return Ok(Node::Where(Box::new(c), Box::new(t), Box::new(b)));
+        }
+        Err(self.err(
+            start,
+            format!("unknown function '{name}' (known: {FUNCTIONS})"),
+        ))
+    }
+
+    /// The symbol `name` (at `start`) that is not a call: a variable of the place, a parameter,
+    /// a constant, or an error naming what is known here.
+    fn symbol(&mut self, name: &'a str, start: usize) -> Result<Node, ExprError> {
         let (n, np) = (self.sym.n, self.sym.np);
         match (name, self.place) {
             ("x", Place::Rhs) => return Ok(Node::X),
