@@ -84,13 +84,7 @@ impl Rheometer {
         options.relative_offset(1)?;
         // the experiments solved where the fit starts: at the warm take-up factors (clamped to
         // their bounds) if given, so that the first evaluation re-solves nothing
-        let take_up: Vec<f64> =
-            if options.estimator == Estimator::Principled && warm.take_up.len() == self.len() {
-                let [lo, hi] = options.take_up_bounds;
-                warm.take_up.iter().map(|t| t.clamp(lo, hi)).collect()
-            } else {
-                Vec::new()
-            };
+        let take_up = self.warm_take_up(options, warm);
         let mut obj = self.objective_at_take_up(start, options, &take_up, warm.solve_at_take_up)?;
         let mut p0 = obj.initial_parameters();
         let (lower, upper) = obj.bounds();
@@ -99,56 +93,22 @@ impl Rheometer {
         let ns = obj.layout.num_shared();
         p0[ns..ns + take_up.len()].copy_from_slice(&take_up);
         let (f_scale, f_scale_source) = self.robust_margin(options)?;
-        let sigma = options
-            .relative_uncertainty
-            .or(self.relative_uncertainty)
-            .unwrap_or(1.0);
-        let mut fo = FitOptions {
-            initial_radius: 0.3,
-            max_radius: 1.0,
-            max_iterations: options.max_iterations,
-            loss: options.loss,
-            // the principled residual is the relative residual over σ
-            f_scale: if options.loss.is_linear() {
-                1.0
-            } else {
-                f_scale / sigma
-            },
-            accuracy: if options.loose_tolerance.is_some() {
-                Accuracy::scheduled()
-            } else {
-                Accuracy::Fixed
-            },
-            cancel: options.cancel.clone(),
-            ..FitOptions::with_bounds(lower.clone(), upper.clone())
-        };
-        // the effects' strengths and shapes in units of their ranges (take-up factors: 1)
-        let mut x_scale = obj.layout.x_scale();
-        x_scale.resize(lower.len(), 1.0);
-        fo.x_scale = x_scale;
-        if let Some(t) = warm.stop_tolerance {
-            (fo.gtol, fo.xtol, fo.ftol) = (t, t, t);
-        }
+        let fo = self.fit_options(
+            options,
+            warm,
+            (&lower, &upper),
+            obj.layout.x_scale(),
+            f_scale,
+            relative_offset,
+        );
         let mut observer = |it: &FitIteration| {
             if let Some(hook) = &options.progress {
                 hook.report(&FitProgress::Iteration(it));
             }
         };
-        if warm.stop_tolerance.is_none() {
-            fo.relative_offset = relative_offset;
-        }
         let fit_result = fit_observed(&mut obj, &p0, &fo, &mut observer)?;
         let solutions: Vec<Solution> = obj.solutions();
-        let residual_profiles: Vec<(Vec<f64>, Vec<f64>)> = solutions
-            .iter()
-            .enumerate()
-            .map(|(k, sol)| {
-                (
-                    self.measurements[k].positions.clone(),
-                    self.relative_residuals(k, sol),
-                )
-            })
-            .collect();
+        let residual_profiles = self.residual_profiles(&solutions);
         let local = obj
             .layout
             .local(&fit_result.p[..ns], 1.0, obj.layout.params.take_up_factor());
@@ -198,6 +158,79 @@ impl Rheometer {
             solutions,
             fit: fit_result,
         })
+    }
+
+    /// The take-up factors the fit starts from: the warm ones clamped to their bounds (for the
+    /// principled estimator, one per experiment), else none.
+    fn warm_take_up(&self, options: &IdentifyOptions, warm: &WarmFit) -> Vec<f64> {
+        if options.estimator == Estimator::Principled && warm.take_up.len() == self.len() {
+            let [lo, hi] = options.take_up_bounds;
+            warm.take_up.iter().map(|t| t.clamp(lo, hi)).collect()
+        } else {
+            Vec::new()
+        }
+    }
+
+    /// The driver's options of the fit within `(lower, upper)`: the trust region, the loss
+    /// with its soft margin `f_scale` over the relative uncertainty, the accuracy schedule,
+    /// the parameter scales `x_scale` (take-up factors: 1) and the stopping tests (loose at a
+    /// grid point of a scan, `warm.stop_tolerance`; else `relative_offset`).
+    fn fit_options(
+        &self,
+        options: &IdentifyOptions,
+        warm: &WarmFit,
+        (lower, upper): (&[f64], &[f64]),
+        mut x_scale: Vec<f64>,
+        f_scale: f64,
+        relative_offset: Option<f64>,
+    ) -> FitOptions {
+        let sigma = options
+            .relative_uncertainty
+            .or(self.relative_uncertainty)
+            .unwrap_or(1.0);
+        let mut fo = FitOptions {
+            initial_radius: 0.3,
+            max_radius: 1.0,
+            max_iterations: options.max_iterations,
+            loss: options.loss,
+            // the principled residual is the relative residual over σ
+            f_scale: if options.loss.is_linear() {
+                1.0
+            } else {
+                f_scale / sigma
+            },
+            accuracy: if options.loose_tolerance.is_some() {
+                Accuracy::scheduled()
+            } else {
+                Accuracy::Fixed
+            },
+            cancel: options.cancel.clone(),
+            ..FitOptions::with_bounds(lower.to_vec(), upper.to_vec())
+        };
+        // the effects' strengths and shapes in units of their ranges (take-up factors: 1)
+        x_scale.resize(lower.len(), 1.0);
+        fo.x_scale = x_scale;
+        if let Some(t) = warm.stop_tolerance {
+            (fo.gtol, fo.xtol, fo.ftol) = (t, t, t);
+        }
+        if warm.stop_tolerance.is_none() {
+            fo.relative_offset = relative_offset;
+        }
+        fo
+    }
+
+    /// Each experiment's measured positions and relative residuals of `solutions`.
+    fn residual_profiles(&self, solutions: &[Solution]) -> Vec<(Vec<f64>, Vec<f64>)> {
+        solutions
+            .iter()
+            .enumerate()
+            .map(|(k, sol)| {
+                (
+                    self.measurements[k].positions.clone(),
+                    self.relative_residuals(k, sol),
+                )
+            })
+            .collect()
     }
 
     /// The soft margin `C` \[-\] (relative residual) of a robust loss and where it comes from

@@ -167,25 +167,36 @@ fn upgrade_legacy(mut v: Value) -> Value {
                 .collect()
         })
     });
-    let is_fitted = |k: &str| {
-        fitted_list
-            .as_ref()
-            .is_none_or(|l| l.iter().any(|x| x == k))
-    };
     if fitted_list.is_none() && obj.get("n").is_some_and(Value::is_number) {
-        // before the list existed every fit fitted (n, κ) and the effects marked fitted
-        let mut names = vec![Value::from("n"), Value::from("kappa")];
-        if let Some(Value::Array(effects)) = obj.get("effects") {
-            for e in effects {
-                if e.get("fitted").and_then(Value::as_bool) == Some(true) {
-                    if let Some(n) = e.get("effect") {
-                        names.push(n.clone());
-                    }
+        insert_legacy_fitted(obj);
+    }
+    upgrade_law_estimates(obj, fitted_list.as_deref());
+    upgrade_effect_strengths(obj);
+    upgrade_noise(obj);
+    upgrade_solver(obj);
+    v
+}
+
+/// The `fitted` list of a legacy report that has none: before the list existed every fit
+/// fitted (n, κ) and the effects marked fitted.
+fn insert_legacy_fitted(obj: &mut serde_json::Map<String, Value>) {
+    let mut names = vec![Value::from("n"), Value::from("kappa")];
+    if let Some(Value::Array(effects)) = obj.get("effects") {
+        for e in effects {
+            if e.get("fitted").and_then(Value::as_bool) == Some(true) {
+                if let Some(n) = e.get("effect") {
+                    names.push(n.clone());
                 }
             }
         }
-        obj.insert("fitted".into(), Value::Array(names));
     }
+    obj.insert("fitted".into(), Value::Array(names));
+}
+
+/// The flat `n`, `kappa` and `K_Pa` (with their `stderr_`/`ci95_` keys) as estimate objects,
+/// fitted where the report's own list `fitted_list` names them (all, without a list).
+fn upgrade_law_estimates(obj: &mut serde_json::Map<String, Value>, fitted_list: Option<&[String]>) {
+    let is_fitted = |k: &str| fitted_list.is_none_or(|l| l.iter().any(|x| x == k));
     for key in ["n", "kappa"] {
         if let Some(x) = obj.get(key).filter(|x| x.is_number()).cloned() {
             let e = estimate_object(
@@ -203,6 +214,11 @@ fn upgrade_legacy(mut v: Value) -> Value {
         e["unit"] = "Pa".into();
         obj.insert("K_Pa".into(), e);
     }
+}
+
+/// Each effect's flat `strength` (with `stderr_strength`, `ci95_strength`) as an estimate
+/// object in the effect's unit.
+fn upgrade_effect_strengths(obj: &mut serde_json::Map<String, Value>) {
     if let Some(Value::Array(effects)) = obj.get_mut("effects") {
         for e in effects.iter_mut() {
             let name = e
@@ -224,6 +240,10 @@ fn upgrade_legacy(mut v: Value) -> Value {
             }
         }
     }
+}
+
+/// The `noise` object from the flat `noise_level` and `noise_source`, where the report has none.
+fn upgrade_noise(obj: &mut serde_json::Map<String, Value>) {
     if !obj.contains_key("noise") {
         if let Some(level) = obj.get("noise_level").cloned() {
             let declared = obj
@@ -241,6 +261,10 @@ fn upgrade_legacy(mut v: Value) -> Value {
             );
         }
     }
+}
+
+/// The `solver` object from the flat solver statistics, where the report has none.
+fn upgrade_solver(obj: &mut serde_json::Map<String, Value>) {
     if !obj.contains_key("solver") {
         let mut solver = serde_json::Map::new();
         for key in [
@@ -255,7 +279,6 @@ fn upgrade_legacy(mut v: Value) -> Value {
         }
         obj.insert("solver".into(), Value::Object(solver));
     }
-    v
 }
 
 /// A digest of the data a fit is made on: FNV-1a (64 bit) over each experiment's name, mass

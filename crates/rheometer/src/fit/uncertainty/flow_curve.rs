@@ -205,12 +205,7 @@ impl FlowCurve {
         let eta0 = |t: f64| eta_with_law(model, params, &law_values(model, params), t, 0.0);
         let shift = eta0(cov_range.reference_temperature_k) / eta0(t_c);
         let [lo, med, hi] = cov_range.reduced_per_s.map(|v| v * shift);
-        let ext = 10f64.powf(options.extension_decades.max(0.0));
-        let (a, b) = ((lo / ext).log10(), (hi * ext).log10());
-        let count = ((b - a) * options.points_per_decade.max(2) as f64).ceil() as usize + 1;
-        let rates: Vec<f64> = (0..count)
-            .map(|i| 10f64.powf(a + (b - a) * i as f64 / (count - 1) as f64))
-            .collect();
+        let rates = rate_grid(lo, hi, options);
         let names = model.law.param_names();
         let cov = law_covariance(summary, names);
         let profile_band = summary.profile_band_needed();
@@ -227,50 +222,17 @@ impl FlowCurve {
             BandMethod::None
         };
         let trace = summary.profile_trace(CHI2_1_95);
-        let points = rates
-            .iter()
-            .map(|&rate| {
-                let (eta, g) = eta_and_gradient(model, params, t_c, rate);
-                let var = |d: &[f64]| -> f64 {
-                    let s: f64 = g.iter().zip(d).map(|(gi, di)| gi * di).sum();
-                    (s / eta).powi(2)
-                };
-                let stat_ln = match (&band, &cov) {
-                    (BandMethod::Delta, Some(c)) => {
-                        let k = g.len();
-                        let mut v = 0.0;
-                        for i in 0..k {
-                            for j in 0..k {
-                                v += g[i] * c[i * k + j] * g[j];
-                            }
-                        }
-                        Some(Z95 * v.max(0.0).sqrt() / eta)
-                    }
-                    _ => None,
-                };
-                let stat95 = match band {
-                    BandMethod::Profile => trace.iter().fold([eta, eta], |[l, h], law| {
-                        let v = eta_with_law(model, params, law, t_c, rate);
-                        [l.min(v), h.max(v)]
-                    }),
-                    _ => {
-                        let s = stat_ln.unwrap_or(0.0);
-                        [eta * (-s).exp(), eta * s.exp()]
-                    }
-                };
-                let sys_ln = Z95 * shifts.iter().map(|d| var(d)).sum::<f64>().sqrt();
-                let (sl, sh) = ((eta / stat95[0]).ln(), (stat95[1] / eta).ln());
-                let tot = |s: f64| (s * s + sys_ln * sys_ln).sqrt();
-                FlowPoint {
-                    strain_rate_per_s: rate,
-                    eta_pa_s: eta,
-                    stat95_pa_s: stat95,
-                    sys95_pa_s: [eta * (-sys_ln).exp(), eta * sys_ln.exp()],
-                    total95_pa_s: [eta * (-tot(sl)).exp(), eta * tot(sh).exp()],
-                    extrapolated: rate < lo * (1.0 - 1e-12) || rate > hi * (1.0 + 1e-12),
-                }
-            })
-            .collect();
+        let inputs = PointInputs {
+            model,
+            params,
+            t_c,
+            covered: [lo, hi],
+            band,
+            cov: cov.as_deref(),
+            trace: &trace,
+            shifts: &shifts,
+        };
+        let points = rates.iter().map(|&rate| inputs.point(rate)).collect();
         let law = law_values(model, params);
         let isotherms = options
             .isotherms_k
@@ -298,6 +260,77 @@ impl FlowCurve {
             not_a_result: summary.law_not_a_result(),
         })
     }
+}
+
+/// What each point of a flow curve is evaluated with: the model with its parameters at the
+/// curve's temperature `t_c`, the strain rates the data cover, and the band's method and
+/// inputs (the law's covariance, the profile trace, the systematic shifts).
+struct PointInputs<'a, L: ViscosityLaw, H: NusseltLaw> {
+    model: &'a FiberModel<L, H>,
+    params: &'a [f64],
+    t_c: f64,
+    covered: [f64; 2],
+    band: BandMethod,
+    cov: Option<&'a [f64]>,
+    trace: &'a [Vec<f64>],
+    shifts: &'a [[f64; 2]],
+}
+
+impl<L: ViscosityLaw, H: NusseltLaw> PointInputs<'_, L, H> {
+    /// The curve's point at strain rate `rate` with its statistical, systematic and total bands.
+    fn point(&self, rate: f64) -> FlowPoint {
+        let [lo, hi] = self.covered;
+        let (eta, g) = eta_and_gradient(self.model, self.params, self.t_c, rate);
+        let var = |d: &[f64]| -> f64 {
+            let s: f64 = g.iter().zip(d).map(|(gi, di)| gi * di).sum();
+            (s / eta).powi(2)
+        };
+        let stat_ln = match (&self.band, &self.cov) {
+            (BandMethod::Delta, Some(c)) => {
+                let k = g.len();
+                let mut v = 0.0;
+                for i in 0..k {
+                    for j in 0..k {
+                        v += g[i] * c[i * k + j] * g[j];
+                    }
+                }
+                Some(Z95 * v.max(0.0).sqrt() / eta)
+            }
+            _ => None,
+        };
+        let stat95 = match self.band {
+            BandMethod::Profile => self.trace.iter().fold([eta, eta], |[l, h], law| {
+                let v = eta_with_law(self.model, self.params, law, self.t_c, rate);
+                [l.min(v), h.max(v)]
+            }),
+            _ => {
+                let s = stat_ln.unwrap_or(0.0);
+                [eta * (-s).exp(), eta * s.exp()]
+            }
+        };
+        let sys_ln = Z95 * self.shifts.iter().map(|d| var(d)).sum::<f64>().sqrt();
+        let (sl, sh) = ((eta / stat95[0]).ln(), (stat95[1] / eta).ln());
+        let tot = |s: f64| (s * s + sys_ln * sys_ln).sqrt();
+        FlowPoint {
+            strain_rate_per_s: rate,
+            eta_pa_s: eta,
+            stat95_pa_s: stat95,
+            sys95_pa_s: [eta * (-sys_ln).exp(), eta * sys_ln.exp()],
+            total95_pa_s: [eta * (-tot(sl)).exp(), eta * tot(sh).exp()],
+            extrapolated: rate < lo * (1.0 - 1e-12) || rate > hi * (1.0 + 1e-12),
+        }
+    }
+}
+
+/// The curve's strain rates: log-spaced over the covered range `[lo, hi]` extended by the
+/// options' decades on each side, at the options' points per decade.
+fn rate_grid(lo: f64, hi: f64, options: &FlowCurveOptions) -> Vec<f64> {
+    let ext = 10f64.powf(options.extension_decades.max(0.0));
+    let (a, b) = ((lo / ext).log10(), (hi * ext).log10());
+    let count = ((b - a) * options.points_per_decade.max(2) as f64).ceil() as usize + 1;
+    (0..count)
+        .map(|i| 10f64.powf(a + (b - a) * i as f64 / (count - 1) as f64))
+        .collect()
 }
 
 /// The law's parameters among the local model parameters `params`.

@@ -471,6 +471,37 @@ impl Profiler<'_> {
         h
     }
 
+    /// Why the linearised interval of column `c` is not to be trusted: at a bound (`side_at`),
+    /// a strong correlation with another parameter, or a curved profile (its `departure` from
+    /// the quadratic, or no finite standard error `se`).
+    fn reasons(
+        &self,
+        c: usize,
+        side_at: Option<BoundSide>,
+        departure: f64,
+        se: f64,
+    ) -> Vec<String> {
+        let fit = &self.id.fit;
+        let corr = fit.correlation().map_or(0.0, |m| {
+            let np = fit.p.len();
+            (0..np)
+                .filter(|&j| j != c)
+                .map(|j| m[c * np + j].abs())
+                .fold(0.0, f64::max)
+        });
+        let mut reasons = Vec::new();
+        if side_at.is_some() {
+            reasons.push("at_bound".to_string());
+        }
+        if corr > RIDGE_CORRELATION {
+            reasons.push("correlation".to_string());
+        }
+        if departure > QUADRATIC_DEPARTURE || (side_at.is_none() && !se.is_finite()) {
+            reasons.push("curved_profile".to_string());
+        }
+        reasons
+    }
+
     /// The profile of `target`, both sides.
     fn profile(&self, target: &Target) -> Result<ProfileInterval, RheometerError> {
         let fit = &self.id.fit;
@@ -479,13 +510,6 @@ impl Profiler<'_> {
         let (lo, hi) = (self.id.lower[c], self.id.upper[c]);
         let se = fit.standard_errors().map_or(f64::NAN, |s| s[c]).abs();
         let side_at = crate::fit::summary::checks::bound_side(theta, lo, hi);
-        let corr = fit.correlation().map_or(0.0, |m| {
-            let np = fit.p.len();
-            (0..np)
-                .filter(|&j| j != c)
-                .map(|j| m[c * np + j].abs())
-                .fold(0.0, f64::max)
-        });
         let base = Warm::of(self.id);
         let mut points = vec![(theta, 0.0, self.id.law().to_vec())];
         let mut ends = [f64::NAN; 2];
@@ -530,38 +554,8 @@ impl Profiler<'_> {
         if ci[0] > ci[1] {
             ci.swap(0, 1);
         }
-        // one-sided bounds: at a bound of the search range, or where the two-sided interval
-        // stays open towards one end (the data are compatible with that end)
-        let open_side = match (
-            ends[0].is_nan() || ends[0] <= lo,
-            ends[1].is_nan() || ends[1] >= hi,
-        ) {
-            _ if side_at.is_some() => side_at,
-            (false, true) => Some(BoundSide::Upper),
-            (true, false) => Some(BoundSide::Lower),
-            _ => None,
-        };
-        let one_sided = open_side.and_then(|s| {
-            let dir = if s == BoundSide::Lower { 1.0 } else { -1.0 };
-            let b = crossing(&points, theta, dir, CHI2_90)?;
-            // a bound on the model parameter becomes one on the reported value
-            let rising = to(theta + 1.0) > to(theta);
-            let side = match (s, rising) {
-                (BoundSide::Upper, true) | (BoundSide::Lower, false) => BoundSide::Lower,
-                _ => BoundSide::Upper,
-            };
-            Some(OneSidedBound { side, bound: to(b) })
-        });
-        let mut reasons = Vec::new();
-        if side_at.is_some() {
-            reasons.push("at_bound".to_string());
-        }
-        if corr > RIDGE_CORRELATION {
-            reasons.push("correlation".to_string());
-        }
-        if departure > QUADRATIC_DEPARTURE || (side_at.is_none() && !se.is_finite()) {
-            reasons.push("curved_profile".to_string());
-        }
+        let one_sided = one_sided_bound(&points, theta, ends, [lo, hi], side_at, &**to);
+        let reasons = self.reasons(c, side_at, departure, se);
         let mut range = [to(lo), to(hi)];
         if range[0] > range[1] {
             range.swap(0, 1);
@@ -584,6 +578,41 @@ impl Profiler<'_> {
                 .collect(),
         })
     }
+}
+
+/// The one-sided 90 % bound of a profile through `points` about `theta` where its interval
+/// stays open towards one side (the crossings `ends` missing or beyond the search range
+/// `[lo, hi]`) or the estimate is at a bound (`side_at`), on the reported scale `to`.
+fn one_sided_bound(
+    points: &[Sample],
+    theta: f64,
+    ends: [f64; 2],
+    [lo, hi]: [f64; 2],
+    side_at: Option<BoundSide>,
+    to: &dyn Fn(f64) -> f64,
+) -> Option<OneSidedBound> {
+    // one-sided bounds: at a bound of the search range, or where the two-sided interval
+    // stays open towards one end (the data are compatible with that end)
+    let open_side = match (
+        ends[0].is_nan() || ends[0] <= lo,
+        ends[1].is_nan() || ends[1] >= hi,
+    ) {
+        _ if side_at.is_some() => side_at,
+        (false, true) => Some(BoundSide::Upper),
+        (true, false) => Some(BoundSide::Lower),
+        _ => None,
+    };
+    open_side.and_then(|s| {
+        let dir = if s == BoundSide::Lower { 1.0 } else { -1.0 };
+        let b = crossing(points, theta, dir, CHI2_90)?;
+        // a bound on the model parameter becomes one on the reported value
+        let rising = to(theta + 1.0) > to(theta);
+        let side = match (s, rising) {
+            (BoundSide::Upper, true) | (BoundSide::Lower, false) => BoundSide::Lower,
+            _ => BoundSide::Upper,
+        };
+        Some(OneSidedBound { side, bound: to(b) })
+    })
 }
 
 /// Where the deviance crosses `level` on the `dir` side of `theta` (linear interpolation of
