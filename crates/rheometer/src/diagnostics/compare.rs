@@ -257,33 +257,8 @@ pub fn compare(
             )
         })
         .collect();
-    let input: Vec<ResidualSeries> = runs
-        .iter()
-        .zip(&series)
-        .map(|(run, (s, r))| ResidualSeries {
-            name: run.name.clone(),
-            positions_m: s.clone(),
-            residuals: r.clone(),
-            measured_m: run.measured.clone(),
-            length_m: run.curve.position.last().copied().filter(|l| *l > 0.0),
-        })
-        .collect();
-    let noise = match &options.fit_noise {
-        Some(n) => n.clone(),
-        None => NoiseSummary::of(
-            &input,
-            options.relative_uncertainty.or(set_uncertainty),
-            &options.noise,
-        )
-        .map_err(CompareError::Data)?,
-    };
+    let noise = noise_of(runs, &series, set_uncertainty, options)?;
     let sigma = noise.level;
-    if !(sigma > 0.0 && sigma.is_finite()) {
-        return Err(CompareError::Data(format!(
-            "cannot estimate the noise level from the data (estimate {sigma}); give \
-             relative_uncertainty in the experiments TOML"
-        )));
-    }
     let n_points: usize = experiments.iter().map(|e| e.points.len()).sum();
     let (mut sum2, mut chi2) = (0.0, 0.0);
     for (k, (e, (s, r))) in experiments.iter_mut().zip(&series).enumerate() {
@@ -314,24 +289,7 @@ pub fn compare(
         .model
         .as_ref()
         .map_or((f64::NAN, f64::NAN), |m| (m.lag1, m.lag1_z));
-    let all = |f: fn(&ComparedPoint) -> f64| -> Vec<f64> {
-        experiments
-            .iter()
-            .flat_map(|e| e.points.iter().map(f))
-            .collect()
-    };
-    let residuals = all(|p| p.residual);
-    let trends = [
-        ("strain_rate", all(|p| p.strain_rate_1_s)),
-        ("temperature", all(|p| p.temperature_k)),
-        ("speed", all(|p| p.speed_m_s)),
-    ]
-    .into_iter()
-    .map(|(q, x)| Trend {
-        quantity: q.into(),
-        spearman: statistics::spearman(&x, &residuals),
-    })
-    .collect();
+    let trends = residual_trends(&experiments);
     Ok(Comparison {
         points: n_points,
         fitted_parameters: options.fitted_parameters,
@@ -349,6 +307,68 @@ pub fn compare(
         segment_options: options.segments,
         experiments,
     })
+}
+
+/// The noise of the residual `series` of `runs`: the fit's if the options carry it, else
+/// estimated from the series (with the options' or the data set's relative uncertainty);
+/// an error if its level is not a positive number.
+fn noise_of(
+    runs: &[SimulatedExperiment],
+    series: &[(Vec<f64>, Vec<f64>)],
+    set_uncertainty: Option<f64>,
+    options: &CompareOptions,
+) -> Result<NoiseSummary, CompareError> {
+    let input: Vec<ResidualSeries> = runs
+        .iter()
+        .zip(series)
+        .map(|(run, (s, r))| ResidualSeries {
+            name: run.name.clone(),
+            positions_m: s.clone(),
+            residuals: r.clone(),
+            measured_m: run.measured.clone(),
+            length_m: run.curve.position.last().copied().filter(|l| *l > 0.0),
+        })
+        .collect();
+    let noise = match &options.fit_noise {
+        Some(n) => n.clone(),
+        None => NoiseSummary::of(
+            &input,
+            options.relative_uncertainty.or(set_uncertainty),
+            &options.noise,
+        )
+        .map_err(CompareError::Data)?,
+    };
+    let sigma = noise.level;
+    if !(sigma > 0.0 && sigma.is_finite()) {
+        return Err(CompareError::Data(format!(
+            "cannot estimate the noise level from the data (estimate {sigma}); give \
+             relative_uncertainty in the experiments TOML"
+        )));
+    }
+    Ok(noise)
+}
+
+/// The rank correlations of the pooled residual of `experiments` with the local strain rate,
+/// temperature and speed.
+fn residual_trends(experiments: &[ComparedExperiment]) -> Vec<Trend> {
+    let all = |f: fn(&ComparedPoint) -> f64| -> Vec<f64> {
+        experiments
+            .iter()
+            .flat_map(|e| e.points.iter().map(f))
+            .collect()
+    };
+    let residuals = all(|p| p.residual);
+    [
+        ("strain_rate", all(|p| p.strain_rate_1_s)),
+        ("temperature", all(|p| p.temperature_k)),
+        ("speed", all(|p| p.speed_m_s)),
+    ]
+    .into_iter()
+    .map(|(q, x)| Trend {
+        quantity: q.into(),
+        spearman: statistics::spearman(&x, &residuals),
+    })
+    .collect()
 }
 
 fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, CompareError> {

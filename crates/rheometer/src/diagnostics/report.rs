@@ -1,7 +1,7 @@
 //! The diagnosis in words, and the before/after residual figure.
 
 use super::candidate::{Candidate, ShapeAlternative};
-use super::diagnose::verdict::Verdict;
+use super::diagnose::verdict::{Help, Unexplained, Verdict};
 use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::refits::consistency::Consistency;
 use super::refits::scan::Profile;
@@ -137,59 +137,76 @@ impl Diagnosis {
                 rms_over_noise,
                 noise_level,
                 stand_ins,
-            } => {
-                let mut t = String::from(
-                    "VERDICT: NONE OF THE CANDIDATES explains the misfit: something else is missing",
-                );
-                if !stand_ins.is_empty() {
-                    t = stand_in_text(stand_ins, *rms_over_noise, &self.reestimated(*noise_level));
-                } else if helps.is_empty() {
-                    t.push_str("; no candidate helps");
-                } else {
-                    let h: Vec<String> = helps
-                        .iter()
-                        .take(4)
-                        .map(|h| format!("{} removes {:.0} %", h.effect, 100.0 * h.share_of_excess))
-                        .collect();
-                    t.push_str(&format!(
-                        " ({} of the excess misfit over the noise)",
-                        h.join(", ")
-                    ));
-                }
-                if stand_ins.is_empty() {
-                    t.push_str(&format!(
-                        "; with the best of them RMS/noise is {rms_over_noise:.2}{}.\n",
-                        self.reestimated(*noise_level)
-                    ));
-                }
-                t.push_str(
-                    "    The material law (n, kappa) of these fits is NOT A RESULT: a model that \
-                     does not describe the data biases it by what it misses.\n",
-                );
-                for u in unexplained.iter().take(4) {
-                    t.push_str(&format!(
-                        "    unexplained: s = {:.3}-{:.3} m, the model too {} by {:.1} % ({:.1} \
-                         standard errors) in {}\n",
-                        u.start_m,
-                        u.end_m,
-                        if u.mean > 0.0 { "thick" } else { "thin" },
-                        100.0 * u.mean.abs(),
-                        u.z.abs(),
-                        if u.experiments.is_empty() {
-                            "the pooled residual".to_string()
-                        } else {
-                            u.experiments.join(", ")
-                        }
-                    ));
-                }
-                t.push_str(
-                    "    Next step: describe the missing effect as an effect of your own (a term \
-                     and a descriptor; see the book's chapter \"When the model fails\") and \
-                     diagnose again with it as a candidate.\n",
-                );
-                t
-            }
+            } => self.none_explains_text(
+                helps,
+                unexplained,
+                *rms_over_noise,
+                *noise_level,
+                stand_ins,
+            ),
         }
+    }
+
+    /// The verdict where none of the candidates explains the misfit: what helps (or the
+    /// stand-ins), that the law is not a result, the segments left `unexplained`, the next step.
+    fn none_explains_text(
+        &self,
+        helps: &[Help],
+        unexplained: &[Unexplained],
+        rms_over_noise: f64,
+        noise_level: f64,
+        stand_ins: &[Consistency],
+    ) -> String {
+        let mut t = String::from(
+            "VERDICT: NONE OF THE CANDIDATES explains the misfit: something else is missing",
+        );
+        if !stand_ins.is_empty() {
+            t = stand_in_text(stand_ins, rms_over_noise, &self.reestimated(noise_level));
+        } else if helps.is_empty() {
+            t.push_str("; no candidate helps");
+        } else {
+            let h: Vec<String> = helps
+                .iter()
+                .take(4)
+                .map(|h| format!("{} removes {:.0} %", h.effect, 100.0 * h.share_of_excess))
+                .collect();
+            t.push_str(&format!(
+                " ({} of the excess misfit over the noise)",
+                h.join(", ")
+            ));
+        }
+        if stand_ins.is_empty() {
+            t.push_str(&format!(
+                "; with the best of them RMS/noise is {rms_over_noise:.2}{}.\n",
+                self.reestimated(noise_level)
+            ));
+        }
+        t.push_str(
+            "    The material law (n, kappa) of these fits is NOT A RESULT: a model that \
+             does not describe the data biases it by what it misses.\n",
+        );
+        for u in unexplained.iter().take(4) {
+            t.push_str(&format!(
+                "    unexplained: s = {:.3}-{:.3} m, the model too {} by {:.1} % ({:.1} \
+                 standard errors) in {}\n",
+                u.start_m,
+                u.end_m,
+                if u.mean > 0.0 { "thick" } else { "thin" },
+                100.0 * u.mean.abs(),
+                u.z.abs(),
+                if u.experiments.is_empty() {
+                    "the pooled residual".to_string()
+                } else {
+                    u.experiments.join(", ")
+                }
+            ));
+        }
+        t.push_str(
+            "    Next step: describe the missing effect as an effect of your own (a term \
+             and a descriptor; see the book's chapter \"When the model fails\") and \
+             diagnose again with it as a candidate.\n",
+        );
+        t
     }
 }
 

@@ -285,6 +285,14 @@ pub(super) fn ties_paragraph(
             a.kappa_shift_se
         ));
     }
+    push_robustness(&mut s, alts);
+    push_what_decides(&mut s, named, first, alts);
+    s
+}
+
+/// The tie paragraph's sentence on whether the material result is robust to the choice among
+/// `alts`.
+fn push_robustness(s: &mut String, alts: &[Alternative]) {
     let fragile: Vec<&Alternative> = alts.iter().filter(|a| !a.material_robust).collect();
     if fragile.is_empty() {
         s.push_str(&format!(
@@ -303,6 +311,12 @@ pub(super) fn ties_paragraph(
                 .join(", ")
         ));
     }
+}
+
+/// The tie paragraph's last sentence: what decides between `named` and `alts` (`first`, the
+/// first alternative, records the named effect's category and check), by the kinds of the
+/// effects in the tie.
+fn push_what_decides(s: &mut String, named: &str, first: &Alternative, alts: &[Alternative]) {
     // what decides: an independent check of each effect in the tie (the records' checks; a
     // record without them, e.g. read from older JSON, the built-in's)
     let members: Vec<(&str, Category)> = std::iter::once((named, first.named_category))
@@ -341,7 +355,6 @@ pub(super) fn ties_paragraph(
     } else if !s.ends_with('\n') {
         s.push_str(".\n");
     }
-    s
 }
 
 #[cfg(test)]

@@ -131,6 +131,13 @@ impl Comparison {
         if let Some(nm) = &self.noise.model {
             Self::noise_lines(nm, &mut s);
         }
+        self.misfit_lines(&mut s);
+        self.segment_lines(&mut s);
+        crate::report::format::wrap_long_lines(&s)
+    }
+
+    /// The summary's lines on the misfit against the noise: `chi2/dof` and the whiteness tests.
+    fn misfit_lines(&self, s: &mut String) {
         let dof = self.dof as f64;
         let excess = (self.chi2 - dof) / (2.0 * dof).sqrt();
         let verdict = if self.dof == 0 {
@@ -172,6 +179,12 @@ impl Comparison {
              (z = {:.1}): {verdict}",
             self.runs.z, self.runs.runs, self.runs.expected, self.lag1, self.lag1_z,
         );
+    }
+
+    /// The summary's lines on the structure of the residual: the systematic segments, the
+    /// trends and each experiment's figures.
+    fn segment_lines(&self, s: &mut String) {
+        let m = self.experiments.len();
         let names: Vec<String> = self.experiments.iter().map(|e| e.name.clone()).collect();
         if self.segments.is_empty() {
             let _ = writeln!(
@@ -213,6 +226,5 @@ impl Comparison {
                 let _ = writeln!(s, "      {}", segment_line(seg, 1, &names, false));
             }
         }
-        crate::report::format::wrap_long_lines(&s)
     }
 }

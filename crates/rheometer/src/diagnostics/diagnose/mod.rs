@@ -77,7 +77,7 @@ use super::ties::DEFAULT_TIE_MARGIN;
 use crate::data::noise_summary::NoiseSummary;
 use crate::diagnostics::refits::scan::refitted_effect;
 use crate::fit::{
-    Estimator, FitWarning, Identification, IdentifyOptions, RheometerError, WarningCode,
+    Estimator, FitSummary, FitWarning, Identification, IdentifyOptions, RheometerError, WarningCode,
 };
 use crate::model::effects::{Effect, EffectSetting, ModelSpec};
 use crate::model::setup::ExperimentSet;
@@ -348,56 +348,18 @@ fn assemble(
     let mut base_fit = first.base.summary.clone();
     // explanations the data cannot tell apart from the result that disagree on its law
     if let Some(f) = final_fit.as_mut() {
-        let rivals = ambiguity::disagreeing_rivals(
-            &first.candidates,
-            &found,
+        verdict = flag_ambiguity(
+            verdict,
             f,
+            &first,
+            &found,
             result_dbic,
             pair.as_ref(),
             options,
         );
-        if !rivals.is_empty() {
-            let w = ambiguity::warning(f, &rivals);
-            verdict = ambiguity::verdict(verdict, f, &rivals);
-            f.warnings.push(w);
-        }
     }
-    if let Verdict::NoneOfTheCandidates {
-        rms_over_noise,
-        stand_ins,
-        ..
-    } = &verdict
-    {
-        // the law of a model that does not describe the data is biased by what it misses
-        let w = match stand_ins.first() {
-            Some(c) => consistency::warning(c),
-            None => FitWarning::new(
-                WarningCode::Implausible,
-                format!(
-                    "none of the candidate effects brings the residuals to the noise (RMS/noise \
-                     {rms_over_noise:.2} with the best of them): the material law (n, kappa) of \
-                     this model is biased by the missing effect and is not a result"
-                ),
-            ),
-        };
-        for s in final_fit.iter_mut().chain(std::iter::once(&mut base_fit)) {
-            s.warnings.push(w.clone());
-        }
-    }
-    let further: Vec<ForwardStep> = steps
-        .iter()
-        .map(|s| ForwardStep {
-            model_effects: s
-                .spec
-                .effects
-                .iter()
-                .map(|e| e.effect.name().to_string())
-                .collect(),
-            base_fit: s.base.summary.clone(),
-            candidates: s.candidates.clone(),
-            named: s.named_candidate().map(|c| c.effect.clone()),
-        })
-        .collect();
+    warn_biased_law(&verdict, final_fit.as_mut(), &mut base_fit);
+    let further = forward_steps(&steps);
     let residuals_before = linear::signature::named_residuals(&first.base);
     let residuals_after = final_id.as_ref().map(linear::signature::named_residuals);
     DiagnosisRun {
@@ -430,6 +392,77 @@ fn assemble(
         best: final_id,
         fit_options,
     }
+}
+
+/// The verdict with the explanations the data cannot tell apart from the result `f` that
+/// disagree on its law (a warning on `f` too, where there are any).
+fn flag_ambiguity(
+    verdict: Verdict,
+    f: &mut FitSummary,
+    first: &step::Step,
+    found: &[String],
+    result_dbic: f64,
+    pair: Option<&crate::diagnostics::refits::pair::PairFound>,
+    options: &DiagnoseOptions,
+) -> Verdict {
+    let rivals =
+        ambiguity::disagreeing_rivals(&first.candidates, found, f, result_dbic, pair, options);
+    if rivals.is_empty() {
+        return verdict;
+    }
+    let w = ambiguity::warning(f, &rivals);
+    let verdict = ambiguity::verdict(verdict, f, &rivals);
+    f.warnings.push(w);
+    verdict
+}
+
+/// Under "none of the candidates", the warning on the final fit and on the user's fit
+/// `base_fit` that the law of a model that does not describe the data is not a result.
+fn warn_biased_law(
+    verdict: &Verdict,
+    final_fit: Option<&mut FitSummary>,
+    base_fit: &mut FitSummary,
+) {
+    if let Verdict::NoneOfTheCandidates {
+        rms_over_noise,
+        stand_ins,
+        ..
+    } = verdict
+    {
+        // the law of a model that does not describe the data is biased by what it misses
+        let w = match stand_ins.first() {
+            Some(c) => consistency::warning(c),
+            None => FitWarning::new(
+                WarningCode::Implausible,
+                format!(
+                    "none of the candidate effects brings the residuals to the noise (RMS/noise \
+                     {rms_over_noise:.2} with the best of them): the material law (n, kappa) of \
+                     this model is biased by the missing effect and is not a result"
+                ),
+            ),
+        };
+        for s in final_fit.into_iter().chain(std::iter::once(base_fit)) {
+            s.warnings.push(w.clone());
+        }
+    }
+}
+
+/// The records of the further steps `steps` (the first one removed).
+fn forward_steps(steps: &[step::Step]) -> Vec<ForwardStep> {
+    steps
+        .iter()
+        .map(|s| ForwardStep {
+            model_effects: s
+                .spec
+                .effects
+                .iter()
+                .map(|e| e.effect.name().to_string())
+                .collect(),
+            base_fit: s.base.summary.clone(),
+            candidates: s.candidates.clone(),
+            named: s.named_candidate().map(|c| c.effect.clone()),
+        })
+        .collect()
 }
 
 /// The verdict of the steps (see [`verdict`]).

@@ -508,10 +508,7 @@ pub fn scan_profile(
     let mut vrh = rheometer_for(rh, spec)?;
     let slot = vrh.spec.effects.len() - 1;
     let grid = scan_grid(effect, scan);
-    let mut inner = options.clone();
-    inner.max_iterations = scan.inner_max_iterations.max(1);
-    inner.simulate.tol = scan.grid_tol.max(options.simulate.tol);
-    inner.simulate.growth_limit = scan.grid_growth_limit;
+    let inner = grid_options(options, scan);
     let base_point = GridStart {
         strength: grid.neutral,
         law: base.law(),
@@ -557,18 +554,7 @@ pub fn scan_profile(
         sides.push(done);
     }
     // all points by increasing strength, the neutral one included
-    let mut pts: Vec<GridStart> = Vec::new();
-    let mut above = Vec::new();
-    for (k, side) in sides.into_iter().enumerate() {
-        let it = side.into_iter().map(|(_, p)| p);
-        if k == 0 {
-            pts.extend(it.rev());
-        } else {
-            above.extend(it);
-        }
-    }
-    pts.push(base_point);
-    pts.extend(above);
+    let mut pts = by_strength(sides, base_point);
     // bracketing where the walk found the effect lowering J at all (a basin to localise)
     let lowest = pts.iter().map(|p| p.cost).fold(f64::INFINITY, f64::min);
     let rounds = if lowest < (1.0 - scan.bracket_below) * cost_base {
@@ -589,9 +575,61 @@ pub fn scan_profile(
         .iter()
         .position(|p| p.strength == grid.neutral)
         .unwrap_or(0);
+    let profile = profile_of(effect, shape, cost_base, &pts, stopped);
+    let costs: Vec<f64> = pts.iter().map(|p| p.cost).collect();
+    let chosen = refine_starts(&costs, Some(neutral), scan);
+    let starts = chosen.iter().map(|&i| pts[i].clone()).collect();
+    Ok(ProfileScan {
+        effect: effect.clone(),
+        profile,
+        starts,
+        rheometer: vrh,
+        candidate: candidate.clone(),
+        growth_limit: scan.refine_growth_limit,
+        max_nodes: scan.refine_max_nodes,
+    })
+}
+
+/// The options of a grid point's fit: `options` with the scan's iteration limit, tolerance
+/// (never tighter than the user's) and mesh-growth limit.
+fn grid_options(options: &IdentifyOptions, scan: &ScanOptions) -> IdentifyOptions {
+    let mut inner = options.clone();
+    inner.max_iterations = scan.inner_max_iterations.max(1);
+    inner.simulate.tol = scan.grid_tol.max(options.simulate.tol);
+    inner.simulate.growth_limit = scan.grid_growth_limit;
+    inner
+}
+
+/// The points of the two walked `sides` (below, then above; each outwards from the neutral
+/// point) and the neutral `base_point`, by increasing strength.
+fn by_strength(sides: Vec<Vec<(f64, GridStart)>>, base_point: GridStart) -> Vec<GridStart> {
+    let mut pts: Vec<GridStart> = Vec::new();
+    let mut above = Vec::new();
+    for (k, side) in sides.into_iter().enumerate() {
+        let it = side.into_iter().map(|(_, p)| p);
+        if k == 0 {
+            pts.extend(it.rev());
+        } else {
+            above.extend(it);
+        }
+    }
+    pts.push(base_point);
+    pts.extend(above);
+    pts
+}
+
+/// The profile of `effect` (with shape `shape`) through the grid points `pts`, relative to the
+/// user's fit's `cost_base`, with the reasons the walk `stopped`.
+fn profile_of(
+    effect: &Effect,
+    shape: Vec<ShapeParameter>,
+    cost_base: f64,
+    pts: &[GridStart],
+    stopped: Vec<String>,
+) -> Profile {
     let (lo, hi) = search_range(effect);
     let (plo, phi) = physical_range(effect);
-    let profile = Profile {
+    Profile {
         effect: effect.name().to_string(),
         unit: effect.unit().to_string(),
         shape,
@@ -609,19 +647,7 @@ pub fn scan_profile(
             })
             .collect(),
         stopped,
-    };
-    let costs: Vec<f64> = pts.iter().map(|p| p.cost).collect();
-    let chosen = refine_starts(&costs, Some(neutral), scan);
-    let starts = chosen.iter().map(|&i| pts[i].clone()).collect();
-    Ok(ProfileScan {
-        effect: effect.clone(),
-        profile,
-        starts,
-        rheometer: vrh,
-        candidate: candidate.clone(),
-        growth_limit: scan.refine_growth_limit,
-        max_nodes: scan.refine_max_nodes,
-    })
+    }
 }
 
 /// A grid point's fit: the user's model with the scanned variant (slot `slot` of `vrh`) fixed
