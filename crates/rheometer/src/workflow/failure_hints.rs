@@ -121,11 +121,6 @@ pub fn hints(
         | (_, Some(BvpError::MaxNodesExceeded { max_nodes, tol, .. })) => Some((*max_nodes, *tol)),
         _ => None,
     };
-    let (t_in, t_air, t_vf) = (
-        experiment.inlet_temperature,
-        experiment.air_temperature,
-        material.vft_t_vf,
-    );
     if let Some(BvpError::MeshGrowthLimit {
         start_nodes, limit, ..
     }) = root.or(solver)
@@ -146,21 +141,7 @@ pub fn hints(
             show(tol)
         ));
     }
-    if solver.is_some() && t_in.min(t_air) - t_vf < VFT_MARGIN_K {
-        out.push(format!(
-            "the {} temperature {:.3} K is within {VFT_MARGIN_K} K of the VFT temperature \
-             vft_T_VF_K = {t_vf} K, where the zero-rate viscosity diverges: the law is not valid \
-             this cold (check inlet_temperature_K, air_temperature_K and vft_T_VF_K)",
-            if t_in <= t_air { "inlet" } else { "air" },
-            t_in.min(t_air),
-        ));
-    }
-    if t_air > t_in {
-        out.push(format!(
-            "the air ({t_air} K) is hotter than the melt at the inlet ({t_in} K): the fiber heats \
-             up along the spin line; check inlet_temperature_K and air_temperature_K"
-        ));
-    }
+    temperature_hints(&mut out, solver.is_some(), experiment, material);
     if let Some([n, _]) = law {
         if n < STRONG_THINNING_N && (stalled_at.is_some() || non_finite || max_nodes.is_some()) {
             out.push(format!(
@@ -181,6 +162,43 @@ pub fn hints(
             ));
         }
     }
+    fallback_hints(&mut out, stalled_at, non_finite);
+    out
+}
+
+/// The hints on the temperatures of `experiment`: within the VFT margin of `material` (for a
+/// solver failure, `solver_failed`), or air hotter than the melt.
+fn temperature_hints(
+    out: &mut Vec<String>,
+    solver_failed: bool,
+    experiment: &Experiment,
+    material: &Material,
+) {
+    let (t_in, t_air, t_vf) = (
+        experiment.inlet_temperature,
+        experiment.air_temperature,
+        material.vft_t_vf,
+    );
+    if solver_failed && t_in.min(t_air) - t_vf < VFT_MARGIN_K {
+        out.push(format!(
+            "the {} temperature {:.3} K is within {VFT_MARGIN_K} K of the VFT temperature \
+             vft_T_VF_K = {t_vf} K, where the zero-rate viscosity diverges: the law is not valid \
+             this cold (check inlet_temperature_K, air_temperature_K and vft_T_VF_K)",
+            if t_in <= t_air { "inlet" } else { "air" },
+            t_in.min(t_air),
+        ));
+    }
+    if t_air > t_in {
+        out.push(format!(
+            "the air ({t_air} K) is hotter than the melt at the inlet ({t_in} K): the fiber heats \
+             up along the spin line; check inlet_temperature_K and air_temperature_K"
+        ));
+    }
+}
+
+/// The hints where no other applies: the continuation's stall point `stalled_at`, an overflow
+/// (`non_finite`), or a check of the inputs.
+fn fallback_hints(out: &mut Vec<String>, stalled_at: Option<f64>, non_finite: bool) {
     if let Some(c) = stalled_at {
         if out.is_empty() {
             out.push(format!(
@@ -204,7 +222,6 @@ pub fn hints(
                 .to_string(),
         );
     }
-    out
 }
 
 /// The failure `e` as an [`ExperimentFailure`] naming the experiment and its line in the

@@ -694,10 +694,7 @@ pub fn design_grid(
     ranges: &DesignRanges,
     loaded: &LoadedExperiments,
 ) -> Result<crate::design::CandidateGrid, Refusal> {
-    use crate::data::input::PLAUSIBLE_RANGES;
-    use crate::data::take_up::{resolve_take_up, MissingTakeUp};
-    use crate::design::{CandidateGrid, TakeUpAxis};
-    use crate::model::setup::TakeUp;
+    use crate::design::CandidateGrid;
     let set = &loaded.set;
     let names = || {
         set.experiments
@@ -720,14 +717,36 @@ pub fn design_grid(
                 )
             })?,
     };
-    let bounds = |key: &str| {
-        PLAUSIBLE_RANGES
-            .iter()
-            .find(|(k, _, _)| *k == key)
-            .map_or((0.0, f64::INFINITY), |&(_, min, max)| (min, max))
-    };
     let (m, k) = ranges.grid;
-    let mass_flows = match (ranges.mass_flow, ranges.stencil_velocity) {
+    let mass_flows = design_mass_flows(ranges, loaded, template, m)?;
+    let take_up = design_take_up(ranges, set, k)?;
+    Ok(CandidateGrid {
+        template,
+        mass_flows,
+        take_up,
+        positions: None,
+    })
+}
+
+/// The plausible range of the experiments file's key `key` (unbounded above where it has
+/// none).
+fn plausible_bounds(key: &str) -> (f64, f64) {
+    crate::data::input::PLAUSIBLE_RANGES
+        .iter()
+        .find(|(k, _, _)| *k == key)
+        .map_or((0.0, f64::INFINITY), |&(_, min, max)| (min, max))
+}
+
+/// The design grid's `m` mass flows: the range given (directly, or as stencil velocities of
+/// the experiment `template`), else from half the smallest to twice the largest of the data.
+fn design_mass_flows(
+    ranges: &DesignRanges,
+    loaded: &LoadedExperiments,
+    template: usize,
+    m: usize,
+) -> Result<Vec<f64>, Refusal> {
+    let set = &loaded.set;
+    let flows = match (ranges.mass_flow, ranges.stencil_velocity) {
         (Some(_), Some(_)) => {
             return Err(Refusal::new(
                 Arg::MassFlow,
@@ -739,7 +758,7 @@ pub fn design_grid(
             r,
             m,
             "mass_flow_kg_s",
-            bounds("mass_flow_kg_s"),
+            plausible_bounds("mass_flow_kg_s"),
         )?,
         (None, Some(r)) => {
             let v0 = loaded.details[template]
@@ -756,7 +775,7 @@ pub fn design_grid(
                 })?;
             let q0 = set.experiments[template].mass_flow;
             // the mass flows must stay plausible: the stencil range maps onto them
-            let (qmin, qmax) = bounds("mass_flow_kg_s");
+            let (qmin, qmax) = plausible_bounds("mass_flow_kg_s");
             let vbounds = (qmin * v0 / q0, qmax * v0 / q0);
             design_range(
                 Arg::StencilVelocity,
@@ -776,7 +795,20 @@ pub fn design_grid(
             diffbvp::mesh::linspace(0.5 * lo, 2.0 * hi, m)
         }
     };
-    let take_up = match (ranges.take_up_diameter, ranges.take_up_velocity) {
+    Ok(flows)
+}
+
+/// The design grid's `k` take-up conditions: the diameters or velocities given, else
+/// diameters from 0.6 times the smallest to 1.3 times the largest take-up diameter of the data.
+fn design_take_up(
+    ranges: &DesignRanges,
+    set: &crate::model::setup::ExperimentSet,
+    k: usize,
+) -> Result<crate::design::TakeUpAxis, Refusal> {
+    use crate::data::take_up::{resolve_take_up, MissingTakeUp};
+    use crate::design::TakeUpAxis;
+    use crate::model::setup::TakeUp;
+    let axis = match (ranges.take_up_diameter, ranges.take_up_velocity) {
         (Some(_), Some(_)) => {
             return Err(Refusal::new(
                 Arg::TakeUpDiameterRange,
@@ -795,7 +827,7 @@ pub fn design_grid(
             r,
             k,
             "take_up_velocity_m_s",
-            bounds("take_up_velocity_m_s"),
+            plausible_bounds("take_up_velocity_m_s"),
         )?),
         (None, None) => {
             let mut d = Vec::new();
@@ -819,12 +851,7 @@ pub fn design_grid(
             TakeUpAxis::Diameter(diffbvp::mesh::linspace(0.6 * lo, 1.3 * hi, k))
         }
     };
-    Ok(CandidateGrid {
-        template,
-        mass_flows,
-        take_up,
-        positions: None,
-    })
+    Ok(axis)
 }
 
 /// The rival effects of a design for discrimination: two or more distinct effects.

@@ -11,7 +11,7 @@ use super::loaded::LoadedExperiments;
 use super::options::{estimated_fit_memory_bytes, show_bytes, show_count, Limit, LoadOptions};
 use super::toml_file::experiment::Located;
 use super::toml_file::schema::LENGTH;
-use crate::model::setup::Inlet;
+use crate::model::setup::{Experiment, Inlet};
 
 /// The error of an experiment's data file, at its `data` key.
 pub(super) fn data_error(at: &Located, experiment: &str, cause: InputError) -> InputError {
@@ -126,6 +126,20 @@ pub(super) fn cross_check(
         .as_deref()
         .map(super::source::show)
         .unwrap_or_default();
+    check_inlet_diameter(loaded, e, at, (s0, d0), &data)?;
+    check_take_up_extrapolation(e, at, options, (s0, s_last), &data)
+}
+
+/// The inlet diameter of `e` against the first measured diameter `d0` (at `s0`, in the data
+/// file `data`): an error where the inlet is below half of it, or above twice it with the
+/// measurement taken near the die.
+fn check_inlet_diameter(
+    loaded: &LoadedExperiments,
+    e: &Experiment,
+    at: &Located,
+    (s0, d0): (f64, f64),
+    data: &str,
+) -> Result<(), InputError> {
     let d_in = match e.inlet {
         Inlet::Diameter(d) => d,
         Inlet::Velocity(u) => {
@@ -161,6 +175,20 @@ pub(super) fn cross_check(
             ),
         });
     }
+    Ok(())
+}
+
+/// Without a take-up condition (and with `take_up_from_data`), the extrapolation of the
+/// smoothed data of `e` (measured from `s0` to `s_last`, in `data`) to the spin-line length: a
+/// warning beyond `take_up_warn_beyond` of the measured span, an error beyond
+/// `take_up_error_beyond`.
+fn check_take_up_extrapolation(
+    e: &Experiment,
+    at: &Located,
+    options: &LoadOptions,
+    (s0, s_last): (f64, f64),
+    data: &str,
+) -> Result<Option<InputWarning>, InputError> {
     if !options.take_up_from_data || e.take_up.is_some() {
         return Ok(None);
     }
