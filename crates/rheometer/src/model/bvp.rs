@@ -195,107 +195,11 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
         scaling: Scaling,
     ) -> Result<Self, FiberError> {
         let e = experiment;
-        let q = positive("mass flow", e.mass_flow)?;
-        let length = positive("spin-line length", e.spinline_length)?;
-        let t_in = positive("inlet temperature", e.inlet_temperature)?;
-        let t_air = positive("air temperature", e.air_temperature)?;
-        finite("density slope", material.density_slope)?;
-        finite("density intercept", material.density_intercept)?;
-        finite("heat capacity slope", material.heat_capacity_slope)?;
-        finite("heat capacity intercept", material.heat_capacity_intercept)?;
-        positive("VFT mu_c", material.vft_mu_c)?;
-        finite("VFT B", material.vft_b)?;
-        finite("VFT T_VF", material.vft_t_vf)?;
-        positive("Trouton ratio", material.trouton)?;
-        positive("air density", air.density)?;
-        positive("air heat capacity", air.heat_capacity)?;
-        positive("air kinematic viscosity", air.kinematic_viscosity)?;
-        positive("air heat conductivity", air.heat_conductivity)?;
-        if t_in <= material.vft_t_vf || t_air <= material.vft_t_vf {
-            return Err(FiberError::InvalidInput(format!(
-                "inlet ({t_in} K) and air ({t_air} K) temperatures must exceed the Vogel temperature {} K",
-                material.vft_t_vf
-            )));
-        }
-        for (what, t) in [("inlet", t_in), ("air", t_air)] {
-            positive(
-                &format!("density at the {what} temperature"),
-                material.density(t),
-            )?;
-            positive(
-                &format!("heat capacity at the {what} temperature"),
-                material.heat_capacity(t),
-            )?;
-        }
-        positive("slenderness", physics.slenderness)?;
+        let [q, length, t_in, t_air] =
+            Self::checked_inputs(material, air, e, physics.slenderness, &scaling)?;
         let r = &scaling.reference;
-        for (name, v) in [
-            ("reference mass flow", r.mass_flow),
-            ("reference length", r.length),
-            ("reference velocity", r.velocity),
-            ("reference temperature", r.temperature),
-            ("reference density", r.density),
-            ("reference heat capacity", r.heat_capacity),
-            ("reference viscosity", r.viscosity),
-            ("reference heat transfer", r.heat_transfer),
-            ("reference air density", r.air_density),
-            ("reference air heat capacity", r.air_heat_capacity),
-            (
-                "reference air kinematic viscosity",
-                r.air_kinematic_viscosity,
-            ),
-            ("reference air heat conductivity", r.air_heat_conductivity),
-            ("reference stress", r.stress),
-            ("gravity", r.gravity),
-        ] {
-            positive(name, v)?;
-        }
-        let rho_in = material.density(t_in);
-        let u_in_si = match e.inlet {
-            Inlet::Diameter(d) => {
-                let d = positive("inlet diameter", d)?;
-                4.0 * q / (PI * rho_in * d * d)
-            }
-            Inlet::Velocity(u) => positive("inlet velocity", u)?,
-        };
-        // derived values that overflow or underflow (e.g. a mass flow of 1e308 kg/s) are refused
-        // here, not reported later as a consequence ("inlet diameter 0 m")
-        let u_in_si = positive(
-            &format!("inlet velocity 4 Q/(π ρ d²) from the mass flow Q = {q:e} kg/s"),
-            u_in_si,
-        )?;
-        let d_in_si = positive(
-            &format!(
-                "inlet diameter from the mass flow {q:e} kg/s and the inlet velocity {u_in_si:e} m/s"
-            ),
-            2.0 * (q / (PI * rho_in * u_in_si)).sqrt(),
-        )?;
-        let take_up = match e.take_up {
-            None => return Err(FiberError::MissingTakeUp(e.name.clone())),
-            Some(TakeUp::Diameter(d)) => {
-                let d = positive("take-up diameter", d)?;
-                if d >= d_in_si {
-                    return Err(FiberError::InvalidInput(format!(
-                        "take-up diameter {d} m must be smaller than the inlet diameter {d_in_si} m"
-                    )));
-                }
-                DimensionlessTakeUp::Diameter {
-                    d_out: d / scaling.diameter(),
-                    d_in: d_in_si / scaling.diameter(),
-                }
-            }
-            Some(TakeUp::Velocity(u)) => {
-                let u = positive("take-up velocity", u)?;
-                if u <= u_in_si {
-                    return Err(FiberError::InvalidInput(format!(
-                        "take-up velocity {u} m/s must exceed the inlet velocity {u_in_si} m/s"
-                    )));
-                }
-                DimensionlessTakeUp::Velocity {
-                    u_out: u / r.velocity,
-                }
-            }
-        };
+        let (u_in_si, d_in_si) = Self::inlet_velocity_and_diameter(e, q, material.density(t_in))?;
+        let take_up = Self::dimensionless_take_up(e, u_in_si, d_in_si, &scaling)?;
         let mut co = Coefficients::new(&scaling, air, physics.slenderness, q, t_air, length);
         co.pr_arg = physics.nusselt.prandtl_argument(co.pr);
         let zero = ZeroRateViscosity {
@@ -331,6 +235,142 @@ impl<L: ViscosityLaw, H: NusseltLaw> FiberModel<L, H> {
             plan,
             mass_flow_scaled,
         })
+    }
+
+    /// The model's inputs checked: the experiment's mass flow, spin-line length and temperatures
+    /// (above the Vogel temperature), the material and air properties, the `slenderness` and the
+    /// reference values of `scaling`; `[mass flow, length, inlet and air temperatures]`, or an
+    /// error naming the first input out of range.
+    fn checked_inputs(
+        material: &Material,
+        air: &Air,
+        e: &Experiment,
+        slenderness: f64,
+        scaling: &Scaling,
+    ) -> Result<[f64; 4], FiberError> {
+        let q = positive("mass flow", e.mass_flow)?;
+        let length = positive("spin-line length", e.spinline_length)?;
+        let t_in = positive("inlet temperature", e.inlet_temperature)?;
+        let t_air = positive("air temperature", e.air_temperature)?;
+        finite("density slope", material.density_slope)?;
+        finite("density intercept", material.density_intercept)?;
+        finite("heat capacity slope", material.heat_capacity_slope)?;
+        finite("heat capacity intercept", material.heat_capacity_intercept)?;
+        positive("VFT mu_c", material.vft_mu_c)?;
+        finite("VFT B", material.vft_b)?;
+        finite("VFT T_VF", material.vft_t_vf)?;
+        positive("Trouton ratio", material.trouton)?;
+        positive("air density", air.density)?;
+        positive("air heat capacity", air.heat_capacity)?;
+        positive("air kinematic viscosity", air.kinematic_viscosity)?;
+        positive("air heat conductivity", air.heat_conductivity)?;
+        if t_in <= material.vft_t_vf || t_air <= material.vft_t_vf {
+            return Err(FiberError::InvalidInput(format!(
+                "inlet ({t_in} K) and air ({t_air} K) temperatures must exceed the Vogel temperature {} K",
+                material.vft_t_vf
+            )));
+        }
+        for (what, t) in [("inlet", t_in), ("air", t_air)] {
+            positive(
+                &format!("density at the {what} temperature"),
+                material.density(t),
+            )?;
+            positive(
+                &format!("heat capacity at the {what} temperature"),
+                material.heat_capacity(t),
+            )?;
+        }
+        positive("slenderness", slenderness)?;
+        let r = &scaling.reference;
+        for (name, v) in [
+            ("reference mass flow", r.mass_flow),
+            ("reference length", r.length),
+            ("reference velocity", r.velocity),
+            ("reference temperature", r.temperature),
+            ("reference density", r.density),
+            ("reference heat capacity", r.heat_capacity),
+            ("reference viscosity", r.viscosity),
+            ("reference heat transfer", r.heat_transfer),
+            ("reference air density", r.air_density),
+            ("reference air heat capacity", r.air_heat_capacity),
+            (
+                "reference air kinematic viscosity",
+                r.air_kinematic_viscosity,
+            ),
+            ("reference air heat conductivity", r.air_heat_conductivity),
+            ("reference stress", r.stress),
+            ("gravity", r.gravity),
+        ] {
+            positive(name, v)?;
+        }
+        Ok([q, length, t_in, t_air])
+    }
+
+    /// The inlet velocity and diameter \[SI\] of `e` (one given, the other from the mass flow `q`
+    /// and the melt density `rho_in` at the inlet), each refused where it overflows or underflows.
+    fn inlet_velocity_and_diameter(
+        e: &Experiment,
+        q: f64,
+        rho_in: f64,
+    ) -> Result<(f64, f64), FiberError> {
+        let u_in_si = match e.inlet {
+            Inlet::Diameter(d) => {
+                let d = positive("inlet diameter", d)?;
+                4.0 * q / (PI * rho_in * d * d)
+            }
+            Inlet::Velocity(u) => positive("inlet velocity", u)?,
+        };
+        // derived values that overflow or underflow (e.g. a mass flow of 1e308 kg/s) are refused
+        // here, not reported later as a consequence ("inlet diameter 0 m")
+        let u_in_si = positive(
+            &format!("inlet velocity 4 Q/(π ρ d²) from the mass flow Q = {q:e} kg/s"),
+            u_in_si,
+        )?;
+        let d_in_si = positive(
+            &format!(
+                "inlet diameter from the mass flow {q:e} kg/s and the inlet velocity {u_in_si:e} m/s"
+            ),
+            2.0 * (q / (PI * rho_in * u_in_si)).sqrt(),
+        )?;
+        Ok((u_in_si, d_in_si))
+    }
+
+    /// The take-up condition of `e` in the model's units: a diameter below the inlet diameter
+    /// `d_in_si`, or a velocity above the inlet velocity `u_in_si`.
+    fn dimensionless_take_up(
+        e: &Experiment,
+        u_in_si: f64,
+        d_in_si: f64,
+        scaling: &Scaling,
+    ) -> Result<DimensionlessTakeUp, FiberError> {
+        let r = &scaling.reference;
+        let take_up = match e.take_up {
+            None => return Err(FiberError::MissingTakeUp(e.name.clone())),
+            Some(TakeUp::Diameter(d)) => {
+                let d = positive("take-up diameter", d)?;
+                if d >= d_in_si {
+                    return Err(FiberError::InvalidInput(format!(
+                        "take-up diameter {d} m must be smaller than the inlet diameter {d_in_si} m"
+                    )));
+                }
+                DimensionlessTakeUp::Diameter {
+                    d_out: d / scaling.diameter(),
+                    d_in: d_in_si / scaling.diameter(),
+                }
+            }
+            Some(TakeUp::Velocity(u)) => {
+                let u = positive("take-up velocity", u)?;
+                if u <= u_in_si {
+                    return Err(FiberError::InvalidInput(format!(
+                        "take-up velocity {u} m/s must exceed the inlet velocity {u_in_si} m/s"
+                    )));
+                }
+                DimensionlessTakeUp::Velocity {
+                    u_out: u / r.velocity,
+                }
+            }
+        };
+        Ok(take_up)
     }
 
     /// Sets the initial Reynolds number `Re_0` of the continuation (default `Re`).
