@@ -467,11 +467,43 @@ pub(crate) fn design_for_estimation_with(
     let mut candidates: Vec<CandidateOutcome> =
         rows_in_order(&all, nt, |row| ctx.row(row, template), report);
     let crit = request.criterion;
-    for c in &mut candidates {
+    let ranking = rank_by_gain(&mut candidates, crit, &current);
+    let notes = estimation_notes(&noise, id);
+    Ok(Design {
+        parameters: id.names.clone(),
+        values: columns.shared.iter().map(|&l| id.local_params[l]).collect(),
+        fit_stderr: id
+            .fit
+            .standard_errors()
+            .unwrap_or_else(|| vec![f64::NAN; id.fit.p.len()])[..id.names.len()]
+            .to_vec(),
+        noise_level: level,
+        noise_model: noise.words(),
+        noise_source: noise.source,
+        candidate_noise: sigmas,
+        template: template.name.clone(),
+        criterion: crit,
+        grid: grid.clone(),
+        current,
+        candidates,
+        ranking,
+        notes,
+        wall_time_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Each candidate's gain over the `current` prediction under `crit`, its rank by the
+/// criterion's score (best first), and the ranking (the candidates with a prediction, best first).
+fn rank_by_gain(
+    candidates: &mut [CandidateOutcome],
+    crit: Criterion,
+    current: &Prediction,
+) -> Vec<usize> {
+    for c in candidates.iter_mut() {
         c.gain = c
             .prediction
             .as_ref()
-            .map_or(f64::NAN, |p| p.gain(crit, &current));
+            .map_or(f64::NAN, |p| p.gain(crit, current));
     }
     let mut ranking: Vec<usize> = (0..candidates.len())
         .filter(|&i| candidates[i].prediction.is_some())
@@ -488,6 +520,12 @@ pub(crate) fn design_for_estimation_with(
     for (r, &i) in ranking.iter().enumerate() {
         candidates[i].rank = Some(r + 1);
     }
+    ranking
+}
+
+/// The design's notes: the noise the predictions assume, what of the fit's noise they leave
+/// out, and the estimator they are for.
+fn estimation_notes(noise: &NoisePlan, id: &Identification) -> Vec<String> {
     let mut notes = vec![format!(
         "predictions assume relative Gaussian noise, {}, a fit weighting every point alike and \
          a take-up factor fitted per experiment, as the principled estimator does",
@@ -522,27 +560,7 @@ pub(crate) fn design_for_estimation_with(
             "the fit used the paper's estimator; the predictions are for the principled one".into(),
         );
     }
-    Ok(Design {
-        parameters: id.names.clone(),
-        values: columns.shared.iter().map(|&l| id.local_params[l]).collect(),
-        fit_stderr: id
-            .fit
-            .standard_errors()
-            .unwrap_or_else(|| vec![f64::NAN; id.fit.p.len()])[..id.names.len()]
-            .to_vec(),
-        noise_level: level,
-        noise_model: noise.words(),
-        noise_source: noise.source,
-        candidate_noise: sigmas,
-        template: template.name.clone(),
-        criterion: crit,
-        grid: grid.clone(),
-        current,
-        candidates,
-        ranking,
-        notes,
-        wall_time_s: t0.elapsed().as_secs_f64(),
-    })
+    notes
 }
 
 /// What every candidate's evaluation shares.
