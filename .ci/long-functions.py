@@ -10,7 +10,8 @@ signatures, trait impls and default trait methods are handled. Trait method decl
 without a body are not functions here.
 
 Usage: .ci/long-functions.py [--limit N] [--top K] [--allow FILE] [PATH ...]
-  PATH     directories or files to check (default: src, crates/diffbvp/src, crates/rheometer/src)
+  PATH     directories or files to check (default: src, crates/diffbvp/src, crates/rheometer/src,
+           python/src)
   --limit  the largest allowed length in lines (default 150)
   --top    also list the K longest functions (a report; does not change the exit status)
   --allow  the allowlist (default: .ci/long-functions.allow next to this script)
@@ -187,7 +188,7 @@ def read_allowlist(path):
             line = raw.split("#", 1)[0].strip()
             if not line:
                 continue
-            m = re.match(r"^(\S+\.rs)\s+(\S+?)\s*:\s*(\S.*)$", line)
+            m = re.match(r"^(\S+\.rs)\s+(\S+?):\s+(\S.*)$", line)
             if not m:
                 sys.exit(f"{path}:{k}: expected `src/file.rs name: reason` (a reason is required)")
             allowed[(m.group(1), m.group(2))] = m.group(3)
@@ -211,7 +212,7 @@ def rust_files(paths):
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("paths", nargs="*", default=["src", "crates/diffbvp/src", "crates/rheometer/src"])
+    ap.add_argument("paths", nargs="*", default=["src", "crates/diffbvp/src", "crates/rheometer/src", "python/src"])
     ap.add_argument("--limit", type=int, default=DEFAULT_LIMIT)
     ap.add_argument("--top", type=int, default=0)
     ap.add_argument("--allow", default=os.path.join(here, "long-functions.allow"))
