@@ -67,12 +67,20 @@ fn a_newtonian_melt_is_reported_newtonian_by_the_diagnosis() {
             text.contains("Its law is Newtonian within the data's strain rates"),
             "seed {seed}:\n{text}"
         );
+        // no shifts of n and kappa counted in standard errors of non-estimates
+        assert!(g.detection.shifts_withheld.is_some(), "seed {seed}");
+        assert!(g
+            .detection
+            .limits
+            .iter()
+            .all(|l| l.shift_n_se.is_none() && l.shift_kappa_se.is_none()));
         let json = serde_json::to_string(&g.json()).unwrap();
         assert!(json.contains("\"law_not_estimated\""), "seed {seed}");
     }
     let thinning = shared::diagnosed(&scenarios::control());
     let b = &thinning.run.diagnosis.base_fit;
     assert!(!b.newtonian_on_data() && b.newtonian_test.is_none());
+    assert!(thinning.run.diagnosis.detection.shifts_withheld.is_none());
     assert!(!thinning
         .run
         .diagnosis
