@@ -87,7 +87,9 @@ class Dataset:
     @classmethod
     def load(cls, path: PathLike, *, allow_large_inputs: bool = False) -> "Dataset":
         """Reads a TOML experiments file and the CSV files (``position_m,diameter_m``) it
-        names. Raises :class:`InputError` naming file, line, table and key.
+        names. Raises :class:`InputError` naming file, line, table and key; what the reader
+        doubts but accepts (two experiments reading one data file, an extrapolated take-up)
+        is a ``UserWarning`` each, with file and line, as the CLI prints it.
 
         The input caps are the command line's (the book's input reference, *Limits*: 16 MiB
         experiments file, 1,000,000 rows and 128 MiB per measurement file, 1000 experiments,

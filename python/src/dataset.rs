@@ -52,6 +52,18 @@ impl Dataset {
     }
 }
 
+/// The reader's warnings about the data (a doubtful key, two experiments reading one file,
+/// an extrapolated take-up), each a Python `UserWarning`, as the CLI prints them on stderr.
+fn warn_about(py: Python<'_>, loaded: &LoadedExperiments) -> PyResult<()> {
+    let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+    for w in &loaded.warnings {
+        let text = std::ffi::CString::new(w.to_string().replace('\0', " "))
+            .map_err(|e| input_error(format!("a warning could not be passed on: {e}")))?;
+        PyErr::warn(py, &category, &text, 2)?;
+    }
+    Ok(())
+}
+
 /// Measurement arrays as the CSV text the library reads (Rust's `{}` prints the shortest
 /// representation that reads back to the same `f64`, so nothing is rounded).
 fn csv_text(positions: &[f64], diameters: &[f64]) -> String {
@@ -198,6 +210,7 @@ fn build(
         };
         loaded.set.measurements[k] = measured;
     }
+    warn_about(py, &loaded)?;
     Ok(DatasetInner {
         loaded,
         path: path.to_path_buf(),
@@ -246,9 +259,12 @@ impl Dataset {
             })
         });
         match result {
-            Ok(inner) => Ok(Dataset {
-                inner: Arc::new(inner),
-            }),
+            Ok(inner) => {
+                warn_about(py, &inner.loaded)?;
+                Ok(Dataset {
+                    inner: Arc::new(inner),
+                })
+            }
             Err(e) if e.exceeded_limit().is_some() => {
                 Err(input_error(request::input_message(&e, Door::Python)))
             }

@@ -110,3 +110,24 @@ def test_a_missing_take_up_names_the_input_at_each_door(rheometer, pmma):
     py = str(e.value)
     assert "has no take-up condition" in py and "take_up_from_data=True" in py, py
     assert "--" not in py, py
+
+
+def test_the_readers_warnings_reach_python(scratch):
+    """The loader's warnings (here: two experiments reading one data file, finding 36 of the
+    hostile round) are a ``UserWarning`` in Python, as the CLI prints them; the shipped data
+    give none."""
+    import shutil
+    import warnings
+
+    folder = scratch / "shared_data_file"
+    shutil.rmtree(folder, ignore_errors=True)
+    shutil.copytree(PMMA.parent, folder)
+    toml = folder / "experiments.toml"
+    text = toml.read_text()
+    assert text.count('data = "v0p27_p2.csv"') == 1
+    toml.write_text(text.replace('data = "v0p27_p2.csv"', 'data = "./v0p27_p1.csv"'))
+    with pytest.warns(UserWarning, match="experiments v0p27_p1 and v0p27_p2 read the same data file"):
+        diffbvp.load(toml)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        diffbvp.load(PMMA)
