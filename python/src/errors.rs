@@ -85,7 +85,7 @@ fn kind_of(e: &(dyn Error + 'static)) -> &'static str {
             RheometerError::Smoothing { .. } | RheometerError::Simulation { .. } => {
                 "SimulationError"
             }
-            RheometerError::Fit(_) => "FitError",
+            RheometerError::Fit(_) | RheometerError::NotEvaluable { .. } => "FitError",
         };
     }
     if let Some(c) = e.downcast_ref::<CompareError>() {

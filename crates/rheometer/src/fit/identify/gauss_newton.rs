@@ -12,7 +12,7 @@ use super::identification::WarmFit;
 use crate::fit::data::Rheometer;
 use crate::fit::estimator::Estimator;
 use crate::fit::layout::FitStart;
-use crate::fit::options::{FitProgress, IdentifyOptions, RheometerError};
+use crate::fit::options::{with_named_point, FitProgress, IdentifyOptions, RheometerError};
 use crate::fit::summary::build::SummaryInput;
 use crate::fit::summary::FitSummary;
 use diffbvp::least_squares::{fit_observed, Accuracy, FitIteration, FitOptions};
@@ -106,7 +106,8 @@ impl Rheometer {
                 hook.report(&FitProgress::Iteration(it));
             }
         };
-        let fit_result = fit_observed(&mut obj, &p0, &fo, &mut observer)?;
+        let fit_result = fit_observed(&mut obj, &p0, &fo, &mut observer)
+            .map_err(|e| with_named_point(e, &obj.layout.names))?;
         let solutions: Vec<Solution> = obj.solutions();
         let residual_profiles = self.residual_profiles(&solutions);
         let local = obj
