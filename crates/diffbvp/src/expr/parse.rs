@@ -107,7 +107,8 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn expect(&mut self, s: &str) -> Result<(), ExprError> {
+    /// Consumes the token `s`, or fails naming what was found instead (an error, never a panic).
+    fn require(&mut self, s: &str) -> Result<(), ExprError> {
         if self.eat(s) {
             Ok(())
         } else {
@@ -252,7 +253,7 @@ impl<'a> Parser<'a> {
     }
 
     fn index(&mut self, name: &str, start: usize, len: usize) -> Result<usize, ExprError> {
-        self.expect("[")?;
+        self.require("[")?;
         self.skip_ws();
         let istart = self.pos;
         while self.pos < self.bytes.len() && self.bytes[self.pos].is_ascii_digit() {
@@ -265,7 +266,7 @@ impl<'a> Parser<'a> {
                 format!("{name}[...] needs a non-negative integer index"),
             )
         })?;
-        self.expect("]")?;
+        self.require("]")?;
         if i >= len {
             return Err(self.err(
                 start,
@@ -280,12 +281,12 @@ impl<'a> Parser<'a> {
     }
 
     fn args(&mut self, name: &str, start: usize, count: usize) -> Result<Vec<Node>, ExprError> {
-        self.expect("(")?;
+        self.require("(")?;
         let mut out = vec![self.comparison()?];
         while self.eat(",") {
             out.push(self.comparison()?);
         }
-        self.expect(")")?;
+        self.require(")")?;
         if out.len() != count {
             return Err(self.err(
                 start,
@@ -313,7 +314,7 @@ impl<'a> Parser<'a> {
         if c == b'(' {
             self.pos += 1;
             let e = self.comparison()?;
-            self.expect(")")?;
+            self.require(")")?;
             return Ok(e);
         }
         if c.is_ascii_digit() || c == b'.' {
