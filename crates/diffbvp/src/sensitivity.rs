@@ -337,6 +337,44 @@ pub fn residual_jacobian<P: Bvp, G: PointFunction>(
     Ok((values, jac))
 }
 
+/// Adds the weight `w` times the gradient `grad` (in the state and the parameters) of a point
+/// inside interval `i`, whose state is the Hermite interpolant with weights `v` (`y = v0 y_i +
+/// v1 f_i + v2 y_{i+1} + v3 f_{i+1}`, `f_j = f(x_j, y_j, p)`), to the adjoint right-hand side
+/// `b` (the two nodes' states, through their slopes the unknowns) and to `dg_dp` (the model
+/// parameters, through the slopes). Shared by point and integral objectives.
+fn add_hermite_gradient(
+    lz: &Linearization,
+    i: usize,
+    v: &[f64; 4],
+    w: f64,
+    grad: &[f64],
+    b: &mut [f64],
+    dg_dp: &mut [f64],
+) {
+    let (n, k, m) = (lz.col.n, lz.col.k, lz.col.m());
+    let np = k + lz.col.q;
+    for (node, (vy, vf)) in [(i, (v[0], v[1])), (i + 1, (v[2], v[3]))] {
+        for l in 0..n {
+            let mut s = vy * grad[l];
+            for c in 0..n {
+                s += vf * grad[c] * lz.jn(node, c, l);
+            }
+            b[node * n + l] += w * s;
+        }
+        for l in 0..np {
+            let mut s = 0.0;
+            for c in 0..n {
+                s += vf * grad[c] * lz.jn(node, c, n + l);
+            }
+            if l < k {
+                b[m * n + l] += w * s;
+            } else {
+                dg_dp[l - k] += w * s;
+            }
+        }
+    }
+}
+
 /// Value and gradient `dG/dp` of `G = Σ_j w_j g(j, x_j, y(x_j), p)` by the adjoint method: one
 /// transposed solve with the solution's factorisation, independent of the number of parameters.
 pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
@@ -396,27 +434,7 @@ pub fn adjoint_gradient<P: Bvp, G: PointFunction>(
             });
         }
         value += w * out[0];
-        // y(x) = v0 y_i + v1 f_i + v2 y_{i+1} + v3 f_{i+1}
-        for (node, (vy, vf)) in [(i, (v[0], v[1])), (i + 1, (v[2], v[3]))] {
-            for l in 0..n {
-                let mut s = vy * grad[l];
-                for c in 0..n {
-                    s += vf * grad[c] * lz.jn(node, c, l);
-                }
-                b[node * n + l] += w * s;
-            }
-            for l in 0..np {
-                let mut s = 0.0;
-                for c in 0..n {
-                    s += vf * grad[c] * lz.jn(node, c, n + l);
-                }
-                if l < k {
-                    b[m * n + l] += w * s;
-                } else {
-                    dg_dp[l - k] += w * s;
-                }
-            }
-        }
+        add_hermite_gradient(lz, i, &v, w, &grad, &mut b, &mut dg_dp);
         for l in 0..k {
             b[m * n + l] += w * grad[n + l];
         }

@@ -57,10 +57,9 @@
 //! # Ok::<(), diffbvp::BvpError>(())
 //! ```
 
-use super::{check_belongs, linearization, Sensitivities};
+use super::{add_hermite_gradient, check_belongs, linearization, Sensitivities};
 use crate::dual_jacobian::{DualFn, DualJacobian};
 use crate::error::BvpError;
-use crate::linearization::Linearization;
 use crate::problem::Bvp;
 use crate::solution::{hermite_weights, Solution};
 use num_dual::DualNum;
@@ -204,45 +203,6 @@ pub fn integral_value<P: Bvp, G: IntegralFunction>(
     Ok(value + phi)
 }
 
-/// Adds the weight `w` times the gradient of a midpoint of interval `i` (the integrand's
-/// gradient `grad` in the midpoint state and the parameters) to `b` and `dg_dp`: through the
-/// Hermite midpoint to the two nodes' states and, through their slopes `f(x_j, y_j, p)`, to the
-/// unknowns and the model parameters.
-fn add_midpoint_gradient(
-    lz: &Linearization,
-    sol: &Solution,
-    i: usize,
-    w: f64,
-    grad: &[f64],
-    b: &mut [f64],
-    dg_dp: &mut [f64],
-) {
-    let (n, k, m) = (lz.col.n, lz.col.k, lz.col.m());
-    let np = k + lz.col.q;
-    // y_mid = v0 y_i + v1 f_i + v2 y_{i+1} + v3 f_{i+1}, f_j = f(x_j, y_j, p)
-    let (v, _) = hermite_weights(0.5, sol.x[i + 1] - sol.x[i]);
-    for (node, (vy, vf)) in [(i, (v[0], v[1])), (i + 1, (v[2], v[3]))] {
-        for l in 0..n {
-            let mut s = vy * grad[l];
-            for c in 0..n {
-                s += vf * grad[c] * lz.jn(node, c, l);
-            }
-            b[node * n + l] += w * s;
-        }
-        for l in 0..np {
-            let mut s = 0.0;
-            for c in 0..n {
-                s += vf * grad[c] * lz.jn(node, c, n + l);
-            }
-            if l < k {
-                b[m * n + l] += w * s;
-            } else {
-                dg_dp[l - k] += w * s;
-            }
-        }
-    }
-}
-
 /// Value and gradient `dG/dp` (one entry per model parameter) of the integral functional `g`
 /// by the adjoint method: the gradient of the quadrature in the node states, unknowns and
 /// parameters from dual numbers (through the Hermite midpoint and its node slopes
@@ -286,7 +246,10 @@ pub fn integral_adjoint<P: Bvp, G: IntegralFunction>(
                     b[pt.node * n + l] += w * grad[l];
                 }
             }
-            Some(i) => add_midpoint_gradient(lz, sol, i, w, &grad[..n + np], &mut b, &mut dg_dp),
+            Some(i) => {
+                let (v, _) = hermite_weights(0.5, sol.x[i + 1] - sol.x[i]);
+                add_hermite_gradient(lz, i, &v, w, &grad[..n + np], &mut b, &mut dg_dp)
+            }
         }
         for l in 0..k {
             b[m * n + l] += w * grad[n + l];
