@@ -163,6 +163,28 @@ struct Profiler<'a> {
 }
 
 impl Profiler<'_> {
+    /// The profiler of `id`'s fit, where its cost is a likelihood: not for the paper's
+    /// estimator (a weighted distance to smoothed data) nor for a model that misses the data
+    /// by several times the noise ([`FitSummary::likelihood_skipped`](crate::fit::FitSummary::likelihood_skipped)).
+    fn of<'a>(
+        rh: &'a Rheometer,
+        id: &'a Identification,
+        options: &'a IdentifyOptions,
+    ) -> Option<Profiler<'a>> {
+        if options.estimator != crate::fit::estimator::Estimator::Principled
+            || id.summary.likelihood_skipped().is_some()
+        {
+            return None;
+        }
+        Some(Profiler {
+            rh,
+            id,
+            options,
+            cost: 2.0 * id.fit.cost,
+            s2: id.fit.residual_variance(),
+        })
+    }
+
     /// Refit with `hold` (model units) from `warm` under `options`' bounds.
     fn refit(
         &self,
@@ -653,20 +675,13 @@ pub(crate) fn newtonian_test_of(
     id: &Identification,
     options: &IdentifyOptions,
 ) -> Result<Option<NewtonianTest>, RheometerError> {
-    if !id.names.iter().any(|n| n == "n")
-        || options.estimator != crate::fit::estimator::Estimator::Principled
-        || id.summary.likelihood_skipped().is_some()
-    {
+    if !id.names.iter().any(|n| n == "n") {
         return Ok(None);
     }
-    let p = Profiler {
-        rh,
-        id,
-        options,
-        cost: 2.0 * id.fit.cost,
-        s2: id.fit.residual_variance(),
-    };
-    p.newtonian_test().map(Some)
+    match Profiler::of(rh, id, options) {
+        Some(p) => p.newtonian_test().map(Some),
+        None => Ok(None),
+    }
 }
 
 /// The profile intervals of `id`'s fitted law parameters and strengths (not shapes) and the
@@ -679,21 +694,9 @@ pub fn intervals(
     options: &IdentifyOptions,
     mode: ProfileMode,
 ) -> Result<(Vec<ProfileInterval>, Option<NewtonianTest>), RheometerError> {
-    // the paper's cost is a weighted distance to smoothed data, not a likelihood
-    // nor a model that misses the data by several times the noise
-    if mode == ProfileMode::Never
-        || id.names.is_empty()
-        || options.estimator != crate::fit::estimator::Estimator::Principled
-        || id.summary.likelihood_skipped().is_some()
-    {
-        return Ok((Vec::new(), None));
-    }
-    let p = Profiler {
-        rh,
-        id,
-        options,
-        cost: 2.0 * id.fit.cost,
-        s2: id.fit.residual_variance(),
+    let p = match Profiler::of(rh, id, options) {
+        Some(p) if mode != ProfileMode::Never && !id.names.is_empty() => p,
+        _ => return Ok((Vec::new(), None)),
     };
     let mut targets = Vec::new();
     for (c, name) in id.names.iter().enumerate() {
