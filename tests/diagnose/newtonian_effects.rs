@@ -156,3 +156,46 @@ fn radiation_on_a_newtonian_melt_is_named() {
         "radiation named in {named} of {seeds}"
     );
 }
+
+/// The rate behind `a_newtonian_melt_is_reported_newtonian_by_the_diagnosis`: over
+/// `NEWTONIAN_DIAGNOSIS_SEEDS` (default 100) Newtonian melts from the independent model (seeds
+/// 6500 on, fresh noise), how often the diagnosis reports the law as Newtonian within the
+/// data's strain rates (target ≥ 90 %), names an effect (false alarm, target ≤ 5 %) or
+/// presents a thinning law as a result (target ≤ 5 %).
+#[test]
+#[ignore = "slow: one diagnosis per replicate (minutes on 2 cores)"]
+fn newtonian_melts_are_reported_newtonian_by_the_diagnosis() {
+    let seeds: u64 = std::env::var("NEWTONIAN_DIAGNOSIS_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(100);
+    let (mut newtonian, mut named, mut thinning) = (0, 0, 0);
+    for k in 0..seeds {
+        let sc = Scenario {
+            seed: 6500 + k,
+            ..scenarios::newtonian()
+        };
+        let d = shared::diagnose_with(&sc, &DiagnoseOptions::default());
+        let g = &d.run.diagnosis;
+        let law = g.law_fit();
+        let is_newtonian = law.newtonian_on_data();
+        let claims_thinning = g.law_is_a_result() && !is_newtonian && law.n.ci95[1] < 1.0;
+        newtonian += usize::from(is_newtonian);
+        named += usize::from(!g.found.is_empty());
+        thinning += usize::from(claims_thinning);
+        println!(
+            "NEWTONIAN DIAGNOSIS | seed {} | newtonian {is_newtonian} | named {:?} | thinning \
+             claimed {claims_thinning} | n {:.4} [{:.4}, {:.4}] | {:.1} s",
+            sc.seed, g.found, law.n.value, law.n.ci95[0], law.n.ci95[1], d.seconds
+        );
+    }
+    let pct = |a: usize| 100.0 * a as f64 / seeds as f64;
+    println!(
+        "NEWTONIAN DIAGNOSIS SUMMARY | {seeds} sets | Newtonian reported {newtonian} ({:.1} %) | \
+         named {named} ({:.1} %) | thinning claimed {thinning} ({:.1} %)",
+        pct(newtonian),
+        pct(named),
+        pct(thinning)
+    );
+    assert!(pct(newtonian) >= 90.0 && pct(named) <= 5.0 && pct(thinning) <= 5.0);
+}
