@@ -17,6 +17,7 @@ use diffbvp::least_squares::Loss;
 use independent::dataset::{Faults, Scenario};
 use independent::model::AirHeat;
 use independent::scenarios::{self, NOISE_SD};
+use rheometer::data::noise_model::NoiseModel;
 use rheometer::diagnostics::diagnose::verdict::Verdict;
 use rheometer::diagnostics::diagnose::{Candidate, DiagnoseOptions, DiagnosisRun};
 
@@ -275,7 +276,18 @@ fn assert_nothing_missing(sc: &Scenario, r: &DiagnosisRun) {
         "κ {k} outside {:?}",
         b.kappa.ci95
     );
-    let ratio = d.noise_level() / NOISE_SD;
+    // the second-difference estimator of the noise level; where the noise model reads the
+    // white noise of a draw as correlated along the line (the outliers' seed 112: ρ̂ = 0.29,
+    // 2.9 standard errors; 3 of 100 clean white sets in `noise_rates`), the level it reports is
+    // that estimate times the AR(1) factor, printed with the correlation, and is not checked
+    // here
+    let rho = d
+        .base_fit
+        .noise
+        .model
+        .as_ref()
+        .map_or(0.0, |m| m.correlation_used);
+    let ratio = d.noise_level() / NoiseModel::level_factor(rho) / NOISE_SD;
     assert!((ratio - 1.0).abs() <= 0.2, "noise estimate / σ = {ratio}");
 }
 

@@ -4,7 +4,8 @@
 //! replicates: how often the residuals are called SYSTEMATIC (target ≤ 5 %), how often an
 //! effect is named (target ≤ 5 %), the false outlier flags per 1000 points (white noise:
 //! target ≤ 1; nothing is planted) and how often the reported law's 95 % intervals of `n` and
-//! `κ` contain the truth (target ≥ 90 % each).
+//! `κ` contain the truth (target ≥ 90 % each); and in how many sets the noise model found the
+//! noise correlated along the line.
 //!
 //! Slow and ignored (one diagnosis per replicate); run with
 //! `cargo test --release --test diagnose noise_rates -- --ignored --nocapture`.
@@ -37,6 +38,7 @@ fn rates(label: &str, make: impl Fn(u64) -> Scenario) -> Rates {
         .unwrap_or(100);
     let (mut systematic, mut named, mut flags, mut points) = (0, 0, 0, 0);
     let (mut covered_n, mut covered_kappa, mut results) = (0, 0, 0);
+    let mut correlated = 0;
     let mut seconds = Vec::new();
     let in_ci = |e: &Estimate, truth: f64| e.ci95[0] <= truth && truth <= e.ci95[1];
     for k in 0..seeds {
@@ -57,14 +59,22 @@ fn rates(label: &str, make: impl Fn(u64) -> Scenario) -> Rates {
             covered_n += usize::from(cn);
             covered_kappa += usize::from(ck);
         }
+        let rho = r
+            .base_fit
+            .noise
+            .model
+            .as_ref()
+            .map_or(0.0, |m| m.correlation_used);
+        correlated += usize::from(rho > 0.0);
         systematic += usize::from(r.systematic);
         named += usize::from(!r.found.is_empty());
         flags += r.outliers().len();
         points += n_points;
         seconds.push(d.seconds);
         println!(
-            "{label} | seed {} | lag-1 {:.2} | systematic {} | named {:?} | outliers {} of {} | \
-             n {:.4} [{:.4}, {:.4}] {} | kappa {:.3} {} | result {} | {:.1} s",
+            "{label} | seed {} | lag-1 {:.2}, found {rho:.2} | systematic {} | named {:?} | \
+             outliers {} of {} | n {:.4} [{:.4}, {:.4}] {} | kappa {:.3} {} | result {} | \
+             {:.1} s",
             sc.seed,
             sc.noise_lag1,
             r.systematic,
@@ -91,7 +101,8 @@ fn rates(label: &str, make: impl Fn(u64) -> Scenario) -> Rates {
         covered_kappa: pct(covered_kappa, results),
     };
     println!(
-        "{label} SUMMARY | {seeds} sets | SYSTEMATIC {systematic} ({:.1} %) | named {named} \
+        "{label} SUMMARY | {seeds} sets | noise found correlated in {correlated} | SYSTEMATIC \
+         {systematic} ({:.1} %) | named {named} \
          ({:.1} %) | false outlier flags {flags} in {points} points ({:.2} per 1000) | law a \
          result in {results}: n covered {:.1} %, kappa covered {:.1} % | diagnosis median \
          {:.1} s, max {:.1} s",

@@ -127,10 +127,23 @@ impl NoiseSummary {
         self.model.as_ref().is_some_and(|m| m.is_outlier(k, i))
     }
 
-    /// The level in words for a report line: `"1.579 % (estimated: ...)"`.
+    /// The level in words for a report line: `"1.579 % (estimated: ...)"`, with the
+    /// along-line correlation where the noise model found one (module docs of
+    /// [`NoiseModel`], item 6).
     pub fn describe(&self) -> String {
         if self.level.is_finite() {
-            format!("{} % ({})", percent(self.level), self.estimator)
+            let correlated = match &self.model {
+                Some(m) if m.correlation_used > 0.0 => format!(
+                    "; the noise is correlated along the line, lag-1 autocorrelation {:.2} \
+                     (white noise gives 0 ± {:.2}), so intervals are {:.2} times as wide as \
+                     for white noise",
+                    m.correlation_used,
+                    m.correlation_se,
+                    m.variance_inflation().sqrt()
+                ),
+                _ => String::new(),
+            };
+            format!("{} % ({}{correlated})", percent(self.level), self.estimator)
         } else {
             "unknown (too few points to estimate it; declare relative_uncertainty)".into()
         }

@@ -28,7 +28,9 @@
 //!   local `σ(sᵢ/L)` (so a noisier take-up region does not pass for a misfit), and
 //!   `dof = N − outliers − p` (`p` fitted parameters);
 //! * whiteness: the Wald–Wolfowitz runs test on the residual signs ([`RunsTest`]) and the noise
-//!   model's lag-1 autocorrelation, per experiment and pooled;
+//!   model's lag-1 autocorrelation, per experiment and pooled; where the noise model finds the
+//!   noise correlated along the line, the lag-1 autocorrelation against the noise's own and no
+//!   runs test (it assumes independent signs);
 //! * where: systematic segments of the pooled residual profile (`segments`), pooled over all
 //!   experiments and per experiment;
 //! * trends: Spearman rank correlations of the residual with strain rate, temperature, speed.
@@ -222,7 +224,8 @@ pub struct Comparison {
     pub runs: RunsTest,
     /// Pooled lag-1 autocorrelation ([`NoiseModel::lag1`]).
     pub lag1: f64,
-    /// `z` of the lag-1 autocorrelation against white noise (`ρ₁ √pairs`).
+    /// `z` of the lag-1 autocorrelation against the noise's own ([`NoiseModel::lag1_z`]:
+    /// `ρ₁ √pairs` for white noise).
     pub lag1_z: f64,
     /// The pooled residual profile.
     pub stations: Vec<Station>,

@@ -119,6 +119,11 @@ pub struct DetectionContext {
     pub sigma: f64,
     /// The relative noise level \[-\] (reported).
     pub noise_level: f64,
+    /// How many times `sigma` the noise a smooth signature picks up is \[-\]: 1 for white
+    /// noise, `√((1 + ρ)/(1 − ρ))` for noise correlated along the line
+    /// ([`NoiseModel::variance_inflation`](crate::data::noise_model::NoiseModel::variance_inflation)).
+    /// It widens the margin between `s50` and `s95`.
+    pub long_run_factor: f64,
     /// `J` of the user's fit.
     pub cost_before: f64,
     /// Number of measurements `N`.
@@ -180,6 +185,7 @@ pub fn detection_limits(
         let lambda_star =
             required_reduction(rest, ctx.measurements, ctx.threshold, k) / (ctx.sigma * ctx.sigma);
         let (s50, s95) = strength_limits(l.norm, ctx.sigma, lambda_star);
+        let s95 = s50 + (s95 - s50) * ctx.long_run_factor;
         let sigma_known = ctx.sigma > 0.0 && ctx.sigma.is_finite();
         if !s95.is_finite() || !sigma_known {
             out.invisible.push(e.name().to_string());
@@ -449,6 +455,7 @@ mod tests {
         ];
         let ctx = DetectionContext {
             sigma: 2.0,
+            long_run_factor: 1.0,
             noise_level: 0.02,
             cost_before: 400.0,
             measurements: 100,

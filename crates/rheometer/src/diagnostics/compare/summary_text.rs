@@ -163,6 +163,29 @@ impl Comparison {
                 k => format!(", {k} outliers left out"),
             }
         );
+        let correlated = self
+            .noise
+            .model
+            .as_ref()
+            .map_or(0.0, |m| m.correlation_used);
+        if correlated > 0.0 {
+            // the runs test assumes independent signs; the lag-1 z is against the noise's own
+            let verdict = if self.lag1_z.is_nan() || self.lag1_z < 2.0 {
+                "no structure beyond the noise's own correlation"
+            } else if self.lag1_z < 3.0 {
+                "marginal evidence of structure beyond the noise's correlation (2-3 sigma)"
+            } else {
+                "structure along s beyond the noise's correlation"
+            };
+            let _ = writeln!(
+                s,
+                "whiteness: not expected (the noise is correlated along the line, lag-1 {:.2}; \
+                 the runs test, z = {:.1}, assumes white noise); lag-1 autocorrelation {:.2} of \
+                 the noise-normalised residuals (z = {:.1} against the noise's): {verdict}",
+                correlated, self.runs.z, self.lag1, self.lag1_z,
+            );
+            return;
+        }
         // evidence against whiteness: the larger of −z(runs) and z(lag-1)
         let evidence = (-self.runs.z).max(self.lag1_z);
         let verdict = if evidence.is_nan() || evidence < 2.0 {

@@ -2,12 +2,14 @@
 //! the effects found so far), ending in the ranked candidates and the one it names.
 
 use super::base::Context;
-use super::linear::calibrate::{calibrate, Calibration};
+use super::linear::calibrate::{calibrate, Calibration, NullNoise};
 use super::linear::linearise::{self, Linearisation};
 use super::linear::signature;
 use super::search;
 use super::shapes;
-use super::verdict::{noise_cost, share_of_excess, MIN_SHARE_OF_EXCESS};
+use super::verdict::{
+    noise_cost, share_of_excess, EXPLAINED_RMS_OVER_NOISE, MIN_SHARE_OF_EXCESS, STRUCTURE_Z,
+};
 use super::{judge, DiagnoseOptions};
 use crate::diagnostics::candidate::{earns_its_place, rank_order, Candidate, Indistinguishable};
 use crate::diagnostics::detection::{detection_limits, DetectionContext, DetectionLimits};
@@ -88,10 +90,26 @@ pub(crate) fn run(
         .map(|(e, c)| (e.extra_parameters(), c.clone()))
         .collect();
     columns.extend(linearise::shape_columns(&ctx, &base, &lin)?);
+    let segments: Vec<usize> = ctx
+        .rh
+        .measurements
+        .iter()
+        .map(|m| m.positions.len())
+        .collect();
+    let null_noise = NullNoise {
+        sd: &sd,
+        correlation: base
+            .summary
+            .noise
+            .model
+            .as_ref()
+            .map_or(0.0, |m| m.calibration_correlation()),
+        segments: &segments,
+    };
     let calibration = calibrate(
         &lin,
         &columns,
-        &sd,
+        &null_noise,
         options.calibration_replicates,
         0x5EED_D1A6,
     );
@@ -147,11 +165,17 @@ fn names(c: &Candidate, options: &DiagnoseOptions, excess: bool) -> bool {
 }
 
 /// Stage 3: whether the user's residuals are systematic by the noise test (RMS over the noise
-/// level above 1.2, or the lag-1 autocorrelation `ρ₁ √pairs` above 3).
+/// level above [`EXPLAINED_RMS_OVER_NOISE`], widened for noise correlated along the line, or
+/// the lag-1 structure above [`STRUCTURE_Z`]; see
+/// [`NoiseModel`](crate::data::noise_model::NoiseModel)).
 fn residuals_systematic(base: &Identification) -> bool {
     let noise = &base.summary.noise;
-    let lag1_z = noise.model.as_ref().map_or(0.0, |m| m.lag1_z);
-    noise.rms_over_noise > 1.2 || lag1_z > 3.0
+    let m = noise.model.as_ref();
+    let lag1_z = m.map_or(0.0, |m| m.lag1_z);
+    let limit = m.map_or(EXPLAINED_RMS_OVER_NOISE, |m| {
+        m.misfit_ratio_limit(EXPLAINED_RMS_OVER_NOISE)
+    });
+    noise.rms_over_noise > limit || lag1_z > STRUCTURE_Z
 }
 
 /// Each residual's noise level in the fit's residual units: the point's relative noise level
@@ -203,6 +227,11 @@ fn limits(
         &DetectionContext {
             sigma: s.noise.level / ctx.sigma,
             noise_level: s.noise.level,
+            long_run_factor: s
+                .noise
+                .model
+                .as_ref()
+                .map_or(1.0, |m| m.variance_inflation().sqrt()),
             cost_before: lin.cost_before,
             measurements: lin.residuals(),
             threshold: ctx.options.earn_threshold,

@@ -21,6 +21,7 @@
 //!   the data cannot tell the explanations apart, and the law is not a result (the range all
 //!   span is given; see the stage `ambiguity`).
 
+use crate::data::noise_model::NoiseModel;
 use crate::data::noise_summary::NoiseSummary;
 use crate::diagnostics::compare::segments::{find_segments, Segment, SegmentOptions};
 use crate::fit::FitSummary;
@@ -32,7 +33,8 @@ pub const MIN_SHARE_OF_EXCESS: f64 = 0.5;
 /// RMS over the noise level at or below which the residuals are at the noise \[-\].
 pub const EXPLAINED_RMS_OVER_NOISE: f64 = 1.2;
 
-/// `ρ₁ √pairs` at or above which the residuals keep a structure along the line.
+/// The lag-1 structure ([`NoiseModel::lag1_z`](crate::data::noise_model::NoiseModel::lag1_z),
+/// standard errors) at or above which the residuals keep a structure along the line.
 pub const STRUCTURE_Z: f64 = 3.0;
 
 /// A candidate that helps: how much of the excess misfit it removes.
@@ -159,21 +161,38 @@ pub(crate) fn share_of_excess(before: f64, after: f64, j_noise: f64) -> f64 {
 /// re-estimated from `fit`'s own residuals where that is lower — the plain model's misfit
 /// inflates a noise estimate (second differences of residuals with a strong systematic part),
 /// and an inflated level would call a poor fit "at the noise".
+///
+/// The noise's along-line correlation is the data's, decided once on the user's fit (`base`):
+/// a refit's residuals do not decide it again (a wrong explanation's leftover misfit could pass
+/// for correlated noise). `fit`'s own level is compared, and used, as it would be with the
+/// data's correlation.
 pub(crate) fn noise_for(fit: &FitSummary, base: &NoiseSummary) -> NoiseSummary {
-    if base.declared() || fit.noise.level.partial_cmp(&base.level) != Some(std::cmp::Ordering::Less)
-    {
+    let rho = correlation_of(base);
+    let own = correlation_of(&fit.noise);
+    let level = fit.noise.level * NoiseModel::level_factor(rho) / NoiseModel::level_factor(own);
+    if base.declared() || level.partial_cmp(&base.level) != Some(std::cmp::Ordering::Less) {
         base.clone()
     } else {
-        fit.noise.clone()
+        let mut noise = fit.noise.clone();
+        noise.level = level;
+        if let Some(m) = noise.model.as_mut() {
+            m.correlation_used = rho;
+        }
+        noise
     }
 }
 
+/// The along-line correlation a noise summary's model uses (0: white, or no model).
+fn correlation_of(noise: &NoiseSummary) -> f64 {
+    noise.model.as_ref().map_or(0.0, |m| m.correlation_used)
+}
+
 /// RMS (outliers excluded) of `fit`'s residuals over the data's noise level `noise` and the
-/// lag-1 structure statistic of its residuals.
+/// lag-1 structure statistic of its residuals against the data's correlation.
 pub(crate) fn at_noise(fit: &FitSummary, noise: &NoiseSummary) -> (f64, f64) {
     let m = fit.noise.model.as_ref();
     let rms = m.map_or(fit.rms_relative_residual, |m| m.rms);
-    let lag1_z = m.map_or(0.0, |m| m.lag1_z);
+    let lag1_z = m.map_or(0.0, |m| m.lag1_z_against(correlation_of(noise)));
     (rms / noise.level, lag1_z)
 }
 
@@ -186,8 +205,12 @@ pub(crate) fn explained(fit: &FitSummary, noise: &NoiseSummary) -> bool {
 /// [`explained`] with both limits `slack` times as wide (a screening fit solved less
 /// accurately: `slack` ≥ 1).
 pub(crate) fn explained_within(fit: &FitSummary, noise: &NoiseSummary, slack: f64) -> bool {
-    let (ratio, z) = at_noise(fit, &noise_for(fit, noise));
-    ratio <= slack * EXPLAINED_RMS_OVER_NOISE && z < slack * STRUCTURE_Z
+    let noise = noise_for(fit, noise);
+    let (ratio, z) = at_noise(fit, &noise);
+    let limit = noise.model.as_ref().map_or(EXPLAINED_RMS_OVER_NOISE, |m| {
+        m.misfit_ratio_limit(EXPLAINED_RMS_OVER_NOISE)
+    });
+    ratio <= slack * limit && z < slack * STRUCTURE_Z
 }
 
 /// Where the residuals of `profiles` (positions and relative residuals per experiment, named

@@ -43,6 +43,9 @@ pub(crate) struct SummaryInput<'a> {
 
 /// The fitted parameters' standard errors, correlation and bound sides.
 struct Uncertainty {
+    /// The factor on the fit's covariance for noise correlated along the line
+    /// ([`NoiseModel::variance_inflation`](crate::data::noise_model::NoiseModel::variance_inflation); 1 for white noise).
+    inflation: f64,
     se: Vec<f64>,
     have_se: bool,
     cov: Option<CovarianceView>,
@@ -119,10 +122,15 @@ impl Uncertainty {
         let fit = input.fit;
         let np = fit.p.len();
         let cov = CovarianceView::of(fit);
+        let inflation = input
+            .noise
+            .model
+            .as_ref()
+            .map_or(1.0, |m| m.variance_inflation());
         let se_opt: Option<Vec<f64>> = cov.as_ref().map(|c| {
             c.variances()
                 .into_iter()
-                .map(|x| x.max(0.0).sqrt())
+                .map(|x| (x * inflation).max(0.0).sqrt())
                 .collect()
         });
         let sides = (0..np)
@@ -135,6 +143,7 @@ impl Uncertainty {
             .as_ref()
             .map(|c| c.groups(np).iter().map(|g| c.correlation_of(g)).collect());
         Uncertainty {
+            inflation,
             have_se: se_opt.is_some(),
             se: se_opt.unwrap_or_else(|| vec![f64::NAN; np]),
             cov,
@@ -310,7 +319,7 @@ fn covariance(input: &SummaryInput<'_>, u: &Uncertainty) -> Option<Covariance> {
     let mut matrix = Vec::with_capacity(ns * ns);
     for i in 0..ns {
         for j in 0..ns {
-            matrix.push(sign[i] * sign[j] * cov.get(i, j));
+            matrix.push(sign[i] * sign[j] * cov.get(i, j) * u.inflation);
         }
     }
     Some(Covariance {

@@ -6,7 +6,9 @@
 //! the strengths, the take-up factors) is refitted, warm-started from the neighbouring refit
 //! (its solutions, take-up factors and strengths). The deviance
 //! `D(θ) = (J(θ) − J_min)/σ̂²`, with the residual variance `σ̂² = J_min/(N − p)` of the fit
-//! (the same `σ̂²` as the linearised covariance), is compared with `χ²₁(0.95) = 3.84`: the
+//! (the same `σ̂²` as the linearised covariance; times the long-run factor
+//! [`variance_inflation`](crate::data::noise_model::NoiseModel::variance_inflation) where the
+//! noise is correlated along the line), is compared with `χ²₁(0.95) = 3.84`: the
 //! 95 % interval is `{θ : D(θ) ≤ 3.84}`. Each side starts at the linearised end
 //! `θ̂ ± 1.96 se` (where `D = 3.84` if the likelihood is quadratic) and is refined by secant
 //! steps on the signed root `√D`, which is linear in `θ` for a quadratic profile. A profile
@@ -181,7 +183,13 @@ impl Profiler<'_> {
             id,
             options,
             cost: 2.0 * id.fit.cost,
-            s2: id.fit.residual_variance(),
+            // the long-run variance where the noise is correlated along the line
+            s2: id.fit.residual_variance()
+                * id.summary
+                    .noise
+                    .model
+                    .as_ref()
+                    .map_or(1.0, |m| m.variance_inflation()),
         })
     }
 

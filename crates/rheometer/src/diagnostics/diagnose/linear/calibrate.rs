@@ -5,7 +5,10 @@
 //!
 //! 1. effect-free residuals like the user's: `e = σ ⊙ z`, `z` standard normal, `σ` each
 //!    point's noise level from the user's fit's noise model (in the fit's residual units), with
-//!    the fitted parameters refitted: `r* = (I − P_X) e` (`X` the fit's Jacobian);
+//!    the fitted parameters refitted: `r* = (I − P_X) e` (`X` the fit's Jacobian). Where the
+//!    noise model finds the noise correlated along the line, `z` is AR(1) with its
+//!    correlation within each experiment (unit variance), so the evidence of effect-free
+//!    correlated noise, which a smooth signature picks up more often, is measured too;
 //! 2. every candidate column — each candidate at its default shape and at every shape the
 //!    global search scans (the sensitivity at strength 0 depends on the shape) — orthogonalised
 //!    against `X`: `c⊥`; its score `(c⊥·e)²/‖c⊥‖²` is the cost it removes from `r*` to first
@@ -47,18 +50,50 @@ fn basis(x: &[f64], n: usize, q: usize) -> DMatrix<f64> {
     DMatrix::from_fn(n, keep.len(), |r, c| u[(r, keep[c])])
 }
 
+/// The noise of the bootstrap: each residual's noise level and the along-line correlation.
+pub(crate) struct NullNoise<'a> {
+    /// Each residual's noise level in the fit's residual units.
+    pub sd: &'a [f64],
+    /// The lag-1 autocorrelation of the noise within an experiment \[-\] (0: white).
+    pub correlation: f64,
+    /// The number of residuals of each experiment, in order (the AR(1) chains restart).
+    pub segments: &'a [usize],
+}
+
+impl NullNoise<'_> {
+    /// Fills `e` with one draw: `sd ⊙ z`, `z` AR(1) of unit variance in each segment.
+    fn draw(&self, rng: &mut SplitMix64, e: &mut DVector<f64>) {
+        let r = self.correlation;
+        let innovation = (1.0 - r * r).sqrt();
+        let mut i = 0;
+        for &len in self.segments {
+            let mut z = 0.0;
+            for j in 0..len {
+                let w = rng.normal();
+                z = if j == 0 { w } else { r * z + innovation * w };
+                e[i] = self.sd[i] * z;
+                i += 1;
+            }
+        }
+    }
+}
+
 /// The bootstrap: `columns` are `(extra parameters k, column)` per candidate and shape (the
-/// residuals' derivative per unit strength), `sd` each residual's noise level in the fit's
-/// residual units.
+/// residuals' derivative per unit strength), `noise` the effect-free noise to draw.
 pub(crate) fn calibrate(
     lin: &Linearisation,
     columns: &[(usize, Vec<f64>)],
-    sd: &[f64],
+    noise: &NullNoise<'_>,
     replicates: usize,
     seed: u64,
 ) -> Calibration {
     let n = lin.residuals();
-    if n == 0 || sd.len() != n || replicates == 0 {
+    if n == 0
+        || noise.sd.len() != n
+        || noise.segments.iter().sum::<usize>() != n
+        || !(0.0..1.0).contains(&noise.correlation)
+        || replicates == 0
+    {
         return Calibration::default();
     }
     let u = basis(&lin.x, n, lin.q);
@@ -83,9 +118,7 @@ pub(crate) fn calibrate(
             let mut e = DVector::zeros(n);
             let mut out = Vec::with_capacity(count);
             for _ in 0..count {
-                for i in 0..n {
-                    e[i] = sd[i] * rng.normal();
-                }
+                noise.draw(&mut rng, &mut e);
                 let ue = u.transpose() * &e;
                 let j_star = (e.norm_squared() - ue.norm_squared()).max(1e-300);
                 let b = ortho
@@ -138,7 +171,12 @@ mod tests {
         };
         let col: Vec<f64> = (0..n).map(|i| i as f64 / n as f64 - 0.5).collect();
         let sd = vec![0.5; n];
-        let cal = calibrate(&lin, &[(1, col)], &sd, 20_000, 7);
+        let white = NullNoise {
+            sd: &sd,
+            correlation: 0.0,
+            segments: &[n],
+        };
+        let cal = calibrate(&lin, &[(1, col)], &white, 20_000, 7);
         // J* ≈ (n − 1) σ²: the ΔBIC at which χ²₁ = 3.84
         let j = (n - 1) as f64 * 0.25;
         let b = n as f64 * (1.0 - 3.84 * 0.25 / j).ln() + (n as f64).ln();
@@ -148,7 +186,17 @@ mod tests {
         // more columns: the best of several is more often extreme
         let col2: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
         let col1: Vec<f64> = (0..n).map(|i| i as f64 / n as f64 - 0.5).collect();
-        let two = calibrate(&lin, &[(1, col1), (1, col2)], &sd, 20_000, 7);
+        let two = calibrate(&lin, &[(1, col1.clone()), (1, col2)], &white, 20_000, 7);
         assert!(two.false_alarm(b) > 0.08, "{}", two.false_alarm(b));
+        // correlated noise: a smooth column's score has variance σ² (1 + ρ)/(1 − ρ) for
+        // ρ = 0.5, three times white noise's, so the same ΔBIC is reached far more often
+        let correlated = NullNoise {
+            correlation: 0.5,
+            ..white
+        };
+        let c = calibrate(&lin, &[(1, col1)], &correlated, 20_000, 7);
+        let p = c.false_alarm(b);
+        // P(3 χ²₁ ≥ 3.84) = P(χ²₁ ≥ 1.28) ≈ 0.26
+        assert!((p - 0.26).abs() < 0.03, "p = {p}");
     }
 }
