@@ -281,12 +281,7 @@ fn assert_nothing_missing(sc: &Scenario, r: &DiagnosisRun) {
     // 2.9 standard errors; 3 of 100 clean white sets in `noise_rates`), the level it reports is
     // that estimate times the AR(1) factor, printed with the correlation, and is not checked
     // here
-    let rho = d
-        .base_fit
-        .noise
-        .model
-        .as_ref()
-        .map_or(0.0, |m| m.correlation_used);
+    let rho = d.base_fit.noise.correlation();
     let ratio = d.noise_level() / NoiseModel::level_factor(rho) / NOISE_SD;
     assert!((ratio - 1.0).abs() <= 0.2, "noise estimate / σ = {ratio}");
 }

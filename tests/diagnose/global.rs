@@ -860,13 +860,7 @@ fn power_at_twice_the_detection_limit() {
             };
             // the noise model took the noise for correlated along the line (issue 65 item 3):
             // elsewhere the diagnosis runs exactly as for white noise
-            if r.diagnosis
-                .base_fit
-                .noise
-                .model
-                .as_ref()
-                .is_some_and(|m| m.correlation_used > 0.0)
-            {
+            if r.diagnosis.base_fit.noise.correlation() > 0.0 {
                 correlated += 1;
             }
             let tie = !hit

@@ -59,12 +59,7 @@ fn rates(label: &str, make: impl Fn(u64) -> Scenario) -> Rates {
             covered_n += usize::from(cn);
             covered_kappa += usize::from(ck);
         }
-        let rho = r
-            .base_fit
-            .noise
-            .model
-            .as_ref()
-            .map_or(0.0, |m| m.correlation_used);
+        let rho = r.base_fit.noise.correlation();
         correlated += usize::from(rho > 0.0);
         systematic += usize::from(r.systematic);
         named += usize::from(!r.found.is_empty());

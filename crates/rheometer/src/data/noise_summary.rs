@@ -122,6 +122,18 @@ impl NoiseSummary {
         }
     }
 
+    /// The along-line correlation of the noise the model uses
+    /// ([`NoiseModel::correlation_used`]; 0 for white noise or without a model) \[-\].
+    pub fn correlation(&self) -> f64 {
+        self.model.as_ref().map_or(0.0, |m| m.correlation_used)
+    }
+
+    /// The factor on parameter variances for this noise
+    /// ([`NoiseModel::variance_inflation`]; 1 for white noise or without a model) \[-\].
+    pub fn variance_inflation(&self) -> f64 {
+        self.model.as_ref().map_or(1.0, |m| m.variance_inflation())
+    }
+
     /// Whether point `i` of experiment `k` is a gross outlier of the noise model.
     pub fn is_outlier(&self, k: usize, i: usize) -> bool {
         self.model.as_ref().is_some_and(|m| m.is_outlier(k, i))

@@ -163,11 +163,7 @@ impl Comparison {
                 k => format!(", {k} outliers left out"),
             }
         );
-        let correlated = self
-            .noise
-            .model
-            .as_ref()
-            .map_or(0.0, |m| m.correlation_used);
+        let correlated = self.noise.correlation();
         if correlated > 0.0 {
             // the runs test assumes independent signs; the lag-1 z is against the noise's own
             let verdict = if self.lag1_z.is_nan() || self.lag1_z < 2.0 {

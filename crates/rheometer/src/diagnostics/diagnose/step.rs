@@ -227,11 +227,7 @@ fn limits(
         &DetectionContext {
             sigma: s.noise.level / ctx.sigma,
             noise_level: s.noise.level,
-            long_run_factor: s
-                .noise
-                .model
-                .as_ref()
-                .map_or(1.0, |m| m.variance_inflation().sqrt()),
+            long_run_factor: s.noise.variance_inflation().sqrt(),
             cost_before: lin.cost_before,
             measurements: lin.residuals(),
             threshold: ctx.options.earn_threshold,

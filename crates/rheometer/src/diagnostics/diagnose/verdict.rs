@@ -167,8 +167,8 @@ pub(crate) fn share_of_excess(before: f64, after: f64, j_noise: f64) -> f64 {
 /// for correlated noise). `fit`'s own level is compared, and used, as it would be with the
 /// data's correlation.
 pub(crate) fn noise_for(fit: &FitSummary, base: &NoiseSummary) -> NoiseSummary {
-    let rho = correlation_of(base);
-    let own = correlation_of(&fit.noise);
+    let rho = base.correlation();
+    let own = fit.noise.correlation();
     let level = fit.noise.level * NoiseModel::level_factor(rho) / NoiseModel::level_factor(own);
     if base.declared() || level.partial_cmp(&base.level) != Some(std::cmp::Ordering::Less) {
         base.clone()
@@ -182,17 +182,12 @@ pub(crate) fn noise_for(fit: &FitSummary, base: &NoiseSummary) -> NoiseSummary {
     }
 }
 
-/// The along-line correlation a noise summary's model uses (0: white, or no model).
-fn correlation_of(noise: &NoiseSummary) -> f64 {
-    noise.model.as_ref().map_or(0.0, |m| m.correlation_used)
-}
-
 /// RMS (outliers excluded) of `fit`'s residuals over the data's noise level `noise` and the
 /// lag-1 structure statistic of its residuals against the data's correlation.
 pub(crate) fn at_noise(fit: &FitSummary, noise: &NoiseSummary) -> (f64, f64) {
     let m = fit.noise.model.as_ref();
     let rms = m.map_or(fit.rms_relative_residual, |m| m.rms);
-    let lag1_z = m.map_or(0.0, |m| m.lag1_z_against(correlation_of(noise)));
+    let lag1_z = m.map_or(0.0, |m| m.lag1_z_against(noise.correlation()));
     (rms / noise.level, lag1_z)
 }
 

@@ -122,11 +122,7 @@ impl Uncertainty {
         let fit = input.fit;
         let np = fit.p.len();
         let cov = CovarianceView::of(fit);
-        let inflation = input
-            .noise
-            .model
-            .as_ref()
-            .map_or(1.0, |m| m.variance_inflation());
+        let inflation = input.noise.variance_inflation();
         let se_opt: Option<Vec<f64>> = cov.as_ref().map(|c| {
             c.variances()
                 .into_iter()

@@ -184,12 +184,7 @@ impl Profiler<'_> {
             options,
             cost: 2.0 * id.fit.cost,
             // the long-run variance where the noise is correlated along the line
-            s2: id.fit.residual_variance()
-                * id.summary
-                    .noise
-                    .model
-                    .as_ref()
-                    .map_or(1.0, |m| m.variance_inflation()),
+            s2: id.fit.residual_variance() * id.summary.noise.variance_inflation(),
         })
     }
 
