@@ -74,8 +74,10 @@ pub struct Diagnosis {
     /// the noise model left out).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub robust: Option<RobustWeights>,
-    /// Whether the residuals are systematic: `rms_over_noise > 1.2`, or `ρ₁ √N > 3`, or a
-    /// candidate earns its place (its refit lowers BIC below the threshold).
+    /// Whether the residuals are systematic: `rms_over_noise > 1.2`, or `ρ₁ √N > 3` (both
+    /// widened for noise correlated along the line), or a candidate's refit lowers BIC below
+    /// the threshold with a false-alarm probability within the limit (named or not: a strength
+    /// or shape at a bound is not credible, but the misfit it removes is real).
     pub systematic: bool,
     /// The candidates, best first.
     pub candidates: Vec<Candidate>,

@@ -11,7 +11,9 @@ use super::verdict::{
     noise_cost, share_of_excess, EXPLAINED_RMS_OVER_NOISE, MIN_SHARE_OF_EXCESS, STRUCTURE_Z,
 };
 use super::{judge, DiagnoseOptions};
-use crate::diagnostics::candidate::{earns_its_place, rank_order, Candidate, Indistinguishable};
+use crate::diagnostics::candidate::{
+    earns_its_place, rank_order, Candidate, Indistinguishable, StrengthStatus,
+};
 use crate::diagnostics::detection::{detection_limits, DetectionContext, DetectionLimits};
 use crate::diagnostics::diagnosis::{RobustWeights, StageTimes};
 use crate::diagnostics::scores::cosine;
@@ -44,7 +46,8 @@ pub(crate) struct Step {
     pub detection: DetectionLimits,
     /// The look-elsewhere calibration at this step.
     pub calibration: Calibration,
-    /// Whether the noise test finds the residuals systematic.
+    /// Whether the residuals are systematic: by the noise test, or shown by a candidate that
+    /// lowers `BIC` beyond the threshold (`reveals_misfit`).
     pub systematic: bool,
     /// The fit settings of this step (the noise weights included).
     pub opts: IdentifyOptions,
@@ -123,6 +126,7 @@ pub(crate) fn run(
     order.sort_by(|&a, &b| rank_order(&records[a], &records[b]));
     // the share rule applies where the noise test finds an excess misfit at all
     let excess = systematic;
+    let systematic = systematic || records.iter().any(|r| reveals_misfit(r, options));
     let named_orig = order
         .iter()
         .copied()
@@ -162,6 +166,25 @@ fn names(c: &Candidate, options: &DiagnoseOptions, excess: bool) -> bool {
     earns_its_place(c, options.earn_threshold)
         && c.false_alarm.partial_cmp(&options.max_false_alarm) != Some(std::cmp::Ordering::Greater)
         && (!excess || c.share_of_excess >= MIN_SHARE_OF_EXCESS)
+}
+
+/// Whether the candidate `c` shows that the user's model misses something, whatever the
+/// noise test says: its refit lowers `BIC` below the naming threshold, the search would find
+/// such an effect on effect-free data in at most [`DiagnoseOptions::max_false_alarm`] of
+/// cases, and its fit is no implausible law (its strength may lie outside its physical range
+/// or at a bound, its shape at a bound: it is then not named, but the misfit it removes is
+/// real). The noise test alone can miss such a misfit where the noise level is estimated from
+/// the residuals: with few experiments a misfit that is smooth along the line can pass for
+/// noise correlated along it, and the model would be called adequate with a law biased by the
+/// missing effect.
+fn reveals_misfit(c: &Candidate, options: &DiagnoseOptions) -> bool {
+    c.refitted()
+        && matches!(
+            c.status,
+            StrengthStatus::Physical | StrengthStatus::Unphysical | StrengthStatus::AtBound
+        )
+        && c.delta_bic < options.earn_threshold
+        && c.false_alarm <= options.max_false_alarm
 }
 
 /// Stage 3: whether the user's residuals are systematic by the noise test (RMS over the noise
