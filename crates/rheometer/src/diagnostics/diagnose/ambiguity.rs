@@ -7,7 +7,9 @@
 //! * a candidate whose `ΔBIC` lies within the tie margin of the result's (see
 //!   [`ties`](crate::diagnostics::ties)), credible or refused only because its best
 //!   strength lies outside its physical range or at a search bound — a fit as good, which only
-//!   the range's prior excludes;
+//!   the range's prior excludes — or only because its law jumped from the user's (its own law
+//!   a result: the jump is a suspicion that the effect buys a law, and as good a fit with
+//!   another law is what "ambiguous" means);
 //! * a pair of candidates fitted jointly within the look-elsewhere margin (see
 //!   [`pair`](crate::diagnostics::refits::pair)).
 //!
@@ -61,17 +63,18 @@ pub(crate) fn disagreeing_rivals<'a>(
         .iter()
         .filter(|c| !found.contains(&c.effect))
         .filter(|c| {
-            matches!(
-                c.status,
-                StrengthStatus::Physical | StrengthStatus::Unphysical | StrengthStatus::AtBound
-            )
-        })
-        .filter(|c| {
             c.delta_bic < options.earn_threshold && c.delta_bic < result_dbic + options.tie_margin
         })
         .filter_map(|c| {
             let fit = c.refit.as_ref()?;
-            laws_disagree(fit, result).then(|| Rival {
+            let may_rival = match c.status {
+                StrengthStatus::Physical | StrengthStatus::Unphysical | StrengthStatus::AtBound => {
+                    true
+                }
+                StrengthStatus::ImplausibleLaw => only_jumped(fit),
+                StrengthStatus::NotRefitted | StrengthStatus::Undetermined => false,
+            };
+            (may_rival && laws_disagree(fit, result)).then(|| Rival {
                 effects: vec![c.effect.clone()],
                 status: c.status,
                 fit,
@@ -88,6 +91,19 @@ pub(crate) fn disagreeing_rivals<'a>(
         }
     }
     rivals
+}
+
+/// Whether a refit refused for an implausible law was refused only for its jump from the
+/// user's law (a move the gain in fit does not pay for), its own law being a result (`n`
+/// plausible, nothing at a bound, no implausible warning of its own). The jump says that the
+/// effect may buy a different law rather than explain the data; where such a refit explains
+/// the data as well as the result, the data cannot say which law is right, and it is a rival.
+/// With few experiments a missing effect biases the user's law by many of its standard
+/// errors, and the true effect's refit is refused for that very jump (three runs with an
+/// aspirator: the right effect's law within its interval of the truth, refused, and a line
+/// co-flow with radiation named with `n` 0.47 against the true 0.8).
+fn only_jumped(fit: &FitSummary) -> bool {
+    fit.law_not_a_result().is_none()
 }
 
 /// The warning on the result's fit where rivals disagree on the law: each law, the range all
@@ -135,6 +151,18 @@ mod tests {
     use crate::diagnostics::ties::tests::cand;
     use StrengthStatus::*;
 
+    /// `c` with its refit's own law implausible (the warning the fit's checks write).
+    fn own_law_implausible(mut c: Candidate) -> Candidate {
+        if let Some(f) = c.refit.as_mut() {
+            f.warnings.push(FitWarning::new(
+                WarningCode::Implausible,
+                "n = 0.1 is implausible for a polymer melt: this is not a material result"
+                    .to_string(),
+            ));
+        }
+        c
+    }
+
     #[test]
     fn rivals_as_good_with_another_law_make_the_verdict_ambiguous() {
         // the named effect: n = 0.844 ± 0.01 (cand's standard errors: 0.01 and 0.1)
@@ -151,7 +179,15 @@ mod tests {
             // another law but worse by more than the margin: no rival
             cand("nusselt_scale", Physical, -43.1, 0.70, 10.70),
             // as good, another law, but its own law implausible: no rival
-            cand("die_temperature_offset", ImplausibleLaw, -60.0, 0.3, 10.7),
+            own_law_implausible(cand(
+                "die_temperature_offset",
+                ImplausibleLaw,
+                -60.0,
+                0.1,
+                10.7,
+            )),
+            // as good, another law, refused only for its jump from the user's law: a rival
+            cand("inlet_diameter", ImplausibleLaw, -58.0, 0.78, 11.0),
             // not refitted: no rival
             cand("air_coflow", NotRefitted, -70.0, 0.7, 10.7),
         ];
@@ -159,7 +195,7 @@ mod tests {
         let found = vec!["air_temperature_profile".to_string()];
         let rivals = disagreeing_rivals(&list, &found, &result, -55.1, None, &options);
         let names: Vec<&str> = rivals.iter().map(|r| r.effects[0].as_str()).collect();
-        assert_eq!(names, ["gauge_offset", "mass_flow_scale"]);
+        assert_eq!(names, ["gauge_offset", "mass_flow_scale", "inlet_diameter"]);
         let w = warning(&result, &rivals);
         assert_eq!(w.code, WarningCode::Implausible);
         assert!(
@@ -187,9 +223,9 @@ mod tests {
         else {
             panic!("{v:?}")
         };
-        assert_eq!(alternatives.len(), 2);
-        // the range spans every law's 95 % interval: 0.80 - 1.96 se to 0.87 + 1.96 se
-        assert!((n_range[0] - (0.80 - 0.0196)).abs() < 1e-3, "{n_range:?}");
+        assert_eq!(alternatives.len(), 3);
+        // the range spans every law's 95 % interval: 0.78 - 1.96 se to 0.87 + 1.96 se
+        assert!((n_range[0] - (0.78 - 0.0196)).abs() < 1e-3, "{n_range:?}");
         assert!((n_range[1] - (0.87 + 0.0196)).abs() < 1e-3, "{n_range:?}");
         assert!(kappa_range[1] > 11.70, "{kappa_range:?}");
         assert!(!v.law_is_a_result());
