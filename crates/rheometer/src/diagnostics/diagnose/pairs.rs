@@ -27,7 +27,9 @@
 
 use super::step::Step;
 use super::DiagnoseOptions;
-use crate::diagnostics::candidate::{strength_status, Candidate, StrengthStatus};
+use crate::diagnostics::candidate::{
+    strength_status, Candidate, Indistinguishable, StrengthStatus,
+};
 use crate::diagnostics::refits::pair::delta_bic;
 use crate::diagnostics::refits::pair::PairFound;
 use crate::fit::{
@@ -111,9 +113,30 @@ impl Member<'_> {
     }
 }
 
+/// Whether the pair `kept + twin` is a result of two settled effects (`settled`) with one of
+/// them replaced by its near-twin: `kept` is settled, `twin` is not, and `twin` cannot be told
+/// apart from the other settled effect at the user's fit (their orthogonalised signatures'
+/// `|cos|` above [`DiagnoseOptions::indistinguishable_cosine`], the threshold at which the
+/// report says the data cannot tell two effects apart). The forward search adds the better
+/// twin first and never tries the other beside the first effect, so without this pair a
+/// twin's law would be printed as the result unchallenged (a die colder than declared with a
+/// co-flow: the co-flow with the Nusselt factor named, `n` 2.5 standard errors off).
+fn substitutes(twins: &[Indistinguishable], settled: &[String], kept: &str, twin: &str) -> bool {
+    settled.iter().any(|e| e == kept)
+        && !settled.iter().any(|e| e == twin)
+        && twins.iter().any(|p| {
+            let pair = [p.effects[0].as_str(), p.effects[1].as_str()];
+            pair.contains(&twin)
+                && settled
+                    .iter()
+                    .any(|e| e != kept && e != twin && pair.contains(&e.as_str()))
+        })
+}
+
 /// The pair search on the first step's candidates; `None` when no pair qualifies. `settled`:
 /// the effects the forward search found where they bring the residuals to the noise (pairs
-/// containing one of them are not fitted).
+/// containing one of them are not fitted, but for one of them beside the other's near-twin,
+/// see [`substitutes`]).
 pub(crate) fn search(
     set: &ExperimentSet,
     base_spec: &ModelSpec,
@@ -131,12 +154,18 @@ pub(crate) fn search(
         .filter_map(|c| member(c, options))
         .collect();
     // a pair that adds an effect to a result already at the noise is the forward search's
-    // next step, which parsimony refused: only other explanations compete with it
+    // next step, which parsimony refused: only other explanations compete with it, among
+    // them the result with one of its effects replaced by a near-twin
     let settled_in = |m: &Member<'_>| settled.contains(&m.candidate.effect);
+    let twins = &first.indistinguishable;
     let mut pairs = Vec::new();
     for i in 0..members.len() {
         for j in i + 1..members.len() {
-            if !settled_in(&members[i]) && !settled_in(&members[j]) {
+            let (a, b) = (&members[i], &members[j]);
+            let other = (!settled_in(a) && !settled_in(b))
+                || substitutes(twins, settled, &a.candidate.effect, &b.candidate.effect)
+                || substitutes(twins, settled, &b.candidate.effect, &a.candidate.effect);
+            if other {
                 pairs.push((i, j));
             }
         }
@@ -357,4 +386,48 @@ fn best_of(fits: Vec<Identification>) -> Option<(Identification, usize)> {
         .into_iter()
         .min_by(|x, y| x.summary.cost.total_cmp(&y.summary.cost))?;
     Some((best, at))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn twin(a: &str, b: &str, cosine: f64) -> Indistinguishable {
+        Indistinguishable {
+            effects: [a.into(), b.into()],
+            cosine,
+        }
+    }
+
+    #[test]
+    fn a_settled_result_is_challenged_only_by_its_members_twins() {
+        let twins = vec![
+            twin("nusselt_scale", "die_temperature_offset", -0.995),
+            twin("air_coflow", "radiation", -0.96),
+        ];
+        let settled: Vec<String> = vec!["air_coflow".into(), "nusselt_scale".into()];
+        // the co-flow beside the Nusselt factor's twin: the result with the twin swapped
+        assert!(substitutes(
+            &twins,
+            &settled,
+            "air_coflow",
+            "die_temperature_offset"
+        ));
+        // the Nusselt factor beside the co-flow's twin
+        assert!(substitutes(&twins, &settled, "nusselt_scale", "radiation"));
+        // a member beside its own twin adds an effect to the result (parsimony refused it)
+        assert!(!substitutes(
+            &twins,
+            &settled,
+            "nusselt_scale",
+            "die_temperature_offset"
+        ));
+        // no twin of the other member: a further effect, not a substitute
+        assert!(!substitutes(&twins, &settled, "air_coflow", "gauge_offset"));
+        // the twin must be outside the result, the kept effect in it
+        assert!(!substitutes(&twins, &settled, "radiation", "nusselt_scale"));
+        // a single settled effect has no partner to swap
+        let one: Vec<String> = vec!["air_coflow".into()];
+        assert!(!substitutes(&twins, &one, "air_coflow", "radiation"));
+    }
 }
