@@ -370,3 +370,31 @@ pub fn slightly_thinning() -> Scenario {
         ..base("slightly_thinning", 116)
     }
 }
+
+/// Three of the shipped set's experiments (the slowest at 1 bar, the middle one, the fastest
+/// at 3 bar) with an aspirator jet of `speed` m/s at the take-up and Lorentzian decay length
+/// `length` m (issue 65: few runs, where a strength scan's valley is narrow).
+pub fn three_runs_aspirator(speed: f64, length: f64, seed: u64) -> Scenario {
+    let experiments = shipped_experiments().into_iter().step_by(4).collect();
+    Scenario {
+        name: "three_runs_aspirator",
+        experiments,
+        ..aspirator(speed, length, seed)
+    }
+}
+
+/// A die `die_offset_k` K off its declared temperature (negative: colder) together with an
+/// aspirator jet of `speed` m/s at the take-up and Lorentzian decay length `length` m (issue
+/// 65: a process fault with a near-twin, the Nusselt factor, inside a pair).
+pub fn die_offset_and_coflow(die_offset_k: f64, speed: f64, length: f64, seed: u64) -> Scenario {
+    Scenario {
+        name: "die_offset_and_coflow",
+        faults: Faults {
+            die_offset_k,
+            ..Faults::none()
+        },
+        air_flow: AirFlow::Aspirator { speed, length },
+        acceptable: vec!["air_coflow", "die_temperature_offset"],
+        ..base("die_offset_and_coflow", seed)
+    }
+}
