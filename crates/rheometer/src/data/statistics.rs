@@ -28,7 +28,7 @@ const MAD_TO_SD: f64 = 1.482_602_218_505_602;
 
 /// Complementary error function `erfc(x)` (Chebyshev fit of Press et al., relative error below
 /// 1.2e-7 everywhere).
-pub fn erfc(x: f64) -> f64 {
+pub(crate) fn erfc(x: f64) -> f64 {
     let z = x.abs();
     let t = 1.0 / (1.0 + 0.5 * z);
     let poly = -z * z - 1.265_512_23
@@ -48,7 +48,7 @@ pub fn erfc(x: f64) -> f64 {
 }
 
 /// `P(χ²₁ > x)` \[-\] for the χ² distribution with one degree of freedom (`1` for `x ≤ 0`).
-pub fn chi2_1_survival(x: f64) -> f64 {
+pub(crate) fn chi2_1_survival(x: f64) -> f64 {
     if x <= 0.0 {
         1.0
     } else {
@@ -71,7 +71,7 @@ pub fn median(v: &mut [f64]) -> f64 {
 }
 
 /// Robust standard deviation `1.4826 · median |v − median v|` (`NaN` if empty).
-pub fn robust_sd(v: &[f64]) -> f64 {
+pub(crate) fn robust_sd(v: &[f64]) -> f64 {
     let mut w = v.to_vec();
     let med = median(&mut w);
     let mut dev: Vec<f64> = v.iter().map(|x| (x - med).abs()).collect();
@@ -265,7 +265,7 @@ fn ranks(v: &[f64]) -> Vec<f64> {
 
 /// Spearman rank correlation of `x` and `y` (`NaN` with fewer than 3 finite pairs or no
 /// spread).
-pub fn spearman(x: &[f64], y: &[f64]) -> f64 {
+pub(crate) fn spearman(x: &[f64], y: &[f64]) -> f64 {
     let (xs, ys): (Vec<f64>, Vec<f64>) = x
         .iter()
         .zip(y)

@@ -106,7 +106,7 @@ pub struct Reference {
 /// The covariance `A⁻¹ B A⁻¹` \[unit²\] of a fit whose information is `a` and whose score's
 /// covariance under the real noise is `b` (both `p × p` row-major; see
 /// `information`); `None` when `a` is not positive definite.
-pub fn sandwich(a: &[f64], b: &[f64], p: usize) -> Option<Vec<f64>> {
+pub(crate) fn sandwich(a: &[f64], b: &[f64], p: usize) -> Option<Vec<f64>> {
     let (ai, _) = spd_inverse(&DMatrix::from_row_slice(p, p, a))?;
     let c = &ai * DMatrix::from_row_slice(p, p, b) * &ai;
     // symmetric by construction; rounding made exact so that Cholesky sees a symmetric matrix

@@ -51,7 +51,7 @@ use crate::model::effects::Effect;
 use serde::{Deserialize, Serialize};
 
 /// The one-sided 95 % quantile of the standard normal distribution.
-pub const Z95_ONE_SIDED: f64 = 1.644_853_626_951_472_2;
+pub(crate) const Z95_ONE_SIDED: f64 = 1.644_853_626_951_472_2;
 
 /// One candidate's detection limit (JSON: an entry of `detection.limits`).
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -142,7 +142,7 @@ pub struct DetectionContext {
 /// `ΔJ*`: the cost a candidate must remove to bring `ΔBIC = N ln(J_after/J_before) + Δk ln N`
 /// down to `threshold`, where `J_before = cost_rest + ΔJ` (`cost_rest`: the cost the candidate
 /// does not carry).
-pub fn required_reduction(cost_rest: f64, n: usize, threshold: f64, extra: usize) -> f64 {
+pub(crate) fn required_reduction(cost_rest: f64, n: usize, threshold: f64, extra: usize) -> f64 {
     let nf = n.max(1) as f64;
     let penalty = extra as f64 * nf.ln();
     cost_rest * ((penalty - threshold) / nf).exp_m1()
@@ -151,7 +151,7 @@ pub fn required_reduction(cost_rest: f64, n: usize, threshold: f64, extra: usize
 /// `(s50, s95)` for a signature `‖c⊥‖ = norm` per unit strength, noise `sigma` (both in the
 /// residuals' units) and the non-centrality `lambda_star` at which the candidate is detected on
 /// average (infinite where the signature vanishes).
-pub fn strength_limits(norm: f64, sigma: f64, lambda_star: f64) -> (f64, f64) {
+pub(crate) fn strength_limits(norm: f64, sigma: f64, lambda_star: f64) -> (f64, f64) {
     if !(norm > 0.0 && norm.is_finite()) {
         return (f64::INFINITY, f64::INFINITY);
     }
@@ -357,7 +357,7 @@ fn signed(v: f64) -> String {
 }
 
 /// `v` with three significant digits.
-pub fn sig3(v: f64) -> String {
+pub(crate) fn sig3(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
     }

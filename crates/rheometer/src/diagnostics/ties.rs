@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 
 /// Default [`DiagnoseOptions::tie_margin`](super::diagnose::DiagnoseOptions::tie_margin): a
 /// `ΔBIC` gap below 6 is less than "strong" evidence (Kass–Raftery) for the named cause.
-pub const DEFAULT_TIE_MARGIN: f64 = 6.0;
+pub(crate) const DEFAULT_TIE_MARGIN: f64 = 6.0;
 
 use crate::fit::summary::Z95;
 
@@ -68,7 +68,12 @@ pub struct Alternative {
 /// Whether `c` ties with the `named` cause: a different candidate that earns its place
 /// ([`earns_its_place`] with `earn_threshold`) with a `ΔBIC` less than `tie_margin` above the
 /// named one's. At-bound, unphysical and unrefitted candidates never tie.
-pub fn ties_with(named: &Candidate, c: &Candidate, earn_threshold: f64, tie_margin: f64) -> bool {
+pub(crate) fn ties_with(
+    named: &Candidate,
+    c: &Candidate,
+    earn_threshold: f64,
+    tie_margin: f64,
+) -> bool {
     c.effect != named.effect
         && earns_its_place(c, earn_threshold)
         && c.delta_bic - named.delta_bic < tie_margin
@@ -160,7 +165,7 @@ pub fn alternatives(
 /// effect's category and independent check read from its descriptor among `effects` (a name
 /// not among them: physics, no check) and `cosine(effect)` its signature cosine with the named
 /// one.
-pub fn alternatives_among(
+pub(crate) fn alternatives_among(
     named: &Candidate,
     candidates: &[Candidate],
     earn_threshold: f64,
@@ -194,7 +199,7 @@ pub fn independent_check(effect: &str) -> Option<&'static str> {
 
 /// What else tells explanations apart that no measurement along the line decides: data at
 /// other conditions.
-pub const OTHER_CONDITIONS: &str = "data at other conditions (another take-up speed, air \
+pub(crate) const OTHER_CONDITIONS: &str = "data at other conditions (another take-up speed, air \
                                     condition or mass flow), which change their signatures \
                                     differently";
 

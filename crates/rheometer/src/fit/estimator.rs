@@ -35,7 +35,7 @@ impl Estimator {
 
 /// The paper's weighted residual `√Δ_j √ε̇(s_j) (d(s_j) − d_fit(s_j))` (dimensionless), `d` the
 /// gauge's reading ([`FiberModel::observed_diameter`]).
-pub struct PaperResidual<'a, L: ViscosityLaw, H: NusseltLaw> {
+pub(crate) struct PaperResidual<'a, L: ViscosityLaw, H: NusseltLaw> {
     /// The fiber model.
     pub model: &'a FiberModel<L, H>,
     /// `√Δ_j` (dimensionless grid spacing).

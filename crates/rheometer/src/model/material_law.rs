@@ -151,7 +151,7 @@ impl ZeroRateViscosity {
 
 /// Shifts `(ΔB/T_o, ΔT_VF/T_o)` of the VFT parameters (dimensionless; see
 /// [`ZeroRateViscosity::eval_shifted`]); `None`: the nominal VFT law.
-pub type VftShift<D> = Option<[D; 2]>;
+pub(crate) type VftShift<D> = Option<[D; 2]>;
 
 impl ZeroRateViscosity {
     /// `μ̃_e0(T̃)`, with the VFT parameters shifted when `shift` is given

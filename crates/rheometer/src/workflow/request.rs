@@ -357,7 +357,7 @@ pub fn positions(p: &[f64], loaded: &LoadedExperiments) -> Result<(), Refusal> {
 
 /// Text with inputs written `@name@` or `@name=value@` (Python's names) in `door`'s words
 /// (see [`Refusal::reason`]); for messages of a workflow that knows its door.
-pub fn in_words_of(text: &str, door: Door) -> String {
+pub(crate) fn in_words_of(text: &str, door: Door) -> String {
     Refusal::new(Arg::Tol, text.to_string()).reason(door)
 }
 

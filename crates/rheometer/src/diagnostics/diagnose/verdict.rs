@@ -35,7 +35,7 @@ pub const EXPLAINED_RMS_OVER_NOISE: f64 = 1.2;
 
 /// The lag-1 structure ([`NoiseModel::lag1_z`](crate::data::noise_model::NoiseModel::lag1_z),
 /// standard errors) at or above which the residuals keep a structure along the line.
-pub const STRUCTURE_Z: f64 = 3.0;
+pub(crate) const STRUCTURE_Z: f64 = 3.0;
 
 /// A candidate that helps: how much of the excess misfit it removes.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

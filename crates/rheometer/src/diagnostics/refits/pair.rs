@@ -65,7 +65,7 @@ pub fn replace_margin(tie_margin: f64, pairs_tried: usize) -> f64 {
 /// if any effect was found): `None` when the pair is worse by more than the tie margin (or
 /// nothing was found and the pair does not clear [`replace_margin`]), else the pair with
 /// [`PairFound::replaces`] and [`PairFound::laws_disagree`] set.
-pub fn against_steps(
+pub(crate) fn against_steps(
     mut pair: PairFound,
     steps_dbic: f64,
     steps_fit: Option<&FitSummary>,
@@ -115,7 +115,7 @@ pub fn law_envelope_of<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> [[
 /// The sentence on explanations that disagree on the law: the result's `n` (`result`, the
 /// named effects), each rival's (`rivals`: its label, e.g. its effects, and its fit), the range
 /// all span, and that none of the laws is a result.
-pub fn disagreement(result: &FitSummary, rivals: &[(String, &FitSummary)]) -> String {
+pub(crate) fn disagreement(result: &FitSummary, rivals: &[(String, &FitSummary)]) -> String {
     let [n, k] = law_envelope_of(rivals.iter().map(|(_, f)| *f).chain([result]));
     let laws: Vec<String> = rivals
         .iter()

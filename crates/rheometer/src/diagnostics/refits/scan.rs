@@ -392,7 +392,7 @@ pub fn shape_variants(
 
 /// What a [`walk_out`] gives: the values reached with their results, and the value where it
 /// stopped with the failure, if any.
-pub type Walk<T, E> = (Vec<(f64, T)>, Option<(f64, E)>);
+pub(crate) type Walk<T, E> = (Vec<(f64, T)>, Option<(f64, E)>);
 
 /// Evaluates `eval` at `values` in order, each call given the previous result (the warm
 /// start; `None` for the first), and stops at the first failure, which is returned with its
@@ -799,7 +799,7 @@ fn bracket_minimum<E>(
 /// and its discrete shapes (scanned, not fitted: the co-flow's tail) fixed at the variant's
 /// values. A further step of the diagnosis adds this effect to the model, so that it refits the
 /// shapes of the refit it starts from, not the variant's grid values.
-pub fn refitted_effect(candidate: &Effect, variant: &Effect) -> Result<Effect, String> {
+pub(crate) fn refitted_effect(candidate: &Effect, variant: &Effect) -> Result<Effect, String> {
     let mut effect = candidate.clone();
     for (sp, v) in variant.shape_values() {
         let open = candidate

@@ -38,7 +38,7 @@ use diffbvp::least_squares::{FitResult, Termination};
 use nalgebra::{DMatrix, SymmetricEigen};
 
 /// Which bound `value` is at (within [`AT_BOUND_TOLERANCE`] of the range width), if any.
-pub fn bound_side(value: f64, lower: f64, upper: f64) -> Option<BoundSide> {
+pub(crate) fn bound_side(value: f64, lower: f64, upper: f64) -> Option<BoundSide> {
     let width = upper - lower;
     let tol = if width.is_finite() && width > 0.0 {
         AT_BOUND_TOLERANCE * width

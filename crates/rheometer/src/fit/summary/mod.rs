@@ -32,7 +32,7 @@ use diffbvp::least_squares::Loss;
 use serde::{Deserialize, Deserializer, Serialize};
 
 /// Half-width of a two-sided 95 % normal interval in standard errors.
-pub const Z95: f64 = 1.959_963_984_540_054;
+pub(crate) const Z95: f64 = 1.959_963_984_540_054;
 
 /// An estimate at a bound of its search range (JSON:
 /// `{"parameter": "kappa", "side": "lower", "bound": 7.0, "value": 7.0}`).
