@@ -36,7 +36,8 @@ pub fn law_outcome(r: &DiagnosisRun, sc: &Scenario) -> &'static str {
 /// Three runs with an aspirator jet drawn per replicate (speed log-uniform in 30–300 m/s,
 /// Lorentzian decay length log-uniform in 0.03–0.3 m: issue 11's range), fresh noise each:
 /// how often the co-flow is named, and how the reported law stands. `FEW_RUNS_SETS`
-/// replicates (default 20).
+/// replicates (default 20); `FEW_RUNS_POINTS` grid points per side of each strength scan
+/// (default the diagnosis' own).
 #[test]
 #[ignore = "a study: one diagnosis per replicate (about a minute for 20 sets)"]
 fn three_runs_study() {
@@ -44,6 +45,15 @@ fn three_runs_study() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(20);
+    // the scan's grid points per side (default 4): a denser grid shows whether the default one
+    // steps over a valley (a lower co-flow refit found only with more points)
+    let mut options = DiagnoseOptions::default();
+    if let Some(points) = std::env::var("FEW_RUNS_POINTS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
+        options.scan.points_per_sign = points;
+    }
     let (mut named, mut holds, mut flagged, mut wrong) = (0, 0, 0, 0);
     let mut seconds = Vec::new();
     for k in 0..sets {
@@ -51,7 +61,7 @@ fn three_runs_study() {
         let speed = 30.0 * 10f64.powf(rng.uniform());
         let length = 0.03 * 10f64.powf(rng.uniform());
         let sc = scenarios::three_runs_aspirator(speed, length, 9800 + k);
-        let d = shared::diagnose_with(&sc, &DiagnoseOptions::default());
+        let d = shared::diagnose_with(&sc, &options);
         let g = &d.run.diagnosis;
         let is_named = g.found.iter().any(|e| e == "air_coflow");
         let outcome = law_outcome(&d.run, &sc);
@@ -63,9 +73,10 @@ fn three_runs_study() {
         }
         seconds.push(d.seconds);
         let f = g.law_fit();
+        let coflow = g.candidates.iter().find(|c| c.effect == "air_coflow");
         println!(
             "FEW RUNS | {k:2} | V {speed:5.1} m/s l {length:.3} m | found {:?} | {} | n {:.3} \
-             [{:.3}, {:.3}] kappa {:.2} | {} | {:.1} s",
+             [{:.3}, {:.3}] kappa {:.2} | {} | air_coflow J/J_base {:.4} | {:.1} s",
             g.found,
             g.verdict.kind(),
             f.n.value,
@@ -73,6 +84,7 @@ fn three_runs_study() {
             f.n.ci95[1],
             f.kappa.value,
             outcome,
+            coflow.map_or(f64::NAN, |c| c.cost_after / c.cost_before),
             d.seconds
         );
     }
