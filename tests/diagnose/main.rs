@@ -5,6 +5,7 @@
 mod independent;
 
 mod ci_coverage;
+mod classes;
 mod detection_limits;
 mod diagnose_candidates;
 mod diagnose_hidden_effects;

@@ -398,3 +398,29 @@ pub fn die_offset_and_coflow(die_offset_k: f64, speed: f64, length: f64, seed: u
         ..base("die_offset_and_coflow", seed)
     }
 }
+
+/// A strongly thinning melt (`n` = 0.45, `κ` = 12.0) with one process or instrument fault
+/// (`faults`), the shipped set's conditions otherwise (issue 65: strong thinning with a fault).
+pub fn strongly_thinning_with(faults: Faults, seed: u64) -> Scenario {
+    Scenario {
+        name: "strongly_thinning_with_fault",
+        law: Law {
+            n: 0.45,
+            kappa: 12.0,
+        },
+        ..with_faults(faults, seed)
+    }
+}
+
+/// Grey-body radiation of emissivity `emissivity` and warm air near the die (`excess` K over
+/// an inverse square of `length` m) together: two physics effects at once (issue 65).
+pub fn radiation_with_warm_air(emissivity: f64, excess: f64, length: f64, seed: u64) -> Scenario {
+    Scenario {
+        name: "radiation_with_warm_air",
+        emissivity,
+        air_heat: AirHeat::InverseSquare { excess, length },
+        acceptable: vec!["radiation", "air_temperature_profile"],
+        expected: None,
+        ..base("radiation_with_warm_air", seed)
+    }
+}
