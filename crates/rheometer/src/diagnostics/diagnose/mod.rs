@@ -216,14 +216,7 @@ pub fn diagnose(
     let t_pairs = Instant::now();
     let pair = if options.max_effects >= 2 && something_to_explain(&steps) {
         let (dbic, fit) = steps_result(&steps);
-        let noise = &steps[0].base.summary.noise;
-        let settled: Vec<String> = match fit {
-            Some(f) if verdict::explained(f, noise) => steps
-                .iter()
-                .filter_map(|s| s.named_candidate().map(|c| c.effect.clone()))
-                .collect(),
-            _ => Vec::new(),
-        };
+        let settled = settled_effects(set, &steps);
         pairs::search(set, base_spec, options, &steps[0], &settled).and_then(|(p, id)| {
             crate::diagnostics::refits::pair::against_steps(
                 p,
@@ -265,6 +258,37 @@ fn without_outliers(
                 .unzip()
         })
         .collect()
+}
+
+/// The effects the forward search found where they settle the diagnosis: their joint fit
+/// brings the residuals to the noise and each has one strength in every experiment (the
+/// consistency test of stage 10). A pair that adds an effect to settled ones is not fitted
+/// (parsimony); a result whose effect is a stand-in settles nothing, so every pair challenges
+/// it (radiation under warm air: the warm air alone reached the noise as a stand-in, and
+/// warm air with radiation, the truth, was never fitted).
+fn settled_effects(set: &ExperimentSet, steps: &[step::Step]) -> Vec<String> {
+    let Some(id) = steps
+        .iter()
+        .rev()
+        .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id))
+    else {
+        return Vec::new();
+    };
+    let noise = &steps[0].base.summary.noise;
+    if !verdict::explained(&id.summary, noise) {
+        return Vec::new();
+    }
+    let found: Vec<String> = steps
+        .iter()
+        .filter_map(|s| s.named_candidate().map(|c| c.effect.clone()))
+        .collect();
+    if consistency::check(id, &found, set)
+        .iter()
+        .any(|c| !c.consistent())
+    {
+        return Vec::new();
+    }
+    found
 }
 
 /// Whether the user's residuals are systematic or an effect was named.
