@@ -130,13 +130,16 @@ def test_take_up_rules(pmma):
 def test_a_stand_in_effect_makes_the_law_no_result():
     """Strain hardening (data/strain_hardening, outside the candidates, truth n = 0.8):
     radiation brings the residuals to the noise with a biased law, but only with a strength
-    that differs between the experiments, so it is a stand-in and the law is no result."""
+    that differs between the experiments, so it is a stand-in and the law is no result (also
+    in the pair that challenges the stand-in and replaces it, radiation with a gauge scale)."""
     from conftest import ROOT
 
     d = diffbvp.diagnose(diffbvp.load(ROOT / "data" / "strain_hardening" / "experiments.toml"))
     assert d.verdict["kind"] == "none_of_the_candidates" and not d.law_is_a_result, d.verdict
     stand_ins = d.verdict["stand_ins"]
-    assert [c["effect"] for c in stand_ins] == d.found, (stand_ins, d.found)
+    stand_in_effects = [c["effect"] for c in stand_ins]
+    assert "radiation" in stand_in_effects, (stand_ins, d.found)
+    assert all(e in d.found for e in stand_in_effects), (stand_ins, d.found)
     c = d.consistency[0]
     assert c["p_value"] < c["level"] and c["dof"][0] == len(c["conditions"]) >= 1, c
     assert len(c["by_experiment"]) == 9
