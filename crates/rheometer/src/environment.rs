@@ -4,7 +4,7 @@
 //! by a default), and `RAYON_NUM_THREADS`, the size of the thread pool, clamped to a number a
 //! machine can run ([`thread_count`]).
 
-use crate::report::output_files::FIFO_WAIT_VARIABLE;
+use crate::report::output_files::{FIFO_WAIT_RANGE, FIFO_WAIT_VARIABLE};
 
 /// A numeric `DIFFBVP_*` variable: its name, range and meaning.
 #[derive(Debug, Clone, Copy)]
@@ -20,7 +20,7 @@ pub(crate) struct NumericVariable {
 /// Every `DIFFBVP_*` variable the program reads.
 pub(crate) const DIFFBVP_VARIABLES: [NumericVariable; 1] = [NumericVariable {
     name: FIFO_WAIT_VARIABLE,
-    range: [0.1, 3600.0],
+    range: FIFO_WAIT_RANGE,
     meaning: "seconds a write into a FIFO waits for a reader (default 10)",
 }];
 

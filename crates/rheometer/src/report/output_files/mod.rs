@@ -33,6 +33,7 @@ pub use temporaries::{
     remove_pending_temporaries, remove_stale_temporaries, temporary_in, temporary_owner,
     TEMPORARY_PREFIX,
 };
+pub(crate) use write::FIFO_WAIT_RANGE;
 pub use write::{
     ensure_not_input, fifo_reader_wait, same_file, write_bytes, write_file, write_target,
     FIFO_READER_WAIT, FIFO_WAIT_VARIABLE,

@@ -14,9 +14,14 @@ use std::time::{Duration, Instant};
 pub const FIFO_READER_WAIT: Duration = Duration::from_secs(10);
 
 /// The environment variable that sets the FIFO reader wait in seconds (a number in
-/// `[0.1, 3600]`, e.g. `DIFFBVP_FIFO_WAIT_S=60` for a reader that starts late; anything else
-/// leaves the default [`FIFO_READER_WAIT`]).
+/// `[0.1, 3600]`, e.g. `DIFFBVP_FIFO_WAIT_S=60` for a reader that starts late; the
+/// program refuses anything else at its start, and the library keeps the default
+/// [`FIFO_READER_WAIT`]).
 pub const FIFO_WAIT_VARIABLE: &str = "DIFFBVP_FIFO_WAIT_S";
+
+/// The accepted values of [`FIFO_WAIT_VARIABLE`], inclusive \[s\]: the one range the
+/// program's check of its environment and the library's reading share.
+pub(crate) const FIFO_WAIT_RANGE: [f64; 2] = [0.1, 3600.0];
 
 /// How long a write into a FIFO waits for a reader: [`FIFO_WAIT_VARIABLE`] if it holds a number
 /// of seconds in `[0.1, 3600]`, else [`FIFO_READER_WAIT`].
@@ -28,7 +33,7 @@ pub fn fifo_reader_wait() -> Duration {
 fn fifo_wait_from(value: Option<&str>) -> Duration {
     value
         .and_then(|v| v.trim().parse::<f64>().ok())
-        .filter(|s| (0.1..=3600.0).contains(s))
+        .filter(|s| (FIFO_WAIT_RANGE[0]..=FIFO_WAIT_RANGE[1]).contains(s))
         .map_or(FIFO_READER_WAIT, Duration::from_secs_f64)
 }
 
