@@ -28,13 +28,16 @@ fn study(label: &str, make: impl Fn(u64, &mut Rng) -> (Scenario, String)) {
     for k in 0..sets {
         let mut rng = Rng::new(0xC1A5 + 97 * k);
         let (sc, what) = make(k, &mut rng);
-        if let Err(e) = sc.generate() {
-            // the independent simulator has no solution at these conditions: no data set
-            println!("{label} | {k:2} | {what} | not generated: {e}");
-            failed += 1;
-            continue;
-        }
-        let d = shared::diagnose_with(&sc, &DiagnoseOptions::default());
+        let generated = match sc.generate() {
+            Ok(g) => g,
+            Err(e) => {
+                // the independent simulator has no solution at these conditions: no data set
+                println!("{label} | {k:2} | {what} | not generated: {e}");
+                failed += 1;
+                continue;
+            }
+        };
+        let d = shared::diagnose_generated(&generated, &DiagnoseOptions::default());
         let g = &d.run.diagnosis;
         let outcome = law_outcome(&d.run, &sc);
         match outcome {

@@ -6,7 +6,7 @@
 
 use crate::independent;
 
-use independent::dataset::Scenario;
+use independent::dataset::{Generated, Scenario};
 use rheometer::data::input::load_experiments;
 use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
 use rheometer::model::effects::{LawChoice, ModelSpec};
@@ -29,7 +29,13 @@ pub struct Diagnosed {
 /// call anew: the tests with options of their own and the studies, which diagnose hundreds of
 /// sets once each, so that the cache of [`diagnosed`] does not hold them.
 pub fn diagnose_with(sc: &Scenario, options: &DiagnoseOptions) -> Diagnosed {
-    let generated = sc.generate().unwrap();
+    diagnose_generated(&sc.generate().unwrap(), options)
+}
+
+/// Loads the data set `generated` and diagnoses it with `options` (the Carreau-type law): for
+/// studies that generate a scenario themselves to tell a set the simulator cannot make from a
+/// failed diagnosis.
+pub fn diagnose_generated(generated: &Generated, options: &DiagnoseOptions) -> Diagnosed {
     let set = load_experiments(&generated.toml).unwrap();
     let t0 = Instant::now();
     let run = diagnose(&set, &ModelSpec::new(LawChoice::Carreau), options).unwrap();
