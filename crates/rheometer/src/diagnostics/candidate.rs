@@ -50,6 +50,19 @@ impl StrengthStatus {
         }
     }
 
+    /// Whether a refit with this status is evidence about the data: its fit is as it stands
+    /// (credible, or refused only for its strength's or shape's range, which a prior excludes,
+    /// not the data), unlike a refit whose law is implausible, whose strength is undetermined,
+    /// or a candidate not refitted. Such a refit shows a misfit the user's model leaves
+    /// ([`diagnose`](super::diagnose)'s systematic test) and rivals the result's law (its
+    /// ambiguity stage).
+    pub fn fit_is_evidence(&self) -> bool {
+        matches!(
+            self,
+            StrengthStatus::Physical | StrengthStatus::Unphysical | StrengthStatus::AtBound
+        )
+    }
+
     /// How a refit's strength stands, as a phrase to follow the effect's name in a sentence
     /// (empty where it is credible or not refitted).
     pub fn qualifier(&self) -> &'static str {

@@ -67,13 +67,8 @@ pub(crate) fn disagreeing_rivals<'a>(
         })
         .filter_map(|c| {
             let fit = c.refit.as_ref()?;
-            let may_rival = match c.status {
-                StrengthStatus::Physical | StrengthStatus::Unphysical | StrengthStatus::AtBound => {
-                    true
-                }
-                StrengthStatus::ImplausibleLaw => only_jumped(fit),
-                StrengthStatus::NotRefitted | StrengthStatus::Undetermined => false,
-            };
+            let may_rival = c.status.fit_is_evidence()
+                || (c.status == StrengthStatus::ImplausibleLaw && only_jumped(fit));
             (may_rival && laws_disagree(fit, result)).then(|| Rival {
                 effects: vec![c.effect.clone()],
                 status: c.status,

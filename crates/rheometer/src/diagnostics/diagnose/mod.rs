@@ -267,21 +267,14 @@ fn without_outliers(
 /// it (radiation under warm air: the warm air alone reached the noise as a stand-in, and
 /// warm air with radiation, the truth, was never fitted).
 fn settled_effects(set: &ExperimentSet, steps: &[step::Step]) -> Vec<String> {
-    let Some(id) = steps
-        .iter()
-        .rev()
-        .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id))
-    else {
+    let Some(id) = final_refit(steps) else {
         return Vec::new();
     };
     let noise = &steps[0].base.summary.noise;
     if !verdict::explained(&id.summary, noise) {
         return Vec::new();
     }
-    let found: Vec<String> = steps
-        .iter()
-        .filter_map(|s| s.named_candidate().map(|c| c.effect.clone()))
-        .collect();
+    let found = found_effects(steps);
     if consistency::check(id, &found, set)
         .iter()
         .any(|c| !c.consistent())
@@ -289,6 +282,22 @@ fn settled_effects(set: &ExperimentSet, steps: &[step::Step]) -> Vec<String> {
         return Vec::new();
     }
     found
+}
+
+/// The effects the steps named, in the order found.
+fn found_effects(steps: &[step::Step]) -> Vec<String> {
+    steps
+        .iter()
+        .filter_map(|s| s.named_candidate().map(|c| c.effect.clone()))
+        .collect()
+}
+
+/// The steps' final fit: the last named refit (all found effects, fitted jointly), if any.
+fn final_refit(steps: &[step::Step]) -> Option<&Identification> {
+    steps
+        .iter()
+        .rev()
+        .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id))
 }
 
 /// Whether the user's residuals are systematic or an effect was named.
@@ -304,11 +313,7 @@ fn steps_result(steps: &[step::Step]) -> (f64, Option<&crate::fit::FitSummary>) 
     let Some(first) = steps.first() else {
         return (0.0, None);
     };
-    let Some(fit) = steps
-        .iter()
-        .rev()
-        .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id))
-    else {
+    let Some(fit) = final_refit(steps) else {
         return (0.0, None);
     };
     let k: usize = steps
@@ -335,15 +340,8 @@ fn assemble(
     t0: Instant,
 ) -> DiagnosisRun {
     let noise = steps[0].base.summary.noise.clone();
-    let mut found: Vec<String> = steps
-        .iter()
-        .filter_map(|s| s.named_candidate().map(|c| c.effect.clone()))
-        .collect();
-    // the final model: the last named refit (all found effects, fitted jointly)
-    let mut final_id: Option<Identification> = steps
-        .iter()
-        .rev()
-        .find_map(|s| s.named_refit.as_ref().map(|(_, id)| id.clone()));
+    let mut found = found_effects(&steps);
+    let mut final_id: Option<Identification> = final_refit(&steps).cloned();
     let mut fit_options = steps.last().map(|s| s.opts.clone()).unwrap_or_default();
     let mut result_dbic = steps_result(&steps).0;
     // a pair found by the joint search replaces what the steps found when clearly better

@@ -135,9 +135,8 @@ fn substitutes(twins: &[Indistinguishable], settled: &[String], kept: &str, twin
 
 /// The pair search on the first step's candidates; `None` when no pair qualifies. `settled`:
 /// the effects the forward search found where they bring the residuals to the noise, each
-/// with one strength in every experiment (pairs
-/// containing one of them are not fitted, but for one of them beside the other's near-twin,
-/// see [`substitutes`]).
+/// with one strength in every experiment (pairs containing one of them are not fitted, but for
+/// one of them beside the other's near-twin, see [`substitutes`]).
 pub(crate) fn search(
     set: &ExperimentSet,
     base_spec: &ModelSpec,

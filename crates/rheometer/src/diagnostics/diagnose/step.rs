@@ -11,9 +11,7 @@ use super::verdict::{
     noise_cost, share_of_excess, EXPLAINED_RMS_OVER_NOISE, MIN_SHARE_OF_EXCESS, STRUCTURE_Z,
 };
 use super::{judge, DiagnoseOptions};
-use crate::diagnostics::candidate::{
-    earns_its_place, rank_order, Candidate, Indistinguishable, StrengthStatus,
-};
+use crate::diagnostics::candidate::{earns_its_place, rank_order, Candidate, Indistinguishable};
 use crate::diagnostics::detection::{detection_limits, DetectionContext, DetectionLimits};
 use crate::diagnostics::diagnosis::{RobustWeights, StageTimes};
 use crate::diagnostics::scores::cosine;
@@ -179,10 +177,7 @@ fn names(c: &Candidate, options: &DiagnoseOptions, excess: bool) -> bool {
 /// missing effect.
 fn reveals_misfit(c: &Candidate, options: &DiagnoseOptions) -> bool {
     c.refitted()
-        && matches!(
-            c.status,
-            StrengthStatus::Physical | StrengthStatus::Unphysical | StrengthStatus::AtBound
-        )
+        && c.status.fit_is_evidence()
         && c.delta_bic < options.earn_threshold
         && c.false_alarm <= options.max_false_alarm
 }
