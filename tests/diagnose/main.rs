@@ -17,5 +17,6 @@ mod global;
 mod newtonian_effects;
 mod noise_rates;
 mod shared;
+mod studies;
 mod twins;
 mod user_effect_descriptor;
