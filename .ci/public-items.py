@@ -42,7 +42,8 @@ def strip(text):
     """Comments, strings and character literals blanked (line structure kept), the test module
     cut off."""
     text = blank(text)
-    text = text.split("#[cfg(test)]", 1)[0]
+    # the test module (a `#[cfg(test)]` on a single `use` or item does not end the file)
+    text = re.split(r"#\[cfg\(test\)\]\s*(?:pub(?:\([^)]*\))?\s+)?mod\s+\w+\s*\{", text, maxsplit=1)[0]
     # a `use` statement on one line, so that its braces do not look like a block
     return re.sub(r"\buse\s+[^;]*;", lambda m: re.sub(r"\s+", " ", m.group(0)), text)
 
