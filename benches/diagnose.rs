@@ -4,8 +4,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rheometer::data::input::load_experiments;
-use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions};
-use rheometer::model::effects::ModelSpec;
+use rheometer::diagnostics::{diagnose, DiagnoseOptions};
+use rheometer::model::ModelSpec;
 use std::hint::black_box;
 use std::path::Path;
 

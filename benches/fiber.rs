@@ -4,10 +4,13 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use diffbvp::continuation::ContinuationOptions as AdapterOptions;
-use rheometer::model::cold_start::StepControl;
-use rheometer::model::setup::{Air, Experiment, Material};
-use rheometer::model::simulate::simulate_from;
-use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions, Simulator};
+use rheometer::model::simulate_from;
+use rheometer::model::StepControl;
+use rheometer::model::{Air, Experiment, Material};
+use rheometer::{
+    model::simulate, model::CarreauLike, model::FiberModel, model::Physics, model::SimulateOptions,
+    model::Simulator,
+};
 use std::hint::black_box;
 
 fn model() -> FiberModel<CarreauLike> {

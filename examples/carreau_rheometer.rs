@@ -11,7 +11,10 @@ use diffbvp::mesh::linspace;
 use indicatif::{ProgressBar, ProgressStyle};
 use rheometer::data::input::load_experiments;
 use rheometer::fit::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
-use rheometer::report::figures::{identification_figures, landscape_map};
+use rheometer::report::figures::{
+    identification_figure_names, identification_figures, landscape_map,
+};
+use rheometer::report::output_files::OutputPlan;
 use std::path::{Path, PathBuf};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -52,6 +55,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let report = id.summary.clone();
     println!("\n{}", report.to_text());
     // ANCHOR_END: identify
+    // every figure is checked before the rest of the run: none may replace a data file
+    let mut names = identification_figure_names("png", set.experiments.len());
+    names.push("fig4_landscape.png".into());
+    let mut plan = OutputPlan::new();
+    plan.inputs(&inputs).dir(&out, "OUT_DIR", &names);
+    let outputs = plan.check()?;
     let paper = IdentifyOptions::with_estimator(Estimator::Paper);
     let id_paper = rheometer.identify(start, &paper)?;
     println!("{}", id_paper.summary.clone().to_text());
@@ -92,10 +101,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     sweep.finish_and_clear();
 
     // Figures: paper Fig. 2, 3, 5 for the principled fit, and Fig. 4, the cost landscape.
-    std::fs::create_dir_all(&out)?;
+    outputs.create_dirs()?;
     let newtonian = rheometer.newtonian_solutions(id.law()[1], &principled)?;
-    for path in identification_figures(&rheometer, &id, &newtonian, &out, "png", &inputs)? {
-        println!("wrote {}", path.display());
+    for figure in identification_figures(&rheometer, &id, &newtonian, &out, "png")? {
+        outputs.write_output(&figure)?;
+        println!("wrote {}", figure.path.display());
     }
     let (ns, kappas) = (linspace(0.0, 1.0, 41), linspace(9.0, 16.0, 41));
     let mut landscape_opts = paper.clone();
@@ -120,13 +130,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "identified (paper J)".to_string(),
     ));
     let path = out.join("fig4_landscape.png");
-    landscape_map(
-        &path,
-        &landscape,
-        "J(n, κ), paper's cost",
-        &markers,
-        &inputs,
-    )?;
+    let figure = landscape_map(&path, &landscape, "J(n, κ), paper's cost", &markers)?;
+    outputs.write_output(&figure)?;
     println!(
         "wrote {} ({}×{} grid in {:.1} s)",
         path.display(),

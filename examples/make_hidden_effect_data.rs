@@ -16,8 +16,10 @@
 
 use rheometer::data::input::load_experiments;
 use rheometer::data::synthetic::{NoiseModel, SplitMix64};
-use rheometer::model::setup::Experiment;
-use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+use rheometer::model::Experiment;
+use rheometer::{
+    model::simulate, model::CarreauLike, model::FiberModel, model::Physics, model::SimulateOptions,
+};
 use std::error::Error;
 use std::fmt::Write as _;
 use std::fs;

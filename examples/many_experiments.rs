@@ -16,7 +16,7 @@
 use rheometer::data::input::load_experiments;
 use rheometer::data::synthetic::{NoiseModel, SplitMix64};
 use rheometer::fit::{FitProgress, IdentifyOptions, ProgressHook, Rheometer};
-use rheometer::model::setup::{ExperimentSet, Measurements};
+use rheometer::model::{ExperimentSet, Measurements};
 use std::error::Error;
 use std::path::Path;
 use std::time::Instant;

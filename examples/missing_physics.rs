@@ -11,11 +11,12 @@
 //!
 //! `cargo run --release --example missing_physics [-- OUT_DIR]`
 
-use rheometer::data::input::load_experiments_with;
-use rheometer::diagnostics::compare::FigureFormat;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::data::input::{load_experiments_with, LoadOptions};
+use rheometer::diagnostics::DiagnoseOptions;
 use rheometer::fit::IdentifyOptions;
-use rheometer::model::effects::{EffectSetting, ModelSpec};
+use rheometer::model::{EffectSetting, ModelSpec};
+use rheometer::report::output_files::{OutputFile, OutputPlan};
+use rheometer::report::plot::FigureFormat;
 use rheometer::workflow::{self, CompareRequest, FitRequest};
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -32,7 +33,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .collect();
     // ANCHOR: story
-    let data = load_experiments_with(&toml, 4)?;
+    let data = load_experiments_with(&toml, &LoadOptions::default())?;
     // principled estimator
     let request = FitRequest::new(IdentifyOptions::default());
 
@@ -43,7 +44,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     // 2. where does it miss?
     let before = CompareRequest::of_fit(fit0.summary().clone(), "the paper's fit");
     let cmp0 = workflow::compare(&data, &before)?;
-    cmp0.write(&out.join("compare_before"), FigureFormat::Png, &inputs)?;
+    let dir = out.join("compare_before");
+    write_checked(&dir, &cmp0.files(&dir, FigureFormat::Png)?, &inputs)?;
     println!("{}", cmp0.to_text());
 
     // 3. which effect is missing?
@@ -66,7 +68,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     println!("{}", fit1.summary().to_text());
     let after = CompareRequest::of_fit(fit1.summary().clone(), "the fit with the effect");
     let cmp1 = workflow::compare(&data, &after)?;
-    cmp1.write(&out.join("compare_after"), FigureFormat::Png, &inputs)?;
+    let dir = out.join("compare_after");
+    write_checked(&dir, &cmp1.files(&dir, FigureFormat::Png)?, &inputs)?;
     println!("{}", cmp1.to_text());
     println!(
         "RMS relative residual: {:.3} % (paper model) -> {:.3} % (with {best}); noise level {}",
@@ -76,5 +79,27 @@ fn main() -> Result<(), Box<dyn Error>> {
     );
     // ANCHOR_END: story
     println!("figures in {}", out.display());
+    Ok(())
+}
+
+/// Writes `files` (all in `dir`) after checking, before any is written, that none replaces one
+/// of the `inputs`.
+fn write_checked(
+    dir: &Path,
+    files: &[OutputFile],
+    inputs: &[PathBuf],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let names: Vec<String> = files
+        .iter()
+        .filter_map(|f| f.path.file_name())
+        .map(|n| n.to_string_lossy().into_owned())
+        .collect();
+    let mut plan = OutputPlan::new();
+    plan.inputs(inputs).dir(dir, "OUT_DIR", &names);
+    let outputs = plan.check()?;
+    outputs.create_dirs()?;
+    for f in files {
+        outputs.write_output(f)?;
+    }
     Ok(())
 }

@@ -10,10 +10,12 @@
 use diffbvp::mesh::linspace;
 use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{solve, Guess, Solution, SolveOptions};
-use rheometer::model::effects::{Effect, ModelSpec};
-use rheometer::model::setup::{Air, Experiment, Material};
-use rheometer::model::simulate::simulate_from;
-use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+use rheometer::model::simulate_from;
+use rheometer::model::{Air, Experiment, Material};
+use rheometer::model::{Effect, ModelSpec};
+use rheometer::{
+    model::simulate, model::CarreauLike, model::FiberModel, model::Physics, model::SimulateOptions,
+};
 use std::hint::black_box;
 
 #[path = "../crates/diffbvp/tests/common/mod.rs"]

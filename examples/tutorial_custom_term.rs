@@ -11,11 +11,11 @@
 #![allow(dead_code)]
 
 use diffbvp::DualNum;
-use rheometer::model::contributions::STEFAN_BOLTZMANN;
-use rheometer::model::setup::{Air, Experiment, Inlet, Material, TakeUp};
+use rheometer::model::STEFAN_BOLTZMANN;
+use rheometer::model::{Air, Experiment, Inlet, Material, TakeUp};
 use rheometer::{
-    simulate, Balance, CarreauLike, FiberError, FiberModel, FiberTerm, Physics, Profiles, SiState,
-    SimulateOptions,
+    model::simulate, model::Balance, model::CarreauLike, model::FiberModel, model::FiberTerm,
+    model::Physics, model::Profiles, model::SiState, model::SimulateOptions, FiberError,
 };
 use std::f64::consts::PI;
 

@@ -5,13 +5,14 @@
 use rheometer::data::input::{parse_experiments, Location};
 use rheometer::design::DesignEstimate;
 use rheometer::fit::{IdentifyOptions, LandscapeSample};
-use rheometer::model::effects::Effect;
+use rheometer::model::Effect;
 use rheometer::workflow::failure_hints::ExperimentFailure;
 use std::error::Error;
 use std::path::Path;
 
+pub use rheometer::report::format::show;
+pub use rheometer::workflow::request::DEFAULT_MAX_NODES;
 use rheometer::workflow::request::{self, Arg, Door, Refusal, MAX_GRID_POINTS};
-pub use rheometer::workflow::request::{show, DEFAULT_MAX_NODES};
 
 /// A refusal as clap shows it after the flag and the value it names: the reason alone.
 fn reason(r: Refusal) -> String {

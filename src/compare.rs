@@ -130,8 +130,7 @@ pub fn run(args: CompareArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     let cmp = workflow::compare(&loaded, &request)
         .map_err(|e| checks::name_experiment(Box::new(e), &experiments, Some(request.law)))?;
     let mut dir = outputs::DirWriter::begin(&outputs, &out, "rheometer compare", "files", names)?;
-    let inputs = outputs.inputs();
-    let written = dir.files(|d| cmp.write(d, g.format.format(), inputs))?;
+    let written = dir.rendered(|d| cmp.files(d, g.format.format()))?;
     dir.finish()?;
     outln!("{}", cmp.to_text());
     g.say(format!(

@@ -2,7 +2,7 @@
 
 use crate::*;
 use rheometer::design::{Criterion, DesignEstimate, DesignRequest, DiscriminationRequest};
-use rheometer::model::effects::Effect;
+use rheometer::model::Effect;
 use rheometer::report::report_json::{to_report_json, ReportKind};
 use rheometer::workflow::request::{self, DesignRanges, Door};
 

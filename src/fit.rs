@@ -263,10 +263,8 @@ fn write_fit_outputs(
         w.files(|_| save_flow_curve_figure(&fig, curve).map(|()| vec![fig.clone()]))?;
     }
     let newtonian = run.newtonian.as_deref().unwrap_or_default();
-    let inputs = outputs.inputs();
-    let written = w.files(|dir| {
-        figures::identification_figures(rh, id, newtonian, dir, g.format.ext(), inputs)
-    })?;
+    let written =
+        w.rendered(|dir| figures::identification_figures(rh, id, newtonian, dir, g.format.ext()))?;
     w.finish()?;
     for p in written {
         g.say(format!("wrote {}", p.display()));

@@ -116,10 +116,7 @@ pub fn run(args: LandscapeArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     }
     let fig = dir.path(&format!("landscape.{}", g.format.ext()));
     let title = format!("J(n, κ), {} estimator", opts.estimator.name());
-    let inputs = outputs.inputs();
-    dir.files(|_| {
-        figures::landscape_map(&fig, &l, &title, &markers, inputs).map(|()| vec![fig.clone()])
-    })?;
+    dir.rendered(|_| figures::landscape_map(&fig, &l, &title, &markers).map(|f| vec![f]))?;
     dir.finish()?;
     g.say(format!(
         "{} points in {:.1} s; wrote {}",

@@ -4,25 +4,27 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use rheometer::data::input::{
-    load_experiments_with_options, LoadOptions, LoadedExperiments, DEFAULT_MAX_JSON_BYTES,
+    load_experiments_with, LoadOptions, LoadedExperiments, DEFAULT_MAX_JSON_BYTES,
 };
-use rheometer::diagnostics::compare::{Comparison, FigureFormat, MissingTakeUp};
-use rheometer::diagnostics::diagnose::{DiagnoseOptions, ResidualProfiles};
-use rheometer::diagnostics::report::save_residual_figure;
+use rheometer::data::take_up::MissingTakeUp;
+use rheometer::diagnostics::save_residual_figure;
+use rheometer::diagnostics::Comparison;
+use rheometer::diagnostics::{DiagnoseOptions, ResidualProfiles};
 use rheometer::fit::{
     DataCheck, Estimator, FarRule, FitSummary, IdentifyOptions, LandscapeRun, PointStatus,
     Rheometer,
 };
-use rheometer::model::effects::{EffectSetting, LawChoice, ModelSpec};
+use rheometer::model::{EffectSetting, LawChoice, ModelSpec};
+use rheometer::model::{FiberSolution, SimulateOptions};
 use rheometer::report::figures::{self, ExperimentView, ModelCurves, View};
 use rheometer::report::flow_curve_figure::save_flow_curve_figure;
 use rheometer::report::output::write_profiles_csv;
 use rheometer::report::output_files::{CheckedOutputs, PARTIAL_NAME};
+use rheometer::report::plot::FigureFormat;
 use rheometer::report::report_json::{to_report_json, ReportKind};
 use rheometer::workflow::failure_hints::ExperimentFailure;
 use rheometer::workflow::request::{self, Door, Refusal};
 use rheometer::workflow::{self, CompareRequest, FitRequest, FitRun};
-use rheometer::{FiberSolution, SimulateOptions};
 use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -247,7 +249,7 @@ pub fn load_input(
         ..LoadOptions::with_min_points(4)
     };
     let options = request::load_options(base, g.allow_large_inputs);
-    let loaded = load_experiments_with_options(path, &options).map_err(|e| {
+    let loaded = load_experiments_with(path, &options).map_err(|e| {
         if e.exceeded_limit().is_some() {
             request::input_message(&e, Door::Cli).into()
         } else {

@@ -3,7 +3,9 @@
 //! marked incomplete (`DIR/PARTIAL.txt`) from its first file to its last.
 
 use crate::*;
-use rheometer::report::output_files::{CheckedOutputs, OutputPlan, PartialMarker, PARTIAL_NAME};
+use rheometer::report::output_files::{
+    CheckedOutputs, OutputFile, OutputPlan, PartialMarker, PARTIAL_NAME,
+};
 use std::time::SystemTime;
 
 /// A plan whose inputs are the experiments file `toml` and its data files.
@@ -85,6 +87,30 @@ impl<'a> DirWriter<'a> {
     /// Writes `text` to the file `name` and marks it done.
     pub fn text(&mut self, name: &str, text: &str) -> Result<(), Box<dyn Error>> {
         self.write(name, |w| w.write_all(text.as_bytes()))
+    }
+
+    /// Runs `f`, which renders files of the directory in memory (figures, a comparison's
+    /// set), then writes each through the checked outputs and marks it done; returns their
+    /// paths.
+    pub fn rendered<E: Into<Box<dyn Error>>>(
+        &mut self,
+        f: impl FnOnce(&Path) -> Result<Vec<OutputFile>, E>,
+    ) -> Result<Vec<PathBuf>, Box<dyn Error>> {
+        let files = match f(&self.dir) {
+            Ok(files) => files,
+            Err(e) => return Err(self.failed(e.into())),
+        };
+        let mut paths = Vec::with_capacity(files.len());
+        for file in &files {
+            let r = self.outputs.write_output(file);
+            let name = file
+                .path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned());
+            self.after(&name.unwrap_or_default(), r.map_err(Into::into))?;
+            paths.push(file.path.clone());
+        }
+        Ok(paths)
     }
 
     /// Runs `f`, which writes files of the directory by itself (figures), and marks the paths

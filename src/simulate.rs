@@ -1,8 +1,8 @@
 //! `rheometer simulate`.
 
 use crate::*;
-use rheometer::model::setup::ExperimentSet;
-use rheometer::model::simulate::Profiles;
+use rheometer::model::ExperimentSet;
+use rheometer::model::Profiles;
 use rheometer::workflow::{SimulateError, SimulateRequest};
 use std::ops::ControlFlow;
 
@@ -61,16 +61,14 @@ pub fn run(args: SimulateArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     // still running) is always marked, with the finished experiments listed
     let mut dir =
         outputs::DirWriter::begin(&outputs, &args.out, "rheometer simulate", "files", entries)?;
-    let inputs = outputs.inputs().to_vec();
     let request = simulate_request(&args, g);
     let all_profiles = simulate_and_write(&loaded, &request, &mut dir, g, &args.out)?;
     // every profile is written; the figures are the last files of the set
     let fig = format!("profiles.{ext}");
-    dir.files(|d| {
-        let path = d.join(&fig);
-        figures::profile_overview(&path, &names, &all_profiles, &inputs).map(|()| vec![path])
+    dir.rendered(|d| {
+        figures::profile_overview(&d.join(&fig), &names, &all_profiles).map(|f| vec![f])
     })?;
-    data_figure(&args, set, &all_profiles, &mut dir, &inputs, g)?;
+    data_figure(&args, set, &all_profiles, &mut dir, g)?;
     dir.finish()?;
     g.say(format!(
         "wrote {} profiles and figures to {}",
@@ -189,7 +187,6 @@ fn data_figure(
     set: &ExperimentSet,
     all_profiles: &[Profiles],
     dir: &mut outputs::DirWriter<'_>,
-    inputs: &[PathBuf],
     g: &Global,
 ) -> Result<(), Box<dyn Error>> {
     let ext = g.format.ext();
@@ -227,9 +224,9 @@ fn data_figure(
         profiles: &profs,
         dashed: false,
     }];
-    let pages = dir.files(|d| {
+    let pages = dir.rendered(|d| {
         let fig = d.join(format!("diameters_vs_data.{ext}"));
-        figures::experiment_panel_pages(&fig, &views, &curves, View::Diameter, inputs)
+        figures::experiment_panel_pages(&fig, &views, &curves, View::Diameter)
     })?;
     if pages.len() > 1 {
         g.say(format!(

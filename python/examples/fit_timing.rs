@@ -4,10 +4,10 @@
 //! `cargo run --release -p diffbvp-python --example fit_timing -- [RUNS] [EXPERIMENTS.toml]`
 //! prints one wall time per run (s) and the median, then `n kappa` of the last fit.
 
-use rheometer::data::input::load_experiments_with;
+use rheometer::data::input::{load_experiments_with, LoadOptions};
 use rheometer::fit::IdentifyOptions;
+use rheometer::model::FiberSolution;
 use rheometer::workflow::{fit, FitRequest};
-use rheometer::FiberSolution;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -16,7 +16,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = args
         .next()
         .unwrap_or_else(|| "data/pmma7n_synthetic/experiments.toml".into());
-    let loaded = load_experiments_with(std::path::Path::new(&path), 4)?;
+    let loaded = load_experiments_with(std::path::Path::new(&path), &LoadOptions::default())?;
     let mut times = Vec::with_capacity(runs);
     let mut last = None;
     for _ in 0..runs {

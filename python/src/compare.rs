@@ -9,7 +9,7 @@ use crate::options;
 use crate::run::interruptible;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rheometer::diagnostics::compare::MissingTakeUp;
+use rheometer::data::take_up::MissingTakeUp;
 use rheometer::fit::FitSummary;
 use rheometer::report::report_json::ReportKind;
 use rheometer::workflow::request::Door;

@@ -7,10 +7,10 @@ use crate::errors::{input_error, to_py_err};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use rheometer::data::input::{
-    load_experiments_with_options, parse_experiments_with, parse_measurements, InputError,
-    LoadOptions, LoadedExperiments,
+    load_experiments_with, parse_experiments_with, parse_measurements, InputError, LoadOptions,
+    LoadedExperiments,
 };
-use rheometer::model::setup::{Inlet, TakeUp};
+use rheometer::model::{Inlet, TakeUp};
 use rheometer::workflow::request::{self, Door};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -243,7 +243,7 @@ impl Dataset {
     fn load(py: Python<'_>, path: PathBuf, allow_large_inputs: bool) -> PyResult<Self> {
         let options = caps(allow_large_inputs);
         let result = py.detach(|| -> Result<DatasetInner, Box<InputError>> {
-            let loaded = load_experiments_with_options(&path, &options).map_err(Box::new)?;
+            let loaded = load_experiments_with(&path, &options).map_err(Box::new)?;
             let toml = std::fs::read_to_string(&path).map_err(|e| {
                 Box::new(InputError::Io {
                     path: path.clone(),

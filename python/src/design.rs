@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::design::{Criterion, DesignRequest, DiscriminationRequest};
 use rheometer::fit::{Estimator, IdentifyOptions};
-use rheometer::model::effects::Effect;
+use rheometer::model::Effect;
 use rheometer::report::report_json::ReportKind;
 use rheometer::workflow::request::{self, DesignRanges};
 use rheometer::workflow::{self, FitRequest};

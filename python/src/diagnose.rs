@@ -3,7 +3,7 @@
 //! calibration) goes to Python through its serde JSON form, with the residual arrays of the
 //! base and the final fit besides.
 //!
-//! [`Diagnosis`]: rheometer::diagnostics::diagnosis::Diagnosis
+//! [`Diagnosis`]: rheometer::diagnostics::Diagnosis
 
 use crate::convert::report_to_py;
 use crate::dataset::Dataset;
@@ -13,8 +13,8 @@ use crate::options;
 use crate::run::interruptible;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
-use rheometer::model::effects::{Effect, ModelSpec};
+use rheometer::diagnostics::DiagnoseOptions;
+use rheometer::model::{Effect, ModelSpec};
 use rheometer::report::report_json::ReportKind;
 use rheometer::workflow::{
     self,

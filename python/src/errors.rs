@@ -7,7 +7,7 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::types::PyType;
 use rheometer::data::input::{InputError, LoadedExperiments};
-use rheometer::diagnostics::compare::CompareError;
+use rheometer::diagnostics::CompareError;
 use rheometer::fit::RheometerError;
 use rheometer::workflow::failure_hints::{failed_experiment, name_experiment, ExperimentFailure};
 use std::error::Error;

@@ -10,11 +10,11 @@ use crate::run::interruptible;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rheometer::fit::{Identification, IdentifyOptions, Rheometer};
-use rheometer::model::effects::{LawChoice, ModelSpec};
+use rheometer::model::{FiberSolution, Profiles};
+use rheometer::model::{LawChoice, ModelSpec};
 use rheometer::report::report_json::ReportKind;
 use rheometer::workflow::request::{self, Arg};
 use rheometer::workflow::{self, FitRequest};
-use rheometer::{FiberSolution, Profiles};
 
 /// Profiles as a dict of numpy arrays (SI units in the key names), the named terms under
 /// `terms`.
@@ -34,8 +34,8 @@ pub fn profiles_dict<'py>(py: Python<'py>, p: &Profiles) -> PyResult<Bound<'py, 
     let terms = PyDict::new(py);
     for (name, balance, v) in &p.terms {
         let unit = match balance {
-            rheometer::Balance::Momentum => "N_m",
-            rheometer::Balance::Energy => "W_m",
+            rheometer::model::Balance::Momentum => "N_m",
+            rheometer::model::Balance::Energy => "W_m",
         };
         terms.set_item(format!("{name}_{unit}"), array1(py, v))?;
     }

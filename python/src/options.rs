@@ -5,7 +5,7 @@ use crate::errors::input_error;
 use diffbvp::least_squares::Loss;
 use pyo3::prelude::*;
 use rheometer::fit::{Estimator, FitSummary, IdentifyOptions};
-use rheometer::model::effects::{EffectSetting, LawChoice};
+use rheometer::model::{EffectSetting, LawChoice};
 
 pub use rheometer::workflow::request::MAX_POINTS;
 use rheometer::workflow::request::{self, Arg, Door, Refusal};

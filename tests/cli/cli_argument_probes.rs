@@ -4,6 +4,7 @@
 //! front must be refused quickly.
 
 use crate::probe;
+use rheometer::data::input::LoadOptions;
 
 use probe::{s, variant, Probe};
 use std::path::{Path, PathBuf};
@@ -581,7 +582,8 @@ fn diagnose_refit_top_zero_or_huge_is_refused() {
 #[test]
 fn loaded_experiments_know_their_toml_line() {
     let (_dir, toml, _dd) = probe::shipped_copy("args_lines");
-    let loaded = rheometer::data::input::load_experiments_with(&toml, 4).unwrap();
+    let loaded =
+        rheometer::data::input::load_experiments_with(&toml, &LoadOptions::default()).unwrap();
     assert_eq!(loaded.details.len(), loaded.set.experiments.len());
     for (e, d) in loaded.set.experiments.iter().zip(&loaded.details) {
         let want = place(&toml, &e.name);

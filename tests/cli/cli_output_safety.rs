@@ -6,6 +6,7 @@
 #![cfg(unix)]
 
 use crate::probe;
+use rheometer::data::input::LoadOptions;
 
 use probe::{checksums_below, rheometer, run_with, s, shipped_copy, Probe};
 use std::fs;
@@ -819,7 +820,7 @@ fn library_landscape_cancelled_up_front_reaches_no_point() {
     use rheometer::fit::{Estimator, IdentifyOptions, PointStatus, Rheometer};
     use std::sync::atomic::AtomicBool;
     let (_dir, toml, _data) = shipped_copy("library_cancel");
-    let loaded = load_experiments_with(&toml, 4).unwrap();
+    let loaded = load_experiments_with(&toml, &LoadOptions::default()).unwrap();
     let rh = Rheometer::new(&loaded.set).unwrap();
     let mut opts = IdentifyOptions::with_estimator(Estimator::Paper);
     opts.simulate.tol = 1e-4;

@@ -11,7 +11,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use rheometer::data::input::{
-    estimated_fit_memory_bytes, load_experiments, load_experiments_with_options, InputError, Limit,
+    estimated_fit_memory_bytes, load_experiments, load_experiments_with, InputError, Limit,
     LoadOptions, DEFAULT_MAX_EXPERIMENTS,
 };
 
@@ -370,7 +370,7 @@ fn the_number_of_experiments_is_capped_before_any_data_is_read() {
         ..LoadOptions::default()
     };
     // then the estimated memory of their fit (2000 x 26 rows, 2002 parameters: 8 GB) stops them
-    let e = load_experiments_with_options(&toml, &options)
+    let e = load_experiments_with(&toml, &options)
         .unwrap_err()
         .to_string();
     assert_contains(
@@ -381,7 +381,7 @@ fn the_number_of_experiments_is_capped_before_any_data_is_read() {
         max_fit_memory_bytes: 16 << 30,
         ..options
     };
-    let loaded = load_experiments_with_options(&toml, &options).unwrap();
+    let loaded = load_experiments_with(&toml, &options).unwrap();
     assert_eq!(loaded.set.experiments.len(), 2000);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -390,7 +390,7 @@ fn the_number_of_experiments_is_capped_before_any_data_is_read() {
 fn rows_are_capped_per_file_and_by_the_fit_memory_while_reading() {
     let (dir, toml, data) = copy("bounds_rows");
     let limited = |options: &LoadOptions| {
-        let e = load_experiments_with_options(&toml, options).unwrap_err();
+        let e = load_experiments_with(&toml, options).unwrap_err();
         match &e {
             InputError::Data { cause, .. } => match &**cause {
                 InputError::Limit { limit, .. } => (*limit, e.to_string()),
@@ -487,7 +487,7 @@ fn oversized_files_are_refused_from_their_size() {
         max_toml_bytes: 100,
         ..LoadOptions::default()
     };
-    let e = load_experiments_with_options(&toml, &options).unwrap_err();
+    let e = load_experiments_with(&toml, &options).unwrap_err();
     assert!(
         matches!(
             e,

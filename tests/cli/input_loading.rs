@@ -1,12 +1,13 @@
 //! Loading the TOML + CSV input format: the shipped data set, overrides, and every error.
 
+use rheometer::data::input::LoadOptions;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rheometer::data::input::{
-    load_experiments, load_experiments_with, load_measurements, parse_experiments, InputError,
+    load_experiments, load_experiments_with, load_measurements_with, parse_experiments, InputError,
 };
-use rheometer::model::setup::{Air, ExperimentSet, Inlet, Material, TakeUp};
+use rheometer::model::{Air, ExperimentSet, Inlet, Material, TakeUp};
 
 const SHIPPED: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -139,13 +140,14 @@ fn shipped_data_set_loads() {
 
 #[test]
 fn shipped_metadata_is_kept() {
-    let loaded = load_experiments_with(Path::new(SHIPPED), 26).unwrap();
+    let loaded =
+        load_experiments_with(Path::new(SHIPPED), &LoadOptions::with_min_points(26)).unwrap();
     let d = &loaded.details[4];
     assert_eq!(d.stencil_velocity_mm_s, Some(0.53));
     assert_eq!(d.take_up_pressure_bar, Some(2.0));
     assert!(d.data.as_ref().unwrap().ends_with("v0p53_p2.csv"));
     // more points required than available
-    let message = load_experiments_with(Path::new(SHIPPED), 27)
+    let message = load_experiments_with(Path::new(SHIPPED), &LoadOptions::with_min_points(27))
         .unwrap_err()
         .to_string();
     assert_contains(
@@ -179,12 +181,19 @@ fn loading_does_not_modify_files() {
 fn csv_loader_min_points_is_a_parameter() {
     let csv = Path::new(SHIPPED).with_file_name("v0p53_p1.csv");
     assert_eq!(
-        load_measurements(&csv, 0.51, 26).unwrap().positions.len(),
+        load_measurements_with(&csv, 0.51, &LoadOptions::with_min_points(26))
+            .unwrap()
+            .positions
+            .len(),
         26
     );
-    let message = load_measurements(&csv, 0.51, 40).unwrap_err().to_string();
+    let message = load_measurements_with(&csv, 0.51, &LoadOptions::with_min_points(40))
+        .unwrap_err()
+        .to_string();
     assert_contains(&message, &["v0p53_p1.csv", "at least 40"]);
-    let message = load_measurements(&csv, 0.45, 4).unwrap_err().to_string();
+    let message = load_measurements_with(&csv, 0.45, &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
     assert_contains(
         &message,
         &["v0p53_p1.csv:25:", "beyond the spin-line length 0.45 m"],

@@ -10,8 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use rheometer::data::input::{
-    load_experiments, load_experiments_with, load_experiments_with_options, InputError,
-    LoadOptions, MAX_NAME_BYTES,
+    load_experiments, load_experiments_with, InputError, LoadOptions, MAX_NAME_BYTES,
 };
 
 struct Copy {
@@ -391,7 +390,7 @@ fn missing_data_names_the_experiment_and_the_key_to_add() {
     // [t34] "experiment v0p27_p1 has no measurements" without file:line or what to add
     let c = Copy::new("msg_missing_data");
     c.toml("data = \"v0p27_p1.csv\"", "#data = \"v0p27_p1.csv\"");
-    let loaded = load_experiments_with(&c.toml, 4).unwrap();
+    let loaded = load_experiments_with(&c.toml, &LoadOptions::default()).unwrap();
     let e = loaded.require_data().unwrap_err().to_string();
     assert_contains(
         &e,
@@ -406,7 +405,7 @@ fn missing_data_names_the_experiment_and_the_key_to_add() {
         require_data: true,
         ..LoadOptions::default()
     };
-    let e2 = load_experiments_with_options(&c.toml, &options)
+    let e2 = load_experiments_with(&c.toml, &options)
         .unwrap_err()
         .to_string();
     assert_eq!(e, e2);
@@ -472,7 +471,7 @@ fn degrees_celsius_in_a_kelvin_key_get_a_hint() {
         "inlet_temperature_K = 513.15",
         "inlet_temperature_C = 513.15",
     );
-    let loaded = load_experiments_with(&c.toml, 4).unwrap();
+    let loaded = load_experiments_with(&c.toml, &LoadOptions::default()).unwrap();
     let w: Vec<String> = loaded.warnings.iter().map(ToString::to_string).collect();
     assert!(
         w.iter()
@@ -591,7 +590,7 @@ fn a_spin_line_far_beyond_the_data_is_refused_and_a_little_beyond_warned() {
         take_up_from_data: false,
         ..LoadOptions::default()
     };
-    assert!(load_experiments_with_options(&c.toml, &options).is_ok());
+    assert!(load_experiments_with(&c.toml, &options).is_ok());
     // data to 0.35 m of 0.51 m: a warning, not an error
     c.csv("v0p27_p1.csv", |_, l| l.to_string());
     let text = std::fs::read_to_string(c.data.join("v0p27_p1.csv")).unwrap();
@@ -605,7 +604,7 @@ fn a_spin_line_far_beyond_the_data_is_refused_and_a_little_beyond_warned() {
         })
         .collect();
     std::fs::write(c.data.join("v0p27_p1.csv"), cut.join("\n") + "\n").unwrap();
-    let loaded = load_experiments_with(&c.toml, 4).unwrap();
+    let loaded = load_experiments_with(&c.toml, &LoadOptions::default()).unwrap();
     let warnings: Vec<String> = loaded.warnings.iter().map(ToString::to_string).collect();
     assert_eq!(warnings.len(), 1, "{warnings:?}");
     assert_contains(
@@ -643,7 +642,7 @@ fn a_spin_line_far_beyond_the_data_is_refused_and_a_little_beyond_warned() {
     // the shipped data (0.5 of 0.51 m): neither
     std::fs::write(&c.toml, &c.shipped).unwrap();
     c.restore_csv("v0p27_p1.csv");
-    assert!(load_experiments_with(&c.toml, 4)
+    assert!(load_experiments_with(&c.toml, &LoadOptions::default())
         .unwrap()
         .warnings
         .is_empty());

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use rheometer::data::input::{load_experiments, parse_experiments, parse_measurements};
 use rheometer::fit::{IdentifyOptions, Rheometer};
-use rheometer::model::setup::{ExperimentSet, Inlet};
+use rheometer::model::{ExperimentSet, Inlet};
 
 fn shipped() -> PathBuf {
     crate::probe::repo().join("data/pmma7n_synthetic/experiments.toml")
@@ -180,12 +180,12 @@ fn every_unit_of_every_key_converts() {
     assert_eq!(set.experiments[0].inlet, Inlet::Velocity(0.02));
     assert_eq!(
         set.experiments[0].take_up,
-        Some(rheometer::model::setup::TakeUp::Velocity(1.0))
+        Some(rheometer::model::TakeUp::Velocity(1.0))
     );
     let set = experiment(&format!("{BASE}take_up_diameter_um = 90\n")).unwrap();
     assert_eq!(
         set.experiments[0].take_up,
-        Some(rheometer::model::setup::TakeUp::Diameter(9e-5))
+        Some(rheometer::model::TakeUp::Diameter(9e-5))
     );
     // the Vogel temperature in °C
     let text = format!(

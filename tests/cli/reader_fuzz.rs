@@ -6,6 +6,7 @@
 //! The runs are deterministic (a fixed seed, no failure persistence) and bounded (a fixed
 //! number of cases per property) so that CI is reproducible and fast (a few seconds in release).
 
+use rheometer::data::input::LoadOptions;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -399,7 +400,7 @@ fn loader_survives_mutated_toml_and_csv_files() {
             std::fs::write(&csv_path, mutated(&base_csv, &cm)).unwrap();
             std::fs::write(&toml_path, mutated(&base_toml, &tm)).unwrap();
             let r = catch_unwind(AssertUnwindSafe(|| {
-                load_experiments_with(&toml_path, 4).map_err(Box::new)
+                load_experiments_with(&toml_path, &LoadOptions::default()).map_err(Box::new)
             }));
             match r {
                 Err(_) => Err(TestCaseError::fail("load_experiments_with panicked")),

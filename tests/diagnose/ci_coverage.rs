@@ -18,8 +18,8 @@ use crate::shared;
 use independent::dataset::Scenario;
 use independent::model::AirFlow;
 use independent::scenarios;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
-use rheometer::model::effects::Effect;
+use rheometer::diagnostics::DiagnoseOptions;
+use rheometer::model::Effect;
 use std::time::Instant;
 
 /// Seeds per scenario (the scenario's own seed first): 16, or `COVERAGE_SEEDS` from the

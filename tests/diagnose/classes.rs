@@ -13,7 +13,7 @@ use crate::studies::{assert_presented_laws_hold, env_count, law_study};
 use independent::dataset::{Faults, Scenario};
 use independent::rng::Rng;
 use independent::scenarios;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::diagnostics::DiagnoseOptions;
 
 /// The study of one class under `label`: `CLASS_SETS` scenarios of `make(replicate, rng)`
 /// (each replicate's own random numbers), then issue 65's target.

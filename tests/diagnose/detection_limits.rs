@@ -21,8 +21,8 @@ use crate::shared;
 
 use independent::dataset::{Expected, Faults, Scenario};
 use independent::scenarios;
-use rheometer::diagnostics::detection::DetectionLimit;
-use rheometer::diagnostics::diagnose::{earns_its_place, DiagnoseOptions, Diagnosis};
+use rheometer::diagnostics::DetectionLimit;
+use rheometer::diagnostics::{earns_its_place, DiagnoseOptions, Diagnosis};
 use rheometer::fit::FitSummary;
 use std::sync::OnceLock;
 

@@ -3,12 +3,15 @@
 
 use diffbvp::sensitivity::Sensitivities;
 use diffbvp::{DualNum, Guess, SolveOptions, Solver};
-use rheometer::model::effects::{
+use rheometer::model::simulate_params;
+use rheometer::model::{Air, Experiment, Material};
+use rheometer::model::{
     Category, Effect, EffectSetting, LawChoice, ModelSpec, STRAIN_THINNING_REFERENCE_KAPPA,
 };
-use rheometer::model::setup::{Air, Experiment, Material};
-use rheometer::model::simulate::simulate_params;
-use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
+use rheometer::{
+    model::Balance, model::CarreauLike, model::FiberModel, model::FiberTerm, model::SiState,
+    model::SimulateOptions,
+};
 
 fn experiment() -> Experiment {
     Experiment::pmma7n_v0p53_p2()
@@ -163,7 +166,7 @@ fn strength_derivatives_match_finite_differences() {
 
 #[test]
 fn settings_parse_names_and_values() {
-    for name in rheometer::model::effects::BUILTIN_NAMES {
+    for name in rheometer::model::BUILTIN_NAMES {
         let s: EffectSetting = name.parse().unwrap();
         assert_eq!(s.effect.name(), name);
         assert!(s.value.is_none());

@@ -7,11 +7,14 @@
 
 use diffbvp::DualNum;
 use rheometer::data::synthetic::{NoiseModel, SplitMix64};
-use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
-use rheometer::model::effects::{Effect, LawChoice, ModelSpec};
-use rheometer::model::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
-use rheometer::model::simulate::simulate_params;
-use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, SiState, SimulateOptions};
+use rheometer::diagnostics::{diagnose, DiagnoseOptions, DiagnosisRun};
+use rheometer::model::simulate_params;
+use rheometer::model::{Air, Experiment, ExperimentSet, Material, Measurements};
+use rheometer::model::{Effect, LawChoice, ModelSpec};
+use rheometer::{
+    model::Balance, model::CarreauLike, model::FiberModel, model::FiberTerm, model::SiState,
+    model::SimulateOptions,
+};
 
 /// 1.5% white noise plus up to 3% extra near the take-up (aspirator disturbance): 3% at
 /// s = 0.50 m.

@@ -18,8 +18,8 @@ use independent::dataset::{Faults, Scenario};
 use independent::model::AirHeat;
 use independent::scenarios::{self, NOISE_SD};
 use rheometer::data::noise_model::NoiseModel;
-use rheometer::diagnostics::diagnose::verdict::Verdict;
-use rheometer::diagnostics::diagnose::{Candidate, DiagnoseOptions, DiagnosisRun};
+use rheometer::diagnostics::Verdict;
+use rheometer::diagnostics::{Candidate, DiagnoseOptions, DiagnosisRun};
 
 /// The diagnosis of `sc` with the default options (made once per test binary and shared by
 /// the tests that ask for the same scenario, [`shared::diagnosed`]), printing the baseline line.
@@ -106,7 +106,7 @@ fn assert_named_is_credible(r: &DiagnosisRun) {
         .iter()
         .find(|c| &c.effect == named)
         .expect("the named candidate is listed");
-    let effect: rheometer::model::effects::Effect = named.parse().unwrap();
+    let effect: rheometer::model::Effect = named.parse().unwrap();
     let (plo, phi) = effect.physical_range();
     for a in c.at_bound().iter().filter(|a| &a.parameter == named) {
         let beyond = (a.bound - phi).max(plo - a.bound);
@@ -303,7 +303,7 @@ fn strong_aspirator_coflow_is_found() {
     let r = run(&sc);
     assert_found(&sc, &r);
     let c = &r.diagnosis.candidates[0];
-    let tail = |shape: &[rheometer::diagnostics::refits::scan::ShapeParameter]| {
+    let tail = |shape: &[rheometer::diagnostics::ShapeParameter]| {
         shape.iter().find(|p| p.name == "tail").map(|p| p.value)
     };
     let a = c
@@ -317,7 +317,7 @@ fn strong_aspirator_coflow_is_found() {
     let other_shape: Vec<_> = other
         .shapes
         .iter()
-        .map(|sh| rheometer::diagnostics::refits::scan::ShapeParameter {
+        .map(|sh| rheometer::diagnostics::ShapeParameter {
             name: sh.name.clone(),
             value: sh.value,
             unit: sh.unit.clone(),

@@ -7,13 +7,16 @@
 use diffbvp::DualNum;
 use rheometer::data::input::load_experiments;
 use rheometer::data::synthetic::{NoiseModel, SplitMix64};
-use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, StrengthStatus};
+use rheometer::diagnostics::{diagnose, DiagnoseOptions, StrengthStatus};
 use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
-use rheometer::model::effects::{LawChoice, ModelSpec};
-use rheometer::model::setup::{Air, Experiment, ExperimentSet, Material, Measurements};
-use rheometer::model::simulate::simulate_params;
-use rheometer::SimulateOptions;
-use rheometer::{Balance, CarreauLike, FiberModel, FiberTerm, Physics, SiState};
+use rheometer::model::simulate_params;
+use rheometer::model::SimulateOptions;
+use rheometer::model::{Air, Experiment, ExperimentSet, Material, Measurements};
+use rheometer::model::{LawChoice, ModelSpec};
+use rheometer::{
+    model::Balance, model::CarreauLike, model::FiberModel, model::FiberTerm, model::Physics,
+    model::SiState,
+};
 
 /// Grey-body radiation `−π d ε σ (T⁴ − T_air⁴)` \[W/m\] with ε = 1.7, written here, not taken
 /// from the radiation candidate.
@@ -146,8 +149,8 @@ fn hidden_radiation_fit() -> (ExperimentSet, Rheometer, Identification) {
 /// distance, the bound of their noise floor) and its ΔBIC within 0.1.
 #[test]
 fn the_grid_tolerance_moves_no_refit() {
-    use rheometer::diagnostics::refits::scan::{scan_candidate, CandidateScan, ScanOptions};
-    use rheometer::model::effects::Effect;
+    use rheometer::diagnostics::{scan_candidate, CandidateScan, ScanOptions};
+    use rheometer::model::Effect;
 
     let (set, rh, base) = hidden_radiation_fit();
     let opts = IdentifyOptions::default();
@@ -185,7 +188,7 @@ fn the_grid_tolerance_moves_no_refit() {
     }
     assert!(compared >= 3, "{compared} grid points near the user's J");
     let (a, b) = (&loose.refits[0], &tight.refits[0]);
-    let strength = |r: &rheometer::diagnostics::refits::scan::Refit| {
+    let strength = |r: &rheometer::diagnostics::Refit| {
         r.identification
             .summary
             .effect("radiation")
@@ -212,10 +215,8 @@ fn the_grid_tolerance_moves_no_refit() {
 #[test]
 fn the_grid_growth_limit_moves_no_refit() {
     use diffbvp::GrowthLimit;
-    use rheometer::diagnostics::refits::scan::{
-        scan_candidate, CandidateScan, ScanOptions, GRID_GROWTH_LIMIT,
-    };
-    use rheometer::model::effects::Effect;
+    use rheometer::diagnostics::{scan_candidate, CandidateScan, ScanOptions, GRID_GROWTH_LIMIT};
+    use rheometer::model::Effect;
 
     let (_, rh, base) = hidden_radiation_fit();
     let opts = IdentifyOptions::default();

@@ -23,8 +23,8 @@ use crate::shared;
 
 use independent::dataset::Scenario;
 use independent::scenarios::{self, NOISE_SD};
-use rheometer::diagnostics::diagnose::{DiagnoseOptions, Diagnosis};
-use rheometer::model::effects::Effect;
+use rheometer::diagnostics::{DiagnoseOptions, Diagnosis};
+use rheometer::model::Effect;
 
 /// Diagnoses `sc` with the two rival candidates only.
 fn rivals(sc: &Scenario) -> Diagnosis {

@@ -12,7 +12,7 @@ use crate::studies::{assert_presented_laws_hold, env_count, law_study};
 
 use independent::rng::Rng;
 use independent::scenarios;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::diagnostics::DiagnoseOptions;
 
 /// Three runs with an aspirator jet drawn per replicate (speed log-uniform in 30–300 m/s,
 /// Lorentzian decay length log-uniform in 0.03–0.3 m: issue 11's range), fresh noise each:

@@ -13,12 +13,12 @@ use crate::shared;
 use independent::dataset::{Faults, Scenario};
 use independent::model::AirHeat;
 use independent::scenarios;
-use rheometer::diagnostics::candidate::earns_its_place;
-use rheometer::diagnostics::diagnose::verdict::Verdict;
-use rheometer::diagnostics::diagnose::{DiagnoseOptions, DiagnosisRun};
+use rheometer::diagnostics::earns_its_place;
+use rheometer::diagnostics::Verdict;
+use rheometer::diagnostics::{DiagnoseOptions, DiagnosisRun};
 use rheometer::fit::{FitStart, Rheometer};
-use rheometer::model::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
-use rheometer::model::setup::ExperimentSet;
+use rheometer::model::ExperimentSet;
+use rheometer::model::{Effect, EffectSetting, LawChoice, ModelSpec};
 use std::time::Instant;
 
 /// What a scenario must give.
@@ -322,7 +322,7 @@ fn radiation_and_warm_air_never_a_wrong_law() {
     assert!(flagged, "a wrong law printed as a result: {:?}", fit.n);
     let pair = d.pair.as_ref().expect("the disagreeing explanation");
     let pf = pair.fit.as_ref().expect("the pair's fit beside the result");
-    let [n, k] = rheometer::diagnostics::refits::pair::law_envelope_of([pf, fit]);
+    let [n, k] = rheometer::diagnostics::law_envelope_of([pf, fit]);
     assert!(holds(n, sc.law.n) && holds(k, sc.law.kappa), "{n:?} {k:?}");
     // the pair beside the result is the truth's
     let mut effects = pair.effects.to_vec();

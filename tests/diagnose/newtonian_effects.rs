@@ -16,7 +16,7 @@ use crate::shared;
 use independent::dataset::Scenario;
 use independent::model::Law;
 use independent::scenarios;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::diagnostics::DiagnoseOptions;
 
 /// Radiation of emissivity `emissivity` on a Newtonian melt with the noise of `seed`.
 fn newtonian_radiating(emissivity: f64, seed: u64) -> Scenario {

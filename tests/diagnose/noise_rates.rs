@@ -17,7 +17,7 @@ use crate::shared;
 
 use independent::dataset::Scenario;
 use independent::scenarios;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::diagnostics::DiagnoseOptions;
 use rheometer::fit::Estimate;
 
 /// The rates over the replicates, in percent (outlier flags per 1000 points).

@@ -8,9 +8,9 @@ use crate::independent;
 
 use independent::dataset::{Generated, Scenario};
 use rheometer::data::input::load_experiments;
-use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions, DiagnosisRun};
-use rheometer::model::effects::{LawChoice, ModelSpec};
-use rheometer::model::setup::ExperimentSet;
+use rheometer::diagnostics::{diagnose, DiagnoseOptions, DiagnosisRun};
+use rheometer::model::ExperimentSet;
+use rheometer::model::{LawChoice, ModelSpec};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;

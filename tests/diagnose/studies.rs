@@ -11,8 +11,8 @@ use crate::independent;
 use crate::shared;
 
 use independent::dataset::Scenario;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
-use rheometer::diagnostics::diagnosis::DiagnosisRun;
+use rheometer::diagnostics::DiagnoseOptions;
+use rheometer::diagnostics::DiagnosisRun;
 
 /// A count read from the environment variable `name` (`default` where unset or not a whole
 /// number).

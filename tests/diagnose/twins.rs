@@ -12,7 +12,7 @@ use crate::studies::{assert_presented_laws_hold, env_count, law_study};
 
 use independent::rng::Rng;
 use independent::scenarios;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::diagnostics::DiagnoseOptions;
 
 /// A die 10–20 K colder than declared with an aspirator of 40–100 m/s and decay length
 /// 0.05–0.15 m (drawn per replicate), nine runs: how the reported law stands, what is named,

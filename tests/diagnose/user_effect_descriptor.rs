@@ -14,9 +14,9 @@ use crate::independent::line_force::LineForce;
 use crate::independent::scenarios::{self, NOISE_SD};
 use diffbvp::DualNum;
 use rheometer::data::input::load_experiments;
-use rheometer::diagnostics::diagnose::{diagnose, DiagnoseOptions};
-use rheometer::model::effects::{Category, Effect, EffectDescriptor, LawChoice, ModelSpec};
-use rheometer::{Balance, FiberTerm, SiState};
+use rheometer::diagnostics::{diagnose, DiagnoseOptions};
+use rheometer::model::{Balance, FiberTerm, SiState};
+use rheometer::model::{Category, Effect, EffectDescriptor, LawChoice, ModelSpec};
 use std::f64::consts::PI;
 
 /// Where the guide sits \[m\] and the width of its contact \[m\].

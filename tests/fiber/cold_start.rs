@@ -3,10 +3,11 @@
 
 use diffbvp::continuation::ContinuationOptions as AdapterOptions;
 use diffbvp::BvpError;
-use rheometer::model::cold_start::StepControl;
-use rheometer::model::setup::{Air, Experiment, Material};
+use rheometer::model::StepControl;
+use rheometer::model::{Air, Experiment, Material};
 use rheometer::{
-    simulate, CarreauLike, FiberError, FiberModel, Physics, SimulateOptions, Simulator,
+    model::simulate, model::CarreauLike, model::FiberModel, model::Physics, model::SimulateOptions,
+    model::Simulator, FiberError,
 };
 
 fn model() -> FiberModel<CarreauLike> {

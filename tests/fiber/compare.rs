@@ -2,12 +2,14 @@
 //! paths and the shipped hidden-effect data set.
 
 use rheometer::data::input::load_experiments;
-use rheometer::diagnostics::compare::{
+use rheometer::data::statistics::RunsTest;
+use rheometer::data::NoiseSource;
+use rheometer::diagnostics::{
     compare, compare_set, simulate_experiments, CompareOptions, Comparison, ModelSetup,
-    NoiseSource, RunsTest, SimulatedExperiment,
+    SimulatedExperiment,
 };
-use rheometer::model::setup::{ExperimentSet, TakeUp};
-use rheometer::{Physics, SimulateOptions};
+use rheometer::model::{ExperimentSet, TakeUp};
+use rheometer::model::{Physics, SimulateOptions};
 use std::path::Path;
 use std::process::Command;
 use std::sync::OnceLock;

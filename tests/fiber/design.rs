@@ -13,12 +13,13 @@ use crate::independent::solve::diameters;
 use crate::noisy_data::noisy_set;
 use rayon::prelude::*;
 use rheometer::data::input::load_experiments_with;
+use rheometer::data::input::LoadOptions;
 use rheometer::design::{
     design_for_estimation, CandidateGrid, CandidateOutcome, Criterion, Design, DesignRequest,
     TakeUpAxis,
 };
 use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
-use rheometer::model::setup::{Experiment, ExperimentSet};
+use rheometer::model::{Experiment, ExperimentSet};
 use std::time::Instant;
 
 /// Replicates of each simulated design (≥ 200 for the criterion; `DESIGN_REPLICATES`
@@ -79,7 +80,7 @@ struct Base {
 fn base() -> Base {
     let scenario = scenario();
     let generated = scenario.generate().unwrap();
-    let loaded = load_experiments_with(&generated.toml, 4).unwrap();
+    let loaded = load_experiments_with(&generated.toml, &LoadOptions::default()).unwrap();
     let rh = Rheometer::new(&loaded.set).unwrap();
     let id = rh
         .identify([0.6, 11.5], &IdentifyOptions::default())
@@ -274,7 +275,7 @@ fn predicted_standard_errors_match_refits_of_independent_simulations() {
 fn grid_50x50_on_the_shipped_data_timing() {
     let loaded = load_experiments_with(
         std::path::Path::new("data/pmma7n_synthetic/experiments.toml"),
-        4,
+        &LoadOptions::default(),
     )
     .unwrap();
     let rh = Rheometer::new(&loaded.set).unwrap();

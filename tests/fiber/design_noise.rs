@@ -20,13 +20,14 @@ use crate::independent::scenarios::control;
 use crate::independent::solve::diameters;
 use rayon::prelude::*;
 use rheometer::data::input::load_experiments_with;
-use rheometer::design::estimation::NoiseSource;
+use rheometer::data::input::LoadOptions;
+use rheometer::design::NoiseSource;
 use rheometer::design::{
     design_for_estimation, noise_level, CandidateGrid, CandidateOutcome, Criterion, Design,
     DesignRequest, TakeUpAxis,
 };
 use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
-use rheometer::model::setup::{Experiment, ExperimentSet, Measurements};
+use rheometer::model::{Experiment, ExperimentSet, Measurements};
 use std::time::Instant;
 
 const TRUTH: Law = Law {
@@ -98,7 +99,7 @@ impl Base {
     fn new() -> Self {
         let scenario = scenario();
         let generated = scenario.generate().unwrap();
-        let loaded = load_experiments_with(&generated.toml, 4).unwrap();
+        let loaded = load_experiments_with(&generated.toml, &LoadOptions::default()).unwrap();
         let positions: Vec<Vec<f64>> = scenario
             .experiments
             .iter()

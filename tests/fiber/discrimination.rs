@@ -23,14 +23,15 @@ use crate::independent::solve::diameters;
 use crate::noisy_data::noisy_set;
 use rayon::prelude::*;
 use rheometer::data::input::load_experiments_with;
+use rheometer::data::input::LoadOptions;
 use rheometer::design::{
     design_for_discrimination, CandidateGrid, Discrimination, DiscriminationRequest, Rival,
     TakeUpAxis,
 };
 use rheometer::fit::{FitStart, Identification, IdentifyOptions, Rheometer};
-use rheometer::model::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
-use rheometer::model::setup::{Experiment, ExperimentSet};
-use rheometer::model::simulate::{simulate_params, SimulateOptions};
+use rheometer::model::{simulate_params, SimulateOptions};
+use rheometer::model::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::model::{Experiment, ExperimentSet};
 use std::time::Instant;
 
 /// True mass flow over the nominal one.
@@ -81,7 +82,9 @@ struct Reference {
 fn reference() -> Reference {
     let scenario = scenario();
     let generated = scenario.generate().unwrap();
-    let set = load_experiments_with(&generated.toml, 4).unwrap().set;
+    let set = load_experiments_with(&generated.toml, &LoadOptions::default())
+        .unwrap()
+        .set;
     let rheometers: Vec<Rheometer> = specs()
         .into_iter()
         .map(|s| Rheometer::with_spec(&set, s).unwrap())

@@ -12,7 +12,7 @@ use diffbvp::least_squares::Termination;
 use independent::scenarios;
 use rheometer::data::input::load_experiments;
 use rheometer::fit::{FitStart, IdentifyOptions, Rheometer};
-use rheometer::model::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::model::{Effect, EffectSetting, LawChoice, ModelSpec};
 
 #[test]
 fn a_far_co_flow_start_reaches_the_optimum_of_the_truth_start() {

@@ -10,14 +10,14 @@
 use diffbvp::sensitivity::{residual_jacobian, Sensitivities};
 use diffbvp::{Guess, SolveOptions, Solver};
 use rheometer::data::synthetic::{NoiseModel, SplitMix64};
-use rheometer::fit::estimator::RelativeResidual;
+use rheometer::fit::RelativeResidual;
 use rheometer::fit::{FitStart, FitSummary, IdentifyOptions, Layout, Rheometer};
-use rheometer::model::effects::{
-    Category, Effect, EffectSetting, ModelSpec, ALL_NAMES, BUILTIN_NAMES,
+use rheometer::model::simulate_params;
+use rheometer::model::{Air, Experiment, ExperimentSet, Inlet, Material, Measurements};
+use rheometer::model::{Category, Effect, EffectSetting, ModelSpec, ALL_NAMES, BUILTIN_NAMES};
+use rheometer::{
+    model::Balance, model::CarreauLike, model::FiberModel, model::Physics, model::SimulateOptions,
 };
-use rheometer::model::setup::{Air, Experiment, ExperimentSet, Inlet, Material, Measurements};
-use rheometer::model::simulate::simulate_params;
-use rheometer::{Balance, CarreauLike, FiberModel, Physics, SimulateOptions};
 
 const TRUTH: [f64; 2] = [0.8, 11.71];
 

@@ -13,16 +13,18 @@
 //!   sensitivities in words.
 
 use crate::probe;
+use rheometer::data::input::LoadOptions;
 
 use rheometer::data::input::{load_experiments_with, parse_experiments, LoadedExperiments};
-use rheometer::data::uncertainty::{Origin, Scope, Uncertainties};
-use rheometer::fit::summary::checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
+use rheometer::data::uncertainty::{Origin, Uncertainties};
 use rheometer::fit::{
     error_budget, ErrorBudget, Identification, IdentifyOptions, Rheometer, SourceStatus,
     WarningCode,
 };
-use rheometer::model::effects::{Effect, EffectSetting, ModelSpec};
-use rheometer::model::setup::{ExperimentSet, Inlet};
+use rheometer::fit::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
+use rheometer::model::Scope;
+use rheometer::model::{Effect, EffectSetting, ModelSpec};
+use rheometer::model::{ExperimentSet, Inlet};
 use serde_json::Value;
 use std::path::Path;
 use std::time::Duration;
@@ -30,7 +32,7 @@ use std::time::Duration;
 fn shipped() -> LoadedExperiments {
     load_experiments_with(
         &probe::repo().join("data/pmma7n_synthetic/experiments.toml"),
-        4,
+        &LoadOptions::default(),
     )
     .unwrap()
 }

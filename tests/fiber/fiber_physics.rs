@@ -1,10 +1,10 @@
 //! Physics checks of the fiber model: alternative formulations, closed forms, balances, limits.
 
 use diffbvp::{Bvp, DualNum, Guess, ResidualScale, SolveOptions};
-use rheometer::model::setup::{Air, Experiment, Material, TakeUp};
+use rheometer::model::{Air, Experiment, Material, TakeUp};
 use rheometer::{
-    simulate, CarreauLike, FiberModel, FiberSolution, Newtonian, Physics, SimulateOptions,
-    Strength, ViscosityLaw,
+    model::simulate, model::CarreauLike, model::FiberModel, model::FiberSolution, model::Newtonian,
+    model::Physics, model::SimulateOptions, model::Strength, model::ViscosityLaw,
 };
 
 fn experiment(take_up: TakeUp) -> Experiment {
@@ -48,7 +48,7 @@ impl Bvp for ThreeState<'_> {
         r[0] = ya[0] - m.inlet_velocity();
         r[1] = ya[2] - m.inlet_temperature();
         let d_out = match m.take_up() {
-            rheometer::model::bvp::DimensionlessTakeUp::Diameter { d_out, .. } => d_out,
+            rheometer::model::DimensionlessTakeUp::Diameter { d_out, .. } => d_out,
             _ => unreachable!(),
         };
         r[2] = m.diameter(yb[0], m.density(yb[2])) / d_out - 1.0;
@@ -203,7 +203,7 @@ fn carreau_tends_to_newtonian() {
 /// The physical solution must not depend on the reference values (in particular not on `α_o`).
 #[test]
 fn profiles_do_not_depend_on_reference_values() {
-    use rheometer::{ReferenceValues, Scaling};
+    use rheometer::model::{ReferenceValues, Scaling};
     let opts = SimulateOptions::with_tol(1e-8);
     let e = experiment(TakeUp::Diameter(9e-5));
     let base = model(CarreauLike::new(), Physics::paper());
@@ -249,8 +249,8 @@ fn profiles_do_not_depend_on_reference_values() {
 
 #[test]
 fn fiber_model_refuses_an_overflowing_inlet_velocity() {
-    use rheometer::model::setup::{Air, Experiment, Material};
-    use rheometer::{CarreauLike, FiberModel, Physics};
+    use rheometer::model::{Air, Experiment, Material};
+    use rheometer::model::{CarreauLike, FiberModel, Physics};
     let mut e = Experiment::pmma7n_v0p53_p2();
     e.mass_flow = 1e308;
     let result = FiberModel::new(

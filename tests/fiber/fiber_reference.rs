@@ -1,10 +1,11 @@
 //! Agreement with the noise-free reference profiles of an independent scipy implementation
 //! (`tests/data/reference_profiles/`, solve_bvp tol 1e-8 with every output point a node).
 
-use rheometer::model::setup::{Air, Experiment, Material};
-use rheometer::model::simulate::simulate_from;
+use rheometer::model::simulate_from;
+use rheometer::model::{Air, Experiment, Material};
 use rheometer::{
-    simulate, CarreauLike, FiberModel, Newtonian, Physics, SimulateOptions, ViscosityLaw,
+    model::simulate, model::CarreauLike, model::FiberModel, model::Newtonian, model::Physics,
+    model::SimulateOptions, model::ViscosityLaw,
 };
 use std::time::Instant;
 

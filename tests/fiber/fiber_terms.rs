@@ -1,11 +1,12 @@
 //! Inputs, errors, named contributions, user terms and optional effects.
 
 use diffbvp::DualNum;
-use rheometer::model::setup::{Air, Experiment, Inlet, Material, TakeUp};
-use rheometer::model::simulate::simulate_params;
+use rheometer::model::simulate_params;
+use rheometer::model::{Air, Experiment, Inlet, Material, TakeUp};
 use rheometer::{
-    simulate, Balance, CarreauLike, FiberError, FiberModel, FiberTerm, InclinedChurchillBernstein,
-    Newtonian, Physics, SiState, SimulateOptions, Strength,
+    model::simulate, model::Balance, model::CarreauLike, model::FiberModel, model::FiberTerm,
+    model::InclinedChurchillBernstein, model::Newtonian, model::Physics, model::SiState,
+    model::SimulateOptions, model::Strength, FiberError,
 };
 
 fn experiment() -> Experiment {
@@ -152,8 +153,7 @@ fn term_report_units_and_signs() {
     let p = sol.profiles(&m, &[0.1]);
     let get = |n: &str| p.terms.iter().find(|t| t.0 == n).unwrap().2[0];
     // Stokes drag in still air: −μ_* r u [N/m]
-    let drag =
-        -2e-5 * rheometer::model::scaling::stokes_tangential_resistance(1e-3) * p.velocity[0];
+    let drag = -2e-5 * rheometer::model::stokes_tangential_resistance(1e-3) * p.velocity[0];
     assert!((get("air_drag") / drag - 1.0).abs() < 1e-12);
     // convection: −π d α (T − T_air) with α = λ_*/d · ½ Nu_CB(d u/ν_*)
     let re = p.diameter[0] * p.velocity[0] / 2e-5;

@@ -685,7 +685,7 @@ fn diagnose_marks_a_candidate_refit_at_its_bound() {
     }
     let coflow = cands.iter().find(|c| c["effect"] == "air_coflow").unwrap();
     let (lo, hi) = "air_coflow"
-        .parse::<rheometer::model::effects::Effect>()
+        .parse::<rheometer::model::Effect>()
         .unwrap()
         .bounds();
     let s = coflow["refit"]["effects"]

@@ -8,9 +8,10 @@
 
 use crate::independent::rng::Rng;
 use crate::independent::scenarios;
+use rheometer::data::input::LoadOptions;
 use rheometer::data::input::{load_experiments_with, LoadedExperiments};
 use rheometer::fit::{BandMethod, FitSummary, IdentifyOptions};
-use rheometer::model::effects::LawChoice;
+use rheometer::model::LawChoice;
 use rheometer::report::flow_curve_figure::save_flow_curve_figure;
 use rheometer::report::format::{fmt_pm, LINE_WIDTH};
 use rheometer::workflow::{fit, FitRequest, FitRun};
@@ -20,7 +21,7 @@ use std::time::Duration;
 fn shipped() -> LoadedExperiments {
     load_experiments_with(
         &crate::probe::repo().join("data/pmma7n_synthetic/experiments.toml"),
-        4,
+        &LoadOptions::default(),
     )
     .unwrap()
 }
@@ -154,7 +155,7 @@ fn profile_intervals_agree_with_the_linearised_ones_on_the_shipped_data() {
 /// strain thinning; returns the summary.
 fn no_thinning_case(sc: &crate::independent::dataset::Scenario, fig: &Path) -> FitSummary {
     let generated = sc.generate().unwrap();
-    let data = load_experiments_with(&generated.toml, 4).unwrap();
+    let data = load_experiments_with(&generated.toml, &LoadOptions::default()).unwrap();
     let run = fit_of(&data);
     let s = run.summary().clone();
     let text = s.to_text();
@@ -239,7 +240,7 @@ fn a_newtonian_melt_gets_a_one_sided_bound_and_the_newtonian_law_preferred() {
 fn a_barely_thinning_melt_is_detected_with_the_truth_in_its_interval() {
     let sc = scenarios::slightly_thinning();
     let generated = sc.generate().unwrap();
-    let data = load_experiments_with(&generated.toml, 4).unwrap();
+    let data = load_experiments_with(&generated.toml, &LoadOptions::default()).unwrap();
     let s = fit_of(&data).summary().clone();
     let t = s.newtonian_test.as_ref().unwrap();
     let n = s.interval("n").unwrap();

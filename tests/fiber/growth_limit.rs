@@ -7,7 +7,7 @@
 
 use diffbvp::GrowthLimit;
 use rheometer::data::input::load_experiments;
-use rheometer::diagnostics::refits::scan::{ScanOptions, REFINE_GROWTH_LIMIT};
+use rheometer::diagnostics::{ScanOptions, REFINE_GROWTH_LIMIT};
 use rheometer::fit::{Identification, IdentifyOptions, Rheometer};
 use std::path::Path;
 

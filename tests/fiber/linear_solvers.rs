@@ -3,8 +3,10 @@
 
 use diffbvp::sensitivity::{adjoint_gradient, PointFunction, Sensitivities};
 use diffbvp::{Bvp, DualNum, Guess, LinearSolverKind, Solution, SolveOptions, Solver};
-use rheometer::model::setup::{Air, Experiment, Material};
-use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+use rheometer::model::{Air, Experiment, Material};
+use rheometer::{
+    model::simulate, model::CarreauLike, model::FiberModel, model::Physics, model::SimulateOptions,
+};
 
 const AGREE: f64 = 1e-12;
 

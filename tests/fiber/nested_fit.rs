@@ -10,7 +10,7 @@ use crate::independent;
 use independent::scenarios;
 use rheometer::data::input::load_experiments;
 use rheometer::fit::{Estimator, IdentifyOptions, NestedStart, Rheometer};
-use rheometer::model::effects::{Effect, EffectSetting, LawChoice, ModelSpec};
+use rheometer::model::{Effect, EffectSetting, LawChoice, ModelSpec};
 
 #[test]
 fn a_fitted_effect_never_leaves_the_fit_worse_than_without_it() {

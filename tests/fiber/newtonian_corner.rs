@@ -16,8 +16,9 @@
 use crate::independent::dataset::Scenario;
 use crate::independent::scenarios;
 use rheometer::data::input::load_experiments_with;
+use rheometer::data::input::LoadOptions;
 use rheometer::fit::{FitSummary, FitWarning, IdentifyOptions, WarningCode};
-use rheometer::model::effects::LawChoice;
+use rheometer::model::LawChoice;
 use rheometer::workflow::{fit, FitRequest};
 use std::time::Instant;
 
@@ -45,7 +46,7 @@ struct Row {
 /// Generates `sc`, fits it as `rheometer fit` does and prints its `CORNER` row.
 fn replicate(sc: &Scenario) -> Row {
     let generated = sc.generate().unwrap();
-    let data = load_experiments_with(&generated.toml, 4).unwrap();
+    let data = load_experiments_with(&generated.toml, &LoadOptions::default()).unwrap();
     let t0 = Instant::now();
     let run = fit(&data, &FitRequest::new(IdentifyOptions::default())).unwrap();
     let seconds = t0.elapsed().as_secs_f64();

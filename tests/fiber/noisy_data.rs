@@ -3,7 +3,7 @@
 
 use crate::independent::rng::Rng;
 use crate::independent::scenarios::NOISE_SD;
-use rheometer::model::setup::{Experiment, ExperimentSet, Measurements};
+use rheometer::model::{Experiment, ExperimentSet, Measurements};
 
 /// `template`'s set with `experiments`, their clean diameters `clean` \[m\] at `positions`
 /// \[m\] multiplied by `1 + σ ξ` (`σ` = [`NOISE_SD`], `ξ` standard normal from `rng`).

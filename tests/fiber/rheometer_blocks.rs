@@ -4,7 +4,7 @@
 
 use diffbvp::least_squares::{fit, Accuracy, FitOptions, FitResult, LeastSquaresProblem, Loss};
 use rheometer::data::input::load_experiments;
-use rheometer::fit::objective::Objective;
+use rheometer::fit::Objective;
 use rheometer::fit::{Estimator, FitStart, IdentifyOptions, Rheometer, RheometerError};
 use std::path::Path;
 

@@ -9,10 +9,10 @@ use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem, Loss};
 use rheometer::data::input::load_experiments;
 use rheometer::data::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
 use rheometer::data::synthetic::{NoiseModel as SyntheticNoise, SplitMix64};
-use rheometer::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
+use rheometer::diagnostics::{compare_set, CompareOptions, ModelSetup};
 use rheometer::fit::{FitSummary, IdentifyOptions, Rheometer};
-use rheometer::model::setup::{ExperimentSet, TakeUp};
-use rheometer::Physics;
+use rheometer::model::Physics;
+use rheometer::model::{ExperimentSet, TakeUp};
 use std::path::Path;
 
 const TRUTH: [f64; 2] = [0.8, 11.71];
@@ -470,17 +470,19 @@ fn the_correct_model_stays_consistent_with_noise_and_outliers_are_reported() {
     let json: serde_json::Value = serde_json::from_str(&cmp.to_json().unwrap()).unwrap();
     assert!(json["noise"]["model"]["outliers"].as_array().unwrap().len() >= OUTLIERS.len());
     assert_eq!(json["experiments"][0]["points"][5]["outlier"], true);
-    // the figures are written (noise band, pooled trend, outlier rings)
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("diffbvp-robust-{}", std::process::id()));
-    let written = cmp
-        .write(&dir, rheometer::report::plot::FigureFormat::Svg, &[])
+    // the figures are rendered (noise band, pooled trend, outlier rings)
+    let dir = std::path::Path::new("compare");
+    let files = cmp
+        .files(dir, rheometer::report::plot::FigureFormat::Svg)
         .unwrap();
-    let svg = std::fs::read_to_string(dir.join("compare_residuals.svg")).unwrap();
+    let residuals = files
+        .iter()
+        .find(|f| f.path == dir.join("compare_residuals.svg"))
+        .expect("the residual figure");
+    let svg = String::from_utf8(residuals.bytes.clone()).unwrap();
     assert!(svg.contains("outliers (") && svg.contains("pooled trend"));
     assert!(svg.contains("noise model"));
-    assert!(written.len() >= 4);
-    let _ = std::fs::remove_dir_all(&dir);
+    assert!(files.len() >= 4);
 }
 
 #[test]

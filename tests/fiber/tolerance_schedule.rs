@@ -5,7 +5,7 @@
 
 use rheometer::data::input::load_experiments;
 use rheometer::fit::{Estimator, Identification, IdentifyOptions, Rheometer};
-use rheometer::model::effects::{Effect, EffectSetting, ModelSpec};
+use rheometer::model::{Effect, EffectSetting, ModelSpec};
 use std::path::Path;
 
 fn fit(rh: &Rheometer, loose: Option<f64>) -> Identification {

@@ -3,14 +3,15 @@
 //! carries one noise level through `fit`, `compare` and `diagnose`.
 
 use crate::probe;
+use rheometer::data::input::LoadOptions;
 
 use rheometer::data::input::{load_experiments_with, LoadedExperiments};
-use rheometer::diagnostics::compare::MissingTakeUp;
-use rheometer::diagnostics::diagnose::DiagnoseOptions;
+use rheometer::data::take_up::MissingTakeUp;
+use rheometer::diagnostics::DiagnoseOptions;
 use rheometer::fit::{Estimator, FitSummary, IdentifyOptions};
-use rheometer::model::effects::ModelSpec;
+use rheometer::model::ModelSpec;
+use rheometer::model::SimulateOptions;
 use rheometer::workflow::{self, CompareRequest, FitRequest, LandscapeRequest, SimulateRequest};
-use rheometer::SimulateOptions;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -20,7 +21,7 @@ fn data_set(set: &str) -> (PathBuf, LoadedExperiments) {
         .join("data")
         .join(set)
         .join("experiments.toml");
-    let loaded = load_experiments_with(&toml, 4).unwrap();
+    let loaded = load_experiments_with(&toml, &LoadOptions::default()).unwrap();
     (toml, loaded)
 }
 

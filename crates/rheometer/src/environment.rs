@@ -66,11 +66,11 @@ where
 /// The most threads per core the pool is given from `RAYON_NUM_THREADS`: more only add
 /// switching and memory (each thread has its own stack), and a huge count makes thread
 /// creation itself the bottleneck or exhausts memory.
-pub const MAX_THREADS_PER_CORE: usize = 4;
+pub(crate) const MAX_THREADS_PER_CORE: usize = 4;
 
 /// The size of the thread pool from the value of `RAYON_NUM_THREADS` (`None`: unset) on a
 /// machine of `cores` cores, and a warning where the value was not used as given: a whole
-/// number from 1 to [`MAX_THREADS_PER_CORE`] × `cores` is used as it is; a larger one is
+/// number from 1 to `MAX_THREADS_PER_CORE` × `cores` is used as it is; a larger one is
 /// clamped to that; `0`, unset or an empty value mean one thread per core; anything else is
 /// ignored with a warning (one thread per core).
 pub fn thread_count(value: Option<&str>, cores: usize) -> (usize, Option<String>) {

@@ -14,16 +14,16 @@
 //!   (the take-up condition a model uses), [`data::statistics`] and [`data::noise_model`]
 //!   (noise estimates, runs test, autocorrelation, rank correlation, the noise along the spin
 //!   line, the one noise level), [`data::synthetic`] (reproducible measurement noise);
-//! * [`model`]: the fiber model — [`model::setup`] (SI inputs: material, air, experiment),
-//!   [`model::scaling`] (non-dimensionalisation, paper Table 2), [`model::material_law`]
+//! * [`model`]: the fiber model — `model::setup` (SI inputs: material, air, experiment),
+//!   `model::scaling` (non-dimensionalisation, paper Table 2), `model::material_law`
 //!   (elongational viscosity laws: Newtonian, Carreau-type, Carreau–Yasuda),
-//!   [`model::catalog`] (one descriptor per candidate effect: name, unit, ranges, shapes,
+//!   `model::catalog` (one descriptor per candidate effect: name, unit, ranges, shapes,
 //!   category, remedy, error-budget source, how it enters the model; data only),
-//!   [`model::contributions`] (named force and heat terms, air environment, Nusselt law),
-//!   [`model::effects`] (the candidate effects and the model specification, law + effects, a
-//!   rheometer fit uses), [`model::bvp`] (the strain-rate formulation as a
-//!   [`Bvp`](diffbvp::Bvp)), [`model::cold_start`] (continuation from the stress-free fiber),
-//!   [`model::simulate`](mod@model::simulate) (the user-facing API with SI profiles) and
+//!   `model::contributions` (named force and heat terms, air environment, Nusselt law),
+//!   `model::effects` (the candidate effects and the model specification, law + effects, a
+//!   rheometer fit uses), `model::bvp` (the strain-rate formulation as a
+//!   [`Bvp`](diffbvp::Bvp)), `model::cold_start` (continuation from the stress-free fiber),
+//!   `model::simulate` (the user-facing API with SI profiles) and
 //!   [`model::profile_sensitivities`] (exact derivatives of the SI profiles with respect to
 //!   the law parameters and the effects' strengths);
 //! * [`fit`]: identification of the elongational viscosity from diameter profiles;
@@ -93,13 +93,3 @@ pub mod report;
 pub mod workflow;
 
 pub use error::FiberError;
-pub use model::bvp::{FiberModel, ParamLayout};
-pub use model::contributions::{
-    Balance, FiberTerm, InclinedChurchillBernstein, NusseltLaw, Physics, SiState, Strength,
-    StrengthPlan,
-};
-pub use model::material_law::{CarreauLike, CarreauYasuda, Newtonian, ViscosityLaw};
-pub use model::scaling::{ReferenceValues, Scaling};
-pub use model::simulate::{
-    simulate, simulate_from, FiberSolution, Profiles, SimulateOptions, Simulator,
-};

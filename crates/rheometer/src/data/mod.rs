@@ -21,3 +21,5 @@ pub mod statistics;
 pub mod synthetic;
 pub mod take_up;
 pub mod uncertainty;
+
+pub use noise_summary::NoiseSource;

@@ -14,7 +14,7 @@
 //!
 //! **Estimators** (positions `s` in m, `L` the line length of each experiment):
 //! 1. *Robust noise scale* `σ`: `1.4826 · MAD` of the spacing-normalised second differences
-//!    ([`second_differences`](crate::data::statistics::second_differences)), pooled over
+//!    (`second_differences`), pooled over
 //!    experiments, leaving out every difference that touches an outlier. A normalised second
 //!    difference has variance `σ²` for independent noise of SD `σ` on any spacing and cancels a
 //!    residual linear in `s`, so a smooth systematic misfit hardly enters; the MAD ignores kinks.

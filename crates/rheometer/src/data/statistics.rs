@@ -4,20 +4,9 @@
 //! (`diagnostics::diagnose`) compute; tail probabilities of the F distribution in
 //! `distributions`.
 //!
-//! **The noise model of record is [`NoiseModel`](crate::data::noise_model::NoiseModel)** (robust
-//! scale, scale along the line, outliers, one lag-1 autocorrelation, the judgement numbers); the
-//! comparison uses it. The older estimators below remain until the diagnosis is switched over:
-//!
-//! | function | used by | what |
-//! |---|---|---|
-//! | [`noise_mad_second_differences`] | the fit report | robust (MAD) SD of spacing-normalised second differences: ignores kinks and outliers (the [`NoiseModel`](crate::data::noise_model::NoiseModel)'s `sigma` without excluding outliers) |
-//! | [`noise_rms_second_differences`] | the diagnosis | RMS of plain second differences (uniform spacing assumed): every point counts |
-//! | [`lag1_autocorrelation_about_mean`] | nobody (deprecated: the comparison now uses [`NoiseModel::lag1`](crate::data::noise_model::NoiseModel::lag1)) | each sequence about its own mean (`NaN` without spread) |
-//! | [`lag1_autocorrelation_about_zero`] | the diagnosis | about zero, i.e. an offset counts as correlation (`0` without spread) |
-//!
-//! The diagnosis's "systematic" test `rms/noise > 1.2` is calibrated on the RMS estimate: the
-//! robust estimate is smaller where the residual has kinks, so that it would call the noise of
-//! a correct model systematic.
+//! The noise model of record is [`NoiseModel`](crate::data::noise_model::NoiseModel) (robust
+//! scale, scale along the line, outliers, one lag-1 autocorrelation, the judgement numbers);
+//! this module holds the building blocks it and the tests share.
 
 pub(crate) mod distributions;
 
@@ -84,7 +73,7 @@ pub(crate) fn robust_sd(v: &[f64]) -> f64 {
 /// the combination `e = (h₂ r_{i−1} − (h₁ + h₂) r_i + h₁ r_{i+1}) / ‖(h₂, h₁ + h₂, h₁)‖` vanishes
 /// for any residual linear in `s` and has the variance `σ²` of independent noise of standard
 /// deviation `σ`. A smooth systematic residual therefore drops out (to second order).
-pub fn second_differences(s: &[f64], r: &[f64]) -> Vec<f64> {
+pub(crate) fn second_differences(s: &[f64], r: &[f64]) -> Vec<f64> {
     let mut out = Vec::new();
     for i in 1..r.len().saturating_sub(1) {
         let h1 = s[i] - s[i - 1];
@@ -96,24 +85,6 @@ pub fn second_differences(s: &[f64], r: &[f64]) -> Vec<f64> {
         }
     }
     out
-}
-
-/// The comparison's and the fit report's noise estimator: robust standard deviation of the
-/// normalised second differences ([`second_differences`]) pooled over all experiments (`NaN`
-/// with fewer than 3 of them); `experiments` are `(positions, residuals)`.
-///
-/// The median absolute deviation ignores the few large differences that a kink of the
-/// systematic residual or an outlier produces; for heteroscedastic noise it estimates the level
-/// of the majority of the points.
-pub fn noise_mad_second_differences(experiments: &[(Vec<f64>, Vec<f64>)]) -> f64 {
-    let e: Vec<f64> = experiments
-        .iter()
-        .flat_map(|(s, r)| second_differences(s, r))
-        .collect();
-    if e.len() < 3 {
-        return f64::NAN;
-    }
-    robust_sd(&e)
 }
 
 /// The Wald–Wolfowitz runs test on the signs of residuals.
@@ -185,62 +156,6 @@ fn z_of(value: f64, expected: f64, variance: f64) -> f64 {
         (value - expected) / variance.sqrt()
     } else {
         f64::NAN
-    }
-}
-
-/// The diagnosis's noise estimator: RMS of the second differences of the residuals along each
-/// sequence (uniform spacing assumed; removes locally linear misfit),
-/// `σ̂² = Σ (r_{j+1} − 2 r_j + r_{j−1})² / (6 · count)` pooled over all sequences (`0` without
-/// any triple).
-pub fn noise_rms_second_differences(sequences: &[&[f64]]) -> f64 {
-    let (mut s, mut c) = (0.0, 0usize);
-    for r in sequences {
-        for w in r.windows(3) {
-            let d = w[2] - 2.0 * w[1] + w[0];
-            s += d * d;
-            c += 1;
-        }
-    }
-    (s / (6 * c.max(1)) as f64).sqrt()
-}
-
-/// The diagnosis's lag-1 autocorrelation, about zero, pooled:
-/// `ρ₁ = Σ r_i r_{i+1} / Σ r_i²` with both sums over all sequences (`0` if all residuals are
-/// 0). Returns `(ρ₁, number of lag pairs)`.
-pub fn lag1_autocorrelation_about_zero(sequences: &[&[f64]]) -> (f64, usize) {
-    let (mut num, mut den, mut c) = (0.0, 0.0, 0usize);
-    for r in sequences {
-        for w in r.windows(2) {
-            num += w[0] * w[1];
-            c += 1;
-        }
-        den += r.iter().map(|v| v * v).sum::<f64>();
-    }
-    (if den > 0.0 { num / den } else { 0.0 }, c)
-}
-
-/// The comparison's lag-1 autocorrelation, of each sequence about its own mean, pooled:
-/// `ρ₁ = Σ (r_i − r̄)(r_{i+1} − r̄) / Σ (r_i − r̄)²` with both sums over all sequences.
-/// Returns `(ρ₁, number of lag pairs)`; for white noise `ρ₁ ≈ N(0, 1/pairs)` (to `O(1/n)`).
-#[deprecated(note = "use NoiseModel::lag1 (noise-normalised, about zero, outliers excluded)")]
-pub fn lag1_autocorrelation_about_mean(sequences: &[&[f64]]) -> (f64, usize) {
-    let (mut num, mut den, mut pairs) = (0.0, 0.0, 0usize);
-    for r in sequences {
-        if r.len() < 2 {
-            continue;
-        }
-        let mean = r.iter().sum::<f64>() / r.len() as f64;
-        den += r.iter().map(|v| (v - mean).powi(2)).sum::<f64>();
-        num += r
-            .windows(2)
-            .map(|w| (w[0] - mean) * (w[1] - mean))
-            .sum::<f64>();
-        pairs += r.len() - 1;
-    }
-    if den > 0.0 {
-        (num / den, pairs)
-    } else {
-        (f64::NAN, pairs)
     }
 }
 

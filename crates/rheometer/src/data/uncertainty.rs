@@ -50,7 +50,8 @@ use crate::model::catalog::{
 };
 use crate::model::setup::Experiment;
 
-pub use crate::model::catalog::{GaugeColumn, Scope};
+pub(crate) use crate::model::catalog::GaugeColumn;
+pub(crate) use crate::model::catalog::Scope;
 
 /// One source of systematic error: its key in `[uncertainty]`, its unit, its default and the
 /// effect that represents it (the effect descriptor's [`budget`](EffectDescriptor::budget) with
@@ -72,7 +73,7 @@ pub struct Source {
     pub max: f64,
     /// Common to all experiments or independent per experiment.
     pub scope: Scope,
-    /// The effect (an [`Effect`](crate::model::effects::Effect)) whose strength represents the
+    /// The effect (an [`Effect`](crate::model::Effect)) whose strength represents the
     /// source.
     pub effect: EffectId,
     /// Strength of the effect per unit of the source, for experiment `e` (`None`: the source

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 /// How many standard errors a strength may lie beyond its physical range and still count as
 /// consistent with it (the two-sided 95 % normal quantile): an emissivity estimated as
 /// 1.02 ± 0.09 is consistent with ε ≤ 1, one of 2.0 ± 0.1 is not.
-pub const PHYSICAL_RANGE_SE: f64 = 1.96;
+pub(crate) const PHYSICAL_RANGE_SE: f64 = 1.96;
 
 /// Whether a candidate's refitted strength may be named as found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -259,7 +259,7 @@ impl Candidate {
 /// ends at a search bound beyond its physical range, a strength whose unbounded optimum lies
 /// within [`PHYSICAL_RANGE_SE`] standard errors of the physical limit is credible, with a note
 /// (the data do not bound it on that side).
-pub fn strength_status(
+pub(crate) fn strength_status(
     effect: &Effect,
     strength: f64,
     stderr: f64,
@@ -336,7 +336,7 @@ fn flat_beyond_physics(effect: &Effect, bound: f64, unbounded: f64, stderr: f64)
 /// value plus its component of the fit's Gauss–Newton step
 /// ([`FitResult::gauss_newton_step`](diffbvp::least_squares::FitResult::gauss_newton_step);
 /// `None` without that parameter or that step).
-pub fn unbounded_optimum(id: &crate::fit::Identification, name: &str) -> Option<f64> {
+pub(crate) fn unbounded_optimum(id: &crate::fit::Identification, name: &str) -> Option<f64> {
     let i = id.names.iter().position(|n| n == name)?;
     let step = id.fit.gauss_newton_step()?;
     Some(id.fit.p[i] + step[i])
@@ -385,7 +385,7 @@ pub fn earns_its_place(c: &Candidate, threshold: f64) -> bool {
 
 /// Ranking: credible refits by `ΔBIC`, then refits that are not credible by `ΔBIC`, then
 /// candidates without a refit by linear score.
-pub fn rank_order(a: &Candidate, b: &Candidate) -> std::cmp::Ordering {
+pub(crate) fn rank_order(a: &Candidate, b: &Candidate) -> std::cmp::Ordering {
     let class = |c: &Candidate| match (c.refitted(), c.status) {
         (true, StrengthStatus::Physical) => 0,
         (true, _) => 1,

@@ -4,9 +4,9 @@
 //! misfit is noise or systematic, and where.
 //!
 //! ```no_run
-//! use rheometer::diagnostics::compare::{compare_set, CompareOptions, ModelSetup};
+//! use rheometer::diagnostics::{compare_set, CompareOptions, ModelSetup};
 //! use rheometer::data::input::load_experiments;
-//! use rheometer::Physics;
+//! use rheometer::model::Physics;
 //! use std::path::Path;
 //! let set = load_experiments(Path::new("data/hidden_radiation/experiments.toml"))?;
 //! let physics = || Physics::paper();
@@ -21,7 +21,7 @@
 //!   from second differences along `s`, the noise scale along the line `σ(s/L)`, gross
 //!   outliers by experiment and position, the lag-1 autocorrelation and `RMS/noise`;
 //! * *noise level* `σ`: the one noise level of the model on these data
-//!   ([`NoiseSummary`]): the fit's when a fit is compared ([`CompareOptions::fit_noise`]),
+//!   (`NoiseSummary`): the fit's when a fit is compared ([`CompareOptions::fit_noise`]),
 //!   else the data set's `relative_uncertainty` if given (or
 //!   [`CompareOptions::relative_uncertainty`]), else the noise model's estimate;
 //! * `χ² = Σ r²/σᵢ²` over the points that are not outliers, with `σᵢ = σ` if given, else the
@@ -38,22 +38,25 @@
 pub(crate) mod compare_figures;
 pub(crate) mod model_runs;
 pub(crate) mod segments;
-pub mod summary_text;
+pub(crate) mod summary_text;
 
-pub use crate::data::statistics::RunsTest;
+pub(crate) use crate::data::statistics::RunsTest;
 pub use model_runs::{compare_set, simulate_experiments, MissingTakeUp, ModelSetup};
-pub use segments::{Segment, SegmentOptions, Station};
+pub(crate) use segments::Segment;
+pub(crate) use segments::SegmentOptions;
+pub(crate) use segments::Station;
 
-pub use crate::data::noise_model::{NoiseModel, NoiseOptions, Outlier, ResidualSeries};
-pub use crate::data::noise_summary::{NoiseSource, NoiseSummary};
+pub(crate) use crate::data::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
+pub(crate) use crate::data::noise_summary::NoiseSummary;
 use crate::data::smoothing::SmoothingError;
 use crate::data::statistics;
 use crate::error::FiberError;
 use crate::model::simulate::Profiles;
-use crate::report::output::{create_output_dir, write_text, OutputError};
+use crate::report::output_files::OutputError;
+use crate::report::output_files::OutputFile;
 use crate::report::plot::PlotError;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use thiserror::Error;
 
 /// What can go wrong in a comparison.
@@ -442,7 +445,7 @@ fn compared_experiment(run: &SimulatedExperiment) -> Result<ComparedExperiment, 
 }
 
 /// Output image format of the figures (the plotting module's).
-pub use crate::report::plot::FigureFormat;
+pub(crate) use crate::report::plot::FigureFormat;
 
 impl Comparison {
     /// The JSON summary (all numbers, per point), stamped as a
@@ -480,7 +483,7 @@ impl Comparison {
         s
     }
 
-    /// The names of the files [`Comparison::write`] writes for `experiments` experiments in
+    /// The names of the files `Comparison::write` writes for `experiments` experiments in
     /// `format` (so that a program can check them all before the work).
     pub fn file_names(experiments: usize, format: FigureFormat) -> Vec<String> {
         let mut v: Vec<String> = Self::TEXT_FILES.iter().map(|s| s.to_string()).collect();
@@ -492,25 +495,18 @@ impl Comparison {
     const TEXT_FILES: [&'static str; 3] =
         ["compare_summary.txt", "compare.json", "compare_points.csv"];
 
-    /// Writes `compare_summary.txt`, `compare.json`, `compare_points.csv` and the figures
-    /// (see `compare_figures::write_figures`) into `dir` (created; refused if it is an input
-    /// or a file), never over a file in `inputs`, each file atomically (see
-    /// `write_atomically`). Returns the written paths.
-    pub fn write(
-        &self,
-        dir: &Path,
-        format: FigureFormat,
-        inputs: &[PathBuf],
-    ) -> Result<Vec<PathBuf>, CompareError> {
-        create_output_dir(dir, inputs)?;
-        let mut written = Vec::new();
+    /// The files of a comparison in `dir`, rendered in memory: `compare_summary.txt`,
+    /// `compare.json`, `compare_points.csv` and the figures (see
+    /// `compare_figures::render_figures`), for the caller to write (a command through its
+    /// checked outputs, a library user with [`OutputFile::save`]).
+    pub fn files(&self, dir: &Path, format: FigureFormat) -> Result<Vec<OutputFile>, CompareError> {
         let texts = [self.to_text(), self.to_json()?, self.to_csv()];
-        for (name, text) in Self::TEXT_FILES.into_iter().zip(texts) {
-            let path = dir.join(name);
-            write_text(&path, &text, inputs)?;
-            written.push(path);
-        }
-        written.extend(compare_figures::write_figures(self, dir, format, inputs)?);
-        Ok(written)
+        let mut files: Vec<OutputFile> = Self::TEXT_FILES
+            .into_iter()
+            .zip(texts)
+            .map(|(name, text)| OutputFile::new(dir.join(name), text))
+            .collect();
+        files.extend(compare_figures::render_figures(self, dir, format)?);
+        Ok(files)
     }
 }

@@ -42,7 +42,7 @@
 //!
 //! **What an undetected effect does to the result.** The fit that leaves out an effect present
 //! with strength `s` is biased by `−s dθ/dq`, with `dθ/dq = −(JᵀJ)⁻¹ Jᵀ c` the error budget's
-//! exact propagation ([`ParameterShift`](crate::fit::ParameterShift)); the report
+//! exact propagation (`ParameterShift`); the report
 //! gives that bias of `n` and `κ` at `s = +s95` (a negative strength reverses the sign), in
 //! absolute units and in units of the fit's statistical standard error.
 

@@ -91,12 +91,12 @@ pub struct Diagnosis {
     pub most_likely_missing: Option<String>,
     /// Other candidates about as consistent with the data as the named one: they earn their
     /// place too, with a `ΔBIC` less than the tie margin above the named one's (best first;
-    /// empty when nothing is named or nothing ties; see [`ties`](super::ties)).
+    /// empty when nothing is named or nothing ties; see `ties`).
     #[serde(default)]
     pub alternatives: Vec<Alternative>,
     /// What these data could have missed: per candidate, the strength named with 50 % and
     /// 95 % probability (linearised at strength 0) and the shift of `(n, κ)` an undetected
-    /// effect of the 95 % strength would cause ([`detection`](super::detection)).
+    /// effect of the 95 % strength would cause (`detection`).
     #[serde(default)]
     pub detection: DetectionLimits,
     /// The look-elsewhere calibration of the first step: the null distribution of the best

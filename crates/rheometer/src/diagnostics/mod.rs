@@ -6,31 +6,54 @@
 //!   spin line, text/JSON summaries and figures;
 //! * the candidate effects themselves (canonical names, strength parameters, neutral values,
 //!   the model specification a rheometer fit uses) live below the model, in
-//!   [`effects`](crate::model::effects);
+//!   `effects`;
 //! * [`diagnose`]: the stages of a diagnosis (fit the base, linearise, test the noise,
 //!   search, choose shapes, judge, rank, ties), ranking the candidates by the excess misfit
 //!   they explain;
-//! * [`candidate`]: the record of one candidate and how candidates are judged and ranked;
-//! * [`diagnosis`]: the result of a diagnosis (JSON) and what figures need besides;
+//! * `candidate`: the record of one candidate and how candidates are judged and ranked;
+//! * `diagnosis`: the result of a diagnosis (JSON) and what figures need besides;
 //! * `calibration`: the look-elsewhere calibration of a diagnosis as a value (the null
 //!   distribution of the best `ΔBIC`), computed by the stage `diagnose::linear::calibrate`;
-//! * [`report`]: the diagnosis in words and its figures;
-//! * [`detection`]: the detection limit of each candidate (the strength the data would reveal)
+//! * `report`: the diagnosis in words and its figures;
+//! * `detection`: the detection limit of each candidate (the strength the data would reveal)
 //!   and the shift of `(n, κ)` an effect just below it would cause;
-//! * [`refits`]: the refits behind a diagnosis — [`refits::scan`], the global search of one
+//! * `refits`: the refits behind a diagnosis — `refits::scan`, the global search of one
 //!   candidate's strength (and shape): the profile of `J` and the refits of its best points;
-//!   [`refits::pair`], two candidates fitted jointly; and `refits::consistency`, whether a
+//!   `refits::pair`, two candidates fitted jointly; and `refits::consistency`, whether a
 //!   fitted effect has one strength in every experiment (a score test of the fit; the
 //!   diagnosis' stage 10 and `fit --with` both use it);
-//! * [`ties`]: candidates about as consistent with the data as the named one (alternatives).
+//! * `ties`: candidates about as consistent with the data as the named one (alternatives).
 
 pub(crate) mod calibration;
-pub mod candidate;
-pub mod compare;
-pub mod detection;
-pub mod diagnose;
-pub mod diagnosis;
-pub mod refits;
-pub mod report;
+pub(crate) mod candidate;
+pub(crate) mod compare;
+pub(crate) mod detection;
+pub(crate) mod diagnose;
+pub(crate) mod diagnosis;
+pub(crate) mod refits;
+pub(crate) mod report;
 pub(crate) mod scores;
-pub mod ties;
+pub(crate) mod ties;
+
+pub use candidate::{
+    earns_its_place, Candidate, Indistinguishable, ShapeAlternative, StrengthStatus,
+};
+pub use compare::{
+    compare, compare_set, simulate_experiments, CompareError, CompareOptions, ComparedExperiment,
+    ComparedPoint, Comparison, ModelSetup, SimulatedExperiment, Trend,
+};
+pub use detection::{detection_limits, DetectionContext, DetectionLimit, DetectionLimits};
+pub use diagnose::verdict::{Help, Unexplained, Verdict};
+pub use diagnose::{
+    diagnose, DiagnoseOptions, Diagnosis, DiagnosisRun, ForwardStep, ResidualProfiles,
+    RobustWeights, StageTimes,
+};
+pub use diagnosis::DiagnosisJson;
+pub use refits::pair::{delta_bic, law_envelope_of, PairFound};
+pub use refits::scan::{
+    physical, physical_range, refine, scan_candidate, search_range, CandidateScan, GridStart,
+    Profile, ProfilePoint, ProfileScan, Refit, ScanOptions, ShapeParameter, GRID_GROWTH_LIMIT,
+    REFINE_GROWTH_LIMIT,
+};
+pub use report::{save_profile_figure, save_residual_figure};
+pub use ties::{alternatives, independent_check, Alternative};

@@ -14,7 +14,7 @@
 //! material result is robust to the choice. Every effect in a tie but strain thinning can be
 //! checked independently of these data (a process condition, the instrument, the air's speed
 //! or temperature, the fiber's temperature): the check is its descriptor's
-//! [`independent_check`](crate::model::effects::EffectDescriptor::independent_check), a
+//! [`independent_check`](crate::model::EffectDescriptor::independent_check), a
 //! user-written candidate's included.
 
 use super::candidate::{earns_its_place, Candidate};
@@ -29,7 +29,7 @@ use crate::fit::summary::Z95;
 
 /// Shifts of `n` and `κ` (in the named refit's standard errors) below which the material
 /// result is robust to the choice between tied causes.
-pub const ROBUST_SHIFT_SE: f64 = 1.0;
+pub(crate) const ROBUST_SHIFT_SE: f64 = 1.0;
 
 /// A candidate about as consistent with the data as the named one (JSON: an entry of
 /// `alternatives`). Its refit (strength, `(n, κ)` with intervals) is the candidate's own
@@ -52,7 +52,7 @@ pub struct Alternative {
     pub n_shift_se: f64,
     /// `(κ_alt − κ_named) / se(κ_named)`.
     pub kappa_shift_se: f64,
-    /// Whether `|n_shift_se|` and `|kappa_shift_se|` are both below [`ROBUST_SHIFT_SE`]: the
+    /// Whether `|n_shift_se|` and `|kappa_shift_se|` are both below `ROBUST_SHIFT_SE`: the
     /// material result does not depend on which of the two causes is chosen.
     pub material_robust: bool,
     /// The measurement outside these data that decides whether the alternative is the cause

@@ -1,8 +1,8 @@
 //! The two estimators of the rheometer as point functions of the simulated fiber.
 
 use crate::model::bvp::FiberModel;
+use crate::model::contributions::NusseltLaw;
 use crate::model::material_law::ViscosityLaw;
-use crate::NusseltLaw;
 use diffbvp::sensitivity::PointFunction;
 use num_dual::DualNum;
 

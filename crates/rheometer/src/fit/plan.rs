@@ -81,7 +81,9 @@ impl Rheometer {
             cold_start_s = cold_start_s.min(t0.elapsed().as_secs_f64());
             // a nearby law (what a trial step asks), warm-started, with its sensitivities
             let mut near = p.clone();
-            let ni = layout.params.law_param(crate::CarreauLike::N);
+            let ni = layout
+                .params
+                .law_param(crate::model::material_law::CarreauLike::N);
             near[ni] = (near[ni] - 0.01).max(options.lower[0]);
             let t1 = Instant::now();
             let warm = simulate_params(model, &near, Some(&cold.solution), sim).map_err(sim_err)?;

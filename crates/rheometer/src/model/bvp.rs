@@ -121,8 +121,8 @@ impl ParamLayout {
     }
 
     /// Index of the law's parameter number `k` (for the Carreau-type law
-    /// [`CarreauLike::N`](crate::CarreauLike::N) is `n`,
-    /// [`CarreauLike::KAPPA`](crate::CarreauLike::KAPPA) is `κ`).
+    /// [`CarreauLike::N`](crate::model::CarreauLike::N) is `n`,
+    /// [`CarreauLike::KAPPA`](crate::model::CarreauLike::KAPPA) is `κ`).
     #[inline]
     pub fn law_param(&self, k: usize) -> usize {
         debug_assert!(k < self.n_law, "law parameter {k} of {}", self.n_law);

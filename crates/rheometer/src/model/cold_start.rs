@@ -14,7 +14,7 @@
 //! Intermediate steps are solved at a loose tolerance ([`PathOptions::intermediate_tol`]); the
 //! final `c = 1` solve uses the caller's options.
 
-pub use diffbvp::continuation::{PathOptions, SimpleSteps, StepControl};
+pub use diffbvp::continuation::{PathOptions, StepControl};
 
 use diffbvp::continuation::{follow, solve_by_continuation};
 use diffbvp::error::BvpError;

@@ -1,6 +1,6 @@
 //! Candidate effects: named contributions a user's model may lack, each with a **strength
 //! parameter** whose neutral value 0 switches it off exactly and which is a model parameter of
-//! the [`FiberModel`](crate::FiberModel) (so derivatives with respect to it are exact,
+//! the [`FiberModel`](crate::model::FiberModel) (so derivatives with respect to it are exact,
 //! through the dual numbers). Some have **shape parameters** (decay lengths, an onset position),
 //! model parameters too, fitted together with the strength unless fixed.
 //!
@@ -32,7 +32,7 @@
 //! predicted measurement.
 //!
 //! **Effects in the law.** The user's Newtonian model is the Carreau-type law at `n = 1` (where
-//! `κ` has no effect). Strain thinning lives in the law ([`Install::Law`]): its strength is
+//! `κ` has no effect). Strain thinning lives in the law (`Install::Law`): its strength is
 //! `s = 1 − n`, the linearised score takes its direction at the descriptor's reference `κ`
 //! ([`STRAIN_THINNING_REFERENCE_KAPPA`]), and a refit frees both `n` and `κ`
 //! ([`EffectDescriptor::fit_parameters`] = 2 in the information criterion).
@@ -64,9 +64,7 @@ use std::str::FromStr;
 use std::sync::Arc;
 
 pub use crate::model::catalog::{
-    BudgetSource, Category, EffectDescriptor, ShapeParameter, ShapeScan, StrengthMap, ALL_NAMES,
-    BUILTIN_NAMES, DEFAULT_COFLOW_DECAY_LENGTH, DEFAULT_COFLOW_LINE_ONSET,
-    DEFAULT_COFLOW_LINE_RAMP_WIDTH, DEFAULT_WARM_AIR_DECAY_LENGTH, STRAIN_THINNING_REFERENCE_KAPPA,
+    Category, EffectDescriptor, ShapeParameter, ALL_NAMES, STRAIN_THINNING_REFERENCE_KAPPA,
 };
 #[cfg(test)]
 use crate::model::catalog::{COFLOW_DECAY, WARM_AIR_DECAY};
@@ -140,7 +138,7 @@ impl fmt::Debug for UserEffect {
     }
 }
 
-/// A candidate effect: a built-in one (its descriptor in [`crate::model::catalog`])
+/// A candidate effect: a built-in one (its descriptor in `crate::model::catalog`)
 /// or a user-written one. Shape parameters are `Option<f64>`: `None` fits them with the
 /// strength (or keeps the default where the shape is not fitted, see
 /// [`ShapeParameter::fitted_with_strength`]), `Some(v)` fixes them at `v`.
@@ -152,7 +150,7 @@ pub enum Effect {
     Radiation,
     /// `air_coflow`: aspirator co-flow near the take-up, strength = amplitude `V` \[m/s\].
     AirCoflow {
-        /// Decay length `ℓ` \[m\] fixed, or `None` (fitted, start [`DEFAULT_COFLOW_DECAY_LENGTH`]).
+        /// Decay length `ℓ` \[m\] fixed, or `None` (fitted, start `DEFAULT_COFLOW_DECAY_LENGTH`).
         decay_length: Option<f64>,
         /// Tail `r` \[-\] of the decay `(1 + r z/ℓ)^(−1/r)` fixed, or `None` (0, the
         /// exponential; not fitted: `diagnose` scans 0 and 0.5, the fit keeps the better).
@@ -160,16 +158,16 @@ pub enum Effect {
     },
     /// `air_coflow_line`: co-flow along the line after an onset, strength = speed `V` \[m/s\].
     AirCoflowLine {
-        /// Onset `s₀` \[m\] fixed, or `None` (fitted, start [`DEFAULT_COFLOW_LINE_ONSET`]).
+        /// Onset `s₀` \[m\] fixed, or `None` (fitted, start `DEFAULT_COFLOW_LINE_ONSET`).
         onset: Option<f64>,
-        /// Ramp width `w` \[m\] fixed, or `None` (fitted, start [`DEFAULT_COFLOW_LINE_RAMP_WIDTH`];
+        /// Ramp width `w` \[m\] fixed, or `None` (fitted, start `DEFAULT_COFLOW_LINE_RAMP_WIDTH`;
         /// `diagnose` scans the onset and fits the width only in its refinement).
         ramp_width: Option<f64>,
     },
     /// `air_temperature_profile`: warm air near the nozzle, strength = excess `ΔT` \[K\].
     AirTemperatureProfile {
         /// Decay length `ℓ` \[m\] fixed, or `None` (fitted, start
-        /// [`DEFAULT_WARM_AIR_DECAY_LENGTH`]).
+        /// `DEFAULT_WARM_AIR_DECAY_LENGTH`).
         decay_length: Option<f64>,
     },
     /// `nusselt_scale`: `𝒩 → (1 + s) 𝒩`, strength `s` \[-\].
@@ -197,7 +195,7 @@ pub enum Effect {
 }
 
 impl Effect {
-    /// Every built-in effect ([`ALL_NAMES`], the order of [`catalog::BUILTIN`]), shapes not
+    /// Every built-in effect ([`ALL_NAMES`], the order of `catalog::BUILTIN`), shapes not
     /// fixed.
     pub fn all() -> Vec<Effect> {
         vec![
@@ -225,7 +223,7 @@ impl Effect {
     }
 
     /// The built-in candidates of `diagnose` (shapes fitted): physics, then process conditions,
-    /// then the instrument ([`BUILTIN_NAMES`]: the descriptors'
+    /// then the instrument (`BUILTIN_NAMES`: the descriptors'
     /// [`default_candidate`](EffectDescriptor::default_candidate)).
     pub fn builtin() -> Vec<Effect> {
         Self::all()
@@ -467,14 +465,14 @@ impl Effect {
         Ok(self)
     }
 
-    /// Name of the model parameter (in [`FiberModel::param_names`](crate::FiberModel::param_names))
-    /// that carries the strength.
+    /// Name of the model parameter that carries the strength (in
+    /// [`FiberModel::param_names`](crate::model::FiberModel::param_names)).
     pub fn model_param(&self) -> &'static str {
         self.descriptor().model_param
     }
 
     /// Model-parameter value for a strength (`1 − s` for `strain_thinning`, `1 + s` for
-    /// `nusselt_scale`, `s` otherwise: the descriptor's [`StrengthMap`]).
+    /// `nusselt_scale`, `s` otherwise: the descriptor's `StrengthMap`).
     pub fn param_value(&self, strength: f64) -> f64 {
         self.descriptor().param_value(strength)
     }
@@ -492,7 +490,7 @@ impl Effect {
     /// Adds the effect to `physics` at its neutral strength, as a model parameter (nothing for
     /// an effect that lives in the law), with its shape parameters as model parameters at their
     /// fixed or default values: the built-in part switched on by
-    /// [`Physics::enable`](crate::Physics::enable), or the user's term. Errors if the
+    /// [`Physics::enable`](crate::model::Physics::enable), or the user's term. Errors if the
     /// strength cannot be named in `physics` (a user effect whose term does not carry its name).
     pub fn apply(&self, physics: Physics) -> Result<Physics, FiberError> {
         let d = self.descriptor();
@@ -659,7 +657,7 @@ impl FromStr for EffectSetting {
 
 /// `(n, κ)` \[-\] of a Newtonian model (the law without strain thinning): `n = 1`, and the `κ`
 /// at which the strain-thinning direction is taken — the reference of the effect that lives in
-/// the law ([`Install::Law`] of [`catalog::STRAIN_THINNING`]).
+/// the law (`Install::Law` of `catalog::STRAIN_THINNING`).
 pub const NEWTONIAN_LAW: [f64; 2] = match catalog::STRAIN_THINNING.install {
     Install::Law { reference } => reference,
     _ => panic!("strain thinning lives in the law"),
@@ -801,6 +799,9 @@ impl ModelSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::catalog::descriptor::StrengthMap;
+    use crate::model::catalog::physics::DEFAULT_COFLOW_LINE_RAMP_WIDTH;
+    use crate::model::catalog::BUILTIN_NAMES;
 
     #[test]
     fn search_ranges_contain_physical_ranges_and_neutral() {
@@ -859,7 +860,7 @@ mod tests {
         impl FiberTerm for Pull {
             fn eval<D: num_dual::DualNum<Primitive = f64> + Copy>(
                 &self,
-                st: &crate::SiState<D>,
+                st: &crate::model::contributions::SiState<D>,
             ) -> D {
                 st.force * 0.0 + (-(st.s - 0.2) * (st.s - 0.2) / 1e-3).exp() * 1e-3
             }

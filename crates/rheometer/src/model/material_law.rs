@@ -6,7 +6,7 @@
 //! Deborah number `De = μ_o u_o/(K_o L_o)` and its parameters `p` (as dual numbers, so
 //! derivatives with respect to them are exact). It returns `μ̃_e = μ_e/μ_o`.
 //!
-//! The strain-rate formulation needs `∂_T μ_e` and `∂_ε̇ μ_e`; [`viscosity_with_partials`] gets
+//! The strain-rate formulation needs `∂_T μ_e` and `∂_ε̇ μ_e`; `viscosity_with_partials_shifted` gets
 //! them by nested dual numbers (one pass with [`DenseDual<D, Const<2>>`](diffbvp::dense_dual::DenseDual) over the caller's `D`,
 //! seeded in `T` and `ε̇`), so a law is written once, without hand-coded derivatives, and the
 //! derivatives of the right-hand side with respect to the states and the law parameters stay
@@ -23,7 +23,7 @@ use diffbvp::dense_dual::DenseDual;
 use nalgebra::Const;
 use num_dual::DualNum;
 
-/// Largest number of law parameters supported by [`viscosity_with_partials`].
+/// Largest number of law parameters supported by [`viscosity_with_partials_shifted`].
 pub(crate) const MAX_LAW_PARAMS: usize = 8;
 
 /// Inputs of a viscosity law at one point, dimensionless.
@@ -298,23 +298,10 @@ impl ViscosityLaw for CarreauYasuda {
     }
 }
 
-/// `(μ_e, ∂_T μ_e, ∂_ε̇ μ_e)` (all dimensionless) at temperature `t`, strain rate `rate` and law
-/// parameters `p`, by nested dual numbers (one pass, two seeds over `D`): `μ_e0` is computed
-/// from `zero` on the lifted temperature so that `∂_T` includes the VFT dependence. Exact for
-/// every `D`.
-#[inline(always)]
-pub fn viscosity_with_partials<L: ViscosityLaw, D: DualNum<Primitive = f64> + Copy>(
-    law: &L,
-    zero: &ZeroRateViscosity,
-    de: f64,
-    t: D,
-    rate: D,
-    p: &[D],
-) -> (D, D, D) {
-    viscosity_with_partials_shifted(law, zero, None, de, t, rate, p)
-}
-
-/// [`viscosity_with_partials`] with the VFT parameters shifted by `shift`.
+/// `(μ_e, ∂_T μ_e, ∂_ε̇ μ_e)` (all dimensionless) at temperature `t`, strain rate `rate`, law
+/// parameters `p` and VFT parameters shifted by `shift`, by nested dual numbers (one pass, two
+/// seeds over `D`): `μ_e0` is computed from `zero` on the lifted temperature so that `∂_T`
+/// includes the VFT dependence. Exact for every `D`.
 #[inline(always)]
 pub(crate) fn viscosity_with_partials_shifted<
     L: ViscosityLaw,
@@ -409,9 +396,27 @@ mod tests {
     fn partials_match_finite_differences() {
         let z = zero();
         let laws: [&dyn Fn(f64, f64) -> (f64, f64, f64); 2] = [
-            &|t, r| viscosity_with_partials(&CarreauLike::new(), &z, 82.486, t, r, &[0.8, 11.71]),
             &|t, r| {
-                viscosity_with_partials(&CarreauYasuda::new(1.5), &z, 82.486, t, r, &[0.7, 11.0])
+                viscosity_with_partials_shifted(
+                    &CarreauLike::new(),
+                    &z,
+                    None,
+                    82.486,
+                    t,
+                    r,
+                    &[0.8, 11.71],
+                )
+            },
+            &|t, r| {
+                viscosity_with_partials_shifted(
+                    &CarreauYasuda::new(1.5),
+                    &z,
+                    None,
+                    82.486,
+                    t,
+                    r,
+                    &[0.7, 11.0],
+                )
             },
         ];
         for law in laws {

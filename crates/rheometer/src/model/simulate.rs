@@ -1,8 +1,8 @@
 //! The user-facing simulation API: from SI inputs to SI profiles.
 //!
 //! ```no_run
-//! use rheometer::model::setup::{Air, Experiment, Inlet, Material, TakeUp};
-//! use rheometer::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+//! use rheometer::model::{Air, Experiment, Inlet, Material, TakeUp};
+//! use rheometer::model::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
 //! let exp = Experiment {
 //!     name: "v0p53_p2".into(),
 //!     mass_flow: 3.08e-5,
@@ -86,7 +86,7 @@ pub struct SimulateOptions {
     /// start; default `true`). `false`: the failed warm start is the error (a start that is not
     /// a solution of the fiber's 4 states is no warm start: it is cold-started either way). The scans' grid
     /// fits whose law is deep in the implausible range set it
-    /// ([`COLD_FALLBACK_MIN_N`](crate::diagnostics::refits::scan::COLD_FALLBACK_MIN_N)): there
+    /// (`COLD_FALLBACK_MIN_N`): there
     /// the continuation towards a nearly rate-independent, strongly thinning fiber is slow and
     /// often fails at its end.
     pub cold_fallback: bool,

@@ -3,17 +3,20 @@
 //!
 //! A thin fiber-specific layer over the model-agnostic [`crate::report::plot`]: it converts units
 //! for display (positions in m, diameters in µm, `1/d²` in 1/mm², temperatures in °C) and lays out
-//! one panel per experiment. Every function refuses to write over one of the `inputs` (see
-//! `ensure_not_input`); the format follows the extension (`.png` or `.svg`), and a function
-//! given a format writes that format. Residual panels carry the noise band (shaded `±2σ`).
+//! one panel per experiment. Every function renders in memory and returns the file (an
+//! [`OutputFile`]: its path and bytes) for the caller to write — a command through its checked
+//! outputs, a library user with [`OutputFile::save`]; the format follows the extension (`.png`
+//! or `.svg`), and a function given a format renders that format. Residual panels carry the
+//! noise band (shaded `±2σ`).
 
-use super::output::{ensure_not_input, OutputError};
+use super::output_files::{OutputError, OutputFile};
 use crate::data::smoothing::SmoothFit;
 use crate::fit::{Identification, Landscape, Rheometer, RheometerError};
 use crate::model::simulate::FiberSolution;
 use crate::model::simulate::Profiles;
 use crate::report::plot::{
-    panels_svg, save_heatmap, save_panels, Band, FigureFormat, Heatmap, Panel, PlotError, Series,
+    panels_svg, render_heatmap, render_panels, Band, FigureFormat, Heatmap, Panel, PlotError,
+    Series,
 };
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -87,11 +90,6 @@ impl View {
     }
 }
 
-fn check(path: &Path, inputs: &[PathBuf]) -> Result<(), FigureError> {
-    ensure_not_input(path, inputs)?;
-    Ok(())
-}
-
 /// Columns of a panel grid for `k` panels (3 for the paper's 9 experiments).
 fn columns(k: usize) -> usize {
     match k {
@@ -109,15 +107,13 @@ fn grid_size(k: usize) -> (u32, u32) {
 }
 
 /// One panel per experiment: measured points, the smooth fit (if given) and `curves`, in the
-/// chosen `view`. Writes `path`.
+/// chosen `view`, rendered as the file `path`.
 pub(crate) fn experiment_panels(
     path: &Path,
     experiments: &[ExperimentView<'_>],
     curves: &[ModelCurves<'_>],
     view: View,
-    inputs: &[PathBuf],
-) -> Result<(), FigureError> {
-    check(path, inputs)?;
+) -> Result<OutputFile, FigureError> {
     let mut panels = Vec::with_capacity(experiments.len());
     for (k, e) in experiments.iter().enumerate() {
         let mut panel =
@@ -156,13 +152,13 @@ pub(crate) fn experiment_panels(
         }
         panels.push(panel);
     }
-    save_panels(
+    let bytes = render_panels(
         path,
         &panels,
         columns(experiments.len()),
         grid_size(experiments.len()),
     )?;
-    Ok(())
+    Ok(OutputFile::new(path, bytes))
 }
 
 /// Most experiment panels in one figure file (8 rows of 3: 1260 × 2560 pixels); more are split
@@ -183,18 +179,16 @@ pub fn panel_page_names(stem: &str, ext: &str, experiments: usize) -> Vec<String
 
 /// Like `experiment_panels`, split into figures of at most [`MAX_PANELS_PER_FIGURE`] panels
 /// so that any number of experiments can be drawn: up to that many, `path` itself; beyond,
-/// `STEM_1.EXT`, `STEM_2.EXT`, … next to it (see [`panel_page_names`]). Returns the paths
-/// written.
+/// `STEM_1.EXT`, `STEM_2.EXT`, … next to it (see [`panel_page_names`]). Returns the rendered
+/// files.
 pub fn experiment_panel_pages(
     path: &Path,
     experiments: &[ExperimentView<'_>],
     curves: &[ModelCurves<'_>],
     view: View,
-    inputs: &[PathBuf],
-) -> Result<Vec<PathBuf>, FigureError> {
+) -> Result<Vec<OutputFile>, FigureError> {
     if experiments.len() <= MAX_PANELS_PER_FIGURE {
-        experiment_panels(path, experiments, curves, view, inputs)?;
-        return Ok(vec![path.to_path_buf()]);
+        return Ok(vec![experiment_panels(path, experiments, curves, view)?]);
     }
     let stem = path
         .file_stem()
@@ -222,21 +216,23 @@ pub fn experiment_panel_pages(
             })
             .collect();
         let p = path.with_file_name(name);
-        experiment_panels(&p, &experiments[start..end], &page_curves, view, inputs)?;
-        written.push(p);
+        written.push(experiment_panels(
+            &p,
+            &experiments[start..end],
+            &page_curves,
+            view,
+        )?);
     }
     Ok(written)
 }
 
 /// Simulated diameter (log scale) and temperature profiles of all experiments in two panels
-/// side by side, one line per experiment. Writes `path`.
+/// side by side, one line per experiment, rendered as the file `path`.
 pub fn profile_overview(
     path: &Path,
     names: &[&str],
     profiles: &[Profiles],
-    inputs: &[PathBuf],
-) -> Result<(), FigureError> {
-    check(path, inputs)?;
+) -> Result<OutputFile, FigureError> {
     let mut d = Panel::new("diameter", "s / m", "d / µm").with_log_y(true);
     let mut t = Panel::new("temperature", "s / m", "T / °C");
     for (k, (name, p)) in names.iter().zip(profiles).enumerate() {
@@ -255,21 +251,19 @@ pub fn profile_overview(
         d = d.with_series(Series::line(*name, dd).with_color(k));
         t = t.with_series(Series::line(*name, tt).with_color(k));
     }
-    save_panels(path, &[d, t], 2, (1200, 480))?;
-    Ok(())
+    let bytes = render_panels(path, &[d, t], 2, (1200, 480))?;
+    Ok(OutputFile::new(path, bytes))
 }
 
 /// The cost landscape as a heat map over `(n, κ)` with a logarithmic colour scale (paper
 /// Fig. 4), with `markers` `(n, κ, label)` (e.g. start points and the identified optimum).
-/// Missing values (failed simulations) are grey. Writes `path`.
+/// Missing values (failed simulations) are grey. Rendered as the file `path`.
 pub fn landscape_map(
     path: &Path,
     landscape: &Landscape,
     title: &str,
     markers: &[(f64, f64, String)],
-    inputs: &[PathBuf],
-) -> Result<(), FigureError> {
-    check(path, inputs)?;
+) -> Result<OutputFile, FigureError> {
     let map = Heatmap {
         title,
         x_label: "n",
@@ -279,8 +273,7 @@ pub fn landscape_map(
         markers,
         ..Heatmap::new(&landscape.n, &landscape.kappa, &landscape.cost)
     };
-    save_heatmap(path, &map)?;
-    Ok(())
+    Ok(OutputFile::new(path, render_heatmap(path, &map)?))
 }
 
 /// Stems of the figures of [`identification_figures`].
@@ -299,12 +292,12 @@ pub fn identification_figure_names(ext: &str, experiments: usize) -> Vec<String>
         .collect()
 }
 
-/// Paper Fig. 2, 3 and 5 for an identification, written into `dir` with extension `ext`
+/// Paper Fig. 2, 3 and 5 for an identification, rendered as files in `dir` with extension `ext`
 /// (`"png"` or `"svg"`): `fig2_smoothing` (measured diameters with the smooth fit),
 /// `fig3_newtonian_vs_identified` (the Newtonian model `n = 1` at the identified κ with the
 /// take-up diameters `d_fit(L)`, and the identified law), and `fig5_inverse_square` (the
 /// velocity-like `1/d²` view), each split into `NAME_1`, `NAME_2`, … beyond
-/// [`MAX_PANELS_PER_FIGURE`] experiments. Returns the paths written.
+/// [`MAX_PANELS_PER_FIGURE`] experiments. Returns the rendered files.
 ///
 /// Draws only: the identified profiles are `id.solutions`, the Newtonian ones `newtonian` (one
 /// solution per experiment, from [`Rheometer::newtonian_solutions`] at `id.kappa`).
@@ -314,9 +307,8 @@ pub fn identification_figures(
     newtonian: &[diffbvp::Solution],
     dir: &Path,
     ext: &str,
-    inputs: &[PathBuf],
-) -> Result<Vec<PathBuf>, FigureError> {
-    // the format asked for, or an error before anything is computed or written
+) -> Result<Vec<OutputFile>, FigureError> {
+    // the format asked for, or an error before anything is computed
     let ext = FigureFormat::of_path(Path::new(&format!("figure.{ext}")))
         .map_err(|_| PlotError::UnsupportedFormat {
             path: dir.join(format!("fig2_smoothing.{ext}")),
@@ -335,7 +327,7 @@ pub fn identification_figures(
             smooth: Some(f),
         })
         .collect();
-    let profiles = |sols: &[diffbvp::Solution]| -> Vec<crate::Profiles> {
+    let profiles = |sols: &[diffbvp::Solution]| -> Vec<crate::model::simulate::Profiles> {
         sols.iter()
             .zip(&rh.models)
             .map(|(s, m)| {
@@ -374,20 +366,13 @@ pub fn identification_figures(
         .collect();
     let mut written = Vec::new();
     let f2 = dir.join(format!("{}.{ext}", IDENTIFICATION_FIGURES[0]));
-    written.extend(experiment_panel_pages(
-        &f2,
-        &views,
-        &[],
-        View::Diameter,
-        inputs,
-    )?);
+    written.extend(experiment_panel_pages(&f2, &views, &[], View::Diameter)?);
     let f3 = dir.join(format!("{}.{ext}", IDENTIFICATION_FIGURES[1]));
     written.extend(experiment_panel_pages(
         &f3,
         &no_smooth,
         &[fitted, newt_curves],
         View::Diameter,
-        inputs,
     )?);
     let f5 = dir.join(format!("{}.{ext}", IDENTIFICATION_FIGURES[2]));
     written.extend(experiment_panel_pages(
@@ -395,7 +380,6 @@ pub fn identification_figures(
         &views,
         &[fitted, newt_curves],
         View::InverseSquare,
-        inputs,
     )?);
     Ok(written)
 }
@@ -415,15 +399,13 @@ pub struct ResidualView<'a> {
 /// One panel per experiment of the relative residual (in %) along the spin line: `before` as
 /// markers, `after` (if given: its label and one view per experiment, same order) as a line,
 /// and the noise band `±2σ` shaded around zero when the relative noise level `noise_sigma`
-/// \[-\] is given. Writes `path`; its extension chooses the format.
+/// \[-\] is given. Rendered as the file `path`; its extension chooses the format.
 pub fn residual_panels(
     path: &Path,
     before: &[ResidualView<'_>],
     after: Option<(&str, &[ResidualView<'_>])>,
     noise_sigma: Option<f64>,
-    inputs: &[PathBuf],
-) -> Result<(), FigureError> {
-    check(path, inputs)?;
+) -> Result<OutputFile, FigureError> {
     let panels = residual_panel_list(before, after, noise_sigma);
     if panels.is_empty() {
         return Err(FigureError::Plot(PlotError::InvalidInput {
@@ -432,8 +414,8 @@ pub fn residual_panels(
         }));
     }
     let cols = columns(panels.len());
-    save_panels(path, &panels, cols, grid_size(panels.len()))?;
-    Ok(())
+    let bytes = render_panels(path, &panels, cols, grid_size(panels.len()))?;
+    Ok(OutputFile::new(path, bytes))
 }
 
 /// The figure of [`residual_panels`] (without `after`) as an SVG document in memory, for an
@@ -494,7 +476,7 @@ fn residual_panel_list(
 mod tests {
     use super::*;
 
-    /// A scratch directory under `target/` (tests leave nothing in /tmp).
+    /// A path under `target/` for a figure (rendering writes nothing).
     fn scratch(name: &str) -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("target")
@@ -505,6 +487,7 @@ mod tests {
     #[test]
     fn residual_panels_have_the_noise_band_and_the_requested_format() {
         let dir = scratch("residuals");
+        let _ = std::fs::remove_dir_all(&dir);
         let s = [0.0, 0.1, 0.2, 0.3];
         let r = [0.004, -0.006, 0.002, 0.0];
         let a = [0.001, -0.001, 0.0, 0.0005];
@@ -519,8 +502,11 @@ mod tests {
         }];
         for ext in ["svg", "png"] {
             let path = dir.join(format!("residuals.{ext}"));
-            residual_panels(&path, &before, Some(("drag", &after)), Some(0.005), &[]).unwrap();
-            let bytes = std::fs::read(&path).unwrap();
+            let file =
+                residual_panels(&path, &before, Some(("drag", &after)), Some(0.005)).unwrap();
+            assert_eq!(file.path, path);
+            assert!(!path.exists(), "rendered, not written");
+            let bytes = file.bytes;
             match ext {
                 "svg" => {
                     let svg = String::from_utf8(bytes).unwrap();
@@ -532,28 +518,11 @@ mod tests {
                 _ => assert_eq!(&bytes[..4], b"\x89PNG"),
             }
         }
-        let err = residual_panels(&dir.join("r.pdf"), &before, None, None, &[]);
+        let err = residual_panels(&dir.join("r.pdf"), &before, None, None);
         assert!(matches!(
             err,
             Err(FigureError::Plot(PlotError::UnsupportedFormat { .. }))
         ));
-    }
-
-    #[test]
-    fn refuses_to_overwrite_an_input() {
-        let dir = scratch("inputs");
-        std::fs::create_dir_all(&dir).unwrap();
-        let input = dir.join("input.png");
-        std::fs::write(&input, b"keep me").unwrap();
-        let p = Profiles {
-            position: vec![0.0, 1.0],
-            diameter: vec![1e-3, 1e-4],
-            temperature: vec![500.0, 400.0],
-            ..Profiles::default()
-        };
-        let err = profile_overview(&input, &["a"], &[p], std::slice::from_ref(&input));
-        assert!(matches!(err, Err(FigureError::Output(_))));
-        assert_eq!(std::fs::read(&input).unwrap(), b"keep me");
     }
 
     #[test]
@@ -580,15 +549,18 @@ mod tests {
         }];
         for (view, name) in [(View::Diameter, "d.svg"), (View::InverseSquare, "u.png")] {
             let path = dir.join(name);
-            experiment_panels(&path, &[e], &curves, view, &[]).unwrap();
-            assert!(std::fs::metadata(&path).unwrap().len() > 100);
+            let file = experiment_panels(&path, &[e], &curves, view).unwrap();
+            assert!(file.bytes.len() > 100);
+            assert_eq!(
+                FigureFormat::of_path(&file.path).unwrap(),
+                FigureFormat::of_path(&path).unwrap()
+            );
         }
     }
 
     #[test]
     fn many_panels_are_split_into_pages_of_their_own_experiments() {
         let dir = scratch("pages");
-        let _ = std::fs::remove_dir_all(&dir);
         let s = [0.0, 0.5, 1.0];
         let d = [1e-3, 3e-4, 1e-4];
         let k = 2 * MAX_PANELS_PER_FIGURE + 1;
@@ -616,9 +588,8 @@ mod tests {
             dashed: false,
         }];
         let path = dir.join("panels.svg");
-        let pages = experiment_panel_pages(&path, &views, &curves, View::Diameter, &[]).unwrap();
+        let pages = experiment_panel_pages(&path, &views, &curves, View::Diameter).unwrap();
         assert_eq!(pages.len(), 3);
-        assert!(!path.exists());
         // 24 panels are 3 × 8 (1260 × 2560 pixels), the last page holds one panel
         let sizes = [
             "width=\"1260\" height=\"2560\"",
@@ -626,12 +597,12 @@ mod tests {
             "width=\"420\" height=\"320\"",
         ];
         for (i, (p, size)) in pages.iter().zip(sizes).enumerate() {
-            assert_eq!(p, &dir.join(format!("panels_{}.svg", i + 1)));
-            let svg = std::fs::read_to_string(p).unwrap();
+            assert_eq!(p.path, dir.join(format!("panels_{}.svg", i + 1)));
+            let svg = String::from_utf8(p.bytes.clone()).unwrap();
             assert!(
                 svg[..svg.len().min(300)].contains(size),
                 "{}: {}",
-                p.display(),
+                p.path.display(),
                 &svg[..200]
             );
             // page i shows the experiments 24 i … 24 i + 23 (titles as SVG text lines)
@@ -641,20 +612,20 @@ mod tests {
                 assert!(
                     svg.contains(&format!("e{e}\n")),
                     "{} lacks e{e}",
-                    p.display()
+                    p.path.display()
                 );
             }
             if i > 0 {
                 assert!(
                     !svg.contains(&format!("e{}\n", first - 1)),
                     "{}",
-                    p.display()
+                    p.path.display()
                 );
             }
         }
         // few experiments: the path itself
-        let one = experiment_panel_pages(&path, &views[..3], &curves, View::Diameter, &[]).unwrap();
-        assert_eq!(one, vec![path.clone()]);
-        assert!(path.is_file());
+        let one = experiment_panel_pages(&path, &views[..3], &curves, View::Diameter).unwrap();
+        assert_eq!(one.len(), 1);
+        assert_eq!(one[0].path, path);
     }
 }

@@ -5,7 +5,6 @@
 //! * [`fmt_pm`]: a value with its uncertainty, both rounded to the digits the uncertainty
 //!   supports (`0.804 ± 0.007`, `(4.9 ± 4.4)e2`);
 //! * [`fmt_at`]: a value at the precision of an uncertainty (interval ends: `[0.790, 0.818]`);
-//! * [`fmt_pct`]: a fraction as a percentage with 2 significant digits (`1.5 %`).
 //!
 //! The rounding rule (the Particle Data Group's, simplified): the uncertainty keeps two
 //! significant digits when its leading digits are below 355 (`0.0012`, `0.034`), one otherwise
@@ -159,11 +158,6 @@ pub fn fmt_at(v: f64, u: f64) -> String {
     at_place(v, place_of(u))
 }
 
-/// A fraction `f` as a percentage with two significant digits: `fmt_pct(0.01534) = "1.5 %"`.
-pub fn fmt_pct(f: f64) -> String {
-    format!("{} %", fmt_sig(100.0 * f, 2))
-}
-
 /// The widest line a report prints, in characters.
 pub const LINE_WIDTH: usize = 100;
 
@@ -250,7 +244,6 @@ mod tests {
         assert_eq!(fmt_sig(999600.0, 3), "1.00e6");
         assert_eq!(fmt_sig(1409.0, 2), "1400");
         assert_eq!(fmt_sig(4459.2, 3), "4460");
-        assert_eq!(fmt_pct(0.01534), "1.5 %");
         assert_eq!(fmt_e(95123.0, 2), "9.5e4");
     }
 

@@ -7,10 +7,10 @@ use crate::diagnostics::compare::{
     MissingTakeUp, ModelSetup,
 };
 use crate::fit::FitSummary;
+use crate::model::contributions::Physics;
 use crate::model::effects::{physics_with, Effect, EffectSetting};
 use crate::model::simulate::SimulateOptions;
 use crate::workflow::request::{in_words_of, Door};
-use crate::Physics;
 
 /// What to compare.
 #[derive(Debug, Clone)]

@@ -41,7 +41,7 @@ pub struct FitRequest {
     /// needs only the estimates saves about half the fit's time without it).
     pub error_budget: bool,
     /// Profile-likelihood intervals and the likelihood-ratio test against the Newtonian law
-    /// (default [`ProfileMode::Auto`]).
+    /// (default `ProfileMode::Auto`).
     pub profile: ProfileMode,
     /// The flow curve's temperature, resolution and isotherms.
     pub flow_curve: FlowCurveOptions,

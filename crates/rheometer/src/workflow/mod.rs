@@ -9,15 +9,16 @@
 //! | `compare` | [`compare()`] | [`Comparison`](crate::diagnostics::compare::Comparison) |
 //! | `diagnose` | [`diagnose()`] | [`DiagnosisRun`] |
 //! | `landscape` | [`landscape()`] | [`LandscapeRun`] |
-//! | `design` | [`design()`] | [`DesignRun`] (its [`Design`](crate::design::Design)) |
-//! | `design --discriminate` | [`discriminate()`] | [`DiscriminationRun`] (its [`Discrimination`](crate::design::Discrimination)) |
+//! | `design` | [`design()`] | `DesignRun` (its [`Design`](crate::design::Design)) |
+//! | `design --discriminate` | [`discriminate()`] | `DiscriminationRun` (its [`Discrimination`](crate::design::Discrimination)) |
 //!
 //! ```no_run
-//! use rheometer::data::input::load_experiments_with;
+//! use rheometer::data::input::{load_experiments_with, LoadOptions};
 //! use rheometer::fit::IdentifyOptions;
 //! use rheometer::workflow::{fit, FitRequest};
 //! use std::path::Path;
-//! let data = load_experiments_with(Path::new("data/pmma7n_synthetic/experiments.toml"), 4)?;
+//! let path = Path::new("data/pmma7n_synthetic/experiments.toml");
+//! let data = load_experiments_with(path, &LoadOptions::default())?;
 //! let run = fit(&data, &FitRequest::new(IdentifyOptions::default()))?;
 //! println!("{}", run.summary().to_text());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -31,12 +32,9 @@ pub mod request;
 mod simulate;
 
 pub use compare::{compare, CompareRequest};
-pub use design::{
-    design, design_with_estimate, discriminate, discriminate_with_estimate, DesignRun,
-    DiscriminationRun,
-};
+pub use design::{design, design_with_estimate, discriminate, discriminate_with_estimate};
 pub use fit::{fit, FitRequest, FitRun};
-pub use simulate::{simulate_experiments, SimulateError, SimulateRequest, SimulatedProfile};
+pub use simulate::{simulate_experiments, SimulateError, SimulateRequest};
 
 use crate::data::input::LoadedExperiments;
 use crate::diagnostics::diagnose::{diagnose as run_diagnosis, DiagnoseOptions};

@@ -222,7 +222,7 @@ impl fmt::Display for Refusal {
 
 impl std::error::Error for Refusal {}
 
-pub use crate::report::format::show;
+pub(crate) use crate::report::format::show;
 
 /// The caps of the loader as a request sets them: `base`, or none at all with the override
 /// every door offers (`--allow-large-inputs` on the command line, `allow_large_inputs=True`
@@ -265,7 +265,7 @@ pub fn input_message(e: &crate::data::input::InputError, door: Door) -> String {
 /// `Dataset.from_toml(measurements=...)`), checked on their lengths before any row is
 /// converted: the caps of a measurement file in `options` apply to them alike, at most
 /// [`LoadOptions::max_rows_per_file`] rows per experiment and, in all `experiments`, the rows
-/// a fit can hold within [`LoadOptions::max_fit_memory_bytes`] ([`max_fit_rows`]). `rows`:
+/// a fit can hold within [`LoadOptions::max_fit_memory_bytes`] (`max_fit_rows`). `rows`:
 /// each experiment's name and number of rows.
 pub fn measurement_rows(
     rows: &[(&str, usize)],
@@ -507,7 +507,7 @@ pub fn kappa(v: f64) -> Result<f64, Refusal> {
     Ok(v)
 }
 
-/// A take-up diameter in [[`MIN_TAKE_UP_DIAMETER_M`], [`MAX_PLAUSIBLE_DIAMETER_M`]] m.
+/// A take-up diameter in [[`MIN_TAKE_UP_DIAMETER_M`], `MAX_PLAUSIBLE_DIAMETER_M`] m.
 pub fn take_up_diameter(v: f64) -> Result<f64, Refusal> {
     if !(MIN_TAKE_UP_DIAMETER_M..=MAX_PLAUSIBLE_DIAMETER_M).contains(&v) {
         return Err(Refusal::new(

@@ -10,7 +10,7 @@ use crate::model::effects::{physics_with, Effect};
 use crate::model::profile_sensitivities::{profile_sensitivities, ProfileSensitivities};
 use crate::model::simulate::{simulate, Profiles, SimulateOptions};
 use crate::workflow::failure_hints::ExperimentFailure;
-use crate::{CarreauLike, FiberModel};
+use crate::{model::bvp::FiberModel, model::material_law::CarreauLike};
 use std::fmt;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
@@ -36,7 +36,7 @@ pub struct SimulateRequest {
     /// The door the request came through (the words of its messages).
     pub door: super::request::Door,
     /// Also compute the exact sensitivities of the profiles with respect to `n`, `κ` and the
-    /// effects' strengths ([`SimulatedProfile::sensitivities`]).
+    /// effects' strengths (`SimulatedProfile::sensitivities`).
     pub sensitivities: bool,
 }
 

@@ -9,7 +9,7 @@ use toml::de::DeTable;
 use super::cross_checks::{
     check_experiment_memory, cross_check, data_error, shared_data_files, with_link_hint,
 };
-use super::csv_file::measurements::{read_measurements, DEFAULT_MIN_POINTS};
+use super::csv_file::measurements::read_measurements;
 use super::csv_file::row_budget::FitBudget;
 use super::error::{short, InputError};
 use super::loaded::LoadedExperiments;
@@ -23,24 +23,14 @@ use crate::data::uncertainty::Uncertainties;
 use crate::model::setup::{Air, ExperimentSet, Material};
 
 /// Loads a TOML experiment file and the CSV files it refers to with the default
-/// [`LoadOptions`] (at least [`DEFAULT_MIN_POINTS`] measurements per file).
+/// [`LoadOptions`] (at least `DEFAULT_MIN_POINTS` measurements per file).
 pub fn load_experiments(path: &Path) -> Result<ExperimentSet, InputError> {
-    load_experiments_with(path, DEFAULT_MIN_POINTS).map(|loaded| loaded.set)
-}
-
-/// Loads a TOML experiment file and its CSV files, requiring at least `min_points` rows per
-/// CSV file (otherwise the default [`LoadOptions`]), and returns the set with the experiments'
-/// metadata.
-pub fn load_experiments_with(
-    path: &Path,
-    min_points: usize,
-) -> Result<LoadedExperiments, InputError> {
-    load_experiments_with_options(path, &LoadOptions::with_min_points(min_points))
+    load_experiments_with(path, &LoadOptions::default()).map(|loaded| loaded.set)
 }
 
 /// Loads a TOML experiment file and its CSV files under `options` (caps on sizes, rows and
 /// experiments, enforced while reading; the checks that need the TOML and the data together).
-pub fn load_experiments_with_options(
+pub fn load_experiments_with(
     path: &Path,
     options: &LoadOptions,
 ) -> Result<LoadedExperiments, InputError> {

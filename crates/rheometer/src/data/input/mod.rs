@@ -6,7 +6,7 @@
 //! of measured diameters per experiment. **The unit is part of every key name** (`_m`, `_kg_s`,
 //! `_K`, …) and of every CSV column name. The process conditions may be given in the units of a
 //! lab sheet, converted once at load to SI (the
-//! [`ExperimentSet`](crate::model::setup::ExperimentSet) is SI whatever the file used); a quantity
+//! [`ExperimentSet`](crate::model::ExperimentSet) is SI whatever the file used); a quantity
 //! given twice in different units is an error naming both keys:
 //!
 //! | quantity | units (key suffix) |
@@ -84,20 +84,20 @@
 //! Checks (on the SI values, so that a value in the wrong unit is still caught, with a hint at
 //! the key that would make it plausible): mass flow, diameters, velocities, lengths and
 //! temperatures must be positive and within plausible ranges for melt spinning
-//! ([`PLAUSIBLE_RANGES`]; diameters between [`MIN_PLAUSIBLE_DIAMETER_M`] = 1 µm and
-//! [`MAX_PLAUSIBLE_DIAMETER_M`] = 2 cm, larger ones being probably millimetres); the inlet and
+//! (a refusal names the range; diameters between 1 µm and 2 cm, larger ones being probably
+//! millimetres); the inlet and
 //! air temperatures must exceed `vft_T_VF_K` (the VFT viscosity is undefined at and below it;
 //! a kelvin value that reads as °C gets a hint) and the zero-shear viscosity at the inlet must
-//! be finite and at most [`MAX_INLET_VISCOSITY_PA_S`] (a glass is not a melt); density and heat
-//! capacity must be plausible for a polymer at the inlet and air temperatures
-//! ([`PLAUSIBLE_MELT_DENSITY_KG_M3`], [`PLAUSIBLE_HEAT_CAPACITY_J_KG_K`]); the inlet velocity
-//! `4 Q/(π ρ(T_in) d_in²)` must be at most [`MAX_PLAUSIBLE_INLET_VELOCITY_M_S`] (a faster one
+//! be finite and at most 10¹² Pa s (a glass is not a melt); density and heat capacity must be
+//! plausible for a polymer at the inlet and air temperatures (300–3500 kg/m³,
+//! 300–10 000 J/(kg K)); the inlet velocity
+//! `4 Q/(π ρ(T_in) d_in²)` must be at most 5 m/s (a faster one
 //! is blamed on the mass flow's unit) and the derived inlet diameter plausible; a take-up
 //! diameter must be smaller than the inlet diameter (a take-up velocity larger than the inlet
-//! velocity), with a draw ratio of at most [`MAX_DRAW_RATIO`]; experiment names must be unique
+//! velocity), with a draw ratio of at most 10⁶; experiment names must be unique
 //! (also ignoring case), without leading or trailing spaces, and at most [`MAX_NAME_BYTES`]
 //! long (they name output files). Errors about values that come from `[defaults]` name the
-//! experiment too. With the measurements, [`load_experiments_with_options`] also checks the
+//! experiment too. With the measurements, [`load_experiments_with`] also checks the
 //! inlet diameter against the first measured diameter and, for an experiment whose take-up
 //! diameter will be `d_fit(L)` of its data, the spin-line length against the measured range
 //! (a warning a little beyond, an error far beyond: [`LoadOptions::take_up_warn_beyond`]).
@@ -114,8 +114,8 @@
 //! and lines starting with `#` are ignored; surrounding spaces and quotes are trimmed; the
 //! dialects of other tools (semicolons, tabs, decimal commas, trailing commas, Fortran `D`
 //! exponents) are refused with what to change. At least
-//! [`DEFAULT_MIN_POINTS`] rows are required by [`load_experiments`]; the minimum is a parameter
-//! of [`load_measurements`] and [`load_experiments_with`].
+//! `DEFAULT_MIN_POINTS` rows are required by [`load_experiments`]; the minimum is a parameter
+//! of [`load_measurements_with`] and [`load_experiments_with`].
 //!
 //! Loading only reads files; it never modifies or writes them.
 //!
@@ -125,10 +125,10 @@
 //! experiments file are in `toml_file`, those of the measurement files in `csv_file`):
 //!
 //! * `options`: [`LoadOptions`] (the caps) and the fit-memory estimate;
-//! * `error`: [`Location`], [`InputError`] and [`InputWarning`], the messages of every failure;
+//! * `error`: [`Location`], [`InputError`] and `InputWarning`, the messages of every failure;
 //! * `source`: opening regular files only, bounded reading, encoding checks;
 //! * `json`: reading a JSON report back (`fit --from`, `compare --fit`), bounded and strict
-//!   ([`read_json`]: the file checks of `source`, `-` for standard input, duplicate keys,
+//!   (`read_json`: the file checks of `source`, `-` for standard input, duplicate keys,
 //!   `NaN`, numbers out of range and truncation named with the field's path);
 //! * `toml_file::syntax`: messages for duplicate keys and for files that are not experiments files;
 //! * `toml_file::schema`: the keys of each table, the rules their values obey, plausible
@@ -138,13 +138,13 @@
 //! * `toml_file::uncertainty`: reading the `[uncertainty]` tables (declared standard
 //!   uncertainties of process conditions, instrument and material data, see
 //!   [`fiber::uncertainty`](crate::data::uncertainty));
-//! * `loaded`: what loading yields, as values ([`LoadedExperiments`], [`ExperimentDetails`]);
+//! * `loaded`: what loading yields, as values ([`LoadedExperiments`], `ExperimentDetails`);
 //! * `csv_file::row_budget`: the rows the measurement files may still hold (the per-file cap
 //!   and the fit's memory), counted while they are read;
 //! * `toml_file::experiment`: one `[[experiment]]` table, its units and plausibility checks;
 //! * `csv_file::measurements`: reading the measurement CSV files;
 //! * `cross_checks`: the checks that need the TOML and the data together;
-//! * `experiments`: building the [`ExperimentSet`](crate::model::setup::ExperimentSet) from the
+//! * `experiments`: building the [`ExperimentSet`](crate::model::ExperimentSet) from the
 //!   tables, and loading a whole data set (the last step: it calls the others).
 
 mod cross_checks;
@@ -157,26 +157,24 @@ mod options;
 mod source;
 mod toml_file;
 
-pub use csv_file::measurements::{
-    load_measurements, load_measurements_with, parse_measurements, CSV_HEADER, DEFAULT_MIN_POINTS,
-};
-pub use error::{InputError, InputWarning, Location};
+pub(crate) use csv_file::measurements::DEFAULT_MIN_POINTS;
+pub use csv_file::measurements::{load_measurements_with, parse_measurements};
+pub use error::{InputError, Location};
 pub use experiments::{
-    load_experiments, load_experiments_with, load_experiments_with_options, parse_experiments,
-    parse_experiments_with,
+    load_experiments, load_experiments_with, parse_experiments, parse_experiments_with,
 };
-pub use json::{parse_json, read_json, show_json_path, JsonSource, DEFAULT_MAX_JSON_BYTES};
-pub use loaded::{ExperimentDetails, LoadedExperiments};
+pub(crate) use json::parse_json;
+pub(crate) use json::read_json;
+pub(crate) use json::show_json_path;
+pub(crate) use json::JsonSource;
+pub use json::DEFAULT_MAX_JSON_BYTES;
+pub use loaded::LoadedExperiments;
+pub(crate) use options::max_fit_rows;
 pub(crate) use options::show_count;
 pub use options::{
-    estimated_fit_memory_bytes, max_fit_rows, Limit, LoadOptions, DEFAULT_MAX_CSV_BYTES,
-    DEFAULT_MAX_EXPERIMENTS, DEFAULT_MAX_FIT_MEMORY_BYTES, DEFAULT_MAX_LINE_BYTES,
-    DEFAULT_MAX_ROWS_PER_FILE, DEFAULT_MAX_TOML_BYTES, FIT_BASE_BYTES, FIT_BYTES_PER_ENTRY,
-    FIT_BYTES_PER_EXPERIMENT,
+    estimated_fit_memory_bytes, Limit, LoadOptions, DEFAULT_MAX_EXPERIMENTS,
+    DEFAULT_MAX_ROWS_PER_FILE,
 };
-pub use toml_file::experiment::{MAX_DRAW_RATIO, MAX_INLET_VISCOSITY_PA_S, MAX_NAME_BYTES};
-pub use toml_file::schema::{
-    MAX_PLAUSIBLE_DIAMETER_M, MAX_PLAUSIBLE_INLET_VELOCITY_M_S, MIN_PLAUSIBLE_DIAMETER_M,
-    MIN_PLAUSIBLE_INLET_DIAMETER_M, PLAUSIBLE_HEAT_CAPACITY_J_KG_K, PLAUSIBLE_MELT_DENSITY_KG_M3,
-    PLAUSIBLE_RANGES,
-};
+pub use toml_file::experiment::MAX_NAME_BYTES;
+pub(crate) use toml_file::schema::MAX_PLAUSIBLE_DIAMETER_M;
+pub(crate) use toml_file::schema::PLAUSIBLE_RANGES;

@@ -38,8 +38,8 @@ pub const FIT_BASE_BYTES: u64 = 20_000_000;
 /// Estimated peak memory \[bytes\] of a fit of `rows` measurement rows in `experiments`
 /// experiments with the default (principled) estimator, which fits `experiments + 2`
 /// parameters (n, κ and one scale per experiment): a dense Jacobian of `rows × (experiments +
-/// 2)` entries ([`FIT_BYTES_PER_ENTRY`] each) and [`FIT_BYTES_PER_EXPERIMENT`] per experiment,
-/// above [`FIT_BASE_BYTES`]. The constants were measured; the estimate is meant to be within
+/// 2)` entries (`FIT_BYTES_PER_ENTRY` each) and `FIT_BYTES_PER_EXPERIMENT` per experiment,
+/// above `FIT_BASE_BYTES`. The constants were measured; the estimate is meant to be within
 /// a factor of two.
 pub fn estimated_fit_memory_bytes(rows: u64, experiments: u64) -> u64 {
     let params = experiments.saturating_add(2);
@@ -74,13 +74,13 @@ pub fn max_fit_rows(experiments: u64, max_bytes: u64) -> u64 {
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadOptions {
     /// Minimum number of measurement rows per CSV file (default
-    /// [`DEFAULT_MIN_POINTS`](super::DEFAULT_MIN_POINTS) = 4).
+    /// `DEFAULT_MIN_POINTS` = 4).
     pub min_points: usize,
-    /// Largest experiments (TOML) file \[bytes\] (default [`DEFAULT_MAX_TOML_BYTES`]).
+    /// Largest experiments (TOML) file \[bytes\] (default `DEFAULT_MAX_TOML_BYTES`).
     pub max_toml_bytes: u64,
-    /// Largest measurement (CSV) file \[bytes\] (default [`DEFAULT_MAX_CSV_BYTES`]).
+    /// Largest measurement (CSV) file \[bytes\] (default `DEFAULT_MAX_CSV_BYTES`).
     pub max_csv_bytes: u64,
-    /// Longest line of a CSV file \[bytes\] (default [`DEFAULT_MAX_LINE_BYTES`]).
+    /// Longest line of a CSV file \[bytes\] (default `DEFAULT_MAX_LINE_BYTES`).
     pub max_line_bytes: usize,
     /// Most measurement rows per CSV file (default [`DEFAULT_MAX_ROWS_PER_FILE`]).
     pub max_rows_per_file: usize,
@@ -88,7 +88,7 @@ pub struct LoadOptions {
     pub max_experiments: usize,
     /// Largest estimated memory of a fit of the whole data set \[bytes\]
     /// ([`estimated_fit_memory_bytes`] of all rows and experiments; default
-    /// [`DEFAULT_MAX_FIT_MEMORY_BYTES`]). Checked as the rows are read.
+    /// `DEFAULT_MAX_FIT_MEMORY_BYTES`). Checked as the rows are read.
     pub max_fit_memory_bytes: u64,
     /// Whether an experiment without a take-up condition in the TOML will take `d_fit(L)` of its
     /// smoothed data (the rheometer's convention, default `true`): then a spin line much longer
@@ -151,7 +151,7 @@ pub enum Limit {
     Experiments,
     /// [`LoadOptions::max_fit_memory_bytes`].
     FitMemory,
-    /// [`JsonSource::max_bytes`](super::JsonSource::max_bytes): a JSON report read back.
+    /// `JsonSource::max_bytes`: a JSON report read back.
     JsonBytes,
 }
 

@@ -7,9 +7,9 @@ use crate::model::simulate::Profiles;
 use crate::report::figures::{
     experiment_panel_pages, panel_page_names, ExperimentView, ModelCurves, View,
 };
-use crate::report::output::ensure_not_input;
-use crate::report::plot::{save_panels, Panel, Series};
-use std::path::{Path, PathBuf};
+use crate::report::output_files::OutputFile;
+use crate::report::plot::{render_panels, Panel, Series};
+use std::path::Path;
 
 fn grid_size(panels: usize, columns: usize) -> (u32, u32) {
     let rows = panels.div_ceil(columns).max(1) as u32;
@@ -47,7 +47,7 @@ fn pooled_trend(cmp: &Comparison, length: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// The names of the figures [`write_figures`] writes for `experiments` experiments.
+/// The names of the figures [`render_figures`] renders for `experiments` experiments.
 pub fn figure_names(experiments: usize, format: FigureFormat) -> Vec<String> {
     let ext = format.extension();
     let mut v = Vec::new();
@@ -58,7 +58,7 @@ pub fn figure_names(experiments: usize, format: FigureFormat) -> Vec<String> {
     v
 }
 
-/// Writes into `dir` (which must exist):
+/// Renders the figures of `cmp` as files in `dir`:
 /// * `compare_diameters.EXT`: measured and simulated diameters per experiment (µm);
 /// * `compare_inverse_d2.EXT`: `1/d²` measured and simulated per experiment (1/mm²);
 ///   (both split into `NAME_1.EXT`, `NAME_2.EXT`, … beyond
@@ -70,20 +70,18 @@ pub fn figure_names(experiments: usize, format: FigureFormat) -> Vec<String> {
 /// * `compare_residual_trends.EXT`: residuals against strain rate, temperature and speed, one
 ///   colour per experiment.
 ///
-/// Never writes over a file in `inputs`. Returns the paths.
-pub fn write_figures(
+/// Returns the rendered files (nothing is written).
+pub fn render_figures(
     cmp: &Comparison,
     dir: &Path,
     format: FigureFormat,
-    inputs: &[PathBuf],
-) -> Result<Vec<PathBuf>, CompareError> {
+) -> Result<Vec<OutputFile>, CompareError> {
     let ext = format.extension();
-    let mut out = diameter_pages(cmp, dir, ext, inputs)?;
+    let mut out = diameter_pages(cmp, dir, ext)?;
     let mut save = |name: &str, panels: &[Panel], columns: usize| -> Result<(), CompareError> {
         let path = dir.join(format!("{name}.{ext}"));
-        ensure_not_input(&path, inputs)?;
-        save_panels(&path, panels, columns, grid_size(panels.len(), columns))?;
-        out.push(path);
+        let bytes = render_panels(&path, panels, columns, grid_size(panels.len(), columns))?;
+        out.push(OutputFile::new(path, bytes));
         Ok(())
     };
     let range = station_range(cmp);
@@ -94,14 +92,12 @@ pub fn write_figures(
 }
 
 /// Measured against model per experiment, as `d` and as `1/d²` (the rheometer's figure
-/// panels): writes `compare_diameters.EXT` and `compare_inverse_d2.EXT` (split into pages) and
-/// returns their paths.
+/// panels): renders `compare_diameters.EXT` and `compare_inverse_d2.EXT` (split into pages).
 fn diameter_pages(
     cmp: &Comparison,
     dir: &Path,
     ext: &str,
-    inputs: &[PathBuf],
-) -> Result<Vec<PathBuf>, CompareError> {
+) -> Result<Vec<OutputFile>, CompareError> {
     let mut out = Vec::new();
     let measured: Vec<(Vec<f64>, Vec<f64>)> = cmp
         .experiments
@@ -139,7 +135,7 @@ fn diameter_pages(
         ("compare_inverse_d2", View::InverseSquare),
     ] {
         let path = dir.join(format!("{name}.{ext}"));
-        out.extend(experiment_panel_pages(&path, &views, &model, view, inputs)?);
+        out.extend(experiment_panel_pages(&path, &views, &model, view)?);
     }
     Ok(out)
 }

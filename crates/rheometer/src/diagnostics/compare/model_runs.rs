@@ -7,10 +7,10 @@ use crate::data::take_up::{resolve_take_up, TakeUpError};
 use crate::fit::FitSummary;
 use crate::in_order::CollectInOrder;
 use crate::model::bvp::FiberModel;
+use crate::model::contributions::Physics;
 use crate::model::material_law::CarreauLike;
 use crate::model::setup::ExperimentSet;
 use crate::model::simulate::{simulate_params, SimulateOptions};
-use crate::Physics;
 use diffbvp::mesh::linspace;
 use rayon::prelude::*;
 

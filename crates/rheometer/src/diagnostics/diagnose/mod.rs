@@ -28,7 +28,7 @@
 //!    (Gaussian errors with unknown variance; `Δk` extra parameters, 2 for strain thinning),
 //!    whether the strength is credible ([`StrengthStatus::Physical`]: a best strength at a
 //!    search bound or outside the physical range is reported as such and never named).
-//! 7. **Rank** ([`rank_order`]): credible refits by `ΔBIC`, then the others. A candidate earns
+//! 7. **Rank** (`rank_order`): credible refits by `ΔBIC`, then the others. A candidate earns
 //!    its place when `ΔBIC` is below [`DiagnoseOptions::earn_threshold`] (−10: "very strong"
 //!    evidence on the Kass–Raftery scale) and its strength is credible.
 //!    The false-alarm probability of each refit (`linear::calibrate`: how often the search over all
@@ -69,7 +69,7 @@ mod pairs;
 mod search;
 mod shapes;
 mod step;
-pub mod verdict;
+pub(crate) mod verdict;
 
 use super::refits::consistency;
 use super::refits::scan::ScanOptions;
@@ -84,14 +84,10 @@ use crate::model::setup::ExperimentSet;
 use std::time::Instant;
 use verdict::{Help, Verdict};
 
-pub use super::candidate::{
-    earns_its_place, rank_order, strength_status, Candidate, Indistinguishable, ShapeAlternative,
-    StrengthStatus, PHYSICAL_RANGE_SE,
-};
 pub use super::diagnosis::{
     Diagnosis, DiagnosisRun, ForwardStep, ResidualProfiles, RobustWeights, StageTimes,
 };
-pub use step::MAX_FALSE_ALARM;
+pub(crate) use step::MAX_FALSE_ALARM;
 
 /// Options of [`diagnose`].
 #[derive(Debug, Clone)]
@@ -113,7 +109,7 @@ pub struct DiagnoseOptions {
     /// `ΔBIC` gap to the named cause below which another candidate that earns its place is
     /// listed as an alternative (default 6: `ΔBIC ≈ −2 ln B`, and a Bayes factor below
     /// `e³ ≈ 20` is less than "strong" evidence on the Kass–Raftery scale, so the data do not
-    /// clearly prefer the named cause; see [`ties`](super::ties)).
+    /// clearly prefer the named cause; see `ties`).
     pub tie_margin: f64,
     /// Start `(n, κ)` of the user's Carreau fit (default: the paper's start heuristic).
     pub start: Option<[f64; 2]>,

@@ -3,10 +3,10 @@
 //! * An effect is named as missing only when it earns its place (credible strength and law,
 //!   `ΔBIC` below the threshold), is unlikely to be a false alarm of the search over all
 //!   candidates (`calibrate`), and removes at least
-//!   [`MIN_SHARE_OF_EXCESS`] of the excess misfit (the cost above what the noise alone
+//!   `MIN_SHARE_OF_EXCESS` of the excess misfit (the cost above what the noise alone
 //!   leaves).
 //! * It is *the* explanation only when, with the named effects, the residuals are at the noise:
-//!   RMS within [`EXPLAINED_RMS_OVER_NOISE`] of the noise level and no structure along the line
+//!   RMS within `EXPLAINED_RMS_OVER_NOISE` of the noise level and no structure along the line
 //!   (lag-1 autocorrelation `ρ₁ √pairs` below 3). Otherwise the verdict is "none of the
 //!   candidates": which ones help and how much, and where along the line (and in which
 //!   experiments) the unexplained residual lies — a user-written effect is the next step.
@@ -28,10 +28,10 @@ use crate::fit::FitSummary;
 use serde::{Deserialize, Serialize};
 
 /// Share of the excess misfit an effect must remove to be named \[-\].
-pub const MIN_SHARE_OF_EXCESS: f64 = 0.5;
+pub(crate) const MIN_SHARE_OF_EXCESS: f64 = 0.5;
 
 /// RMS over the noise level at or below which the residuals are at the noise \[-\].
-pub const EXPLAINED_RMS_OVER_NOISE: f64 = 1.2;
+pub(crate) const EXPLAINED_RMS_OVER_NOISE: f64 = 1.2;
 
 /// The lag-1 structure ([`NoiseModel::lag1_z`](crate::data::noise_model::NoiseModel::lag1_z),
 /// standard errors) at or above which the residuals keep a structure along the line.

@@ -3,5 +3,5 @@
 //! (`consistency`).
 
 pub(crate) mod consistency;
-pub mod pair;
-pub mod scan;
+pub(crate) mod pair;
+pub(crate) mod scan;

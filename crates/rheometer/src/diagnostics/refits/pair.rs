@@ -2,7 +2,7 @@
 //! forward search's result (the search itself is `diagnose::pairs`).
 //!
 //! * **Replacement** needs `ΔBIC` lower than the forward search's result by more than
-//!   [`replace_margin`]: the tie margin plus `2 ln M` for the `M` pairs tried. The best of `M`
+//!   `replace_margin`: the tie margin plus `2 ln M` for the `M` pairs tried. The best of `M`
 //!   pairs is the winner of a search, and giving each pair a prior weight `1/M` against the
 //!   forward search's one result is what makes a spurious pair rare: on a die-offset set of the
 //!   power study the best of 36 pairs (Nusselt factor + radiation) beat the true single effect
@@ -33,14 +33,14 @@ pub struct PairFound {
     /// `ΔBIC` against the user's model of what the forward search found (0 if nothing).
     pub delta_bic_of_steps: f64,
     /// `ΔBIC` gap by which the pair must beat the forward search's result to replace it
-    /// ([`replace_margin`]).
+    /// (`replace_margin`).
     #[serde(default)]
     pub replace_margin: f64,
     /// Whether the pair replaces the forward search's result; otherwise it is an explanation
     /// the data do not clearly separate from it, reported beside it.
     pub replaces: bool,
     /// `n` of the pair's fit and of the forward search's final fit, where the two
-    /// explanations disagree on the law ([`laws_disagree`]): the law is then no result.
+    /// explanations disagree on the law (`laws_disagree`): the law is then no result.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub laws_disagree: Option<[f64; 2]>,
     /// The pair's fit where it does not replace the forward search's result (where it does,
@@ -57,7 +57,7 @@ pub fn delta_bic(n: f64, j0: f64, j: f64, k: usize) -> f64 {
 
 /// The `ΔBIC` gap a pair must beat the forward search's result by to replace it: the tie
 /// margin plus `2 ln M` for `M` pairs tried (each pair's prior weight `1/M`).
-pub fn replace_margin(tie_margin: f64, pairs_tried: usize) -> f64 {
+pub(crate) fn replace_margin(tie_margin: f64, pairs_tried: usize) -> f64 {
     tie_margin + 2.0 * (pairs_tried.max(1) as f64).ln()
 }
 
@@ -92,7 +92,7 @@ pub(crate) fn against_steps(
 }
 
 /// Whether two fits' laws disagree: either's `n` or `κ` outside the other's 95 % interval.
-pub fn laws_disagree(a: &FitSummary, b: &FitSummary) -> bool {
+pub(crate) fn laws_disagree(a: &FitSummary, b: &FitSummary) -> bool {
     let outside = |v: f64, ci: [f64; 2]| v < ci[0] || v > ci[1];
     outside(a.n.value, b.n.ci95)
         || outside(b.n.value, a.n.ci95)

@@ -2,27 +2,27 @@
 //! point a refit of the user's material parameters with the strength **fixed**, then the best
 //! grid points refined by the bounded least-squares fit with the strength freed.
 //!
-//! * **Grid** ([`scan_grid`]): the neutral value plus, on each side with room, a geometric
+//! * **Grid** (`scan_grid`): the neutral value plus, on each side with room, a geometric
 //!   sequence of magnitudes from [`ScanOptions::smallest_relative`] of that side's extent up to
 //!   the bound, so small and large strengths are both seen (a co-flow weaker than the fiber only
 //!   scales the Nusselt number; one stronger reverses the relative speed).
-//! * **Walk** ([`walk_out`]): each side is walked outwards from the neutral value, every point
+//! * **Walk** (`walk_out`): each side is walked outwards from the neutral value, every point
 //!   warm-started from its inner neighbour (law and fiber solutions); the first point whose fit
 //!   fails ends that side, and the failure is recorded in the profile, not an error; so does a
 //!   point whose `J` exceeds [`ScanOptions::stop_above`] times the user's. A point whose start
-//!   law is far below the plausible range ([`COLD_FALLBACK_MIN_N`]) and whose warm start fails
+//!   law is far below the plausible range (`COLD_FALLBACK_MIN_N`) and whose warm start fails
 //!   is fitted from [`ScanOptions::restart_law`] instead of by a slow cold start at that law.
-//! * **Inward walk** ([`walk_in`]): where the user's law is implausible (it compensates a
+//! * **Inward walk** (`walk_in`): where the user's law is implausible (it compensates a
 //!   missing effect), each side is walked again from its outermost point inwards, started
 //!   from a plausible law ([`ScanOptions::restart_law`]); every point keeps the lower `J`.
-//! * **Shapes** ([`shape_variants`]): effects with a shape (today the decay lengths of
+//! * **Shapes** (`shape_variants`): effects with a shape (today the decay lengths of
 //!   `air_coflow` and `air_temperature_profile`) are scanned for a few shapes, each a variant of
 //!   the effect.
 //! * **Refinement**: the lowest local minima of the profile (at most
 //!   [`ScanOptions::refine`]) are refitted with the strength freed.
 //! * **Physical range** ([`physical_range`], [`physical`]): what the diagnosis may name as
 //!   found. Everything this module needs from an [`Effect`] goes through [`search_range`],
-//!   [`physical_range`] and [`shape_variants`].
+//!   [`physical_range`] and `shape_variants`.
 
 use crate::fit::identify::identification::WarmFit;
 use crate::fit::values::thresholds::PLAUSIBLE_N;
@@ -55,7 +55,7 @@ pub const REFINE_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
 /// explodes at the take-up). A refit creeping along that edge on such a mesh spends most of its
 /// time there without reaching a lower cost, so such a point fails instead, and the trust
 /// region takes a shorter step.
-pub const REFINE_MAX_NODES: usize = 2000;
+pub(crate) const REFINE_MAX_NODES: usize = 2000;
 
 /// The growth limit of the grid points' BVP solves ([`ScanOptions::grid_growth_limit`]): 16
 /// times the start's mesh, always 5000 nodes (the floor is what binds: about 100–250 times the
@@ -78,13 +78,13 @@ pub const GRID_GROWTH_LIMIT: GrowthLimit = GrowthLimit {
 /// continuation, while a refit from the plausible law is quick and ends at a lower `J`.
 ///
 /// [`SimulateOptions::cold_fallback`]: crate::model::simulate::SimulateOptions::cold_fallback
-pub const COLD_FALLBACK_MIN_N: f64 = 0.5 * PLAUSIBLE_N[0];
+pub(crate) const COLD_FALLBACK_MIN_N: f64 = 0.5 * PLAUSIBLE_N[0];
 
 /// Settings of the global search.
 #[derive(Debug, Clone)]
 pub struct ScanOptions {
     /// Grid points per side of the neutral value for physical effects (default 4; process and
-    /// instrument candidates get half as many, see [`scan_grid`]).
+    /// instrument candidates get half as many, see `scan_grid`).
     pub points_per_sign: usize,
     /// Smallest grid magnitude relative to the side's extent (default 1e-2).
     pub smallest_relative: f64,
@@ -113,7 +113,7 @@ pub struct ScanOptions {
     /// towards 20 000 nodes, and the trust region takes a shorter one.
     pub refine_growth_limit: Option<GrowthLimit>,
     /// The largest mesh of a refinement's (and a pair's joint fit's) BVP solves (default
-    /// [`REFINE_MAX_NODES`]; the fit's own `max_nodes` if smaller).
+    /// `REFINE_MAX_NODES`; the fit's own `max_nodes` if smaller).
     pub refine_max_nodes: usize,
     /// How far the grid points' BVP solves may refine beyond the mesh they start from (default
     /// [`GRID_GROWTH_LIMIT`]; `None`: up to `max_nodes`). Looser than
@@ -133,7 +133,7 @@ pub struct ScanOptions {
     /// `J` (default 0.02): elsewhere there is no basin to localise.
     pub bracket_below: f64,
     /// The plausible material law `(n, κ)` each side is walked back inwards from where the
-    /// user's law is implausible (`n` below 0.2; see [`walk_in`]; default `None`: no inward
+    /// user's law is implausible (`n` below 0.2; see `walk_in`; default `None`: no inward
     /// walk; the diagnosis sets its start law).
     pub restart_law: Option<[f64; 2]>,
     /// Gauss–Newton iteration limit of the inward walk's first (outermost) fit (default 20).
@@ -256,7 +256,7 @@ pub struct CandidateScan {
 
 /// Grid of a scan: strengths on each side of the neutral value, each ordered outwards.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ScanGrid {
+pub(crate) struct ScanGrid {
     /// The neutral value.
     pub neutral: f64,
     /// Strengths below the neutral value, decreasing.
@@ -289,7 +289,7 @@ pub fn physical(effect: &Effect, value: f64) -> Result<(), String> {
 /// geometrically from `smallest_relative ×` the side's extent up to the bound itself. Values
 /// beyond the physical range are reached by the refinement (bounded by the search range), so a
 /// best fit outside physics is still found and reported as such.
-pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
+pub(crate) fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
     let neutral = effect.neutral();
     let (slo, shi) = search_range(effect);
     let (plo, phi) = physical_range(effect);
@@ -331,8 +331,8 @@ pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
 
 /// The variants of `effect` whose shapes are scanned, each with its shape parameters: every
 /// shape parameter the effect fits with its strength ([`Effect::free_shapes`]) and marks
-/// [`scanned`](crate::model::effects::ShapeParameter::scanned) is fixed at the values of its
-/// descriptor's [`scan`](crate::model::effects::ShapeParameter::scan) (lengths `0.4 ×`, `1 ×`
+/// [`scanned`](crate::model::ShapeParameter::scanned) is fixed at the values of its
+/// descriptor's [`scan`](crate::model::ShapeParameter::scan) (lengths `0.4 ×`, `1 ×`
 /// and `2.5 ×` the default, for the co-flow also `0.15 ×`: a jet within a few centimetres of
 /// the take-up is found only from a short decay length; an onset at 30 %, 50 % and 70 % of the
 /// spin line of length `length` \[m\]), clamped to its bounds; the other free shapes (the line
@@ -341,7 +341,7 @@ pub fn scan_grid(effect: &Effect, options: &ScanOptions) -> ScanGrid {
 /// discrete choice. Without `scan_shapes`, one variant with the free shapes at their
 /// defaults. The refinement frees every free shape again and holds the discrete ones at the
 /// variant's values ([`refine`]).
-pub fn shape_variants(
+pub(crate) fn shape_variants(
     effect: &Effect,
     scan_shapes: bool,
     length: f64,
@@ -397,7 +397,7 @@ pub(crate) type Walk<T, E> = (Vec<(f64, T)>, Option<(f64, E)>);
 /// Evaluates `eval` at `values` in order, each call given the previous result (the warm
 /// start; `None` for the first), and stops at the first failure, which is returned with its
 /// value.
-pub fn walk_out<T, E>(
+pub(crate) fn walk_out<T, E>(
     values: &[f64],
     first: Option<&T>,
     mut eval: impl FnMut(f64, Option<&T>) -> Result<T, E>,
@@ -475,7 +475,7 @@ pub struct ProfileScan {
     /// The profile.
     pub profile: Profile,
     /// The grid points to refine (local minima of the profile, lowest first; see
-    /// [`refine_starts`]).
+    /// `refine_starts`).
     pub starts: Vec<GridStart>,
     /// The user's model with the variant's strength freed (for [`refine`]).
     pub rheometer: Rheometer,
@@ -491,7 +491,7 @@ pub struct ProfileScan {
 /// `rh` (the user's model; its neutral candidates are dropped) from the user's fit `base`
 /// (`J` = `cost_base`): each side of [`scan_grid`] walked outwards with the strength fixed.
 #[allow(clippy::too_many_arguments)] // the candidate, its variant and its shape describe one job
-pub fn scan_profile(
+pub(crate) fn scan_profile(
     rh: &Rheometer,
     candidate: &Effect,
     effect: &Effect,
@@ -721,7 +721,7 @@ fn needs_inward_walk(done: &[(f64, GridStart)], base: &GridStart) -> bool {
 /// [`ScanOptions::restart_iterations`] steps, then every point inwards warm-started from its
 /// outer neighbour's inward fit (`fit(strength, law, from, iterations)`); each point keeps the
 /// lower `J` of its two fits.
-pub fn walk_in<E>(
+pub(crate) fn walk_in<E>(
     mut done: Vec<(f64, GridStart)>,
     law: [f64; 2],
     scan: &ScanOptions,
@@ -813,7 +813,7 @@ pub(crate) fn refitted_effect(candidate: &Effect, variant: &Effect) -> Result<Ef
     Ok(effect)
 }
 
-/// Refines a grid point of [`scan_profile`]: the bounded least-squares fit with the strength
+/// Refines a grid point of `scan_profile`: the bounded least-squares fit with the strength
 /// freed, warm-started from the point (full tolerances and iteration budget of `options`, the
 /// scan's [`growth_limit`](ProfileScan::growth_limit)).
 pub fn refine(
@@ -863,7 +863,7 @@ pub fn refine(
     })
 }
 
-/// The global search of one candidate variant: [`scan_profile`], then [`refine`] of its best
+/// The global search of one candidate variant: `scan_profile`, then [`refine`] of its best
 /// grid points (refits that fail are left out).
 pub fn scan_candidate(
     rh: &Rheometer,
@@ -891,7 +891,11 @@ pub fn scan_candidate(
 /// Indices of the grid points to refine: local minima of `costs` (by increasing strength)
 /// other than `neutral`, lowest first, at most `refine`; without such a minimum, the lowest
 /// point other than `neutral`.
-pub fn refine_starts(costs: &[f64], neutral: Option<usize>, scan: &ScanOptions) -> Vec<usize> {
+pub(crate) fn refine_starts(
+    costs: &[f64],
+    neutral: Option<usize>,
+    scan: &ScanOptions,
+) -> Vec<usize> {
     let n = costs.len();
     let candidates: Vec<usize> = (0..n).filter(|&i| Some(i) != neutral).collect();
     let mut minima: Vec<usize> = candidates
@@ -917,7 +921,7 @@ pub fn refine_starts(costs: &[f64], neutral: Option<usize>, scan: &ScanOptions) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::effects::DEFAULT_COFLOW_DECAY_LENGTH;
+    use crate::model::catalog::physics::DEFAULT_COFLOW_DECAY_LENGTH;
 
     #[test]
     fn grid_spans_small_and_large_magnitudes_on_both_sides() {
@@ -1159,7 +1163,7 @@ mod tests {
         assert_eq!(onsets, vec![0.3 * 0.5, 0.5 * 0.5, 0.7 * 0.5]);
         assert!(line.iter().all(|(_, s)| s.len() == 2
             && s[1].name == "ramp_width"
-            && s[1].value == crate::model::effects::DEFAULT_COFLOW_LINE_RAMP_WIDTH));
+            && s[1].value == crate::model::catalog::physics::DEFAULT_COFLOW_LINE_RAMP_WIDTH));
         assert_eq!(
             shape_variants(
                 &Effect::AirTemperatureProfile { decay_length: None },
@@ -1168,7 +1172,7 @@ mod tests {
             )[0]
             .1[0]
                 .value,
-            crate::model::effects::DEFAULT_WARM_AIR_DECAY_LENGTH
+            crate::model::catalog::physics::DEFAULT_WARM_AIR_DECAY_LENGTH
         );
     }
 }

@@ -1,22 +1,22 @@
 //! The checks of a fit: a bad fit is never printed as a good one.
 //!
-//! * **Estimates at a bound.** An estimate within [`AT_BOUND_TOLERANCE`] of the width of its
+//! * **Estimates at a bound.** An estimate within `AT_BOUND_TOLERANCE` of the width of its
 //!   search range from a bound is listed in [`FitSummary::at_bound`] and marked `AT LOWER
 //!   BOUND` / `AT UPPER BOUND` in the text. The optimum then lies at or beyond the search
 //!   range, and the normal-approximation interval is not valid: its `ci95` is `NaN` (`null` in
 //!   JSON) and the text prints no interval for it.
 //! * **Misfit far above the noise.** The RMS relative residual is compared with the fit's one
-//!   noise level ([`NoiseSummary`](crate::data::noise_summary::NoiseSummary): declared, else
-//!   estimated by the noise model). Above [`MISFIT_RATIO`] times the noise the report warns and
+//!   noise level (`NoiseSummary`: declared, else
+//!   estimated by the noise model). Above `MISFIT_RATIO` times the noise the report warns and
 //!   names the worst experiments.
 //! * **Huge standard errors**: `SE(n) >` [`LARGE_STDERR_N`], `SE(κ) >` [`LARGE_STDERR_KAPPA`],
-//!   a fitted strength with a standard error above [`LARGE_STDERR_STRENGTH_FRACTION`] of its
+//!   a fitted strength with a standard error above `LARGE_STDERR_STRENGTH_FRACTION` of its
 //!   search range, or a `K` interval reaching `0` or `∞`.
 //! * **A singular or ill-conditioned covariance** (no standard errors, or a correlation matrix
-//!   with reciprocal condition number below [`ILL_CONDITIONED_RCOND`]).
+//!   with reciprocal condition number below `ILL_CONDITIONED_RCOND`).
 //! * **A fit short of its optimum**: it ended without a convergence test being met (iteration
 //!   budget, stall, collapsed trust region) and the Gauss–Newton step from its end would still
-//!   lower `χ²` by at least [`NOT_CONVERGED_CHI2`].
+//!   lower `χ²` by at least `NOT_CONVERGED_CHI2`.
 //! * **Data the model cannot describe**: measured diameters that do not decrease along the spin
 //!   line ([`Rheometer::data_warnings`](crate::fit::Rheometer::data_warnings)).
 //!
@@ -27,12 +27,17 @@ use crate::fit::estimator::Estimator;
 use crate::fit::layout::EffectSlot;
 use crate::fit::options::{FitWarning, WarningCode};
 use crate::fit::summary::{BoundSide, FitSummary};
+pub(crate) use crate::fit::values::thresholds::AT_BOUND_TOLERANCE;
+pub(crate) use crate::fit::values::thresholds::ILL_CONDITIONED_RCOND;
+pub(crate) use crate::fit::values::thresholds::IMPLAUSIBLE_NOISE_RATIO;
+pub(crate) use crate::fit::values::thresholds::JUMP_SE;
+pub(crate) use crate::fit::values::thresholds::LARGE_STDERR_STRENGTH_FRACTION;
+pub(crate) use crate::fit::values::thresholds::MISFIT_RATIO;
+pub(crate) use crate::fit::values::thresholds::MISFIT_WITHOUT_NOISE;
 use crate::fit::values::thresholds::NOISE_FREE_LEVEL;
-pub use crate::fit::values::thresholds::{
-    AT_BOUND_TOLERANCE, ILL_CONDITIONED_RCOND, IMPLAUSIBLE_NOISE_RATIO, JUMP_SE,
-    LARGE_STDERR_KAPPA, LARGE_STDERR_N, LARGE_STDERR_STRENGTH_FRACTION, MISFIT_RATIO,
-    MISFIT_WITHOUT_NOISE, NOT_CONVERGED_CHI2, PLAUSIBLE_N,
-};
+pub(crate) use crate::fit::values::thresholds::NOT_CONVERGED_CHI2;
+pub(crate) use crate::fit::values::thresholds::PLAUSIBLE_N;
+pub use crate::fit::values::thresholds::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 use crate::report::format::fmt_g;
 use diffbvp::least_squares::{FitResult, Termination};
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -219,7 +224,7 @@ fn check_covariance(
 
 /// An effect fixed (`--with radiation=2`) at a strength outside its physical range (G02):
 /// the fit then rests on a model no spinning line can have; an `unphysical` warning naming the
-/// effect, its value and its range ([`Effect::judge`](crate::model::effects::Effect::judge)).
+/// effect, its value and its range ([`Effect::judge`](crate::model::Effect::judge)).
 pub(crate) fn check_fixed_effects(s: &FitSummary, w: &mut Vec<FitWarning>) {
     for e in &s.effects {
         if e.strength.fitted {
@@ -317,7 +322,7 @@ pub(crate) fn check_law(s: &FitSummary, w: &mut Vec<FitWarning>) {
 /// reference: a refit that moves it clearly into the plausible range (the 95 % interval of
 /// its `n` above the lower bound, or its value where it has no interval) is not checked
 /// against it.
-pub fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarning)> {
+pub(crate) fn law_jump(base: &FitSummary, refit: &FitSummary) -> Option<(f64, FitWarning)> {
     let lowest = if refit.n.has_interval() {
         refit.n.ci95[0]
     } else {

@@ -57,7 +57,7 @@ impl ProfileInterval {
 
 impl FitSummary {
     /// Whether the likelihood-ratio test prefers the Newtonian law
-    /// ([`NewtonianTest::law_not_estimated`](crate::fit::NewtonianTest::law_not_estimated)):
+    /// (`NewtonianTest::law_not_estimated`):
     /// the law is Newtonian within the data's strain rates, `n` and `κ` are not estimates
     /// (the report gives the finding and the bounds on thinning instead).
     pub fn newtonian_on_data(&self) -> bool {

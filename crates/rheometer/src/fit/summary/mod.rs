@@ -14,7 +14,7 @@
 //! a fit doubtful are in [`summary::checks`](crate::fit::summary::checks).
 
 pub(crate) mod build;
-pub mod checks;
+pub(crate) mod checks;
 pub(crate) mod finding;
 pub(crate) mod read;
 pub(crate) mod text;
@@ -494,7 +494,7 @@ impl FitSummary {
 
     /// Why the profile-likelihood intervals and the likelihood-ratio test against the
     /// Newtonian law are not computed for this fit: a `misfit` warning (the RMS relative
-    /// residual beyond [`MISFIT_RATIO`](crate::fit::values::thresholds::MISFIT_RATIO) times the
+    /// residual beyond `MISFIT_RATIO` times the
     /// noise). Both read the deviance as a likelihood of a model that describes the data up to the
     /// noise; where it misses them by several times the noise they would be statements about
     /// a wrong model (the law is no result either, see [`law_not_a_result`](Self::law_not_a_result)),

@@ -331,7 +331,7 @@ pub enum DataCheck {
 impl FitSummary {
     /// Reads the fit of a report file `path` (`-`: standard input): a fit report or, where
     /// `wanted` has [`ReportKind::Diagnosis`], a diagnosis' final fit (its base fit if it has
-    /// none). The file is read bounded (at most `max_bytes`) and strictly ([`read_json`]),
+    /// none). The file is read bounded (at most `max_bytes`) and strictly (`read_json`),
     /// its stamp checked (`check_report`: the current schema version, a wanted kind), then
     /// its fields' types (errors name the path, `n.value`) and values
     /// ([`validate`](Self::validate)); `flag` names the option that gave the file.
@@ -437,7 +437,7 @@ impl FitSummary {
 
     /// Parses the JSON text of a fit summary held in memory (a Python dict, a test's text);
     /// `source` names it in errors. The text is parsed as strictly as a file
-    /// ([`parse_json`]: duplicate keys, `NaN`, numbers out of range refused, naming the
+    /// (`parse_json`: duplicate keys, `NaN`, numbers out of range refused, naming the
     /// field), but needs no stamp, and reports of earlier layouts (bare numbers for `n`, `κ`
     /// and strengths) read too; files are read by [`read_file`](Self::read_file), which
     /// takes the current layout only.
@@ -561,8 +561,8 @@ impl FitSummary {
         })
     }
 
-    /// Checks the values (as read from a file `source`): `n` in [`FIT_FILE_N_RANGE`], `κ` in
-    /// [`FIT_FILE_KAPPA_RANGE`], take-up factors in [`FIT_FILE_TAKE_UP_RANGE`], effects known,
+    /// Checks the values (as read from a file `source`): `n` in `FIT_FILE_N_RANGE`, `κ` in
+    /// `FIT_FILE_KAPPA_RANGE`, take-up factors in `FIT_FILE_TAKE_UP_RANGE`, effects known,
     /// once each, with finite strengths inside their search ranges, and as many experiment
     /// names (if given) as take-up factors. Errors name the file and the field.
     pub fn validate(&self, source: &str) -> Result<(), String> {

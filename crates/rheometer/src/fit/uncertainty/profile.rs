@@ -751,7 +751,7 @@ impl FitSummary {
     /// The laws `(n, κ)` along the law parameters' profiles within deviance `level` (the
     /// optimum included); where the Newtonian law is preferred
     /// ([`newtonian_on_data`](Self::newtonian_on_data)), the Newtonian law and the thinning
-    /// laws within `level` that the [`ThinningBound`] refitted (onset within the data, and
+    /// laws within `level` that the `ThinningBound` refitted (onset within the data, and
     /// the strongest thinning's onset beyond them).
     pub fn profile_trace(&self, level: f64) -> Vec<Vec<f64>> {
         if let Some(t) = self

@@ -88,7 +88,7 @@ pub struct ShapeParameter {
     pub fitted_with_strength: bool,
     /// Whether `diagnose`'s global search scans it across its range as variants of the effect
     /// (`false`: the scan holds it at its default and only the refinement fits it; the same as
-    /// [`scan`](Self::scan) not being [`ShapeScan::Default`]).
+    /// [`scan`](Self::scan) not being `ShapeScan::Default`).
     pub scanned: bool,
     /// The values the global search gives it.
     #[serde(skip)]
@@ -169,13 +169,13 @@ pub enum Install {
         /// `(n, κ)` of the law without the effect \[-\].
         reference: [f64; 2],
     },
-    /// A built-in part of [`Physics`](crate::Physics) carrying the strength named
+    /// A built-in part of [`Physics`](crate::model::Physics) carrying the strength named
     /// [`EffectDescriptor::model_param`] (a term such as radiation, the convection term's
     /// factor, an air profile, a process or instrument parameter), switched on at unit
-    /// amplitude by [`Physics::enable`](crate::Physics::enable).
+    /// amplitude by [`Physics::enable`](crate::model::Physics::enable).
     Physics,
-    /// The user's [`FiberTerm`](crate::FiberTerm) times the strength (carried by
-    /// [`UserEffect`](crate::model::effects::UserEffect)).
+    /// The user's [`FiberTerm`](crate::model::FiberTerm) times the strength (carried by
+    /// [`UserEffect`](crate::model::UserEffect)).
     UserTerm,
 }
 
@@ -234,9 +234,9 @@ pub fn one_per_unit(_: &Experiment) -> Option<f64> {
 
 /// One effect, described in one place: everything the model, the fit, the diagnosis (scan,
 /// judge, ranking, ties, detection limits), the error budget and the reports need to know of
-/// it. The built-in effects are the constants of [`catalog`](super) (see its table); a
+/// it. The built-in effects are the constants of `catalog` (see its table); a
 /// user-written candidate is a descriptor made with [`EffectDescriptor::user`] plus a
-/// [`FiberTerm`](crate::FiberTerm) ([`Effect::user`](crate::model::effects::Effect::user)).
+/// [`FiberTerm`](crate::model::FiberTerm) ([`Effect::user`](crate::model::Effect::user)).
 #[derive(Debug, Clone, Copy)]
 pub struct EffectDescriptor {
     /// Canonical name (CLI, JSON, reports); also the name of its strength parameter unless the
@@ -282,7 +282,7 @@ pub struct EffectDescriptor {
 
 /// The identity of an effect, handed out by its descriptor ([`EffectDescriptor::id`]): two
 /// effects are the same effect exactly when their ids are equal (the catalog and
-/// [`ModelSpec::validate`](crate::model::effects::ModelSpec::validate) keep names unique). Compare
+/// [`ModelSpec::validate`](crate::model::ModelSpec::validate) keep names unique). Compare
 /// ids, not names; a name from input becomes an id where it is parsed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct EffectId(&'static str);
@@ -307,7 +307,7 @@ impl EffectDescriptor {
     /// (all fields are public):
     ///
     /// ```
-    /// use rheometer::model::effects::{Category, EffectDescriptor};
+    /// use rheometer::model::{Category, EffectDescriptor};
     /// const GUIDE_DRAG: EffectDescriptor = EffectDescriptor::user("guide_drag")
     ///     .with_unit("mN", "F")
     ///     .with_description("friction of a thread guide at s = 0.2 m, strength = its force")
@@ -338,7 +338,7 @@ impl EffectDescriptor {
     }
 
     /// The fields the built-in effects share (a default candidate, a part of
-    /// [`Physics`](crate::Physics), strength = parameter, neutral 0, no shapes, no
+    /// [`Physics`](crate::model::Physics), strength = parameter, neutral 0, no shapes, no
     /// independent check or budget source); each built-in constant overrides the rest.
     pub(crate) const fn builtin(name: &'static str, category: Category) -> Self {
         EffectDescriptor {
@@ -405,7 +405,7 @@ impl EffectDescriptor {
         self
     }
 
-    /// The model parameter for strength `s` ([`StrengthMap::param_value`]).
+    /// The model parameter for strength `s` (`StrengthMap::param_value`).
     pub const fn param_value(&self, s: f64) -> f64 {
         self.map.param_value(s)
     }
@@ -415,7 +415,7 @@ impl EffectDescriptor {
         self.map.strength_of(p)
     }
 
-    /// Whether the effect lives in the viscosity law ([`Install::Law`]).
+    /// Whether the effect lives in the viscosity law (`Install::Law`).
     pub const fn installs_in_law(&self) -> bool {
         matches!(self.install, Install::Law { .. })
     }

@@ -3,16 +3,16 @@
 //! search and physical ranges, shapes, how its strength maps to the model parameter, how many
 //! parameters a refit adds, the independent check that tells it apart from a cause with the same
 //! signature, the error-budget source it represents, and how it enters the model. Every consumer
-//! reads the descriptor: the model ([`Physics`](crate::Physics) names its modifiers' strengths
-//! and shapes after the descriptors), the fit's parameter layout, `diagnose` (scan, judge, rank, ties,
-//! detection limits), the error budget and the reports.
+//! reads the descriptor: the model ([`Physics`](crate::model::Physics) names its modifiers'
+//! strengths and shapes after the descriptors), the fit's parameter layout, `diagnose` (scan,
+//! judge, rank, ties, detection limits), the error budget and the reports.
 //!
 //! Data only: this module imports nothing of the model, so that the physics below and the
 //! effects above both read it. The built-in effects live in one file per family
-//! (`physics`, `process`, `instrument`, `material`) and in one table, [`BUILTIN`]; a
+//! (`physics`, `process`, `instrument`, `material`) and in one table, `BUILTIN`; a
 //! user-written candidate is a descriptor ([`EffectDescriptor::user`]) and a
-//! [`FiberTerm`](crate::FiberTerm), joined by
-//! [`Effect::user`](crate::model::effects::Effect::user).
+//! [`FiberTerm`](crate::model::FiberTerm), joined by
+//! [`Effect::user`](crate::model::Effect::user).
 //!
 //! | name | strength (unit) | enters as | shape parameters (unit, default, bounds) | category | physical range | search range | budget source |
 //! |---|---|---|---|---|---|---|---|
@@ -37,36 +37,47 @@
 //! air speed or temperature next to the fiber, the fiber temperature with a pyrometer); the
 //! error budget's sources are the descriptors' [`budget`](EffectDescriptor::budget) fields.
 //!
-//! **Adding a built-in effect**: its descriptor in its family's file and in [`BUILTIN`], its
-//! physics in one file of [`modifiers`](crate::model::contributions::modifiers) with its registry
+//! **Adding a built-in effect**: its descriptor in its family's file and in `BUILTIN`, its
+//! physics in one file of [`modifiers`](crate::model::modifiers) with its registry
 //! line (the descriptor names its strength and shapes; a term instead for a force or heat flux), a
-//! variant of [`Effect`](crate::model::effects::Effect) returning the descriptor, and a row above
+//! variant of [`Effect`](crate::model::Effect) returning the descriptor, and a row above
 //! (a unit test checks the table against the descriptors). **Adding your own**: see
 //! [`EffectDescriptor::user`].
 
-mod descriptor;
+pub(crate) mod descriptor;
 pub(crate) mod instrument;
 pub(crate) mod material;
 pub(crate) mod physics;
 pub(crate) mod process;
 
-pub use descriptor::{
-    one_per_unit, BudgetSource, Category, EffectDescriptor, EffectId, GaugeColumn, Install, Scope,
-    ShapeParameter, ShapeScan, StrengthMap,
-};
-pub use instrument::{GAUGE_OFFSET, GAUGE_SCALE};
-pub use material::{VFT_B_OFFSET, VFT_T_VF_OFFSET};
-pub use physics::{
-    AIR_COFLOW, AIR_COFLOW_LINE, AIR_TEMPERATURE_PROFILE, COFLOW_DECAY, COFLOW_LINE_ONSET,
-    COFLOW_LINE_RAMP, COFLOW_TAIL, DEFAULT_COFLOW_DECAY_LENGTH, DEFAULT_COFLOW_LINE_ONSET,
-    DEFAULT_COFLOW_LINE_RAMP_WIDTH, DEFAULT_WARM_AIR_DECAY_LENGTH, NUSSELT_SCALE, RADIATION,
-    STRAIN_THINNING, STRAIN_THINNING_REFERENCE_KAPPA, WARM_AIR_DECAY,
-};
-pub use process::{DIE_TEMPERATURE_OFFSET, INLET_DIAMETER, INLET_VELOCITY, MASS_FLOW_SCALE};
+pub(crate) use descriptor::BudgetSource;
+pub(crate) use descriptor::EffectId;
+pub(crate) use descriptor::GaugeColumn;
+pub(crate) use descriptor::Install;
+pub use descriptor::{Category, EffectDescriptor, Scope, ShapeParameter};
+pub(crate) use instrument::GAUGE_OFFSET;
+pub(crate) use instrument::GAUGE_SCALE;
+pub(crate) use material::VFT_B_OFFSET;
+pub(crate) use material::VFT_T_VF_OFFSET;
+pub(crate) use physics::AIR_COFLOW;
+pub(crate) use physics::AIR_COFLOW_LINE;
+pub(crate) use physics::AIR_TEMPERATURE_PROFILE;
+pub(crate) use physics::COFLOW_DECAY;
+pub(crate) use physics::COFLOW_LINE_ONSET;
+pub(crate) use physics::COFLOW_LINE_RAMP;
+pub(crate) use physics::NUSSELT_SCALE;
+pub(crate) use physics::RADIATION;
+pub(crate) use physics::STRAIN_THINNING;
+pub use physics::STRAIN_THINNING_REFERENCE_KAPPA;
+pub(crate) use physics::WARM_AIR_DECAY;
+pub(crate) use process::DIE_TEMPERATURE_OFFSET;
+pub(crate) use process::INLET_DIAMETER;
+pub(crate) use process::INLET_VELOCITY;
+pub(crate) use process::MASS_FLOW_SCALE;
 
 /// Every built-in effect, in the canonical order of reports and of
-/// [`Effect::all`](crate::model::effects::Effect::all): physics, process, instrument, material.
-pub const BUILTIN: [&EffectDescriptor; 14] = [
+/// [`Effect::all`](crate::model::Effect::all): physics, process, instrument, material.
+pub(crate) const BUILTIN: [&EffectDescriptor; 14] = [
     &STRAIN_THINNING,
     &RADIATION,
     &AIR_COFLOW,
@@ -103,10 +114,10 @@ const fn names<const N: usize>(
     out
 }
 
-/// Every built-in effect name ([`BUILTIN`] order).
+/// Every built-in effect name (`BUILTIN` order).
 pub const ALL_NAMES: [&str; 14] = names(&BUILTIN, false);
 
-/// The names of the default candidates of `diagnose` ([`BUILTIN`] order).
+/// The names of the default candidates of `diagnose` (`BUILTIN` order).
 pub const BUILTIN_NAMES: [&str; 11] = names(&BUILTIN, true);
 
 /// The built-in descriptor named `name`.
@@ -116,6 +127,7 @@ pub fn builtin(name: &str) -> Option<&'static EffectDescriptor> {
 
 #[cfg(test)]
 mod tests {
+    use super::descriptor::ShapeScan;
     use super::*;
 
     #[test]

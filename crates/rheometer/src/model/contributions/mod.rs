@@ -42,7 +42,7 @@ use modifiers::{AirProfile, InletFactors, Part};
 use num_dual::DualNum;
 use std::f64::consts::PI;
 
-pub mod modifiers;
+pub(crate) mod modifiers;
 
 /// Stefan–Boltzmann constant σ [W/(m² K⁴)].
 pub const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
@@ -85,7 +85,7 @@ pub trait NusseltLaw: Send + Sync {
 
     /// `𝒩` with an extra regularisation `extra_sq` (≥ 0, dimensionless) of the Reynolds
     /// number and the inclination dependence where the relative speed changes sign, used with an
-    /// air co-flow (see [`COFLOW_INCLINATION_REGULARISATION`]); it is exactly 0 in still air.
+    /// air co-flow (see `COFLOW_INCLINATION_REGULARISATION`); it is exactly 0 in still air.
     /// Default: ignores `extra_sq`.
     fn nusselt_regularised<D: DualNum<Primitive = f64> + Copy>(
         &self,
@@ -112,11 +112,11 @@ pub trait NusseltLaw: Send + Sync {
 /// base model is reproduced exactly. Elsewhere it changes the inclination factor (½ for the
 /// tangential flow along the fiber) by `≲ ε_c²/Re²` relative (0.25% at `Re = 1`) and `Re_ε^½`
 /// by `≲ ε_c²/(4 Re²)` (0.06%).
-pub const COFLOW_INCLINATION_REGULARISATION: f64 = 0.05;
+pub(crate) const COFLOW_INCLINATION_REGULARISATION: f64 = 0.05;
 
 /// Air speed scale \[m/s\] of the co-flow regularisation weight `w` (see
 /// [`COFLOW_INCLINATION_REGULARISATION`]).
-pub const COFLOW_REGULARISATION_SPEED: f64 = 0.01;
+pub(crate) const COFLOW_REGULARISATION_SPEED: f64 = 0.01;
 
 /// Default Nusselt law of `docs/model-closure.md` (an assumption; the paper's law is not public):
 /// `𝒩 = (1 − ½ Re_τ²/(Re² + ε_i²)) Nu_CB(Re_ε, Pr)`, `Re_ε = √(Re² + ε_r²)`, with the
@@ -316,7 +316,7 @@ pub struct Term {
 impl Term {
     /// Name of its strength as a model parameter: the candidate effect's name where the term's
     /// strength is one (`nusselt_scale` for `convection`, its descriptor
-    /// [`super::catalog::NUSSELT_SCALE`]), else the term's name.
+    /// `super::catalog::NUSSELT_SCALE`), else the term's name.
     pub fn parameter_name(&self) -> &'static str {
         match self.kind {
             TermKind::Convection => NUSSELT_SCALE.model_param,
@@ -344,7 +344,7 @@ pub struct ProcessFactors<D> {
 
 /// The set of contributions: the force and heat terms, the Nusselt law, and the built-in
 /// effects that change the air, the inlet, the gauge or the material data (each a modifier
-/// registered in [`modifiers`], held in registry order, added by its `with_*` builder,
+/// registered in `modifiers`, held in registry order, added by its `with_*` builder,
 /// [`enable`](Self::enable) or [`set_strength`](Self::set_strength)).
 #[derive(Debug)]
 pub struct Physics<H: NusseltLaw = InclinedChurchillBernstein> {
@@ -749,7 +749,7 @@ impl Source {
 
 /// The strengths of a [`Physics`] resolved once: for every term and every slot of every
 /// modifier whether it is off, a fixed factor or which entry of the strength parameters `sp` it
-/// reads. [`FiberModel`](crate::FiberModel) builds it at construction so that its right-hand
+/// reads. [`FiberModel`](crate::model::FiberModel) builds it at construction so that its right-hand
 /// side neither counts the parameterised terms nor looks up the modifiers' slots on every call;
 /// the `*_planned` methods of [`Physics`] take it. A plan belongs to the physics it was made
 /// from: rebuild it ([`Physics::plan`]) after changing a strength.

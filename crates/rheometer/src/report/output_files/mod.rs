@@ -8,17 +8,20 @@
 //!   **before any work**: no output is an input (same device and inode, so hard and symbolic
 //!   links count), no two outputs are the same file, directories exist or can be created and
 //!   accept new files, names fit NAME_MAX, write-protected files are refused.
-//! * [`write_file`] writes one output the way its kind requires ([`Target`]): regular files
+//! * [`OutputFile`] is an output rendered in memory (a figure, a text), written through the
+//!   checked outputs or saved by itself.
+//! * `write_file` writes one output the way its kind requires ([`Target`]): regular files
 //!   through a temporary with a short name in the same directory, renamed over the file when
 //!   complete (never half-written; permissions kept; a file without write permission is
 //!   refused); character devices (`/dev/null`), FIFOs, `/dev/fd/N` and `-` (standard output)
 //!   in place, never renamed over or replaced by a regular file.
 //! * Temporaries are registered while written: [`remove_pending_temporaries`] (for a program
-//!   ending on a signal) removes them; [`remove_stale_temporaries`] removes those of ended
+//!   ending on a signal) removes them; `remove_stale_temporaries` removes those of ended
 //!   runs (`kill -9`), which [`OutputPlan::check`] does in every output directory.
 //! * [`PartialMarker`] marks an output directory as incomplete while it is written.
 
 mod error;
+mod file;
 mod marker;
 mod plan;
 mod target;
@@ -26,15 +29,11 @@ mod temporaries;
 mod write;
 
 pub use error::OutputError;
+pub use file::OutputFile;
 pub use marker::{PartialMarker, PARTIAL_NAME};
 pub use plan::{CheckedOutputs, OutputPlan};
-pub use target::{blocking_file, check_replaceable, classify, name_max, Target, STDOUT_PATH};
-pub use temporaries::{
-    remove_pending_temporaries, remove_stale_temporaries, temporary_in, temporary_owner,
-    TEMPORARY_PREFIX,
-};
+pub use target::Target;
+pub use temporaries::remove_pending_temporaries;
+pub(crate) use write::write_bytes;
 pub(crate) use write::FIFO_WAIT_RANGE;
-pub use write::{
-    ensure_not_input, fifo_reader_wait, same_file, write_bytes, write_file, write_target,
-    FIFO_READER_WAIT, FIFO_WAIT_VARIABLE,
-};
+pub(crate) use write::FIFO_WAIT_VARIABLE;

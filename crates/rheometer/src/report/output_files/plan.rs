@@ -2,6 +2,7 @@
 //! each other and against the file system; [`CheckedOutputs`] writes them.
 
 use super::error::OutputError;
+use super::file::OutputFile;
 use super::target::{blocking_file, check_directory, check_replaceable, classify, Target};
 use super::temporaries::remove_stale_temporaries;
 use super::write::{ensure_not_input, same_file, write_target};
@@ -136,13 +137,13 @@ impl OutputPlan {
     /// * each directory: not an input, not a file or below one, writable (a temporary is
     ///   created and removed), every name within NAME_MAX; the temporaries that ended runs
     ///   left in it are removed;
-    /// * each file ([`classify`]): not a directory, block device, socket, standard input or
+    /// * each file (`classify`): not a directory, block device, socket, standard input or
     ///   dangling link; a regular file not an input, not write-protected, its directory
     ///   writable; a FIFO not an input;
     /// * no two outputs the same file (by device and inode, or by path for new files), and
     ///   at most one on standard output.
     ///
-    /// Errors name the flag ([`OutputError::Planned`]).
+    /// Errors name the flag (`OutputError::Planned`).
     pub fn check(&self) -> Result<CheckedOutputs, OutputError> {
         let mut removed = Vec::new();
         for d in &self.dirs {
@@ -415,8 +416,8 @@ impl CheckedOutputs {
     }
 
     /// Writes the planned output `path` with `write` (see
-    /// [`write_file`](super::write_file)); an unplanned path is refused
-    /// ([`OutputError::NotPlanned`]).
+    /// `write_file`); an unplanned path is refused
+    /// (`OutputError::NotPlanned`).
     pub fn write(
         &self,
         path: &Path,
@@ -431,8 +432,131 @@ impl CheckedOutputs {
         write_target(&now, path, &self.inputs, write)
     }
 
+    /// Writes the planned output `file` (see [`CheckedOutputs::write`]).
+    pub fn write_output(&self, file: &OutputFile) -> Result<(), OutputError> {
+        self.write(&file.path, |w| w.write_all(&file.bytes))
+    }
+
     /// Writes `text` to the planned output `path` (see [`CheckedOutputs::write`]).
     pub fn write_text(&self, path: &Path, text: &str) -> Result<(), OutputError> {
         self.write(path, |w| w.write_all(text.as_bytes()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The refusal behind the planned output's label, after checking that the label names
+    /// the flag `flag`.
+    fn refusal(e: OutputError, flag: &str) -> OutputError {
+        match e {
+            OutputError::Planned { origin, source } => {
+                assert!(origin.starts_with(flag), "{origin}");
+                *source
+            }
+            e => panic!("not labelled with its flag: {e}"),
+        }
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        let d = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("target")
+            .join("unit-scratch")
+            .join(format!("output-plan-{name}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&d);
+        fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn hard_and_symbolic_links_to_an_input_are_refused() {
+        let d = scratch("links");
+        let input = d.join("data.csv");
+        fs::write(&input, b"keep me").unwrap();
+        let hard = d.join("hard.json");
+        fs::hard_link(&input, &hard).unwrap();
+        let mut links = vec![hard];
+        #[cfg(unix)]
+        {
+            let sym = d.join("sym.json");
+            std::os::unix::fs::symlink(&input, &sym).unwrap();
+            links.push(sym);
+        }
+        for link in &links {
+            let err = OutputPlan::new()
+                .input(&input)
+                .file(link, "--json")
+                .check()
+                .unwrap_err();
+            let err = refusal(err, "--json");
+            assert!(
+                matches!(err, OutputError::WouldOverwriteInput { .. }),
+                "{}: {err}",
+                link.display()
+            );
+        }
+        assert_eq!(fs::read(&input).unwrap(), b"keep me");
+    }
+
+    #[test]
+    fn writes_replace_atomically_and_leave_no_temporary() {
+        let d = scratch("atomic");
+        let p = d.join("out.txt");
+        let outputs = OutputPlan::new().file(&p, "--out").check().unwrap();
+        outputs.write_text(&p, "first").unwrap();
+        outputs
+            .write_output(&OutputFile::new(&p, "second"))
+            .unwrap();
+        assert_eq!(fs::read_to_string(&p).unwrap(), "second");
+        let failed = outputs.write(&p, |w| {
+            w.write_all(b"half")?;
+            Err(io::Error::other("disk on fire"))
+        });
+        assert!(failed.is_err());
+        assert_eq!(fs::read_to_string(&p).unwrap(), "second");
+        let names: Vec<_> = fs::read_dir(&d)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name())
+            .collect();
+        assert_eq!(names.len(), 1, "{names:?}");
+        let unplanned = outputs.write_text(&d.join("other.txt"), "x").unwrap_err();
+        assert!(
+            matches!(unplanned, OutputError::NotPlanned { .. }),
+            "{unplanned}"
+        );
+    }
+
+    #[test]
+    fn output_directory_checks_name_the_blocking_file() {
+        let d = scratch("dirs");
+        let input = d.join("v.csv");
+        fs::write(&input, b"1").unwrap();
+        let no_names: [&str; 0] = [];
+        let e = OutputPlan::new()
+            .input(&input)
+            .dir(&input, "--dir", no_names)
+            .check()
+            .unwrap_err();
+        let e = refusal(e, "--dir");
+        assert!(matches!(e, OutputError::DirectoryIsInput { .. }), "{e}");
+        let e = OutputPlan::new()
+            .dir(input.join("sub"), "--dir", no_names)
+            .check()
+            .unwrap_err();
+        assert!(e.to_string().contains("v.csv"), "{e}");
+        let e = OutputPlan::new()
+            .input(&input)
+            .dir(&d, "--dir", ["v.csv"])
+            .check()
+            .unwrap_err();
+        let e = refusal(e, "--dir");
+        assert!(matches!(e, OutputError::WouldOverwriteInput { .. }), "{e}");
+        OutputPlan::new()
+            .input(&input)
+            .dir(&d, "--dir", ["new.csv"])
+            .check()
+            .unwrap();
     }
 }

@@ -76,9 +76,9 @@ pub fn ensure_not_input(path: &Path, inputs: &[PathBuf]) -> Result<(), OutputErr
 /// * `-` and names of standard output: written to standard output;
 /// * `/dev/fd/N` and the like: through that descriptor, in place;
 /// * character devices and FIFOs: opened and written in place, never renamed over (a FIFO
-///   without a reader is waited for up to [`FIFO_READER_WAIT`]);
+///   without a reader is waited for up to `FIFO_READER_WAIT`);
 /// * regular files (new or existing, links resolved): written to a temporary in the same
-///   directory (short name, see [`temporary_in`](super::temporary_in)) and renamed over the
+///   directory (short name, see `temporary_in`) and renamed over the
 ///   file when complete; a write-protected file is refused, an existing file's permissions
 ///   are kept; missing directories are created. On failure the temporary is removed and the
 ///   file is untouched.

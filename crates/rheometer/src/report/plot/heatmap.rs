@@ -13,7 +13,7 @@ use super::error::{invalid, PlotError};
 use super::legend::{draw_legend, legend_size, LegendEntry, PixelRect, Swatch};
 use super::style::colors::{viridis, ColorScale, MARKER_COLORS, MISSING};
 use super::style::fonts::FONT;
-use super::write::{write_figure, DrawResult, Figure};
+use super::write::{render_figure, write_figure, DrawResult, Figure};
 
 /// A scalar field on a rectilinear grid, e.g. a cost landscape `J(x, y)`, with a colour bar.
 ///
@@ -78,9 +78,22 @@ impl<'a> Heatmap<'a> {
 ///
 /// Errors if the grid is empty or not finite and strictly monotonic, if `values` does not have
 /// `xs.len() * ys.len()` entries, or if the size is 0 or larger than
-/// [`MAX_SIDE`](super::MAX_SIDE).
+/// `MAX_SIDE`.
 pub fn save_heatmap(path: &Path, heatmap: &Heatmap<'_>) -> Result<(), PlotError> {
-    let hm = heatmap;
+    validate(path, heatmap)?;
+    write_figure(path, heatmap.size, heatmap)
+}
+
+/// The heat map of [`save_heatmap`] rendered in memory as the file `path` would hold it (PNG or
+/// SVG by its extension), without writing it.
+pub(crate) fn render_heatmap(path: &Path, heatmap: &Heatmap<'_>) -> Result<Vec<u8>, PlotError> {
+    validate(path, heatmap)?;
+    render_figure(path, heatmap.size, heatmap)
+}
+
+/// The checks of [`save_heatmap`]: non-empty, finite, monotonic coordinates (positive on a
+/// logarithmic axis) and one value per cell.
+fn validate(path: &Path, hm: &Heatmap<'_>) -> Result<(), PlotError> {
     for (name, c, log) in [("xs", hm.xs, hm.log_x), ("ys", hm.ys, hm.log_y)] {
         if c.is_empty() {
             return Err(invalid(path, format!("heat map: {name} is empty")));
@@ -118,7 +131,7 @@ pub fn save_heatmap(path: &Path, heatmap: &Heatmap<'_>) -> Result<(), PlotError>
             ),
         ));
     }
-    write_figure(path, hm.size, hm)
+    Ok(())
 }
 
 /// Cell edges for cell centres `c` (finite, strictly monotonic, non-empty, and positive if

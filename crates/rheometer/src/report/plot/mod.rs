@@ -68,8 +68,11 @@ mod write;
 
 pub use error::PlotError;
 pub use flow_curve::{flow_curve_svg, save_flow_curve, FlowCurvePlot, ReferencePoints};
+pub(crate) use heatmap::render_heatmap;
 pub use heatmap::{save_heatmap, Heatmap};
+pub(crate) use panel_draw::render_panels;
 pub use panel_draw::{panels_svg, save_panels};
-pub use panels::{Band, BandShape, LegendPlacement, Panel, RefLine, Series, Style};
+pub(crate) use panels::Band;
+pub use panels::{Panel, Series, Style};
 pub use style::colors::PALETTE;
-pub use write::{FigureFormat, MAX_SIDE};
+pub use write::FigureFormat;

@@ -15,7 +15,7 @@ use super::legend::{
 use super::panels::{BandShape, LegendPlacement, Panel, Style};
 use super::style::colors::PALETTE;
 use super::style::fonts::FONT;
-use super::write::{render_svg, write_figure, DrawResult, Figure};
+use super::write::{render_figure, render_svg, write_figure, DrawResult, Figure};
 use std::path::Path;
 
 /// Neutral colour of bands and reference lines without a palette index.
@@ -480,33 +480,45 @@ fn grid_shape(path: &Path, panels: &[Panel], columns: usize) -> Result<(usize, u
 /// `size.0 × size.1` pixel figure at `path` (`.png` or `.svg`).
 ///
 /// `columns` larger than the number of panels is reduced to it. Errors if there are no panels,
-/// `columns` is 0, or the size is 0 or larger than [`MAX_SIDE`](super::MAX_SIDE).
+/// `columns` is 0, or the size is 0 or larger than `MAX_SIDE`.
 pub fn save_panels(
     path: &Path,
     panels: &[Panel],
     columns: usize,
     size: (u32, u32),
 ) -> Result<(), PlotError> {
-    let (rows, columns) = grid_shape(path, panels, columns)?;
-    let grid = PanelGrid {
-        panels,
-        rows,
-        columns,
-    };
-    write_figure(path, size, &grid)
+    write_figure(path, size, &PanelGrid::new(path, panels, columns)?)
+}
+
+/// The grid of [`save_panels`] rendered in memory as the file `path` would hold it (PNG or
+/// SVG by its extension), without writing it.
+pub(crate) fn render_panels(
+    path: &Path,
+    panels: &[Panel],
+    columns: usize,
+    size: (u32, u32),
+) -> Result<Vec<u8>, PlotError> {
+    render_figure(path, size, &PanelGrid::new(path, panels, columns)?)
 }
 
 /// The grid of [`save_panels`] as an SVG document in memory (e.g. to embed in an HTML page);
 /// errors name `"<svg>"` as the path.
 pub fn panels_svg(panels: &[Panel], columns: usize, size: (u32, u32)) -> Result<String, PlotError> {
     let path = Path::new("<svg>");
-    let (rows, columns) = grid_shape(path, panels, columns)?;
-    let grid = PanelGrid {
-        panels,
-        rows,
-        columns,
-    };
-    render_svg(path, size, &grid)
+    render_svg(path, size, &PanelGrid::new(path, panels, columns)?)
+}
+
+impl<'a> PanelGrid<'a> {
+    /// `panels` in `columns` columns and as many rows as needed (see `grid_shape`; `path`
+    /// names the figure in errors).
+    fn new(path: &Path, panels: &'a [Panel], columns: usize) -> Result<Self, PlotError> {
+        let (rows, columns) = grid_shape(path, panels, columns)?;
+        Ok(PanelGrid {
+            panels,
+            rows,
+            columns,
+        })
+    }
 }
 
 #[cfg(test)]
@@ -541,7 +553,7 @@ mod tests {
         let p = Panel::default()
             .with_series(super::super::Series::line("", vec![(0.0, 0.0), (1.0, 1.0)]))
             .with_noise_band("noise", 3.0)
-            .with_ref_line(super::super::RefLine::new("", 10.0));
+            .with_ref_line(super::super::panels::RefLine::new("", 10.0));
         let ((x0, x1), (y0, y1)) = panel_ranges(&p);
         assert!(x0 < 0.0 && x1 > 1.0 && y0 < -3.0 && y1 > 10.0);
     }

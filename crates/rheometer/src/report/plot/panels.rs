@@ -271,7 +271,7 @@ impl Panel {
         self
     }
 
-    /// Adds a noise band `±sigma` around zero ([`Band::noise`]), labelled `label`.
+    /// Adds a noise band `±sigma` around zero (`Band::noise`), labelled `label`.
     pub fn with_noise_band(self, label: impl Into<String>, sigma: f64) -> Self {
         self.with_band(Band::noise(label, sigma))
     }

@@ -163,26 +163,35 @@ pub(super) fn render_rgb<F: Figure>(
     Ok(downsample(&canvas, size, s))
 }
 
-/// Validates, renders in memory (PNG encoded in memory too), and only then writes `path`
-/// through the output layer ([`write_bytes`]): a regular file via a temporary renamed into
-/// place (missing directories created), a character device or FIFO in place.
+/// Validates and renders `figure` in memory as the file `path` names it: PNG bytes or an SVG
+/// document, as its extension says (`path` is not written).
+pub(super) fn render_figure<F: Figure>(
+    path: &Path,
+    size: (u32, u32),
+    figure: &F,
+) -> Result<Vec<u8>, PlotError> {
+    match FigureFormat::of_path(path)? {
+        FigureFormat::Png => {
+            let rgb = render_rgb(path, size, figure)?;
+            encode_png(&rgb, size).map_err(|e| draw_error(path)(Box::new(e)))
+        }
+        FigureFormat::Svg => Ok(render_svg(path, size, figure)?.into_bytes()),
+    }
+}
+
+/// Renders in memory ([`render_figure`]) and only then writes `path` through the output layer
+/// ([`write_bytes`]): a regular file via a temporary renamed into place (missing directories
+/// created), a character device or FIFO in place; a drawing failure leaves no file behind.
 pub(super) fn write_figure<F: Figure>(
     path: &Path,
     size: (u32, u32),
     figure: &F,
 ) -> Result<(), PlotError> {
-    let format = FigureFormat::of_path(path)?;
+    FigureFormat::of_path(path)?;
     if path.is_dir() {
         return Err(invalid(path, "the output path is an existing directory"));
     }
-    // Render first so that a drawing failure leaves no file behind.
-    let bytes = match format {
-        FigureFormat::Png => {
-            let rgb = render_rgb(path, size, figure)?;
-            encode_png(&rgb, size).map_err(|e| draw_error(path)(Box::new(e)))?
-        }
-        FigureFormat::Svg => render_svg(path, size, figure)?.into_bytes(),
-    };
+    let bytes = render_figure(path, size, figure)?;
     write_bytes(path, &[], &bytes)?;
     Ok(())
 }

@@ -24,21 +24,8 @@ pub const DEFAULT_MIN_POINTS: usize = 4;
 pub const CSV_HEADER: [&str; 2] = ["position_m", "diameter_m"];
 
 /// Loads one measurement CSV file, requiring positions within `[0, spinline_length]` \[m\]
-/// (pass `f64::INFINITY` to skip that check) and at least `min_points` rows, under the default
-/// caps of [`LoadOptions`].
-pub fn load_measurements(
-    path: &Path,
-    spinline_length: f64,
-    min_points: usize,
-) -> Result<Measurements, InputError> {
-    load_measurements_with(
-        path,
-        spinline_length,
-        &LoadOptions::with_min_points(min_points),
-    )
-}
-
-/// [`load_measurements`] under `options` (`min_points`, the byte, line and row caps).
+/// (pass `f64::INFINITY` to skip that check) and at least `options.min_points` rows, under the
+/// byte, line and row caps of `options`.
 pub fn load_measurements_with(
     path: &Path,
     spinline_length: f64,
@@ -66,7 +53,7 @@ pub(in crate::data::input) fn read_measurements(
 }
 
 /// Parses the text of a measurement CSV file; `path` is used in error messages only. See
-/// [`load_measurements`].
+/// `load_measurements`.
 pub fn parse_measurements(
     text: &str,
     path: &Path,

@@ -60,7 +60,11 @@ mod tests {
     #[test]
     fn a_modifier_added_in_one_file_is_fitted() {
         use crate::model::setup::{Air, Experiment, Material};
-        use crate::{simulate, CarreauLike, FiberModel, Physics, SimulateOptions};
+        use crate::{
+            model::bvp::FiberModel, model::contributions::Physics,
+            model::material_law::CarreauLike, model::simulate::simulate,
+            model::simulate::SimulateOptions,
+        };
 
         let diameters = |physics: Physics| {
             let model = FiberModel::new(

@@ -6,8 +6,8 @@
 
 use crate::model::catalog::{EffectDescriptor, AIR_COFLOW, COFLOW_DECAY};
 use crate::model::contributions::modifiers::{add, AirProfile, Modifier, Part, Values, SLOTS};
+use crate::model::contributions::NusseltLaw;
 use crate::model::contributions::{Coefficients, Physics, Strength};
-use crate::NusseltLaw;
 use num_dual::DualNum;
 
 /// The aspirator co-flow with amplitude `V` \[m/s\].

@@ -6,8 +6,8 @@ use crate::model::catalog::{
     EffectDescriptor, AIR_COFLOW_LINE, COFLOW_LINE_ONSET, COFLOW_LINE_RAMP,
 };
 use crate::model::contributions::modifiers::{add, AirProfile, Modifier, Part, Values, SLOTS};
+use crate::model::contributions::NusseltLaw;
 use crate::model::contributions::{Coefficients, Physics, Strength};
-use crate::NusseltLaw;
 use num_dual::DualNum;
 
 /// The co-flow along the line with speed `V` \[m/s\].

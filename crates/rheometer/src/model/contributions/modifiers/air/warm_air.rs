@@ -4,8 +4,8 @@
 
 use crate::model::catalog::{EffectDescriptor, AIR_TEMPERATURE_PROFILE, WARM_AIR_DECAY};
 use crate::model::contributions::modifiers::{add, AirProfile, Modifier, Part, Values, SLOTS};
+use crate::model::contributions::NusseltLaw;
 use crate::model::contributions::{Coefficients, Physics, Strength};
-use crate::NusseltLaw;
 use num_dual::DualNum;
 
 /// The warm-air profile with excess `ΔT` \[K\].

@@ -30,7 +30,7 @@ impl Modifier for InletVelocity {
     }
 }
 
-impl<H: crate::NusseltLaw> crate::model::contributions::Physics<H> {
+impl<H: crate::model::contributions::NusseltLaw> crate::model::contributions::Physics<H> {
     /// Makes the relative inlet-velocity error `δ` (`u(0) = (1 + δ) u_in`) a model parameter
     /// named `"inlet_velocity"` with default value `error` \[-\].
     pub fn with_inlet_velocity_error(mut self, error: f64) -> Self {
