@@ -212,6 +212,16 @@ impl Candidate {
             .map_or([f64::NAN; 2], |e| e.ci95)
     }
 
+    /// The refit's estimate of `n` when fitted there.
+    pub fn n_estimate(&self) -> Option<&Estimate> {
+        self.fitted_law(|s| &s.n)
+    }
+
+    /// The refit's estimate of `κ` when fitted there.
+    pub fn kappa_estimate(&self) -> Option<&Estimate> {
+        self.fitted_law(|s| &s.kappa)
+    }
+
     fn fitted_law(&self, pick: impl Fn(&FitSummary) -> &Estimate) -> Option<&Estimate> {
         self.refit.as_ref().map(pick).filter(|e| e.fitted)
     }

@@ -5,7 +5,7 @@ use super::diagnose::verdict::{Help, Unexplained, Verdict};
 use super::diagnosis::{Diagnosis, DiagnosisRun, ResidualProfiles};
 use super::refits::consistency::Consistency;
 use super::refits::scan::Profile;
-use crate::fit::summary::Z95;
+use crate::fit::summary::Estimate;
 use crate::report::format::{fmt_at, fmt_g, fmt_pm, unit_suffix};
 use crate::report::plot::{save_panels, Panel, PlotError, Series};
 use std::path::Path;
@@ -359,17 +359,13 @@ pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), Plo
 
 /// `"0.804 ± 0.007 (95% CI [0.790, 0.818])"` (rounded to the standard error behind the
 /// interval), or the estimate marked at its bound without an interval.
-fn estimate_with_ci(c: &Candidate, name: &str, value: f64, ci: [f64; 2]) -> String {
-    estimate_with_ci_bounds(c.at_bound(), name, value, ci)
+fn estimate_with_ci(c: &Candidate, name: &str, e: Option<&Estimate>) -> String {
+    estimate_with_ci_bounds(c.at_bound(), name, e.unwrap_or(&Estimate::unknown()))
 }
 
 /// [`estimate_with_ci`] of a fit's estimate `name` (its bounds from `at_bound`).
-fn estimate_with_ci_bounds(
-    at_bound: &[crate::fit::AtBound],
-    name: &str,
-    value: f64,
-    ci: [f64; 2],
-) -> String {
+fn estimate_with_ci_bounds(at_bound: &[crate::fit::AtBound], name: &str, e: &Estimate) -> String {
+    let (value, ci) = (e.value, e.ci95);
     match at_bound.iter().find(|b| b.parameter == name) {
         Some(b) => format!(
             "{} (AT ITS {} BOUND: no valid 95% CI)",
@@ -377,7 +373,7 @@ fn estimate_with_ci_bounds(
             b.side.name().to_uppercase()
         ),
         None if ci.iter().all(|v| v.is_finite()) => {
-            let se = (ci[1] - ci[0]) / (2.0 * Z95);
+            let se = e.stderr;
             format!(
                 "{} (95% CI [{}, {}])",
                 fmt_pm(value, se),
@@ -455,7 +451,7 @@ fn shape_alternative_line(c: &Candidate, a: &ShapeAlternative) -> String {
         .collect::<Vec<_>>()
         .join(", ");
     let shift = |x: f64, x0: f64, se: f64| (x - x0) / se;
-    let se_of = |ci: [f64; 2]| (ci[1] - ci[0]) / (2.0 * crate::fit::summary::Z95);
+    let se_of = |e: Option<&Estimate>| e.map_or(f64::NAN, Estimate::valid_stderr);
     format!(
         "SHAPE: these data cannot choose the shape of {}: with {shape} (delta BIC {:+.1}) its \
          strength is {}, n = {} (95% CI [{}, {}]), kappa = {} (95% CI [{}, {}]): n {:+.1}, \
@@ -470,8 +466,8 @@ fn shape_alternative_line(c: &Candidate, a: &ShapeAlternative) -> String {
         fmt_at(r.kappa.value, r.kappa.stderr),
         fmt_at(r.kappa.ci95[0], r.kappa.stderr),
         fmt_at(r.kappa.ci95[1], r.kappa.stderr),
-        shift(r.n.value, c.n(), se_of(c.ci95_n())),
-        shift(r.kappa.value, c.kappa(), se_of(c.ci95_kappa()))
+        shift(r.n.value, c.n(), se_of(c.n_estimate())),
+        shift(r.kappa.value, c.kappa(), se_of(c.kappa_estimate()))
     )
 }
 

@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 /// `ΔBIC` gap below 6 is less than "strong" evidence (Kass–Raftery) for the named cause.
 pub(crate) const DEFAULT_TIE_MARGIN: f64 = 6.0;
 
-use crate::fit::summary::Z95;
+use crate::fit::summary::Estimate;
 
 /// Shifts of `n` and `κ` (in the named refit's standard errors) below which the material
 /// result is robust to the choice between tied causes.
@@ -80,12 +80,8 @@ pub(crate) fn ties_with(
 }
 
 /// Standard error of a refit's law parameter where its interval is valid (`NaN` else).
-fn stderr_of(ci: [f64; 2]) -> f64 {
-    if ci.iter().all(|v| v.is_finite()) {
-        (ci[1] - ci[0]) / (2.0 * Z95)
-    } else {
-        f64::NAN
-    }
+fn stderr_of(e: Option<&Estimate>) -> f64 {
+    e.map_or(f64::NAN, Estimate::valid_stderr)
 }
 
 /// `(alt − named) / se`, `NaN` unless `se` is positive and finite.
@@ -109,8 +105,12 @@ impl Alternative {
         category: Category,
         signature_cosine: f64,
     ) -> Self {
-        let n_shift_se = shift(alt.n(), named.n(), stderr_of(named.ci95_n()));
-        let kappa_shift_se = shift(alt.kappa(), named.kappa(), stderr_of(named.ci95_kappa()));
+        let n_shift_se = shift(alt.n(), named.n(), stderr_of(named.n_estimate()));
+        let kappa_shift_se = shift(
+            alt.kappa(),
+            named.kappa(),
+            stderr_of(named.kappa_estimate()),
+        );
         Alternative {
             effect: alt.effect.clone(),
             category,

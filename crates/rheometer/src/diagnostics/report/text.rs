@@ -225,8 +225,8 @@ impl Diagnosis {
             };
             s.push_str(&format!(
                 "{lead}: n = {}, kappa = {}.\n",
-                estimate_with_ci(c, "n", c.n(), c.ci95_n()),
-                estimate_with_ci(c, "kappa", c.kappa(), c.ci95_kappa())
+                estimate_with_ci(c, "n", c.n_estimate()),
+                estimate_with_ci(c, "kappa", c.kappa_estimate())
             ));
         }
         if let Some(a) = &c.shape_alternative {
@@ -542,8 +542,8 @@ fn law_line(effects: &str, note: &str, f: &FitSummary) -> String {
     };
     format!(
         "With {effects}{note}: n = {}, kappa = {}, RMS {:.3} %{strengths}.\n",
-        estimate_with_ci_bounds(&f.at_bound, "n", f.n.value, f.n.ci95),
-        estimate_with_ci_bounds(&f.at_bound, "kappa", f.kappa.value, f.kappa.ci95),
+        estimate_with_ci_bounds(&f.at_bound, "n", &f.n),
+        estimate_with_ci_bounds(&f.at_bound, "kappa", &f.kappa),
         100.0 * f.rms_relative_residual
     )
 }

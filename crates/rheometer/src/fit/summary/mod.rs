@@ -168,6 +168,15 @@ impl Estimate {
         }
     }
 
+    /// The standard error where the 95 % interval is valid (finite), `NaN` else.
+    pub fn valid_stderr(&self) -> f64 {
+        if self.ci95.iter().all(|v| v.is_finite()) {
+            self.stderr
+        } else {
+            f64::NAN
+        }
+    }
+
     /// An estimate not known (a report written before it existed): `NaN` everywhere.
     pub fn unknown() -> Self {
         Estimate {
