@@ -19,7 +19,6 @@ mod fiber_reference;
 mod fiber_terms;
 mod fit_warnings;
 mod flow_curve_intervals;
-mod growth_limit;
 mod independent_model;
 mod landscape;
 mod linear_solvers;

@@ -51,9 +51,8 @@ pub use diagnose::{
 pub use diagnosis::DiagnosisJson;
 pub use refits::pair::{delta_bic, law_envelope_of, PairFound};
 pub use refits::scan::{
-    physical, physical_range, refine, scan_candidate, search_range, CandidateScan, GridStart,
-    Profile, ProfilePoint, ProfileScan, Refit, ScanOptions, ShapeParameter, GRID_GROWTH_LIMIT,
-    REFINE_GROWTH_LIMIT,
+    physical, physical_range, search_range, Profile, ProfilePoint, Refit, ScanOptions,
+    ShapeParameter,
 };
 pub use report::{save_profile_figure, save_residual_figure};
 pub use ties::{alternatives, independent_check, Alternative};
