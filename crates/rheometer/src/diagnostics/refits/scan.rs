@@ -1155,18 +1155,26 @@ mod tests {
         refits: Vec<Refit>,
     }
 
-    /// The global search of one candidate variant: `scan_profile`, then [`refine`] of its best
-    /// grid points (refits that fail are left out).
+    /// The global search of one candidate variant at its default shape: `scan_profile`, then
+    /// [`refine`] of its best grid points (refits that fail are left out); `J` of the user's
+    /// fit `base` is `cost_base`.
     fn scan_candidate(
         rh: &Rheometer,
         effect: &Effect,
-        shape: Vec<ShapeParameter>,
-        base: &Identification,
-        cost_base: f64,
+        (base, cost_base): (&Identification, f64),
         options: &IdentifyOptions,
         scan: &ScanOptions,
     ) -> Result<CandidateScan, RheometerError> {
-        let ps = scan_profile(rh, effect, effect, shape, base, cost_base, options, scan)?;
+        let ps = scan_profile(
+            rh,
+            effect,
+            effect,
+            Vec::new(),
+            base,
+            cost_base,
+            options,
+            scan,
+        )?;
         let mut refits: Vec<Refit> = ps
             .starts
             .iter()
@@ -1216,7 +1224,7 @@ mod tests {
                 grid_tol,
                 ..ScanOptions::default()
             };
-            scan_candidate(&rh, &radiation, Vec::new(), &base, cost_base, &opts, &so).unwrap()
+            scan_candidate(&rh, &radiation, (&base, cost_base), &opts, &so).unwrap()
         };
         let loose = scan(ScanOptions::default().grid_tol);
         let tight = scan(1e-4);
@@ -1289,7 +1297,7 @@ mod tests {
                 stop_above: 1e3,
                 ..ScanOptions::default()
             };
-            scan_candidate(&rh, &coflow, Vec::new(), &base, cost_base, &opts, &so).unwrap()
+            scan_candidate(&rh, &coflow, (&base, cost_base), &opts, &so).unwrap()
         };
         assert_eq!(
             ScanOptions::default().grid_growth_limit,
