@@ -119,7 +119,7 @@ impl LossArgs {
     }
 }
 
-/// `--tol`: in [`request::TOL_RANGE`].
+/// `--tol`: in [1e-12, 0.1] (`request::tol`).
 pub fn parse_tol(s: &str) -> Result<f64, String> {
     request::tol(number(s)?).map_err(reason)
 }
@@ -136,13 +136,12 @@ pub fn parse_n(s: &str) -> Result<f64, String> {
     request::n(number(s)?).map_err(reason)
 }
 
-/// `--kappa`: a finite κ with |κ| <= [`request::MAX_ABS_KAPPA`].
+/// `--kappa`: a finite κ with |κ| <= 700 (`request::kappa`).
 pub fn parse_kappa(s: &str) -> Result<f64, String> {
     request::kappa(number(s)?).map_err(reason)
 }
 
-/// `--take-up-diameter`: in [[`request::MIN_TAKE_UP_DIAMETER_M`], the largest plausible
-/// diameter] m.
+/// `--take-up-diameter`: in [1e-7, 0.02] m (`request::take_up_diameter`).
 pub fn parse_take_up_diameter(s: &str) -> Result<f64, String> {
     request::take_up_diameter(number(s)?).map_err(reason)
 }
@@ -192,7 +191,7 @@ pub fn parse_pair(s: &str) -> Result<(f64, f64), String> {
     Ok((a, b))
 }
 
-/// The `--grid` size "NxM": 2 to [`request::MAX_GRID_SIDE`] values per direction, at most
+/// The `--grid` size "NxM": 2 to 1000 values per direction, at most
 /// [`MAX_GRID_POINTS`] points.
 pub fn parse_grid(s: &str) -> Result<(usize, usize), String> {
     let (a, b) = parse_two::<i128>(s, &['x', 'X'], "\"NxM\"", "a count")?;

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use rheometer::data::input::{
     estimated_fit_memory_bytes, load_experiments, load_experiments_with, InputError, Limit,
-    LoadOptions, DEFAULT_MAX_EXPERIMENTS,
+    LoadOptions,
 };
 
 /// A scratch copy of the shipped data set: (scratch dir, TOML, data dir).
@@ -345,8 +345,11 @@ fn the_number_of_experiments_is_capped_before_any_data_is_read() {
                     "{} [[experiment]] tables",
                     if n == 2000 { "2,000" } else { "20,000" }
                 ),
-                &format!("more than the limit of {DEFAULT_MAX_EXPERIMENTS}")
-                    .replace("1000", "1,000"),
+                &format!(
+                    "more than the limit of {}",
+                    LoadOptions::default().max_experiments
+                )
+                .replace("1000", "1,000"),
                 "max_experiments",
             ],
         );

@@ -21,7 +21,10 @@ use rheometer::fit::{
     error_budget, ErrorBudget, Identification, IdentifyOptions, Rheometer, SourceStatus,
     WarningCode,
 };
-use rheometer::fit::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
+/// The standard errors above which a fit warns that the data do not determine the parameter
+/// (the book's JSON reference: SE(n) > 0.2, SE(κ) > 1).
+const LARGE_STDERR_N: f64 = 0.2;
+const LARGE_STDERR_KAPPA: f64 = 1.0;
 use rheometer::model::Scope;
 use rheometer::model::{Effect, EffectSetting, ModelSpec};
 use rheometer::model::{ExperimentSet, Inlet};

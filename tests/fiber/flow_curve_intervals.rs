@@ -13,7 +13,10 @@ use rheometer::data::input::{load_experiments_with, LoadedExperiments};
 use rheometer::fit::{BandMethod, FitSummary, IdentifyOptions};
 use rheometer::model::LawChoice;
 use rheometer::report::flow_curve_figure::save_flow_curve_figure;
-use rheometer::report::format::{fmt_pm, LINE_WIDTH};
+use rheometer::report::format::fmt_pm;
+
+/// The widest line a report prints (the reports' promise, in characters).
+const LINE_WIDTH: usize = 100;
 use rheometer::workflow::{fit, FitRequest, FitRun};
 use std::path::Path;
 use std::time::Duration;

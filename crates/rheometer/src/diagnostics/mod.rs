@@ -49,10 +49,9 @@ pub use diagnose::{
     RobustWeights, StageTimes,
 };
 pub use diagnosis::DiagnosisJson;
-pub use refits::pair::{delta_bic, law_envelope_of, PairFound};
+pub use refits::pair::PairFound;
 pub use refits::scan::{
-    physical, physical_range, search_range, Profile, ProfilePoint, Refit, ScanOptions,
-    ShapeParameter,
+    physical, physical_range, Profile, ProfilePoint, Refit, ScanOptions, ShapeParameter,
 };
-pub use report::{save_profile_figure, save_residual_figure};
-pub use ties::{alternatives, independent_check, Alternative};
+pub use report::save_residual_figure;
+pub use ties::{alternatives, Alternative};

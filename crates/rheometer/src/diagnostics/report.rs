@@ -416,7 +416,7 @@ pub fn save_residual_figure(
 }
 
 impl DiagnosisRun {
-    /// Writes the figure of the `J` profiles ([`save_profile_figure`]).
+    /// Writes the figure of the `J` profiles: one panel per candidate, `J` against its strength.
     pub fn save_profile_figure(&self, path: &Path) -> Result<(), PlotError> {
         save_profile_figure(path, &self.diagnosis)
     }

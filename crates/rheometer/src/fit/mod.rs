@@ -54,7 +54,6 @@ pub(crate) mod values;
 
 pub use estimator::RelativeResidual;
 pub use objective::Objective;
-pub use summary::checks::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 
 pub use data::Rheometer;
 pub use estimator::Estimator;

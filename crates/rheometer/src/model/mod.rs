@@ -39,9 +39,7 @@ pub use contributions::{
     Balance, Coefficients, FiberTerm, InclinedChurchillBernstein, LocalState, NusseltLaw, Physics,
     ProcessFactors, SiScales, SiState, Strength, StrengthPlan, Term, TermKind, STEFAN_BOLTZMANN,
 };
-pub use effects::{
-    physics_with, Effect, EffectSetting, LawChoice, ModelSpec, UserEffect, NEWTONIAN_LAW,
-};
+pub use effects::{physics_with, Effect, EffectSetting, LawChoice, ModelSpec, UserEffect};
 pub use material_law::{
     viscosity, CarreauLike, CarreauYasuda, LawInputs, Newtonian, ViscosityLaw, ZeroRateViscosity,
 };

@@ -159,12 +159,12 @@ pub fn fmt_at(v: f64, u: f64) -> String {
 }
 
 /// The widest line a report prints, in characters.
-pub const LINE_WIDTH: usize = 100;
+pub(crate) const LINE_WIDTH: usize = 100;
 
 /// `text` wrapped at word boundaries to lines of at most `width` characters: the first line
 /// starts with `first`, the following ones with `rest` (indentation). A single word longer
 /// than the room is kept whole; runs of spaces are kept except at a break.
-pub fn wrap(text: &str, width: usize, first: &str, rest: &str) -> String {
+pub(crate) fn wrap(text: &str, width: usize, first: &str, rest: &str) -> String {
     let mut out = String::new();
     let mut line = first.to_string();
     let mut empty = true;

@@ -19,7 +19,7 @@ use std::fmt;
 /// run's memory and its CSV files bounded.
 pub const MAX_POINTS: usize = 100_000;
 /// Largest number of values per direction of a landscape or design grid.
-pub const MAX_GRID_SIDE: usize = 1000;
+pub(crate) const MAX_GRID_SIDE: usize = 1000;
 /// Largest number of points of a landscape grid (N x M).
 pub const MAX_GRID_POINTS: usize = 100_000;
 /// Smallest mesh limit (the cold start begins on a mesh of 21 nodes).
@@ -29,11 +29,11 @@ pub const MAX_MAX_NODES: usize = 1_000_000;
 /// Default mesh limit of the solves of `simulate`, `fit`, `diagnose`, `compare` and `design`.
 pub const DEFAULT_MAX_NODES: usize = 20_000;
 /// Smallest take-up diameter a user may give \[m\].
-pub const MIN_TAKE_UP_DIAMETER_M: f64 = 1e-7;
+pub(crate) const MIN_TAKE_UP_DIAMETER_M: f64 = 1e-7;
 /// Largest |κ| (K = e^κ Pa stays a finite positive number).
-pub const MAX_ABS_KAPPA: f64 = 700.0;
+pub(crate) const MAX_ABS_KAPPA: f64 = 700.0;
 /// Range of a BVP tolerance \[-\].
-pub const TOL_RANGE: (f64, f64) = (1e-12, 0.1);
+pub(crate) const TOL_RANGE: (f64, f64) = (1e-12, 0.1);
 /// Range (exclusive) of a relative noise level given to the design \[-\].
 pub(crate) const NOISE_RANGE: (f64, f64) = (0.0, 0.5);
 
@@ -399,7 +399,7 @@ pub fn landscape_max_nodes(v: Option<i128>) -> Result<usize, Refusal> {
     }
 }
 
-/// A BVP tolerance in [`TOL_RANGE`].
+/// A BVP tolerance in [1e-12, 0.1].
 pub fn tol(v: f64) -> Result<f64, Refusal> {
     if !(TOL_RANGE.0..=TOL_RANGE.1).contains(&v) {
         return Err(Refusal::new(
@@ -492,7 +492,7 @@ pub fn n(v: f64) -> Result<f64, Refusal> {
     Ok(v)
 }
 
-/// `κ`: finite with |κ| <= [`MAX_ABS_KAPPA`].
+/// `κ`: finite with |κ| <= 700.
 pub fn kappa(v: f64) -> Result<f64, Refusal> {
     if v.is_nan() || v.abs() > MAX_ABS_KAPPA {
         return Err(Refusal::new(
@@ -507,7 +507,7 @@ pub fn kappa(v: f64) -> Result<f64, Refusal> {
     Ok(v)
 }
 
-/// A take-up diameter in [[`MIN_TAKE_UP_DIAMETER_M`], `MAX_PLAUSIBLE_DIAMETER_M`] m.
+/// A take-up diameter in [1e-7, 0.02] m.
 pub fn take_up_diameter(v: f64) -> Result<f64, Refusal> {
     if !(MIN_TAKE_UP_DIAMETER_M..=MAX_PLAUSIBLE_DIAMETER_M).contains(&v) {
         return Err(Refusal::new(
@@ -549,7 +549,7 @@ pub fn noise(v: f64) -> Result<f64, Refusal> {
     Ok(v)
 }
 
-/// A grid of `a` x `b` points: 2 to [`MAX_GRID_SIDE`] values per direction and at most
+/// A grid of `a` x `b` points: 2 to 1000 values per direction and at most
 /// `max_points` points.
 pub fn grid(a: i128, b: i128, max_points: usize) -> Result<(usize, usize), Refusal> {
     let side = |v: i128| usize::try_from(v).ok();

@@ -95,11 +95,12 @@
 //! is blamed on the mass flow's unit) and the derived inlet diameter plausible; a take-up
 //! diameter must be smaller than the inlet diameter (a take-up velocity larger than the inlet
 //! velocity), with a draw ratio of at most 10⁶; experiment names must be unique
-//! (also ignoring case), without leading or trailing spaces, and at most [`MAX_NAME_BYTES`]
-//! long (they name output files). Errors about values that come from `[defaults]` name the
-//! experiment too. With the measurements, [`load_experiments_with`] also checks the
-//! inlet diameter against the first measured diameter and, for an experiment whose take-up
-//! diameter will be `d_fit(L)` of its data, the spin-line length against the measured range
+//! (also ignoring case), without leading or trailing spaces, and at most 236 bytes long (they
+//! name output files: 255 bytes less the longest suffix, `_fitted_profile.csv`). Errors about
+//! values that come from `[defaults]` name the experiment too. With the measurements,
+//! [`load_experiments_with`] also checks the inlet diameter against the first measured diameter
+//! and, for an experiment whose take-up diameter will be `d_fit(L)` of its data, the spin-line
+//! length against the measured range
 //! (a warning a little beyond, an error far beyond: [`LoadOptions::take_up_warn_beyond`]).
 //!
 //! Inputs are read only from regular files (a FIFO, device or directory is refused before it is
@@ -171,10 +172,6 @@ pub use json::DEFAULT_MAX_JSON_BYTES;
 pub use loaded::LoadedExperiments;
 pub(crate) use options::max_fit_rows;
 pub(crate) use options::show_count;
-pub use options::{
-    estimated_fit_memory_bytes, Limit, LoadOptions, DEFAULT_MAX_EXPERIMENTS,
-    DEFAULT_MAX_ROWS_PER_FILE,
-};
-pub use toml_file::experiment::MAX_NAME_BYTES;
+pub use options::{estimated_fit_memory_bytes, Limit, LoadOptions, DEFAULT_MAX_ROWS_PER_FILE};
 pub(crate) use toml_file::schema::MAX_PLAUSIBLE_DIAMETER_M;
 pub(crate) use toml_file::schema::PLAUSIBLE_RANGES;

@@ -84,7 +84,7 @@ pub struct LoadOptions {
     pub max_line_bytes: usize,
     /// Most measurement rows per CSV file (default [`DEFAULT_MAX_ROWS_PER_FILE`]).
     pub max_rows_per_file: usize,
-    /// Most experiments per data set (default [`DEFAULT_MAX_EXPERIMENTS`]).
+    /// Most experiments per data set (default 1000).
     pub max_experiments: usize,
     /// Largest estimated memory of a fit of the whole data set \[bytes\]
     /// ([`estimated_fit_memory_bytes`] of all rows and experiments; default

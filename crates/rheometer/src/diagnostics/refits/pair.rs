@@ -102,7 +102,7 @@ pub(crate) fn laws_disagree(a: &FitSummary, b: &FitSummary) -> bool {
 
 /// The union of the 95 % intervals of `n` and of `κ` over `fits`: where the law lies when the
 /// data cannot choose between them.
-pub fn law_envelope_of<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> [[f64; 2]; 2] {
+pub(crate) fn law_envelope_of<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> [[f64; 2]; 2] {
     let mut n = [f64::INFINITY, f64::NEG_INFINITY];
     let mut k = n;
     for f in fits {

@@ -9,8 +9,8 @@
 //!   noise level (`NoiseSummary`: declared, else
 //!   estimated by the noise model). Above `MISFIT_RATIO` times the noise the report warns and
 //!   names the worst experiments.
-//! * **Huge standard errors**: `SE(n) >` [`LARGE_STDERR_N`], `SE(κ) >` [`LARGE_STDERR_KAPPA`],
-//!   a fitted strength with a standard error above `LARGE_STDERR_STRENGTH_FRACTION` of its
+//! * **Huge standard errors**: `SE(n) > 0.2` (`LARGE_STDERR_N`), `SE(κ) > 1`
+//!   (`LARGE_STDERR_KAPPA`), a fitted strength with a standard error above `LARGE_STDERR_STRENGTH_FRACTION` of its
 //!   search range, or a `K` interval reaching `0` or `∞`.
 //! * **A singular or ill-conditioned covariance** (no standard errors, or a correlation matrix
 //!   with reciprocal condition number below `ILL_CONDITIONED_RCOND`).
@@ -37,7 +37,7 @@ pub(crate) use crate::fit::values::thresholds::MISFIT_WITHOUT_NOISE;
 use crate::fit::values::thresholds::NOISE_FREE_LEVEL;
 pub(crate) use crate::fit::values::thresholds::NOT_CONVERGED_CHI2;
 pub(crate) use crate::fit::values::thresholds::PLAUSIBLE_N;
-pub use crate::fit::values::thresholds::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
+pub(crate) use crate::fit::values::thresholds::{LARGE_STDERR_KAPPA, LARGE_STDERR_N};
 use crate::report::format::fmt_g;
 use diffbvp::least_squares::{FitResult, Termination};
 use nalgebra::{DMatrix, SymmetricEigen};

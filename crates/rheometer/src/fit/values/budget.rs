@@ -143,7 +143,7 @@ impl ErrorBudget {
 
     /// One warning when the systematic standard uncertainty of `κ` or `n` dominates the
     /// statistical one (is larger) and is itself large by the limits the fit's checks apply to
-    /// statistical errors ([`LARGE_STDERR_KAPPA`], [`LARGE_STDERR_N`]): the law is then not
+    /// statistical errors (SE(κ) > 1, SE(n) > 0.2): the law is then not
     /// determined by these data and this knowledge of the process, instrument and material.
     /// Below that the budget is a table, and the systematic uncertainty is quoted beside the
     /// estimates. The warning names the largest sources and the remedy of the largest.
