@@ -449,6 +449,27 @@ fn reports_without_the_new_fields_still_read() {
     assert!(fp.experiments.is_empty());
 }
 
+#[test]
+fn a_termination_the_toolkit_does_not_know_is_refused() {
+    // the termination is typed: a report reads only the toolkit's own texts back
+    let rep = FitSummary::from_json(
+        r#"{"estimator": "Principled", "n": 0.8, "kappa": 11.6, "termination": "cost change below ftol"}"#,
+        "ok.json",
+    )
+    .unwrap();
+    assert_eq!(rep.solver.termination_text(), "cost change below ftol");
+    let e = FitSummary::from_json(
+        r#"{"estimator": "Principled", "n": 0.8, "kappa": 11.6, "termination": "converged"}"#,
+        "bad.json",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("unknown termination \"converged\"") && e.contains("\"step below xtol\""),
+        "{e}"
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // values read from `--fit` JSON files
 

@@ -289,6 +289,59 @@ pub enum Termination {
     Stalled,
 }
 
+impl Termination {
+    /// Every reason, in declaration order.
+    pub const ALL: [Termination; 8] = [
+        Termination::Gradient,
+        Termination::Step,
+        Termination::CostChange,
+        Termination::MaxIterations,
+        Termination::RadiusCollapsed,
+        Termination::RelativeOffset,
+        Termination::NoiseFloor,
+        Termination::Stalled,
+    ];
+}
+
+/// The reason whose text ([`Display`](fmt::Display)) is `s`; an error listing the known texts
+/// otherwise.
+impl std::str::FromStr for Termination {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        Termination::ALL
+            .into_iter()
+            .find(|t| t.to_string() == s)
+            .ok_or_else(|| {
+                let known: Vec<String> = Termination::ALL
+                    .iter()
+                    .map(|t| format!("\"{t}\""))
+                    .collect();
+                format!(
+                    "unknown termination {s:?}: expected one of {}",
+                    known.join(", ")
+                )
+            })
+    }
+}
+
+/// Written as its text ([`Display`](fmt::Display)), so that a record reads as it prints.
+#[cfg(feature = "serde")]
+impl serde::Serialize for Termination {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+/// Read from its text (see [`FromStr`](std::str::FromStr)).
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for Termination {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
+    }
+}
+
 impl fmt::Display for Termination {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let s = match self {
@@ -657,4 +710,22 @@ fn trust_region_step(j: &DMatrix<f64>, r: &DVector<f64>, d: &[f64], radius: f64)
         u = step_for(hi);
     }
     DVector::from_iterator(np, (0..np).map(|i| u[i] / d[i]))
+}
+
+#[cfg(test)]
+mod termination_tests {
+    use super::Termination;
+
+    #[test]
+    fn every_termination_reads_back_from_its_text() {
+        let texts: Vec<String> = Termination::ALL.iter().map(|t| t.to_string()).collect();
+        for (t, s) in Termination::ALL.iter().zip(&texts) {
+            assert_eq!(&s.parse::<Termination>().unwrap(), t);
+            assert_eq!(texts.iter().filter(|x| *x == s).count(), 1, "{s} twice");
+        }
+        let e = "converged".parse::<Termination>().unwrap_err();
+        assert!(
+            e.contains("unknown termination \"converged\"") && e.contains("gradient below gtol")
+        );
+    }
 }

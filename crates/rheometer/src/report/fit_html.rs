@@ -399,7 +399,7 @@ fn fit_section(page: &mut HtmlPage, input: &FitReportInput<'_>) {
         "{} residuals; {} fitted parameters; the fit ended: {}.",
         s.residuals,
         s.fitted_parameters(),
-        s.solver.termination
+        s.solver.termination_text()
     ));
     page.paragraph(lines.join("\n"));
     let take_up = s.estimator == crate::fit::Estimator::Principled;

@@ -209,7 +209,7 @@ impl FitSummary {
             solver: SolverRecord {
                 iterations: fit.iterations,
                 failed_evaluations: fit.failed_evaluations,
-                termination: fit.termination.to_string(),
+                termination: Some(fit.termination.clone()),
                 wall_time_s: input.wall_time_s,
                 bvp_tolerance: input.bvp_tolerance,
                 nodes: input.nodes,

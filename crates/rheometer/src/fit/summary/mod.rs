@@ -28,7 +28,7 @@ use crate::fit::values::curve::FlowCurve;
 use crate::fit::values::likelihood::{NewtonianTest, ProfileInterval};
 use crate::model::effects::{Category, LawChoice};
 use crate::report::serde_nan;
-use diffbvp::least_squares::Loss;
+use diffbvp::least_squares::{Loss, Termination};
 use serde::{Deserialize, Deserializer, Serialize};
 
 /// Half-width of a two-sided 95 % normal interval in standard errors.
@@ -226,6 +226,15 @@ pub struct Covariance {
     pub matrix: Vec<f64>,
 }
 
+impl SolverRecord {
+    /// Why the fit stopped, in words (`"not recorded"` for a record without it).
+    pub fn termination_text(&self) -> String {
+        self.termination
+            .as_ref()
+            .map_or_else(|| "not recorded".to_string(), |t| t.to_string())
+    }
+}
+
 impl Covariance {
     /// The entry of parameters `a` and `b` (`None` if either is not fitted).
     pub fn get(&self, a: &str, b: &str) -> Option<f64> {
@@ -243,8 +252,8 @@ pub struct SolverRecord {
     pub iterations: usize,
     /// Trial points where a BVP failed (rejected steps).
     pub failed_evaluations: usize,
-    /// Why the fit stopped.
-    pub termination: String,
+    /// Why the fit stopped (`None` only in a record without it).
+    pub termination: Option<Termination>,
     /// Wall time \[s\].
     pub wall_time_s: f64,
     /// BVP tolerance of the final solves \[-\].
@@ -375,7 +384,7 @@ impl Default for SolverRecord {
         SolverRecord {
             iterations: 0,
             failed_evaluations: 0,
-            termination: String::new(),
+            termination: None,
             wall_time_s: f64::NAN,
             bvp_tolerance: f64::NAN,
             nodes: Vec::new(),
@@ -586,7 +595,7 @@ pub(crate) mod tests {
             solver: SolverRecord {
                 iterations: 5,
                 failed_evaluations: 0,
-                termination: "converged".into(),
+                termination: Some(Termination::CostChange),
                 wall_time_s: 0.0,
                 bvp_tolerance: 1e-6,
                 nodes: vec![100],

@@ -180,7 +180,10 @@ impl FitSummary {
             fmt_g(self.start[1])
         ));
         let sv = &self.solver;
-        s.push_str(&format!("    termination       = {}\n", sv.termination));
+        s.push_str(&format!(
+            "    termination       = {}\n",
+            sv.termination_text()
+        ));
         s.push_str(&format!(
             "    iterations        = {} ({} failed BVP trial points)\n",
             sv.iterations, sv.failed_evaluations
