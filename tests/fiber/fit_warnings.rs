@@ -430,8 +430,10 @@ fn library_bounds_that_exclude_the_optimum_are_marked() {
 }
 
 #[test]
-fn reports_without_the_new_fields_still_read() {
-    // a report as written before `law`, `at_bound`, `warnings` ... existed
+fn reports_of_an_earlier_layout_are_refused() {
+    // a report as written before the layout of schema 1 (flat standard errors, solver
+    // statistics beside the estimates): refused naming a field of that layout, not read with
+    // its standard errors silently left out
     let old = r#"{
       "estimator": "Principled", "start": [0.5, 15.0], "n": 0.8, "kappa": 11.6,
       "K_Pa": 109000.0, "stderr_n": 0.007, "stderr_kappa": 0.087,
@@ -440,26 +442,39 @@ fn reports_without_the_new_fields_still_read() {
       "take_up_factors": [1.0, 1.0], "residuals": 52, "iterations": 9,
       "failed_evaluations": 0, "wall_time_s": 0.5, "termination": "cost change below ftol"
     }"#;
-    let rep = FitSummary::from_json(old, "old.json").unwrap();
-    assert!(rep.warnings.is_empty() && rep.at_bound.is_empty());
-    let text = rep.to_text();
-    assert!(line(&text, "n:").contains("95% CI ["), "{text}");
-    let fp = FitSummary::from_json(old, "old.json").unwrap();
-    assert_eq!(fp.take_up_factors.len(), 2);
-    assert!(fp.experiments.is_empty());
+    let e = FitSummary::from_json(old, "old.json").unwrap_err();
+    assert!(
+        e.starts_with("old.json: field `stderr_n`: a report of an earlier layout")
+            && e.contains("rheometer fit --json"),
+        "{e}"
+    );
+    // the same estimates in today's layout read
+    let now = r#"{
+      "estimator": "Principled", "start": [0.5, 15.0],
+      "n": {"value": 0.8, "stderr": 0.007, "ci95": [0.79, 0.81], "fitted": true},
+      "kappa": {"value": 11.6, "stderr": 0.087, "ci95": [11.4, 11.8], "fitted": true},
+      "take_up_factors": [1.0, 1.0], "residuals": 52,
+      "solver": {"iterations": 9, "termination": "cost change below ftol"}
+    }"#;
+    let rep = FitSummary::from_json(now, "now.json").unwrap();
+    assert_eq!(rep.n.stderr, 0.007);
+    assert_eq!(rep.solver.iterations, 9);
+    assert!(line(&rep.to_text(), "n:").contains("95% CI ["));
 }
 
 #[test]
 fn a_termination_the_toolkit_does_not_know_is_refused() {
     // the termination is typed: a report reads only the toolkit's own texts back
     let rep = FitSummary::from_json(
-        r#"{"estimator": "Principled", "n": 0.8, "kappa": 11.6, "termination": "cost change below ftol"}"#,
+        r#"{"estimator": "Principled", "n": 0.8, "kappa": 11.6,
+            "solver": {"termination": "cost change below ftol"}}"#,
         "ok.json",
     )
     .unwrap();
     assert_eq!(rep.solver.termination_text(), "cost change below ftol");
     let e = FitSummary::from_json(
-        r#"{"estimator": "Principled", "n": 0.8, "kappa": 11.6, "termination": "converged"}"#,
+        r#"{"estimator": "Principled", "n": 0.8, "kappa": 11.6,
+            "solver": {"termination": "converged"}}"#,
         "bad.json",
     )
     .unwrap_err()

@@ -10,7 +10,7 @@ use crate::fit::estimator::Estimator;
 use crate::fit::summary::{FitSummary, WarningCode};
 use crate::model::effects::{Effect, EffectSetting};
 use crate::model::setup::{Experiment, Measurements};
-use crate::report::report_json::{check_report, ReportKind};
+use crate::report::report_json::{check_report, ReportKind, SCHEMA_VERSION};
 use serde_json::Value;
 use std::path::Path;
 
@@ -135,149 +135,33 @@ fn check_fields(obj: &serde_json::Map<String, Value>) -> Result<(), String> {
     Ok(())
 }
 
-/// `{"value": v, "stderr": se, "ci95": ci, "fitted": fitted}` from the flat fields of a report
-/// written before estimates were objects.
-fn estimate_object(
-    name: &str,
-    v: &Value,
-    se: Option<&Value>,
-    ci: Option<&Value>,
-    fitted: bool,
-) -> Value {
-    let mut e = serde_json::json!({"name": name, "value": v, "unit": "-", "fitted": fitted});
-    if let Some(se) = se {
-        e["stderr"] = se.clone();
-    }
-    if let Some(ci) = ci {
-        e["ci95"] = ci.clone();
-    }
-    e
-}
+/// The top-level fields of reports written before the layout of schema 1 (flat standard
+/// errors and intervals, the noise level and solver statistics beside the estimates).
+const EARLIER_LAYOUT_FIELDS: [&str; 11] = [
+    "stderr_n",
+    "stderr_kappa",
+    "ci95_n",
+    "ci95_kappa",
+    "ci95_K_Pa",
+    "noise_level",
+    "noise_source",
+    "iterations",
+    "failed_evaluations",
+    "termination",
+    "wall_time_s",
+];
 
-/// A report written before [`FitSummary`] existed (flat `n`, `stderr_n`, `ci95_n`, ...,
-/// `noise_level`, `iterations`) in today's form; today's reports pass unchanged.
-fn upgrade_legacy(mut v: Value) -> Value {
-    let Some(obj) = v.as_object_mut() else {
-        return v;
-    };
-    let fitted_list: Option<Vec<String>> = obj.get("fitted").and_then(|f| {
-        f.as_array().map(|a| {
-            a.iter()
-                .filter_map(|x| x.as_str().map(String::from))
-                .collect()
-        })
-    });
-    if fitted_list.is_none() && obj.get("n").is_some_and(Value::is_number) {
-        insert_legacy_fitted(obj);
-    }
-    upgrade_law_estimates(obj, fitted_list.as_deref());
-    upgrade_effect_strengths(obj);
-    upgrade_noise(obj);
-    upgrade_solver(obj);
-    v
-}
-
-/// The `fitted` list of a legacy report that has none: before the list existed every fit
-/// fitted (n, κ) and the effects marked fitted.
-fn insert_legacy_fitted(obj: &mut serde_json::Map<String, Value>) {
-    let mut names = vec![Value::from("n"), Value::from("kappa")];
-    if let Some(Value::Array(effects)) = obj.get("effects") {
-        for e in effects {
-            if e.get("fitted").and_then(Value::as_bool) == Some(true) {
-                if let Some(n) = e.get("effect") {
-                    names.push(n.clone());
-                }
-            }
-        }
-    }
-    obj.insert("fitted".into(), Value::Array(names));
-}
-
-/// The flat `n`, `kappa` and `K_Pa` (with their `stderr_`/`ci95_` keys) as estimate objects,
-/// fitted where the report's own list `fitted_list` names them (all, without a list).
-fn upgrade_law_estimates(obj: &mut serde_json::Map<String, Value>, fitted_list: Option<&[String]>) {
-    let is_fitted = |k: &str| fitted_list.is_none_or(|l| l.iter().any(|x| x == k));
-    for key in ["n", "kappa"] {
-        if let Some(x) = obj.get(key).filter(|x| x.is_number()).cloned() {
-            let e = estimate_object(
-                key,
-                &x,
-                obj.get(&format!("stderr_{key}")),
-                obj.get(&format!("ci95_{key}")),
-                is_fitted(key),
-            );
-            obj.insert(key.into(), e);
-        }
-    }
-    if let Some(x) = obj.get("K_Pa").filter(|x| x.is_number()).cloned() {
-        let mut e = estimate_object("K", &x, None, obj.get("ci95_K_Pa"), is_fitted("kappa"));
-        e["unit"] = "Pa".into();
-        obj.insert("K_Pa".into(), e);
-    }
-}
-
-/// Each effect's flat `strength` (with `stderr_strength`, `ci95_strength`) as an estimate
-/// object in the effect's unit.
-fn upgrade_effect_strengths(obj: &mut serde_json::Map<String, Value>) {
-    if let Some(Value::Array(effects)) = obj.get_mut("effects") {
-        for e in effects.iter_mut() {
-            let name = e
-                .get("effect")
-                .and_then(Value::as_str)
-                .unwrap_or("")
-                .to_string();
-            if let Some(x) = e.get("strength").filter(|x| x.is_number()).cloned() {
-                let fitted = e.get("fitted").and_then(Value::as_bool).unwrap_or(false);
-                let mut est = estimate_object(
-                    &name,
-                    &x,
-                    e.get("stderr_strength"),
-                    e.get("ci95_strength"),
-                    fitted,
-                );
-                est["unit"] = e.get("unit").cloned().unwrap_or_else(|| "-".into());
-                e["strength"] = est;
-            }
-        }
-    }
-}
-
-/// The `noise` object from the flat `noise_level` and `noise_source`, where the report has none.
-fn upgrade_noise(obj: &mut serde_json::Map<String, Value>) {
-    if !obj.contains_key("noise") {
-        if let Some(level) = obj.get("noise_level").cloned() {
-            let declared = obj
-                .get("noise_source")
-                .and_then(Value::as_str)
-                .is_some_and(|s| s.starts_with("declared"));
-            obj.insert(
-                "noise".into(),
-                serde_json::json!({
-                    "level": level,
-                    "source": if declared { "declared" } else { "estimated" },
-                    "estimator": obj.get("noise_source").cloned().unwrap_or_else(|| "".into()),
-                    "rms_over_noise": null,
-                }),
-            );
-        }
-    }
-}
-
-/// The `solver` object from the flat solver statistics, where the report has none.
-fn upgrade_solver(obj: &mut serde_json::Map<String, Value>) {
-    if !obj.contains_key("solver") {
-        let mut solver = serde_json::Map::new();
-        for key in [
-            "iterations",
-            "failed_evaluations",
-            "termination",
-            "wall_time_s",
-        ] {
-            if let Some(x) = obj.get(key) {
-                solver.insert(key.into(), x.clone());
-            }
-        }
-        obj.insert("solver".into(), Value::Object(solver));
+/// Refuses a report of an earlier layout (see [`EARLIER_LAYOUT_FIELDS`]): its fields would
+/// otherwise be left out silently.
+fn refuse_earlier_layout(obj: &serde_json::Map<String, Value>) -> Result<(), String> {
+    match EARLIER_LAYOUT_FIELDS.iter().find(|k| obj.contains_key(**k)) {
+        Some(k) => Err(format!(
+            "field `{k}`: a report of an earlier layout (written by a rheometer before schema \
+             {SCHEMA_VERSION}, with its standard errors and solver statistics as flat fields); \
+             this version reads only its own reports: fit the data again with this version \
+             (`rheometer fit --json`, or `diffbvp.fit` in Python)"
+        )),
+        None => Ok(()),
     }
 }
 
@@ -399,7 +283,7 @@ impl FitSummary {
                 ));
             }
         }
-        Self::from_value(value, source, false)
+        Self::from_value(value, source)
     }
 
     /// Whether this fit (read from `source`) was made on the data `data` (the experiments and
@@ -438,13 +322,12 @@ impl FitSummary {
     /// Parses the JSON text of a fit summary held in memory (a Python dict, a test's text);
     /// `source` names it in errors. The text is parsed as strictly as a file
     /// (`parse_json`: duplicate keys, `NaN`, numbers out of range refused, naming the
-    /// field), but needs no stamp, and reports of earlier layouts (bare numbers for `n`, `κ`
-    /// and strengths) read too; files are read by [`read_file`](Self::read_file), which
-    /// takes the current layout only.
+    /// field), but needs no stamp; files are read by [`read_file`](Self::read_file), which
+    /// checks it. Either way only this version's layout is read.
     pub fn from_json(text: &str, source: &str) -> Result<Self, String> {
         let value = parse_json(text, Path::new(source), "rheometer fit --json FILE")
             .map_err(|e| e.to_string())?;
-        Self::from_value(value, source, true)
+        Self::from_value(value, source)
     }
 
     /// A fit to continue from: the JSON text of a fit report (`rheometer fit --json`) or of a
@@ -458,7 +341,7 @@ impl FitSummary {
             .as_object()
             .is_some_and(|o| o.contains_key("verdict") && o.contains_key("base_fit"));
         if !diagnosis {
-            return Self::from_value(value, source, true);
+            return Self::from_value(value, source);
         }
         let Value::Object(mut obj) = value else {
             return Err(format!("{source}: a diagnosis is a JSON object"));
@@ -467,17 +350,13 @@ impl FitSummary {
             Some(f) => ("final_fit", f),
             None => ("base_fit", obj.remove("base_fit").unwrap_or(Value::Null)),
         };
-        Self::from_value(
-            fit,
-            &format!("{source} (the diagnosis' field \"{field}\")"),
-            true,
-        )
+        Self::from_value(fit, &format!("{source} (the diagnosis' field \"{field}\")"))
     }
 
-    /// A fit from a parsed report: the fields the next step needs checked one by one, then
-    /// (with `legacy`) earlier layouts brought to today's, then every field's type (an error
-    /// names its path, `experiments[2]`), then the values ([`validate`](Self::validate)).
-    fn from_value(value: Value, source: &str, legacy: bool) -> Result<Self, String> {
+    /// A fit from a parsed report: the fields the next step needs checked one by one, a report
+    /// of an earlier layout refused, then every field's type (an error names its path,
+    /// `experiments[2]`), then the values ([`validate`](Self::validate)).
+    fn from_value(value: Value, source: &str) -> Result<Self, String> {
         let obj = value.as_object().ok_or_else(|| {
             format!(
                 "{source}: the JSON is {}, not a report: a fit report is a JSON object {{...}}",
@@ -485,7 +364,7 @@ impl FitSummary {
             )
         })?;
         check_fields(obj).map_err(|e| format!("{source}: {e}"))?;
-        let value = if legacy { upgrade_legacy(value) } else { value };
+        refuse_earlier_layout(obj).map_err(|e| format!("{source}: {e}"))?;
         let mut s: FitSummary = serde_path_to_error::deserialize(value).map_err(|e| {
             let path = e.path().to_string();
             let inner = e.into_inner().to_string();
