@@ -51,7 +51,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     // 3. which effect is missing?
     let run = workflow::diagnose(&data, &ModelSpec::default(), &DiagnoseOptions::default())?;
     println!("{}", run.diagnosis.to_text());
-    run.save_figure(&out.join("residuals_before_after.png"))?;
+    let figure = run.residual_figure(&out.join("residuals_before_after.png"))?;
+    write_checked(&out, std::slice::from_ref(&figure), &inputs)?;
 
     // 4. add it, refit from the paper's fit, compare again
     let Some(best) = run.diagnosis.most_likely_missing.clone() else {

@@ -130,9 +130,9 @@ pub fn run(args: DiagnoseArgs, g: &Global) -> Result<(), Box<dyn Error>> {
     dir.text("diagnosis.txt", &text)?;
     dir.text("diagnosis.json", &js)?;
     let fig = dir.path(&format!("residuals_before_after.{ext}"));
-    dir.files(|_| run.save_figure(&fig).map(|()| vec![fig.clone()]))?;
+    dir.rendered(|_| run.residual_figure(&fig).map(|f| vec![f]))?;
     let prof = dir.path(&format!("j_profiles.{ext}"));
-    dir.files(|_| run.save_profile_figure(&prof).map(|()| vec![prof.clone()]))?;
+    dir.rendered(|_| run.profile_figure(&prof).map(|f| vec![f]))?;
     dir.finish()?;
     g.say(format!(
         "wrote the report, {} and {} to {}",

@@ -243,9 +243,7 @@ fn write_fit_outputs(
         let before = profiles_of(rh, &id0.solutions);
         let after = profiles_of(rh, &id.solutions);
         let fig = w.path(&format!("residuals_before_after.{}", g.format.ext()));
-        w.files(|_| {
-            save_residual_figure(&fig, &before, Some((&label, &after))).map(|()| vec![fig.clone()])
-        })?;
+        w.rendered(|_| residual_figure(&fig, &before, Some((&label, &after))).map(|f| vec![f]))?;
         outln!(
             "RMS relative residual: {:.4} % without {label}, {:.4} % with it ({})",
             100.0 * id0.rms(),
@@ -260,7 +258,7 @@ fn write_fit_outputs(
             &to_report_json(ReportKind::FlowCurve, curve)?,
         )?;
         let fig = w.path(&format!("flow_curve.{}", g.format.ext()));
-        w.files(|_| save_flow_curve_figure(&fig, curve).map(|()| vec![fig.clone()]))?;
+        w.rendered(|_| flow_curve_figure(&fig, curve).map(|f| vec![f]))?;
     }
     let newtonian = run.newtonian.as_deref().unwrap_or_default();
     let written =

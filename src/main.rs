@@ -7,7 +7,7 @@ use rheometer::data::input::{
     load_experiments_with, LoadOptions, LoadedExperiments, DEFAULT_MAX_JSON_BYTES,
 };
 use rheometer::data::take_up::MissingTakeUp;
-use rheometer::diagnostics::save_residual_figure;
+use rheometer::diagnostics::residual_figure;
 use rheometer::diagnostics::Comparison;
 use rheometer::diagnostics::{DiagnoseOptions, ResidualProfiles};
 use rheometer::fit::{
@@ -17,7 +17,7 @@ use rheometer::fit::{
 use rheometer::model::{EffectSetting, LawChoice, ModelSpec};
 use rheometer::model::{FiberSolution, SimulateOptions};
 use rheometer::report::figures::{self, ExperimentView, ModelCurves, View};
-use rheometer::report::flow_curve_figure::save_flow_curve_figure;
+use rheometer::report::flow_curve_figure::flow_curve_figure;
 use rheometer::report::output::write_profiles_csv;
 use rheometer::report::output_files::{CheckedOutputs, PARTIAL_NAME};
 use rheometer::report::plot::FigureFormat;

@@ -113,24 +113,6 @@ impl<'a> DirWriter<'a> {
         Ok(paths)
     }
 
-    /// Runs `f`, which writes files of the directory by itself (figures), and marks the paths
-    /// it returns done.
-    pub fn files<E: Into<Box<dyn Error>>>(
-        &mut self,
-        f: impl FnOnce(&Path) -> Result<Vec<PathBuf>, E>,
-    ) -> Result<Vec<PathBuf>, Box<dyn Error>> {
-        match f(&self.dir) {
-            Ok(paths) => {
-                for p in &paths {
-                    let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
-                    self.marker.done(&name.unwrap_or_default())?;
-                }
-                Ok(paths)
-            }
-            Err(e) => Err(self.failed(e.into())),
-        }
-    }
-
     fn after(&mut self, name: &str, r: Result<(), Box<dyn Error>>) -> Result<(), Box<dyn Error>> {
         match r {
             Ok(()) => {

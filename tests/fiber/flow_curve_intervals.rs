@@ -12,7 +12,7 @@ use rheometer::data::input::LoadOptions;
 use rheometer::data::input::{load_experiments_with, LoadedExperiments};
 use rheometer::fit::{BandMethod, FitSummary, IdentifyOptions};
 use rheometer::model::LawChoice;
-use rheometer::report::flow_curve_figure::save_flow_curve_figure;
+use rheometer::report::flow_curve_figure::flow_curve_figure;
 use rheometer::report::format::fmt_pm;
 
 /// The widest line a report prints (the reports' promise, in characters).
@@ -216,7 +216,7 @@ fn no_thinning_case(sc: &crate::independent::dataset::Scenario, fig: &Path) -> F
         );
         assert!(p.stat95_pa_s[1] > p.stat95_pa_s[0], "no band: {p:?}");
     }
-    save_flow_curve_figure(fig, c).unwrap();
+    flow_curve_figure(fig, c).unwrap().save().unwrap();
     assert!(std::fs::metadata(fig).unwrap().len() > 10_000);
     s
 }

@@ -53,5 +53,5 @@ pub use refits::pair::PairFound;
 pub use refits::scan::{
     physical, physical_range, Profile, ProfilePoint, Refit, ScanOptions, ShapeParameter,
 };
-pub use report::save_residual_figure;
+pub use report::residual_figure;
 pub use ties::{alternatives, Alternative};

@@ -7,7 +7,8 @@ use super::refits::consistency::Consistency;
 use super::refits::scan::Profile;
 use crate::fit::summary::Estimate;
 use crate::report::format::{fmt_at, fmt_g, fmt_pm, unit_suffix};
-use crate::report::plot::{save_panels, Panel, PlotError, Series};
+use crate::report::output_files::OutputFile;
+use crate::report::plot::{render_panels, Panel, PlotError, Series};
 use std::path::Path;
 
 mod text;
@@ -295,7 +296,7 @@ fn profile_line(p: &Profile) -> String {
 
 /// Profiles of `J/J_base` against strength, one panel per candidate (one curve per scanned
 /// shape; dashed vertical lines: the physical range of the strength).
-pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), PlotError> {
+pub(crate) fn profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<OutputFile, PlotError> {
     let panels: Vec<Panel> = diagnosis
         .candidates
         .iter()
@@ -354,7 +355,8 @@ pub fn save_profile_figure(path: &Path, diagnosis: &Diagnosis) -> Result<(), Plo
         .collect();
     let cols = 3.min(panels.len().max(1));
     let rows = panels.len().div_ceil(cols).max(1) as u32;
-    save_panels(path, &panels, cols, (440 * cols as u32, 340 * rows))
+    let bytes = render_panels(path, &panels, cols, (440 * cols as u32, 340 * rows))?;
+    Ok(OutputFile::new(path, bytes))
 }
 
 /// `"0.804 ± 0.007 (95% CI [0.790, 0.818])"` (rounded to the standard error behind the
@@ -385,12 +387,13 @@ fn estimate_with_ci_bounds(at_bound: &[crate::fit::AtBound], name: &str, e: &Est
     }
 }
 
-/// Residuals before (and after) adding an effect, one panel per experiment.
-pub fn save_residual_figure(
+/// Residuals before (and after) adding an effect, one panel per experiment, rendered as the
+/// file `path` (write it with [`OutputFile::save`] or through a command's checked outputs).
+pub fn residual_figure(
     path: &Path,
     before: &ResidualProfiles,
     after: Option<(&str, &ResidualProfiles)>,
-) -> Result<(), PlotError> {
+) -> Result<OutputFile, PlotError> {
     let panels: Vec<Panel> = before
         .iter()
         .enumerate()
@@ -412,20 +415,22 @@ pub fn save_residual_figure(
         .collect();
     let cols = 3.min(panels.len().max(1));
     let rows = panels.len().div_ceil(cols) as u32;
-    save_panels(path, &panels, cols, (420 * cols as u32, 320 * rows.max(1)))
+    let bytes = render_panels(path, &panels, cols, (420 * cols as u32, 320 * rows.max(1)))?;
+    Ok(OutputFile::new(path, bytes))
 }
 
 impl DiagnosisRun {
-    /// Writes the figure of the `J` profiles: one panel per candidate, `J` against its strength.
-    pub fn save_profile_figure(&self, path: &Path) -> Result<(), PlotError> {
-        save_profile_figure(path, &self.diagnosis)
+    /// The figure of the `J` profiles (one panel per candidate, `J` against its strength),
+    /// rendered as the file `path`.
+    pub fn profile_figure(&self, path: &Path) -> Result<OutputFile, PlotError> {
+        profile_figure(path, &self.diagnosis)
     }
 
-    /// Writes the before/after residual figure.
-    pub fn save_figure(&self, path: &Path) -> Result<(), PlotError> {
+    /// The before/after residual figure, rendered as the file `path`.
+    pub fn residual_figure(&self, path: &Path) -> Result<OutputFile, PlotError> {
         // the "after" residuals are the final fit's, with every effect found
         let name = self.diagnosis.found.join(" + ");
-        save_residual_figure(
+        residual_figure(
             path,
             &self.residuals_before,
             self.residuals_after.as_ref().map(|a| (name.as_str(), a)),

@@ -3,13 +3,14 @@
 //! the extrapolated parts dashed; isotherms (if computed) as markers.
 //!
 //! Drawn by [`crate::report::plot`]'s flow-curve figure ([`FlowCurvePlot`]) from the [`FlowCurve`]
-//! value alone, as a file ([`save_flow_curve_figure`]) or as SVG text for an HTML report
+//! value alone, as a file ([`flow_curve_figure`]) or as SVG text for an HTML report
 //! (`flow_curve_figure_svg`): the two are the same drawing.
 
 use crate::fit::{BandMethod, FlowCurve, FlowPoint};
 use crate::report::format::fmt_g;
+use crate::report::output_files::OutputFile;
 use crate::report::plot::{
-    flow_curve_svg, save_flow_curve, FlowCurvePlot, PlotError, ReferencePoints,
+    flow_curve_svg, render_flow_curve, FlowCurvePlot, PlotError, ReferencePoints,
 };
 use std::path::Path;
 
@@ -101,13 +102,15 @@ impl Drawn {
     }
 }
 
-/// Writes the flow-curve figure of `curve` to `path` (PNG or SVG by extension).
-pub fn save_flow_curve_figure(path: &Path, curve: &FlowCurve) -> Result<(), PlotError> {
-    Drawn::of(curve).with_plot(curve, |plot| save_flow_curve(path, plot))
+/// The flow-curve figure of `curve`, rendered as the file `path` (PNG or SVG by extension;
+/// write it with [`OutputFile::save`] or through a command's checked outputs).
+pub fn flow_curve_figure(path: &Path, curve: &FlowCurve) -> Result<OutputFile, PlotError> {
+    let bytes = Drawn::of(curve).with_plot(curve, |plot| render_flow_curve(path, plot))?;
+    Ok(OutputFile::new(path, bytes))
 }
 
 /// The flow-curve figure of `curve` as an SVG document (the drawing of
-/// [`save_flow_curve_figure`]), e.g. for an HTML report.
+/// [`flow_curve_figure`]), e.g. for an HTML report.
 pub(crate) fn flow_curve_figure_svg(curve: &FlowCurve) -> Result<String, PlotError> {
     Drawn::of(curve).with_plot(curve, flow_curve_svg)
 }

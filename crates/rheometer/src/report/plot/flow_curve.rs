@@ -9,7 +9,7 @@
 use std::path::Path;
 
 use super::error::{invalid, PlotError};
-use super::panel_draw::{panels_svg, save_panels};
+use super::panel_draw::{panels_svg, render_panels, save_panels};
 use super::panels::{Band, Panel, RefLine, Series};
 
 /// Points measured elsewhere, drawn as markers beside the flow curve: shear data shown as
@@ -256,6 +256,15 @@ fn extend_from(previous: Option<(f64, f64)>, points: Vec<(f64, f64)>) -> Vec<(f6
 pub fn save_flow_curve(path: &Path, plot: &FlowCurvePlot<'_>) -> Result<(), PlotError> {
     plot.validate(path)?;
     save_panels(path, &[plot.panel()], 1, plot.size)
+}
+
+/// The figure of [`save_flow_curve`] rendered in memory as the file `path` would hold it.
+pub(crate) fn render_flow_curve(
+    path: &Path,
+    plot: &FlowCurvePlot<'_>,
+) -> Result<Vec<u8>, PlotError> {
+    plot.validate(path)?;
+    render_panels(path, &[plot.panel()], 1, plot.size)
 }
 
 /// The flow curve of [`save_flow_curve`] as an SVG document in memory (e.g. for an HTML page).

@@ -67,6 +67,7 @@ mod style;
 mod write;
 
 pub use error::PlotError;
+pub(crate) use flow_curve::render_flow_curve;
 pub use flow_curve::{flow_curve_svg, save_flow_curve, FlowCurvePlot, ReferencePoints};
 pub(crate) use heatmap::render_heatmap;
 pub use heatmap::{save_heatmap, Heatmap};
