@@ -15,7 +15,7 @@
 //! for `s > 0.35 m`, with the seeded generator of `rheometer::data::synthetic`.
 
 use rheometer::data::input::load_experiments;
-use rheometer::data::synthetic::{NoiseModel, SplitMix64};
+use rheometer::data::synthetic::{SplitMix64, SyntheticNoise};
 use rheometer::model::Experiment;
 use rheometer::{
     model::simulate, model::CarreauLike, model::FiberModel, model::Physics, model::SimulateOptions,
@@ -119,7 +119,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
 
     // noise: per experiment first all ξ₁, then all ξ₂
-    let noise = NoiseModel::pmma7n_synthetic();
+    let noise = SyntheticNoise::pmma7n_synthetic();
     let mut rng = SplitMix64::new(SEED);
     let mut files: Vec<(PathBuf, String)> = Vec::new();
     for r in &runs {

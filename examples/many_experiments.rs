@@ -14,7 +14,7 @@
 //! progress on stderr, then the estimate with its standard errors and the time of each phase.
 
 use rheometer::data::input::load_experiments;
-use rheometer::data::synthetic::{NoiseModel, SplitMix64};
+use rheometer::data::synthetic::{SplitMix64, SyntheticNoise};
 use rheometer::fit::{FitProgress, IdentifyOptions, ProgressHook, Rheometer};
 use rheometer::model::{ExperimentSet, Measurements};
 use std::error::Error;
@@ -44,7 +44,7 @@ fn replicated(m: usize, seed: u64) -> Result<ExperimentSet, Box<dyn Error>> {
             Ok(rows.iter().map(|r| r[c]).collect())
         })
         .collect::<Result<_, Box<dyn Error>>>()?;
-    let noise = NoiseModel::pmma7n_synthetic();
+    let noise = SyntheticNoise::pmma7n_synthetic();
     let mut rng = SplitMix64::new(seed);
     let mut set = ExperimentSet {
         experiments: Vec::with_capacity(m),

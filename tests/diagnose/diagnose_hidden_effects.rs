@@ -6,7 +6,7 @@
 //! reported 95% CIs. On data without a hidden effect no candidate may earn its place.
 
 use diffbvp::DualNum;
-use rheometer::data::synthetic::{NoiseModel, SplitMix64};
+use rheometer::data::synthetic::{SplitMix64, SyntheticNoise};
 use rheometer::diagnostics::{diagnose, DiagnoseOptions, DiagnosisRun};
 use rheometer::model::simulate_params;
 use rheometer::model::{Air, Experiment, ExperimentSet, Material, Measurements};
@@ -18,7 +18,7 @@ use rheometer::{
 
 /// 1.5% white noise plus up to 3% extra near the take-up (aspirator disturbance): 3% at
 /// s = 0.50 m.
-const NOISE: NoiseModel = NoiseModel {
+const NOISE: SyntheticNoise = SyntheticNoise {
     relative_sd: 0.015,
     disturbance_start: 0.35,
     disturbance_width: 0.15,

@@ -5,7 +5,7 @@
 //! must be in the diagnosis.
 
 use diffbvp::DualNum;
-use rheometer::data::synthetic::{NoiseModel, SplitMix64};
+use rheometer::data::synthetic::{SplitMix64, SyntheticNoise};
 use rheometer::diagnostics::{diagnose, DiagnoseOptions, StrengthStatus};
 use rheometer::model::simulate_params;
 use rheometer::model::SimulateOptions;
@@ -29,7 +29,7 @@ impl FiberTerm for StrongRadiation {
 
 #[test]
 fn radiation_needing_emissivity_above_one_is_reported_and_not_named() {
-    let noise = NoiseModel {
+    let noise = SyntheticNoise {
         relative_sd: 0.01,
         disturbance_start: 0.35,
         disturbance_width: 0.15,

@@ -9,7 +9,7 @@
 
 use diffbvp::sensitivity::{residual_jacobian, Sensitivities};
 use diffbvp::{Guess, SolveOptions, Solver};
-use rheometer::data::synthetic::{NoiseModel, SplitMix64};
+use rheometer::data::synthetic::{SplitMix64, SyntheticNoise};
 use rheometer::fit::RelativeResidual;
 use rheometer::fit::{FitStart, FitSummary, IdentifyOptions, Layout, Rheometer};
 use rheometer::model::simulate_params;
@@ -422,7 +422,7 @@ fn judge_and_categories() {
 fn data_set(
     exps: &[Experiment],
     seed: u64,
-    noise: Option<NoiseModel>,
+    noise: Option<SyntheticNoise>,
     simulate: impl Fn(&Experiment) -> Vec<f64>,
 ) -> ExperimentSet {
     let mut rng = SplitMix64::new(seed);
@@ -449,7 +449,7 @@ fn data_set(
     }
 }
 
-const WHITE: NoiseModel = NoiseModel {
+const WHITE: SyntheticNoise = SyntheticNoise {
     relative_sd: 0.015,
     disturbance_start: 10.0,
     disturbance_width: 1.0,

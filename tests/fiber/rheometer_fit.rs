@@ -1,7 +1,7 @@
 //! Acceptance of the rheometer on the shipped synthetic data (truth (n, κ) = (0.8, 11.71)).
 
 use rheometer::data::input::load_experiments;
-use rheometer::data::synthetic::NoiseModel;
+use rheometer::data::synthetic::SyntheticNoise;
 use rheometer::fit::{Estimator, IdentifyOptions, Rheometer, PAPER_TABLE3_STARTS};
 use std::path::Path;
 
@@ -13,7 +13,7 @@ fn rheometer() -> Rheometer {
 /// RMS of the noise model of TRUTH.md over the 26 shared positions.
 fn truth_noise_level() -> f64 {
     let positions: Vec<f64> = (0..26).map(|i| 0.02 * f64::from(i)).collect();
-    NoiseModel::pmma7n_synthetic().rms_level(&positions)
+    SyntheticNoise::pmma7n_synthetic().rms_level(&positions)
 }
 
 #[test]

@@ -8,7 +8,7 @@
 use diffbvp::least_squares::{fit, FitOptions, LeastSquaresProblem, Loss};
 use rheometer::data::input::load_experiments;
 use rheometer::data::noise_model::{NoiseModel, NoiseOptions, ResidualSeries};
-use rheometer::data::synthetic::{NoiseModel as SyntheticNoise, SplitMix64};
+use rheometer::data::synthetic::{SplitMix64, SyntheticNoise};
 use rheometer::diagnostics::{compare_set, CompareOptions, ModelSetup};
 use rheometer::fit::{FitSummary, IdentifyOptions, Rheometer};
 use rheometer::model::Physics;

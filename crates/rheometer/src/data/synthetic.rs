@@ -12,10 +12,10 @@
 //! reproduced exactly from its seed and the order of its experiments.
 //!
 //! ```
-//! use rheometer::data::synthetic::{NoiseModel, SplitMix64};
+//! use rheometer::data::synthetic::{SplitMix64, SyntheticNoise};
 //! let s = [0.0, 0.2, 0.4, 0.5];
 //! let clean = [1e-3, 3e-4, 1.1e-4, 1e-4];
-//! let noise = NoiseModel::pmma7n_synthetic();
+//! let noise = SyntheticNoise::pmma7n_synthetic();
 //! let mut rng = SplitMix64::new(20_250_611);
 //! let measured = noise.apply(&s, &clean, &mut rng)?;
 //! assert!(measured.iter().zip(&clean).all(|(m, c)| (m / c - 1.0).abs() < 0.1));
@@ -56,7 +56,7 @@ impl SplitMix64 {
 /// Relative measurement noise: white noise everywhere plus a disturbance growing
 /// quadratically beyond a position (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NoiseModel {
+pub struct SyntheticNoise {
     /// Relative standard deviation `σ` of every measurement \[-\].
     pub relative_sd: f64,
     /// Position `s₀` where the extra disturbance starts \[m\].
@@ -67,11 +67,11 @@ pub struct NoiseModel {
     pub disturbance_amplitude: f64,
 }
 
-impl NoiseModel {
+impl SyntheticNoise {
     /// The noise of `data/pmma7n_synthetic` and `data/hidden_radiation`: 1.5% everywhere,
     /// plus `0.04 ((s − 0.35 m)/0.16 m)²` beyond 0.35 m.
     pub fn pmma7n_synthetic() -> Self {
-        NoiseModel {
+        SyntheticNoise {
             relative_sd: 0.015,
             disturbance_start: 0.35,
             disturbance_width: 0.16,
@@ -81,7 +81,7 @@ impl NoiseModel {
 
     /// White noise only, relative standard deviation `relative_sd` \[-\].
     pub fn white(relative_sd: f64) -> Self {
-        NoiseModel {
+        SyntheticNoise {
             relative_sd,
             disturbance_start: f64::INFINITY,
             disturbance_width: 1.0,
@@ -166,7 +166,7 @@ mod tests {
     fn noise_is_reproducible_and_grows_at_the_take_up() {
         let s: Vec<f64> = (0..26).map(|i| 0.02 * f64::from(i)).collect();
         let clean = vec![1e-4; s.len()];
-        let m = NoiseModel::pmma7n_synthetic();
+        let m = SyntheticNoise::pmma7n_synthetic();
         let a = m.apply(&s, &clean, &mut SplitMix64::new(7)).unwrap();
         let b = m.apply(&s, &clean, &mut SplitMix64::new(7)).unwrap();
         assert_eq!(a, b);
