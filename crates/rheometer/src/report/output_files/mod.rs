@@ -37,3 +37,16 @@ pub use temporaries::remove_pending_temporaries;
 pub(crate) use write::write_bytes;
 pub(crate) use write::FIFO_WAIT_RANGE;
 pub(crate) use write::FIFO_WAIT_VARIABLE;
+
+/// A fresh scratch directory `target/unit-scratch/output-files-NAME-PID` (under the crate) for
+/// the layer's unit tests.
+#[cfg(test)]
+pub(crate) fn scratch(name: &str) -> std::path::PathBuf {
+    let d = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("target")
+        .join("unit-scratch")
+        .join(format!("output-files-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}

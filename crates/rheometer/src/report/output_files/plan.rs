@@ -459,19 +459,11 @@ mod tests {
         }
     }
 
-    fn scratch(name: &str) -> PathBuf {
-        let d = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("target")
-            .join("unit-scratch")
-            .join(format!("output-plan-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
-    }
+    use super::super::scratch;
 
     #[test]
     fn hard_and_symbolic_links_to_an_input_are_refused() {
-        let d = scratch("links");
+        let d = scratch("plan-links");
         let input = d.join("data.csv");
         fs::write(&input, b"keep me").unwrap();
         let hard = d.join("hard.json");
@@ -501,7 +493,7 @@ mod tests {
 
     #[test]
     fn writes_replace_atomically_and_leave_no_temporary() {
-        let d = scratch("atomic");
+        let d = scratch("plan-atomic");
         let p = d.join("out.txt");
         let outputs = OutputPlan::new().file(&p, "--out").check().unwrap();
         outputs.write_text(&p, "first").unwrap();
@@ -530,7 +522,7 @@ mod tests {
 
     #[test]
     fn output_directory_checks_name_the_blocking_file() {
-        let d = scratch("dirs");
+        let d = scratch("plan-dirs");
         let input = d.join("v.csv");
         fs::write(&input, b"1").unwrap();
         let no_names: [&str; 0] = [];

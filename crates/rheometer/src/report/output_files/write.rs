@@ -254,15 +254,7 @@ fn open_special(path: &Path, fifo: bool) -> Result<fs::File, OutputError> {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> PathBuf {
-        let d = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("target")
-            .join("unit-scratch")
-            .join(format!("output-files-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
-    }
+    use super::super::scratch;
 
     #[test]
     fn the_fifo_wait_is_ten_seconds_unless_the_variable_gives_a_sane_one() {
