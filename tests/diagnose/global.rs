@@ -79,16 +79,12 @@ fn check(sc: &Scenario, e: &Expect) -> (ExperimentSet, DiagnosisRun) {
         local_from_truth(&set, &r, sc, e)
     };
     println!(
-        "GLOBAL | {} | found {:?} | verdict {verdict} | n {:.4} [{:.4}, {:.4}] κ {:.4} [{:.4}, \
-         {:.4}] | RMS {:.3} % noise {:.3} % | J {:.6e} local from truth {:.6e} | {:.1} s",
+        "GLOBAL | {} | found {:?} | verdict {verdict} | n {} κ {} | RMS {:.3} % noise {:.3} % | \
+         J {:.6e} local from truth {:.6e} | {:.1} s",
         sc.name,
         d.found,
-        fit.n.value,
-        fit.n.ci95[0],
-        fit.n.ci95[1],
-        fit.kappa.value,
-        fit.kappa.ci95[0],
-        fit.kappa.ci95[1],
+        shared::with_interval(&fit.n, 4),
+        shared::with_interval(&fit.kappa, 4),
         100.0 * fit.rms_relative_residual,
         100.0 * d.base_fit.noise.level,
         fit.cost,

@@ -63,3 +63,15 @@ pub fn diagnosed(sc: &Scenario) -> Arc<Diagnosed> {
     cell.get_or_init(|| Arc::new(diagnose_with(sc, &DiagnoseOptions::default())))
         .clone()
 }
+
+/// An estimate and its 95 % interval with `digits` decimals, as the studies print them:
+/// `"0.803 [0.790, 0.818]"`.
+pub fn with_interval(e: &rheometer::fit::Estimate, digits: usize) -> String {
+    format!(
+        "{:.d$} [{:.d$}, {:.d$}]",
+        e.value,
+        e.ci95[0],
+        e.ci95[1],
+        d = digits
+    )
+}

@@ -130,16 +130,11 @@ pub fn law_study(
         let g = &d.run.diagnosis;
         let f = g.law_fit();
         println!(
-            "{label} | {k:2} | {what} | found {:?} | {} | n {:.3} [{:.3}, {:.3}] kappa {:.2} \
-             [{:.2}, {:.2}] | {} | {} | {:.1} s",
+            "{label} | {k:2} | {what} | found {:?} | {} | n {} kappa {} | {} | {} | {:.1} s",
             g.found,
             g.verdict.kind(),
-            f.n.value,
-            f.n.ci95[0],
-            f.n.ci95[1],
-            f.kappa.value,
-            f.kappa.ci95[0],
-            f.kappa.ci95[1],
+            shared::with_interval(&f.n, 3),
+            shared::with_interval(&f.kappa, 2),
             outcome.label(),
             note(&d.run),
             d.seconds
