@@ -119,7 +119,7 @@ impl LossArgs {
     }
 }
 
-/// `--tol`: in [1e-12, 0.1] (`request::tol`).
+/// `--tol`: a BVP tolerance in the range `request::tol` holds.
 pub fn parse_tol(s: &str) -> Result<f64, String> {
     request::tol(number(s)?).map_err(reason)
 }
@@ -136,12 +136,12 @@ pub fn parse_n(s: &str) -> Result<f64, String> {
     request::n(number(s)?).map_err(reason)
 }
 
-/// `--kappa`: a finite κ with |κ| <= 700 (`request::kappa`).
+/// `--kappa`: a finite κ within the bound `request::kappa` holds.
 pub fn parse_kappa(s: &str) -> Result<f64, String> {
     request::kappa(number(s)?).map_err(reason)
 }
 
-/// `--take-up-diameter`: in [1e-7, 0.02] m (`request::take_up_diameter`).
+/// `--take-up-diameter`: a diameter in the range `request::take_up_diameter` holds.
 pub fn parse_take_up_diameter(s: &str) -> Result<f64, String> {
     request::take_up_diameter(number(s)?).map_err(reason)
 }
@@ -191,8 +191,8 @@ pub fn parse_pair(s: &str) -> Result<(f64, f64), String> {
     Ok((a, b))
 }
 
-/// The `--grid` size "NxM": 2 to 1000 values per direction, at most
-/// [`MAX_GRID_POINTS`] points.
+/// The `--grid` size "NxM": the counts per direction and in all that `request::grid` allows
+/// (at most [`MAX_GRID_POINTS`] points).
 pub fn parse_grid(s: &str) -> Result<(usize, usize), String> {
     let (a, b) = parse_two::<i128>(s, &['x', 'X'], "\"NxM\"", "a count")?;
     request::grid(a, b, MAX_GRID_POINTS).map_err(reason)
